@@ -1,0 +1,47 @@
+# Tri-state options: AUTO enables a part when its toolchain is found, ON requires it,
+# OFF skips it. The resolved values are COREDEM_CUDA_ENABLED / COREDEM_OPENFOAM_ENABLED.
+
+set(COREDEM_CUDA AUTO CACHE STRING "Build the CUDA DEM backend (AUTO|ON|OFF)")
+set_property(CACHE COREDEM_CUDA PROPERTY STRINGS AUTO ON OFF)
+set(COREDEM_OPENFOAM AUTO CACHE STRING "Build the OpenFOAM participant (AUTO|ON|OFF)")
+set_property(CACHE COREDEM_OPENFOAM PROPERTY STRINGS AUTO ON OFF)
+option(COREDEM_ENABLE_ASSERTS "Keep internal COREDEM_ASSERT checks in release builds" OFF)
+
+foreach(opt COREDEM_CUDA COREDEM_OPENFOAM)
+  if(NOT ${opt} MATCHES "^(AUTO|ON|OFF)$")
+    message(FATAL_ERROR "${opt}=${${opt}} is not allowed; use AUTO, ON or OFF.")
+  endif()
+endforeach()
+
+# --- CUDA ------------------------------------------------------------------------------
+set(COREDEM_CUDA_ENABLED OFF)
+if(NOT COREDEM_CUDA STREQUAL "OFF")
+  include(CheckLanguage)
+  if(NOT CMAKE_CUDA_COMPILER)
+    # nvcc is often installed outside PATH; look in the usual toolkit location too.
+    find_program(_coredem_nvcc nvcc HINTS ENV CUDAToolkit_ROOT PATH_SUFFIXES bin
+                 PATHS /usr/local/cuda/bin)
+    if(_coredem_nvcc)
+      set(CMAKE_CUDA_COMPILER ${_coredem_nvcc} CACHE FILEPATH "CUDA compiler")
+    endif()
+  endif()
+  check_language(CUDA)
+  if(CMAKE_CUDA_COMPILER)
+    if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
+      # One real architecture keeps CI compile time low; set CMAKE_CUDA_ARCHITECTURES=native
+      # (or a list) on a GPU machine. PTX for 75 JIT-compiles on any newer device.
+      set(CMAKE_CUDA_ARCHITECTURES 75)
+    endif()
+    enable_language(CUDA)
+    set(CMAKE_CUDA_STANDARD 20)
+    set(CMAKE_CUDA_STANDARD_REQUIRED ON)
+    find_package(CUDAToolkit REQUIRED)
+    set(COREDEM_CUDA_ENABLED ON)
+  elseif(COREDEM_CUDA STREQUAL "ON")
+    message(FATAL_ERROR "COREDEM_CUDA=ON but no CUDA compiler (nvcc) was found. Put nvcc on "
+                        "PATH or set CUDAToolkit_ROOT, or configure with -DCOREDEM_CUDA=OFF.")
+  endif()
+endif()
+
+# --- OpenFOAM (resolved in cmake/CoredemOpenFOAM.cmake) ----------------------------------
+include(CoredemOpenFOAM)
