@@ -1,0 +1,228 @@
+#pragma once
+/// @file
+/// The DEM core's public API: `coredem::dem::DemSystem`, built from a plain `DemConfig`.
+///
+/// Typical use by the server (one CFD step, DESIGN §1):
+/// @code
+///   coredem::dem::DemSystem dem(config, coredem::dem::BackendKind::Auto, threads);
+///   int nSub = coredem::dem::TimeHandler::subStepsFor(dtCfd, dem.dtDemMax());
+///   dem.setGasFields(view);                          // per-cell arrays, frozen for the step
+///   const coredem::dem::CellSources& s = dem.advance(dtCfd, nSub);  // sub-step averages
+///   dem.writeState("state.h5");                      // bitwise restart with readState
+/// @endcode
+///
+/// Units are SI everywhere. Coupling cells are numbered cell = i + nx*(j + ny*k).
+/// All methods throw coredem::UserError on bad input, with a message that says what to fix.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace coredem::dem {
+
+/// Which backend runs the kernels. `Auto` = Cuda if a CUDA device is present, else Cpu.
+enum class BackendKind { Cpu, Cuda, Auto };
+
+/// Parses "cpu" | "cuda" | "auto" (UserError otherwise).
+BackendKind parseBackend(const std::string& name);
+/// "cpu" or "cuda".
+std::string backendName(BackendKind kind);
+/// True when this build contains the CUDA backend (COREDEM_CUDA_ENABLED).
+bool cudaBackendBuilt();
+/// Number of visible CUDA devices (0 when the CUDA backend is not built or no GPU/driver).
+int cudaDeviceCount();
+
+/// Contact properties of one solid material (PHYSICS §2.1, Eqs. 9–13).
+/// Pairs of different materials use k_n = 2 k_a k_b/(k_a+k_b), e_n = min(e_a, e_b),
+/// μ = min(μ_a, μ_b) [C]; particle–wall contacts use the particle's material with
+/// m_eff = m_i (the wall is rigid, immobile, and has the particle's properties).
+struct Material {
+  std::string name = "default";
+  double kn = 1000.0;              ///< normal spring stiffness k_n (N/m)
+  double en = 0.97;                ///< normal restitution coefficient e_n (-), 0 < e_n <= 1
+  double mu = 0.1;                 ///< Coulomb friction coefficient μ (-)
+  double ktFactor = 2.0 / 7.0;     ///< k_t = ktFactor·k_n (MFiX KT_FAC)
+  double etatFactor = 0.5;         ///< η_t = etatFactor·η_n (MFiX DES_ETAT_FAC)
+};
+
+/// How a ParticleSet places its particles.
+enum class Packing {
+  Lattice,  ///< simple cubic, spacing `spacing` (0: the diameter), sites from regionMin + s/2, x fastest
+  Random,   ///< non-overlapping uniform random positions in the region, from `seed`
+  Explicit  ///< the `positions` (and optional `velocities`) given below, one entry per particle
+};
+
+/// A group of identical particles placed in an axis-aligned box region.
+struct ParticleSet {
+  std::string name = "particles";
+  int material = 0;                            ///< index into DemConfig::materials
+  Packing packing = Packing::Lattice;
+  std::array<double, 3> regionMin{0, 0, 0};    ///< region (m); particles lie fully inside
+  std::array<double, 3> regionMax{0, 0, 0};
+  std::size_t count = 0;                       ///< number of particles (Explicit: positions.size()/3)
+  double diameter = 1e-3;                      ///< d_p (m)
+  double density = 2500.0;                     ///< ρ_p (kg/m³)
+  double temperature = 293.15;                 ///< T_p (K)
+  std::vector<double> composition;             ///< solid species mass fractions (sum 1), size = solidSpecies
+  double spacing = 0.0;                        ///< Lattice spacing (m); 0 = diameter
+  std::array<double, 3> velocity{0, 0, 0};     ///< initial velocity (m/s), added to the jitter
+  double velocityJitter = 0.0;                 ///< each component + uniform[-a, a] (m/s)
+  std::uint64_t seed = 12345;                  ///< for Random packing and the jitter
+  std::vector<double> positions;               ///< Explicit: x0,y0,z0,x1,... (m)
+  std::vector<double> velocities;              ///< Explicit (optional): same layout (m/s)
+  std::vector<double> angularVelocities;       ///< Explicit (optional): same layout (rad/s)
+};
+
+/// An infinite rigid plane wall; particles live on the side its normal points to.
+struct Wall {
+  std::array<double, 3> point{0, 0, 0};
+  std::array<double, 3> normal{0, 0, 1};  ///< need not be unit length (normalised)
+};
+
+/// Uniform Cartesian coupling grid (PCM cells): cell = i + nx*(j + ny*k). counts = 0: no coupling.
+struct CouplingGrid {
+  std::array<double, 3> origin{0, 0, 0};
+  std::array<double, 3> spacing{0, 0, 0};
+  std::array<int, 3> counts{0, 0, 0};
+  std::size_t cellCount() const {
+    return static_cast<std::size_t>(counts[0]) * counts[1] * counts[2];
+  }
+};
+
+/// A named chemical species with its molar mass (kg/mol).
+struct Species {
+  std::string name;
+  double molarMass = 0.0;
+};
+
+/// Tuning of neighbour search and contact storage (defaults from bench measurements,
+/// docs/performance.md "## DEM core").
+struct NeighbourOptions {
+  double skinFactor = 0.1;       ///< Verlet skin = skinFactor · d_max; lists rebuilt when a particle moved > skin/2
+  int historySlots = 12;         ///< tangential-history slots per particle (contacts incl. walls)
+  int initialNeighbourSlots = 16;///< neighbour-list width per particle (grows automatically)
+};
+
+/// Everything needed to build a DemSystem. Plain data; validated by the constructor.
+struct DemConfig {
+  std::vector<Material> materials{Material{}};
+  std::vector<ParticleSet> particleSets;
+  std::vector<Wall> walls;
+  std::array<double, 3> gravity{0.0, 0.0, -9.81};   ///< m/s²
+  CouplingGrid grid;
+  std::vector<Species> solidSpecies;   ///< per-particle composition entries
+  std::vector<Species> gasSpecies;     ///< Y_g and R_species entries
+  NeighbourOptions neighbour;
+  double epsMinDrag = 0.35;            ///< ε_min clip in drag (PHYSICS §1.1 [C])
+  double dtFactor = 50.0;              ///< Δt_DEM,max = t_col,min / dtFactor (PHYSICS Eq. 12)
+
+  /// Adds the six planes of the axis-aligned box [lo, hi] (normals pointing inwards).
+  void addBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi);
+};
+
+/// Read-only view of the per-cell gas fields of one CFD step (N = grid cell count,
+/// ns = gasSpecies.size()). Spans must outlive the setGasFields call only (they are copied).
+struct GasFieldsView {
+  std::span<const double> ug;       ///< u_g, N*3 (m/s), interleaved x,y,z per cell
+  std::span<const double> gradP;    ///< ∇p, N*3 (Pa/m)
+  std::span<const double> Tg;       ///< T_g, N (K)
+  std::span<const double> rhoG;     ///< ρ_g, N (kg/m³)
+  std::span<const double> muG;      ///< μ_g, N (Pa s)
+  std::span<const double> kappaG;   ///< κ_g, N (W/m/K)
+  std::span<const double> cpG;      ///< c_p,g, N (J/kg/K)
+  std::span<const double> Yg;       ///< Y_g, N*ns (-), species fastest
+};
+
+/// Per-cell sources for the CFD, averaged over the sub-steps of one advance() (PHYSICS §1.1).
+/// Heat and species entries stay zero until the thermochemistry kernels are integrated.
+struct CellSources {
+  std::vector<double> epsG;      ///< ε_g (-), N
+  std::vector<double> kSl;       ///< K_sl = (1/V_c) Σ β V_p/(1-ε) (kg/m³/s), N
+  std::vector<double> kSlUs;     ///< K_sl·U_s = (1/V_c) Σ β V_p/(1-ε) v_p (kg/m²/s²), N*3
+  std::vector<double> heatH;     ///< H, implicit gas→particle heat coefficient (W/m³/K), N
+  std::vector<double> heatHTp;   ///< H·T̄_p (W/m³), N
+  std::vector<double> rSpecies;  ///< R_species (kg/m³/s), N*ns
+  std::vector<double> qHom;      ///< homogeneous reaction heat (W/m³), N
+};
+
+/// Host copy of the particle state (for tests, snapshots and the server), in the system's
+/// current internal order (which changes on neighbour-list rebuilds; use globalId to match).
+struct ParticleData {
+  std::size_t count = 0;
+  int nSpecies = 0;
+  std::vector<double> position, velocity, angularVelocity, force;  ///< N*3 (force: last sub-step, contacts+walls+gas, no gravity)
+  std::vector<double> radius, mass, density, temperature;          ///< N
+  std::vector<double> species;                                     ///< N*nSpecies
+  std::vector<std::int32_t> material;                              ///< N
+  std::vector<std::int64_t> globalId;                              ///< N
+};
+
+/// Wall-clock seconds spent per stage since construction (or resetStageTimes()).
+struct StageTimes {
+  double neighbour = 0;  ///< cell keys, sort, reorder, neighbour lists
+  double contact = 0;    ///< contact + wall + gas forces
+  double integrate = 0;  ///< motion update
+  double coupling = 0;   ///< PCM ε_g and cell-source deposition
+  std::uint64_t rebuilds = 0;
+};
+
+/// The DEM system: particles, contacts and the sub-cycled integrator on one backend.
+/// Not thread-safe: call from one thread.
+class DemSystem {
+public:
+  /// @pre config valid (UserError otherwise: what is wrong and how to fix it).
+  /// @param threads OpenMP threads for the cpu backend (0 = OpenMP default).
+  explicit DemSystem(const DemConfig& config, BackendKind backend = BackendKind::Cpu,
+                     int threads = 0);
+  ~DemSystem();
+  DemSystem(const DemSystem&) = delete;
+  DemSystem& operator=(const DemSystem&) = delete;
+
+  /// Largest stable DEM step: min over present material pairs and walls of t_col / dtFactor
+  /// (PHYSICS Eq. 12 with Eq. 13 damping), using the lightest particle of each material.
+  double dtDemMax() const;
+
+  /// Copies the gas fields used (frozen) during the next advance() calls.
+  /// @pre a coupling grid is configured; every span has the size documented in GasFieldsView
+  ///      (optional: kappaG, cpG, Tg, Yg may be empty); all values finite, ρ_g, μ_g > 0.
+  void setGasFields(const GasFieldsView& gas);
+
+  /// Advances by dtCfd in nSub equal sub-steps (Δt_DEM = dtCfd/nSub), returns the
+  /// sub-step-averaged cell sources (empty vectors when no coupling grid).
+  /// @pre dtCfd > 0, nSub >= 1, dtCfd/nSub <= dtDemMax()·(1 + 1e-12).
+  const CellSources& advance(double dtCfd, int nSub);
+
+  /// Writes the full state (particles, contact history, neighbour lists, time) to HDF5.
+  void writeState(const std::string& path) const;
+  /// Replaces the state by the one in `path`; continuing is bitwise identical to not
+  /// having stopped. @pre written by a system with the same config hash.
+  void readState(const std::string& path);
+
+  double time() const;                 ///< simulated time (s)
+  std::uint64_t step() const;          ///< DEM sub-steps taken
+  std::size_t particleCount() const;
+  std::size_t cellCount() const;       ///< coupling cells (0 without a grid)
+  std::string backendName() const;     ///< "cpu" or "cuda"
+  std::string configHash() const;      ///< 16 hex digits over materials, walls, gravity, grid, species, options
+  const DemConfig& config() const;
+
+  ParticleData particles() const;      ///< host copy of the state
+  /// Overwrites velocities / angular velocities by global id order (size N*3 each; empty = keep).
+  void setVelocities(std::span<const double> velocityByGid, std::span<const double> omegaByGid);
+  std::size_t contactCount() const;    ///< particle–particle contacts (pairs) + wall contacts, last sub-step
+  std::size_t pairContactCount() const;///< particle–particle contact pairs, last sub-step
+  std::array<double, 3> wallForce() const;  ///< Σ force exerted by all walls on particles, last sub-step (N)
+  std::size_t memoryBytes() const;     ///< bytes of particle, neighbour and contact storage
+  StageTimes stageTimes() const;
+  void resetStageTimes();
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> _impl;
+};
+
+} // namespace coredem::dem
