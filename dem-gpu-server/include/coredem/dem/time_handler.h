@@ -6,6 +6,7 @@
 
 #include "coredem/common/check.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 

@@ -1,0 +1,26 @@
+#pragma once
+/// @file
+/// Shared backend vocabulary: the lambda qualifier for parallel_for bodies and the error
+/// hook. A backend ("Exec") is a small type providing (see cpu/cpu_exec.h):
+///   parallelFor(n, f)            f(i) for i in [0, n), any order, no two i alias
+///   reduceMax(n, f)              max_i f(i) (exact, so order-independent)
+///   sortByKey(keys, n, numKeys, perm)   stable permutation sorting keys ascending
+///   exclusiveScan(in, out, n)    out[i] = Σ_{k<i} in[k]
+///   allocHost/freeHost (pinned for CUDA), allocDevice/freeDevice, copyToDevice/copyToHost,
+///   synchronize(); separateDevice tells whether device memory differs from host memory.
+
+#include <string>
+
+#if defined(__CUDACC__)
+#define DEM_LAMBDA __host__ __device__
+#else
+#define DEM_LAMBDA
+#endif
+
+namespace coredem::dem::backend {
+
+/// Throws coredem::UserError(message) (defined out of line so that nvcc-compiled code does
+/// not need the fmt-based check macros).
+[[noreturn]] void raiseUserError(const std::string& message);
+
+} // namespace coredem::dem::backend

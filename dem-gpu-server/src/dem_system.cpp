@@ -1,0 +1,560 @@
+// DemSystem: config validation, particle generation, Δt_DEM, sub-cycling, state I/O.
+// Everything that runs per particle per step is in the backend engine (engine_impl.h).
+#include "coredem/dem/dem_system.h"
+
+#include "engine.h"
+#include "state_io.h"
+
+#include "coredem/common/check.h"
+#include "coredem/common/log.h"
+#include "coredem/dem/kernels/collision_time.h"
+#include "coredem/dem/kernels/damping.h"
+#include "coredem/dem/kernels/pressure_gradient.h"
+#include "coredem/dem/time_handler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <unordered_map>
+
+#ifndef COREDEM_VERSION
+#define COREDEM_VERSION "0.0.0"
+#endif
+
+namespace coredem::dem {
+
+BackendKind parseBackend(const std::string& name) {
+  if (name == "cpu") return BackendKind::Cpu;
+  if (name == "cuda") return BackendKind::Cuda;
+  if (name == "auto") return BackendKind::Auto;
+  throw UserError("unknown DEM backend '" + name + "'; use cpu, cuda or auto");
+}
+
+std::string backendName(BackendKind kind) {
+  switch (kind) {
+  case BackendKind::Cpu: return "cpu";
+  case BackendKind::Cuda: return "cuda";
+  case BackendKind::Auto: return "auto";
+  }
+  return "?";
+}
+
+bool cudaBackendBuilt() {
+#if defined(COREDEM_CUDA_ENABLED)
+  return true;
+#else
+  return false;
+#endif
+}
+
+int cudaDeviceCount() {
+#if defined(COREDEM_CUDA_ENABLED)
+  return cudaDevices();
+#else
+  return 0;
+#endif
+}
+
+void DemConfig::addBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
+  for (int d = 0; d < 3; ++d) {
+    Wall a, b;
+    a.point = lo;
+    b.point = hi;
+    a.normal = {0, 0, 0};
+    b.normal = {0, 0, 0};
+    a.normal[d] = 1.0;
+    b.normal[d] = -1.0;
+    walls.push_back(a);
+    walls.push_back(b);
+  }
+}
+
+namespace {
+
+/// splitmix64: small, portable, reproducible.
+struct Rng {
+  std::uint64_t s;
+  std::uint64_t next() {
+    std::uint64_t z = (s += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+  }
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  // [0, 1)
+};
+
+void validate(const DemConfig& c) {
+  COREDEM_CHECK(!c.materials.empty(), "DemConfig.materials is empty; define at least one material");
+  for (std::size_t m = 0; m < c.materials.size(); ++m) {
+    const Material& mat = c.materials[m];
+    COREDEM_CHECK(mat.kn > 0 && std::isfinite(mat.kn), "material '{}': kn = {} must be > 0", mat.name, mat.kn);
+    COREDEM_CHECK(mat.en > 0 && mat.en <= 1, "material '{}': en = {} must be in (0, 1]", mat.name, mat.en);
+    COREDEM_CHECK(mat.mu >= 0, "material '{}': mu = {} must be >= 0", mat.name, mat.mu);
+    COREDEM_CHECK(mat.ktFactor > 0, "material '{}': ktFactor = {} must be > 0", mat.name, mat.ktFactor);
+    COREDEM_CHECK(mat.etatFactor >= 0, "material '{}': etatFactor = {} must be >= 0", mat.name, mat.etatFactor);
+  }
+  for (const ParticleSet& s : c.particleSets) {
+    COREDEM_CHECK(s.material >= 0 && s.material < static_cast<int>(c.materials.size()),
+                  "particle set '{}': material index {} is not in 0..{}", s.name, s.material,
+                  c.materials.size() - 1);
+    COREDEM_CHECK(s.diameter > 0 && std::isfinite(s.diameter), "particle set '{}': diameter {} must be > 0", s.name, s.diameter);
+    COREDEM_CHECK(s.density > 0 && std::isfinite(s.density), "particle set '{}': density {} must be > 0", s.name, s.density);
+    COREDEM_CHECK(s.temperature > 0, "particle set '{}': temperature {} K must be > 0", s.name, s.temperature);
+    COREDEM_CHECK(s.composition.empty() || s.composition.size() == c.solidSpecies.size(),
+                  "particle set '{}': composition has {} entries but {} solid species are defined",
+                  s.name, s.composition.size(), c.solidSpecies.size());
+    if (!s.composition.empty()) {
+      double sum = 0;
+      for (double y : s.composition) {
+        COREDEM_CHECK(y >= 0, "particle set '{}': negative mass fraction in composition", s.name);
+        sum += y;
+      }
+      COREDEM_CHECK(std::fabs(sum - 1.0) < 1e-9, "particle set '{}': composition sums to {}, not 1", s.name, sum);
+    }
+    if (s.packing == Packing::Explicit) {
+      COREDEM_CHECK(s.positions.size() % 3 == 0 && !s.positions.empty(),
+                    "particle set '{}': Explicit packing needs positions as x,y,z triples", s.name);
+      const std::size_t n = s.positions.size() / 3;
+      COREDEM_CHECK(s.velocities.empty() || s.velocities.size() == 3 * n,
+                    "particle set '{}': velocities must have 3 values per particle ({}), got {}", s.name, 3 * n, s.velocities.size());
+      COREDEM_CHECK(s.angularVelocities.empty() || s.angularVelocities.size() == 3 * n,
+                    "particle set '{}': angularVelocities must have 3 values per particle", s.name);
+    } else {
+      for (int d = 0; d < 3; ++d) {
+        COREDEM_CHECK(s.regionMax[d] > s.regionMin[d], "particle set '{}': region max[{}] = {} must exceed min = {}",
+                      s.name, d, s.regionMax[d], s.regionMin[d]);
+      }
+    }
+  }
+  for (const Wall& w : c.walls) {
+    const double l = std::hypot(w.normal[0], w.normal[1], w.normal[2]);
+    COREDEM_CHECK(l > 0 && std::isfinite(l), "a wall has a zero or non-finite normal; give a nonzero normal");
+  }
+  const CouplingGrid& g = c.grid;
+  const bool any = g.counts[0] != 0 || g.counts[1] != 0 || g.counts[2] != 0;
+  if (any) {
+    for (int d = 0; d < 3; ++d) {
+      COREDEM_CHECK(g.counts[d] > 0, "coupling grid: counts[{}] = {} must be > 0 (or all counts 0 for no coupling)", d, g.counts[d]);
+      COREDEM_CHECK(g.spacing[d] > 0, "coupling grid: spacing[{}] = {} must be > 0", d, g.spacing[d]);
+    }
+    COREDEM_CHECK(g.cellCount() < (1ull << 31), "coupling grid has {} cells; at most 2^31-1 are supported", g.cellCount());
+  }
+  COREDEM_CHECK(c.neighbour.skinFactor >= 0, "neighbour.skinFactor {} must be >= 0", c.neighbour.skinFactor);
+  COREDEM_CHECK(c.neighbour.initialNeighbourSlots >= 1, "neighbour.initialNeighbourSlots must be >= 1");
+  COREDEM_CHECK(c.dtFactor >= 1, "dtFactor {} must be >= 1 (PHYSICS: 50)", c.dtFactor);
+  COREDEM_CHECK(c.epsMinDrag > 0 && c.epsMinDrag < 1, "epsMinDrag {} must be in (0, 1)", c.epsMinDrag);
+  for (const Species& sp : c.gasSpecies)
+    COREDEM_CHECK(sp.molarMass > 0, "gas species '{}': molar mass must be > 0 (kg/mol)", sp.name);
+  for (const Species& sp : c.solidSpecies)
+    COREDEM_CHECK(sp.molarMass > 0, "solid species '{}': molar mass must be > 0 (kg/mol)", sp.name);
+}
+
+/// Positions of one set (x,y,z triples).
+std::vector<double> placeParticles(const ParticleSet& s) {
+  std::vector<double> p;
+  if (s.packing == Packing::Explicit) return s.positions;
+  const double r = 0.5 * s.diameter;
+  if (s.packing == Packing::Lattice) {
+    const double sp = s.spacing > 0 ? s.spacing : s.diameter;
+    long long n[3];
+    for (int d = 0; d < 3; ++d) n[d] = static_cast<long long>(std::floor((s.regionMax[d] - s.regionMin[d]) / sp + 1e-9));
+    const long long sites = n[0] * n[1] * n[2];
+    COREDEM_CHECK(sites >= static_cast<long long>(s.count),
+                  "particle set '{}': the region holds {} lattice sites at spacing {} m but count = {}; "
+                  "enlarge the region or reduce the count", s.name, sites, sp, s.count);
+    p.reserve(3 * s.count);
+    for (std::size_t k = 0; k < s.count; ++k) {
+      const long long i = static_cast<long long>(k) % n[0];
+      const long long j = (static_cast<long long>(k) / n[0]) % n[1];
+      const long long l = static_cast<long long>(k) / (n[0] * n[1]);
+      p.push_back(s.regionMin[0] + (i + 0.5) * sp);
+      p.push_back(s.regionMin[1] + (j + 0.5) * sp);
+      p.push_back(s.regionMin[2] + (l + 0.5) * sp);
+    }
+    return p;
+  }
+  // Random: rejection sampling with a hash grid of cell size d.
+  double lo[3], hi[3];
+  for (int d = 0; d < 3; ++d) {
+    lo[d] = s.regionMin[d] + r;
+    hi[d] = s.regionMax[d] - r;
+    COREDEM_CHECK(hi[d] > lo[d], "particle set '{}': the region is thinner than one diameter along axis {}", s.name, d);
+  }
+  Rng rng{s.seed};
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> grid;
+  auto cellOf = [&](double x, int d) { return static_cast<std::int64_t>(std::floor((x - lo[d]) / s.diameter)); };
+  auto key = [](std::int64_t a, std::int64_t b, std::int64_t c) {
+    return (static_cast<std::uint64_t>(a) * 73856093ull) ^ (static_cast<std::uint64_t>(b) * 19349663ull) ^
+           (static_cast<std::uint64_t>(c) * 83492791ull);
+  };
+  const std::size_t maxAttempts = 2000 * s.count + 10000;
+  std::size_t attempts = 0;
+  while (p.size() < 3 * s.count) {
+    COREDEM_CHECK(++attempts < maxAttempts,
+                  "particle set '{}': could not place {} non-overlapping particles of diameter {} m in the "
+                  "region (placed {}); enlarge the region, reduce the count or use Lattice packing",
+                  s.name, s.count, s.diameter, p.size() / 3);
+    double x[3];
+    for (int d = 0; d < 3; ++d) x[d] = lo[d] + (hi[d] - lo[d]) * rng.uniform();
+    const std::int64_t c[3] = {cellOf(x[0], 0), cellOf(x[1], 1), cellOf(x[2], 2)};
+    bool ok = true;
+    for (int a = -1; a <= 1 && ok; ++a)
+      for (int b = -1; b <= 1 && ok; ++b)
+        for (int e = -1; e <= 1 && ok; ++e) {
+          auto it = grid.find(key(c[0] + a, c[1] + b, c[2] + e));
+          if (it == grid.end()) continue;
+          for (std::size_t q : it->second) {
+            const double dx = p[3 * q] - x[0], dy = p[3 * q + 1] - x[1], dz = p[3 * q + 2] - x[2];
+            if (dx * dx + dy * dy + dz * dz < s.diameter * s.diameter) {
+              ok = false;
+              break;
+            }
+          }
+        }
+    if (!ok) continue;
+    grid[key(c[0], c[1], c[2])].push_back(p.size() / 3);
+    p.insert(p.end(), x, x + 3);
+  }
+  return p;
+}
+
+std::string hex16(std::uint64_t h) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+/// FNV-1a over a canonical text of everything except the particle sets.
+std::string hashConfig(const DemConfig& c) {
+  std::string t;
+  auto num = [&](double v) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%.17g;", v);
+    t += b;
+  };
+  for (const Material& m : c.materials) {
+    t += m.name + ":";
+    for (double v : {m.kn, m.en, m.mu, m.ktFactor, m.etatFactor}) num(v);
+  }
+  t += "|walls:";
+  for (const Wall& w : c.walls)
+    for (int d = 0; d < 3; ++d) num(w.point[d]), num(w.normal[d]);
+  t += "|g:";
+  for (double v : c.gravity) num(v);
+  t += "|grid:";
+  for (int d = 0; d < 3; ++d) num(c.grid.origin[d]), num(c.grid.spacing[d]), num(c.grid.counts[d]);
+  t += "|species:";
+  for (const Species& s : c.solidSpecies) t += s.name + ":", num(s.molarMass);
+  t += "|gas:";
+  for (const Species& s : c.gasSpecies) t += s.name + ":", num(s.molarMass);
+  t += "|opts:";
+  num(c.neighbour.skinFactor), num(c.neighbour.historySlots), num(c.epsMinDrag), num(c.dtFactor);
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (unsigned char ch : t) {
+    h ^= ch;
+    h *= 0x100000001b3ull;
+  }
+  return hex16(h);
+}
+
+PairProps pairProps(const Material& a, const Material& b) {
+  const double kn = 2.0 * a.kn * b.kn / (a.kn + b.kn);
+  const double en = std::min(a.en, b.en);
+  const double ktf = 0.5 * (a.ktFactor + b.ktFactor);
+  const double etf = 0.5 * (a.etatFactor + b.etatFactor);
+  return PairProps{kn, ktf * kn, kernels::dampingFactor(en), etf, std::min(a.mu, b.mu)};
+}
+
+} // namespace
+
+struct DemSystem::Impl {
+  DemConfig config;
+  EngineSetup setup;
+  std::unique_ptr<Engine> engine;
+  TimeHandler time;
+  std::uint64_t step = 0;
+  double dtMax = 0;
+  std::string hash;
+  CellSources sources;
+  std::size_t nParticles = 0;
+  BackendKind kind = BackendKind::Cpu;
+  std::unique_ptr<Engine> makeEngine() const {
+#if defined(COREDEM_CUDA_ENABLED)
+    if (kind == BackendKind::Cuda) return makeCudaEngine(setup);
+#endif
+    return makeCpuEngine(setup);
+  }
+  std::shared_ptr<spdlog::logger> log = coredem::logger("dem.system");
+};
+
+DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
+    : _impl(std::make_unique<Impl>()) {
+  Impl& m = *_impl;
+  validate(config);
+  COREDEM_CHECK(threads >= 0, "threads = {} must be >= 0 (0 = OpenMP default)", threads);
+  m.config = config;
+  m.hash = hashConfig(config);
+
+  // Particles.
+  HostState st;
+  const int ns = static_cast<int>(config.solidSpecies.size());
+  st.nSpecies = ns;
+  st.historySlots = config.neighbour.historySlots;
+  st.neighbourSlots = config.neighbour.initialNeighbourSlots;
+  double rmax = 0;
+  std::vector<double> minMass(config.materials.size(), std::numeric_limits<double>::infinity());
+  std::int64_t nextId = 0;
+  for (const ParticleSet& s : config.particleSets) {
+    const std::vector<double> p = placeParticles(s);
+    const std::size_t n = p.size() / 3;
+    Rng rng{s.seed ^ 0x5bd1e995a5a5a5a5ull};
+    const double r = 0.5 * s.diameter;
+    const double mass = s.density * kernels::sphereVolume(r);
+    rmax = std::max(rmax, r);
+    minMass[s.material] = std::min(minMass[s.material], mass);
+    for (std::size_t k = 0; k < n; ++k) {
+      for (int d = 0; d < 3; ++d) {
+        st.pos.push_back(p[3 * k + d]);
+        double v = s.velocity[d];
+        if (!s.velocities.empty()) v = s.velocities[3 * k + d];
+        if (s.velocityJitter > 0) v += s.velocityJitter * (2.0 * rng.uniform() - 1.0);
+        st.vel.push_back(v);
+        st.omega.push_back(s.angularVelocities.empty() ? 0.0 : s.angularVelocities[3 * k + d]);
+      }
+      st.radius.push_back(r);
+      st.mass.push_back(mass);
+      st.density.push_back(s.density);
+      st.temperature.push_back(s.temperature);
+      for (int q = 0; q < ns; ++q) st.species.push_back(s.composition.empty() ? (q == 0 ? 1.0 : 0.0) : s.composition[q]);
+      st.material.push_back(s.material);
+      st.gid.push_back(nextId++);
+    }
+  }
+  const std::size_t n = st.gid.size();
+  COREDEM_CHECK(n < (1ull << 31), "{} particles: at most 2^31-1 are supported", n);
+  st.n = n;
+  st.force.assign(3 * n, 0.0);
+  st.torque.assign(3 * n, 0.0);
+  st.fwall.assign(3 * n, 0.0);
+  st.xref = st.pos;
+  st.contacts.assign(n, 0);
+  st.histKey.assign(n * st.historySlots, -1);
+  st.histDisp.assign(3 * n * st.historySlots, 0.0);
+  st.nbCount.assign(n, 0);
+  st.nbList.assign(n * st.neighbourSlots, 0);
+  st.listValid = 0;
+  m.nParticles = n;
+
+  // Δt_DEM,max = min t_col / dtFactor over present material pairs and walls (Eqs. 12–13).
+  const std::size_t nm = config.materials.size();
+  double tcol = std::numeric_limits<double>::infinity();
+  for (std::size_t a = 0; a < nm; ++a) {
+    if (!std::isfinite(minMass[a])) continue;
+    for (std::size_t b = 0; b < nm; ++b) {
+      if (!std::isfinite(minMass[b])) continue;
+      const PairProps pp = pairProps(config.materials[a], config.materials[b]);
+      const double meff = kernels::effectiveMass(minMass[a], minMass[b]);
+      tcol = std::min(tcol, kernels::collisionTime(pp.kn, meff, pp.dampFactor * std::sqrt(pp.kn * meff)));
+    }
+    if (!config.walls.empty()) {
+      const PairProps pp = pairProps(config.materials[a], config.materials[a]);
+      tcol = std::min(tcol, kernels::collisionTime(pp.kn, minMass[a], pp.dampFactor * std::sqrt(pp.kn * minMass[a])));
+    }
+  }
+  m.dtMax = std::isfinite(tcol) ? tcol / config.dtFactor : std::numeric_limits<double>::infinity();
+
+  // Engine set-up.
+  EngineSetup& es = m.setup;
+  es.nMaterials = static_cast<int>(nm);
+  for (std::size_t a = 0; a < nm; ++a)
+    for (std::size_t b = 0; b < nm; ++b) es.pairs.push_back(pairProps(config.materials[a], config.materials[b]));
+  for (const Wall& w : config.walls) {
+    const double l = std::hypot(w.normal[0], w.normal[1], w.normal[2]);
+    es.walls.push_back(kernels::PlaneWall{{w.point[0], w.point[1], w.point[2]},
+                                          {w.normal[0] / l, w.normal[1] / l, w.normal[2] / l}});
+  }
+  es.gravity = {config.gravity[0], config.gravity[1], config.gravity[2]};
+  es.nCells = config.grid.cellCount();
+  es.coupled = es.nCells > 0;
+  if (es.coupled) {
+    const CouplingGrid& g = config.grid;
+    es.grid = kernels::GridParams{{g.origin[0], g.origin[1], g.origin[2]},
+                                  {1.0 / g.spacing[0], 1.0 / g.spacing[1], 1.0 / g.spacing[2]},
+                                  g.counts[0], g.counts[1], g.counts[2]};
+    es.cellVolume = g.spacing[0] * g.spacing[1] * g.spacing[2];
+  }
+  es.nGasSpecies = static_cast<int>(config.gasSpecies.size());
+  es.epsMin = config.epsMinDrag;
+  es.maxRadius = rmax;
+  es.skin = config.neighbour.skinFactor * 2.0 * rmax;
+  es.historySlots = config.neighbour.historySlots;
+  es.neighbourSlots = config.neighbour.initialNeighbourSlots;
+  es.threads = threads;
+
+  BackendKind kind = backend;
+  if (kind == BackendKind::Auto) kind = cudaDeviceCount() > 0 ? BackendKind::Cuda : BackendKind::Cpu;
+  if (kind == BackendKind::Cuda) {
+    COREDEM_CHECK(cudaBackendBuilt(), "backend 'cuda' requested but this build has no CUDA backend; "
+                                      "rebuild with -DCOREDEM_CUDA=ON or use --backend cpu");
+    COREDEM_CHECK(cudaDeviceCount() > 0, "backend 'cuda' requested but no CUDA device is visible; "
+                                         "use --backend cpu (or auto)");
+  }
+  m.kind = kind;
+  m.engine = m.makeEngine();
+  m.engine->setState(st);
+  m.log->debug("DemSystem: {} particles, backend {}, dt_dem_max {:.6g} s, config {}", n,
+               m.engine->name(), m.dtMax, m.hash);
+}
+
+DemSystem::~DemSystem() = default;
+
+double DemSystem::dtDemMax() const { return _impl->dtMax; }
+
+void DemSystem::setGasFields(const GasFieldsView& gas) {
+  Impl& m = *_impl;
+  COREDEM_CHECK(m.setup.coupled, "setGasFields: no coupling grid is configured (DemConfig.grid counts are 0)");
+  const std::size_t nc = m.setup.nCells;
+  const std::size_t ns = m.config.gasSpecies.size();
+  auto check = [&](std::span<const double> s, std::size_t want, const char* name, bool optional,
+                   bool positive) -> std::vector<double> {
+    if (s.empty() && optional) return {};
+    COREDEM_CHECK(s.size() == want, "setGasFields: {} has {} values, expected {} ({} cells)", name,
+                  s.size(), want, nc);
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      COREDEM_CHECK(std::isfinite(s[k]), "setGasFields: {}[{}] is not finite", name, k);
+      COREDEM_CHECK(!positive || s[k] > 0, "setGasFields: {}[{}] = {} must be > 0", name, k, s[k]);
+    }
+    return std::vector<double>(s.begin(), s.end());
+  };
+  GasArrays g;
+  g.ug = check(gas.ug, 3 * nc, "u_g", false, false);
+  g.gradP = check(gas.gradP, 3 * nc, "grad_p", false, false);
+  g.rhoG = check(gas.rhoG, nc, "rho_g", false, true);
+  g.muG = check(gas.muG, nc, "mu_g", false, true);
+  g.Tg = check(gas.Tg, nc, "T_g", true, true);
+  g.kappaG = check(gas.kappaG, nc, "kappa_g", true, true);
+  g.cpG = check(gas.cpG, nc, "cp_g", true, true);
+  g.Yg = check(gas.Yg, nc * ns, "Y_g", true, false);
+  m.engine->setGas(g);
+}
+
+const CellSources& DemSystem::advance(double dtCfd, int nSub) {
+  Impl& m = *_impl;
+  COREDEM_CHECK(dtCfd > 0 && std::isfinite(dtCfd), "advance: dtCfd = {} must be > 0 and finite", dtCfd);
+  COREDEM_CHECK(nSub >= 1, "advance: nSub = {} must be >= 1", nSub);
+  const double dt = dtCfd / nSub;
+  COREDEM_CHECK(dt <= m.dtMax * (1.0 + 1e-12),
+                "advance: dtCfd/nSub = {:.6g} s exceeds the stable DEM step {:.6g} s (t_col/{}); use "
+                "nSub >= {} (TimeHandler::subStepsFor)", dt, m.dtMax, m.config.dtFactor,
+                TimeHandler::subStepsFor(dtCfd, m.dtMax));
+  m.engine->beginWindow();
+  for (int s = 0; s < nSub; ++s) {
+    m.engine->subStep(dt);
+    m.time.add(dt);
+    ++m.step;
+  }
+  m.engine->endWindow(nSub, m.sources);
+  return m.sources;
+}
+
+void DemSystem::writeState(const std::string& path) const {
+  Impl& m = *_impl;
+  StateMeta meta;
+  meta.time = m.time.time();
+  meta.timeCompensation = m.time.compensation();
+  meta.step = m.step;
+  meta.backend = m.engine->name();
+  meta.configHash = m.hash;
+  meta.softwareVersion = COREDEM_VERSION;
+  meta.protocolVersion = "1";
+  writeStateFile(path, m.engine->state(), meta);
+}
+
+void DemSystem::readState(const std::string& path) {
+  Impl& m = *_impl;
+  HostState st;
+  StateMeta meta;
+  readStateFile(path, st, meta);
+  COREDEM_CHECK(meta.configHash == m.hash,
+                "state file '{}' was written with config hash {} but this system's is {}: restart with "
+                "the same materials, walls, gravity, grid, species and options", path, meta.configHash, m.hash);
+  COREDEM_CHECK(st.nSpecies == static_cast<int>(m.config.solidSpecies.size()),
+                "state file '{}' has {} solid species, the config {}", path, st.nSpecies, m.config.solidSpecies.size());
+  COREDEM_CHECK(st.historySlots >= 1, "state file '{}': bad history_slots", path);
+  double rmax = 0;
+  for (std::size_t i = 0; i < st.n; ++i) {
+    rmax = std::max(rmax, st.radius[i]);
+    COREDEM_CHECK(st.material[i] >= 0 && st.material[i] < static_cast<int>(m.config.materials.size()),
+                  "state file '{}': particle {} has material {} not in the config", path, i, st.material[i]);
+  }
+  COREDEM_CHECK(rmax <= m.setup.maxRadius * (1 + 1e-12) || m.nParticles == 0,
+                "state file '{}' holds particles larger (r = {}) than the configured sets (r = {})", path, rmax,
+                m.setup.maxRadius);
+  if (m.nParticles == 0 && rmax > 0) {
+    // Built without particle sets: take the neighbour cell size from the file.
+    m.setup.maxRadius = rmax;
+    m.setup.skin = m.config.neighbour.skinFactor * 2.0 * rmax;
+    m.engine.reset();
+    m.engine = m.makeEngine();
+  }
+  m.engine->setState(st);
+  m.nParticles = st.n;
+  m.time.restore(meta.time, meta.timeCompensation);
+  m.step = meta.step;
+}
+
+double DemSystem::time() const { return _impl->time.time(); }
+std::uint64_t DemSystem::step() const { return _impl->step; }
+std::size_t DemSystem::particleCount() const { return _impl->nParticles; }
+std::size_t DemSystem::cellCount() const { return _impl->setup.nCells; }
+std::string DemSystem::backendName() const { return _impl->engine->name(); }
+std::string DemSystem::configHash() const { return _impl->hash; }
+const DemConfig& DemSystem::config() const { return _impl->config; }
+
+ParticleData DemSystem::particles() const {
+  HostState s = _impl->engine->state();
+  ParticleData p;
+  p.count = s.n;
+  p.nSpecies = s.nSpecies;
+  p.position = std::move(s.pos);
+  p.velocity = std::move(s.vel);
+  p.angularVelocity = std::move(s.omega);
+  p.force = std::move(s.force);
+  p.radius = std::move(s.radius);
+  p.mass = std::move(s.mass);
+  p.density = std::move(s.density);
+  p.temperature = std::move(s.temperature);
+  p.species = std::move(s.species);
+  p.material = std::move(s.material);
+  p.globalId = std::move(s.gid);
+  return p;
+}
+
+void DemSystem::setVelocities(std::span<const double> velocityByGid, std::span<const double> omegaByGid) {
+  Impl& m = *_impl;
+  HostState s = m.engine->state();
+  COREDEM_CHECK(velocityByGid.empty() || velocityByGid.size() == 3 * s.n,
+                "setVelocities: {} velocity values, expected {}", velocityByGid.size(), 3 * s.n);
+  COREDEM_CHECK(omegaByGid.empty() || omegaByGid.size() == 3 * s.n,
+                "setVelocities: {} angular velocity values, expected {}", omegaByGid.size(), 3 * s.n);
+  for (std::size_t i = 0; i < s.n; ++i) {
+    const std::size_t g = static_cast<std::size_t>(s.gid[i]);
+    for (int d = 0; d < 3; ++d) {
+      if (!velocityByGid.empty()) s.vel[3 * i + d] = velocityByGid[3 * g + d];
+      if (!omegaByGid.empty()) s.omega[3 * i + d] = omegaByGid[3 * g + d];
+    }
+  }
+  m.engine->setState(s);
+}
+
+std::size_t DemSystem::contactCount() const {
+  return _impl->engine->pairContacts() + _impl->engine->wallContacts();
+}
+std::size_t DemSystem::pairContactCount() const { return _impl->engine->pairContacts(); }
+std::array<double, 3> DemSystem::wallForce() const { return _impl->engine->wallForce(); }
+std::size_t DemSystem::memoryBytes() const { return _impl->engine->memoryBytes(); }
+StageTimes DemSystem::stageTimes() const { return _impl->engine->times(); }
+void DemSystem::resetStageTimes() { _impl->engine->times() = StageTimes{}; }
+
+} // namespace coredem::dem

@@ -1,0 +1,91 @@
+#pragma once
+/// @file
+/// The backend-neutral interface between DemSystem (host: config, time, I/O) and the
+/// templated engine that runs the kernels (engine_impl.h, instantiated once per backend).
+
+#include "coredem/dem/dem_system.h"
+#include "coredem/dem/kernels/pcm.h"
+#include "coredem/dem/kernels/vec3.h"
+#include "coredem/dem/kernels/wall_contact.h"
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace coredem::dem {
+
+/// Contact properties of a material pair, with the m_eff-independent damping factor.
+struct PairProps {
+  double kn, kt, dampFactor, etatFactor, mu;
+};
+
+/// Everything the engine needs besides the particles. Plain data.
+struct EngineSetup {
+  int nMaterials = 1;
+  std::vector<PairProps> pairs;          ///< nMaterials², [a*nMaterials + b]; walls use [a*n + a]
+  std::vector<kernels::PlaneWall> walls;
+  kernels::Vec3 gravity{0, 0, 0};
+  bool coupled = false;
+  kernels::GridParams grid{};            ///< valid when coupled
+  double cellVolume = 0;
+  std::size_t nCells = 0;
+  int nGasSpecies = 0;
+  double epsMin = 0.35;
+  double skin = 0;                       ///< m
+  double maxRadius = 0;                  ///< m
+  int historySlots = 12;
+  int neighbourSlots = 16;
+  int threads = 0;
+};
+
+/// Host copy of the full engine state (particles in internal order, contact history,
+/// neighbour lists, rebuild reference). What writeState/readState store.
+struct HostState {
+  std::size_t n = 0;
+  int nSpecies = 0;
+  int historySlots = 0;
+  int neighbourSlots = 0;
+  std::vector<double> pos, vel, omega, force, torque, fwall, xref;  // N*3
+  std::vector<double> radius, mass, density, temperature;          // N
+  std::vector<double> species;                                     // N*nSpecies
+  std::vector<std::int32_t> material, contacts;                    // N
+  std::vector<std::int64_t> gid;                                   // N
+  std::vector<std::int64_t> histKey;                               // N*K (−1 empty, ≥0 partner gid, −(w+2) wall w)
+  std::vector<double> histDisp;                                    // N*K*3
+  std::vector<std::int32_t> nbCount;                               // N
+  std::vector<std::int32_t> nbList;                                // N*M
+  std::int32_t listValid = 0;                                      // 1: nbList usable as is
+};
+
+/// Host copies of the gas fields (per cell).
+struct GasArrays {
+  std::vector<double> ug, gradP, Tg, rhoG, muG, kappaG, cpG, Yg;
+};
+
+class Engine {
+public:
+  virtual ~Engine() = default;
+  virtual void setState(const HostState& s) = 0;
+  virtual HostState state() = 0;
+  virtual void setGas(const GasArrays& g) = 0;
+  /// Freezes ε_g (PCM at the current positions) and clears the source accumulators.
+  virtual void beginWindow() = 0;
+  /// One DEM sub-step of length dt (rebuild if needed, forces, sources, motion).
+  virtual void subStep(double dt) = 0;
+  /// Sub-step-averaged sources after nSub sub-steps.
+  virtual void endWindow(int nSub, CellSources& out) = 0;
+  virtual std::size_t pairContacts() = 0;
+  virtual std::size_t wallContacts() = 0;
+  virtual std::array<double, 3> wallForce() = 0;
+  virtual std::size_t memoryBytes() const = 0;
+  virtual StageTimes& times() = 0;
+  virtual const char* name() const = 0;
+};
+
+std::unique_ptr<Engine> makeCpuEngine(const EngineSetup& setup);
+/// Defined only when the CUDA backend is built (COREDEM_CUDA_ENABLED).
+std::unique_ptr<Engine> makeCudaEngine(const EngineSetup& setup);
+int cudaDevices();
+
+} // namespace coredem::dem

@@ -1,0 +1,204 @@
+// HDF5 state I/O with the HDF5 C API. Arrays are stored with their natural shapes
+// ([N], [N,3], [N,K], [N,K,3]); /meta carries the scalars as attributes.
+#include "state_io.h"
+
+#include "coredem/common/check.h"
+
+#include <hdf5.h>
+
+#include <vector>
+
+namespace coredem::dem {
+namespace {
+
+template <class T>
+hid_t h5type();
+template <>
+hid_t h5type<double>() { return H5T_NATIVE_DOUBLE; }
+template <>
+hid_t h5type<std::int32_t>() { return H5T_NATIVE_INT32; }
+template <>
+hid_t h5type<std::int64_t>() { return H5T_NATIVE_INT64; }
+template <>
+hid_t h5type<std::uint64_t>() { return H5T_NATIVE_UINT64; }
+
+/// Closes an HDF5 handle on scope exit.
+struct Handle {
+  hid_t id;
+  herr_t (*close)(hid_t);
+  ~Handle() {
+    if (id >= 0) close(id);
+  }
+};
+
+template <class T>
+void writeArray(hid_t group, const char* name, const std::vector<T>& v, std::vector<hsize_t> dims) {
+  hsize_t total = 1;
+  for (hsize_t d : dims) total *= d;
+  COREDEM_ASSERT(total == v.size());
+  Handle space{H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose};
+  Handle ds{H5Dcreate2(group, name, h5type<T>(), space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose};
+  COREDEM_CHECK(ds.id >= 0, "cannot create HDF5 dataset '{}'", name);
+  if (total > 0) {
+    COREDEM_CHECK(H5Dwrite(ds.id, h5type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) >= 0,
+                  "cannot write HDF5 dataset '{}'", name);
+  }
+}
+
+template <class T>
+void readArray(hid_t group, const char* name, std::vector<T>& v, hsize_t expected,
+               const std::string& path) {
+  COREDEM_CHECK(H5Lexists(group, name, H5P_DEFAULT) > 0,
+                "state file '{}' has no dataset '{}': it was not written by DemSystem::writeState "
+                "(or is truncated)", path, name);
+  Handle ds{H5Dopen2(group, name, H5P_DEFAULT), H5Dclose};
+  Handle space{H5Dget_space(ds.id), H5Sclose};
+  const hssize_t total = H5Sget_simple_extent_npoints(space.id);
+  COREDEM_CHECK(total >= 0 && static_cast<hsize_t>(total) == expected,
+                "state file '{}': dataset '{}' has {} values, expected {}", path, name, total, expected);
+  v.resize(static_cast<std::size_t>(expected));
+  if (expected > 0) {
+    COREDEM_CHECK(H5Dread(ds.id, h5type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) >= 0,
+                  "state file '{}': cannot read dataset '{}'", path, name);
+  }
+}
+
+template <class T>
+void writeAttr(hid_t obj, const char* name, T value) {
+  Handle space{H5Screate(H5S_SCALAR), H5Sclose};
+  Handle a{H5Acreate2(obj, name, h5type<T>(), space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
+  H5Awrite(a.id, h5type<T>(), &value);
+}
+
+void writeAttr(hid_t obj, const char* name, const std::string& value) {
+  Handle type{H5Tcopy(H5T_C_S1), H5Tclose};
+  H5Tset_size(type.id, value.empty() ? 1 : value.size());
+  H5Tset_strpad(type.id, H5T_STR_NULLTERM);
+  Handle space{H5Screate(H5S_SCALAR), H5Sclose};
+  Handle a{H5Acreate2(obj, name, type.id, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
+  std::string buf = value.empty() ? std::string(1, '\0') : value;
+  H5Awrite(a.id, type.id, buf.data());
+}
+
+template <class T>
+T readAttr(hid_t obj, const char* name, const std::string& path) {
+  COREDEM_CHECK(H5Aexists(obj, name) > 0, "state file '{}': /meta has no attribute '{}'", path, name);
+  Handle a{H5Aopen(obj, name, H5P_DEFAULT), H5Aclose};
+  T value{};
+  H5Aread(a.id, h5type<T>(), &value);
+  return value;
+}
+
+std::string readStringAttr(hid_t obj, const char* name, const std::string& path) {
+  COREDEM_CHECK(H5Aexists(obj, name) > 0, "state file '{}': /meta has no attribute '{}'", path, name);
+  Handle a{H5Aopen(obj, name, H5P_DEFAULT), H5Aclose};
+  Handle type{H5Aget_type(a.id), H5Tclose};
+  const std::size_t size = H5Tget_size(type.id);
+  std::string buf(size, '\0');
+  Handle mem{H5Tcopy(H5T_C_S1), H5Tclose};
+  H5Tset_size(mem.id, size);
+  H5Aread(a.id, mem.id, buf.data());
+  buf.resize(buf.find('\0') == std::string::npos ? size : buf.find('\0'));
+  return buf;
+}
+
+} // namespace
+
+void writeStateFile(const std::string& path, const HostState& s, const StateMeta& meta) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  Handle file{H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose};
+  COREDEM_CHECK(file.id >= 0, "cannot create state file '{}': check that the directory exists "
+                              "and is writable", path);
+  const hsize_t n = s.n, K = static_cast<hsize_t>(s.historySlots),
+                M = static_cast<hsize_t>(s.neighbourSlots), ns = static_cast<hsize_t>(s.nSpecies);
+  {
+    Handle g{H5Gcreate2(file.id, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
+    writeArray(g.id, "position", s.pos, {n, 3});
+    writeArray(g.id, "velocity", s.vel, {n, 3});
+    writeArray(g.id, "angular_velocity", s.omega, {n, 3});
+    writeArray(g.id, "force", s.force, {n, 3});
+    writeArray(g.id, "torque", s.torque, {n, 3});
+    writeArray(g.id, "wall_force", s.fwall, {n, 3});
+    writeArray(g.id, "position_at_rebuild", s.xref, {n, 3});
+    writeArray(g.id, "radius", s.radius, {n});
+    writeArray(g.id, "mass", s.mass, {n});
+    writeArray(g.id, "density", s.density, {n});
+    writeArray(g.id, "temperature", s.temperature, {n});
+    writeArray(g.id, "species", s.species, {n, ns});
+    writeArray(g.id, "material", s.material, {n});
+    writeArray(g.id, "global_id", s.gid, {n});
+  }
+  {
+    Handle g{H5Gcreate2(file.id, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
+    writeArray(g.id, "history_key", s.histKey, {n, K});
+    writeArray(g.id, "history_displacement", s.histDisp, {n, K, 3});
+    writeArray(g.id, "contact_count", s.contacts, {n});
+    writeArray(g.id, "neighbour_count", s.nbCount, {n});
+    writeArray(g.id, "neighbour_list", s.nbList, {n, M});
+  }
+  Handle g{H5Gcreate2(file.id, "meta", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
+  writeAttr(g.id, "time", meta.time);
+  writeAttr(g.id, "time_compensation", meta.timeCompensation);
+  writeAttr(g.id, "step", meta.step);
+  writeAttr(g.id, "backend", meta.backend);
+  writeAttr(g.id, "config_hash", meta.configHash);
+  writeAttr(g.id, "software_version", meta.softwareVersion);
+  writeAttr(g.id, "protocol_version", meta.protocolVersion);
+  writeAttr(g.id, "particle_count", static_cast<std::uint64_t>(s.n));
+  writeAttr(g.id, "n_species", static_cast<std::int32_t>(s.nSpecies));
+  writeAttr(g.id, "history_slots", static_cast<std::int32_t>(s.historySlots));
+  writeAttr(g.id, "neighbour_slots", static_cast<std::int32_t>(s.neighbourSlots));
+  writeAttr(g.id, "neighbour_list_valid", static_cast<std::int32_t>(s.listValid));
+  COREDEM_CHECK(H5Fflush(file.id, H5F_SCOPE_GLOBAL) >= 0, "cannot flush state file '{}'", path);
+}
+
+void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  COREDEM_CHECK(H5Fis_hdf5(path.c_str()) > 0,
+                "state file '{}' does not exist or is not an HDF5 file", path);
+  Handle file{H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
+  COREDEM_CHECK(file.id >= 0, "cannot open state file '{}'", path);
+  COREDEM_CHECK(H5Lexists(file.id, "meta", H5P_DEFAULT) > 0 && H5Lexists(file.id, "particles", H5P_DEFAULT) > 0 &&
+                    H5Lexists(file.id, "contacts", H5P_DEFAULT) > 0,
+                "'{}' is not a CoReDEM DEM state file (needs /meta, /particles, /contacts)", path);
+  Handle gm{H5Gopen2(file.id, "meta", H5P_DEFAULT), H5Gclose};
+  meta.time = readAttr<double>(gm.id, "time", path);
+  meta.timeCompensation = readAttr<double>(gm.id, "time_compensation", path);
+  meta.step = readAttr<std::uint64_t>(gm.id, "step", path);
+  meta.backend = readStringAttr(gm.id, "backend", path);
+  meta.configHash = readStringAttr(gm.id, "config_hash", path);
+  meta.softwareVersion = readStringAttr(gm.id, "software_version", path);
+  meta.protocolVersion = readStringAttr(gm.id, "protocol_version", path);
+  s.n = readAttr<std::uint64_t>(gm.id, "particle_count", path);
+  s.nSpecies = readAttr<std::int32_t>(gm.id, "n_species", path);
+  s.historySlots = readAttr<std::int32_t>(gm.id, "history_slots", path);
+  s.neighbourSlots = readAttr<std::int32_t>(gm.id, "neighbour_slots", path);
+  s.listValid = readAttr<std::int32_t>(gm.id, "neighbour_list_valid", path);
+  const hsize_t n = s.n, K = static_cast<hsize_t>(s.historySlots),
+                M = static_cast<hsize_t>(s.neighbourSlots), ns = static_cast<hsize_t>(s.nSpecies);
+  {
+    Handle g{H5Gopen2(file.id, "particles", H5P_DEFAULT), H5Gclose};
+    readArray(g.id, "position", s.pos, 3 * n, path);
+    readArray(g.id, "velocity", s.vel, 3 * n, path);
+    readArray(g.id, "angular_velocity", s.omega, 3 * n, path);
+    readArray(g.id, "force", s.force, 3 * n, path);
+    readArray(g.id, "torque", s.torque, 3 * n, path);
+    readArray(g.id, "wall_force", s.fwall, 3 * n, path);
+    readArray(g.id, "position_at_rebuild", s.xref, 3 * n, path);
+    readArray(g.id, "radius", s.radius, n, path);
+    readArray(g.id, "mass", s.mass, n, path);
+    readArray(g.id, "density", s.density, n, path);
+    readArray(g.id, "temperature", s.temperature, n, path);
+    readArray(g.id, "species", s.species, n * ns, path);
+    readArray(g.id, "material", s.material, n, path);
+    readArray(g.id, "global_id", s.gid, n, path);
+  }
+  Handle g{H5Gopen2(file.id, "contacts", H5P_DEFAULT), H5Gclose};
+  readArray(g.id, "history_key", s.histKey, n * K, path);
+  readArray(g.id, "history_displacement", s.histDisp, 3 * n * K, path);
+  readArray(g.id, "contact_count", s.contacts, n, path);
+  readArray(g.id, "neighbour_count", s.nbCount, n, path);
+  readArray(g.id, "neighbour_list", s.nbList, n * M, path);
+}
+
+} // namespace coredem::dem

@@ -1,0 +1,26 @@
+#pragma once
+/// @file
+/// HDF5 state files (DESIGN §4): /particles/<field>, /contacts/<field>, /meta attributes.
+
+#include "engine.h"
+
+#include <cstdint>
+#include <string>
+
+namespace coredem::dem {
+
+struct StateMeta {
+  double time = 0;
+  double timeCompensation = 0;  ///< Kahan compensation term, for bitwise restarts
+  std::uint64_t step = 0;
+  std::string backend;
+  std::string configHash;
+  std::string softwareVersion;
+  std::string protocolVersion;
+};
+
+void writeStateFile(const std::string& path, const HostState& s, const StateMeta& meta);
+/// Throws UserError when the file is missing, not HDF5, or lacks a field.
+void readStateFile(const std::string& path, HostState& s, StateMeta& meta);
+
+} // namespace coredem::dem
