@@ -1,0 +1,67 @@
+#pragma once
+/// @file
+/// Names, shapes and units of the per-cell coupling arrays: the one place where they are fixed.
+///
+/// Every array is float64, little-endian, one row per coupling cell in the cell order of
+/// `v1::CartesianGrid` (flat index i + nx*(j + ny*k)). Shapes: EXTENT_SCALAR -> [N],
+/// EXTENT_VECTOR3 -> [N,3], EXTENT_SPECIES -> [N, n_species] (columns in Configure.species order).
+///
+/// Usage (sender):
+/// @code
+///   Message m = makeGasFields(step, time, dt, cells, nSpecies);
+///   m.addArray(fields::kGasVelocity, uGas /* span<const double>, 3*N values */,
+///              fields::shapeOf(fields::kGasVelocity, cells, nSpecies));
+/// @endcode
+
+#include <coredem/v1/common.pb.h>
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+namespace coredem::protocol::fields {
+
+// GasFields (CFD -> DEM)
+inline constexpr std::string_view kGasVelocity = "u_g";            ///< [N,3] m/s
+inline constexpr std::string_view kPressureGradient = "grad_p";    ///< [N,3] Pa/m
+inline constexpr std::string_view kGasTemperature = "T_g";         ///< [N] K
+inline constexpr std::string_view kGasDensity = "rho_g";           ///< [N] kg/m3
+inline constexpr std::string_view kGasViscosity = "mu_g";          ///< [N] Pa s
+inline constexpr std::string_view kGasConductivity = "kappa_g";    ///< [N] W/m/K
+inline constexpr std::string_view kGasHeatCapacity = "cp_g";       ///< [N] J/kg/K
+inline constexpr std::string_view kGasMassFractions = "Y_g";       ///< [N,n_species] -
+
+// Sources (DEM -> CFD), averaged over the n_sub DEM sub-steps of the CFD step
+inline constexpr std::string_view kVoidFraction = "eps_g";         ///< [N] -
+inline constexpr std::string_view kDragCoefficient = "K_sl";       ///< [N] kg/m3/s
+inline constexpr std::string_view kDragCoefficientTimesUs = "K_sl_Us"; ///< [N,3] N/m3
+inline constexpr std::string_view kHeatCoefficient = "H";          ///< [N] W/m3/K (implicit)
+inline constexpr std::string_view kHeatCoefficientTimesTp = "H_Tp"; ///< [N] W/m3 (explicit)
+inline constexpr std::string_view kSpeciesSources = "R_species";   ///< [N,n_species] kg/m3/s
+inline constexpr std::string_view kHomogeneousHeat = "Q_hom";      ///< [N] W/m3
+
+/// One coupling field.
+struct FieldSpec {
+  std::string_view name;
+  v1::Extent extent;
+  std::string_view unit;
+  std::string_view description;
+};
+
+/// The arrays a GasFields message must carry, in the canonical order.
+std::span<const FieldSpec> gasFields();
+/// The arrays a Sources message must carry, in the canonical order.
+std::span<const FieldSpec> sourceFields();
+/// The spec of a GasFields or Sources field by name; nullptr if the name is not one of them.
+const FieldSpec* findField(std::string_view name);
+
+/// Shape of an array of the given extent: [cells], [cells,3] or [cells,species].
+std::vector<std::uint64_t> shapeOf(v1::Extent extent, std::uint64_t cells, std::uint64_t species);
+/// Shape of a named field; throws coredem::UserError for an unknown name.
+std::vector<std::uint64_t> shapeOf(std::string_view name, std::uint64_t cells,
+                                   std::uint64_t species);
+/// Values per cell of an extent (1, 3 or species).
+std::uint64_t componentsOf(v1::Extent extent, std::uint64_t species);
+
+} // namespace coredem::protocol::fields

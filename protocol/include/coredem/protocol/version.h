@@ -1,0 +1,35 @@
+#pragma once
+/// @file
+/// Protocol version and the negotiation rule (DESIGN §3):
+/// same major -> accept and use min(minor); different major -> reject naming both versions.
+
+#include <coredem/protocol/status.h>
+
+#include <cstdint>
+#include <string>
+
+namespace coredem::protocol {
+
+struct Version {
+  std::uint32_t major = 0;
+  std::uint32_t minor = 0;
+  friend bool operator==(const Version&, const Version&) = default;
+  /// "1.0"
+  [[nodiscard]] std::string toString() const;
+};
+
+/// The version this build speaks.
+inline constexpr Version kProtocolVersion{1, 0};
+
+/// Outcome of a handshake.
+struct Negotiation {
+  bool accepted = false;
+  Version agreed;       ///< valid when accepted: {major, min(minor_ours, minor_theirs)}
+  Status status;        ///< ERROR_CODE_VERSION with a message naming both versions if refused
+};
+
+/// Applies the rule. `ours` is the server's version, `theirs` the client's Hello.
+/// @post accepted == (ours.major == theirs.major)
+Negotiation negotiate(Version ours, Version theirs);
+
+} // namespace coredem::protocol

@@ -1,0 +1,434 @@
+// ZeroMQ transport. The only translation unit that includes zmq.hpp: ZeroMQ stays private.
+#include "message_impl.h"
+
+#include <coredem/common/log.h>
+#include <coredem/protocol/transport.h>
+
+#include <zmq.hpp>
+
+#include <cstring>
+#include <regex>
+
+namespace coredem::protocol {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+std::shared_ptr<spdlog::logger> transportLog() {
+  static auto log = logger("protocol.transport");
+  return log;
+}
+
+[[noreturn]] void rethrowZmq(const zmq::error_t& e, const std::string& what) {
+  throw TransportError(what + ": ZeroMQ error " + std::to_string(e.num()) + " (" + e.what() +
+                       ")");
+}
+
+void setCommonOptions(zmq::socket_t& socket, const TransportOptions& o) {
+  socket.set(zmq::sockopt::linger, static_cast<int>(o.linger.count()));
+  socket.set(zmq::sockopt::heartbeat_ivl, static_cast<int>(o.heartbeatInterval.count()));
+  socket.set(zmq::sockopt::heartbeat_timeout, static_cast<int>(o.heartbeatTimeout.count()));
+  socket.set(zmq::sockopt::heartbeat_ttl, static_cast<int>(o.heartbeatTimeout.count()));
+  // A send never blocks forever: after 10 s it fails and is reported.
+  socket.set(zmq::sockopt::sndtimeo, 10000);
+}
+
+void setKey(zmq::socket_t& socket, int option, const std::string& key, const char* which) {
+  if (key.size() != 40) {
+    throw ProtocolError(v1::ERROR_CODE_SECURITY,
+                        std::string("CURVE ") + which +
+                            " must be a 40-character Z85 key (see generateCurveKeyPair), got " +
+                            std::to_string(key.size()) + " characters");
+  }
+  if (zmq_setsockopt(socket.handle(), option, key.c_str(), 41) != 0) {
+    throw ProtocolError(v1::ERROR_CODE_SECURITY,
+                        std::string("setting the CURVE ") + which + " failed: " +
+                            zmq_strerror(zmq_errno()) +
+                            (zmq_has("curve") ? "" : " (libzmq was built without CURVE)"));
+  }
+}
+
+void freeShared(void* /*data*/, void* hint) {
+  delete static_cast<std::shared_ptr<const void>*>(hint);
+}
+
+/// Sends envelope + arrays, arrays without copying (ZeroMQ holds a reference to the owner).
+void sendMessage(zmq::socket_t& socket, const PeerId* peer, const Message& message,
+                 const std::string& what) {
+  const auto& impl = MessageAccess::impl(message);
+  std::string env = serializeEnvelope(impl.envelope);
+  try {
+    if (peer) {
+      socket.send(zmq::buffer(*peer), zmq::send_flags::sndmore);
+    }
+    auto more = impl.arrays.empty() ? zmq::send_flags::none : zmq::send_flags::sndmore;
+    if (!socket.send(zmq::buffer(env), more)) {
+      throw TransportError(what + ": send timed out (the peer does not read)");
+    }
+    for (std::size_t i = 0; i < impl.arrays.size(); ++i) {
+      const Buffer& b = impl.arrays[i];
+      auto flags = i + 1 < impl.arrays.size() ? zmq::send_flags::sndmore : zmq::send_flags::none;
+      zmq::message_t frame;
+      if (b.size > 0 && b.owner) {
+        auto* hint = new std::shared_ptr<const void>(b.owner);
+        frame = zmq::message_t(const_cast<std::byte*>(b.data), b.size, &freeShared, hint);
+      } else if (b.size > 0) {
+        frame = zmq::message_t(b.data, b.size); // caller-owned memory: copy
+      }
+      if (!socket.send(std::move(frame), flags)) {
+        throw TransportError(what + ": send timed out (the peer does not read)");
+      }
+    }
+  } catch (const zmq::error_t& e) {
+    rethrowZmq(e, what);
+  }
+}
+
+void sendRaw(zmq::socket_t& socket, const PeerId* peer, const Frames& frames,
+             const std::string& what) {
+  try {
+    if (peer) {
+      socket.send(zmq::buffer(*peer),
+                  frames.empty() ? zmq::send_flags::none : zmq::send_flags::sndmore);
+    }
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      auto flags = i + 1 < frames.size() ? zmq::send_flags::sndmore : zmq::send_flags::none;
+      if (!socket.send(zmq::buffer(frames[i]), flags)) {
+        throw TransportError(what + ": send timed out");
+      }
+    }
+  } catch (const zmq::error_t& e) {
+    rethrowZmq(e, what);
+  }
+}
+
+/// Waits until the socket is readable or the deadline passes.
+bool waitReadable(zmq::socket_t& socket, Clock::time_point deadline) {
+  for (;;) {
+    auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+    if (left.count() < 0) {
+      left = std::chrono::milliseconds(0);
+    }
+    zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+    try {
+      int n = zmq::poll(&item, 1, left);
+      if (n > 0) {
+        return true;
+      }
+    } catch (const zmq::error_t& e) {
+      if (e.num() != EINTR) {
+        rethrowZmq(e, "poll");
+      }
+    }
+    if (Clock::now() >= deadline) {
+      return false;
+    }
+  }
+}
+
+/// Receives all frames of one multipart message (after poll said readable).
+std::vector<zmq::message_t> receiveFrames(zmq::socket_t& socket, const std::string& what) {
+  std::vector<zmq::message_t> frames;
+  try {
+    for (;;) {
+      zmq::message_t frame;
+      if (!socket.recv(frame, zmq::recv_flags::dontwait)) {
+        break; // parts of a multipart message arrive together; nothing more
+      }
+      bool more = frame.more();
+      frames.push_back(std::move(frame));
+      if (!more) {
+        break;
+      }
+    }
+  } catch (const zmq::error_t& e) {
+    rethrowZmq(e, what);
+  }
+  return frames;
+}
+
+/// Decodes received frames [first, end) into a Message; applies the BufferProvider.
+Status decodeFrames(std::vector<zmq::message_t>& frames, std::size_t first, Message& out,
+                    const ReceiveOptions& options) {
+  if (frames.size() <= first) {
+    return decodeInto(out, nullptr, 0, {});
+  }
+  auto keepEnv = std::make_shared<zmq::message_t>(std::move(frames[first]));
+  std::vector<Buffer> arrays;
+  for (std::size_t i = first + 1; i < frames.size(); ++i) {
+    auto keep = std::make_shared<zmq::message_t>(std::move(frames[i]));
+    Buffer b{nullptr, static_cast<const std::byte*>(keep->data()), keep->size()};
+    b.owner = std::move(keep);
+    arrays.push_back(std::move(b));
+  }
+  Status s = decodeInto(out, static_cast<const std::byte*>(keepEnv->data()), keepEnv->size(),
+                        std::move(arrays));
+  if (s.ok() && options.buffers) {
+    auto& impl = MessageAccess::impl(out);
+    for (std::size_t i = 0; i < impl.arrays.size(); ++i) {
+      const auto& d = impl.envelope.arrays(static_cast<int>(i));
+      std::span<std::byte> dst = options.buffers(d);
+      if (dst.empty()) {
+        continue;
+      }
+      Buffer& b = impl.arrays[i];
+      COREDEM_CHECK(dst.size() >= b.size,
+                    "BufferProvider returned {} bytes for array '{}' of {} bytes", dst.size(),
+                    d.name(), b.size);
+      if (b.size) {
+        std::memcpy(dst.data(), b.data, b.size);
+      }
+      b = Buffer{nullptr, dst.data(), b.size};
+    }
+  }
+  return s;
+}
+
+std::string describe(const Message& m) {
+  const auto& env = m.envelope();
+  return messageTypeName(env.type()) + " (sequence " + std::to_string(env.sequence()) +
+         ", step " + std::to_string(env.step()) + ")";
+}
+
+} // namespace
+
+bool isLoopbackEndpoint(std::string_view endpoint) {
+  if (endpoint.starts_with("ipc://") || endpoint.starts_with("inproc://")) {
+    return true;
+  }
+  if (!endpoint.starts_with("tcp://")) {
+    return false;
+  }
+  std::string_view rest = endpoint.substr(6);
+  std::string_view host;
+  if (rest.starts_with("[")) {
+    auto close = rest.find(']');
+    if (close == std::string_view::npos) {
+      return false;
+    }
+    host = rest.substr(1, close - 1);
+    return host == "::1";
+  }
+  auto colon = rest.rfind(':');
+  host = colon == std::string_view::npos ? rest : rest.substr(0, colon);
+  if (host == "localhost") {
+    return true;
+  }
+  static const std::regex ipv4Loopback(R"(127\.\d{1,3}\.\d{1,3}\.\d{1,3})");
+  return std::regex_match(host.begin(), host.end(), ipv4Loopback);
+}
+
+std::pair<std::string, std::string> generateCurveKeyPair() {
+  char pub[41] = {};
+  char sec[41] = {};
+  if (!zmq_has("curve") || zmq_curve_keypair(pub, sec) != 0) {
+    throw ProtocolError(v1::ERROR_CODE_UNSUPPORTED,
+                        "this libzmq has no CURVE support; install libzmq built with libsodium");
+  }
+  return {pub, sec};
+}
+
+// ---- Server ----------------------------------------------------------------------------
+
+struct Server::Impl {
+  TransportOptions options;
+  zmq::context_t context{1};
+  zmq::socket_t socket{context, zmq::socket_type::router};
+  std::string endpoint;
+  std::shared_ptr<spdlog::logger> log = transportLog();
+};
+
+Server::Server(TransportOptions options) {
+  try {
+    _impl = std::make_unique<Impl>();
+    _impl->options = std::move(options);
+    setCommonOptions(_impl->socket, _impl->options);
+    _impl->socket.set(zmq::sockopt::router_mandatory, 1);
+    if (_impl->options.curve.serverConfigured()) {
+      int one = 1;
+      zmq_setsockopt(_impl->socket.handle(), ZMQ_CURVE_SERVER, &one, sizeof(one));
+      setKey(_impl->socket, ZMQ_CURVE_SECRETKEY, _impl->options.curve.serverSecretKey,
+             "server secret key");
+    }
+  } catch (const zmq::error_t& e) {
+    rethrowZmq(e, "creating the server socket");
+  }
+}
+
+Server::~Server() = default;
+Server::Server(Server&&) noexcept = default;
+Server& Server::operator=(Server&&) noexcept = default;
+
+std::string Server::bind(const std::string& endpoint) {
+  if (!isLoopbackEndpoint(endpoint) && !_impl->options.curve.serverConfigured()) {
+    throw ProtocolError(v1::ERROR_CODE_SECURITY,
+                        "refusing to bind " + endpoint +
+                            ": a non-loopback endpoint requires CURVE keys (DESIGN §1). Bind "
+                            "tcp://127.0.0.1:PORT or ipc://PATH, or set "
+                            "TransportOptions::curve (serverSecretKey/serverPublicKey)");
+  }
+  try {
+    _impl->socket.bind(endpoint);
+    _impl->endpoint = _impl->socket.get(zmq::sockopt::last_endpoint);
+  } catch (const zmq::error_t& e) {
+    rethrowZmq(e, "binding " + endpoint +
+                      " (is the address valid and free? use tcp://127.0.0.1:* for any port)");
+  }
+  _impl->log->debug("server bound to {}", _impl->endpoint);
+  return _impl->endpoint;
+}
+
+std::string Server::endpoint() const { return _impl->endpoint; }
+
+std::optional<Request> Server::receive(std::chrono::milliseconds timeout,
+                                       const ReceiveOptions& options) {
+  auto deadline = Clock::now() + timeout;
+  if (!waitReadable(_impl->socket, deadline)) {
+    return std::nullopt;
+  }
+  auto frames = receiveFrames(_impl->socket, "receiving on " + _impl->endpoint);
+  if (frames.empty()) {
+    return std::nullopt;
+  }
+  Request request;
+  request.peer = frames[0].to_string();
+  request.status = decodeFrames(frames, 1, request.message, options);
+  if (!request.status.ok()) {
+    _impl->log->warn("undecodable message on {}: {}", _impl->endpoint,
+                     request.status.toString());
+  }
+  return request;
+}
+
+void Server::reply(const PeerId& peer, Message message) {
+  if (message.envelope().sender().empty() && !_impl->options.sender.empty()) {
+    message.envelope().set_sender(_impl->options.sender);
+  }
+  try {
+    sendMessage(_impl->socket, &peer, message, "replying " + describe(message));
+  } catch (const TransportError& e) {
+    // EHOSTUNREACH: the peer has gone; its reply is dropped (it will time out and report).
+    _impl->log->warn("reply dropped: {}", e.what());
+  }
+}
+
+void Server::replyFrames(const PeerId& peer, const Frames& frames) {
+  sendRaw(_impl->socket, &peer, frames, "replying raw frames");
+}
+
+// ---- Client ----------------------------------------------------------------------------
+
+struct Client::Impl {
+  TransportOptions options;
+  zmq::context_t context{1};
+  zmq::socket_t socket{context, zmq::socket_type::dealer};
+  std::string endpoint;
+  std::uint64_t nextSequence = 1;
+  std::shared_ptr<spdlog::logger> log = transportLog();
+};
+
+Client::Client(TransportOptions options) {
+  try {
+    _impl = std::make_unique<Impl>();
+    _impl->options = std::move(options);
+    setCommonOptions(_impl->socket, _impl->options);
+    if (_impl->options.curve.clientConfigured()) {
+      setKey(_impl->socket, ZMQ_CURVE_SERVERKEY, _impl->options.curve.serverPublicKey,
+             "server public key");
+      setKey(_impl->socket, ZMQ_CURVE_PUBLICKEY, _impl->options.curve.clientPublicKey,
+             "client public key");
+      setKey(_impl->socket, ZMQ_CURVE_SECRETKEY, _impl->options.curve.clientSecretKey,
+             "client secret key");
+    }
+  } catch (const zmq::error_t& e) {
+    rethrowZmq(e, "creating the client socket");
+  }
+}
+
+Client::~Client() = default;
+Client::Client(Client&&) noexcept = default;
+Client& Client::operator=(Client&&) noexcept = default;
+
+void Client::connect(const std::string& endpoint) {
+  try {
+    _impl->socket.connect(endpoint);
+  } catch (const zmq::error_t& e) {
+    rethrowZmq(e, "connecting to " + endpoint);
+  }
+  _impl->endpoint = endpoint;
+}
+
+std::string Client::endpoint() const { return _impl->endpoint; }
+
+std::uint64_t Client::nextSequence() const { return _impl->nextSequence; }
+
+std::uint64_t Client::send(Message message) {
+  auto& env = message.envelope();
+  if (env.sequence() == 0) {
+    env.set_sequence(_impl->nextSequence);
+  }
+  if (env.sequence() >= _impl->nextSequence) {
+    _impl->nextSequence = env.sequence() + 1;
+  }
+  if (env.sender().empty() && !_impl->options.sender.empty()) {
+    env.set_sender(_impl->options.sender);
+  }
+  sendMessage(_impl->socket, nullptr, message,
+              "sending " + describe(message) + " to " + _impl->endpoint);
+  return env.sequence();
+}
+
+void Client::sendFrames(const Frames& frames) {
+  sendRaw(_impl->socket, nullptr, frames, "sending raw frames to " + _impl->endpoint);
+}
+
+std::optional<Message> Client::receive(std::chrono::milliseconds timeout,
+                                       const ReceiveOptions& options, Status* status) {
+  auto deadline = Clock::now() + timeout;
+  if (!waitReadable(_impl->socket, deadline)) {
+    return std::nullopt;
+  }
+  auto frames = receiveFrames(_impl->socket, "receiving from " + _impl->endpoint);
+  Message m;
+  Status s = decodeFrames(frames, 0, m, options);
+  if (status) {
+    *status = s;
+  } else if (!s.ok()) {
+    throw ProtocolError(s.code, "undecodable reply from " + _impl->endpoint + ": " + s.message);
+  }
+  return m;
+}
+
+Message Client::request(Message message, std::chrono::milliseconds timeout,
+                        const ReceiveOptions& options) {
+  const std::string what = describe(message);
+  const auto type = message.type();
+  const auto step = message.envelope().step();
+  auto deadline = Clock::now() + timeout;
+  std::uint64_t seq = send(std::move(message));
+  for (;;) {
+    auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+    std::optional<Message> reply;
+    if (left.count() > 0) {
+      reply = receive(left, options);
+    }
+    if (!reply) {
+      throw TimeoutError(_impl->endpoint, "reply to " + what,
+                         "no reply from " + _impl->endpoint + " within " +
+                             std::to_string(timeout.count()) + " ms while awaiting the reply to " +
+                             messageTypeName(type) + " (sequence " + std::to_string(seq) +
+                             ", step " + std::to_string(step) +
+                             "); is the server running, reachable and not stalled?");
+    }
+    const auto& env = reply->envelope();
+    if (env.sequence() == seq ||
+        (env.sequence() == 0 && reply->type() == v1::MESSAGE_TYPE_ERROR)) {
+      return std::move(*reply);
+    }
+    _impl->log->debug("discarding stale reply {} from {} (awaiting sequence {})",
+                      describe(*reply), _impl->endpoint, seq);
+  }
+}
+
+} // namespace coredem::protocol

@@ -1,0 +1,361 @@
+#include "message_impl.h"
+
+#include <coredem/protocol/fields.h>
+#include <coredem/protocol/validate.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <set>
+#include <sstream>
+
+namespace coredem::protocol {
+
+namespace {
+
+std::string shapeString(const std::vector<std::uint64_t>& shape) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < shape.size(); ++i) {
+    s += (i ? "," : "") + std::to_string(shape[i]);
+  }
+  return s + "]";
+}
+
+/// The body case that belongs to a message type.
+v1::Envelope::BodyCase bodyCaseOf(v1::MessageType type) {
+  switch (type) {
+  case v1::MESSAGE_TYPE_HELLO:
+    return v1::Envelope::kHello;
+  case v1::MESSAGE_TYPE_WELCOME:
+    return v1::Envelope::kWelcome;
+  case v1::MESSAGE_TYPE_REJECT:
+    return v1::Envelope::kReject;
+  case v1::MESSAGE_TYPE_CONFIGURE:
+    return v1::Envelope::kConfigure;
+  case v1::MESSAGE_TYPE_CONFIGURED:
+    return v1::Envelope::kConfigured;
+  case v1::MESSAGE_TYPE_GAS_FIELDS:
+    return v1::Envelope::kGasFields;
+  case v1::MESSAGE_TYPE_SOURCES:
+    return v1::Envelope::kSources;
+  case v1::MESSAGE_TYPE_STEP_GRANT:
+    return v1::Envelope::kStepGrant;
+  case v1::MESSAGE_TYPE_STEP_DONE:
+    return v1::Envelope::kStepDone;
+  case v1::MESSAGE_TYPE_CHECKPOINT_REQUEST:
+    return v1::Envelope::kCheckpointRequest;
+  case v1::MESSAGE_TYPE_CHECKPOINT_DONE:
+    return v1::Envelope::kCheckpointDone;
+  case v1::MESSAGE_TYPE_HEARTBEAT:
+    return v1::Envelope::kHeartbeat;
+  case v1::MESSAGE_TYPE_ERROR:
+    return v1::Envelope::kError;
+  case v1::MESSAGE_TYPE_SHUTDOWN:
+    return v1::Envelope::kShutdown;
+  case v1::MESSAGE_TYPE_ACK:
+    return v1::Envelope::kAck;
+  default:
+    return v1::Envelope::BODY_NOT_SET;
+  }
+}
+
+template <class T>
+Status checkFinite(const ArrayView& view) {
+  const std::size_t n = view.bytes.size() / sizeof(T);
+  const std::byte* p = view.bytes.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    T v;
+    std::memcpy(&v, p + i * sizeof(T), sizeof(T));
+    if (!std::isfinite(v)) {
+      std::string what = std::isnan(v) ? "NaN" : (v > 0 ? "+Inf" : "-Inf");
+      std::string where = "flat index " + std::to_string(i);
+      const auto& shape = view.descriptor->shape();
+      if (shape.size() == 2 && shape[1] > 0) {
+        where += " (row " + std::to_string(i / shape[1]) + ", column " +
+                 std::to_string(i % shape[1]) + ")";
+      }
+      return Status::error(v1::ERROR_CODE_NON_FINITE,
+                           "array '" + view.name() + "' contains " + what + " at " + where +
+                               "; every value must be finite - check the sender's solution "
+                               "for divergence at that cell");
+    }
+  }
+  return {};
+}
+
+Status checkArrays(const Message& message, std::span<const fields::FieldSpec> required,
+                   std::uint64_t cells, std::uint64_t species, bool requireFinite) {
+  std::set<std::string, std::less<>> seen;
+  for (std::size_t i = 0; i < message.arrayCount(); ++i) {
+    ArrayView v = message.array(i);
+    if (!seen.insert(v.name()).second) {
+      return Status::error(v1::ERROR_CODE_DUPLICATE_FIELD,
+                           "array '" + v.name() + "' appears more than once in one " +
+                               messageTypeName(message.type()) + " message; send it once");
+    }
+  }
+  for (const auto& spec : required) {
+    auto v = message.findArray(spec.name);
+    if (!v) {
+      return Status::error(v1::ERROR_CODE_MISSING_FIELD,
+                           messageTypeName(message.type()) + " message lacks the required array '" +
+                               std::string(spec.name) + "' (" + std::string(spec.description) +
+                               ", " + std::string(spec.unit) + "); send every field listed in "
+                               "coredem/protocol/fields.h");
+    }
+    if (v->dtype() != v1::DTYPE_FLOAT64) {
+      return Status::error(v1::ERROR_CODE_DTYPE,
+                           "array '" + v->name() + "' has dtype " + dtypeName(v->dtype()) +
+                               " but coupling fields are float64; convert before sending");
+    }
+    auto expected = fields::shapeOf(spec.extent, cells, species);
+    if (v->shape() != expected) {
+      return Status::error(v1::ERROR_CODE_SHAPE,
+                           "array '" + v->name() + "' has shape " + shapeString(v->shape()) +
+                               " but " + shapeString(expected) + " was expected for " +
+                               std::to_string(cells) + " configured cells and " +
+                               std::to_string(species) +
+                               " species; send one row per coupling cell of Configure");
+    }
+  }
+  if (requireFinite) {
+    for (std::size_t i = 0; i < message.arrayCount(); ++i) {
+      ArrayView v = message.array(i);
+      Status s;
+      if (v.dtype() == v1::DTYPE_FLOAT64) {
+        s = checkFinite<double>(v);
+      } else if (v.dtype() == v1::DTYPE_FLOAT32) {
+        s = checkFinite<float>(v);
+      }
+      if (!s.ok()) {
+        return s;
+      }
+    }
+  }
+  return {};
+}
+
+Status structure(const Message& message) {
+  const auto& impl = MessageAccess::impl(message);
+  const auto& env = impl.envelope;
+  if (static_cast<std::size_t>(env.arrays_size()) != impl.arrays.size()) {
+    return Status::error(v1::ERROR_CODE_FRAME_COUNT,
+                         "the envelope describes " + std::to_string(env.arrays_size()) +
+                             " arrays but the message has " +
+                             std::to_string(impl.arrays.size()) + " array frames");
+  }
+  for (int i = 0; i < env.arrays_size(); ++i) {
+    const auto& d = env.arrays(i);
+    std::size_t elem = dtypeSize(d.dtype());
+    if (elem == 0) {
+      return Status::error(v1::ERROR_CODE_DTYPE, "array '" + d.name() + "' has unknown dtype " +
+                                                     dtypeName(d.dtype()));
+    }
+    std::uint64_t elements = 0;
+    if (impl.arrays[static_cast<std::size_t>(i)].size != d.byte_length() ||
+        !shapeElements(d.shape(), &elements) || elements * elem != d.byte_length()) {
+      return Status::error(v1::ERROR_CODE_BYTE_LENGTH,
+                           "array '" + d.name() +
+                               "': frame size, byte_length and prod(shape)*sizeof(dtype) "
+                               "disagree");
+    }
+  }
+  return {};
+}
+
+} // namespace
+
+std::uint64_t cellCount(const v1::CouplingMesh& mesh) {
+  if (mesh.kind_case() != v1::CouplingMesh::kCartesian) {
+    return 0;
+  }
+  const auto& c = mesh.cartesian().counts();
+  return c.x() * c.y() * c.z();
+}
+
+Status validate(const Message& message, const Expectation& e) {
+  if (Status s = structure(message); !s.ok()) {
+    return s;
+  }
+  const auto& env = message.envelope();
+  const v1::MessageType type = env.type();
+  if (!v1::MessageType_IsValid(type) || type == v1::MESSAGE_TYPE_UNSPECIFIED) {
+    return Status::error(v1::ERROR_CODE_UNKNOWN_TYPE,
+                         "message type " + std::to_string(static_cast<int>(type)) +
+                             " is not known to coredem protocol v1 (this build knows 1.." +
+                             std::to_string(static_cast<int>(v1::MessageType_MAX)) +
+                             "); the sender may speak a newer version - check the Hello "
+                             "negotiation");
+  }
+  if (env.body_case() != bodyCaseOf(type)) {
+    return Status::error(v1::ERROR_CODE_BODY_MISMATCH,
+                         "Envelope.type is " + messageTypeName(type) +
+                             " but the body carries another message (oneof case " +
+                             std::to_string(static_cast<int>(env.body_case())) +
+                             "); set the body that matches the type");
+  }
+  if (!e.types.empty() && std::find(e.types.begin(), e.types.end(), type) == e.types.end()) {
+    std::string allowed;
+    for (auto t : e.types) {
+      allowed += (allowed.empty() ? "" : ", ") + messageTypeName(t);
+    }
+    return Status::error(v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+                         "a " + messageTypeName(type) + " message is not expected now; expected " +
+                             allowed);
+  }
+  if (e.sessionId && env.session_id() != *e.sessionId) {
+    return Status::error(v1::ERROR_CODE_UNKNOWN_SESSION,
+                         "session id '" + env.session_id() + "' does not match this session ('" +
+                             *e.sessionId + "'); use the session_id of the Welcome reply");
+  }
+  if (e.sequence && env.sequence() != *e.sequence) {
+    return Status::error(v1::ERROR_CODE_OUT_OF_ORDER,
+                         "sequence number " + std::to_string(env.sequence()) + " received, " +
+                             std::to_string(*e.sequence) + " expected");
+  }
+  if (e.sequenceAfter && env.sequence() <= *e.sequenceAfter) {
+    return Status::error(v1::ERROR_CODE_OUT_OF_ORDER,
+                         "sequence number " + std::to_string(env.sequence()) +
+                             " is not greater than the last one received (" +
+                             std::to_string(*e.sequenceAfter) +
+                             "); a message was duplicated or replayed");
+  }
+  if (e.step && env.step() != *e.step) {
+    return Status::error(v1::ERROR_CODE_OUT_OF_ORDER,
+                         messageTypeName(type) + " for step " + std::to_string(env.step()) +
+                             " received, step " + std::to_string(*e.step) +
+                             " expected; steps are exchanged in order, one per CFD step");
+  }
+  if (type == v1::MESSAGE_TYPE_GAS_FIELDS || type == v1::MESSAGE_TYPE_SOURCES) {
+    if (!e.cells || !e.species) {
+      return Status::error(v1::ERROR_CODE_NOT_CONFIGURED,
+                           messageTypeName(type) +
+                               " received before Configure; send Hello and Configure first");
+    }
+    std::uint64_t bodyCells = type == v1::MESSAGE_TYPE_GAS_FIELDS
+                                  ? env.gas_fields().cell_count()
+                                  : env.sources().cell_count();
+    std::uint64_t bodySpecies = type == v1::MESSAGE_TYPE_GAS_FIELDS
+                                    ? env.gas_fields().species_count()
+                                    : env.sources().species_count();
+    if (bodyCells != *e.cells || bodySpecies != *e.species) {
+      return Status::error(v1::ERROR_CODE_SHAPE,
+                           messageTypeName(type) + " declares " + std::to_string(bodyCells) +
+                               " cells and " + std::to_string(bodySpecies) +
+                               " species but the configured mesh has " +
+                               std::to_string(*e.cells) + " cells and " +
+                               std::to_string(*e.species) +
+                               " species; send fields on the configured coupling mesh");
+    }
+    auto required =
+        type == v1::MESSAGE_TYPE_GAS_FIELDS ? fields::gasFields() : fields::sourceFields();
+    return checkArrays(message, required, *e.cells, *e.species, e.requireFinite);
+  }
+  return checkArrays(message, {}, 0, 0, e.requireFinite);
+}
+
+namespace {
+bool positive(const v1::Vec3& v) { return v.x() > 0 && v.y() > 0 && v.z() > 0; }
+bool finite3(const v1::Vec3& v) {
+  return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
+}
+Status bad(const std::string& msg) {
+  return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION, "Configure: " + msg);
+}
+} // namespace
+
+Status validateConfigure(const v1::Configure& c) {
+  if (c.coupling_mesh().kind_case() != v1::CouplingMesh::kCartesian) {
+    return bad("coupling_mesh must be a CartesianGrid (the only mesh kind of protocol 1.0)");
+  }
+  const auto& g = c.coupling_mesh().cartesian();
+  if (g.counts().x() == 0 || g.counts().y() == 0 || g.counts().z() == 0) {
+    return bad("coupling_mesh.cartesian.counts must be >= 1 on every axis");
+  }
+  if (!positive(g.spacing()) || !finite3(g.spacing()) || !finite3(g.origin())) {
+    return bad("coupling_mesh.cartesian.spacing must be finite and > 0 on every axis");
+  }
+  std::set<std::string> names;
+  for (const auto& s : c.species()) {
+    if (s.name().empty() || !names.insert(s.name()).second) {
+      return bad("species name '" + s.name() + "' is empty or repeated; names must be unique");
+    }
+    if (!(s.molar_mass() > 0) || !std::isfinite(s.molar_mass())) {
+      return bad("species '" + s.name() + "' has molar_mass " + std::to_string(s.molar_mass()) +
+                 " kg/mol; it must be > 0 (e.g. 0.044 for CO2)");
+    }
+  }
+  const auto& sc = c.sub_cycling();
+  if (!(sc.dt_cfd() > 0) || sc.n_sub() == 0 || !(sc.dt_dem() > 0)) {
+    return bad("sub_cycling needs dt_cfd > 0, n_sub >= 1 and dt_dem > 0");
+  }
+  if (std::abs(sc.dt_dem() * sc.n_sub() - sc.dt_cfd()) > 1e-12 * sc.dt_cfd()) {
+    std::ostringstream os;
+    os.precision(17);
+    os << "sub_cycling: dt_dem * n_sub = " << sc.dt_dem() * sc.n_sub() << " s differs from dt_cfd = "
+       << sc.dt_cfd() << " s (relative tolerance 1e-12); set dt_dem = dt_cfd / n_sub";
+    return bad(os.str());
+  }
+  std::set<std::uint32_t> materialIds;
+  for (const auto& m : c.materials()) {
+    if (!materialIds.insert(m.id()).second) {
+      return bad("material id " + std::to_string(m.id()) + " is used twice");
+    }
+    if (!(m.density() > 0) || !(m.k_n() > 0) || !(m.e_n() > 0 && m.e_n() <= 1) ||
+        !(m.friction() >= 0) || (m.has_kt_factor() && !(m.kt_factor() > 0)) ||
+        (m.has_etat_factor() && !(m.etat_factor() >= 0))) {
+      return bad("material " + std::to_string(m.id()) + " ('" + m.name() +
+                 "') needs density > 0, k_n > 0, 0 < e_n <= 1, friction >= 0, kt_factor > 0, "
+                 "etat_factor >= 0");
+    }
+  }
+  if (c.initial_state_file().empty()) {
+    for (int i = 0; i < c.particle_sets_size(); ++i) {
+      const auto& p = c.particle_sets(i);
+      std::string which = "particle_sets[" + std::to_string(i) + "]";
+      if (!materialIds.count(p.material_id())) {
+        return bad(which + " refers to material " + std::to_string(p.material_id()) +
+                   ", which is not among materials");
+      }
+      if (p.count() == 0 || !(p.diameter() > 0) || p.density() < 0 || !(p.temperature() > 0)) {
+        return bad(which + " needs count >= 1, diameter > 0, density >= 0 (0 = material's) "
+                           "and temperature > 0 K");
+      }
+      if (!(p.region_min().x() < p.region_max().x() && p.region_min().y() < p.region_max().y() &&
+            p.region_min().z() < p.region_max().z())) {
+        return bad(which + " region_min must be below region_max on every axis");
+      }
+      if (p.packing() == v1::PACKING_UNSPECIFIED) {
+        return bad(which + " packing must be LATTICE or RANDOM");
+      }
+      if (p.composition_size() > 0) {
+        double sum = 0;
+        for (const auto& nv : p.composition()) {
+          if (!(nv.value() >= 0)) {
+            return bad(which + " composition '" + nv.name() + "' is negative");
+          }
+          sum += nv.value();
+        }
+        if (std::abs(sum - 1.0) > 1e-9) {
+          return bad(which + " composition mass fractions sum to " + std::to_string(sum) +
+                     "; they must sum to 1 (tolerance 1e-9)");
+        }
+      }
+    }
+  }
+  if (c.walls().has_box()) {
+    const auto& b = c.walls().box();
+    if (!(b.min().x() < b.max().x() && b.min().y() < b.max().y() && b.min().z() < b.max().z())) {
+      return bad("walls.box min must be below max on every axis");
+    }
+  }
+  for (const auto& p : c.walls().planes()) {
+    const auto& n = p.normal();
+    if (n.x() == 0 && n.y() == 0 && n.z() == 0) {
+      return bad("a wall plane has a zero normal");
+    }
+  }
+  return {};
+}
+
+} // namespace coredem::protocol
