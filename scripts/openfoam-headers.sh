@@ -166,6 +166,10 @@ if ! timeout 600 apt-get -q update >"$apt_dir/update.log" 2>&1; then
   say "warning: apt-get update reported errors (see $apt_dir/update.log); trying the download anyway"
 fi
 t_update=$(($(date +%s) - t0))
+if ! compgen -G "$apt_dir/lists/*_Sources*" >/dev/null; then
+  grep -E '^(W|E):' "$apt_dir/update.log" | head -n 5 >&2 || true
+  die 3 "could not fetch any source index from the system's apt sources (no network, a proxy that is not configured, or the Debian mirror is unreachable). Log: $apt_dir/update.log. Without network, configure with -DCOREDEM_OPENFOAM=OFF."
+fi
 
 # --- 3. Download the source package of exactly the installed version ---------------------------
 dl_dir="$cache_dir/download"
