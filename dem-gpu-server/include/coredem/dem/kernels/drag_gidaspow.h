@@ -41,8 +41,8 @@ DEM_HD double gidaspowBeta(double eps, double rhoG, double muG, double dp, doubl
   }
   const double re = reynoldsParticle(eps, rhoG, dp, slip, muG);
   if (re <= 0.0) {
-    // lim Re→0 of C_D·Re·μ/(ε ρ d) = 24 μ_g/(ε d_p): Stokes limit, finite at zero slip.
-    return 0.75 * 24.0 * muG / (eps * dp) * s * ::pow(eps, -2.65) / dp;
+    // Re → 0: C_D ρ_g |Δu| → 24 μ_g/(ε d_p), so β → 18 μ_g (1−ε) ε^−2.65 / d_p² (finite).
+    return 18.0 * muG * s * ::pow(eps, -2.65) / (dp * dp);
   }
   return 0.75 * dragCoefficientWenYu(re) * eps * s * rhoG * slip * ::pow(eps, -2.65) / dp;
 }
@@ -59,7 +59,7 @@ DEM_HD double gidaspowParticleCoefficient(const GidaspowParams& p, double epsCel
     betaOverS = 150.0 * s * muG / (eps * dp * dp) + 1.75 * rhoG * slip / dp;
   } else {
     const double re = reynoldsParticle(eps, rhoG, dp, slip, muG);
-    betaOverS = re <= 0.0 ? 0.75 * 24.0 * muG / (eps * dp) * ::pow(eps, -2.65) / dp
+    betaOverS = re <= 0.0 ? 18.0 * muG * ::pow(eps, -2.65) / (dp * dp)
                           : 0.75 * dragCoefficientWenYu(re) * eps * rhoG * slip *
                                 ::pow(eps, -2.65) / dp;
   }
