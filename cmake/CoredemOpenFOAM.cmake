@@ -46,20 +46,25 @@ set(_coredem_openfoam_inc_DPMTurbulenceModels
     TurbulenceModels/turbulenceModels/lnInclude TurbulenceModels/incompressible/lnInclude
     TurbulenceModels/phaseIncompressible/lnInclude)
 
+# Ends _coredem_openfoam_resolve with <out_why> = the concatenated message.
+macro(_coredem_openfoam_fail)
+  string(CONCAT _coredem_openfoam_msg ${ARGN})
+  set(${out_why} "${_coredem_openfoam_msg}" PARENT_SCOPE)
+  return()
+endmacro()
+
 # Sets <out_ok> TRUE and defines the target when everything is there; otherwise <out_why>
 # says what is missing and what to do.
 function(_coredem_openfoam_resolve out_ok out_why)
   set(${out_ok} FALSE PARENT_SCOPE)
   find_program(_dpkg_query dpkg-query NO_CACHE)
   if(NOT _dpkg_query)
-    set(${out_why} "dpkg-query not found: the OpenFOAM participant needs Debian's openfoam package" PARENT_SCOPE)
-    return()
+    _coredem_openfoam_fail("dpkg-query not found: the OpenFOAM participant needs Debian's openfoam package")
   endif()
   execute_process(COMMAND ${_dpkg_query} -W "-f=\${Status}|\${Version}|\${source:Version}" openfoam
                   OUTPUT_VARIABLE _q RESULT_VARIABLE _rc ERROR_QUIET)
   if(NOT _rc EQUAL 0 OR NOT _q MATCHES "install ok installed")
-    set(${out_why} "Debian's openfoam package is not installed (scripts/install-deps.sh installs it)" PARENT_SCOPE)
-    return()
+    _coredem_openfoam_fail("Debian's openfoam package is not installed (scripts/install-deps.sh installs it)")
   endif()
   string(REPLACE "|" ";" _q "${_q}")
   list(GET _q 1 _bin_version)
@@ -70,15 +75,13 @@ function(_coredem_openfoam_resolve out_ok out_why)
     find_library(COREDEM_OPENFOAM_LIB_${lib} NAMES ${lib} PATHS ${COREDEM_OPENFOAM_LIBDIR}
                  NO_DEFAULT_PATH)
     if(NOT COREDEM_OPENFOAM_LIB_${lib})
-      set(${out_why} "lib${lib}.so not found in ${COREDEM_OPENFOAM_LIBDIR} although openfoam "
-                     "${_bin_version} is installed (apt-get install --reinstall libopenfoam)" PARENT_SCOPE)
-      return()
+      _coredem_openfoam_fail("lib${lib}.so not found in ${COREDEM_OPENFOAM_LIBDIR} although openfoam "
+                     "${_bin_version} is installed (apt-get install --reinstall libopenfoam)")
     endif()
   endforeach()
   if(NOT EXISTS ${COREDEM_OPENFOAM_PROJECT_DIR}/etc/controlDict)
-    set(${out_why} "${COREDEM_OPENFOAM_PROJECT_DIR}/etc/controlDict is missing: OpenFOAM "
-                   "applications cannot run without the etc tree (set COREDEM_OPENFOAM_PROJECT_DIR)" PARENT_SCOPE)
-    return()
+    _coredem_openfoam_fail("${COREDEM_OPENFOAM_PROJECT_DIR}/etc/controlDict is missing: OpenFOAM "
+                   "applications cannot run without the etc tree (set COREDEM_OPENFOAM_PROJECT_DIR)")
   endif()
   find_program(COREDEM_OPENFOAM_BLOCKMESH blockMesh PATHS /usr/bin)
   if(COREDEM_OPENFOAM_BLOCKMESH)
@@ -102,13 +105,13 @@ function(_coredem_openfoam_resolve out_ok out_why)
   if(_fresh)
     message(STATUS "OpenFOAM ${_src_version} headers: ${_dir} (stamp present)")
   else()
-    message(STATUS "OpenFOAM ${_src_version} headers: preparing ${_dir} (download ~45 MB, ~1 min)")
+    message(STATUS "OpenFOAM ${_src_version} headers: scripts/openfoam-headers.sh ${_dir} "
+                   "(the first time downloads ~45 MB and takes under a minute)")
     execute_process(COMMAND bash ${_coredem_openfoam_script} ${_dir}
                     RESULT_VARIABLE _rc TIMEOUT 1800)
     if(NOT _rc EQUAL 0)
-      set(${out_why} "scripts/openfoam-headers.sh ${_dir} failed (exit ${_rc}; its message is "
-                     "above)" PARENT_SCOPE)
-      return()
+      _coredem_openfoam_fail("scripts/openfoam-headers.sh ${_dir} failed (exit ${_rc}, see its message "
+                     "above)")
     endif()
   endif()
 
@@ -116,8 +119,7 @@ function(_coredem_openfoam_resolve out_ok out_why)
   set(_incs)
   foreach(inc ${_coredem_openfoam_core_includes})
     if(NOT IS_DIRECTORY ${_src}/${inc})
-      set(${out_why} "${_src}/${inc} is missing; delete ${_stamp} and configure again" PARENT_SCOPE)
-      return()
+      _coredem_openfoam_fail("${_src}/${inc} is missing; delete ${_stamp} and configure again")
     endif()
     list(APPEND _incs ${_src}/${inc})
   endforeach()
