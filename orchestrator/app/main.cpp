@@ -1,0 +1,101 @@
+// coredem: the CoReDEM orchestrator CLI (docs/orchestrator.md).
+//   coredem run CASE_DIR [--out RUN_DIR] [--auto-restart N] [--stop-after STEP]
+//   coredem resume RUN_DIR [--auto-restart N] [--stop-after STEP]
+//   coredem inspect FILE
+//   coredem check CASE_DIR
+#include <coredem/common/log.h>
+#include <coredem/orchestrator/case_config.h>
+#include <coredem/orchestrator/outputs.h>
+#include <coredem/orchestrator/session.h>
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <unistd.h>
+
+using namespace coredem::orchestrator;
+namespace fs = std::filesystem;
+
+int main(int argc, char** argv) {
+  CLI::App app{"coredem: orchestrates a coupled CFD-DEM run (DEM server + CFD participant)"};
+  app.set_version_flag("--version", std::string("coredem ") + COREDEM_SOFTWARE_VERSION);
+  app.require_subcommand(1);
+
+  std::string caseDir, out, runDir, file;
+  int autoRestart = 0;
+  std::int64_t stopAfter = -1;
+
+  auto* run = app.add_subcommand("run", "validate CASE_DIR/case.yaml and run it");
+  run->add_option("CASE_DIR", caseDir, "case folder with case.yaml (or a case file)")->required();
+  run->add_option("--out", out, "run folder (default runs/<name>, timestamped if it exists)");
+  run->add_option("--auto-restart", autoRestart,
+                  "after a participant fault, relaunch and resume from the last checkpoint up "
+                  "to N times")
+      ->check(CLI::NonNegativeNumber);
+  run->add_option("--stop-after", stopAfter,
+                  "stop after this step with a checkpoint (continue with coredem resume)");
+
+  auto* resume = app.add_subcommand("resume", "continue a run from its latest complete checkpoint");
+  resume->add_option("RUN_DIR", runDir, "run folder created by coredem run")->required();
+  resume->add_option("--auto-restart", autoRestart, "as for run")->check(CLI::NonNegativeNumber);
+  resume->add_option("--stop-after", stopAfter, "as for run");
+
+  auto* inspect = app.add_subcommand("inspect", "summarise a snapshot/state HDF5 file or a checkpoint");
+  inspect->add_option("FILE", file, "HDF5 file, manifest.json or checkpoint folder")->required();
+
+  auto* check = app.add_subcommand("check", "validate a case file and exit (0 valid, 2 invalid)");
+  check->add_option("CASE_DIR", caseDir, "case folder with case.yaml (or a case file)")->required();
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : kExitBadInput;
+  }
+
+  auto log = coredem::logger("orchestrator");
+  try {
+    if (*inspect) {
+      std::cout << inspectSummary(file);
+      return kExitOk;
+    }
+    if (*check) {
+      const CaseConfig c = loadCase(caseDir);
+      checkParticipantInput(c);
+      std::cout << c.caseFile.string() << ": valid\n";
+      return kExitOk;
+    }
+    RunOptions opts;
+    opts.autoRestart = autoRestart;
+    if (stopAfter >= 0) {
+      opts.stopAfterStep = stopAfter;
+    }
+    opts.tty = ::isatty(STDERR_FILENO) != 0;
+    CaseConfig config;
+    if (*run) {
+      config = loadCase(caseDir);      // throws CaseError: nothing written yet
+      checkParticipantInput(config);   // the gas section, by the participant itself
+      opts.runDir = prepareRunDir(config, out.empty() ? std::nullopt : std::optional<fs::path>(out));
+      log->info("run folder {}", opts.runDir.string());
+    } else {
+      opts.runDir = fs::absolute(runDir);
+      config = loadRunCase(opts.runDir);
+      opts.resume = true;
+    }
+    const int rc = runSession(config, opts);
+    if (rc == kExitOk) {
+      std::printf("results: %s (timeseries.csv, particles.xdmf, checkpoints/)\n",
+                  opts.runDir.string().c_str());
+    }
+    return rc;
+  } catch (const CaseError& e) {
+    log->error("{}", e.what());
+    return kExitBadInput;
+  } catch (const coredem::UserError& e) {
+    log->error("{}", e.what());
+    return kExitFault;
+  } catch (const std::exception& e) {
+    log->error("internal error: {}", e.what());
+    return kExitFault;
+  }
+}

@@ -1,0 +1,135 @@
+#pragma once
+/// @file
+/// The case file `case.yaml` (docs/case-schema.md): loading, validation against the schema,
+/// and the parsed configuration. Every error names the file, line, key and what is allowed,
+/// and is thrown as CaseError (exit code 2 in the CLI).
+
+#include <coredem/common/check.h>
+#include <coredem/orchestrator/time_handler.h>
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace coredem::orchestrator {
+
+/// A case file that does not follow the schema (or a file it names that is missing).
+class CaseError : public UserError {
+public:
+  using UserError::UserError;
+};
+
+using Vec3 = std::array<double, 3>;
+
+struct GridConfig {
+  Vec3 origin{};
+  Vec3 spacing{};
+  std::array<std::uint64_t, 3> cells{};
+};
+
+struct SpeciesConfig {
+  std::string name;
+  double molarMass = 0.0; ///< kg/mol
+};
+
+struct GasPropertiesConfig {
+  double density = 1.204, viscosity = 1.81e-5, conductivity = 0.0257, cp = 1005.0,
+         temperature = 293.15, pressure = 101325.0;
+};
+
+struct MaterialConfig {
+  std::string name;
+  double density = 0.0, kN = 0.0, eN = 0.0, friction = 0.0;
+  std::optional<double> ktFactor, etatFactor;
+  double cp = 0.0, conductivity = 0.0, emissivity = 0.0;
+};
+
+struct ParticleSetConfig {
+  std::string name;
+  std::string material;
+  std::uint64_t count = 0;
+  double diameter = 0.0, density = 0.0, temperature = 293.15;
+  std::vector<std::pair<std::string, double>> composition;
+  std::string packing = "lattice";
+  Vec3 regionMin{}, regionMax{};
+  std::uint64_t seed = 1;
+  Vec3 velocity{};
+};
+
+struct PlaneConfig {
+  Vec3 point{}, normal{};
+};
+
+struct WallsConfig {
+  std::optional<std::pair<Vec3, Vec3>> box;
+  std::vector<PlaneConfig> planes;
+  std::string material;
+  double temperature = 0.0;
+};
+
+struct DemConfig {
+  std::string endpoint;        ///< empty: coredem starts coredem-dem itself
+  std::string backend = "cpu";
+  int threads = 0;             ///< 0: let the server choose
+  double timeoutSeconds = 60;  ///< deadline of every request to D
+};
+
+struct CfdConfig {
+  std::string participant = "coredem-gas";
+  std::string gasKey = "gas";  ///< key of the coredem-gas section
+  double timeoutSeconds = 60;  ///< deadline for C's next StepDone
+};
+
+struct CheckpointConfig {
+  std::int64_t everySteps = 0;  ///< 0 = off
+  double everySeconds = 0.0;    ///< wall-clock seconds, 0 = off
+  int keep = 3;
+};
+
+struct OutputConfig {
+  std::int64_t snapshotEvery = 0;   ///< steps between particle snapshots, 0 = none
+  std::int64_t timeseriesEvery = 1; ///< steps between timeseries rows
+};
+
+/// A validated case.
+struct CaseConfig {
+  std::filesystem::path caseDir;   ///< absolute
+  std::filesystem::path caseFile;  ///< absolute path of case.yaml
+  std::string text;                ///< the case file's bytes (hashed into the config hash)
+  std::string configHash;          ///< SHA-256 of text
+
+  std::string name;
+  std::string description;
+  double endTime = 0.0;
+  DtPolicyConfig dt;
+  GridConfig grid;
+  Vec3 gravity{0.0, 0.0, -9.81};
+  std::vector<SpeciesConfig> species;
+  GasPropertiesConfig gasProperties;
+  std::vector<MaterialConfig> materials;
+  std::vector<ParticleSetConfig> particles;
+  std::filesystem::path initialState; ///< absolute, empty when particle sets are used
+  WallsConfig walls;
+  std::vector<std::pair<std::string, std::string>> models;
+  DemConfig dem;
+  CfdConfig cfd;
+  CheckpointConfig checkpoint;
+  OutputConfig output;
+  bool hasGasSection = false;
+};
+
+/// Loads and validates CASE_DIR/case.yaml (or a file path). Throws CaseError.
+CaseConfig loadCase(const std::filesystem::path& caseDirOrFile);
+
+/// Parses case text as if read from `file` (relative paths resolve against `caseDir`).
+CaseConfig parseCase(const std::string& text, const std::filesystem::path& file,
+                     const std::filesystem::path& caseDir);
+
+/// Index of a material by name, or -1.
+int materialIndex(const CaseConfig& config, const std::string& name);
+
+} // namespace coredem::orchestrator

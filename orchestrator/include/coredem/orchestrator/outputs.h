@@ -1,0 +1,64 @@
+#pragma once
+/// @file
+/// Run outputs (DESIGN §6): timeseries.csv, particle snapshots indexed by an XDMF file that
+/// ParaView opens, and the summary printed by `coredem inspect`.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace coredem::orchestrator {
+
+/// Appends one row per reported step to a CSV file. The columns are fixed by the first row
+/// (or read back from an existing file on resume); values of unknown names are dropped,
+/// missing ones are written empty. Each row is written with one write() and flushed.
+class TimeseriesWriter {
+public:
+  /// Opens `path`. With `resumeAfterStep >= 0` an existing file is kept up to and including
+  /// that step (later rows, written after the checkpoint, are removed) and appended to.
+  explicit TimeseriesWriter(std::filesystem::path path, std::int64_t resumeAfterStep = -1);
+  ~TimeseriesWriter();
+
+  /// Writes a row; the first call (on a new file) fixes the columns in the given order.
+  void write(const std::vector<std::pair<std::string, double>>& row);
+  const std::vector<std::string>& columns() const { return _columns; }
+
+private:
+  std::filesystem::path _path;
+  std::vector<std::string> _columns;
+  int _fd = -1;
+};
+
+/// One dataset of an HDF5 file.
+struct DatasetInfo {
+  std::string path;                 ///< e.g. "/particles/position"
+  std::vector<std::uint64_t> dims;
+  std::string type;                 ///< "float64", "int64", "string", ...
+  bool numeric = false;
+  double min = 0, max = 0, mean = 0; ///< for numeric datasets
+};
+
+struct AttributeInfo {
+  std::string path;  ///< object path + "@" + name, e.g. "/meta@time"
+  std::string value; ///< as text
+};
+
+/// Every dataset (recursively) and attribute of an HDF5 file, with statistics.
+/// Throws UserError if the file cannot be opened as HDF5.
+void scanHdf5(const std::filesystem::path& file, std::vector<DatasetInfo>& datasets,
+              std::vector<AttributeInfo>& attributes, bool statistics = true);
+
+/// Writes `xdmfPath` (atomically) describing the particle snapshots `snapshots` (paths
+/// relative to the XDMF's folder, with their times) as a temporal collection of
+/// poly-vertex grids: geometry from /particles/position (N×3), and every other /particles
+/// dataset with N rows as a node attribute (Scalar for [N], Vector for [N,3]).
+void writeParticleXdmf(const std::filesystem::path& xdmfPath,
+                       const std::vector<std::pair<double, std::string>>& snapshots);
+
+/// `coredem inspect FILE`: a readable summary of an HDF5 state/snapshot, a manifest.json
+/// or a checkpoint folder (with hash verification).
+std::string inspectSummary(const std::filesystem::path& file);
+
+} // namespace coredem::orchestrator

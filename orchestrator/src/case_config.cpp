@@ -1,0 +1,532 @@
+#include <coredem/orchestrator/case_config.h>
+
+#include <coredem/orchestrator/sha256.h>
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace coredem::orchestrator {
+namespace {
+
+std::string join(const std::vector<std::string>& items) {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    out += (i ? ", " : "") + items[i];
+  }
+  return out;
+}
+
+std::string describe(const YAML::Node& n) {
+  switch (n.Type()) {
+  case YAML::NodeType::Null: return "nothing (null)";
+  case YAML::NodeType::Sequence: return "a list";
+  case YAML::NodeType::Map: return "a mapping";
+  case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
+  default: return "an undefined value";
+  }
+}
+
+/// A mapping of the case file with the keys it allows. Every accessor checks type and range
+/// and throws CaseError with "file:line:col: key: problem; allowed".
+class Section {
+public:
+  Section(YAML::Node node, std::string file, std::string path, std::vector<std::string> allowed,
+          const YAML::Mark& parentMark)
+      : _node(std::move(node)), _file(std::move(file)), _path(std::move(path)),
+        _allowed(std::move(allowed)) {
+    const YAML::Mark mark = _node.IsDefined() && !_node.IsNull() ? _node.Mark() : parentMark;
+    if (!_node.IsMap()) {
+      fail(mark, _path.empty() ? "the case file" : _path,
+           fmt::format("expected a mapping with keys {}, got {}", join(_allowed),
+                       describe(_node)));
+    }
+    for (const auto& kv : _node) {
+      const std::string key = kv.first.Scalar();
+      if (std::find(_allowed.begin(), _allowed.end(), key) == _allowed.end()) {
+        fail(kv.first.Mark(), full(key),
+             fmt::format("unknown key; allowed keys {}: {}",
+                         _path.empty() ? "at the top level" : "in '" + _path + "'",
+                         join(_allowed)));
+      }
+    }
+  }
+
+  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& key,
+                         const std::string& what) const {
+    if (mark.line >= 0) {
+      throw CaseError(
+          fmt::format("{}:{}:{}: {}: {}", _file, mark.line + 1, mark.column + 1, key, what));
+    }
+    throw CaseError(fmt::format("{}: {}: {}", _file, key, what));
+  }
+
+  std::string full(const std::string& key) const { return _path.empty() ? key : _path + "." + key; }
+  bool has(const std::string& key) const { return bool(_node[key]); }
+  YAML::Node raw(const std::string& key) const { return _node[key]; }
+  YAML::Mark mark() const { return _node.Mark(); }
+  YAML::Mark markOf(const std::string& key) const {
+    for (const auto& kv : _node) {
+      if (kv.first.Scalar() == key) {
+        return kv.second.IsNull() ? kv.first.Mark() : kv.second.Mark();
+      }
+    }
+    return _node.Mark();
+  }
+  const std::string& file() const { return _file; }
+
+  void require(const std::string& key, const std::string& what) const {
+    if (!has(key)) {
+      fail(_node.Mark(), _path.empty() ? "the case file" : _path,
+           fmt::format("missing required key '{}' ({})", key, what));
+    }
+  }
+
+  double number(const std::string& key, std::optional<double> def, double lo, double hi,
+                const std::string& what, bool loOpen = false) const {
+    if (!has(key)) {
+      if (!def) {
+        require(key, what);
+      }
+      return *def;
+    }
+    return numberOf(_node[key], full(key), lo, hi, what, loOpen);
+  }
+
+  double numberOf(const YAML::Node& n, const std::string& key, double lo, double hi,
+                  const std::string& what, bool loOpen = false) const {
+    double v = 0.0;
+    bool ok = n.IsScalar();
+    if (ok) {
+      try {
+        v = n.as<double>();
+      } catch (const YAML::Exception&) {
+        ok = false;
+      }
+    }
+    if (!ok || !std::isfinite(v)) {
+      fail(n.Mark(), key, fmt::format("expected a number ({}), got {}", what, describe(n)));
+    }
+    if (v < lo || v > hi || (loOpen && v == lo)) {
+      fail(n.Mark(), key,
+           fmt::format("{} is out of range; allowed: {} ({})", v, rangeText(lo, hi, loOpen), what));
+    }
+    return v;
+  }
+
+  std::int64_t integer(const std::string& key, std::optional<std::int64_t> def, std::int64_t lo,
+                       std::int64_t hi, const std::string& what) const {
+    if (!has(key)) {
+      if (!def) {
+        require(key, what);
+      }
+      return *def;
+    }
+    const YAML::Node n = _node[key];
+    std::int64_t v = 0;
+    bool ok = n.IsScalar();
+    if (ok) {
+      try {
+        v = n.as<std::int64_t>();
+      } catch (const YAML::Exception&) {
+        ok = false;
+      }
+    }
+    if (!ok) {
+      fail(n.Mark(), full(key), fmt::format("expected an integer ({}), got {}", what, describe(n)));
+    }
+    if (v < lo || v > hi) {
+      fail(n.Mark(), full(key),
+           fmt::format("{} is out of range; allowed: {} to {} ({})", v, lo, hi, what));
+    }
+    return v;
+  }
+
+  std::string string(const std::string& key, std::optional<std::string> def,
+                     const std::string& what) const {
+    if (!has(key)) {
+      if (!def) {
+        require(key, what);
+      }
+      return *def;
+    }
+    const YAML::Node n = _node[key];
+    if (!n.IsScalar()) {
+      fail(n.Mark(), full(key), fmt::format("expected a string ({}), got {}", what, describe(n)));
+    }
+    return n.Scalar();
+  }
+
+  std::string choice(const std::string& key, std::optional<std::string> def,
+                     const std::vector<std::string>& options) const {
+    const std::string v = string(key, def, "one of " + join(options));
+    if (std::find(options.begin(), options.end(), v) == options.end()) {
+      fail(markOf(key), full(key), fmt::format("'{}' is not allowed; allowed: {}", v, join(options)));
+    }
+    return v;
+  }
+
+  Vec3 vec3(const std::string& key, std::optional<Vec3> def, const std::string& what,
+            double lo = -std::numeric_limits<double>::max(),
+            double hi = std::numeric_limits<double>::max(), bool loOpen = false) const {
+    if (!has(key)) {
+      if (!def) {
+        require(key, what);
+      }
+      return *def;
+    }
+    const YAML::Node n = _node[key];
+    if (!n.IsSequence() || n.size() != 3) {
+      fail(n.Mark(), full(key),
+           fmt::format("expected a list of 3 numbers [x, y, z] ({}), got {}", what, describe(n)));
+    }
+    Vec3 v{};
+    for (std::size_t i = 0; i < 3; ++i) {
+      v[i] = numberOf(n[i], fmt::format("{}[{}]", full(key), i), lo, hi, what, loOpen);
+    }
+    return v;
+  }
+
+  Section section(const std::string& key, std::vector<std::string> allowed) const {
+    return Section(_node[key], _file, full(key), std::move(allowed), markOf(key));
+  }
+
+  std::vector<Section> list(const std::string& key, std::vector<std::string> allowed,
+                            const std::string& what) const {
+    const YAML::Node n = _node[key];
+    if (!n.IsSequence()) {
+      fail(markOf(key), full(key), fmt::format("expected a list ({}), got {}", what, describe(n)));
+    }
+    std::vector<Section> out;
+    for (std::size_t i = 0; i < n.size(); ++i) {
+      out.emplace_back(n[i], _file, fmt::format("{}[{}]", full(key), i), allowed, n.Mark());
+    }
+    return out;
+  }
+
+private:
+  static std::string rangeText(double lo, double hi, bool loOpen) {
+    const double big = std::numeric_limits<double>::max();
+    if (hi == big && lo == -big) {
+      return "any finite number";
+    }
+    if (hi == big) {
+      return fmt::format("{} {}", loOpen ? ">" : ">=", lo);
+    }
+    return fmt::format("{} {} and <= {}", loOpen ? ">" : ">=", lo, hi);
+  }
+
+  YAML::Node _node;
+  std::string _file;
+  std::string _path;
+  std::vector<std::string> _allowed;
+};
+
+constexpr double kBig = std::numeric_limits<double>::max();
+
+} // namespace
+
+int materialIndex(const CaseConfig& config, const std::string& name) {
+  for (std::size_t i = 0; i < config.materials.size(); ++i) {
+    if (config.materials[i].name == name) {
+      return int(i);
+    }
+  }
+  return -1;
+}
+
+CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::path& caseDir) {
+  const std::string fileName = file.string();
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", fileName, e.mark.line + 1,
+                                e.mark.column + 1, e.msg));
+  }
+  CaseConfig c;
+  c.caseDir = caseDir;
+  c.caseFile = fs::absolute(file);
+  c.text = text;
+  c.configHash = sha256Hex(text);
+
+  const Section top(root, fileName, "",
+                    {"name", "description", "time", "grid", "gravity", "species",
+                     "gas_properties", "materials", "particles", "initial_state", "walls",
+                     "models", "dem", "cfd", "gas", "checkpoint", "output"},
+                    YAML::Mark());
+  c.name = top.string("name", std::nullopt, "the case name, used for the run folder");
+  if (c.name.empty() || c.name.find('/') != std::string::npos) {
+    top.fail(top.markOf("name"), "name", "must be a non-empty name without '/'");
+  }
+  c.description = top.string("description", std::string(), "free text");
+
+  // time
+  top.require("time", "end time and time step");
+  {
+    const Section t = top.section("time", {"end", "dt", "adaptive"});
+    c.endTime = t.number("end", std::nullopt, 0.0, kBig, "simulated end time in s, > 0", true);
+    c.dt.dt = t.number("dt", std::nullopt, 0.0, kBig,
+                       "CFD time step in s, > 0 (the first step when adaptive)", true);
+    if (t.has("adaptive")) {
+      const Section a = t.section("adaptive", {"courant", "dt_min", "dt_max", "max_growth"});
+      c.dt.kind = DtPolicyConfig::Kind::Courant;
+      c.dt.courant = a.number("courant", std::nullopt, 0.0, 100.0, "target Courant number", true);
+      c.dt.dtMin = a.number("dt_min", std::nullopt, 0.0, kBig, "smallest CFD step in s", true);
+      c.dt.dtMax = a.number("dt_max", std::nullopt, 0.0, kBig, "largest CFD step in s", true);
+      c.dt.maxGrowth = a.number("max_growth", 1.2, 1.0, 10.0, "largest step-to-step growth factor");
+      if (c.dt.dtMin > c.dt.dtMax) {
+        a.fail(a.markOf("dt_min"), "time.adaptive.dt_min",
+               fmt::format("{} is larger than dt_max = {}; need dt_min <= dt_max", c.dt.dtMin,
+                           c.dt.dtMax));
+      }
+      if (c.dt.dt < c.dt.dtMin || c.dt.dt > c.dt.dtMax) {
+        t.fail(t.markOf("dt"), "time.dt",
+               fmt::format("{} must lie in [dt_min, dt_max] = [{}, {}] when adaptive", c.dt.dt,
+                           c.dt.dtMin, c.dt.dtMax));
+      }
+    }
+  }
+
+  // coupling grid
+  top.require("grid", "the coupling grid");
+  {
+    const Section g = top.section("grid", {"origin", "spacing", "cells"});
+    c.grid.origin = g.vec3("origin", Vec3{0, 0, 0}, "m, lower corner");
+    c.grid.spacing = g.vec3("spacing", std::nullopt, "cell size in m, > 0", 0.0, kBig, true);
+    const Vec3 cells = g.vec3("cells", std::nullopt, "cells per axis, integers >= 1", 1.0, 1e6);
+    for (int i = 0; i < 3; ++i) {
+      if (cells[i] != std::floor(cells[i])) {
+        g.fail(g.markOf("cells"), "grid.cells", "cell counts must be integers >= 1");
+      }
+      c.grid.cells[i] = std::uint64_t(cells[i]);
+    }
+  }
+  c.gravity = top.vec3("gravity", Vec3{0.0, 0.0, -9.81}, "m/s2");
+
+  if (top.has("species")) {
+    std::set<std::string> seen;
+    for (const auto& s : top.list("species", {"name", "molar_mass"}, "gas species")) {
+      SpeciesConfig sp;
+      sp.name = s.string("name", std::nullopt, "species name, e.g. CO2");
+      sp.molarMass = s.number("molar_mass", std::nullopt, 0.0, kBig, "kg/mol, > 0", true);
+      if (!seen.insert(sp.name).second) {
+        s.fail(s.markOf("name"), "species", fmt::format("species '{}' is listed twice", sp.name));
+      }
+      c.species.push_back(sp);
+    }
+  }
+
+  if (top.has("gas_properties")) {
+    const Section g = top.section("gas_properties", {"density", "viscosity", "conductivity",
+                                                      "cp", "temperature", "pressure"});
+    auto& p = c.gasProperties;
+    p.density = g.number("density", p.density, 0.0, kBig, "kg/m3, > 0", true);
+    p.viscosity = g.number("viscosity", p.viscosity, 0.0, kBig, "Pa s, > 0", true);
+    p.conductivity = g.number("conductivity", p.conductivity, 0.0, kBig, "W/m/K, > 0", true);
+    p.cp = g.number("cp", p.cp, 0.0, kBig, "J/kg/K, > 0", true);
+    p.temperature = g.number("temperature", p.temperature, 0.0, kBig, "K, > 0", true);
+    p.pressure = g.number("pressure", p.pressure, 0.0, kBig, "Pa, > 0", true);
+  }
+
+  top.require("materials", "a list of solid materials");
+  for (const auto& m : top.list("materials",
+                                {"name", "density", "k_n", "e_n", "friction", "kt_factor",
+                                 "etat_factor", "cp", "conductivity", "emissivity"},
+                                "solid materials")) {
+    MaterialConfig mc;
+    mc.name = m.string("name", std::nullopt, "material name");
+    mc.density = m.number("density", std::nullopt, 0.0, kBig, "kg/m3, > 0", true);
+    mc.kN = m.number("k_n", std::nullopt, 0.0, kBig, "normal spring stiffness in N/m, > 0", true);
+    mc.eN = m.number("e_n", std::nullopt, 0.0, 1.0, "normal restitution coefficient in (0, 1]", true);
+    mc.friction = m.number("friction", 0.3, 0.0, kBig, "Coulomb friction coefficient, >= 0");
+    if (m.has("kt_factor")) {
+      mc.ktFactor = m.number("kt_factor", std::nullopt, 0.0, kBig, "k_t/k_n (default 2/7)", true);
+    }
+    if (m.has("etat_factor")) {
+      mc.etatFactor = m.number("etat_factor", std::nullopt, 0.0, kBig, "eta_t/eta_n (default 1/2)");
+    }
+    mc.cp = m.number("cp", 840.0, 0.0, kBig, "specific heat in J/kg/K, > 0", true);
+    mc.conductivity = m.number("conductivity", 1.0, 0.0, kBig, "W/m/K, > 0", true);
+    mc.emissivity = m.number("emissivity", 0.0, 0.0, 1.0, "emissivity in [0, 1]");
+    if (materialIndex(c, mc.name) >= 0) {
+      m.fail(m.markOf("name"), "materials", fmt::format("material '{}' is defined twice", mc.name));
+    }
+    c.materials.push_back(mc);
+  }
+  if (c.materials.empty()) {
+    top.fail(top.markOf("materials"), "materials", "needs at least one material");
+  }
+
+  if (top.has("initial_state")) {
+    const std::string rel = top.string("initial_state", std::nullopt,
+                                       "HDF5 state file, relative to the case folder");
+    c.initialState = fs::absolute(caseDir / rel);
+    if (!fs::is_regular_file(c.initialState)) {
+      top.fail(top.markOf("initial_state"), "initial_state",
+               fmt::format("file '{}' not found (looked for {}); give an HDF5 state file relative "
+                           "to the case folder",
+                           rel, c.initialState.string()));
+    }
+  }
+  if (top.has("particles")) {
+    for (const auto& p : top.list("particles",
+                                  {"name", "material", "count", "diameter", "density",
+                                   "temperature", "composition", "packing", "region", "seed",
+                                   "velocity"},
+                                  "particle sets")) {
+      ParticleSetConfig ps;
+      ps.name = p.string("name", std::string("set") + std::to_string(c.particles.size()),
+                         "label for outputs");
+      ps.material = p.string("material", std::nullopt, "name of a material in 'materials'");
+      if (materialIndex(c, ps.material) < 0) {
+        std::vector<std::string> names;
+        for (const auto& m : c.materials) {
+          names.push_back(m.name);
+        }
+        p.fail(p.markOf("material"), p.full("material"),
+               fmt::format("unknown material '{}'; allowed: {}", ps.material, join(names)));
+      }
+      ps.count = std::uint64_t(p.integer("count", std::nullopt, 1, 100000000, "number of particles"));
+      ps.diameter = p.number("diameter", std::nullopt, 0.0, kBig, "m, > 0", true);
+      ps.density = p.number("density", 0.0, 0.0, kBig, "kg/m3 (0 = the material's)");
+      ps.temperature = p.number("temperature", 293.15, 0.0, kBig, "initial temperature in K", true);
+      if (p.has("composition")) {
+        const YAML::Node comp = p.raw("composition");
+        if (!comp.IsMap()) {
+          p.fail(p.markOf("composition"), p.full("composition"),
+                 "expected a mapping species -> mass fraction, e.g. {Fe2O3: 1.0}");
+        }
+        double sum = 0.0;
+        for (const auto& kv : comp) {
+          const double f = p.numberOf(kv.second, p.full("composition." + kv.first.Scalar()), 0.0,
+                                      1.0, "mass fraction in [0, 1]");
+          ps.composition.emplace_back(kv.first.Scalar(), f);
+          sum += f;
+        }
+        if (std::abs(sum - 1.0) > 1e-9) {
+          p.fail(p.markOf("composition"), p.full("composition"),
+                 fmt::format("mass fractions sum to {}, must sum to 1", sum));
+        }
+      }
+      ps.packing = p.choice("packing", std::string("lattice"), {"lattice", "random"});
+      p.require("region", "box {min: [x,y,z], max: [x,y,z]} in m to fill");
+      const Section r = p.section("region", {"min", "max"});
+      ps.regionMin = r.vec3("min", std::nullopt, "m");
+      ps.regionMax = r.vec3("max", std::nullopt, "m");
+      for (int i = 0; i < 3; ++i) {
+        if (ps.regionMax[i] <= ps.regionMin[i]) {
+          r.fail(r.markOf("max"), r.full("max"), "every component must exceed the one of 'min'");
+        }
+      }
+      ps.seed = std::uint64_t(p.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max(),
+                                        "random seed"));
+      ps.velocity = p.vec3("velocity", Vec3{0, 0, 0}, "initial velocity in m/s");
+      c.particles.push_back(ps);
+    }
+  }
+  if (c.particles.empty() && c.initialState.empty()) {
+    top.fail(top.mark(), "particles",
+             "the case needs 'particles' (a list of particle sets) or 'initial_state'");
+  }
+
+  if (top.has("walls")) {
+    const Section w = top.section("walls", {"box", "planes", "material", "temperature"});
+    if (w.has("box")) {
+      const Section b = w.section("box", {"min", "max"});
+      c.walls.box = std::make_pair(b.vec3("min", std::nullopt, "m"), b.vec3("max", std::nullopt, "m"));
+    }
+    if (w.has("planes")) {
+      for (const auto& pl : w.list("planes", {"point", "normal"}, "planar walls")) {
+        c.walls.planes.push_back({pl.vec3("point", std::nullopt, "m"),
+                                  pl.vec3("normal", std::nullopt, "into the domain")});
+      }
+    }
+    c.walls.material = w.string("material", c.materials.front().name, "material of the walls");
+    if (materialIndex(c, c.walls.material) < 0) {
+      w.fail(w.markOf("material"), "walls.material",
+             fmt::format("unknown material '{}'", c.walls.material));
+    }
+    c.walls.temperature = w.number("temperature", 0.0, 0.0, kBig, "K; 0 = adiabatic");
+  } else {
+    c.walls.material = c.materials.front().name;
+  }
+
+  if (top.has("models")) {
+    const YAML::Node m = top.raw("models");
+    if (!m.IsMap()) {
+      top.fail(top.markOf("models"), "models", "expected a mapping name -> model, e.g. {drag: gidaspow}");
+    }
+    for (const auto& kv : m) {
+      if (!kv.second.IsScalar()) {
+        top.fail(kv.second.Mark(), "models." + kv.first.Scalar(), "expected a model name");
+      }
+      c.models.emplace_back(kv.first.Scalar(), kv.second.Scalar());
+    }
+  }
+
+  if (top.has("dem")) {
+    const Section d = top.section("dem", {"endpoint", "backend", "threads", "timeout_s"});
+    c.dem.endpoint = d.string("endpoint", std::string(),
+                              "endpoint of a running coredem-dem, e.g. tcp://127.0.0.1:5555");
+    if (!c.dem.endpoint.empty() && c.dem.endpoint.rfind("tcp://", 0) != 0 &&
+        c.dem.endpoint.rfind("ipc://", 0) != 0) {
+      d.fail(d.markOf("endpoint"), "dem.endpoint", "must start with tcp:// or ipc://");
+    }
+    c.dem.backend = d.choice("backend", std::string("cpu"), {"cpu", "cuda", "auto"});
+    c.dem.threads = int(d.integer("threads", 0, 0, 4096, "OpenMP threads, 0 = default"));
+    c.dem.timeoutSeconds = d.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
+  }
+  if (top.has("cfd")) {
+    const Section f = top.section("cfd", {"participant", "gas_key", "timeout_s"});
+    c.cfd.participant = f.choice("participant", std::string("coredem-gas"), {"coredem-gas"});
+    c.cfd.gasKey = f.string("gas_key", std::string("gas"), "key of the coredem-gas section");
+    c.cfd.timeoutSeconds = f.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
+  }
+  c.hasGasSection = top.has("gas");
+
+  if (top.has("checkpoint")) {
+    const Section k = top.section("checkpoint", {"every_steps", "every_seconds", "keep"});
+    c.checkpoint.everySteps = k.integer("every_steps", 0, 0, std::numeric_limits<std::int64_t>::max(),
+                                        "steps between checkpoints, 0 = off");
+    c.checkpoint.everySeconds = k.number("every_seconds", 0.0, 0.0, kBig,
+                                         "wall-clock seconds between checkpoints, 0 = off");
+    c.checkpoint.keep = int(k.integer("keep", 3, 1, 1000000, "checkpoints to keep"));
+  }
+  if (top.has("output")) {
+    const Section o = top.section("output", {"every", "timeseries_every"});
+    c.output.snapshotEvery = o.integer("every", 0, 0, std::numeric_limits<std::int64_t>::max(),
+                                       "steps between particle snapshots, 0 = none");
+    c.output.timeseriesEvery = o.integer("timeseries_every", 1, 1,
+                                         std::numeric_limits<std::int64_t>::max(),
+                                         "steps between timeseries.csv rows");
+  }
+  return c;
+}
+
+CaseConfig loadCase(const fs::path& caseDirOrFile) {
+  fs::path file = caseDirOrFile;
+  if (fs::is_directory(file)) {
+    file /= "case.yaml";
+  }
+  if (!fs::is_regular_file(file)) {
+    throw CaseError(fmt::format("{}: case file not found; give a case folder that contains "
+                                "case.yaml (or the path of a case file)",
+                                file.string()));
+  }
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in.good() && !in.eof()) {
+    throw CaseError(fmt::format("{}: cannot read the case file", file.string()));
+  }
+  return parseCase(text.str(), file, fs::absolute(file).parent_path());
+}
+
+} // namespace coredem::orchestrator

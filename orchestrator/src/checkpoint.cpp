@@ -1,0 +1,278 @@
+#include <coredem/orchestrator/checkpoint.h>
+
+#include <coredem/common/check.h>
+#include <coredem/orchestrator/sha256.h>
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <fcntl.h>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace coredem::orchestrator {
+namespace {
+
+void fsyncPath(const fs::path& p, bool directory) {
+  const int fd = ::open(p.c_str(), directory ? (O_RDONLY | O_DIRECTORY) : O_RDONLY);
+  if (fd < 0) {
+    return; // best effort for directories on file systems that refuse O_DIRECTORY
+  }
+  ::fsync(fd);
+  ::close(fd);
+}
+
+std::string jsonEscape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+    case '"': out += "\\\""; break;
+    case '\\': out += "\\\\"; break;
+    case '\n': out += "\\n"; break;
+    case '\t': out += "\\t"; break;
+    default:
+      if (static_cast<unsigned char>(c) < 0x20) {
+        char buf[8];
+        std::snprintf(buf, sizeof buf, "\\u%04x", c);
+        out += buf;
+      } else {
+        out += c;
+      }
+    }
+  }
+  return out;
+}
+
+std::string quoted(const std::string& s) { return "\"" + jsonEscape(s) + "\""; }
+
+std::string formatDouble(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+} // namespace
+
+void writeFileAtomic(const fs::path& path, const std::string& content) {
+  const fs::path tmp = path.parent_path() / (path.filename().string() + ".tmp." +
+                                             std::to_string(::getpid()));
+  {
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    COREDEM_CHECK(fd >= 0, "cannot create '{}': {}", tmp.string(), std::strerror(errno));
+    std::size_t done = 0;
+    while (done < content.size()) {
+      const ssize_t n = ::write(fd, content.data() + done, content.size() - done);
+      if (n < 0 && errno == EINTR) {
+        continue;
+      }
+      if (n < 0) {
+        const int err = errno;
+        ::close(fd);
+        ::unlink(tmp.c_str());
+        COREDEM_CHECK(false, "cannot write '{}': {}", tmp.string(), std::strerror(err));
+      }
+      done += std::size_t(n);
+    }
+    const bool synced = ::fsync(fd) == 0;
+    ::close(fd);
+    if (!synced) {
+      ::unlink(tmp.c_str());
+      COREDEM_CHECK(false, "fsync of '{}' failed: {}", tmp.string(), std::strerror(errno));
+    }
+  }
+  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int err = errno;
+    ::unlink(tmp.c_str());
+    COREDEM_CHECK(false, "cannot rename '{}' to '{}': {}", tmp.string(), path.string(),
+                  std::strerror(err));
+  }
+  fsyncPath(path.parent_path().empty() ? fs::path(".") : path.parent_path(), true);
+}
+
+fs::path checkpointDir(const fs::path& runDir, std::int64_t step) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%08lld", static_cast<long long>(step));
+  return runDir / "checkpoints" / buf;
+}
+
+std::string doubleToHex(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%a", v);
+  return buf;
+}
+
+double doubleFromHex(const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  COREDEM_CHECK(end && *end == '\0' && !text.empty(), "'{}' is not a number", text);
+  return v;
+}
+
+std::string utcNow() {
+  const std::time_t now = std::time(nullptr);
+  std::tm tm{};
+  ::gmtime_r(&now, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+void writeManifest(const fs::path& dir, Manifest manifest,
+                   const std::vector<std::pair<std::string, std::string>>& filesAndParticipants) {
+  manifest.files.clear();
+  for (const auto& [rel, who] : filesAndParticipants) {
+    const fs::path file = dir / rel;
+    COREDEM_CHECK(fs::is_regular_file(file),
+                  "checkpoint file '{}' reported by the {} participant does not exist",
+                  file.string(), who);
+    manifest.files.push_back({rel, who, fs::file_size(file), sha256File(file)});
+    fsyncPath(file, false);
+  }
+  if (manifest.created.empty()) {
+    manifest.created = utcNow();
+  }
+  std::ostringstream js;
+  js << "{\n";
+  js << "  \"format\": \"coredem-checkpoint-1\",\n";
+  js << "  \"step\": " << manifest.step << ",\n";
+  js << "  \"time\": " << formatDouble(manifest.time) << ",\n";
+  js << "  \"time_hex\": " << quoted(doubleToHex(manifest.time)) << ",\n";
+  js << "  \"time_compensation_hex\": " << quoted(doubleToHex(manifest.timeCompensation)) << ",\n";
+  js << "  \"last_dt_hex\": " << quoted(doubleToHex(manifest.lastDt)) << ",\n";
+  js << "  \"last_courant_hex\": " << quoted(doubleToHex(manifest.lastCourant)) << ",\n";
+  js << "  \"software_version\": " << quoted(manifest.softwareVersion) << ",\n";
+  js << "  \"protocol_version\": " << quoted(manifest.protocolVersion) << ",\n";
+  js << "  \"config_hash\": " << quoted(manifest.configHash) << ",\n";
+  js << "  \"created\": " << quoted(manifest.created) << ",\n";
+  js << "  \"files\": [";
+  for (std::size_t i = 0; i < manifest.files.size(); ++i) {
+    const auto& f = manifest.files[i];
+    js << (i ? ",\n" : "\n") << "    {\"path\": " << quoted(f.path)
+       << ", \"participant\": " << quoted(f.participant) << ", \"bytes\": " << f.bytes
+       << ", \"sha256\": " << quoted(f.sha256) << "}";
+  }
+  js << (manifest.files.empty() ? "]\n" : "\n  ]\n");
+  js << "}\n";
+  writeFileAtomic(dir / "manifest.json", js.str());
+}
+
+Manifest readManifest(const fs::path& dir) {
+  const fs::path file = dir / "manifest.json";
+  COREDEM_CHECK(fs::is_regular_file(file), "{}: no manifest (the checkpoint is incomplete)",
+                file.string());
+  Manifest m;
+  try {
+    const YAML::Node root = YAML::LoadFile(file.string()); // JSON is YAML flow style
+    COREDEM_CHECK(root["format"] && root["format"].as<std::string>() == "coredem-checkpoint-1",
+                  "{}: not a coredem checkpoint manifest (format)", file.string());
+    m.step = root["step"].as<std::int64_t>();
+    m.time = doubleFromHex(root["time_hex"].as<std::string>());
+    m.timeCompensation = doubleFromHex(root["time_compensation_hex"].as<std::string>());
+    m.lastDt = doubleFromHex(root["last_dt_hex"].as<std::string>());
+    m.lastCourant = doubleFromHex(root["last_courant_hex"].as<std::string>());
+    m.softwareVersion = root["software_version"].as<std::string>();
+    m.protocolVersion = root["protocol_version"].as<std::string>();
+    m.configHash = root["config_hash"].as<std::string>();
+    m.created = root["created"].as<std::string>();
+    for (const auto& f : root["files"]) {
+      m.files.push_back({f["path"].as<std::string>(), f["participant"].as<std::string>(),
+                         f["bytes"].as<std::uint64_t>(), f["sha256"].as<std::string>()});
+    }
+  } catch (const YAML::Exception& e) {
+    COREDEM_CHECK(false, "{}: malformed manifest: {}", file.string(), e.what());
+  }
+  return m;
+}
+
+std::string verifyCheckpoint(const fs::path& dir) {
+  Manifest m;
+  try {
+    m = readManifest(dir);
+  } catch (const UserError& e) {
+    return e.what();
+  }
+  for (const auto& f : m.files) {
+    const fs::path file = dir / f.path;
+    if (!fs::is_regular_file(file)) {
+      return fmt::format("{}: file listed in the manifest is missing", file.string());
+    }
+    if (fs::file_size(file) != f.bytes) {
+      return fmt::format("{}: size {} bytes, manifest says {} (truncated or modified)",
+                         file.string(), fs::file_size(file), f.bytes);
+    }
+    if (sha256File(file) != f.sha256) {
+      return fmt::format("{}: SHA-256 does not match the manifest (corrupted)", file.string());
+    }
+  }
+  return "";
+}
+
+std::vector<std::int64_t> listCheckpointSteps(const fs::path& runDir) {
+  std::vector<std::int64_t> steps;
+  const fs::path root = runDir / "checkpoints";
+  if (!fs::is_directory(root)) {
+    return steps;
+  }
+  for (const auto& entry : fs::directory_iterator(root)) {
+    if (!entry.is_directory()) {
+      continue;
+    }
+    const std::string name = entry.path().filename().string();
+    if (name.empty() || !std::all_of(name.begin(), name.end(), ::isdigit)) {
+      continue;
+    }
+    steps.push_back(std::stoll(name));
+  }
+  std::sort(steps.begin(), steps.end());
+  return steps;
+}
+
+ResumeChoice selectResumeCheckpoint(const fs::path& runDir) {
+  ResumeChoice choice;
+  auto steps = listCheckpointSteps(runDir);
+  for (auto it = steps.rbegin(); it != steps.rend(); ++it) {
+    const fs::path dir = checkpointDir(runDir, *it);
+    const std::string problem = verifyCheckpoint(dir);
+    if (problem.empty()) {
+      choice.dir = dir;
+      choice.manifest = readManifest(dir);
+      break;
+    }
+    choice.skipped.push_back({dir, problem});
+  }
+  return choice;
+}
+
+std::vector<fs::path> pruneCheckpoints(const fs::path& runDir, int keep) {
+  std::vector<fs::path> removed;
+  const auto steps = listCheckpointSteps(runDir);
+  int complete = 0;
+  bool newestCompleteSeen = false;
+  for (auto it = steps.rbegin(); it != steps.rend(); ++it) {
+    const fs::path dir = checkpointDir(runDir, *it);
+    const bool hasManifest = fs::is_regular_file(dir / "manifest.json");
+    if (!newestCompleteSeen) {
+      if (!hasManifest) {
+        continue; // newer than any complete checkpoint: maybe being written; leave it
+      }
+      newestCompleteSeen = true;
+    }
+    if (hasManifest && complete < keep) {
+      ++complete;
+      continue;
+    }
+    fs::remove_all(dir);
+    removed.push_back(dir);
+  }
+  return removed;
+}
+
+} // namespace coredem::orchestrator

@@ -1,0 +1,72 @@
+#include <coredem/orchestrator/time_handler.h>
+
+#include <coredem/common/check.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace coredem::orchestrator {
+
+bool timeEquals(double a, double b, double tol) {
+  const double scale = std::max({1.0, std::abs(a), std::abs(b)});
+  return std::abs(a - b) <= tol * scale;
+}
+
+TimeHandler::TimeHandler(double time, double compensation) : _sum(time), _carry(compensation) {}
+
+void TimeHandler::advance(double dt) {
+  COREDEM_ASSERT(dt > 0.0 && std::isfinite(dt));
+  // Kahan: _carry holds the low-order bits lost by the previous additions.
+  const double y = dt - _carry;
+  const double t = _sum + y;
+  _carry = (t - _sum) - y;
+  _sum = t;
+}
+
+double TimeHandler::remaining(double tEnd) const {
+  return reached(tEnd) ? 0.0 : (tEnd - _sum) + _carry;
+}
+
+bool TimeHandler::reached(double tEnd) const {
+  return _sum - _carry >= tEnd || timeEquals(_sum - _carry, tEnd);
+}
+
+DtPolicy::DtPolicy(const DtPolicyConfig& config, double lastDt)
+    : _config(config), _last(lastDt > 0.0 ? lastDt : config.dt) {}
+
+double DtPolicy::next(double courant, double remaining) {
+  COREDEM_ASSERT(remaining > 0.0);
+  double dt = _config.dt;
+  if (_config.kind == DtPolicyConfig::Kind::Courant) {
+    dt = _last;
+    if (courant >= 0.0) {
+      const double factor =
+          courant > 0.0 ? std::min(_config.courant / courant, _config.maxGrowth) : _config.maxGrowth;
+      dt = _last * factor;
+    }
+    dt = std::clamp(dt, _config.dtMin, _config.dtMax);
+  }
+  _last = dt;
+  // Land exactly on tEnd: take the remainder when it is shorter than dt, or when the step
+  // after this one would be a sliver (< 1e-6 dt).
+  if (remaining <= dt * (1.0 + 1e-6)) {
+    return remaining;
+  }
+  return dt;
+}
+
+SubcyclePlan planSubcycles(double dtCfd, double dtDemMax) {
+  COREDEM_ASSERT(dtCfd > 0.0 && std::isfinite(dtCfd));
+  COREDEM_ASSERT(dtDemMax > 0.0 && std::isfinite(dtDemMax));
+  const double ratio = dtCfd / dtDemMax;
+  double n = std::ceil(ratio);
+  if (n > 1.0 && ratio - (n - 1.0) <= 1e-12 * ratio) {
+    n -= 1.0; // ratio is an integer up to round-off
+  }
+  SubcyclePlan plan;
+  plan.nSub = std::max<std::int64_t>(1, static_cast<std::int64_t>(n));
+  plan.dtDem = dtCfd / static_cast<double>(plan.nSub);
+  return plan;
+}
+
+} // namespace coredem::orchestrator

@@ -1,0 +1,142 @@
+// Case schema validation: good cases parse; each kind of error names file, line, key and
+// what is allowed.
+#include <coredem/orchestrator/case_config.h>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+using namespace coredem::orchestrator;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kGood = R"(name: unit-case
+time:
+  end: 0.01
+  dt: 1.0e-4
+grid:
+  origin: [0, 0, 0]
+  spacing: [0.01, 0.01, 0.01]
+  cells: [2, 2, 4]
+materials:
+  - name: glass
+    density: 2500
+    k_n: 1000
+    e_n: 0.9
+particles:
+  - material: glass
+    count: 10
+    diameter: 2.0e-3
+    region: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}
+checkpoint: {every_steps: 10, keep: 2}
+output: {every: 5}
+)";
+
+std::string errorOf(const std::string& text) {
+  try {
+    parseCase(text, "cases/x/case.yaml", fs::temp_directory_path());
+  } catch (const CaseError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::string replace(std::string s, const std::string& from, const std::string& to) {
+  const auto pos = s.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return s.replace(pos, from.size(), to);
+}
+
+} // namespace
+
+TEST(CaseConfig, GoodCaseParses) {
+  const CaseConfig c = parseCase(kGood, "case.yaml", fs::temp_directory_path());
+  EXPECT_EQ(c.name, "unit-case");
+  EXPECT_DOUBLE_EQ(c.endTime, 0.01);
+  EXPECT_EQ(c.dt.kind, DtPolicyConfig::Kind::Fixed);
+  EXPECT_EQ(c.grid.cells[2], 4u);
+  ASSERT_EQ(c.particles.size(), 1u);
+  EXPECT_EQ(c.particles[0].count, 10u);
+  EXPECT_EQ(c.particles[0].packing, "lattice");
+  EXPECT_EQ(c.checkpoint.everySteps, 10);
+  EXPECT_EQ(c.checkpoint.keep, 2);
+  EXPECT_EQ(c.output.snapshotEvery, 5);
+  EXPECT_EQ(c.dem.backend, "cpu");
+  EXPECT_EQ(c.cfd.participant, "coredem-gas");
+  EXPECT_EQ(c.configHash.size(), 64u);
+}
+
+TEST(CaseConfig, UnknownKeyNamesLineKeyAndAllowed) {
+  const std::string e = errorOf(replace(kGood, "  dt: 1.0e-4", "  dtt: 1.0e-4"));
+  EXPECT_NE(e.find("cases/x/case.yaml:4:3: time.dtt: unknown key"), std::string::npos) << e;
+  EXPECT_NE(e.find("allowed keys in 'time': end, dt, adaptive"), std::string::npos) << e;
+}
+
+TEST(CaseConfig, UnknownTopLevelKey) {
+  const std::string e = errorOf(std::string(kGood) + "partciles: []\n");
+  EXPECT_NE(e.find(":21:1: partciles: unknown key; allowed keys at the top level"),
+            std::string::npos)
+      << e;
+}
+
+TEST(CaseConfig, WrongTypeNamesExpectedType) {
+  const std::string e = errorOf(replace(kGood, "end: 0.01", "end: soon"));
+  EXPECT_NE(e.find("case.yaml:3:8: time.end: expected a number"), std::string::npos) << e;
+  EXPECT_NE(e.find("got 'soon'"), std::string::npos) << e;
+  const std::string v = errorOf(replace(kGood, "cells: [2, 2, 4]", "cells: 8"));
+  EXPECT_NE(v.find("grid.cells: expected a list of 3 numbers"), std::string::npos) << v;
+  const std::string m = errorOf(replace(kGood, "time:\n  end: 0.01\n  dt: 1.0e-4\n", "time: 3\n"));
+  EXPECT_NE(m.find("time: expected a mapping"), std::string::npos) << m;
+}
+
+TEST(CaseConfig, OutOfRangeAndChoices) {
+  const std::string e = errorOf(replace(kGood, "e_n: 0.9", "e_n: 1.5"));
+  EXPECT_NE(e.find("materials[0].e_n: 1.5 is out of range; allowed: > 0 and <= 1"),
+            std::string::npos)
+      << e;
+  const std::string p = errorOf(replace(kGood, "count: 10", "count: 10\n    packing: hexagonal"));
+  EXPECT_NE(p.find("particles[0].packing: 'hexagonal' is not allowed; allowed: lattice, random"),
+            std::string::npos)
+      << p;
+  const std::string m = errorOf(replace(kGood, "material: glass", "material: steel"));
+  EXPECT_NE(m.find("unknown material 'steel'; allowed: glass"), std::string::npos) << m;
+}
+
+TEST(CaseConfig, MissingRequiredKey) {
+  const std::string e = errorOf(replace(kGood, "  dt: 1.0e-4\n", ""));
+  EXPECT_NE(e.find("time: missing required key 'dt'"), std::string::npos) << e;
+}
+
+TEST(CaseConfig, MissingFileNamesTheFile) {
+  const std::string e = errorOf(std::string(kGood) + "initial_state: no-such-state.h5\n");
+  EXPECT_NE(e.find("initial_state: file 'no-such-state.h5' not found"), std::string::npos) << e;
+  EXPECT_NE(e.find(":21:16:"), std::string::npos) << e;
+}
+
+TEST(CaseConfig, MissingCaseFolder) {
+  try {
+    loadCase(fs::temp_directory_path() / "coredem-no-such-case");
+    FAIL() << "no error";
+  } catch (const CaseError& e) {
+    EXPECT_NE(std::string(e.what()).find("coredem-no-such-case: case file not found"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(CaseConfig, InvalidYamlHasLine) {
+  const std::string e = errorOf("name: a\ntime: [1, 2\n");
+  EXPECT_NE(e.find("not valid YAML"), std::string::npos) << e;
+}
+
+TEST(CaseConfig, AdaptiveBounds) {
+  const std::string good = replace(kGood, "  dt: 1.0e-4\n",
+                                   "  dt: 1.0e-4\n  adaptive: {courant: 0.5, dt_min: 1.0e-5, "
+                                   "dt_max: 1.0e-3}\n");
+  const CaseConfig c = parseCase(good, "case.yaml", fs::temp_directory_path());
+  EXPECT_EQ(c.dt.kind, DtPolicyConfig::Kind::Courant);
+  EXPECT_DOUBLE_EQ(c.dt.dtMax, 1e-3);
+  const std::string e = errorOf(replace(good, "dt_min: 1.0e-5", "dt_min: 1.0e-2"));
+  EXPECT_NE(e.find("need dt_min <= dt_max"), std::string::npos) << e;
+}
