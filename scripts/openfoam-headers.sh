@@ -105,6 +105,7 @@ if ! flock -w 900 9; then
 fi
 
 if [[ "$force" == false && -f "$stamp" ]] && diff -q <(echo "$stamp_text") <(grep -v '^prepared=' "$stamp") >/dev/null; then
+  touch "$stamp" # lets CMake see the cache as newer than this script and skip calling it
   say "OpenFOAM $src_version headers are ready in $cache_dir (stamp present, nothing to do)"
   exit 0
 fi
