@@ -1,0 +1,89 @@
+#pragma once
+/// @file
+/// Homogeneous water–gas shift R3, CO + H2O ⇌ CO2 + H2, evaluated per CFD cell by the DEM
+/// server (PHYSICS §6.2, §1) and returned as species and heat sources.
+///
+///   ω = ε_g k_f(T) [C_CO C_H2O − C_CO2 C_H2 / K_eq(T)]     mol/(m³ of cell · s), C_j = ρ_g Y_j/M_j
+///   k_f = 2.78e-3 exp(−1510/T) m³/(mol s)   (Yoon, Wei & Denn 1978 / Gururajan 1992 [K])
+///   K_eq options: YoonDenn 0.0265 exp(3968/T) (default [C]); Seed exp(−4.33 + 4577.8/T);
+///                 Thermodynamic exp(−ΔG°/(RT)) from the NASA-7 data (exactly consistent).
+///   R_n = M_n ν_n ω  (kg/(m³ s));  S_h,rxn,g = −ΔH_R3(T_g) ω  (W/m³)
+///
+/// The seed's extracted rate is not equilibrium-consistent (PHYSICS §0.3); this form is.
+/// ω already contains ε_g: do not multiply by ε_g again (§1).
+
+#include <coredem/dem/kernels/common.h>
+#include <coredem/dem/kernels/nasa7.h>
+#include <coredem/dem/kernels/reaction_enthalpy.h>
+
+#include <cmath>
+
+namespace coredem::dem::kernels {
+
+enum class WgsEquilibrium : int { YoonDenn = 0, Seed = 1, Thermodynamic = 2 };
+
+struct WgsParams {
+  double kf0 = 2.78e-3;       ///< m³/(mol s)
+  double efOverR = 1510.0;    ///< K
+  WgsEquilibrium equilibrium = WgsEquilibrium::YoonDenn;
+  bool enabled = true;
+};
+
+/// K_eq(T) of CO + H2O ⇌ CO2 + H2, −.
+DEM_HD double wgsEquilibriumConstant(const WgsParams& p, double t) {
+  switch (p.equilibrium) {
+  case WgsEquilibrium::Seed: return std::exp(-4.33 + 4577.8 / t);
+  case WgsEquilibrium::Thermodynamic:
+    return equilibriumConstant(clgStoichiometry(ClgReaction::R3), t);
+  case WgsEquilibrium::YoonDenn:
+  default: return 0.0265 * std::exp(3968.0 / t);
+  }
+}
+
+/// Net forward rate ω, mol/(m³ s), from concentrations (mol/m³).
+DEM_HD double wgsRate(const WgsParams& p, double t, double epsG, double cCO, double cH2O,
+                      double cCO2, double cH2) {
+  if (!p.enabled) {
+    return 0.0;
+  }
+  const double kf = p.kf0 * std::exp(-p.efOverR / t);
+  return epsG * kf * (cCO * cH2O - cCO2 * cH2 / wgsEquilibriumConstant(p, t));
+}
+
+struct WgsCellSources {
+  double omega;                         ///< mol/(m³ s)
+  double massSource[kGasSpeciesCount];  ///< kg/(m³ s), GasSpecies order
+  double heatSource;                    ///< W/m³ into the gas
+};
+
+/// Sources of one cell. T_g (K), ε_g (−), ρ_g (kg/m³), mass fractions Y in GasSpecies order.
+/// If dt > 0, ω is limited so that no reactant concentration goes negative within dt.
+DEM_HD WgsCellSources wgsCellSources(const WgsParams& p, double tG, double epsG, double rhoG,
+                                     const double* y, double dt = 0.0) {
+  WgsCellSources out{};
+  double c[kGasSpeciesCount];
+  for (int k = 0; k < kGasSpeciesCount; ++k) {
+    c[k] = rhoG * y[k] / molarMass(static_cast<GasSpecies>(k));
+  }
+  double w = wgsRate(p, tG, epsG, c[idx(GasSpecies::CO)], c[idx(GasSpecies::H2O)],
+                     c[idx(GasSpecies::CO2)], c[idx(GasSpecies::H2)]);
+  if (dt > 0.0) {
+    // ω dt ≤ ε_g C of the species consumed (per m³ of cell).
+    const double a = w > 0.0 ? (c[idx(GasSpecies::CO)] < c[idx(GasSpecies::H2O)] ? c[idx(GasSpecies::CO)] : c[idx(GasSpecies::H2O)])
+                             : (c[idx(GasSpecies::CO2)] < c[idx(GasSpecies::H2)] ? c[idx(GasSpecies::CO2)] : c[idx(GasSpecies::H2)]);
+    const double wMax = epsG * a / dt;
+    if (std::fabs(w) > wMax) {
+      w = w > 0.0 ? wMax : -wMax;
+    }
+  }
+  out.omega = w;
+  out.massSource[idx(GasSpecies::CO)] = -molarMass(Species::CO) * w;
+  out.massSource[idx(GasSpecies::H2O)] = -molarMass(Species::H2O) * w;
+  out.massSource[idx(GasSpecies::CO2)] = molarMass(Species::CO2) * w;
+  out.massSource[idx(GasSpecies::H2)] = molarMass(Species::H2) * w;
+  out.massSource[idx(GasSpecies::N2)] = 0.0;
+  out.heatSource = -reactionEnthalpy(ClgReaction::R3, tG) * w;
+  return out;
+}
+
+} // namespace coredem::dem::kernels

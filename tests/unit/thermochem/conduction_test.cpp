@@ -1,0 +1,301 @@
+// Contact conduction (PHYSICS §3.2) and gas-lens conduction (§3.3) vs the MFiX reference
+// constants (§8.1, §8.2), reference/refvalues.py, closed forms and an independent fine
+// long-double quadrature.
+#include <coredem/dem/kernels/conduction_contact.h>
+#include <coredem/dem/kernels/conduction_gas_lens.h>
+#include <coredem/dem/kernels/conduction_quadrature.h>
+#include <coredem/dem/verification/analytic.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+namespace k = coredem::dem::kernels;
+namespace v = coredem::dem::verification;
+
+namespace {
+constexpr double kPi = 3.141592653589793;
+const double kMfixCcDistance = (0.4799731 - 0.1499864) * 1e-2; // §8.1 positions
+const double kMfixPfpDistance = (1.498 - 1.150) * 1e-2;        // §8.2 positions
+
+// Independent reference for the lens integral: direct gap formula in long double (64-bit
+// mantissa), root of gap = s_min by bisection, the clipped part integrated exactly, the rest by
+// 10-point Gauss–Legendre on panels graded geometrically towards R_in (ratio 1.02).
+long double fineLensIntegral(long double r1, long double r2, long double l, long double flpc,
+                             long double sMin) {
+  const long double big = std::max(r1, r2);
+  const long double small = std::min(r1, r2);
+  const long double rLens = (1 + flpc) * big;
+  auto chord = [](long double ra, long double rb, long double d) {
+    const long double x = (ra * ra - rb * rb + d * d) / (2 * d);
+    return std::sqrt(ra * ra - x * x);
+  };
+  const long double rOut = chord(rLens, small, l);
+  const long double rIn = l < big + small ? chord(big, small, l) : 0.0L;
+  auto gap = [&](long double r) {
+    return l - std::sqrt(big * big - r * r) - std::sqrt(small * small - r * r);
+  };
+  long double lo = rIn;
+  long double hi = rOut;
+  if (gap(rIn) < sMin) {
+    for (int i = 0; i < 200; ++i) {
+      const long double mid = 0.5L * (lo + hi);
+      (gap(mid) < sMin ? lo : hi) = mid;
+    }
+  } else {
+    hi = rIn;
+  }
+  const long double rStar = hi;
+  long double total = kPi * (rStar * rStar - rIn * rIn) / sMin;
+  // 10-point Gauss–Legendre nodes/weights (positive half; numpy.polynomial.legendre.leggauss).
+  static const long double x[5] = {0.14887433898163122L, 0.4333953941292472L, 0.6794095682990244L,
+                                   0.8650633666889845L, 0.9739065285171717L};
+  static const long double w[5] = {0.295524224714753L, 0.2692667193099965L, 0.219086362515982L,
+                                   0.14945134915058036L, 0.06667134430868807L};
+  auto panel = [&](long double a, long double b) {
+    const long double c = 0.5L * (a + b);
+    const long double h = 0.5L * (b - a);
+    long double s = 0;
+    for (int i = 0; i < 5; ++i) {
+      for (long double r : {c - h * x[i], c + h * x[i]}) {
+        s += w[i] * 2 * kPi * r / std::max(gap(r), sMin);
+      }
+    }
+    return s * h;
+  };
+  // Panels: first width grows geometrically from 1e-4·(distance to the singular point).
+  const long double origin = rIn;
+  long double a = rStar;
+  long double width = std::max((rStar - origin) * 0.02L, (rOut - rIn) * 1e-9L);
+  while (a < rOut) {
+    const long double b = std::min(rOut, a + width);
+    total += panel(a, b);
+    a = b;
+    width = std::max(width, (a - origin) * 0.02L);
+  }
+  return total;
+}
+
+// Equal spheres: I has a closed form. With w = √(R² − r²):
+//   ∫ 2π r dr / (l − 2w) = 2π [F(w_a) − F(w_b)],  F(w) = −w/2 − (l/4) ln(l − 2w).
+long double equalSpheresLensIntegral(long double rad, long double l, long double flpc,
+                                     long double sMin) {
+  const long double rLens = (1 + flpc) * rad;
+  const long double x = (rLens * rLens - rad * rad + l * l) / (2 * l);
+  const long double rOut = std::sqrt(rLens * rLens - x * x);
+  const long double rIn = l < 2 * rad ? std::sqrt(rad * rad - l * l / 4) : 0.0L;
+  auto F = [&](long double w) { return -w / 2 - l / 4 * std::log(l - 2 * w); };
+  const long double wOut = std::sqrt(rad * rad - rOut * rOut);
+  if (l - 2 * std::sqrt(rad * rad - rIn * rIn) >= sMin) { // never clipped
+    return 2 * kPi * (F(std::sqrt(rad * rad - rIn * rIn)) - F(wOut));
+  }
+  const long double wStar = (l - sMin) / 2; // gap = s_min
+  const long double rStar = std::sqrt(rad * rad - wStar * wStar);
+  return kPi * (rStar * rStar - rIn * rIn) / sMin + 2 * kPi * (F(wStar) - F(wOut));
+}
+} // namespace
+
+// ---- quadrature --------------------------------------------------------------------------
+
+// K15 is exact for polynomials of degree ≤ 22 on one panel; the adaptive driver reaches the
+// requested tolerance on a peaked function (∫ dx/(x² + 1e-6) on [−1, 1] = 2000 atan(1000)).
+TEST(Quadrature, GaussKronrodExactnessAndAdaptivity) {
+  for (int deg = 0; deg <= 22; ++deg) {
+    double err = 0.0;
+    const double val = k::gaussKronrod15([deg](double x) { return std::pow(x, deg); }, 0.0, 2.0, err);
+    const double exact = std::pow(2.0, deg + 1) / (deg + 1);
+    EXPECT_NEAR(val, exact, 1e-14 * exact) << "degree " << deg;
+  }
+  const auto r = k::integrateAdaptive([](double x) { return 1.0 / (x * x + 1e-6); }, -1.0, 1.0, 1e-12);
+  const double exact = 2000.0 * std::atan(1000.0);
+  EXPECT_TRUE(r.converged);
+  EXPECT_NEAR(r.value, exact, 1e-12 * exact);
+}
+
+// ---- contact conduction -------------------------------------------------------------------
+
+// MFiX-CC (§8.1): r_c = 1.475235004121685e-05 m (refvalues.py, acos form, ~1e-12 accurate);
+// a = A_C = 0.01027998273952850 s⁻¹ (MFiX file) and b = 0.004106681767591312 (refvalues.py).
+TEST(ContactConduction, MfixReferenceConstants) {
+  const double rc = k::intersectionCircleRadius(1.5e-3, 1.8e-3, kMfixCcDistance);
+  EXPECT_NEAR(rc, 1.475235004121685e-05, 1e-10 * rc);
+  const auto c = v::contactConductionCoefficients(3.0e-3, v::musserMaterialA(), 3.6e-3,
+                                                  v::musserMaterialB(), kMfixCcDistance);
+  EXPECT_NEAR(c.a, 0.01027998273952850, 1e-10 * c.a);
+  EXPECT_NEAR(c.b, 0.004106681767591312, 1e-10 * c.b);
+  // Errata check: the seed's factor 2 would give half of A_C.
+  EXPECT_GT(std::fabs(c.a / 0.01027998273952850 - 0.5), 0.4);
+}
+
+// Stable intersection radius: equal spheres have r_c = √((R − l/2)(R + l/2)) exactly; the
+// Heron form must hold 1e-14 relative down to overlaps of 1e-12 R where the textbook formula
+// loses most digits.
+TEST(ContactConduction, IntersectionRadiusIsAccurateForTinyOverlaps) {
+  const double rad = 1.5e-3;
+  for (double ov : {1e-5, 1e-9, 1e-12, 1e-14}) {
+    const double l = 2.0 * rad - ov * rad;
+    const double exact = std::sqrt((rad - 0.5 * l) * (rad + 0.5 * l));
+    EXPECT_NEAR(k::intersectionCircleRadius(rad, rad, l), exact, 1e-14 * exact) << ov;
+  }
+  EXPECT_EQ(k::intersectionCircleRadius(1e-3, 2e-3, 3e-3), 0.0);   // touching: no circle
+  EXPECT_EQ(k::intersectionCircleRadius(1e-3, 2e-3, 3.1e-3), 0.0); // apart
+  EXPECT_EQ(k::intersectionCircleRadius(1e-3, 2e-3, 0.5e-3), 1e-3); // inside [C]
+  EXPECT_EQ(k::contactConductance(1.0, 2.0, 1e-3, 2e-3, 3e-3), 0.0);
+}
+
+// Seed variants (§8.1 table; refvalues.py): particle 1 = A (3.0 mm, 373.15 K), particle 2 =
+// material B (278.15 K). Printed digits: r_c 6 significant, a/b 7, T 1e-4 K.
+TEST(ContactConduction, SeedVariantTable) {
+  struct Row {
+    double d2, ov, rc, a, b, tInf, t1, t2;
+  };
+  const Row rows[] = {
+      {2.4e-3, 1e-5, 1.15358e-4, 8.038552e-02, 1.083803e-01, 332.6944, 338.8205, 324.4350},
+      {2.4e-3, 4e-5, 2.30040e-4, 1.603001e-01, 2.161256e-01, 332.6944, 333.6324, 331.4298},
+      {3.0e-3, 1e-5, 1.22372e-4, 8.527360e-02, 5.886498e-02, 316.9472, 330.2448, 307.7678},
+      {3.0e-3, 4e-5, 2.44131e-4, 1.701196e-01, 1.174348e-01, 316.9472, 320.1162, 314.7596},
+      {3.6e-3, 1e-5, 1.27820e-4, 8.906987e-02, 3.558193e-02, 305.2678, 324.7842, 297.4713},
+      {3.6e-3, 2e-5, 1.80623e-4, 1.258650e-01, 5.028096e-02, 305.2678, 316.9296, 300.6091},
+      {3.6e-3, 3e-5, 2.21044e-4, 1.540313e-01, 6.153295e-02, 305.2678, 313.1305, 302.1268},
+      {3.6e-3, 4e-5, 2.55038e-4, 1.777200e-01, 7.099619e-02, 305.2678, 310.9119, 303.0131}};
+  for (const Row& r : rows) {
+    SCOPED_TRACE(r.d2);
+    SCOPED_TRACE(r.ov);
+    const double l = 1.5e-3 + 0.5 * r.d2 - r.ov;
+    EXPECT_NEAR(k::intersectionCircleRadius(1.5e-3, 0.5 * r.d2, l), r.rc, 5e-6 * r.rc);
+    const auto c = v::contactConductionCoefficients(3.0e-3, v::musserMaterialA(), r.d2,
+                                                    v::musserMaterialB(), l);
+    EXPECT_NEAR(c.a, r.a, 5e-7 * r.a);
+    EXPECT_NEAR(c.b, r.b, 5e-7 * r.b);
+    EXPECT_NEAR(v::twoParticleEquilibrium(c.a, c.b, 373.15, 278.15), r.tInf, 5e-5);
+    const auto t = v::twoParticleExchange(c.a, c.b, 373.15, 278.15, 10.0);
+    EXPECT_NEAR(t.t1, r.t1, 5e-5);
+    EXPECT_NEAR(t.t2, r.t2, 5e-5);
+  }
+}
+
+// Q_ij = −Q_ji bitwise, whichever particle evaluates the pair, for both conduction kernels.
+TEST(Conduction, PairTermsAreExactlyAntisymmetric) {
+  std::mt19937_64 rng(12345);
+  std::uniform_real_distribution<double> rad(0.2e-3, 2e-3), k(0.05, 60.0), t(250.0, 1300.0),
+      frac(0.9, 1.15);
+  k::GasLensParams lens;
+  for (int n = 0; n < 400; ++n) {
+    const double ri = rad(rng), rj = rad(rng), ki = k(rng), kj = k(rng), ti = t(rng), tj = t(rng);
+    const double l = frac(rng) * (ri + rj);
+    const double qij = k::contactConductionHeat(ki, kj, ri, rj, l, ti, tj);
+    const double qji = k::contactConductionHeat(kj, ki, rj, ri, l, tj, ti);
+    EXPECT_EQ(qij, -qji);
+    const double pij = k::gasLensHeat(lens, 0.05, ri, rj, l, ti, tj);
+    const double pji = k::gasLensHeat(lens, 0.05, rj, ri, l, tj, ti);
+    EXPECT_EQ(pij, -pji);
+    if (l < ri + rj) {
+      EXPECT_NE(qij, 0.0);
+    }
+  }
+}
+
+// ---- gas lens ------------------------------------------------------------------------------
+
+// MFiX-PFP (§8.2): R_out = 5.565457e-4 m, R_in = 0, exact I = 3.675223767717116e-3 m
+// (refvalues.py, tolerance 1e-12 absolute per piece → ~3e-10 relative), a, b from it.
+// MFiX's own a = 0.0401067383 comes from its loose EPS = 1e-2 Simpson (6.7e-5 relative).
+TEST(GasLens, MfixReferenceConstants) {
+  const k::GasLensParams p;
+  const auto geo = k::gasLensGeometry(p, 1.5e-3, 1.8e-3, kMfixPfpDistance);
+  EXPECT_TRUE(geo.active);
+  EXPECT_FALSE(geo.contact);
+  EXPECT_EQ(geo.rIn, 0.0);
+  EXPECT_NEAR(geo.rOut, 5.565457e-4, 5e-11);
+  const auto in = k::gasLensIntegral(p, 1.5e-3, 1.8e-3, kMfixPfpDistance);
+  EXPECT_TRUE(in.converged);
+  EXPECT_NEAR(in.value, 3.675223767717116e-3, 1e-9 * in.value);
+  const auto c = v::gasLensCoefficients(3.0e-3, v::musserMaterialA(), 3.6e-3, v::musserMaterialB(),
+                                        kMfixPfpDistance, v::kMusserLensGasConductivity);
+  EXPECT_NEAR(c.a, 4.010942558902641e-02, 1e-9 * c.a);
+  EXPECT_NEAR(c.b, 1.602304701754486e-02, 1e-9 * c.b);
+  EXPECT_NEAR(c.a, 0.0401067383, 1e-4 * c.a);
+  EXPECT_NEAR(c.b, 0.0160219735, 1e-4 * c.b);
+}
+
+// Seed gap / overlap variants (§8.2 table, refvalues.py full digits) → 1e-9 relative.
+TEST(GasLens, SeedVariantsMatchReferenceScript) {
+  struct Row {
+    double gap, sMin, integral;
+  };
+  const Row rows[] = {{1e-5, 1e-6, 1.828676331275730e-02},  {2e-5, 1e-6, 1.476554955240080e-02},
+                      {1.8e-4, 1e-6, 3.675223767717136e-03}, {-1e-5, 1e-6, 3.509926424950854e-02},
+                      {-1e-5, 4e-10, 7.519425564719893e-02}, {-4e-5, 1e-6, 3.479358596745044e-02},
+                      {-4e-5, 4e-10, 7.451045283921354e-02}};
+  for (const Row& r : rows) {
+    SCOPED_TRACE(r.gap);
+    SCOPED_TRACE(r.sMin);
+    k::GasLensParams p;
+    p.minSeparation = r.sMin;
+    const double l = 1.5e-3 + 1.8e-3 + r.gap;
+    const auto in = k::gasLensIntegral(p, 1.5e-3, 1.8e-3, l);
+    EXPECT_TRUE(in.converged);
+    EXPECT_NEAR(in.value, r.integral, 1e-9 * r.integral);
+  }
+  // §8.2 table, printed a/b (7 significant digits) for the touching case with s_min = 1e-6.
+  k::GasLensParams p;
+  const auto c = v::gasLensCoefficients(3.0e-3, v::musserMaterialA(), 3.6e-3, v::musserMaterialB(),
+                                        3.3e-3 - 1e-5, v::kMusserLensGasConductivity, p);
+  EXPECT_NEAR(c.a, 0.3830546, 5e-7 * 0.3830546);
+  EXPECT_NEAR(c.b, 0.1530239, 5e-7 * 0.1530239);
+}
+
+// Accuracy target 1e-8 relative (PHYSICS §3.3): compare against the closed form for equal
+// spheres and the independent long-double quadrature for unequal spheres, in and out of
+// contact, with s_min from 4e-10 to 1e-6 m. Observed agreement is ~1e-13; assert 1e-10.
+TEST(GasLens, QuadratureAccurateToBetterThan1e8) {
+  for (double sMin : {4e-10, 1e-8, 1e-6}) {
+    for (double gap : {-4e-5, -1e-6, -1e-9, 1e-9, 1e-7, 1e-5, 2e-4}) {
+      SCOPED_TRACE(sMin);
+      SCOPED_TRACE(gap);
+      k::GasLensParams p;
+      p.minSeparation = sMin;
+      const double rad = 1.5e-3;
+      const double le = 2 * rad + gap;
+      const auto eq = k::gasLensIntegral(p, rad, rad, le);
+      const long double exactEq = equalSpheresLensIntegral(rad, le, 0.2L, sMin);
+      EXPECT_TRUE(eq.converged);
+      EXPECT_NEAR(eq.value, static_cast<double>(exactEq), 1e-10 * eq.value);
+      const double lu = 1.5e-3 + 1.8e-3 + gap;
+      const auto un = k::gasLensIntegral(p, 1.5e-3, 1.8e-3, lu);
+      const long double fine = fineLensIntegral(1.5e-3L, 1.8e-3L, lu, 0.2L, sMin);
+      EXPECT_TRUE(un.converged);
+      EXPECT_NEAR(un.value, static_cast<double>(fine), 1e-10 * un.value);
+    }
+  }
+}
+
+// Closed form when the whole lens is clipped (s_min ≥ max gap): I = π(R_out² − R_in²)/s_min.
+// And no lens beyond reach: l ≥ R_lens + R_S → 0.
+TEST(GasLens, ClippedLimitAndReach) {
+  k::GasLensParams p;
+  p.minSeparation = 1.0; // 1 m ≫ any gap
+  for (double l : {3.2e-3, 3.3e-3, 3.4e-3}) {
+    const auto geo = k::gasLensGeometry(p, 1.5e-3, 1.8e-3, l);
+    const double exact = kPi * (geo.rOut * geo.rOut - geo.rIn * geo.rIn) / p.minSeparation;
+    EXPECT_NEAR(k::gasLensIntegral(p, 1.5e-3, 1.8e-3, l).value, exact, 1e-14 * exact) << l;
+  }
+  k::GasLensParams d;
+  const double reach = 1.2 * 1.8e-3 + 1.5e-3;
+  EXPECT_EQ(k::gasLensIntegral(d, 1.5e-3, 1.8e-3, reach).value, 0.0);
+  EXPECT_GT(k::gasLensIntegral(d, 1.5e-3, 1.8e-3, reach * (1 - 1e-6)).value, 0.0);
+  // Lens around the larger sphere: swapping the argument order changes nothing.
+  EXPECT_EQ(k::gasLensIntegral(d, 1.8e-3, 1.5e-3, 3.4e-3).value,
+            k::gasLensIntegral(d, 1.5e-3, 1.8e-3, 3.4e-3).value);
+}
+
+// s_min dominates touching particles (§3.3): 1e-6 → 4e-10 m roughly doubles I (0.0351 → 0.0752).
+TEST(GasLens, MinimumSeparationControlsTouchingCase) {
+  k::GasLensParams coarse;
+  k::GasLensParams fine;
+  fine.minSeparation = 4e-10;
+  const double l = 3.3e-3 - 1e-5;
+  EXPECT_NEAR(k::gasLensIntegral(coarse, 1.5e-3, 1.8e-3, l).value, 0.0351, 5e-5);
+  EXPECT_NEAR(k::gasLensIntegral(fine, 1.5e-3, 1.8e-3, l).value, 0.0752, 5e-5);
+}

@@ -1,0 +1,166 @@
+// NASA-7 data, reaction enthalpies and equilibrium constants vs PHYSICS.md §3.5 / Appendix A
+// and the numbers printed by physics/reference/nasa.py (same Burcat/MFiX coefficients).
+#include <coredem/dem/kernels/nasa7.h>
+#include <coredem/dem/kernels/reaction_enthalpy.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace k = coredem::dem::kernels;
+using k::Species;
+
+namespace {
+
+struct Ref {
+  Species s;
+  double t;
+  double h;  // J/mol
+  double cp; // J/(mol K)
+  double s0; // J/(mol K)
+};
+
+// reference/nasa.py H(s,T), Cp(s,T), S(s,T) printed with %.15e.
+const Ref kRefs[] = {
+    {Species::CO, 300.0, -1.104754571058376e+05, 2.914305617896342e+01, 1.978365840221654e+02},
+    {Species::CO, 1173.15, -8.302661507205073e+04, 3.395704366721154e+01, 2.399039378642747e+02},
+    {Species::CO2, 500.0, -3.852073786014339e+05, 4.462034858712661e+01, 2.348796998563710e+02},
+    {Species::CO2, 1500.0, -3.318909695461878e+05, 5.822492870266791e+01, 2.921167703414503e+02},
+    {Species::H2, 300.0, 5.336050519790599e+01, 2.885078499429371e+01, 1.308586887286421e+02},
+    {Species::H2, 1173.15, 2.597975601922082e+04, 3.096876485386089e+01, 1.711158307000313e+02},
+    {Species::H2O, 500.0, -2.348997968798022e+05, 3.521405135799814e+01, 2.065289943489106e+02},
+    {Species::H2O, 1500.0, -1.935853211552782e+05, 4.733367528372539e+01, 2.506847280013882e+02},
+    {Species::N2, 300.0, 5.388085010456956e+01, 2.912538728061013e+01, 1.917887784316625e+02},
+    {Species::N2, 1173.15, 2.719802963623932e+04, 3.352001505643950e+01, 2.334614758613164e+02},
+    {Species::C, 500.0, 2.365541321801280e+03, 1.459203767436161e+01, 1.165752319022243e+01},
+    {Species::C, 1500.0, 2.319015013367180e+04, 2.380191326717621e+01, 3.366195993361097e+01},
+    {Species::Fe2O3, 300.0, -8.240508313859400e+05, 1.042148538537081e+02, 8.804706910378975e+01},
+    {Species::Fe2O3, 1173.15, -6.991191707022114e+05, 1.424389033653509e+02, 2.756711642427959e+02},
+    {Species::Fe3O4, 500.0, -1.083174659704864e+06, 1.932472729815171e+02, 2.353659257748382e+02},
+    {Species::Fe3O4, 1500.0, -8.708183257900418e+05, 1.966929300318852e+02, 4.713896457431098e+02},
+    {Species::Al2O3, 300.0, -1.675543873269881e+06, 7.943262028186017e+01, 5.140982453323183e+01},
+    {Species::Al2O3, 1173.15, -1.575842320512224e+06, 1.271068067273066e+02, 2.004159109101352e+02},
+    {Species::Al2O3, 1500.0, -1.533438444227489e+06, 1.324467335012064e+02, 2.322739416290896e+02},
+};
+
+} // namespace
+
+// Same polynomials evaluated in a different order (Horner vs term sums): agreement to a few
+// ulp of the largest term. Tolerances: C_p and S 1e-12 relative; H 1e-12 relative to the
+// largest polynomial term R·|a6| (≤ 2e5 R), i.e. ≤ 2e-6 J/mol, because H can be a small
+// difference of large terms (e.g. H2 at 300 K = 53 J/mol).
+TEST(Nasa7, MatchesReferenceScript) {
+  for (const Ref& r : kRefs) {
+    SCOPED_TRACE(static_cast<int>(r.s));
+    SCOPED_TRACE(r.t);
+    EXPECT_NEAR(k::nasa7CpMolar(r.s, r.t), r.cp, 1e-12 * r.cp);
+    EXPECT_NEAR(k::nasa7EntropyMolar(r.s, r.t), r.s0, 1e-12 * r.s0);
+    EXPECT_NEAR(k::nasa7EnthalpyMolar(r.s, r.t), r.h, 2e-6);
+  }
+}
+
+// PHYSICS §3.5 table, rounded to the printed digits (H 0.01 kJ/mol, C_p 0.01 J/mol/K; the
+// oxide C_p at 0.1 J/mol/K).
+TEST(Nasa7, FormationEnthalpiesAndHeatCapacitiesOfPhysicsTable) {
+  struct Row {
+    Species s;
+    double hf;    // kJ/mol
+    double cp298; // J/mol/K
+    double cp1173;
+    double cpTol;
+  };
+  const Row rows[] = {{Species::CO, -110.53, 29.14, 33.96, 0.005},
+                      {Species::CO2, -393.51, 37.14, 55.90, 0.005},
+                      {Species::H2, 0.0, 28.84, 30.97, 0.005},
+                      {Species::H2O, -241.82, 33.59, 43.61, 0.005},
+                      {Species::N2, 0.0, 29.12, 33.52, 0.005},
+                      {Species::C, 0.0, 8.53, 22.49, 0.005},
+                      {Species::Fe2O3, -824.24, 103.9, 142.4, 0.05},
+                      {Species::Fe3O4, -1118.38, 150.7, 197.1, 0.05},
+                      {Species::Al2O3, -1675.69, 79.0, 127.1, 0.05}};
+  for (const Row& r : rows) {
+    SCOPED_TRACE(static_cast<int>(r.s));
+    EXPECT_NEAR(k::nasa7EnthalpyMolar(r.s, k::kTref) / 1000.0, r.hf, 0.005);
+    EXPECT_NEAR(k::nasa7CpMolar(r.s, k::kTref), r.cp298, r.cpTol);
+    EXPECT_NEAR(k::nasa7CpMolar(r.s, 1173.15), r.cp1173, r.cpTol);
+  }
+}
+
+// Interval selection: below the break the low set, at and above it the upper set.
+TEST(Nasa7, IntervalSelection) {
+  const k::Nasa7Data co = k::nasa7Data(Species::CO);
+  EXPECT_EQ(k::nasa7IntervalIndex(co, 999.999), 0);
+  EXPECT_EQ(k::nasa7IntervalIndex(co, 1000.0), 1);
+  const k::Nasa7Data fe = k::nasa7Data(Species::Fe2O3);
+  EXPECT_EQ(k::nasa7IntervalIndex(fe, 500.0), 0);
+  EXPECT_EQ(k::nasa7IntervalIndex(fe, 980.0), 1);
+  EXPECT_EQ(k::nasa7IntervalIndex(fe, 1200.0), 2);
+  EXPECT_EQ(k::nasa7IntervalIndex(fe, 5000.0), 2); // extrapolates the last interval
+  EXPECT_TRUE(k::nasa7InRange(Species::Fe3O4, 1173.15));
+  EXPECT_FALSE(k::nasa7InRange(Species::Fe3O4, 2000.0));
+  EXPECT_FALSE(k::nasa7InRange(Species::Fe2O3, 250.0));
+}
+
+// The Burcat fits are continuous at the 1000 K break to well below 1 J/mol (H) and 0.1 %
+// (C_p); a wrong coefficient set would break this by orders of magnitude.
+TEST(Nasa7, ContinuousAtTheMidpointForGases) {
+  for (Species s : {Species::CO, Species::CO2, Species::H2, Species::H2O, Species::N2, Species::C}) {
+    SCOPED_TRACE(static_cast<int>(s));
+    const double below = 1000.0 * (1.0 - 1e-12);
+    EXPECT_NEAR(k::nasa7EnthalpyMolar(s, below), k::nasa7EnthalpyMolar(s, 1000.0), 1.0);
+    EXPECT_NEAR(k::nasa7CpMolar(s, below), k::nasa7CpMolar(s, 1000.0),
+                1e-3 * k::nasa7CpMolar(s, 1000.0));
+  }
+}
+
+// ΔH_r(T) vs reference/nasa.py (printed to 11 significant digits) → 1e-9 relative.
+TEST(ReactionEnthalpy, MatchesReferenceScript) {
+  struct Row {
+    double t;
+    double dh[5];
+  };
+  const Row rows[] = {
+      {298.15, {1.7244902145e+05, 1.3129525120e+05, -4.1153770249e+04, -4.7001726854e+04, -5.8479566050e+03}},
+      {1073.15, {1.6992109543e+05, 1.3588043422e+05, -3.4040661208e+04, -3.8819141453e+04, -4.7784802453e+03}},
+      {1173.15, {1.6889680007e+05, 1.3580729144e+05, -3.3089508636e+04, -3.9513193113e+04, -6.4236844773e+03}},
+      {1223.15, {1.6836718336e+05, 1.3573825311e+05, -3.2628930257e+04, -4.0141464098e+04, -7.5125338411e+03}}};
+  for (const Row& r : rows) {
+    for (int i = 0; i < 5; ++i) {
+      SCOPED_TRACE(r.t);
+      SCOPED_TRACE(i);
+      const double dh = k::reactionEnthalpy(static_cast<k::ClgReaction>(i), r.t);
+      EXPECT_NEAR(dh, r.dh[i], 1e-9 * std::fabs(r.dh[i]));
+    }
+  }
+  // PHYSICS §3.5 table (kJ/mol, rounded): R1 +172.45 and R4 −47.0 at 298.15 K.
+  EXPECT_NEAR(k::reactionEnthalpy(k::ClgReaction::R1, 298.15) / 1e3, 172.45, 0.005);
+  EXPECT_NEAR(k::reactionEnthalpy(k::ClgReaction::R4, 298.15) / 1e3, -47.0, 0.05);
+}
+
+// Thermodynamic WGS equilibrium constant vs reference/nasa.py ("K_thermo").
+TEST(ReactionEnthalpy, WgsEquilibriumConstantFromGibbs) {
+  const k::Stoichiometry wgs = k::clgStoichiometry(k::ClgReaction::R3);
+  EXPECT_NEAR(k::equilibriumConstant(wgs, 1000.0), 1.435337193742, 1e-11);
+  EXPECT_NEAR(k::equilibriumConstant(wgs, 1173.15), 0.7854914807524, 1e-11);
+}
+
+// Molar masses from atomic masses: every CLG reaction balances to round-off (a few ulp of
+// the largest term, 3 M_Fe2O3 ≈ 0.48 kg/mol → 2e-16), and they match PHYSICS §6 to 2e-6.
+TEST(ReactionEnthalpy, ReactionsBalanceMassToRoundOff) {
+  for (int i = 0; i < static_cast<int>(k::ClgReaction::Count); ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_LE(std::fabs(k::stoichiometricMassBalance(k::clgStoichiometry(static_cast<k::ClgReaction>(i)))),
+              2e-16);
+  }
+  struct Row {
+    Species s;
+    double gPerMol;
+  };
+  const Row table[] = {{Species::C, 12.011},  {Species::CO, 28.010},     {Species::CO2, 44.009},
+                       {Species::H2, 2.016},  {Species::H2O, 18.015},    {Species::N2, 28.014},
+                       {Species::Fe2O3, 159.688}, {Species::Fe3O4, 231.533}, {Species::Al2O3, 101.961}};
+  for (const Row& r : table) {
+    SCOPED_TRACE(static_cast<int>(r.s));
+    EXPECT_NEAR(k::molarMass(r.s) * 1e3, r.gPerMol, 2.1e-3);
+  }
+}
