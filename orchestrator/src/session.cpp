@@ -858,6 +858,21 @@ CaseConfig loadRunCase(const fs::path& runDir) {
   return c;
 }
 
+namespace {
+/// Nothing half-written after a failure: checkpoint folders without a manifest and a
+/// snapshot being received are removed.
+void removeIncomplete(const fs::path& runDir) {
+  for (const auto step : listCheckpointSteps(runDir)) {
+    const fs::path d = checkpointDir(runDir, step);
+    if (!fs::exists(d / "manifest.json")) {
+      logger("orchestrator.session")->info("removing incomplete checkpoint {}", d.string());
+      fs::remove_all(d);
+    }
+  }
+  fs::remove_all(runDir / "snapshots" / ".incoming");
+}
+} // namespace
+
 int runSession(const CaseConfig& config, const RunOptions& options) {
   auto log = logger("orchestrator.session");
   std::signal(SIGINT, onSignal);
@@ -870,11 +885,13 @@ int runSession(const CaseConfig& config, const RunOptions& options) {
       Session session(config, opts);
       return session.run();
     } catch (const Interrupted& e) {
+      removeIncomplete(opts.runDir);
       log->error("{}; participants stopped. Continue with: coredem resume {}", e.what(),
                  opts.runDir.string());
       return kExitInterrupted;
     } catch (const ParticipantFault& e) {
       log->error("{}", e.what());
+      removeIncomplete(opts.runDir);
       const bool canResume = selectResumeCheckpoint(opts.runDir).dir.has_value();
       if (restartsLeft > 0 && canResume) {
         --restartsLeft;

@@ -1,0 +1,362 @@
+// End-to-end tests of `coredem run/resume` with the real DEM server and coredem-gas:
+// restart identity (200 straight == 100 + resume + 100, bitwise DEM state on the cpu
+// backend), kill -9 of the DEM server (with and without --auto-restart), bad case files.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <fcntl.h>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <spawn.h>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+#include <vector>
+
+extern char** environ;
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace {
+
+const fs::path kBin = COREDEM_BIN_DIR;
+const fs::path kCases = COREDEM_E2E_CASES;
+
+fs::path tempDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() /
+                     ("coredem-e2e-" + std::to_string(::getpid()) + "-" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string readAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Starts coredem with `args`, output into `log`. Returns the pid.
+pid_t startCoredem(const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<std::string> argv = {(kBin / "coredem").string()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> c;
+  for (auto& a : argv) {
+    c.push_back(a.data());
+  }
+  c.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, c[0], &fa, nullptr, c.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  EXPECT_EQ(rc, 0) << "cannot start " << argv[0];
+  return pid;
+}
+
+/// Waits for pid with a deadline (kills it on timeout); returns the exit code (-signal).
+int waitExit(pid_t pid, std::chrono::seconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  int status = 0;
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > end) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      ADD_FAILURE() << "coredem did not finish within " << timeout.count() << " s";
+      return -1000;
+    }
+    std::this_thread::sleep_for(5ms);
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+}
+
+int runCoredem(const std::vector<std::string>& args, const fs::path& log,
+               std::chrono::seconds timeout = 50s) {
+  return waitExit(startCoredem(args, log), timeout);
+}
+
+/// Direct children of `parent` whose command name is `comm`.
+std::vector<pid_t> childrenNamed(pid_t parent, const std::string& comm) {
+  std::vector<pid_t> out;
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string name = e.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) {
+      continue;
+    }
+    const std::string stat = readAll(e.path() / "stat");
+    const auto open = stat.find('('), close = stat.rfind(')');
+    if (open == std::string::npos || close == std::string::npos) {
+      continue;
+    }
+    const std::string c = stat.substr(open + 1, close - open - 1);
+    std::istringstream rest(stat.substr(close + 2));
+    char state;
+    pid_t ppid;
+    rest >> state >> ppid;
+    if (ppid == parent && c == comm.substr(0, 15)) {
+      out.push_back(std::stoi(name));
+    }
+  }
+  return out;
+}
+
+/// The DEM state file listed in a checkpoint manifest.
+fs::path demStateOf(const fs::path& checkpoint) {
+  const std::string m = readAll(checkpoint / "manifest.json");
+  std::smatch match;
+  const std::regex re("\\{\"path\": \"([^\"]+)\", \"participant\": \"dem\"");
+  EXPECT_TRUE(std::regex_search(m, match, re)) << "no DEM file in " << checkpoint;
+  return checkpoint / match[1].str();
+}
+
+/// Every dataset of an HDF5 file as raw bytes (in its own file type), by path.
+herr_t collectDataset(hid_t g, const char* name, const H5L_info_t*, void* data) {
+  auto& out = *static_cast<std::map<std::string, std::string>*>(data);
+  H5O_info_t info;
+#if H5_VERSION_GE(1, 12, 0)
+  H5Oget_info_by_name3(g, name, &info, H5O_INFO_BASIC, H5P_DEFAULT);
+#else
+  H5Oget_info_by_name2(g, name, &info, H5O_INFO_BASIC, H5P_DEFAULT);
+#endif
+  if (info.type != H5O_TYPE_DATASET) {
+    return 0;
+  }
+  const hid_t ds = H5Dopen2(g, name, H5P_DEFAULT);
+  const hid_t type = H5Dget_type(ds);
+  if (H5Tis_variable_str(type) <= 0) {
+    const hid_t space = H5Dget_space(ds);
+    const std::size_t bytes = std::size_t(H5Sget_simple_extent_npoints(space)) * H5Tget_size(type);
+    std::string buf(bytes, '\0');
+    if (bytes > 0) {
+      H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data());
+    }
+    out[name] = buf;
+    H5Sclose(space);
+  }
+  H5Tclose(type);
+  H5Dclose(ds);
+  return 0;
+}
+
+std::map<std::string, std::string> datasetsOf(const fs::path& file) {
+  std::map<std::string, std::string> out;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  EXPECT_GE(f, 0) << "cannot open " << file;
+  if (f >= 0) {
+    H5Lvisit(f, H5_INDEX_NAME, H5_ITER_INC, collectDataset, &out);
+    H5Fclose(f);
+  }
+  return out;
+}
+
+/// Asserts that two DEM state files hold bitwise identical particle and contact datasets.
+void expectSameDemState(const fs::path& a, const fs::path& b) {
+  const auto da = datasetsOf(a), db = datasetsOf(b);
+  ASSERT_FALSE(da.empty());
+  ASSERT_TRUE(da.count("particles/position")) << "no particles/position in " << a;
+  std::size_t compared = 0;
+  for (const auto& [name, bytes] : da) {
+    if (name.rfind("particles/", 0) != 0 && name.rfind("contacts/", 0) != 0) {
+      continue;
+    }
+    ASSERT_TRUE(db.count(name)) << name << " missing in " << b;
+    EXPECT_TRUE(bytes == db.at(name)) << "dataset " << name << " differs between " << a << " and " << b;
+    ++compared;
+  }
+  EXPECT_GE(compared, 5u);
+}
+
+std::vector<fs::path> leftovers(const fs::path& runDir) {
+  std::vector<fs::path> out;
+  for (const auto& e : fs::recursive_directory_iterator(runDir)) {
+    if (e.path().filename().string().find(".tmp") != std::string::npos) {
+      out.push_back(e.path());
+    }
+  }
+  return out;
+}
+
+class CoredemE2E : public ::testing::Test {
+protected:
+  void SetUp() override {
+    for (const char* exe : {"coredem", "coredem-dem", "coredem-gas"}) {
+      ASSERT_EQ(::access((kBin / exe).c_str(), X_OK), 0)
+          << (kBin / exe) << " is not built: build all targets first";
+    }
+    dir = tempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+  void TearDown() override {
+    if (!HasFailure()) {
+      fs::remove_all(dir);
+    }
+  }
+  fs::path dir;
+  const fs::path restartCase = kCases / "restart";
+  const fs::path finalCheckpoint = "checkpoints/00000200";
+};
+
+} // namespace
+
+// 200 steps straight vs 100 + resume + 100: bitwise identical DEM state (particles and
+// contact history), identical gas ledgers and identical physical timeseries columns.
+TEST_F(CoredemE2E, RestartIdentity) {
+  const fs::path a = dir / "straight", b = dir / "split";
+  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", a.string()}, dir / "a.log"), 0)
+      << readAll(dir / "a.log");
+  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", b.string(), "--stop-after", "100"},
+                       dir / "b1.log"),
+            0)
+      << readAll(dir / "b1.log");
+  ASSERT_TRUE(fs::exists(b / "checkpoints/00000100/manifest.json"));
+  ASSERT_FALSE(fs::exists(b / finalCheckpoint));
+  ASSERT_EQ(runCoredem({"resume", b.string()}, dir / "b2.log"), 0) << readAll(dir / "b2.log");
+  EXPECT_NE(readAll(dir / "b2.log").find("resuming"), std::string::npos);
+  expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(b / finalCheckpoint));
+  // Same number of rows, and the simulated time column identical.
+  const std::string ta = readAll(a / "timeseries.csv"), tb = readAll(b / "timeseries.csv");
+  EXPECT_EQ(std::count(ta.begin(), ta.end(), '\n'), 201);
+  EXPECT_EQ(std::count(tb.begin(), tb.end(), '\n'), 201);
+  EXPECT_TRUE(leftovers(b).empty());
+  // Snapshots: 0, 50, 100, 150, 200 in both, listed in particles.xdmf.
+  for (const auto& run : {a, b}) {
+    for (int s : {0, 50, 100, 150, 200}) {
+      char name[64];
+      std::snprintf(name, sizeof name, "snapshots/particles_%08d.h5", s);
+      EXPECT_TRUE(fs::exists(run / name)) << run / name;
+    }
+    EXPECT_NE(readAll(run / "particles.xdmf").find("particles_00000200.h5:/particles/position"),
+              std::string::npos);
+  }
+}
+
+// kill -9 of the DEM server mid-run with --auto-restart 1: the run completes from the last
+// checkpoint and ends in the same state as an uninterrupted run.
+TEST_F(CoredemE2E, KillDemServerAutoRestart) {
+  const fs::path a = dir / "straight", k = dir / "killed";
+  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", a.string()}, dir / "a.log"), 0)
+      << readAll(dir / "a.log");
+  const pid_t o = startCoredem(
+      {"run", restartCase.string(), "--out", k.string(), "--auto-restart", "1"}, dir / "k.log");
+  // Kill D once the checkpoint of step 40 is complete (the run is then mid-way).
+  const auto end = std::chrono::steady_clock::now() + 40s;
+  pid_t killed = 0;
+  while (std::chrono::steady_clock::now() < end && !killed) {
+    if (fs::exists(k / "checkpoints/00000040/manifest.json")) {
+      const auto dems = childrenNamed(o, "coredem-dem");
+      ASSERT_EQ(dems.size(), 1u);
+      ::kill(dems[0], SIGKILL);
+      killed = dems[0];
+    }
+    std::this_thread::sleep_for(2ms);
+  }
+  ASSERT_NE(killed, 0) << "never saw checkpoint 40";
+  ASSERT_EQ(waitExit(o, 50s), 0) << readAll(dir / "k.log");
+  const std::string log = readAll(dir / "k.log");
+  EXPECT_NE(log.find("DEM server coredem-dem: process " + std::to_string(killed) +
+                     " killed by signal 9"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("auto-restart"), std::string::npos) << log;
+  expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(k / finalCheckpoint));
+  EXPECT_TRUE(leftovers(k).empty());
+}
+
+// Without --auto-restart: the fault is named, the CFD participant is shut down, exit code 1,
+// no temp files, and every checkpoint folder left is complete.
+TEST_F(CoredemE2E, KillDemServerReportsAndStops) {
+  const fs::path k = dir / "killed";
+  const pid_t o = startCoredem({"run", restartCase.string(), "--out", k.string()}, dir / "k.log");
+  const auto end = std::chrono::steady_clock::now() + 40s;
+  pid_t gas = 0;
+  bool killed = false;
+  while (std::chrono::steady_clock::now() < end && !killed) {
+    if (fs::exists(k / "checkpoints/00000020/manifest.json")) {
+      const auto dems = childrenNamed(o, "coredem-dem");
+      const auto gases = childrenNamed(o, "coredem-gas");
+      ASSERT_EQ(dems.size(), 1u);
+      ASSERT_EQ(gases.size(), 1u);
+      gas = gases[0];
+      ::kill(dems[0], SIGKILL);
+      killed = true;
+    }
+    std::this_thread::sleep_for(2ms);
+  }
+  ASSERT_TRUE(killed);
+  EXPECT_EQ(waitExit(o, 50s), 1);
+  const std::string log = readAll(dir / "k.log");
+  EXPECT_NE(log.find("DEM server coredem-dem: process"), std::string::npos) << log;
+  EXPECT_NE(log.find("killed by signal 9 (SIGKILL)"), std::string::npos) << log;
+  EXPECT_NE(log.find("coredem resume"), std::string::npos) << log;
+  EXPECT_NE(::kill(gas, 0), 0) << "coredem-gas (pid " << gas << ") still runs";
+  EXPECT_TRUE(leftovers(k).empty());
+  for (const auto& e : fs::directory_iterator(k / "checkpoints")) {
+    EXPECT_TRUE(fs::exists(e.path() / "manifest.json")) << "incomplete checkpoint left: " << e.path();
+  }
+}
+
+// Bad case files: a clear message naming file, line and key; exit code 2; nothing written.
+namespace {
+struct BadCase {
+  std::string name;
+  std::string from, to;       // textual edit of the restart case
+  std::string expected;       // message fragment
+};
+
+std::string editedCase(const std::string& from, const std::string& to) {
+  std::string text = readAll(kCases / "restart" / "case.yaml");
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  return text.replace(pos, from.size(), to);
+}
+} // namespace
+
+class BadCaseTest : public ::testing::TestWithParam<BadCase> {};
+
+TEST_P(BadCaseTest, ClearMessageExitTwoNothingWritten) {
+  ASSERT_EQ(::access((kBin / "coredem").c_str(), X_OK), 0);
+  const BadCase& bc = GetParam();
+  const fs::path d = tempDir("bad-" + bc.name);
+  fs::create_directories(d / "case");
+  std::ofstream(d / "case" / "case.yaml") << editedCase(bc.from, bc.to);
+  const fs::path out = d / "run";
+  const int rc = runCoredem({"run", (d / "case").string(), "--out", out.string()}, d / "log", 30s);
+  const std::string log = readAll(d / "log");
+  EXPECT_EQ(rc, 2) << log;
+  EXPECT_NE(log.find(bc.expected), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(out)) << "coredem wrote " << out << " for a bad case";
+  fs::remove_all(d);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Orchestrator, BadCaseTest,
+    ::testing::Values(
+        BadCase{"UnknownKey", "  every_steps: 20", "  every_step: 20",
+                "case.yaml:40:3: checkpoint.every_step: unknown key; allowed keys in "
+                "'checkpoint': every_steps, every_seconds, keep"},
+        BadCase{"WrongType", "  dt: 5.0e-4", "  dt: fast",
+                "case.yaml:6:7: time.dt: expected a number"},
+        BadCase{"MissingFile", "particles:", "initial_state: beads-at-rest.h5\nparticles:",
+                "initial_state: file 'beads-at-rest.h5' not found"},
+        BadCase{"GasSectionUnknownKey", "  T_g: 500.0", "  T_gas: 500.0", "T_gas"}),
+    [](const auto& info) { return info.param.name; });
+
+TEST(CoredemCli, MissingCaseFolderExitsTwo) {
+  const fs::path d = tempDir("nocase");
+  const int rc = runCoredem({"run", (d / "nope").string(), "--out", (d / "run").string()},
+                            d / "log", 30s);
+  EXPECT_EQ(rc, 2);
+  EXPECT_NE(readAll(d / "log").find("case file not found"), std::string::npos);
+  EXPECT_FALSE(fs::exists(d / "run"));
+  fs::remove_all(d);
+}
