@@ -1,0 +1,204 @@
+#pragma once
+/// @file
+/// The coupling client: the only thing a CFD solver links to take part in a CoReDEM run
+/// (docs/client.md). One class behind pimpl; no ZeroMQ, protobuf or OpenFOAM type appears
+/// here, and this header compiles as C++14 (OpenFOAM translation units use C++14).
+///
+/// @code
+///   coredem::client::Participant p;            // endpoints from COREDEM_* environment variables
+///   p.initialize();                            // handshakes with O and D, first grant
+///   while (p.isRunning()) {
+///     ... advance the CFD solution by p.dt() ...
+///     const coredem::client::Sources& s = p.exchange(p.step(), p.dt(), {
+///         {"u_g", {u.data(), u.size()}}, {"grad_p", gradP}, {"T_g", T}, {"rho_g", rho},
+///         {"mu_g", mu}, {"kappa_g", kappa}, {"cp_g", cp}, {"Y_g", Y}});
+///     applySources(s.field("eps_g"), s.field("K_sl"), ...);
+///     p.advance(courant, ledgers, checkpointFiles);   // StepDone -> next grant or Shutdown
+///   }
+///   p.finalize();
+/// @endcode
+///
+/// Every call checks the participant's state first and throws StateError when called out of
+/// order; bad arguments throw ClientError(Argument); a peer that does not answer within the
+/// deadline throws ClientError(Timeout) naming the peer and the awaited reply.
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace coredem {
+namespace client {
+
+/// Read-only view of contiguous doubles (a C++14 stand-in for std::span<const double>).
+struct ConstView {
+  const double* data = nullptr;
+  std::size_t size = 0;
+
+  ConstView() = default;
+  ConstView(const double* d, std::size_t n) : data(d), size(n) {}
+  /// Any contiguous container of doubles (std::vector, std::array, std::span, Foam::List...).
+  template <class Container,
+            class = decltype(static_cast<const double*>(std::declval<const Container&>().data())),
+            class = decltype(static_cast<std::size_t>(std::declval<const Container&>().size()))>
+  ConstView(const Container& c) : data(c.data()), size(static_cast<std::size_t>(c.size())) {}
+
+  const double* begin() const { return data; }
+  const double* end() const { return data + size; }
+  double operator[](std::size_t i) const { return data[i]; }
+};
+
+/// One named array passed to exchange(): a GasFields name of docs/protocol.md and its values.
+struct NamedField {
+  std::string name;
+  ConstView values;
+};
+
+/// What went wrong, for callers that branch on it (and for the C API's status codes).
+enum class ErrorCode {
+  Argument = 1, ///< a bad argument or environment (missing endpoint, wrong field size, ...)
+  State = 2,    ///< a call out of order (see State)
+  Protocol = 3, ///< a malformed or unexpected message from a peer
+  Timeout = 4,  ///< a peer did not answer within the deadline
+  Peer = 5,     ///< a peer answered with Error or Reject (message has its code and text)
+  Internal = 6  ///< a bug in CoReDEM
+};
+
+/// Every error thrown by the client library.
+class ClientError : public std::runtime_error {
+public:
+  ClientError(ErrorCode code, const std::string& message)
+      : std::runtime_error(message), _code(code) {}
+  ErrorCode code() const { return _code; }
+
+private:
+  ErrorCode _code;
+};
+
+/// A call was made in a state that does not allow it.
+class StateError : public ClientError {
+public:
+  explicit StateError(const std::string& message) : ClientError(ErrorCode::State, message) {}
+};
+
+/// The participant's life cycle. Allowed calls:
+/// Created --initialize--> Granted (or Finished when O shut the run down at once)
+/// Granted --exchange--> Exchanged --advance--> Granted | Finished
+/// any --finalize--> Finalized
+enum class State { Created, Granted, Exchanged, Finished, Finalized };
+
+/// "Created", "Granted", ...
+const char* stateName(State s);
+
+/// How to reach the orchestrator (O) and the DEM server (D). Empty strings are taken from the
+/// environment: COREDEM_CONTROL_ENDPOINT, COREDEM_DEM_ENDPOINT, COREDEM_SESSION,
+/// COREDEM_TIMEOUT_S (docs/client.md).
+struct Options {
+  std::string controlEndpoint;
+  std::string demEndpoint;
+  std::string sessionId;
+  double timeoutSeconds = 0.0;   ///< per-request deadline; 0 = environment or 60 s
+  std::string name = "cfd";      ///< this participant's name in logs and messages
+  std::string softwareVersion;   ///< e.g. "coredemFoam 0.1.0"; empty = the library's version
+  /// CURVE keys (Z85) when D requires them (remote D): D's public key; the client key pair is
+  /// generated when empty. Environment: COREDEM_DEM_SERVER_KEY.
+  std::string demServerPublicKey;
+};
+
+/// The coupling grid and species from O's Configure.
+struct Grid {
+  double origin[3] = {0.0, 0.0, 0.0};   ///< m, lower corner of cell (0,0,0)
+  double spacing[3] = {0.0, 0.0, 0.0};  ///< m
+  std::int64_t counts[3] = {0, 0, 0};   ///< cells per axis; cell = i + nx*(j + ny*k)
+  std::vector<std::string> species;     ///< gas species, the column order of Y_g / R_species
+  std::vector<double> molarMasses;      ///< kg/mol, same order
+  std::int64_t cellCount() const { return counts[0] * counts[1] * counts[2]; }
+};
+
+/// Sources of the last exchange (sub-step averages over the CFD step), valid until the next
+/// exchange() or finalize(). Names: eps_g, K_sl, K_sl_Us, H, H_Tp, R_species, Q_hom.
+class Sources {
+public:
+  /// The named array; throws ClientError(Argument) for a name D did not send.
+  ConstView field(const std::string& name) const;
+  bool has(const std::string& name) const;
+  std::vector<std::string> names() const;
+  std::int64_t step = 0;
+  std::uint32_t substeps = 0;   ///< DEM sub-steps averaged
+  std::map<std::string, std::vector<double>> arrays;
+};
+
+/// Ledgers reported in StepDone (named doubles, docs/client.md).
+struct Ledgers {
+  std::vector<std::pair<std::string, double>> mass;    ///< kg
+  std::vector<std::pair<std::string, double>> energy;  ///< J
+  std::vector<std::pair<std::string, double>> species; ///< kg
+};
+
+class Participant {
+public:
+  explicit Participant(Options options = Options());
+  ~Participant();
+  Participant(const Participant&) = delete;
+  Participant& operator=(const Participant&) = delete;
+  Participant(Participant&&) noexcept;
+  Participant& operator=(Participant&&) noexcept;
+
+  /// Handshakes with O (Hello, Configure), connects to D (Hello), tells O it is ready and
+  /// waits for the first grant.
+  /// @pre state() == Created  @post state() == Granted, or Finished if O ended the run
+  void initialize();
+
+  State state() const;
+  /// True while O keeps granting steps (state Granted or Exchanged).
+  bool isRunning() const;
+
+  // ---- the current grant (valid in Granted / Exchanged) ---------------------------------
+  std::int64_t step() const;       ///< step number n of the grant
+  double time() const;             ///< s, simulated time at the start of step n
+  double dt() const;               ///< s, Δt_CFD of step n: advance exactly this much
+  int nSub() const;                ///< DEM sub-steps of the step
+  double dtDem() const;            ///< s, Δt_DEM = dt()/nSub()
+  bool requiresCheckpoint() const; ///< write your state after this step
+  std::string checkpointDir() const; ///< where to write it ("" if not requested)
+  /// Why O ended the run (valid in Finished).
+  std::string shutdownReason() const;
+
+  /// Coupling grid and species (valid after initialize).
+  const Grid& grid() const;
+  /// Start step and time from Configure (e.g. a restart).
+  std::int64_t startStep() const;
+  double startTime() const;
+
+  /// Sends the gas fields of step `step` to D and returns D's sources.
+  /// Required names: u_g [N*3], grad_p [N*3], T_g, rho_g, mu_g, kappa_g, cp_g [N],
+  /// Y_g [N*n_species]; sizes are checked here before anything is sent.
+  /// @pre state() == Granted, step == this->step(), dt == this->dt() (relative 1e-12)
+  /// @post state() == Exchanged
+  const Sources& exchange(std::int64_t step, double dt, const std::vector<NamedField>& fields);
+
+  /// The sources of the last exchange(). @pre state() == Exchanged
+  const Sources& sources() const;
+
+  /// Ends the step: StepDone to O with the Courant number, ledgers (cumulative or per step, as
+  /// documented by the participant) and the checkpoint files written for this step (paths
+  /// relative to checkpointDir()); then waits for the next grant or Shutdown.
+  /// @pre state() == Exchanged  @post state() == Granted or Finished
+  void advance(double courant, const Ledgers& ledgers = Ledgers(),
+               const std::vector<std::string>& checkpointFiles = std::vector<std::string>());
+
+  /// Closes both connections. Safe to call in any state (also after an error); a second
+  /// call is a no-op. @post state() == Finalized
+  void finalize();
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> _impl;
+};
+
+} // namespace client
+} // namespace coredem

@@ -1,0 +1,453 @@
+// The coupling client (docs/client.md): C's side of docs/session.md over the protocol library.
+#include "coredem/client/participant.h"
+
+#include "coredem/common/check.h"
+#include "coredem/common/log.h"
+#include "coredem/protocol/protocol.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <set>
+
+namespace coredem::client {
+
+namespace v1 = coredem::v1;
+namespace proto = coredem::protocol;
+
+namespace {
+
+constexpr const char* kLibraryVersion = "coredem-client 0.1.0";
+constexpr double kDefaultTimeoutS = 60.0;
+/// |dt - granted dt| <= kDtTolerance * granted dt (the DEM sub-cycles exactly the granted dt).
+constexpr double kDtTolerance = 1e-12;
+
+std::string fromEnv(const std::string& given, const char* var) {
+  if (!given.empty()) {
+    return given;
+  }
+  const char* v = std::getenv(var);
+  return v != nullptr ? std::string(v) : std::string();
+}
+
+} // namespace
+
+const char* stateName(State s) {
+  switch (s) {
+  case State::Created: return "Created";
+  case State::Granted: return "Granted";
+  case State::Exchanged: return "Exchanged";
+  case State::Finished: return "Finished";
+  case State::Finalized: return "Finalized";
+  }
+  return "?";
+}
+
+ConstView Sources::field(const std::string& name) const {
+  const auto it = arrays.find(name);
+  if (it == arrays.end()) {
+    throw ClientError(ErrorCode::Argument,
+                      "Sources: no array '" + name + "' (D sent: " +
+                          [&] {
+                            std::string s;
+                            for (const auto& kv : arrays) s += (s.empty() ? "" : ", ") + kv.first;
+                            return s;
+                          }() +
+                          ")");
+  }
+  return ConstView(it->second.data(), it->second.size());
+}
+
+bool Sources::has(const std::string& name) const { return arrays.count(name) == 1; }
+
+std::vector<std::string> Sources::names() const {
+  std::vector<std::string> n;
+  for (const auto& kv : arrays) {
+    n.push_back(kv.first);
+  }
+  return n;
+}
+
+struct Participant::Impl {
+  Options opt;
+  State state = State::Created;
+  std::chrono::milliseconds timeout{60000};
+  std::string controlEp, demEp, session;
+  std::unique_ptr<proto::Client> control, dem;
+  std::shared_ptr<spdlog::logger> log = coredem::logger("client");
+
+  Grid grid;
+  std::int64_t startStep = 0;
+  double startTime = 0.0;
+
+  // The current grant.
+  std::int64_t step = 0;
+  double time = 0.0, dt = 0.0, dtDem = 0.0;
+  int nSub = 0;
+  std::string checkpointDir;
+  std::string shutdownReason;
+
+  Sources sources;
+
+  void require(std::initializer_list<State> allowed, const char* call, const char* hint) const {
+    for (State s : allowed) {
+      if (s == state) {
+        return;
+      }
+    }
+    throw StateError(fmt::format("Participant::{}() called in state {}: {}", call,
+                                 stateName(state), hint));
+  }
+
+  proto::TransportOptions transport(bool forDem) const {
+    proto::TransportOptions t;
+    t.sender = opt.name + " (" + (opt.softwareVersion.empty() ? kLibraryVersion : opt.softwareVersion) + ")";
+    if (forDem) {
+      const auto key = fromEnv(opt.demServerPublicKey, "COREDEM_DEM_SERVER_KEY");
+      if (!key.empty()) {
+        const auto pair = proto::generateCurveKeyPair();
+        t.curve.serverPublicKey = key;
+        t.curve.clientPublicKey = pair.first;
+        t.curve.clientSecretKey = pair.second;
+      }
+    }
+    return t;
+  }
+
+  /// Takes a grant or Shutdown reply of O.
+  void takeGrantOrShutdown(const proto::Message& reply, std::int64_t expectedStep) {
+    if (reply.type() == v1::MESSAGE_TYPE_SHUTDOWN) {
+      shutdownReason = reply.envelope().shutdown().reason();
+      state = State::Finished;
+      log->info("{}: the orchestrator ended the run ({})", opt.name,
+                shutdownReason.empty() ? "no reason given" : shutdownReason);
+      return;
+    }
+    proto::expectType(reply, v1::MESSAGE_TYPE_STEP_GRANT);
+    proto::Expectation e;
+    e.types = {v1::MESSAGE_TYPE_STEP_GRANT};
+    e.step = expectedStep;
+    if (const auto s = proto::validate(reply, e); !s.ok()) {
+      throw proto::ProtocolError(s.code, "orchestrator " + controlEp + " sent a bad StepGrant: " +
+                                             s.message);
+    }
+    const auto& g = reply.envelope().step_grant();
+    COREDEM_CHECK(g.dt_cfd() > 0.0 && g.n_sub() >= 1,
+                  "orchestrator {} granted step {} with dt_cfd = {} s and n_sub = {}: both must "
+                  "be positive", controlEp, expectedStep, g.dt_cfd(), g.n_sub());
+    step = reply.envelope().step();
+    time = reply.envelope().time();
+    dt = g.dt_cfd();
+    nSub = static_cast<int>(g.n_sub());
+    dtDem = g.dt_dem() > 0.0 ? g.dt_dem() : dt / nSub;
+    checkpointDir = g.has_checkpoint() ? g.checkpoint().directory() : std::string();
+    state = State::Granted;
+  }
+
+  proto::Message handshake(proto::Client& client, const std::string& peer) {
+    auto hello = proto::makeHello(v1::ROLE_CFD,
+                                  opt.softwareVersion.empty() ? kLibraryVersion : opt.softwareVersion);
+    hello.setSessionId(session);
+    auto reply = client.request(std::move(hello), timeout);
+    proto::expectType(reply, v1::MESSAGE_TYPE_WELCOME);
+    const auto& w = reply.envelope().welcome();
+    COREDEM_CHECK(w.protocol_major() == proto::kProtocolVersion.major,
+                  "{} at {} speaks protocol {}.{}, this client {}", peer, client.endpoint(),
+                  w.protocol_major(), w.protocol_minor(), proto::kProtocolVersion.toString());
+    log->info("{}: connected to {} at {} (protocol {}.{}, session {})", opt.name, peer,
+              client.endpoint(), w.protocol_major(), w.protocol_minor(), session);
+    return reply;
+  }
+
+  void initialize() {
+    controlEp = fromEnv(opt.controlEndpoint, "COREDEM_CONTROL_ENDPOINT");
+    demEp = fromEnv(opt.demEndpoint, "COREDEM_DEM_ENDPOINT");
+    session = fromEnv(opt.sessionId, "COREDEM_SESSION");
+    COREDEM_CHECK(!controlEp.empty(), "no orchestrator control endpoint: set COREDEM_CONTROL_ENDPOINT "
+                  "(or Options::controlEndpoint / --control), e.g. tcp://127.0.0.1:40123");
+    COREDEM_CHECK(!demEp.empty(), "no DEM server endpoint: set COREDEM_DEM_ENDPOINT (or "
+                  "Options::demEndpoint / --dem), e.g. tcp://127.0.0.1:40125");
+    COREDEM_CHECK(!session.empty(), "no session id: set COREDEM_SESSION (or Options::sessionId / "
+                  "--session) to the id the orchestrator passes");
+    double t = opt.timeoutSeconds;
+    if (t <= 0.0) {
+      const auto env = fromEnv("", "COREDEM_TIMEOUT_S");
+      t = kDefaultTimeoutS;
+      if (!env.empty()) {
+        char* end = nullptr;
+        t = std::strtod(env.c_str(), &end);
+        COREDEM_CHECK(end != env.c_str() && *end == '\0' && t > 0.0,
+                      "COREDEM_TIMEOUT_S='{}' is not a positive number of seconds", env);
+      }
+    }
+    timeout = std::chrono::milliseconds(static_cast<std::int64_t>(std::ceil(t * 1000.0)));
+
+    // 1. Hello to O.
+    control = std::make_unique<proto::Client>(transport(false));
+    control->connect(controlEp);
+    handshake(*control, "orchestrator");
+
+    // 2. The case.
+    proto::Message ask(v1::MESSAGE_TYPE_CONFIGURE);
+    ask.setBody(v1::Configure{});
+    ask.setSessionId(session);
+    auto cfg = control->request(std::move(ask), timeout);
+    proto::expectType(cfg, v1::MESSAGE_TYPE_CONFIGURE);
+    const auto& c = cfg.envelope().configure();
+    COREDEM_CHECK(c.coupling_mesh().has_cartesian(),
+                  "orchestrator {} sent a Configure without a Cartesian coupling grid; this "
+                  "client supports coupling_mesh.cartesian only", controlEp);
+    const auto& g = c.coupling_mesh().cartesian();
+    grid.origin[0] = g.origin().x(); grid.origin[1] = g.origin().y(); grid.origin[2] = g.origin().z();
+    grid.spacing[0] = g.spacing().x(); grid.spacing[1] = g.spacing().y(); grid.spacing[2] = g.spacing().z();
+    grid.counts[0] = static_cast<std::int64_t>(g.counts().x());
+    grid.counts[1] = static_cast<std::int64_t>(g.counts().y());
+    grid.counts[2] = static_cast<std::int64_t>(g.counts().z());
+    COREDEM_CHECK(grid.cellCount() > 0, "orchestrator {} sent an empty coupling grid ({} x {} x {})",
+                  controlEp, grid.counts[0], grid.counts[1], grid.counts[2]);
+    grid.species.clear();
+    grid.molarMasses.clear();
+    for (const auto& s : c.species()) {
+      grid.species.push_back(s.name());
+      grid.molarMasses.push_back(s.molar_mass());
+    }
+    startStep = c.start_step();
+    startTime = c.start_time();
+
+    // 3. Hello to D.
+    dem = std::make_unique<proto::Client>(transport(true));
+    dem->connect(demEp);
+    handshake(*dem, "DEM server");
+
+    // 4. Ready: the reply is the first grant.
+    auto ready = proto::makeConfigured(static_cast<std::uint64_t>(grid.cellCount()), 0,
+                                       static_cast<std::uint32_t>(grid.species.size()), 0, 0.0);
+    ready.setSessionId(session);
+    ready.setStep(startStep);
+    takeGrantOrShutdown(control->request(std::move(ready), timeout), startStep + 1);
+    if (state == State::Granted) {
+      log->info("{}: coupled on a {} x {} x {} grid with {} species; first grant: step {}, dt {} s",
+                opt.name, grid.counts[0], grid.counts[1], grid.counts[2], grid.species.size(), step, dt);
+    }
+  }
+
+  const Sources& exchange(std::int64_t s, double d, const std::vector<NamedField>& fields) {
+    COREDEM_CHECK(s == step, "exchange(step = {}): the granted step is {}; send the fields of the "
+                  "granted step", s, step);
+    COREDEM_CHECK(std::abs(d - dt) <= kDtTolerance * dt,
+                  "exchange(dt = {:.17g} s): the granted dt of step {} is {:.17g} s; the DEM "
+                  "sub-cycles exactly the granted dt, so advance by dt()", d, step, dt);
+    const auto cells = static_cast<std::uint64_t>(grid.cellCount());
+    const auto ns = static_cast<std::uint64_t>(grid.species.size());
+    std::map<std::string, ConstView> given;
+    for (const auto& f : fields) {
+      COREDEM_CHECK(proto::fields::findField(f.name) != nullptr &&
+                        std::any_of(proto::fields::gasFields().begin(), proto::fields::gasFields().end(),
+                                    [&](const auto& spec) { return spec.name == f.name; }),
+                    "exchange: '{}' is not a GasFields array; the names are u_g, grad_p, T_g, "
+                    "rho_g, mu_g, kappa_g, cp_g, Y_g", f.name);
+      COREDEM_CHECK(given.emplace(f.name, f.values).second, "exchange: field '{}' given twice", f.name);
+    }
+    auto msg = proto::makeGasFields(step, time, dt, cells, static_cast<std::uint32_t>(ns));
+    msg.setSessionId(session);
+    for (const auto& spec : proto::fields::gasFields()) {
+      const std::string name(spec.name);
+      const auto it = given.find(name);
+      COREDEM_CHECK(it != given.end(), "exchange: the gas field '{}' ({}) is missing", name,
+                    spec.unit);
+      const auto shape = proto::fields::shapeOf(spec.extent, cells, ns);
+      const std::uint64_t n = cells * proto::fields::componentsOf(spec.extent, ns);
+      COREDEM_CHECK(it->second.size == n,
+                    "exchange: '{}' has {} values; the coupling grid has {} cells, so it needs {} "
+                    "({} per cell)", name, it->second.size, cells, n,
+                    proto::fields::componentsOf(spec.extent, ns));
+      COREDEM_CHECK(n == 0 || it->second.data != nullptr, "exchange: '{}' points to null", name);
+      // No copy: request() returns only after D replied, i.e. after the frames were sent.
+      msg.addArrayShared<double>(name, std::shared_ptr<const void>(it->second.data, [](const void*) {}),
+                                 std::span<const double>(it->second.data, it->second.size), shape);
+    }
+    // Receive the sources straight into our vectors (one copy).
+    Sources next;
+    proto::ReceiveOptions ro;
+    ro.buffers = [&next](const v1::ArrayDescriptor& d) -> std::span<std::byte> {
+      if (d.dtype() != v1::DTYPE_FLOAT64 || d.byte_length() % sizeof(double) != 0) {
+        return {};
+      }
+      auto& v = next.arrays[d.name()];
+      v.resize(d.byte_length() / sizeof(double));
+      return std::as_writable_bytes(std::span<double>(v));
+    };
+    auto reply = dem->request(std::move(msg), timeout, ro);
+    proto::expectType(reply, v1::MESSAGE_TYPE_SOURCES);
+    proto::Expectation e;
+    e.types = {v1::MESSAGE_TYPE_SOURCES};
+    e.step = step;
+    e.cells = cells;
+    e.species = ns;
+    if (const auto st = proto::validate(reply, e); !st.ok()) {
+      throw proto::ProtocolError(st.code, "DEM server " + demEp + " sent bad Sources for step " +
+                                              std::to_string(step) + ": " + st.message);
+    }
+    for (const auto& spec : proto::fields::sourceFields()) {
+      const std::string name(spec.name);
+      if (next.arrays.count(name) == 0) {  // received without the provider (not float64)
+        const auto v = reply.values<double>(name);
+        next.arrays[name].assign(v.begin(), v.end());
+      }
+    }
+    next.step = step;
+    next.substeps = reply.envelope().sources().substeps();
+    sources = std::move(next);
+    state = State::Exchanged;
+    return sources;
+  }
+
+  void advance(double courant, const Ledgers& ledgers, const std::vector<std::string>& files) {
+    COREDEM_CHECK(std::isfinite(courant) && courant >= 0.0,
+                  "advance: the Courant number must be finite and >= 0 (got {})", courant);
+    COREDEM_CHECK(files.empty() || !checkpointDir.empty(),
+                  "advance: checkpoint files given for step {}, but its grant asked for no "
+                  "checkpoint", step);
+    v1::StepDone body;
+    body.set_cfl(courant);
+    auto fill = [](auto* list, const std::vector<std::pair<std::string, double>>& values) {
+      for (const auto& [name, value] : values) {
+        proto::addNamedValue(list, name, value);
+      }
+    };
+    fill(body.mutable_ledger()->mutable_mass(), ledgers.mass);
+    fill(body.mutable_ledger()->mutable_energy(), ledgers.energy);
+    fill(body.mutable_ledger()->mutable_species(), ledgers.species);
+    if (!checkpointDir.empty()) {
+      body.mutable_checkpoint()->set_directory(checkpointDir);
+      for (const auto& f : files) {
+        body.mutable_checkpoint()->add_files(f);
+      }
+    }
+    auto done = proto::makeStepDone(step, time, body);
+    done.setSessionId(session);
+    takeGrantOrShutdown(control->request(std::move(done), timeout), step + 1);
+  }
+
+  void finalize() {
+    if (state == State::Finalized) {
+      return;
+    }
+    if (state == State::Granted || state == State::Exchanged) {
+      log->warn("{}: finalize() during step {} before the orchestrator ended the run", opt.name, step);
+    }
+    dem.reset();
+    control.reset();
+    sources = Sources();
+    state = State::Finalized;
+  }
+};
+
+namespace {
+
+/// Runs f, turning every exception into ClientError with the matching code.
+template <class F> decltype(auto) guarded(const char* call, F&& f) {
+  try {
+    return f();
+  } catch (const ClientError&) {
+    throw;
+  } catch (const proto::TimeoutError& e) {
+    throw ClientError(ErrorCode::Timeout, std::string(call) + ": " + e.what());
+  } catch (const proto::PeerError& e) {
+    throw ClientError(ErrorCode::Peer, std::string(call) + ": the peer refused: " + e.what());
+  } catch (const proto::TransportError& e) {
+    throw ClientError(ErrorCode::Protocol, std::string(call) + ": " + e.what());
+  } catch (const proto::ProtocolError& e) {
+    throw ClientError(ErrorCode::Protocol, std::string(call) + ": " + e.what());
+  } catch (const coredem::UserError& e) {
+    throw ClientError(ErrorCode::Argument, std::string(call) + ": " + e.what());
+  } catch (const std::exception& e) {
+    throw ClientError(ErrorCode::Internal, std::string(call) + ": internal error: " + e.what());
+  }
+}
+
+} // namespace
+
+Participant::Participant(Options options) : _impl(std::make_unique<Impl>()) {
+  _impl->opt = std::move(options);
+}
+Participant::~Participant() {
+  if (_impl) {
+    try {
+      _impl->finalize();
+    } catch (...) { // never throw from a destructor
+    }
+  }
+}
+Participant::Participant(Participant&&) noexcept = default;
+Participant& Participant::operator=(Participant&&) noexcept = default;
+
+void Participant::initialize() {
+  _impl->require({State::Created}, "initialize", "initialize() is called once, first");
+  guarded("initialize", [&] { _impl->initialize(); });
+}
+
+State Participant::state() const { return _impl->state; }
+bool Participant::isRunning() const {
+  return _impl->state == State::Granted || _impl->state == State::Exchanged;
+}
+
+#define COREDEM_GRANT_GETTER(type, name, member)                                             \
+  type Participant::name() const {                                                           \
+    _impl->require({State::Granted, State::Exchanged}, #name,                                 \
+                   "the grant is known between initialize()/advance() and the end of the run"); \
+    return _impl->member;                                                                    \
+  }
+COREDEM_GRANT_GETTER(std::int64_t, step, step)
+COREDEM_GRANT_GETTER(double, time, time)
+COREDEM_GRANT_GETTER(double, dt, dt)
+COREDEM_GRANT_GETTER(int, nSub, nSub)
+COREDEM_GRANT_GETTER(double, dtDem, dtDem)
+COREDEM_GRANT_GETTER(std::string, checkpointDir, checkpointDir)
+#undef COREDEM_GRANT_GETTER
+
+bool Participant::requiresCheckpoint() const { return !checkpointDir().empty(); }
+
+std::string Participant::shutdownReason() const {
+  _impl->require({State::Finished, State::Finalized}, "shutdownReason", "the run has not ended");
+  return _impl->shutdownReason;
+}
+
+const Grid& Participant::grid() const {
+  _impl->require({State::Granted, State::Exchanged, State::Finished}, "grid",
+                 "the grid arrives with initialize()");
+  return _impl->grid;
+}
+std::int64_t Participant::startStep() const {
+  _impl->require({State::Granted, State::Exchanged, State::Finished}, "startStep",
+                 "the start step arrives with initialize()");
+  return _impl->startStep;
+}
+double Participant::startTime() const {
+  _impl->require({State::Granted, State::Exchanged, State::Finished}, "startTime",
+                 "the start time arrives with initialize()");
+  return _impl->startTime;
+}
+
+const Sources& Participant::exchange(std::int64_t step, double dt,
+                                     const std::vector<NamedField>& fields) {
+  _impl->require({State::Granted}, "exchange",
+                 "exchange() once per grant, after initialize() or advance() granted a step");
+  return guarded("exchange", [&]() -> const Sources& { return _impl->exchange(step, dt, fields); });
+}
+
+const Sources& Participant::sources() const {
+  _impl->require({State::Exchanged}, "sources", "sources exist between exchange() and advance()");
+  return _impl->sources;
+}
+
+void Participant::advance(double courant, const Ledgers& ledgers,
+                          const std::vector<std::string>& checkpointFiles) {
+  _impl->require({State::Exchanged}, "advance", "advance() follows exchange() of the granted step");
+  guarded("advance", [&] { _impl->advance(courant, ledgers, checkpointFiles); });
+}
+
+void Participant::finalize() { _impl->finalize(); }
+
+} // namespace coredem::client
