@@ -1,0 +1,154 @@
+// v1::Configure -> dem::DemConfig.
+#include "configure_map.h"
+
+#include "coredem/common/check.h"
+
+#include <algorithm>
+#include <charconv>
+#include <map>
+
+namespace coredem::server {
+
+namespace {
+
+std::array<double, 3> vec(const v1::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+double parseDouble(const std::string& key, const std::string& value) {
+  double v = 0.0;
+  const auto* end = value.data() + value.size();
+  const auto r = std::from_chars(value.data(), end, v);
+  COREDEM_CHECK(r.ec == std::errc() && r.ptr == end,
+                "Configure option '{}' = '{}' is not a number", key, value);
+  return v;
+}
+
+} // namespace
+
+dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* warnings) {
+  dem::DemConfig cfg;
+
+  // Materials, addressed by id.
+  std::map<std::uint32_t, int> materialIndex;
+  std::map<std::uint32_t, double> materialDensity;
+  cfg.materials.clear();
+  for (const auto& m : c.materials()) {
+    COREDEM_CHECK(materialIndex.count(m.id()) == 0, "Configure: material id {} appears twice", m.id());
+    dem::Material d;
+    d.name = m.name().empty() ? "material-" + std::to_string(m.id()) : m.name();
+    d.kn = m.k_n();
+    d.en = m.e_n();
+    d.mu = m.friction();
+    d.ktFactor = m.has_kt_factor() ? m.kt_factor() : 2.0 / 7.0;
+    d.etatFactor = m.has_etat_factor() ? m.etat_factor() : 0.5;
+    materialIndex[m.id()] = static_cast<int>(cfg.materials.size());
+    materialDensity[m.id()] = m.density();
+    cfg.materials.push_back(d);
+  }
+  COREDEM_CHECK(!cfg.materials.empty(), "Configure: no materials; give at least one (k_n, e_n, "
+                "friction, density)");
+
+  // Gas species (Y_g / R_species columns).
+  for (const auto& s : c.species()) {
+    cfg.gasSpecies.push_back({s.name(), s.molar_mass()});
+  }
+
+  // Solid species: the names used in particle compositions, in order of first appearance.
+  std::vector<std::string> solid;
+  for (const auto& ps : c.particle_sets()) {
+    for (const auto& nv : ps.composition()) {
+      if (std::find(solid.begin(), solid.end(), nv.name()) == solid.end()) {
+        solid.push_back(nv.name());
+      }
+    }
+  }
+  for (const auto& name : solid) {
+    double molar = 0.0;
+    for (const auto& s : c.species()) {
+      if (s.name() == name) {
+        molar = s.molar_mass();
+      }
+    }
+    cfg.solidSpecies.push_back({name, molar});
+  }
+
+  // Particle sets (ignored when an initial state file is given: the file has the particles).
+  if (c.initial_state_file().empty()) {
+    int index = 0;
+    for (const auto& ps : c.particle_sets()) {
+      const auto it = materialIndex.find(ps.material_id());
+      COREDEM_CHECK(it != materialIndex.end(), "Configure: particle set {} ('{}') uses material "
+                    "id {}, which is not among the materials", index, ps.name(), ps.material_id());
+      dem::ParticleSet d;
+      d.name = ps.name().empty() ? "set-" + std::to_string(index) : ps.name();
+      d.material = it->second;
+      switch (ps.packing()) {
+      case v1::PACKING_RANDOM: d.packing = dem::Packing::Random; break;
+      case v1::PACKING_LATTICE:
+      case v1::PACKING_UNSPECIFIED: d.packing = dem::Packing::Lattice; break;
+      default:
+        COREDEM_CHECK(false, "Configure: particle set '{}' has an unknown packing {}; use "
+                      "LATTICE or RANDOM", d.name, static_cast<int>(ps.packing()));
+      }
+      d.regionMin = vec(ps.region_min());
+      d.regionMax = vec(ps.region_max());
+      d.count = static_cast<std::size_t>(ps.count());
+      d.diameter = ps.diameter();
+      d.density = ps.density() > 0.0 ? ps.density() : materialDensity[ps.material_id()];
+      d.temperature = ps.temperature() > 0.0 ? ps.temperature() : d.temperature;
+      d.composition.assign(solid.size(), 0.0);
+      for (const auto& nv : ps.composition()) {
+        const auto k = std::find(solid.begin(), solid.end(), nv.name()) - solid.begin();
+        d.composition[static_cast<std::size_t>(k)] = nv.value();
+      }
+      d.velocity = vec(ps.initial_velocity());
+      if (ps.seed() != 0) {
+        d.seed = ps.seed();
+      }
+      cfg.particleSets.push_back(std::move(d));
+      ++index;
+    }
+  }
+
+  // Walls.
+  if (c.walls().has_box()) {
+    cfg.addBox(vec(c.walls().box().min()), vec(c.walls().box().max()));
+  }
+  for (const auto& p : c.walls().planes()) {
+    cfg.walls.push_back(dem::Wall{vec(p.point()), vec(p.normal())});
+  }
+  cfg.gravity = vec(c.gravity());
+
+  // Coupling grid.
+  if (c.coupling_mesh().has_cartesian()) {
+    const auto& g = c.coupling_mesh().cartesian();
+    cfg.grid.origin = vec(g.origin());
+    cfg.grid.spacing = vec(g.spacing());
+    COREDEM_CHECK(g.counts().x() < (1u << 30) && g.counts().y() < (1u << 30) &&
+                      g.counts().z() < (1u << 30),
+                  "Configure: coupling grid counts {} x {} x {} are too large", g.counts().x(),
+                  g.counts().y(), g.counts().z());
+    cfg.grid.counts = {static_cast<int>(g.counts().x()), static_cast<int>(g.counts().y()),
+                       static_cast<int>(g.counts().z())};
+  }
+
+  // Model options by name.
+  for (const auto& kv : c.options()) {
+    if (kv.key() == "dem.dt_factor" || kv.key() == "dt_factor") {
+      cfg.dtFactor = parseDouble(kv.key(), kv.value());
+    } else if (kv.key() == "dem.eps_min_drag" || kv.key() == "eps_min_drag") {
+      cfg.epsMinDrag = parseDouble(kv.key(), kv.value());
+    } else if (kv.key() == "dem.skin_factor") {
+      cfg.neighbour.skinFactor = parseDouble(kv.key(), kv.value());
+    } else if (kv.key() == "dem.history_slots") {
+      cfg.neighbour.historySlots = static_cast<int>(parseDouble(kv.key(), kv.value()));
+    } else if (kv.key() == "drag") {
+      COREDEM_CHECK(kv.value() == "gidaspow", "Configure option drag = '{}': this server "
+                    "implements 'gidaspow' only", kv.value());
+    } else if (warnings != nullptr) {
+      warnings->push_back(kv.key());
+    }
+  }
+  return cfg;
+}
+
+} // namespace coredem::server

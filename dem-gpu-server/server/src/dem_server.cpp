@@ -1,0 +1,769 @@
+// coredem-dem: D of docs/session.md over the protocol library and the DEM core.
+#include "coredem/server/dem_server.h"
+
+#include "configure_map.h"
+#include "state_meta.h"
+
+#include "coredem/common/check.h"
+#include "coredem/common/log.h"
+#include "coredem/dem/dem_system.h"
+#include "coredem/dem/time_handler.h"
+#include "coredem/protocol/protocol.h"
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <random>
+#include <sys/stat.h>
+
+namespace coredem::server {
+
+namespace v1 = coredem::v1;
+namespace proto = coredem::protocol;
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+constexpr const char* kSoftware = "coredem-dem 0.1.0";
+/// Relative tolerance of dt comparisons (grant vs GasFields, dt_dem·n_sub vs dt_cfd).
+constexpr double kDtTolerance = 1e-12;
+
+std::string randomSessionId() {
+  std::random_device rd;
+  std::mt19937_64 gen((static_cast<std::uint64_t>(rd()) << 32) ^ rd() ^
+                      static_cast<std::uint64_t>(Clock::now().time_since_epoch().count()));
+  return fmt::format("{:016x}", gen());
+}
+
+std::string hexPeer(const proto::PeerId& p) {
+  std::string s;
+  for (unsigned char ch : p) {
+    s += fmt::format("{:02x}", ch);
+  }
+  return s;
+}
+
+const char* stateName(SessionState s) {
+  switch (s) {
+  case SessionState::Idle: return "idle";
+  case SessionState::Connected: return "connected";
+  case SessionState::Configured: return "configured";
+  }
+  return "?";
+}
+
+std::string readKey(const fs::path& p) {
+  std::ifstream in(p);
+  COREDEM_CHECK(in.good(), "cannot read the CURVE key file {}: create the pair with "
+                "`coredem-dem --generate-curve-keys DIR`", p.string());
+  std::string k;
+  in >> k;
+  COREDEM_CHECK(k.size() == 40, "{} does not hold a 40-character Z85 CURVE key", p.string());
+  return k;
+}
+
+proto::TransportOptions transportOptions(const ServerOptions& o) {
+  proto::TransportOptions t;
+  t.sender = kSoftware;
+  if (!o.curveKeysDir.empty()) {
+    t.curve.serverPublicKey = readKey(fs::path(o.curveKeysDir) / "server.public");
+    t.curve.serverSecretKey = readKey(fs::path(o.curveKeysDir) / "server.secret");
+  }
+  return t;
+}
+
+struct Grant {
+  proto::PeerId peer;
+  std::uint64_t sequence = 0;
+  std::int64_t step = 0;
+  double time = 0.0;
+  double dtCfd = 0.0;
+  std::uint32_t nSub = 1;
+  std::string checkpointDir;
+};
+
+struct Held {
+  proto::Request request;
+  Clock::time_point since;
+};
+
+} // namespace
+
+struct DemServer::Impl {
+  ServerOptions opt;
+  proto::Server server;
+  std::string endpoint;
+  std::shared_ptr<spdlog::logger> log = coredem::logger("dem.server");
+  std::atomic<bool> stopFlag{false};
+  bool sessionEnded = false;
+
+  // ---- the session ---------------------------------------------------------------------
+  SessionState state = SessionState::Idle;
+  std::string session;
+  proto::PeerId oPeer, cPeer;
+  std::string oName, cName;
+  Clock::time_point started, lastActivity;
+  std::map<proto::PeerId, std::uint64_t> lastSequence;
+  std::unique_ptr<dem::DemSystem> system;
+  std::uint64_t cells = 0;
+  std::uint32_t species = 0;
+  std::vector<std::string> speciesNames;
+  double cellVolume = 0.0;
+  std::int64_t lastStep = 0;  ///< last completed step
+  std::int64_t stepsDone = 0; ///< in this session
+  std::optional<Grant> grant;
+  std::optional<Held> held;
+  ServerLedgers ledgers;
+
+  explicit Impl(ServerOptions o) : opt(std::move(o)), server(transportOptions(opt)) {}
+
+  // ---- replies ---------------------------------------------------------------------------
+  void send(const proto::PeerId& peer, proto::Message m, std::uint64_t sequence, std::int64_t step) {
+    m.setSessionId(session);
+    m.setSequence(sequence);
+    m.setStep(step);
+    server.reply(peer, std::move(m));
+  }
+
+  std::string peerName(const proto::PeerId& p) const {
+    if (!oPeer.empty() && p == oPeer) {
+      return fmt::format("orchestrator '{}'", oName);
+    }
+    if (!cPeer.empty() && p == cPeer) {
+      return fmt::format("CFD participant '{}'", cName);
+    }
+    return fmt::format("peer {}", hexPeer(p));
+  }
+
+  void refuse(const proto::Request& r, v1::ErrorCode code, const std::string& message) {
+    const auto& env = r.message.envelope();
+    log->warn("session {}: refused {} from {}: {}: {}", session.empty() ? "-" : session,
+              proto::messageTypeName(env.type()), peerName(r.peer), proto::errorCodeName(code),
+              message);
+    send(r.peer, proto::makeError(code, message, env.sequence(), env.type()), env.sequence(),
+         env.step());
+  }
+
+  void reject(const proto::Request& r, v1::ErrorCode code, const std::string& reason) {
+    const auto& env = r.message.envelope();
+    log->warn("rejected Hello from '{}' ({}): {}: {}", env.sender(), hexPeer(r.peer),
+              proto::errorCodeName(code), reason);
+    auto m = proto::makeReject(code, reason);
+    m.envelope().mutable_reject()->set_server_protocol_major(proto::kProtocolVersion.major);
+    m.envelope().mutable_reject()->set_server_protocol_minor(proto::kProtocolVersion.minor);
+    m.setSequence(env.sequence());
+    server.reply(r.peer, std::move(m));
+  }
+
+  // ---- session ---------------------------------------------------------------------------
+  void endSession(const std::string& reason) {
+    if (state == SessionState::Idle) {
+      return;
+    }
+    if (held) {
+      refuse(held->request, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             "the session ended before this step was granted (" + reason + ")");
+    }
+    if (grant) {
+      auto m = proto::makeError(v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+                                "the session ended during step " + std::to_string(grant->step) +
+                                    " (" + reason + ")",
+                                grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT);
+      send(grant->peer, std::move(m), grant->sequence, grant->step);
+    }
+    const double secs = std::chrono::duration<double>(Clock::now() - started).count();
+    log->info("session {} ended: {} (orchestrator '{}', CFD participant '{}', {} steps, {:.1f} s)",
+              session, reason, oName, cName.empty() ? "-" : cName, stepsDone, secs);
+    state = SessionState::Idle;
+    session.clear();
+    oPeer.clear();
+    cPeer.clear();
+    oName.clear();
+    cName.clear();
+    lastSequence.clear();
+    system.reset();
+    grant.reset();
+    held.reset();
+    ledgers = ServerLedgers();
+    stepsDone = 0;
+    sessionEnded = true;
+  }
+
+  void onHello(const proto::Request& r) {
+    const auto& env = r.message.envelope();
+    if (env.body_case() != v1::Envelope::kHello) {
+      refuse(r, v1::ERROR_CODE_BODY_MISMATCH, "a HELLO envelope must carry a Hello body");
+      return;
+    }
+    const auto& h = env.hello();
+    const auto n = proto::negotiate(proto::kProtocolVersion, {h.protocol_major(), h.protocol_minor()});
+    if (!n.accepted) {
+      reject(r, v1::ERROR_CODE_VERSION, n.status.message);
+      return;
+    }
+    if (h.role() == v1::ROLE_ORCHESTRATOR) {
+      if (state != SessionState::Idle) {
+        const double secs = std::chrono::duration<double>(Clock::now() - started).count();
+        reject(r, v1::ERROR_CODE_SESSION_BUSY,
+               fmt::format("coredem-dem at {} already serves session {} of orchestrator '{}' "
+                           "(for {:.0f} s); wait until it ends or start another coredem-dem",
+                           endpoint, session, oName, secs));
+        return;
+      }
+      session = randomSessionId();
+      oPeer = r.peer;
+      oName = env.sender().empty() ? hexPeer(r.peer) : env.sender();
+      state = SessionState::Connected;
+      started = lastActivity = Clock::now();
+      sessionEnded = false;
+      lastSequence[r.peer] = env.sequence();
+      log->info("session {}: orchestrator '{}' connected (protocol {}.{}, peer {})", session, oName,
+                n.agreed.major, n.agreed.minor, hexPeer(r.peer));
+    } else if (h.role() == v1::ROLE_CFD) {
+      if (state == SessionState::Idle) {
+        reject(r, v1::ERROR_CODE_NOT_CONFIGURED,
+               "no active session: the orchestrator connects first and passes its session id to "
+               "the CFD participant (COREDEM_SESSION)");
+        return;
+      }
+      if (env.session_id() != session) {
+        reject(r, v1::ERROR_CODE_UNKNOWN_SESSION,
+               fmt::format("session id '{}' is not the active session of coredem-dem at {}; use "
+                           "the id the orchestrator passes in COREDEM_SESSION", env.session_id(),
+                           endpoint));
+        return;
+      }
+      if (!cPeer.empty() && cPeer != r.peer) {
+        log->warn("session {}: CFD participant '{}' replaced by a new connection '{}'", session,
+                  cName, env.sender());
+      }
+      cPeer = r.peer;
+      cName = env.sender().empty() ? hexPeer(r.peer) : env.sender();
+      lastSequence[r.peer] = env.sequence();
+      log->info("session {}: CFD participant '{}' connected (protocol {}.{}, peer {})", session,
+                cName, n.agreed.major, n.agreed.minor, hexPeer(r.peer));
+    } else {
+      reject(r, v1::ERROR_CODE_UNSUPPORTED,
+             "coredem-dem takes sessions of an orchestrator (ROLE_ORCHESTRATOR) and its CFD "
+             "participant (ROLE_CFD) only");
+      return;
+    }
+    auto w = proto::makeWelcome(v1::ROLE_DEM, kSoftware, n.agreed.major, n.agreed.minor, session);
+    send(r.peer, std::move(w), env.sequence(), env.step());
+  }
+
+  void onConfigure(const proto::Request& r) {
+    const auto& c = r.message.envelope().configure();
+    if (r.peer != oPeer) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, "only the session's orchestrator configures");
+      return;
+    }
+    if (stepsDone > 0 || grant) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             "the session has started stepping; start a new session to configure again");
+      return;
+    }
+    if (const auto s = proto::validateConfigure(c); !s.ok()) {
+      refuse(r, s.code, s.message);
+      return;
+    }
+    std::unique_ptr<dem::DemSystem> next;
+    ServerLedgers restored;
+    std::vector<std::string> ignored;
+    try {
+      COREDEM_CHECK(c.coupling_mesh().has_cartesian(), "Configure has no Cartesian coupling grid");
+      const auto cfg = toDemConfig(c, &ignored);
+      next = std::make_unique<dem::DemSystem>(cfg, dem::parseBackend(opt.backend), opt.threads);
+      if (!c.initial_state_file().empty()) {
+        COREDEM_CHECK(fs::exists(c.initial_state_file()), "initial state file '{}' does not exist",
+                      c.initial_state_file());
+        next->readState(c.initial_state_file());
+        restored = readServerLedgers(c.initial_state_file(), c.species_size());
+      }
+    } catch (const coredem::UserError& e) {
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION, e.what());
+      return;
+    }
+    for (const auto& k : ignored) {
+      log->warn("session {}: Configure option '{}' is not a DEM server option (ignored)", session, k);
+    }
+    system = std::move(next);
+    ledgers = restored;
+    if (ledgers.speciesToGas.size() != static_cast<std::size_t>(c.species_size())) {
+      ledgers.speciesToGas.assign(static_cast<std::size_t>(c.species_size()), 0.0);
+    }
+    cells = proto::cellCount(c.coupling_mesh());
+    species = static_cast<std::uint32_t>(c.species_size());
+    speciesNames.clear();
+    for (const auto& s : c.species()) {
+      speciesNames.push_back(s.name());
+    }
+    const auto& g = c.coupling_mesh().cartesian();
+    cellVolume = g.spacing().x() * g.spacing().y() * g.spacing().z();
+    lastStep = c.start_step();
+    state = SessionState::Configured;
+    const double dtMax = system->dtDemMax();
+    std::uint32_t nSub = 0;
+    if (c.sub_cycling().dt_cfd() > 0.0) {
+      nSub = static_cast<std::uint32_t>(dem::TimeHandler::subStepsFor(c.sub_cycling().dt_cfd(), dtMax));
+    }
+    log->info("session {}: configured by '{}': {} particles{}, grid {} x {} x {}, {} gas species, "
+              "backend {}, dt_dem_max {:.4g} s, start step {}", session, oName,
+              system->particleCount(),
+              c.initial_state_file().empty() ? "" : " from " + c.initial_state_file(),
+              g.counts().x(), g.counts().y(), g.counts().z(), species, system->backendName(),
+              dtMax, lastStep);
+    auto m = proto::makeConfigured(cells, system->particleCount(), species, nSub, dtMax);
+    send(r.peer, std::move(m), r.message.envelope().sequence(), lastStep);
+  }
+
+  void onGrant(const proto::Request& r) {
+    const auto& env = r.message.envelope();
+    const auto& g = env.step_grant();
+    if (r.peer != oPeer) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, "only the session's orchestrator grants steps");
+      return;
+    }
+    if (state != SessionState::Configured) {
+      refuse(r, v1::ERROR_CODE_NOT_CONFIGURED, "send Configure before the first StepGrant");
+      return;
+    }
+    if (grant) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             fmt::format("step {} is still running (waiting for the CFD participant's GasFields)",
+                         grant->step));
+      return;
+    }
+    if (env.step() != lastStep + 1) {
+      refuse(r, v1::ERROR_CODE_OUT_OF_ORDER,
+             fmt::format("StepGrant for step {}, but the next step is {}", env.step(), lastStep + 1));
+      return;
+    }
+    const double dtMax = system->dtDemMax();
+    if (!(g.dt_cfd() > 0.0) || !std::isfinite(g.dt_cfd()) || g.n_sub() < 1) {
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+             fmt::format("StepGrant of step {}: dt_cfd = {} s and n_sub = {} must be positive",
+                         env.step(), g.dt_cfd(), g.n_sub()));
+      return;
+    }
+    if (g.dt_cfd() / g.n_sub() > dtMax * (1.0 + kDtTolerance)) {
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+             fmt::format("StepGrant of step {}: dt_cfd/n_sub = {:.6g} s exceeds this DEM's "
+                         "dt_dem_max = {:.6g} s; use n_sub >= {}", env.step(),
+                         g.dt_cfd() / g.n_sub(), dtMax,
+                         dem::TimeHandler::subStepsFor(g.dt_cfd(), dtMax)));
+      return;
+    }
+    if (g.dt_dem() > 0.0 && std::abs(g.dt_dem() * g.n_sub() - g.dt_cfd()) > kDtTolerance * g.dt_cfd()) {
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+             fmt::format("StepGrant of step {}: dt_dem * n_sub = {:.17g} s differs from dt_cfd = "
+                         "{:.17g} s", env.step(), g.dt_dem() * g.n_sub(), g.dt_cfd()));
+      return;
+    }
+    Grant next;
+    next.peer = r.peer;
+    next.sequence = env.sequence();
+    next.step = env.step();
+    next.time = env.time();
+    next.dtCfd = g.dt_cfd();
+    next.nSub = g.n_sub();
+    next.checkpointDir = g.has_checkpoint() ? g.checkpoint().directory() : std::string();
+    grant = next;
+    log->debug("session {}: step {} granted (dt {} s, n_sub {})", session, next.step, next.dtCfd, next.nSub);
+    if (held) {
+      auto h = std::move(*held);
+      held.reset();
+      runStep(h.request);
+    }
+  }
+
+  proto::Expectation gasExpectation(const proto::PeerId& peer) const {
+    proto::Expectation e;
+    e.types = {v1::MESSAGE_TYPE_GAS_FIELDS};
+    e.sessionId = session;
+    e.sequenceAfter = lastSequence.count(peer) != 0 ? lastSequence.at(peer) : 0;
+    e.step = grant ? grant->step : lastStep + 1;
+    e.cells = cells;
+    e.species = species;
+    return e;
+  }
+
+  void onGasFields(proto::Request& r) {
+    if (r.peer != cPeer) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             "GasFields come from the session's CFD participant: send Hello{role=CFD} with the "
+             "session id first");
+      return;
+    }
+    if (held) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             fmt::format("the GasFields of step {} are already waiting for their StepGrant",
+                         held->request.message.envelope().step()));
+      return;
+    }
+    if (!grant) { // the grant is on its way from O on another connection: wait for it
+      held = Held{std::move(r), Clock::now()};
+      return;
+    }
+    runStep(r);
+  }
+
+  void runStep(const proto::Request& r) {
+    const auto& env = r.message.envelope();
+    const auto& body = env.gas_fields();
+    if (std::abs(body.dt() - grant->dtCfd) > kDtTolerance * grant->dtCfd) {
+      refuse(r, v1::ERROR_CODE_OUT_OF_ORDER,
+             fmt::format("GasFields of step {} carry dt = {:.17g} s; the step was granted with "
+                         "dt = {:.17g} s", env.step(), body.dt(), grant->dtCfd));
+      return;
+    }
+    const auto t0 = Clock::now();
+    namespace f = proto::fields;
+    dem::GasFieldsView view;
+    view.ug = r.message.values<double>(f::kGasVelocity);
+    view.gradP = r.message.values<double>(f::kPressureGradient);
+    view.Tg = r.message.values<double>(f::kGasTemperature);
+    view.rhoG = r.message.values<double>(f::kGasDensity);
+    view.muG = r.message.values<double>(f::kGasViscosity);
+    view.kappaG = r.message.values<double>(f::kGasConductivity);
+    view.cpG = r.message.values<double>(f::kGasHeatCapacity);
+    view.Yg = r.message.values<double>(f::kGasMassFractions);
+    try {
+      system->setGasFields(view);
+    } catch (const coredem::UserError& e) {
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+             fmt::format("GasFields of step {}: {}", env.step(), e.what()));
+      return;
+    }
+    const dem::CellSources* s = nullptr;
+    try {
+      s = &system->advance(grant->dtCfd, static_cast<int>(grant->nSub));
+    } catch (const std::exception& e) {
+      log->error("session {}: step {} failed in the DEM core: {}", session, grant->step, e.what());
+      refuse(r, v1::ERROR_CODE_INTERNAL, fmt::format("step {} failed in the DEM core: {}", grant->step, e.what()));
+      auto m = proto::makeError(v1::ERROR_CODE_INTERNAL, e.what(), grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT);
+      send(grant->peer, std::move(m), grant->sequence, grant->step);
+      grant.reset();
+      return;
+    }
+    const double dt = grant->dtCfd;
+
+    // Ledgers: what the particles took from / gave to the gas during this step.
+    const auto n = static_cast<std::size_t>(cells);
+    double heat = 0.0;
+    for (std::size_t c = 0; c < n; ++c) {
+      heat += s->heatH[c] * view.Tg[c] - s->heatHTp[c];
+    }
+    ledgers.heatFromGas += heat * cellVolume * dt;
+    for (std::size_t k = 0; k < species; ++k) {
+      double sum = 0.0;
+      for (std::size_t c = 0; c < n; ++c) {
+        sum += s->rSpecies[c * species + k];
+      }
+      ledgers.speciesToGas[k] += sum * cellVolume * dt;
+    }
+    v1::Ledger ledger = ledgerMessage();
+
+    // Sources to C.
+    auto src = proto::makeSources(env.step(), env.time(), dt, cells, species, grant->nSub);
+    auto add = [&](std::string_view name, const std::vector<double>& v) {
+      src.addArray<double>(name, std::span<const double>(v), f::shapeOf(name, cells, species));
+    };
+    add(f::kVoidFraction, s->epsG);
+    add(f::kDragCoefficient, s->kSl);
+    add(f::kDragCoefficientTimesUs, s->kSlUs);
+    add(f::kHeatCoefficient, s->heatH);
+    add(f::kHeatCoefficientTimesTp, s->heatHTp);
+    add(f::kSpeciesSources, s->rSpecies);
+    add(f::kHomogeneousHeat, s->qHom);
+    *src.envelope().mutable_sources()->mutable_ledger() = ledger;
+    send(r.peer, std::move(src), env.sequence(), env.step());
+
+    // Checkpoint requested with the grant, then StepDone to O.
+    v1::StepDone done;
+    *done.mutable_ledger() = ledger;
+    bool checkpointOk = true;
+    std::string checkpointError;
+    if (!grant->checkpointDir.empty()) {
+      try {
+        const auto files = writeCheckpoint(grant->checkpointDir, grant->step);
+        done.mutable_checkpoint()->set_directory(grant->checkpointDir);
+        for (const auto& file : files) {
+          done.mutable_checkpoint()->add_files(file);
+        }
+      } catch (const std::exception& e) {
+        checkpointOk = false;
+        checkpointError = e.what();
+      }
+    }
+    addDiagnostics(done);
+    done.set_wall_seconds(std::chrono::duration<double>(Clock::now() - t0).count());
+    if (checkpointOk) {
+      send(grant->peer, proto::makeStepDone(grant->step, grant->time, done), grant->sequence, grant->step);
+    } else {
+      log->error("session {}: checkpoint of step {} into {} failed: {}", session, grant->step,
+                 grant->checkpointDir, checkpointError);
+      send(grant->peer,
+           proto::makeError(v1::ERROR_CODE_CHECKPOINT_FAILED,
+                            fmt::format("step {} done, but writing its checkpoint into {} failed: {}",
+                                        grant->step, grant->checkpointDir, checkpointError),
+                            grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT),
+           grant->sequence, grant->step);
+    }
+    lastStep = grant->step;
+    ++stepsDone;
+    grant.reset();
+  }
+
+  v1::Ledger ledgerMessage() const {
+    v1::Ledger l;
+    const auto p = system->particles();
+    double mass = 0.0, kinetic = 0.0;
+    for (std::size_t i = 0; i < p.count; ++i) {
+      const double m = p.mass[i];
+      mass += m;
+      const double inertia = 0.4 * m * p.radius[i] * p.radius[i];
+      for (int a = 0; a < 3; ++a) {
+        kinetic += 0.5 * m * p.velocity[3 * i + a] * p.velocity[3 * i + a] +
+                   0.5 * inertia * p.angularVelocity[3 * i + a] * p.angularVelocity[3 * i + a];
+      }
+    }
+    proto::addNamedValue(l.mutable_mass(), "dem.particle_mass_kg", mass);
+    proto::addNamedValue(l.mutable_energy(), "dem.kinetic_energy_J", kinetic);
+    proto::addNamedValue(l.mutable_energy(), "dem.heat_from_gas_J", ledgers.heatFromGas);
+    for (std::size_t k = 0; k < speciesNames.size(); ++k) {
+      proto::addNamedValue(l.mutable_species(), "dem.species_to_gas." + speciesNames[k] + "_kg",
+                           ledgers.speciesToGas[k]);
+    }
+    return l;
+  }
+
+  void addDiagnostics(v1::StepDone& done) const {
+    const auto p = system->particles();
+    double sum = 0.0, lo = p.count > 0 ? p.temperature[0] : 0.0, hi = lo;
+    for (std::size_t i = 0; i < p.count; ++i) {
+      sum += p.temperature[i];
+      lo = std::min(lo, p.temperature[i]);
+      hi = std::max(hi, p.temperature[i]);
+    }
+    auto* d = done.mutable_diagnostics();
+    proto::addNamedValue(d, "particles", static_cast<double>(p.count));
+    proto::addNamedValue(d, "contacts", static_cast<double>(system->contactCount()));
+    proto::addNamedValue(d, "mean_T_p", p.count > 0 ? sum / static_cast<double>(p.count) : 0.0);
+    proto::addNamedValue(d, "min_T_p", lo);
+    proto::addNamedValue(d, "max_T_p", hi);
+    proto::addNamedValue(d, "dem_time_s", system->time());
+  }
+
+  /// Writes DIR/dem.h5 (temp file + rename) and returns the file names relative to DIR.
+  std::vector<std::string> writeCheckpoint(const std::string& dir, std::int64_t step) {
+    fs::create_directories(dir);
+    const fs::path final = fs::path(dir) / "dem.h5";
+    const fs::path tmp = fs::path(dir) / ".dem.h5.tmp";
+    fs::remove(tmp);
+    system->writeState(tmp.string());
+    ServerLedgers l = ledgers;
+    writeServerLedgers(tmp.string(), l, step, session);
+    fs::rename(tmp, final);
+    log->info("session {}: checkpoint of step {} written to {}", session, step, final.string());
+    return {"dem.h5"};
+  }
+
+  void onCheckpoint(const proto::Request& r) {
+    const auto& env = r.message.envelope();
+    if (r.peer != oPeer) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, "only the session's orchestrator asks for checkpoints");
+      return;
+    }
+    if (state != SessionState::Configured) {
+      refuse(r, v1::ERROR_CODE_NOT_CONFIGURED, "nothing to checkpoint before Configure");
+      return;
+    }
+    if (grant) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             fmt::format("step {} is running; ask for a checkpoint between steps (or with the grant)",
+                         grant->step));
+      return;
+    }
+    const auto& dir = env.checkpoint_request().directory();
+    if (dir.empty()) {
+      refuse(r, v1::ERROR_CODE_CHECKPOINT_FAILED, "CheckpointRequest without a directory");
+      return;
+    }
+    try {
+      auto files = writeCheckpoint(dir, lastStep);
+      send(r.peer, proto::makeCheckpointDone(lastStep, dir, files), env.sequence(), lastStep);
+    } catch (const std::exception& e) {
+      refuse(r, v1::ERROR_CODE_CHECKPOINT_FAILED,
+             fmt::format("writing the state of step {} into {} failed: {}", lastStep, dir, e.what()));
+    }
+  }
+
+  void onShutdown(const proto::Request& r) {
+    const auto& env = r.message.envelope();
+    if (r.peer != oPeer) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, "only the session's orchestrator ends the session");
+      return;
+    }
+    send(r.peer, proto::makeAck("session " + session + " ended"), env.sequence(), env.step());
+    endSession("Shutdown from the orchestrator" +
+               (env.shutdown().reason().empty() ? std::string() : ": " + env.shutdown().reason()));
+  }
+
+  // ---- dispatch --------------------------------------------------------------------------
+  void handle(proto::Request& r) {
+    const auto& env = r.message.envelope();
+    if (!r.status.ok()) {
+      refuse(r, r.status.code, r.status.message);
+      return;
+    }
+    const auto type = env.type();
+    if (type == v1::MESSAGE_TYPE_HELLO) {
+      onHello(r);
+      return;
+    }
+    if (type == v1::MESSAGE_TYPE_HEARTBEAT) {
+      if (state != SessionState::Idle && (r.peer == oPeer || r.peer == cPeer)) {
+        lastActivity = Clock::now();
+      }
+      send(r.peer, proto::makeHeartbeat(stateName(state)), env.sequence(), lastStep);
+      return;
+    }
+    if (state == SessionState::Idle) {
+      refuse(r, v1::ERROR_CODE_NOT_CONFIGURED,
+             "no active session: an orchestrator starts one with Hello{role=ORCHESTRATOR}");
+      return;
+    }
+    if (r.peer != oPeer && r.peer != cPeer) {
+      refuse(r, v1::ERROR_CODE_UNKNOWN_SESSION,
+             fmt::format("this connection has not joined session {}: send Hello first",
+                         env.session_id().empty() ? std::string("(none given)") : env.session_id()));
+      return;
+    }
+    proto::Expectation e;
+    if (type == v1::MESSAGE_TYPE_GAS_FIELDS) {
+      if (state != SessionState::Configured) {
+        refuse(r, v1::ERROR_CODE_NOT_CONFIGURED, "GasFields before the orchestrator's Configure");
+        return;
+      }
+      e = gasExpectation(r.peer);
+    } else {
+      e.sessionId = session;
+      e.sequenceAfter = lastSequence[r.peer];
+    }
+    if (const auto s = proto::validate(r.message, e); !s.ok()) {
+      refuse(r, s.code, s.message);
+      return;
+    }
+    lastSequence[r.peer] = env.sequence();
+    lastActivity = Clock::now();
+    switch (type) {
+    case v1::MESSAGE_TYPE_CONFIGURE: onConfigure(r); break;
+    case v1::MESSAGE_TYPE_STEP_GRANT: onGrant(r); break;
+    case v1::MESSAGE_TYPE_GAS_FIELDS: onGasFields(r); break;
+    case v1::MESSAGE_TYPE_CHECKPOINT_REQUEST: onCheckpoint(r); break;
+    case v1::MESSAGE_TYPE_SHUTDOWN: onShutdown(r); break;
+    default:
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             fmt::format("coredem-dem does not take {} messages", proto::messageTypeName(type)));
+    }
+  }
+
+  void housekeeping() {
+    const auto now = Clock::now();
+    if (held && std::chrono::duration<double>(now - held->since).count() > opt.grantWaitSeconds) {
+      auto h = std::move(*held);
+      held.reset();
+      refuse(h.request, v1::ERROR_CODE_TIMEOUT,
+             fmt::format("no StepGrant for step {} from orchestrator '{}' within {} s",
+                         h.request.message.envelope().step(), oName, opt.grantWaitSeconds));
+    }
+    if (state != SessionState::Idle &&
+        std::chrono::duration<double>(now - lastActivity).count() > opt.sessionTimeoutSeconds) {
+      endSession(fmt::format("no message from orchestrator '{}' or CFD participant '{}' for {} s "
+                             "(--timeout-s)", oName, cName.empty() ? "-" : cName,
+                             opt.sessionTimeoutSeconds));
+    }
+  }
+};
+
+DemServer::DemServer(ServerOptions options) : _impl(std::make_unique<Impl>(std::move(options))) {
+  auto& m = *_impl;
+  dem::parseBackend(m.opt.backend); // fail early on a bad name
+  if (!proto::isLoopbackEndpoint(m.opt.bind) && m.opt.curveKeysDir.empty()) {
+    COREDEM_CHECK(m.opt.insecure,
+                  "--bind {} is not a loopback address: give --curve-keys DIR (CURVE encryption "
+                  "and authentication, DESIGN §1) or, on a trusted network only, --insecure",
+                  m.opt.bind);
+    m.log->warn("binding {} WITHOUT encryption (--insecure): anyone who reaches this port can "
+                "drive this server", m.opt.bind);
+  }
+  m.endpoint = m.server.bind(m.opt.bind);
+  m.log->info("coredem-dem listening on {} (backend {}, threads {}, session timeout {} s)",
+              m.endpoint, m.opt.backend, m.opt.threads, m.opt.sessionTimeoutSeconds);
+}
+
+DemServer::~DemServer() = default;
+
+std::string DemServer::endpoint() const { return _impl->endpoint; }
+SessionState DemServer::sessionState() const { return _impl->state; }
+
+bool DemServer::poll(std::chrono::milliseconds wait) {
+  auto& m = *_impl;
+  if (m.stopFlag.load()) {
+    return false;
+  }
+  auto req = m.server.receive(wait);
+  if (req) {
+    try {
+      m.handle(*req);
+    } catch (const std::exception& e) {
+      // A bug or an unexpected failure while handling one message: answer and keep serving.
+      m.log->error("internal error while handling a {} message: {}",
+                   proto::messageTypeName(req->message.envelope().type()), e.what());
+      m.send(req->peer,
+             proto::makeError(v1::ERROR_CODE_INTERNAL, std::string("internal error: ") + e.what(),
+                              req->message.envelope().sequence(), req->message.envelope().type()),
+             req->message.envelope().sequence(), req->message.envelope().step());
+    }
+  }
+  m.housekeeping();
+  return !m.stopFlag.load() && !(m.opt.exitAfterSession && m.sessionEnded);
+}
+
+int DemServer::run() {
+  while (poll(std::chrono::milliseconds(200))) {
+  }
+  if (_impl->state != SessionState::Idle) {
+    _impl->endSession("the server is stopping");
+  }
+  _impl->log->info("coredem-dem at {} stopped", _impl->endpoint);
+  return 0;
+}
+
+void DemServer::stop() { _impl->stopFlag.store(true); }
+
+void generateCurveKeys(const std::string& dir) {
+  fs::create_directories(dir);
+  const auto pair = proto::generateCurveKeyPair();
+  const auto write = [](const fs::path& p, const std::string& key, bool secret) {
+    const auto tmp = p.string() + ".tmp";
+    {
+      std::ofstream out(tmp, std::ios::trunc);
+      COREDEM_CHECK(out.good(), "cannot write {}", tmp);
+      out << key << "\n";
+    }
+    if (secret) {
+      ::chmod(tmp.c_str(), 0600);
+    }
+    fs::rename(tmp, p);
+  };
+  write(fs::path(dir) / "server.public", pair.first, false);
+  write(fs::path(dir) / "server.secret", pair.second, true);
+}
+
+} // namespace coredem::server

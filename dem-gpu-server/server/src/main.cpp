@@ -1,0 +1,95 @@
+// coredem-dem: the DEM server (docs/client.md "coredem-dem: command line").
+#include "coredem/server/dem_server.h"
+
+#include "coredem/common/check.h"
+#include "coredem/common/log.h"
+
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+namespace {
+
+std::atomic<coredem::server::DemServer*> gServer{nullptr};
+
+extern "C" void onSignal(int) {
+  if (auto* s = gServer.load()) {
+    s->stop();
+  }
+}
+
+void writeEndpointFile(const std::string& path, const std::string& endpoint) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    COREDEM_CHECK(out.good(), "cannot write the endpoint file {}", tmp);
+    out << endpoint << "\n";
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"coredem-dem: the CoReDEM DEM server (protocol v1, one session at a time)"};
+  coredem::server::ServerOptions o;
+  std::string endpointFile, generateKeys;
+  app.add_option("--bind", o.bind, "endpoint to bind, e.g. tcp://127.0.0.1:* or ipc:///tmp/dem.sock")
+      ->capture_default_str();
+  app.add_option("--backend", o.backend, "cpu | cuda | auto")
+      ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
+      ->capture_default_str();
+  app.add_option("--threads", o.threads, "OpenMP threads of the cpu backend (0 = all)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--timeout-s", o.sessionTimeoutSeconds,
+                 "end a session whose peers are silent this long (s)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--curve-keys", o.curveKeysDir,
+                 "directory with server.public and server.secret (CURVE; needed for non-loopback binds)");
+  app.add_flag("--insecure", o.insecure, "allow a non-loopback bind without CURVE (trusted networks only)");
+  app.add_flag("--exit-after-session", o.exitAfterSession,
+               "exit when the first session ends (set by the orchestrator that started this server)");
+  app.add_option("--endpoint-file", endpointFile, "write the bound endpoint into this file");
+  app.add_option("--generate-curve-keys", generateKeys,
+                 "write a new CURVE key pair into DIR/server.{public,secret} and exit");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  auto log = coredem::logger("dem.server");
+  try {
+    if (!generateKeys.empty()) {
+      coredem::server::generateCurveKeys(generateKeys);
+      std::cout << "CURVE key pair written to " << generateKeys << "/server.{public,secret}\n";
+      return 0;
+    }
+    std::unique_ptr<coredem::server::DemServer> server;
+    try {
+      server = std::make_unique<coredem::server::DemServer>(o);
+    } catch (const coredem::UserError& e) {
+      log->error("{}", e.what());
+      return 2;
+    }
+    std::cout << "COREDEM_DEM_ENDPOINT=" << server->endpoint() << std::endl;
+    if (!endpointFile.empty()) {
+      writeEndpointFile(endpointFile, server->endpoint());
+    }
+    gServer.store(server.get());
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    const int rc = server->run();
+    gServer.store(nullptr);
+    return rc;
+  } catch (const std::exception& e) {
+    log->error("{}", e.what());
+    return 1;
+  }
+}
