@@ -1,1 +1,238 @@
-int main(){}
+// coredem-golden-gen DIR: writes one golden multipart message per message type of protocol
+// v1.0 into DIR (protocol/golden/v1.0). The files are committed and never regenerated for a
+// released version: tests/unit/protocol/golden_test.cpp decodes them with the current code
+// forever and checks every value written below. Container format: multipart_file.h.
+#include <coredem/protocol/fields.h>
+#include <coredem/protocol/message.h>
+#include <coredem/protocol/multipart_file.h>
+
+#include <cstdio>
+#include <filesystem>
+
+using namespace coredem::protocol;
+namespace v1 = coredem::v1;
+
+namespace {
+
+constexpr std::uint64_t kCells = 2;   // a 2 x 1 x 1 grid
+constexpr std::uint32_t kSpecies = 2; // O2, N2
+
+/// Array values of the golden GasFields/Sources: field f (index in fields.h order), flat
+/// index i -> 0.25 * (f + 1) + 0.125 * i (exact in binary).
+double goldenValue(std::size_t f, std::size_t i) { return 0.25 * double(f + 1) + 0.125 * double(i); }
+
+void stamp(Message& m, std::uint64_t seq) {
+  m.setSessionId("golden-session").setSequence(seq).setStep(3).setTime(0.25);
+  m.envelope().set_sender("coredem-golden-gen 1.0");
+}
+
+v1::Configure goldenConfigure() {
+  v1::Configure c;
+  c.set_case_name("golden");
+  auto* g = c.mutable_coupling_mesh()->mutable_cartesian();
+  g->mutable_origin()->set_x(-0.5);
+  g->mutable_origin()->set_y(0.0);
+  g->mutable_origin()->set_z(0.25);
+  g->mutable_spacing()->set_x(0.5);
+  g->mutable_spacing()->set_y(1.0);
+  g->mutable_spacing()->set_z(2.0);
+  g->mutable_counts()->set_x(2);
+  g->mutable_counts()->set_y(1);
+  g->mutable_counts()->set_z(1);
+  auto* o2 = c.add_species();
+  o2->set_name("O2");
+  o2->set_molar_mass(0.032);
+  auto* n2 = c.add_species();
+  n2->set_name("N2");
+  n2->set_molar_mass(0.028);
+  auto* gas = c.mutable_gas()->mutable_constant();
+  gas->set_density(1.2);
+  gas->set_viscosity(1.8e-5);
+  gas->set_conductivity(0.026);
+  gas->set_cp(1005.0);
+  gas->set_temperature(300.0);
+  gas->set_pressure(101325.0);
+  auto* p = c.add_particle_sets();
+  p->set_material_id(1);
+  p->set_count(100);
+  p->set_diameter(1e-3);
+  p->set_density(0.0);
+  p->set_temperature(1073.15);
+  auto* fe = p->add_composition();
+  fe->set_name("Fe2O3");
+  fe->set_value(0.6);
+  auto* al = p->add_composition();
+  al->set_name("Al2O3");
+  al->set_value(0.4);
+  p->set_packing(v1::PACKING_RANDOM);
+  p->mutable_region_min()->set_x(-0.5);
+  p->mutable_region_max()->set_x(0.5);
+  p->mutable_region_max()->set_y(1.0);
+  p->mutable_region_min()->set_z(0.25);
+  p->mutable_region_max()->set_z(2.25);
+  p->set_seed(42);
+  p->mutable_initial_velocity()->set_z(-0.5);
+  p->set_name("carrier");
+  auto* m = c.add_materials();
+  m->set_id(1);
+  m->set_name("ilmenite");
+  m->set_density(4200.0);
+  m->set_k_n(1000.0);
+  m->set_e_n(0.9);
+  m->set_friction(0.3);
+  m->set_kt_factor(0.25); // explicit; etat_factor left unset (default 1/2)
+  m->set_cp(850.0);
+  m->set_conductivity(2.5);
+  m->set_emissivity(0.8);
+  auto* w = c.mutable_walls();
+  w->mutable_box()->mutable_min()->set_x(-0.5);
+  w->mutable_box()->mutable_max()->set_x(0.5);
+  w->mutable_box()->mutable_max()->set_y(1.0);
+  w->mutable_box()->mutable_min()->set_z(0.25);
+  w->mutable_box()->mutable_max()->set_z(2.25);
+  auto* plane = w->add_planes();
+  plane->mutable_point()->set_z(0.25);
+  plane->mutable_normal()->set_z(1.0);
+  w->set_material_id(1);
+  w->set_temperature(0.0);
+  c.mutable_gravity()->set_z(-9.81);
+  c.mutable_sub_cycling()->set_dt_cfd(1e-4);
+  c.mutable_sub_cycling()->set_n_sub(50);
+  c.mutable_sub_cycling()->set_dt_dem(2e-6);
+  c.set_start_step(3);
+  c.set_start_time(0.25);
+  auto* opt = c.add_options();
+  opt->set_key("drag");
+  opt->set_value("gidaspow");
+  c.set_output_directory("out");
+  return c;
+}
+
+void addFieldArrays(Message& m, std::span<const fields::FieldSpec> specs) {
+  std::size_t f = 0;
+  for (const auto& spec : specs) {
+    std::vector<double> v(kCells * fields::componentsOf(spec.extent, kSpecies));
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      v[i] = goldenValue(f, i);
+    }
+    m.addArray<double>(spec.name, v, fields::shapeOf(spec.extent, kCells, kSpecies));
+    ++f;
+  }
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: coredem-golden-gen OUTPUT_DIR   (e.g. protocol/golden/v1.0)\n");
+    return 2;
+  }
+  std::filesystem::path dir = argv[1];
+  std::filesystem::create_directories(dir);
+  std::vector<std::pair<std::string, Message>> all;
+
+  {
+    v1::FieldManifestEntry e;
+    e.set_name("u_g");
+    e.set_dtype(v1::DTYPE_FLOAT64);
+    e.set_extent(v1::EXTENT_VECTOR3);
+    e.set_direction(v1::FIELD_DIRECTION_SENDS);
+    e.set_unit("m/s");
+    Message m = makeHello(v1::ROLE_CFD, "coredem-gas 0.1.0", {"gas_fields", "checkpoint"}, {e});
+    m.setSessionId("").setSequence(1).setStep(0).setTime(0.0);
+    all.emplace_back("hello", std::move(m));
+  }
+  {
+    Message m = makeWelcome(v1::ROLE_DEM, "coredem-dem 0.1.0", 1, 0, "golden-session");
+    m.envelope().mutable_welcome()->add_capabilities("cpu");
+    stamp(m, 1);
+    all.emplace_back("welcome", std::move(m));
+  }
+  {
+    Message m = makeReject(v1::ERROR_CODE_VERSION, "protocol 1.0 vs 2.3");
+    stamp(m, 1);
+    all.emplace_back("reject", std::move(m));
+  }
+  {
+    Message m = makeConfigure(goldenConfigure());
+    stamp(m, 2);
+    all.emplace_back("configure", std::move(m));
+  }
+  {
+    Message m = makeConfigured(2, 100, 2, 50, 2e-6);
+    stamp(m, 2);
+    all.emplace_back("configured", std::move(m));
+  }
+  {
+    Message m = makeGasFields(3, 0.25, 1e-4, kCells, kSpecies);
+    stamp(m, 3);
+    addFieldArrays(m, fields::gasFields());
+    all.emplace_back("gas_fields", std::move(m));
+  }
+  {
+    Message m = makeSources(3, 0.25, 1e-4, kCells, kSpecies, 50);
+    auto* l = m.envelope().mutable_sources()->mutable_ledger();
+    addNamedValue(l->mutable_mass(), "particles", 0.0132);
+    addNamedValue(l->mutable_energy(), "particles", 5.5e3);
+    addNamedValue(l->mutable_species(), "O2", -1.5e-6);
+    stamp(m, 3);
+    addFieldArrays(m, fields::sourceFields());
+    all.emplace_back("sources", std::move(m));
+  }
+  {
+    Message m = makeStepGrant(3, 0.25, 1e-4, 50, 2e-6);
+    stamp(m, 4);
+    all.emplace_back("step_grant", std::move(m));
+  }
+  {
+    v1::StepDone d;
+    d.set_cfl(0.35);
+    d.set_max_dt(2e-4);
+    d.set_wall_seconds(0.125);
+    addNamedValue(d.mutable_ledger()->mutable_mass(), "gas_in", 1.5);
+    addNamedValue(d.mutable_ledger()->mutable_energy(), "gas_in", 300.0);
+    addNamedValue(d.mutable_ledger()->mutable_species(), "CO2", 2.5e-3);
+    addNamedValue(d.mutable_diagnostics(), "mean_T_p", 1050.5);
+    Message m = makeStepDone(3, 0.25, d);
+    stamp(m, 4);
+    all.emplace_back("step_done", std::move(m));
+  }
+  {
+    Message m = makeCheckpointRequest(3, "checkpoints/3", "periodic");
+    stamp(m, 5);
+    all.emplace_back("checkpoint_request", std::move(m));
+  }
+  {
+    Message m = makeCheckpointDone(3, "checkpoints/3", {"dem.h5", "dem.json"});
+    stamp(m, 5);
+    all.emplace_back("checkpoint_done", std::move(m));
+  }
+  {
+    Message m = makeHeartbeat("stepping");
+    m.envelope().mutable_heartbeat()->set_unix_time(1.75e9);
+    stamp(m, 6);
+    all.emplace_back("heartbeat", std::move(m));
+  }
+  {
+    Message m = makeError(v1::ERROR_CODE_NON_FINITE, "array 'T_g' contains NaN at flat index 1", 3,
+                          v1::MESSAGE_TYPE_GAS_FIELDS);
+    stamp(m, 3);
+    all.emplace_back("error", std::move(m));
+  }
+  {
+    Message m = makeShutdown("campaign finished");
+    stamp(m, 7);
+    all.emplace_back("shutdown", std::move(m));
+  }
+  {
+    Message m = makeAck("shutting down");
+    stamp(m, 7);
+    all.emplace_back("ack", std::move(m));
+  }
+  for (const auto& [name, message] : all) {
+    auto path = dir / (name + ".cdmf");
+    writeMultipartFile(path, message.encode());
+    std::printf("wrote %s (%zu arrays)\n", path.string().c_str(), message.arrayCount());
+  }
+  return 0;
+}

@@ -1,0 +1,277 @@
+// Validation of received messages (DESIGN §3): each violation yields its own code and a
+// message naming the field.
+#include "test_messages.h"
+
+#include <coredem/protocol/validate.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace coredem::protocol;
+namespace v1 = coredem::v1;
+
+namespace {
+
+constexpr std::uint64_t kCells = 12;
+constexpr std::uint32_t kSpecies = 3;
+
+Expectation gasExpectation() {
+  Expectation e;
+  e.types = {v1::MESSAGE_TYPE_GAS_FIELDS};
+  e.cells = kCells;
+  e.species = kSpecies;
+  return e;
+}
+
+/// Re-decodes a message after `edit` changed its envelope (array frames unchanged).
+template <class Edit>
+Message withEnvelope(const Message& m, Edit edit) {
+  Frames frames = m.encode();
+  v1::Envelope env = m.envelope();
+  edit(env);
+  frames[0] = env.SerializeAsString();
+  Status s;
+  Message r = Message::decode(frames, &s);
+  EXPECT_TRUE(s.ok()) << s.toString();
+  return r;
+}
+
+/// Replaces array `name` by `values` with the given dtype/shape.
+template <class T>
+Message withArray(const Message& m, const std::string& name, const std::vector<T>& values,
+                  std::vector<std::uint64_t> shape) {
+  Message r(m.envelope());
+  for (std::size_t i = 0; i < m.arrayCount(); ++i) {
+    ArrayView v = m.array(i);
+    if (v.name() == name) {
+      r.addArray<T>(name, values, shape);
+    } else {
+      r.addArrayBytes(v.name(), v.dtype(), v.shape(), v.bytes);
+    }
+  }
+  return r;
+}
+
+} // namespace
+
+TEST(Validate, AcceptsAValidGasFieldsMessage) {
+  Message m = test::gasFieldsMessage(kCells, kSpecies, 4, 7);
+  Expectation e = gasExpectation();
+  e.step = 4;
+  e.sequence = 7;
+  Status s = validate(m, e);
+  EXPECT_TRUE(s.ok()) << s.toString();
+}
+
+TEST(Validate, RejectsNaNAndInfNamingFieldAndFirstIndex) {
+  Message m = test::gasFieldsMessage(kCells, kSpecies);
+  std::vector<double> t(kCells, 300.0);
+  t[5] = std::numeric_limits<double>::quiet_NaN();
+  t[9] = std::numeric_limits<double>::infinity();
+  Status s = validate(withArray<double>(m, "T_g", t, {kCells}), gasExpectation());
+  EXPECT_EQ(s.code, v1::ERROR_CODE_NON_FINITE);
+  EXPECT_NE(s.message.find("'T_g'"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("NaN at flat index 5"), std::string::npos) << s.message;
+
+  std::vector<double> u(kCells * 3, 0.0);
+  u[3 * 2 + 1] = -std::numeric_limits<double>::infinity();
+  s = validate(withArray<double>(m, "u_g", u, {kCells, 3}), gasExpectation());
+  EXPECT_EQ(s.code, v1::ERROR_CODE_NON_FINITE);
+  EXPECT_NE(s.message.find("-Inf at flat index 7 (row 2, column 1)"), std::string::npos)
+      << s.message;
+
+  Expectation lenient = gasExpectation();
+  lenient.requireFinite = false;
+  EXPECT_TRUE(validate(withArray<double>(m, "T_g", t, {kCells}), lenient).ok());
+}
+
+TEST(Validate, RejectsWrongDtypeShapeMissingAndDuplicateArrays) {
+  Message m = test::gasFieldsMessage(kCells, kSpecies);
+
+  std::vector<float> f(kCells, 1.0f);
+  Status s = validate(withArray<float>(m, "rho_g", f, {kCells}), gasExpectation());
+  EXPECT_EQ(s.code, v1::ERROR_CODE_DTYPE);
+  EXPECT_NE(s.message.find("'rho_g'"), std::string::npos);
+
+  std::vector<double> d(kCells * 3, 1.0);
+  s = validate(withArray<double>(m, "grad_p", d, {kCells * 3}), gasExpectation());
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  EXPECT_NE(s.message.find("[36]"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("[12,3]"), std::string::npos) << s.message;
+
+  std::vector<double> y(kCells * 2, 0.5); // 2 species columns, 3 configured
+  s = validate(withArray<double>(m, "Y_g", y, {kCells, 2}), gasExpectation());
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+
+  Message missing(m.envelope());
+  for (std::size_t i = 0; i + 1 < m.arrayCount(); ++i) {
+    ArrayView v = m.array(i);
+    missing.addArrayBytes(v.name(), v.dtype(), v.shape(), v.bytes);
+  }
+  s = validate(missing, gasExpectation());
+  EXPECT_EQ(s.code, v1::ERROR_CODE_MISSING_FIELD);
+  EXPECT_NE(s.message.find("'Y_g'"), std::string::npos);
+
+  // Duplicate: two descriptors with the same name (only possible on the wire).
+  Frames frames = m.encode();
+  v1::Envelope env = m.envelope();
+  env.mutable_arrays(3)->set_name("T_g");
+  frames[0] = env.SerializeAsString();
+  Status ds;
+  Message dup = Message::decode(frames, &ds);
+  ASSERT_TRUE(ds.ok());
+  EXPECT_EQ(validate(dup, gasExpectation()).code, v1::ERROR_CODE_DUPLICATE_FIELD);
+}
+
+TEST(Validate, ExtraArraysAreAllowedButChecked) {
+  Message m = test::gasFieldsMessage(kCells, kSpecies);
+  std::vector<double> extra{1.0, std::nan("")};
+  m.addArray<double>("future_field", extra, {2});
+  Status s = validate(m, gasExpectation());
+  EXPECT_EQ(s.code, v1::ERROR_CODE_NON_FINITE);
+  EXPECT_NE(s.message.find("future_field"), std::string::npos);
+}
+
+TEST(Validate, CountsDeclaredInTheBodyMustMatch) {
+  Message m = test::gasFieldsMessage(kCells, kSpecies);
+  Message other = withEnvelope(m, [](v1::Envelope& e) { e.mutable_gas_fields()->set_cell_count(11); });
+  EXPECT_EQ(validate(other, gasExpectation()).code, v1::ERROR_CODE_SHAPE);
+}
+
+TEST(Validate, TypeSessionSequenceAndStep) {
+  Message m = test::gasFieldsMessage(kCells, kSpecies, 3, 10);
+  m.setSessionId("abc");
+
+  Message unknown = withEnvelope(m, [](v1::Envelope& e) { e.set_type(static_cast<v1::MessageType>(99)); });
+  Status s = validate(unknown, {});
+  EXPECT_EQ(s.code, v1::ERROR_CODE_UNKNOWN_TYPE);
+  EXPECT_NE(s.message.find("99"), std::string::npos);
+
+  Message unspecified = withEnvelope(m, [](v1::Envelope& e) { e.set_type(v1::MESSAGE_TYPE_UNSPECIFIED); });
+  EXPECT_EQ(validate(unspecified, {}).code, v1::ERROR_CODE_UNKNOWN_TYPE);
+
+  Message mismatch = withEnvelope(m, [](v1::Envelope& e) { e.set_type(v1::MESSAGE_TYPE_SOURCES); });
+  EXPECT_EQ(validate(mismatch, {}).code, v1::ERROR_CODE_BODY_MISMATCH);
+
+  Expectation e = gasExpectation();
+  e.types = {v1::MESSAGE_TYPE_CONFIGURE};
+  EXPECT_EQ(validate(m, e).code, v1::ERROR_CODE_UNEXPECTED_MESSAGE);
+
+  e = gasExpectation();
+  e.sessionId = "xyz";
+  EXPECT_EQ(validate(m, e).code, v1::ERROR_CODE_UNKNOWN_SESSION);
+
+  e = gasExpectation();
+  e.sequence = 11;
+  EXPECT_EQ(validate(m, e).code, v1::ERROR_CODE_OUT_OF_ORDER);
+  e.sequence.reset();
+  e.sequenceAfter = 10;
+  EXPECT_EQ(validate(m, e).code, v1::ERROR_CODE_OUT_OF_ORDER);
+  e.sequenceAfter = 9;
+  EXPECT_TRUE(validate(m, e).ok());
+
+  e = gasExpectation();
+  e.step = 2;
+  s = validate(m, e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_OUT_OF_ORDER);
+  EXPECT_NE(s.message.find("step 3"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("step 2 expected"), std::string::npos) << s.message;
+
+  e = gasExpectation();
+  e.cells.reset();
+  EXPECT_EQ(validate(m, e).code, v1::ERROR_CODE_NOT_CONFIGURED);
+}
+
+namespace {
+v1::Configure validConfigure() {
+  v1::Configure c;
+  auto* g = c.mutable_coupling_mesh()->mutable_cartesian();
+  g->mutable_spacing()->set_x(0.01);
+  g->mutable_spacing()->set_y(0.01);
+  g->mutable_spacing()->set_z(0.01);
+  g->mutable_counts()->set_x(4);
+  g->mutable_counts()->set_y(3);
+  g->mutable_counts()->set_z(1);
+  auto* s = c.add_species();
+  s->set_name("CO2");
+  s->set_molar_mass(0.044);
+  c.mutable_sub_cycling()->set_dt_cfd(1e-4);
+  c.mutable_sub_cycling()->set_n_sub(3);
+  c.mutable_sub_cycling()->set_dt_dem(1e-4 / 3);
+  auto* m = c.add_materials();
+  m->set_id(2);
+  m->set_density(2500);
+  m->set_k_n(1e3);
+  m->set_e_n(0.9);
+  m->set_friction(0.3);
+  auto* p = c.add_particle_sets();
+  p->set_material_id(2);
+  p->set_count(10);
+  p->set_diameter(1e-3);
+  p->set_temperature(300);
+  p->set_packing(v1::PACKING_LATTICE);
+  p->mutable_region_max()->set_x(0.04);
+  p->mutable_region_max()->set_y(0.03);
+  p->mutable_region_max()->set_z(0.01);
+  auto* y = p->add_composition();
+  y->set_name("C");
+  y->set_value(0.7);
+  y = p->add_composition();
+  y->set_name("ash");
+  y->set_value(0.3);
+  return c;
+}
+} // namespace
+
+TEST(ValidateConfigure, AcceptsAConsistentCase) {
+  Status s = validateConfigure(validConfigure());
+  EXPECT_TRUE(s.ok()) << s.toString();
+  EXPECT_EQ(cellCount(validConfigure().coupling_mesh()), 12u);
+}
+
+TEST(ValidateConfigure, RejectsInconsistentCases) {
+  auto expectBad = [](v1::Configure c, const std::string& needle) {
+    Status s = validateConfigure(c);
+    EXPECT_EQ(s.code, v1::ERROR_CODE_INVALID_CONFIGURATION) << needle;
+    EXPECT_NE(s.message.find(needle), std::string::npos) << s.message;
+  };
+  v1::Configure c = validConfigure();
+  c.mutable_sub_cycling()->set_dt_dem(1e-4 / 3 * (1 + 1e-9));
+  expectBad(c, "dt_dem");
+
+  c = validConfigure();
+  c.mutable_coupling_mesh()->clear_cartesian();
+  expectBad(c, "CartesianGrid");
+
+  c = validConfigure();
+  c.mutable_coupling_mesh()->mutable_cartesian()->mutable_counts()->set_y(0);
+  expectBad(c, "counts");
+
+  c = validConfigure();
+  c.mutable_species(0)->set_molar_mass(0);
+  expectBad(c, "molar_mass");
+
+  c = validConfigure();
+  *c.add_species() = c.species(0);
+  expectBad(c, "unique");
+
+  c = validConfigure();
+  c.mutable_particle_sets(0)->set_material_id(7);
+  expectBad(c, "material 7");
+
+  c = validConfigure();
+  c.mutable_particle_sets(0)->mutable_composition(0)->set_value(0.69);
+  expectBad(c, "sum to");
+
+  c = validConfigure();
+  c.mutable_materials(0)->set_e_n(1.5);
+  expectBad(c, "e_n");
+
+  // An initial state file replaces the particle sets: their contents are not checked.
+  c = validConfigure();
+  c.mutable_particle_sets(0)->set_material_id(7);
+  c.set_initial_state_file("state.h5");
+  EXPECT_TRUE(validateConfigure(c).ok());
+}

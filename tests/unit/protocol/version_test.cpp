@@ -1,0 +1,34 @@
+// Version negotiation rule (DESIGN §3).
+#include <coredem/protocol/version.h>
+
+#include <gtest/gtest.h>
+
+using namespace coredem::protocol;
+
+TEST(Version, SameMajorAcceptsWithTheLowerMinor) {
+  Negotiation n = negotiate({1, 0}, {1, 3});
+  EXPECT_TRUE(n.accepted);
+  EXPECT_EQ(n.agreed, (Version{1, 0}));
+  EXPECT_TRUE(n.status.ok());
+
+  n = negotiate({1, 4}, {1, 2});
+  EXPECT_TRUE(n.accepted);
+  EXPECT_EQ(n.agreed, (Version{1, 2}));
+}
+
+TEST(Version, OtherMajorIsRejectedNamingBothVersions) {
+  Negotiation n = negotiate({1, 0}, {2, 5});
+  EXPECT_FALSE(n.accepted);
+  EXPECT_EQ(n.status.code, coredem::v1::ERROR_CODE_VERSION);
+  EXPECT_NE(n.status.message.find("1.0"), std::string::npos) << n.status.message;
+  EXPECT_NE(n.status.message.find("2.5"), std::string::npos) << n.status.message;
+
+  n = negotiate({1, 0}, {0, 9});
+  EXPECT_FALSE(n.accepted);
+  EXPECT_NE(n.status.message.find("0.9"), std::string::npos);
+}
+
+TEST(Version, ThisBuildSpeaksOneDotZero) {
+  EXPECT_EQ(kProtocolVersion, (Version{1, 0}));
+  EXPECT_EQ(kProtocolVersion.toString(), "1.0");
+}
