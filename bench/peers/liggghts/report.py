@@ -120,6 +120,12 @@ def main(argv):
               + ", ".join(f"{k} {100 * v / total:.0f}%" for k, v in split.items() if total > 0)
               + "  (Other = integration, gravity and the six wall fixes)")
     print(f"LIGGGHTS neighbour-list builds during the timed loop: {lig[0]['builds']}")
+    if ours:
+        raw = ours[-1]["raw"]
+        extras = [f"{k} = {raw[k]}" for k in ("rebuilds", "skin_factor", "wall_contacts_per_particle",
+                                              "setup_s", "stage_s") if k in raw]
+        if extras:
+            print("CoReDEM (last run): " + ", ".join(extras))
     print("Timed loops only: LIGGGHTS' 'Loop time' (read_data, setup, the first neighbour build and")
     print("force evaluation excluded); CoReDEM's own timed step loop (its setup excluded).")
     print("contacts/particle: LIGGGHTS counts particle-particle contacts per particle after the last")
