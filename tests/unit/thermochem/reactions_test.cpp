@@ -145,6 +145,13 @@ TEST(CharGasification, ParticleRatesConserveMass) {
   EXPECT_LT(full.heat, 0.0); // endothermic: the particle is cooled
   const auto gone = k::charGasification(p, t, pBar, 0.0, mC0);
   EXPECT_EQ(gone.nR1 + gone.nR2, 0.0);
+  // Step limiter: a step that would burn more carbon than present is scaled to burn all of it.
+  const double mLeft = 1e-20;
+  const double dt = 1.0;
+  const auto r = k::charGasification(p, t, pBar, mLeft, mC0);
+  const double s = k::charStepLimiter(r, mLeft, dt);
+  EXPECT_NEAR(-r.mdotC * s * dt, std::min(mLeft, -r.mdotC * dt), 1e-15 * mLeft);
+  EXPECT_EQ(k::charStepLimiter(full, mC0, 1e-6), 1.0);
 }
 
 // ---- oxygen-carrier reduction ---------------------------------------------------------------

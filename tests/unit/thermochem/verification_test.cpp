@@ -88,3 +88,25 @@ TEST(Verification, ReactionAnalytic) {
   EXPECT_NEAR(fin.xD, 5.0 / 11.0, 1e-15);
   EXPECT_NEAR(fin.xI, 6.0 / 11.0, 1e-15);
 }
+
+// Case presets used by the verification suite reproduce the §8 constants.
+TEST(Verification, CasePresets) {
+  const auto cc = v::contactConductionCoefficients(v::mfixContactConductionCase());
+  EXPECT_NEAR(cc.a, 0.01027998273952850, 1e-10 * cc.a);
+  const auto sv = v::contactConductionCoefficients(v::seedContactConductionCase(2.4e-3, 1e-5));
+  EXPECT_NEAR(sv.a, 8.038552e-02, 5e-7 * sv.a);
+  EXPECT_NEAR(sv.b, 1.083803e-01, 5e-7 * sv.b);
+  const auto pfp = v::gasLensCoefficients(v::mfixLensCase());
+  EXPECT_NEAR(pfp.a, 4.010942558902641e-02, 1e-9 * pfp.a);
+  coredem::dem::kernels::GasLensParams fine;
+  fine.minSeparation = 4e-10;
+  const auto touch = v::gasLensCoefficients(v::seedLensCase(-1e-5), fine);
+  EXPECT_NEAR(touch.a, 8.206299e-01, 5e-7 * touch.a); // §8.2 table
+  EXPECT_NEAR(touch.b, 3.278280e-01, 5e-7 * touch.b);
+  EXPECT_NEAR(v::twoParticleExchange(touch.a, touch.b, 373.15, 278.15, 10.0).t1, 305.2685, 5e-5);
+  EXPECT_NEAR(v::mfixConvectionCellVoidage(), 0.995759, 5e-7);
+  // A lens case whose quadrature cannot converge is reported, not silently returned.
+  coredem::dem::kernels::GasLensParams impossible;
+  impossible.relTol = 1e-30;
+  EXPECT_THROW(v::gasLensCoefficients(v::seedLensCase(-1e-5), impossible), coredem::UserError);
+}

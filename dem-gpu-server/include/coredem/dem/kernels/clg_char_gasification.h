@@ -91,4 +91,11 @@ DEM_HD CharGasificationRates charGasification(const CharGasificationParams& p, d
   return out;
 }
 
+/// Scale factor s ∈ [0, 1] so that a step dt does not consume more carbon than present
+/// (multiply every rate of `r` by s).
+DEM_HD double charStepLimiter(const CharGasificationRates& r, double mC, double dt) {
+  const double loss = -r.mdotC * dt;
+  return loss > mC && loss > 0.0 ? (mC > 0.0 ? mC / loss : 0.0) : 1.0;
+}
+
 } // namespace coredem::dem::kernels

@@ -103,6 +103,59 @@ inline ExchangeCoefficients gasLensCoefficients(double d1, const Material& m1, d
   return {g / (sphereMass(m1, d1) * m1.cp), g / (sphereMass(m2, d2) * m2.cp), g};
 }
 
+/// A pair of fixed particles exchanging heat by conduction (§8.1, §8.2).
+struct TwoParticleCase {
+  double d1;   ///< m
+  Material m1;
+  double d2;   ///< m
+  Material m2;
+  double l;    ///< centre distance, m
+  double t10;  ///< K
+  double t20;  ///< K
+};
+
+/// MFiX-CC (§8.1): A at y = 1.499864 mm (298.15 K), B at y = 4.799731 mm (453.15 K).
+inline TwoParticleCase mfixContactConductionCase() {
+  return {3.0e-3, musserMaterialA(), 3.6e-3, musserMaterialB(), (0.4799731 - 0.1499864) * 1e-2,
+          298.15, 453.15};
+}
+
+/// Seed contact variants (§8.1): A (3.0 mm, 373.15 K) and material B of diameter d2 at
+/// 278.15 K, overlapping by `overlap` (m).
+inline TwoParticleCase seedContactConductionCase(double d2, double overlap) {
+  return {3.0e-3, musserMaterialA(), d2, musserMaterialB(), 1.5e-3 + 0.5 * d2 - overlap, 373.15,
+          278.15};
+}
+
+/// MFiX-PFP (§8.2): A at y = 11.50 mm (298.15 K), B at y = 14.98 mm (453.15 K), gap 0.18 mm.
+inline TwoParticleCase mfixLensCase() {
+  return {3.0e-3, musserMaterialA(), 3.6e-3, musserMaterialB(), (1.498 - 1.150) * 1e-2, 298.15,
+          453.15};
+}
+
+/// Seed gas-lens variants (§8.2): A (3.0 mm, 373.15 K), B (3.6 mm, 278.15 K), surface gap
+/// `gap` (m; negative = overlap).
+inline TwoParticleCase seedLensCase(double gap) {
+  return {3.0e-3, musserMaterialA(), 3.6e-3, musserMaterialB(), 3.3e-3 + gap, 373.15, 278.15};
+}
+
+/// Contact coefficients of a case.
+inline ExchangeCoefficients contactConductionCoefficients(const TwoParticleCase& c) {
+  return contactConductionCoefficients(c.d1, c.m1, c.d2, c.m2, c.l);
+}
+
+/// Lens coefficients of a case (gas conductivity κ_g of §8.0 unless given).
+inline ExchangeCoefficients gasLensCoefficients(const TwoParticleCase& c,
+                                                const kernels::GasLensParams& p = {},
+                                                double kG = kMusserLensGasConductivity) {
+  return gasLensCoefficients(c.d1, c.m1, c.d2, c.m2, c.l, kG, p);
+}
+
+/// Gas voidage of the MFiX convection cell (4 × 4 × 0.36 cm with one 3.6-mm particle), §8.3.
+inline double mfixConvectionCellVoidage() {
+  return 1.0 - sphereVolume(3.6e-3) / (0.04 * 0.04 * 0.0036);
+}
+
 /// Convection rate constant h A_p/(m C_p), s⁻¹ (§8.3).
 inline double convectionCoefficient(const kernels::ConvectionParams& p, const kernels::GasState& g,
                                     double d, const Material& m, double slip) {
