@@ -40,9 +40,11 @@ __global__ void evalKernel(std::size_t n, F f, double* out) {
   if (i < n) out[i] = f(i);
 }
 
-__global__ inline void iotaKernel(std::size_t n, std::uint32_t* v) {
+template <class T>
+__global__ void iotaKernel(std::size_t n, T* v) {
+  static_assert(sizeof(T) == 4, "32-bit indices");
   const std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i < n) v[i] = static_cast<std::uint32_t>(i);
+  if (i < n) v[i] = static_cast<T>(i);
 }
 
 struct CudaExec {

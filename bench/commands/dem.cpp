@@ -1,0 +1,121 @@
+// coredem-bench dem: throughput of the DEM core on the decks of bench/decks.md.
+//   coredem-bench dem --case packed --particles 100000 --steps 500 --backend cpu --threads 2 [--json]
+// Prints particle_steps_per_s, contacts per particle, bytes per particle and the time per
+// stage. Figures are measured, never asserted.
+#include "commands.h"
+
+#include "coredem/common/check.h"
+#include "coredem/dem/dem_system.h"
+
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace {
+
+using namespace coredem::dem;
+
+/// The decks of bench/decks.md (material: Patil glass, PHYSICS §7).
+DemConfig deck(const std::string& name, std::size_t n) {
+  DemConfig c;
+  c.materials[0] = Material{"glass", 1000.0, 0.97, 0.1, 2.0 / 7.0, 0.5};
+  const double d = 1e-3;
+  const bool packed = name == "packed";
+  const double s = packed ? 0.9999 * d : 1.2 * d;
+  const long long nx = std::llround(std::cbrt(static_cast<double>(n)));
+  const long long ny = nx;
+  const long long nz = (static_cast<long long>(n) + nx * ny - 1) / (nx * ny);
+  ParticleSet p;
+  p.name = name;
+  p.packing = Packing::Lattice;
+  p.spacing = s;
+  p.count = n;
+  p.diameter = d;
+  p.density = 2500.0;
+  p.regionMin = {0, 0, 0};
+  p.regionMax = {nx * s, ny * s, nz * s};
+  if (packed) {
+    c.gravity = {0, 0, -9.81};
+    c.addBox({0, 0, 0}, {nx * s, ny * s, 2.0 * nz * s});
+  } else {
+    c.gravity = {0, 0, 0};
+    p.velocityJitter = 0.5;
+    p.seed = 20240611;
+    c.addBox({0, 0, 0}, {nx * s, ny * s, nz * s});
+  }
+  c.particleSets.push_back(p);
+  return c;
+}
+
+int runDem(int argc, char** argv) {
+  CLI::App app{"DEM core throughput on the packed / agitated decks (bench/decks.md)", "coredem-bench dem"};
+  std::string deckName = "packed", backend = "cpu";
+  std::size_t n = 10000;
+  int steps = 500, threads = 2, warmup = 20;
+  double skin = -1;
+  bool json = false;
+  app.add_option("--case", deckName, "deck: packed | agitated")->check(CLI::IsMember({"packed", "agitated"}));
+  app.add_option("--particles", n, "number of particles")->check(CLI::Range(1.0, 2.0e9));
+  app.add_option("--steps", steps, "measured DEM steps")->check(CLI::PositiveNumber);
+  app.add_option("--warmup", warmup, "unmeasured steps first")->check(CLI::NonNegativeNumber);
+  app.add_option("--backend", backend, "cpu | cuda | auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
+  app.add_option("--threads", threads, "OpenMP threads (cpu backend)")->check(CLI::NonNegativeNumber);
+  app.add_option("--skin", skin, "Verlet skin as a fraction of d_max (default: the library's)");
+  app.add_flag("--json", json, "print one JSON object");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    DemConfig cfg = deck(deckName, n);
+    if (skin >= 0) cfg.neighbour.skinFactor = skin;
+    const auto t0 = std::chrono::steady_clock::now();
+    DemSystem sys(cfg, parseBackend(backend), threads);
+    const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double dt = sys.dtDemMax();
+    if (warmup > 0) sys.advance(warmup * dt, warmup);
+    sys.resetStageTimes();
+    const auto t1 = std::chrono::steady_clock::now();
+    sys.advance(steps * dt, steps);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    const StageTimes st = sys.stageTimes();
+    const double pairsPer = 2.0 * static_cast<double>(sys.pairContactCount()) / static_cast<double>(n);
+    const double wallPer = static_cast<double>(sys.contactCount() - sys.pairContactCount()) / static_cast<double>(n);
+    const double bytesPer = static_cast<double>(sys.memoryBytes()) / static_cast<double>(n);
+    const double rate = static_cast<double>(n) * steps / wall;
+    if (json) {
+      std::printf("{\"command\":\"dem\",\"case\":\"%s\",\"backend\":\"%s\",\"threads\":%d,\"particles\":%zu,"
+                  "\"steps\":%d,\"dt_dem\":%.6e,\"skin_factor\":%.4g,\"wall_s\":%.6f,\"setup_s\":%.6f,"
+                  "\"particle_steps_per_s\":%.6e,\"contacts_per_particle\":%.4f,"
+                  "\"wall_contacts_per_particle\":%.4f,\"bytes_per_particle\":%.1f,"
+                  "\"stage_s\":{\"neighbour\":%.6f,\"contact\":%.6f,\"integrate\":%.6f,\"coupling\":%.6f},"
+                  "\"rebuilds\":%llu}\n",
+                  deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt, cfg.neighbour.skinFactor,
+                  wall, setup, rate, pairsPer, wallPer, bytesPer, st.neighbour, st.contact, st.integrate,
+                  st.coupling, static_cast<unsigned long long>(st.rebuilds));
+    } else {
+      std::printf("case %s, backend %s, threads %d, N = %zu, %d steps of dt_DEM = %.4e s (skin %.3g d)\n",
+                  deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt, cfg.neighbour.skinFactor);
+      std::printf("particle_steps_per_s     %.4e\n", rate);
+      std::printf("contacts_per_particle    %.3f  (+ %.3f wall contacts)\n", pairsPer, wallPer);
+      std::printf("bytes_per_particle       %.0f\n", bytesPer);
+      std::printf("wall time                %.3f s  (set-up %.3f s)\n", wall, setup);
+      std::printf("stage neighbour search   %.3f s  (%llu rebuilds)\n", st.neighbour,
+                  static_cast<unsigned long long>(st.rebuilds));
+      std::printf("stage contact forces     %.3f s\n", st.contact);
+      std::printf("stage integration        %.3f s\n", st.integrate);
+    }
+    return 0;
+  } catch (const coredem::UserError& e) {
+    std::fprintf(stderr, "coredem-bench dem: %s\n", e.what());
+    return 1;
+  }
+}
+
+} // namespace
+
+COREDEM_BENCH_COMMAND("dem", "DEM core throughput on the packed / agitated decks", runDem);
