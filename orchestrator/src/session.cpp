@@ -769,12 +769,18 @@ int Session::run() {
 } // namespace
 
 void checkParticipantInput(const CaseConfig& config) {
+  if (config.dem.endpoint.empty()) {
+    COREDEM_CHECK(!findProgram("coredem-dem").empty(),
+                  "coredem-dem not found next to coredem ({}) or on PATH; build it (cmake --build "
+                  "build --target coredem-dem) or name a running server in dem.endpoint",
+                  executableDir().string());
+  }
+  const fs::path exe = findProgram(config.cfd.participant);
+  COREDEM_CHECK(!exe.empty(), "{} not found next to coredem ({}) or on PATH; build it (cmake --build "
+                              "build --target {})",
+                config.cfd.participant, executableDir().string(), config.cfd.participant);
   if (config.cfd.participant != "coredem-gas") {
     return;
-  }
-  const fs::path exe = findProgram("coredem-gas");
-  if (exe.empty()) {
-    return; // reported when the run starts it
   }
   char tmpl[] = "/tmp/coredem-check-XXXXXX";
   const int fd = ::mkstemp(tmpl);
