@@ -285,6 +285,10 @@ TEST(GasLens, ClippedLimitAndReach) {
   const double reach = 1.2 * 1.8e-3 + 1.5e-3;
   EXPECT_EQ(k::gasLensIntegral(d, 1.5e-3, 1.8e-3, reach).value, 0.0);
   EXPECT_GT(k::gasLensIntegral(d, 1.5e-3, 1.8e-3, reach * (1 - 1e-6)).value, 0.0);
+  // s_min ≤ 0 would make the contact integral diverge: reported as not converged.
+  k::GasLensParams bad;
+  bad.minSeparation = 0.0;
+  EXPECT_FALSE(k::gasLensIntegral(bad, 1.5e-3, 1.8e-3, 3.2e-3).converged);
   // Lens around the larger sphere: swapping the argument order changes nothing.
   EXPECT_EQ(k::gasLensIntegral(d, 1.8e-3, 1.5e-3, 3.4e-3).value,
             k::gasLensIntegral(d, 1.5e-3, 1.8e-3, 3.4e-3).value);

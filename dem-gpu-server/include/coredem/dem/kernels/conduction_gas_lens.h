@@ -35,7 +35,7 @@ namespace coredem::dem::kernels {
 
 struct GasLensParams {
   double lensFraction = 0.2;    ///< FLPC: lens radius = (1 + FLPC) R_L, −
-  double minSeparation = 1.0e-6; ///< s_min, m
+  double minSeparation = 1.0e-6; ///< s_min, m (> 0: the integral diverges at contact otherwise)
   double relTol = 1.0e-10;      ///< relative tolerance of the quadrature
 };
 
@@ -69,6 +69,9 @@ struct GasLensIntegral {
 /// The lens integral I of Eq. 24 (m). Depends only on the sorted radii and l.
 DEM_HD GasLensIntegral gasLensIntegral(const GasLensParams& p, double ri, double rj, double l) {
   constexpr double pi = 3.141592653589793;
+  if (!(p.minSeparation > 0.0) || !(p.lensFraction >= 0.0)) {
+    return {0.0, 0.0, false}; // invalid parameters (the case parser rejects them)
+  }
   const GasLensGeometry geo = gasLensGeometry(p, ri, rj, l);
   if (!geo.active) {
     return {0.0, 0.0, true};
