@@ -287,4 +287,18 @@ inline ReactionState reactionAnalytic(const ReactionCase& c, double t) {
   return {m, xB, (c.m0 * c.xD0 + rD * tc) / m, c.m0 * c.xI0 / m};
 }
 
+/// Shrinking core with a constant rate coefficient k (s⁻¹): dξ/dt = k (1 − ξ)^(2/3) gives
+/// 1 − ξ(t) = (1 − k t/3)³ for t < 3/k and 0 afterwards (PHYSICS §6.1 char with constant gas,
+/// §6.3 grain model with constant gas). For pure-carbon char, 1 − ξ = m_C/m_C0 and the
+/// diameter of a constant-density particle is d0 (1 − k t/3).
+inline double shrinkingCoreUnreacted(double k, double t) {
+  const double s = 1.0 - k * t / 3.0;
+  return s > 0.0 ? s * s * s : 0.0;
+}
+
+/// Time at which a pure-carbon particle reaches d = threshold · d0 under a constant rate k.
+inline double shrinkingCoreRemovalTime(double k, double threshold) {
+  return 3.0 * (1.0 - threshold) / k;
+}
+
 } // namespace coredem::dem::verification
