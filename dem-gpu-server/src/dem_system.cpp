@@ -339,6 +339,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   st.fwall.assign(3 * n, 0.0);
   st.xref = st.pos;
   st.contacts.assign(n, 0);
+  st.wallContacts.assign(n, 0);
   st.histKey.assign(n * st.historySlots, -1);
   st.histDisp.assign(3 * n * st.historySlots, 0.0);
   st.nbCount.assign(n, 0);

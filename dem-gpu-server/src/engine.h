@@ -49,7 +49,7 @@ struct HostState {
   std::vector<double> pos, vel, omega, force, torque, fwall, xref;  // N*3
   std::vector<double> radius, mass, density, temperature;          // N
   std::vector<double> species;                                     // N*nSpecies
-  std::vector<std::int32_t> material, contacts;                    // N
+  std::vector<std::int32_t> material, contacts, wallContacts;      // N (contacts: pair, last sub-step)
   std::vector<std::int64_t> gid;                                   // N
   std::vector<std::int64_t> histKey;                               // N*K (−1 empty, ≥0 partner gid, −(w+2) wall w)
   std::vector<double> histDisp;                                    // N*K*3

@@ -102,7 +102,7 @@ public:
     put(_p.temperature, s.temperature); put(_p.species, s.species); put(_p.material, s.material);
     put(_p.contacts, s.contacts); put(_p.gid, s.gid); put(_p.histKey, s.histKey);
     put(_p.histDisp, s.histDisp); put(_p.nbCount, s.nbCount); put(_p.nbList, s.nbList);
-    for (std::size_t k = 0; k < s.n; ++k) _p.wallContacts.h()[k] = 0;
+    put(_p.wallContacts, s.wallContacts);
     _p.toDevice(kAllFields);
     _listValid = s.listValid != 0 && s.nbList.size() == s.n * static_cast<std::size_t>(s.neighbourSlots);
     reserveScratch();
@@ -120,7 +120,7 @@ public:
     get(_p.torque, s.torque); get(_p.fwall, s.fwall); get(_p.xref, s.xref);
     get(_p.radius, s.radius); get(_p.mass, s.mass); get(_p.density, s.density);
     get(_p.temperature, s.temperature); get(_p.species, s.species); get(_p.material, s.material);
-    get(_p.contacts, s.contacts); get(_p.gid, s.gid); get(_p.histKey, s.histKey);
+    get(_p.contacts, s.contacts); get(_p.wallContacts, s.wallContacts); get(_p.gid, s.gid); get(_p.histKey, s.histKey);
     get(_p.histDisp, s.histDisp); get(_p.nbCount, s.nbCount); get(_p.nbList, s.nbList);
     s.listValid = _listValid ? 1 : 0;
     return s;
@@ -458,7 +458,9 @@ public:
     kernels::GidaspowParams drag;
     drag.epsMin = _s.epsMin;
 
-    _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+    // reduceMax runs the kernel body once per index (side effects on index i only) and
+    // returns the largest number of contacts of a particle, in the same pass.
+    const double maxSlots = _exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
       const long long ii = static_cast<long long>(i);
       const Vec3 xi = load3(x, ii);
@@ -467,15 +469,17 @@ public:
       const double ri = r[i];
       const double mi = m[i];
       const int ai = mat[i];
+      // Slots in use are compacted at the front: the last sub-step used nc + nwc of them.
+      const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
       std::int64_t oldKey[kMaxHistorySlots];
       Vec3 oldD[kMaxHistorySlots];
-      for (int s = 0; s < K; ++s) {
+      for (int s = 0; s < used; ++s) {
         oldKey[s] = hk[i * K + s];
         oldD[s] = load3(hd, ii * K + s);
       }
       int slot = 0;
       auto history = [&](std::int64_t key) {
-        for (int s = 0; s < K; ++s)
+        for (int s = 0; s < used; ++s)
           if (oldKey[s] == key) return oldD[s];
         return Vec3{0.0, 0.0, 0.0};
       };
@@ -547,17 +551,15 @@ public:
         ++wallCount;
       }
       F += FW;
-      for (int s = slot; s < K; ++s) hk[i * K + s] = -1;
+      for (int s = slot; s < used; ++s) hk[i * K + s] = -1;
       store3(f, ii, F);
       store3(tq, ii, T);
       store3(fw, ii, FW);
       nc[i] = pairCount;
       nwc[i] = wallCount;
-    });
+      return static_cast<double>(pairCount + wallCount);
+    }, 0.0);
     _p.produced(kForce | kTorque | kFwall | kHistKey | kHistDisp | kContacts | kWallContacts);
-    const std::int32_t* cc = _p.contacts.d();
-    const double maxSlots = _exec.reduceMax(
-        n, [=] DEM_LAMBDA(std::size_t i) { return static_cast<double>(cc[i] + nwc[i]); }, 0.0);
     if (maxSlots > K) {
       backend::raiseUserError("a particle has " + std::to_string(static_cast<int>(maxSlots)) +
                               " simultaneous contacts but only " + std::to_string(K) +
@@ -578,7 +580,7 @@ public:
     double* w = _p.omega.d();
     const double* xr = _p.xref.d();
     const kernels::Vec3 g = _s.gravity;
-    _exec.parallelFor(_p.n, [=] DEM_LAMBDA(std::size_t i) {
+    const double maxDisp2 = _exec.reduceMax(_p.n, [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
       const long long ii = static_cast<long long>(i);
       const double invM = 1.0 / m[i];
@@ -586,17 +588,13 @@ public:
       const double invI = 1.0 / (0.4 * m[i] * r[i] * r[i]);  // I = 2/5 m R² (Eq. 7)
       store3(w, ii, load3(w, ii) + (dt * invI) * load3(tq, ii));
       store3(v, ii, vn);
-      store3(x, ii, load3(x, ii) + dt * vn);
-    });
+      const Vec3 xn = load3(x, ii) + dt * vn;
+      store3(x, ii, xn);
+      const Vec3 d = xn - load3(xr, ii);
+      return dot(d, d);
+    }, 0.0);
     _p.produced(kPos | kVel | kOmega);
-    return _exec.reduceMax(
-        _p.n,
-        [=] DEM_LAMBDA(std::size_t i) {
-          const kernels::Vec3 d = kernels::load3(x, static_cast<long long>(i)) -
-                                  kernels::load3(xr, static_cast<long long>(i));
-          return kernels::dot(d, d);
-        },
-        0.0);
+    return maxDisp2;
   }
 
   void subStep(double dt) override {

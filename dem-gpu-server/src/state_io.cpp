@@ -133,6 +133,7 @@ void writeStateFile(const std::string& path, const HostState& s, const StateMeta
     writeArray(g.id, "history_key", s.histKey, {n, K});
     writeArray(g.id, "history_displacement", s.histDisp, {n, K, 3});
     writeArray(g.id, "contact_count", s.contacts, {n});
+    writeArray(g.id, "wall_contact_count", s.wallContacts, {n});
     writeArray(g.id, "neighbour_count", s.nbCount, {n});
     writeArray(g.id, "neighbour_list", s.nbList, {n, M});
   }
@@ -197,6 +198,7 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
   readArray(g.id, "history_key", s.histKey, n * K, path);
   readArray(g.id, "history_displacement", s.histDisp, 3 * n * K, path);
   readArray(g.id, "contact_count", s.contacts, n, path);
+  readArray(g.id, "wall_contact_count", s.wallContacts, n, path);
   readArray(g.id, "neighbour_count", s.nbCount, n, path);
   readArray(g.id, "neighbour_list", s.nbList, n * M, path);
 }

@@ -3,7 +3,8 @@
 /// Shared backend vocabulary: the lambda qualifier for parallel_for bodies and the error
 /// hook. A backend ("Exec") is a small type providing (see cpu/cpu_exec.h):
 ///   parallelFor(n, f)            f(i) for i in [0, n), any order, no two i alias
-///   reduceMax(n, f)              max_i f(i) (exact, so order-independent)
+///   reduceMax(n, f, init)        max(init, max_i f(i)); exact, so order-independent. f may
+///                                write outputs of its own index i (fused kernel + reduction)
 ///   sortByKey(keys, n, numKeys, perm)   stable permutation sorting keys ascending
 ///   exclusiveScan(in, out, n)    out[i] = Σ_{k<i} in[k]
 ///   allocHost/freeHost (pinned for CUDA), allocDevice/freeDevice, copyToDevice/copyToHost,

@@ -21,7 +21,7 @@ TEST(PackedBed, SettledBedWallForceEqualsWeight) {
   s.seed = 99;
   c.particleSets.push_back(s);
   c.addBox({0, 0, 0}, {L, L, 4 * L});
-  DemSystem sys(c, BackendKind::Cpu, 2);
+  DemSystem sys(c, BackendKind::Cpu, 1);
   const double dtCfd = 1e-3;
   const int nSub = TimeHandler::subStepsFor(dtCfd, sys.dtDemMax());
   for (int k = 0; k < 400; ++k) sys.advance(dtCfd, nSub);  // 0.4 s: fall + settle
@@ -45,4 +45,24 @@ TEST(PackedBed, SettledBedWallForceEqualsWeight) {
   EXPECT_NEAR(mean[0], 0.0, 1e-3 * weight);
   EXPECT_NEAR(mean[1], 0.0, 1e-3 * weight);
   EXPECT_GT(sys.pairContactCount(), p.count);  // a real bed: more than one contact per particle
+}
+
+TEST(PackedBed, TooFewHistorySlotsIsAUserError) {
+  // A simple-cubic packing gives interior particles 6 contacts; 4 slots cannot hold them.
+  DemConfig c;
+  ParticleSet s;
+  s.packing = Packing::Lattice;
+  s.spacing = 0.999e-3;
+  s.count = 27;
+  s.regionMin = {0, 0, 0};
+  s.regionMax = {3 * 0.999e-3, 3 * 0.999e-3, 3 * 0.999e-3};
+  c.particleSets.push_back(s);
+  c.neighbour.historySlots = 4;
+  DemSystem sys(c, BackendKind::Cpu, 1);
+  try {
+    sys.advance(sys.dtDemMax(), 1);
+    FAIL() << "expected a UserError";
+  } catch (const coredem::UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("historySlots"), std::string::npos) << e.what();
+  }
 }
