@@ -71,8 +71,10 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
     cfg.solidSpecies.push_back({name, molar});
   }
 
-  // Particle sets (ignored when an initial state file is given: the file has the particles).
-  if (c.initial_state_file().empty()) {
+  // Particle sets. With an initial state file the file's particles replace them after
+  // construction (readState), but they are still built when given: the DEM core derives
+  // dt_dem_max from the sets' materials and sizes.
+  {
     int index = 0;
     for (const auto& ps : c.particle_sets()) {
       const auto it = materialIndex.find(ps.material_id());

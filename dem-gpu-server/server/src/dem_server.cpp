@@ -193,6 +193,17 @@ struct DemServer::Impl {
     sessionEnded = true;
   }
 
+  static std::string nameOf(const proto::Request& r) {
+    const auto& env = r.message.envelope();
+    if (!env.sender().empty()) {
+      return env.sender();
+    }
+    if (!env.hello().software_version().empty()) {
+      return env.hello().software_version();
+    }
+    return hexPeer(r.peer);
+  }
+
   void onHello(const proto::Request& r) {
     const auto& env = r.message.envelope();
     if (env.body_case() != v1::Envelope::kHello) {
@@ -216,7 +227,7 @@ struct DemServer::Impl {
       }
       session = randomSessionId();
       oPeer = r.peer;
-      oName = env.sender().empty() ? hexPeer(r.peer) : env.sender();
+      oName = nameOf(r);
       state = SessionState::Connected;
       started = lastActivity = Clock::now();
       sessionEnded = false;
@@ -242,7 +253,7 @@ struct DemServer::Impl {
                   cName, env.sender());
       }
       cPeer = r.peer;
-      cName = env.sender().empty() ? hexPeer(r.peer) : env.sender();
+      cName = nameOf(r);
       lastSequence[r.peer] = env.sequence();
       log->info("session {}: CFD participant '{}' connected (protocol {}.{}, peer {})", session,
                 cName, n.agreed.major, n.agreed.minor, hexPeer(r.peer));
@@ -284,6 +295,10 @@ struct DemServer::Impl {
         next->readState(c.initial_state_file());
         restored = readServerLedgers(c.initial_state_file(), c.species_size());
       }
+      COREDEM_CHECK(std::isfinite(next->dtDemMax()) && next->dtDemMax() > 0.0,
+                    "no stable DEM time step can be derived (dt_dem_max = {}): give the particle "
+                    "sets (with an initial state file too, they define the sizes and materials)",
+                    next->dtDemMax());
     } catch (const coredem::UserError& e) {
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION, e.what());
       return;
