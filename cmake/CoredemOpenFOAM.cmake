@@ -13,6 +13,7 @@
 #   coredem_add_openfoam_application(NAME SOURCES ... [LIBS ...] [INCLUDES ...])
 #                               an OpenFOAM application in build/bin, compiled with OpenFOAM's
 #                               own C++ standard (COREDEM_OPENFOAM_CXX_STANDARD)
+#   COREDEM_OPENFOAM_HEADERS    the prepared tree (openfoam-headers.stamp, src/, wmake/)
 #   COREDEM_OPENFOAM_SRC        the prepared source tree's src/ (like wmake's $(LIB_SRC))
 #   COREDEM_OPENFOAM_PROJECT_DIR  the WM_PROJECT_DIR applications need at run time
 #   COREDEM_OPENFOAM_API        e.g. 1912
@@ -141,6 +142,7 @@ function(_coredem_openfoam_resolve out_ok out_why)
   endif()
 
   set(COREDEM_OPENFOAM_SRC ${_src} CACHE INTERNAL "OpenFOAM src/ with lnInclude trees")
+  set(COREDEM_OPENFOAM_HEADERS ${_dir} CACHE INTERNAL "Prepared OpenFOAM tree (stamp, src/, wmake/)")
   set(COREDEM_OPENFOAM_API ${_api} CACHE INTERNAL "OpenFOAM API number")
   set(COREDEM_OPENFOAM_VERSION ${_bin_version} CACHE INTERNAL "Installed openfoam package version")
   set(COREDEM_OPENFOAM_BIN_DIR "${_bin_dir}" CACHE INTERNAL "Debian's OpenFOAM utilities")
