@@ -1,15 +1,15 @@
 // Contact conduction (PHYSICS §3.2) and gas-lens conduction (§3.3) vs the MFiX reference
 // constants (§8.1, §8.2), reference/refvalues.py, closed forms and an independent fine
 // long-double quadrature.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
 #include <coredem/dem/kernels/conduction_contact.h>
 #include <coredem/dem/kernels/conduction_gas_lens.h>
 #include <coredem/dem/kernels/conduction_quadrature.h>
 #include <coredem/dem/verification/analytic.h>
-
-#include <gtest/gtest.h>
-
-#include <cmath>
-#include <random>
 
 namespace k = coredem::dem::kernels;
 namespace v = coredem::dem::verification;
@@ -103,11 +103,13 @@ long double equalSpheresLensIntegral(long double rad, long double l, long double
 TEST(Quadrature, GaussKronrodExactnessAndAdaptivity) {
   for (int deg = 0; deg <= 22; ++deg) {
     double err = 0.0;
-    const double val = k::gaussKronrod15([deg](double x) { return std::pow(x, deg); }, 0.0, 2.0, err);
+    const double val =
+        k::gaussKronrod15([deg](double x) { return std::pow(x, deg); }, 0.0, 2.0, err);
     const double exact = std::pow(2.0, deg + 1) / (deg + 1);
     EXPECT_NEAR(val, exact, 1e-14 * exact) << "degree " << deg;
   }
-  const auto r = k::integrateAdaptive([](double x) { return 1.0 / (x * x + 1e-6); }, -1.0, 1.0, 1e-12);
+  const auto r =
+      k::integrateAdaptive([](double x) { return 1.0 / (x * x + 1e-6); }, -1.0, 1.0, 1e-12);
   const double exact = 2000.0 * std::atan(1000.0);
   EXPECT_TRUE(r.converged);
   EXPECT_NEAR(r.value, exact, 1e-12 * exact);
@@ -138,8 +140,8 @@ TEST(ContactConduction, IntersectionRadiusIsAccurateForTinyOverlaps) {
     const double exact = std::sqrt((rad - 0.5 * l) * (rad + 0.5 * l));
     EXPECT_NEAR(k::intersectionCircleRadius(rad, rad, l), exact, 1e-14 * exact) << ov;
   }
-  EXPECT_EQ(k::intersectionCircleRadius(1e-3, 2e-3, 3e-3), 0.0);   // touching: no circle
-  EXPECT_EQ(k::intersectionCircleRadius(1e-3, 2e-3, 3.1e-3), 0.0); // apart
+  EXPECT_EQ(k::intersectionCircleRadius(1e-3, 2e-3, 3e-3), 0.0);    // touching: no circle
+  EXPECT_EQ(k::intersectionCircleRadius(1e-3, 2e-3, 3.1e-3), 0.0);  // apart
   EXPECT_EQ(k::intersectionCircleRadius(1e-3, 2e-3, 0.5e-3), 1e-3); // inside [C]
   EXPECT_EQ(k::contactConductance(1.0, 2.0, 1e-3, 2e-3, 3e-3), 0.0);
 }
@@ -224,7 +226,7 @@ TEST(GasLens, SeedVariantsMatchReferenceScript) {
   struct Row {
     double gap, sMin, integral;
   };
-  const Row rows[] = {{1e-5, 1e-6, 1.828676331275730e-02},  {2e-5, 1e-6, 1.476554955240080e-02},
+  const Row rows[] = {{1e-5, 1e-6, 1.828676331275730e-02},   {2e-5, 1e-6, 1.476554955240080e-02},
                       {1.8e-4, 1e-6, 3.675223767717136e-03}, {-1e-5, 1e-6, 3.509926424950854e-02},
                       {-1e-5, 4e-10, 7.519425564719893e-02}, {-4e-5, 1e-6, 3.479358596745044e-02},
                       {-4e-5, 4e-10, 7.451045283921354e-02}};

@@ -1,19 +1,21 @@
 // Li–Mason / Ranz–Marshall convection (PHYSICS §3.1) vs the MFiX convection case (§8.3)
 // and the Li–Mason table of §8.3.
-#include <coredem/dem/kernels/convection.h>
-#include <coredem/dem/verification/analytic.h>
+#include <cmath>
 
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <coredem/dem/kernels/convection.h>
+#include <coredem/dem/verification/analytic.h>
 
 namespace k = coredem::dem::kernels;
 namespace v = coredem::dem::verification;
 
 namespace {
-constexpr double kD = 3.6e-3;      // particle B
+constexpr double kD = 3.6e-3; // particle B
 constexpr double kPi = 3.141592653589793;
-double cellVoidage() { return 1.0 - v::sphereVolume(kD) / (0.04 * 0.04 * 0.0036); }
+double cellVoidage() {
+  return 1.0 - v::sphereVolume(kD) / (0.04 * 0.04 * 0.0036);
+}
 } // namespace
 
 // MFiX-CONV, Ranz–Marshall, Re without ε: Re = 1376.372, Pr = 0.35834, Nu = 17.8107 and
@@ -88,12 +90,18 @@ TEST(Convection, LiMasonBranches) {
   const double pr = 0.7;
   const double eps = 0.8;
   const double en = std::pow(eps, 3.5);
-  EXPECT_DOUBLE_EQ(k::nusseltLiMason(199.0, pr, eps, 3.5), 2.0 + 0.6 * en * std::sqrt(199.0) * std::cbrt(pr));
+  EXPECT_DOUBLE_EQ(k::nusseltLiMason(199.0, pr, eps, 3.5),
+                   2.0 + 0.6 * en * std::sqrt(199.0) * std::cbrt(pr));
   EXPECT_NEAR(k::nusseltLiMason(200.0, pr, eps, 3.5),
-              2.0 + (0.5 * en * std::sqrt(200.0) + 0.02 * en * std::pow(200.0, 0.8)) * std::cbrt(pr), 1e-13);
+              2.0 +
+                  (0.5 * en * std::sqrt(200.0) + 0.02 * en * std::pow(200.0, 0.8)) * std::cbrt(pr),
+              1e-13);
   EXPECT_NEAR(k::nusseltLiMason(1499.0, pr, eps, 3.5),
-              2.0 + (0.5 * en * std::sqrt(1499.0) + 0.02 * en * std::pow(1499.0, 0.8)) * std::cbrt(pr), 1e-13);
-  EXPECT_NEAR(k::nusseltLiMason(1500.0, pr, eps, 3.5), 2.0 + 4.5e-5 * en * std::pow(1500.0, 1.8), 1e-13);
+              2.0 + (0.5 * en * std::sqrt(1499.0) + 0.02 * en * std::pow(1499.0, 0.8)) *
+                        std::cbrt(pr),
+              1e-13);
+  EXPECT_NEAR(k::nusseltLiMason(1500.0, pr, eps, 3.5), 2.0 + 4.5e-5 * en * std::pow(1500.0, 1.8),
+              1e-13);
   EXPECT_DOUBLE_EQ(k::nusseltLiMason(150.0, pr, 1.0, 3.5), k::nusseltRanzMarshall(150.0, pr));
 }
 
@@ -109,7 +117,8 @@ TEST(Convection, VoidageSwitchAndClip) {
   EXPECT_NEAR(k::nusselt(without, g, kD, 0.3), k::nusseltLiMason(re, pr, 0.5, 3.5), 1e-14);
   k::GasState packed = g;
   packed.eps = 0.1; // over-packed PCM cell → evaluated at ε_min = 0.35
-  EXPECT_NEAR(k::nusselt(with, packed, kD, 0.3), k::nusseltLiMason(0.35 * re, pr, 0.35, 3.5), 1e-14);
+  EXPECT_NEAR(k::nusselt(with, packed, kD, 0.3), k::nusseltLiMason(0.35 * re, pr, 0.35, 3.5),
+              1e-14);
 }
 
 // Implicit/explicit split: H T_g − (H T_p) equals the cell sum of Q_gp / V_c.

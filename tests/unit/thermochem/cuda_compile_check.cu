@@ -28,7 +28,8 @@ __global__ void thermochemKernelsCompileCheck(const double* in, double* out, int
   acc += k::contactConductionHeat(1.0, 2.0, 1e-3, 1e-3, 1.99e-3, t, 300.0);
   k::GasLensParams lp;
   acc += k::gasLensHeat(lp, 0.05, 1e-3, 1e-3, 2.01e-3, t, 300.0);
-  acc += k::radiationHeat(0.8, 1e-3, k::radiationEnvironmentTemperature(0.9, 1000.0, 2.0 * t, 2), t);
+  acc +=
+      k::radiationHeat(0.8, 1e-3, k::radiationEnvironmentTemperature(0.9, 1000.0, 2.0 * t, 2), t);
   acc += k::nasa7EnthalpyMolar(k::Species::Fe3O4, t) + k::reactionEnthalpy(k::ClgReaction::R4, t);
   k::HeterogeneousReaction r;
   r.n = 1;

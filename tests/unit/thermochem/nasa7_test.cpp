@@ -1,11 +1,11 @@
 // NASA-7 data, reaction enthalpies and equilibrium constants vs PHYSICS.md §3.5 / Appendix A
 // and the numbers printed by physics/reference/nasa.py (same Burcat/MFiX coefficients).
-#include <coredem/dem/kernels/nasa7.h>
-#include <coredem/dem/kernels/reaction_enthalpy.h>
+#include <cmath>
 
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <coredem/dem/kernels/nasa7.h>
+#include <coredem/dem/kernels/reaction_enthalpy.h>
 
 namespace k = coredem::dem::kernels;
 using k::Species;
@@ -69,15 +69,12 @@ TEST(Nasa7, FormationEnthalpiesAndHeatCapacitiesOfPhysicsTable) {
     double cp1173;
     double cpTol;
   };
-  const Row rows[] = {{Species::CO, -110.53, 29.14, 33.96, 0.005},
-                      {Species::CO2, -393.51, 37.14, 55.90, 0.005},
-                      {Species::H2, 0.0, 28.84, 30.97, 0.005},
-                      {Species::H2O, -241.82, 33.59, 43.61, 0.005},
-                      {Species::N2, 0.0, 29.12, 33.52, 0.005},
-                      {Species::C, 0.0, 8.53, 22.49, 0.005},
-                      {Species::Fe2O3, -824.24, 103.9, 142.4, 0.05},
-                      {Species::Fe3O4, -1118.38, 150.7, 197.1, 0.05},
-                      {Species::Al2O3, -1675.69, 79.0, 127.1, 0.05}};
+  const Row rows[] = {
+      {Species::CO, -110.53, 29.14, 33.96, 0.005},   {Species::CO2, -393.51, 37.14, 55.90, 0.005},
+      {Species::H2, 0.0, 28.84, 30.97, 0.005},       {Species::H2O, -241.82, 33.59, 43.61, 0.005},
+      {Species::N2, 0.0, 29.12, 33.52, 0.005},       {Species::C, 0.0, 8.53, 22.49, 0.005},
+      {Species::Fe2O3, -824.24, 103.9, 142.4, 0.05}, {Species::Fe3O4, -1118.38, 150.7, 197.1, 0.05},
+      {Species::Al2O3, -1675.69, 79.0, 127.1, 0.05}};
   for (const Row& r : rows) {
     SCOPED_TRACE(static_cast<int>(r.s));
     EXPECT_NEAR(k::nasa7EnthalpyMolar(r.s, k::kTref) / 1000.0, r.hf, 0.005);
@@ -104,7 +101,8 @@ TEST(Nasa7, IntervalSelection) {
 // The Burcat fits are continuous at the 1000 K break to well below 1 J/mol (H) and 0.1 %
 // (C_p); a wrong coefficient set would break this by orders of magnitude.
 TEST(Nasa7, ContinuousAtTheMidpointForGases) {
-  for (Species s : {Species::CO, Species::CO2, Species::H2, Species::H2O, Species::N2, Species::C}) {
+  for (Species s :
+       {Species::CO, Species::CO2, Species::H2, Species::H2O, Species::N2, Species::C}) {
     SCOPED_TRACE(static_cast<int>(s));
     const double below = 1000.0 * (1.0 - 1e-12);
     EXPECT_NEAR(k::nasa7EnthalpyMolar(s, below), k::nasa7EnthalpyMolar(s, 1000.0), 1.0);
@@ -119,11 +117,18 @@ TEST(ReactionEnthalpy, MatchesReferenceScript) {
     double t;
     double dh[5];
   };
-  const Row rows[] = {
-      {298.15, {1.7244902145e+05, 1.3129525120e+05, -4.1153770249e+04, -4.7001726854e+04, -5.8479566050e+03}},
-      {1073.15, {1.6992109543e+05, 1.3588043422e+05, -3.4040661208e+04, -3.8819141453e+04, -4.7784802453e+03}},
-      {1173.15, {1.6889680007e+05, 1.3580729144e+05, -3.3089508636e+04, -3.9513193113e+04, -6.4236844773e+03}},
-      {1223.15, {1.6836718336e+05, 1.3573825311e+05, -3.2628930257e+04, -4.0141464098e+04, -7.5125338411e+03}}};
+  const Row rows[] = {{298.15,
+                       {1.7244902145e+05, 1.3129525120e+05, -4.1153770249e+04, -4.7001726854e+04,
+                        -5.8479566050e+03}},
+                      {1073.15,
+                       {1.6992109543e+05, 1.3588043422e+05, -3.4040661208e+04, -3.8819141453e+04,
+                        -4.7784802453e+03}},
+                      {1173.15,
+                       {1.6889680007e+05, 1.3580729144e+05, -3.3089508636e+04, -3.9513193113e+04,
+                        -6.4236844773e+03}},
+                      {1223.15,
+                       {1.6836718336e+05, 1.3573825311e+05, -3.2628930257e+04, -4.0141464098e+04,
+                        -7.5125338411e+03}}};
   for (const Row& r : rows) {
     for (int i = 0; i < 5; ++i) {
       SCOPED_TRACE(r.t);
@@ -149,16 +154,18 @@ TEST(ReactionEnthalpy, WgsEquilibriumConstantFromGibbs) {
 TEST(ReactionEnthalpy, ReactionsBalanceMassToRoundOff) {
   for (int i = 0; i < static_cast<int>(k::ClgReaction::Count); ++i) {
     SCOPED_TRACE(i);
-    EXPECT_LE(std::fabs(k::stoichiometricMassBalance(k::clgStoichiometry(static_cast<k::ClgReaction>(i)))),
+    EXPECT_LE(std::fabs(k::stoichiometricMassBalance(
+                  k::clgStoichiometry(static_cast<k::ClgReaction>(i)))),
               2e-16);
   }
   struct Row {
     Species s;
     double gPerMol;
   };
-  const Row table[] = {{Species::C, 12.011},  {Species::CO, 28.010},     {Species::CO2, 44.009},
-                       {Species::H2, 2.016},  {Species::H2O, 18.015},    {Species::N2, 28.014},
-                       {Species::Fe2O3, 159.688}, {Species::Fe3O4, 231.533}, {Species::Al2O3, 101.961}};
+  const Row table[] = {
+      {Species::C, 12.011},      {Species::CO, 28.010},     {Species::CO2, 44.009},
+      {Species::H2, 2.016},      {Species::H2O, 18.015},    {Species::N2, 28.014},
+      {Species::Fe2O3, 159.688}, {Species::Fe3O4, 231.533}, {Species::Al2O3, 101.961}};
   for (const Row& r : table) {
     SCOPED_TRACE(static_cast<int>(r.s));
     EXPECT_NEAR(k::molarMass(r.s) * 1e3, r.gPerMol, 2.1e-3);

@@ -1,11 +1,11 @@
 // Radiation kernel (PHYSICS §3.4) and the RK4 reference of the MFiX radiation case (§8.4).
-#include <coredem/dem/kernels/radiation.h>
-#include <coredem/dem/verification/analytic.h>
+#include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <vector>
+#include <coredem/dem/kernels/radiation.h>
+#include <coredem/dem/verification/analytic.h>
 
 namespace k = coredem::dem::kernels;
 namespace v = coredem::dem::verification;

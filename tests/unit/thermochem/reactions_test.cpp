@@ -1,15 +1,15 @@
 // Heterogeneous reactions: the generic data-defined reaction (PHYSICS §8.5), char
 // gasification R1/R2 (§6.1) and oxygen-carrier reduction R4/R5 (§6.3).
+#include <cmath>
+
+#include <gtest/gtest.h>
+
 #include <coredem/dem/kernels/clg_char_gasification.h>
 #include <coredem/dem/kernels/clg_oc_reduction.h>
 #include <coredem/dem/kernels/reaction_enthalpy.h>
 #include <coredem/dem/kernels/reaction_generic.h>
 #include <coredem/dem/kernels/species_particle.h>
 #include <coredem/dem/verification/analytic.h>
-
-#include <gtest/gtest.h>
-
-#include <cmath>
 
 namespace k = coredem::dem::kernels;
 namespace v = coredem::dem::verification;
@@ -93,7 +93,8 @@ TEST(GenericReaction, ArrheniusRate) {
   r.order = 0.7;
   const double conc[2] = {0.0, 4.2};
   const double t = 1100.0;
-  const double expect = 3.0e2 * std::sqrt(t) * std::exp(-80e3 / (8.314462618 * t)) * std::pow(4.2, 0.7);
+  const double expect =
+      3.0e2 * std::sqrt(t) * std::exp(-80e3 / (8.314462618 * t)) * std::pow(4.2, 0.7);
   EXPECT_NEAR(k::heterogeneousRate(r, t, conc), expect, 1e-14 * expect);
   const double zero[2] = {0.0, 0.0};
   EXPECT_EQ(k::heterogeneousRate(r, t, zero), 0.0);
@@ -131,14 +132,16 @@ TEST(CharGasification, ParticleRatesConserveMass) {
   const auto half = k::charGasification(p, t, pBar, 0.125 * mC0, mC0);
   EXPECT_NEAR(half.nR1 / full.nR1, 0.25, 1e-14); // (1/8)^(2/3)
   EXPECT_NEAR(half.nR2 / full.nR2, 0.25, 1e-14);
-  EXPECT_NEAR(full.nR2, mC0 / k::molarMass(k::Species::C) * k::charRateH2O(p, t, 0.5, 0.05), 1e-14 * full.nR2);
+  EXPECT_NEAR(full.nR2, mC0 / k::molarMass(k::Species::C) * k::charRateH2O(p, t, 0.5, 0.05),
+              1e-14 * full.nR2);
   double gas = 0.0;
   for (double m : full.mdotGas) {
     gas += m;
   }
   EXPECT_NEAR(full.mdotC + gas, 0.0, 1e-15 * std::fabs(full.mdotC));
   EXPECT_NEAR(full.mdotGas[idx(GasSpecies::CO)],
-              k::molarMass(k::Species::CO) * (2.0 * full.nR1 + full.nR2), 1e-15 * full.mdotGas[idx(GasSpecies::CO)]);
+              k::molarMass(k::Species::CO) * (2.0 * full.nR1 + full.nR2),
+              1e-15 * full.mdotGas[idx(GasSpecies::CO)]);
   const double q = -k::reactionEnthalpy(k::ClgReaction::R1, t) * full.nR1 -
                    k::reactionEnthalpy(k::ClgReaction::R2, t) * full.nR2;
   EXPECT_NEAR(full.heat, q, 1e-14 * std::fabs(q));
@@ -184,7 +187,8 @@ TEST(OcReduction, ConservationAlongAReductionPath) {
   double x[3] = {0.6, 0.0, 0.4};
   const double mAl = m * x[2];
   auto mEqOf = [&] {
-    return m * (x[0] + x[1] * 3.0 * k::molarMass(k::Species::Fe2O3) / (2.0 * k::molarMass(k::Species::Fe3O4)));
+    return m * (x[0] + x[1] * 3.0 * k::molarMass(k::Species::Fe2O3) /
+                           (2.0 * k::molarMass(k::Species::Fe3O4)));
   };
   const double mEq0 = mEqOf();
   double gasMass = 0.0;
@@ -213,5 +217,6 @@ TEST(OcReduction, ConservationAlongAReductionPath) {
   EXPECT_GT(r.conversion, 0.999);
   // Total mass loss = M_O per mol of reaction: m0 − m = (M_O/(3 M_Fe2O3)) · (Fe2O3 reduced).
   const double reduced = mEq0 * r.conversion;
-  EXPECT_NEAR(m0 - m, reduced * 15.999e-3 / (3.0 * k::molarMass(k::Species::Fe2O3)), 1e-10 * (m0 - m));
+  EXPECT_NEAR(m0 - m, reduced * 15.999e-3 / (3.0 * k::molarMass(k::Species::Fe2O3)),
+              1e-10 * (m0 - m));
 }

@@ -1,12 +1,12 @@
 // Particle species/mass/diameter update (PHYSICS §4, Eqs. 31–32, removal §1.1) and the
 // particle energy equation (Eq. 18, §3.5).
-#include <coredem/dem/kernels/nasa7.h>
-#include <coredem/dem/kernels/particle_energy.h>
-#include <coredem/dem/kernels/species_particle.h>
+#include <cmath>
 
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <coredem/dem/kernels/nasa7.h>
+#include <coredem/dem/kernels/particle_energy.h>
+#include <coredem/dem/kernels/species_particle.h>
 
 namespace k = coredem::dem::kernels;
 
@@ -60,7 +60,8 @@ TEST(ParticleSpecies, GasCompositionHelpers) {
   EXPECT_NEAR(mMix, 0.5 * (mH2O + mN2), 1e-17);
   const double rho = k::idealGasDensity(101325.0, mMix, 1173.0);
   EXPECT_NEAR(rho, 0.239, 0.0005);
-  EXPECT_NEAR(k::molarConcentration(rho, y[0], mH2O), 0.5 * 101325.0 / (8.314462618 * 1173.0), 1e-12);
+  EXPECT_NEAR(k::molarConcentration(rho, y[0], mH2O), 0.5 * 101325.0 / (8.314462618 * 1173.0),
+              1e-12);
 }
 
 // Eq. 18: dT/dt = ΣQ/(m C_p); Euler update; Q_rxn = −Σ ΔH ṅ.

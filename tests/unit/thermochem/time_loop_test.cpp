@@ -1,6 +1,15 @@
 // Explicit time loops built from the kernels (the way the DEM server integrates Eq. 18 and
 // Eq. 31), compared with the analytic solutions: energy conservation of the pair terms and
 // the seed's accuracy targets (PHYSICS §8.1: relative error < 6e-4 %).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
 #include <coredem/dem/kernels/clg_char_gasification.h>
 #include <coredem/dem/kernels/clg_oc_reduction.h>
 #include <coredem/dem/kernels/conduction_contact.h>
@@ -10,15 +19,6 @@
 #include <coredem/dem/kernels/reaction_generic.h>
 #include <coredem/dem/kernels/species_particle.h>
 #include <coredem/dem/verification/analytic.h>
-
-#include <gtest/gtest.h>
-
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <string>
-#include <functional>
-#include <vector>
 
 namespace k = coredem::dem::kernels;
 namespace v = coredem::dem::verification;
@@ -56,8 +56,8 @@ LoopResult runPair(double mc1, double mc2, double t10, double t20, double a, dou
     t2 = k::particleTemperatureEuler(t2, s2, mc2, 1.0, dt);
     if (n % every == 0 || n == steps) {
       const auto ex = v::twoParticleExchange(a, b, t10, t20, n * dt);
-      res.maxRelError = std::max({res.maxRelError, std::fabs(t1 - ex.t1) / ex.t1,
-                                  std::fabs(t2 - ex.t2) / ex.t2});
+      res.maxRelError =
+          std::max({res.maxRelError, std::fabs(t1 - ex.t1) / ex.t1, std::fabs(t2 - ex.t2) / ex.t2});
       res.maxEnergyDrift = std::max(res.maxEnergyDrift, std::fabs(mc1 * t1 + mc2 * t2 - e0) / e0);
     }
   }
@@ -75,9 +75,10 @@ TEST(TimeLoop, MfixContactConductionEulerMatchesAnalytic) {
   const auto c = v::contactConductionCoefficients(3.0e-3, ma, 3.6e-3, mb, l);
   const double mc1 = v::sphereMass(ma, 3.0e-3) * ma.cp;
   const double mc2 = v::sphereMass(mb, 3.6e-3) * mb.cp;
-  const LoopResult r = runPair(mc1, mc2, 298.15, 453.15, c.a, c.b, 1e-3, 500.0, [&](double t1, double t2) {
-    return k::contactConductionHeat(ma.k, mb.k, 1.5e-3, 1.8e-3, l, t1, t2);
-  });
+  const LoopResult r =
+      runPair(mc1, mc2, 298.15, 453.15, c.a, c.b, 1e-3, 500.0, [&](double t1, double t2) {
+        return k::contactConductionHeat(ma.k, mb.k, 1.5e-3, 1.8e-3, l, t1, t2);
+      });
   RecordProperty("max_relative_error", sci(r.maxRelError));
   RecordProperty("max_energy_drift", sci(r.maxEnergyDrift));
   EXPECT_LT(r.maxRelError, 6e-6); // 6e-4 %
@@ -93,9 +94,10 @@ TEST(TimeLoop, SeedContactVariantEulerMatchesAnalytic) {
   const auto c = v::contactConductionCoefficients(3.0e-3, ma, 3.6e-3, mb, l);
   const double mc1 = v::sphereMass(ma, 3.0e-3) * ma.cp;
   const double mc2 = v::sphereMass(mb, 3.6e-3) * mb.cp;
-  const LoopResult r = runPair(mc1, mc2, 373.15, 278.15, c.a, c.b, 1e-4, 50.0, [&](double t1, double t2) {
-    return k::contactConductionHeat(ma.k, mb.k, 1.5e-3, 1.8e-3, l, t1, t2);
-  });
+  const LoopResult r =
+      runPair(mc1, mc2, 373.15, 278.15, c.a, c.b, 1e-4, 50.0, [&](double t1, double t2) {
+        return k::contactConductionHeat(ma.k, mb.k, 1.5e-3, 1.8e-3, l, t1, t2);
+      });
   RecordProperty("max_relative_error", sci(r.maxRelError));
   RecordProperty("max_energy_drift", sci(r.maxEnergyDrift));
   EXPECT_LT(r.maxRelError, 1e-6);
@@ -113,9 +115,10 @@ TEST(TimeLoop, MfixLensConductionEulerMatchesAnalytic) {
   const double mc1 = v::sphereMass(ma, 3.0e-3) * ma.cp;
   const double mc2 = v::sphereMass(mb, 3.6e-3) * mb.cp;
   const k::GasLensParams p;
-  const LoopResult r = runPair(mc1, mc2, 298.15, 453.15, c.a, c.b, 1e-4, 50.0, [&](double t1, double t2) {
-    return k::gasLensHeat(p, kg, 1.5e-3, 1.8e-3, l, t1, t2);
-  });
+  const LoopResult r =
+      runPair(mc1, mc2, 298.15, 453.15, c.a, c.b, 1e-4, 50.0, [&](double t1, double t2) {
+        return k::gasLensHeat(p, kg, 1.5e-3, 1.8e-3, l, t1, t2);
+      });
   RecordProperty("max_relative_error", sci(r.maxRelError));
   RecordProperty("max_energy_drift", sci(r.maxEnergyDrift));
   EXPECT_LT(r.maxRelError, 1.5e-6);
@@ -154,8 +157,8 @@ TEST(TimeLoop, ReactionWithSpeciesUpdateMatchesAnalytic) {
   const v::ReactionCase c = v::mfixReactionCase();
   k::HeterogeneousReaction r;
   r.n = 4;
-  const k::ReactionPhase ph[4] = {k::ReactionPhase::Gas, k::ReactionPhase::Solid, k::ReactionPhase::Gas,
-                                  k::ReactionPhase::Solid};
+  const k::ReactionPhase ph[4] = {k::ReactionPhase::Gas, k::ReactionPhase::Solid,
+                                  k::ReactionPhase::Gas, k::ReactionPhase::Solid};
   const int index[4] = {0, 0, 1, 1};
   const double nu[4] = {-1.0, -2.0, 1.0, 1.0};
   const double mm[4] = {c.molarA, c.molarB, c.molarC, c.molarD};
@@ -168,7 +171,7 @@ TEST(TimeLoop, ReactionWithSpeciesUpdateMatchesAnalytic) {
   r.A = c.omega;
   double m = c.m0;
   double x[3] = {c.xB0, c.xD0, c.xI0}; // [B, D, I]
-  double gas = 0.0;                   // net gas mass produced
+  double gas = 0.0;                    // net gas mass produced
   const double dt = 1e-3;
   double maxMassErr = 0.0;
   double maxFracErr = 0.0;
@@ -185,8 +188,8 @@ TEST(TimeLoop, ReactionWithSpeciesUpdateMatchesAnalytic) {
       const double t = n * dt;
       const v::ReactionState ex = v::reactionAnalytic(c, t);
       maxMassErr = std::max(maxMassErr, std::fabs(m - ex.m) / ex.m);
-      maxFracErr = std::max({maxFracErr, std::fabs(x[0] - ex.xB), std::fabs(x[1] - ex.xD),
-                             std::fabs(x[2] - ex.xI)});
+      maxFracErr = std::max(
+          {maxFracErr, std::fabs(x[0] - ex.xB), std::fabs(x[1] - ex.xD), std::fabs(x[2] - ex.xI)});
     }
   }
   // Between output times the analytic solution is linear and Euler reproduces it; the only

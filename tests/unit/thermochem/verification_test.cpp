@@ -1,10 +1,10 @@
 // The analytic solutions of the verification suite (dem-gpu-server/.../verification/analytic.h)
 // vs the numbers of PHYSICS.md §8 and the MFiX reference files quoted there.
-#include <coredem/dem/verification/analytic.h>
+#include <cmath>
 
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <coredem/dem/verification/analytic.h>
 
 namespace v = coredem::dem::verification;
 
@@ -29,8 +29,8 @@ TEST(Verification, MusserPropertySet) {
 // 2e-6 K. T_∞ = 408.9050 K in PHYSICS is computed from the rounded m C of §8.0 (408.90516 K
 // exactly) → tolerance 2e-4 K.
 TEST(Verification, MfixContactConductionAnalytic) {
-  const auto c = v::contactConductionCoefficients(3.0e-3, v::musserMaterialA(), 3.6e-3,
-                                                  v::musserMaterialB(), (0.4799731 - 0.1499864) * 1e-2);
+  const auto c = v::contactConductionCoefficients(
+      3.0e-3, v::musserMaterialA(), 3.6e-3, v::musserMaterialB(), (0.4799731 - 0.1499864) * 1e-2);
   EXPECT_NEAR(v::twoParticleExchange(c.a, c.b, 298.15, 453.15, 9.901).t1, 312.85412739, 2e-6);
   const auto t50 = v::twoParticleExchange(c.a, c.b, 298.15, 453.15, 49.901);
   EXPECT_NEAR(t50.t1, 354.88198678, 2e-6);

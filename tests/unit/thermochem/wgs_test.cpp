@@ -1,10 +1,10 @@
 // Homogeneous water–gas shift (PHYSICS §6.2): equilibrium consistency, sources, limiter.
-#include <coredem/dem/kernels/reaction_enthalpy.h>
-#include <coredem/dem/kernels/wgs.h>
+#include <cmath>
 
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <coredem/dem/kernels/reaction_enthalpy.h>
+#include <coredem/dem/kernels/wgs.h>
 
 namespace k = coredem::dem::kernels;
 using k::GasSpecies;
@@ -29,7 +29,8 @@ TEST(Wgs, EquilibriumConstants) {
 // At the equilibrium composition of each option the net rate vanishes (to round-off of the
 // forward term), below it the reaction runs forward, above it backward.
 TEST(Wgs, RateVanishesAtEquilibrium) {
-  for (auto opt : {k::WgsEquilibrium::YoonDenn, k::WgsEquilibrium::Seed, k::WgsEquilibrium::Thermodynamic}) {
+  for (auto opt :
+       {k::WgsEquilibrium::YoonDenn, k::WgsEquilibrium::Seed, k::WgsEquilibrium::Thermodynamic}) {
     k::WgsParams p;
     p.equilibrium = opt;
     const double t = 1173.15;
@@ -101,7 +102,8 @@ TEST(Wgs, SourcesHeatAndLimiter) {
   EXPECT_NEAR(s.massSource[idx(GasSpecies::CO)], -k::molarMass(k::Species::CO) * s.omega, 1e-18);
   EXPECT_NEAR(s.massSource[idx(GasSpecies::H2)], k::molarMass(k::Species::H2) * s.omega, 1e-18);
   EXPECT_EQ(s.massSource[idx(GasSpecies::N2)], 0.0);
-  EXPECT_NEAR(s.heatSource, -k::reactionEnthalpy(k::ClgReaction::R3, t) * s.omega, 1e-12 * std::fabs(s.heatSource));
+  EXPECT_NEAR(s.heatSource, -k::reactionEnthalpy(k::ClgReaction::R3, t) * s.omega,
+              1e-12 * std::fabs(s.heatSource));
   EXPECT_GT(s.heatSource, 0.0);
   const double cCO = 0.3 * 0.2 / k::molarMass(k::Species::CO);
   const double cH2O = 0.3 * 0.2 / k::molarMass(k::Species::H2O);

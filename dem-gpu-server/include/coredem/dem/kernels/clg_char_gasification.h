@@ -17,27 +17,27 @@
 /// found): A = 1e7 s⁻¹, E_H2O = 210 kJ/mol, E_CO2 = 230 kJ/mol, K_H2O = K_CO2 = 1 bar⁻¹,
 /// K_H2 = K_CO = 10 bar⁻¹ (temperature independent).
 
+#include <cmath>
+
 #include <coredem/dem/kernels/common.h>
 #include <coredem/dem/kernels/nasa7.h>
 #include <coredem/dem/kernels/reaction_enthalpy.h>
-
-#include <cmath>
 
 namespace coredem::dem::kernels {
 
 /// Adsorption constant K = K0 exp(−ΔH_ads/(R T)), bar⁻¹.
 struct AdsorptionConstant {
-  double k0;   ///< bar⁻¹
+  double k0;    ///< bar⁻¹
   double dHads; ///< J/mol (0: temperature independent)
 };
 
 struct CharGasificationParams {
-  double aCO2 = 1.0e7;          ///< s⁻¹
-  double eCO2 = 230.0e3;        ///< J/mol
+  double aCO2 = 1.0e7;   ///< s⁻¹
+  double eCO2 = 230.0e3; ///< J/mol
   AdsorptionConstant kCO2{1.0, 0.0};
   AdsorptionConstant kCO{10.0, 0.0};
-  double aH2O = 1.0e7;          ///< s⁻¹
-  double eH2O = 210.0e3;        ///< J/mol
+  double aH2O = 1.0e7;   ///< s⁻¹
+  double eH2O = 210.0e3; ///< J/mol
   AdsorptionConstant kH2O{1.0, 0.0};
   AdsorptionConstant kH2{10.0, 0.0};
 };
@@ -79,8 +79,10 @@ DEM_HD CharGasificationRates charGasification(const CharGasificationParams& p, d
   const double unreacted = mC / mC0; // 1 − X
   const double core = std::cbrt(unreacted * unreacted);
   const double molC0 = mC0 / molarMass(Species::C);
-  out.nR1 = molC0 * charRateCO2(p, tP, pBar[idx(GasSpecies::CO2)], pBar[idx(GasSpecies::CO)]) * core;
-  out.nR2 = molC0 * charRateH2O(p, tP, pBar[idx(GasSpecies::H2O)], pBar[idx(GasSpecies::H2)]) * core;
+  out.nR1 =
+      molC0 * charRateCO2(p, tP, pBar[idx(GasSpecies::CO2)], pBar[idx(GasSpecies::CO)]) * core;
+  out.nR2 =
+      molC0 * charRateH2O(p, tP, pBar[idx(GasSpecies::H2O)], pBar[idx(GasSpecies::H2)]) * core;
   out.mdotC = -molarMass(Species::C) * (out.nR1 + out.nR2);
   out.mdotGas[idx(GasSpecies::CO2)] = -molarMass(Species::CO2) * out.nR1;
   out.mdotGas[idx(GasSpecies::CO)] = molarMass(Species::CO) * (2.0 * out.nR1 + out.nR2);

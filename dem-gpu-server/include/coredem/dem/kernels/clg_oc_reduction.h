@@ -15,31 +15,34 @@
 ///
 /// The seed's prefactor R0/(2 M_O2) is replaced by the mass-balance form above (PHYSICS §0.3).
 /// Defaults: ρ_m = 32811 mol/m³, r_g = 2.6e-7 m (IDAES, citing Abad 2007); CO: k0 = 1e-4 m/s,
-/// E = 20 kJ/mol, n = 1; H2: k0 = 9e-4 mol^(1−n) m^(3n−2)/s, E = 24 kJ/mol, n = 0.8 ([K], to verify).
+/// E = 20 kJ/mol, n = 1; H2: k0 = 9e-4 mol^(1−n) m^(3n−2)/s, E = 24 kJ/mol, n = 0.8 ([K], to
+/// verify).
+
+#include <cmath>
 
 #include <coredem/dem/kernels/common.h>
 #include <coredem/dem/kernels/nasa7.h>
 #include <coredem/dem/kernels/reaction_enthalpy.h>
 
-#include <cmath>
-
 namespace coredem::dem::kernels {
 
 struct OcReductionParams {
-  double rhoMolar = 32811.0;  ///< ρ_m, mol Fe2O3 per m³
+  double rhoMolar = 32811.0;   ///< ρ_m, mol Fe2O3 per m³
   double grainRadius = 2.6e-7; ///< r_g, m
-  double b = 3.0;             ///< mol Fe2O3 per mol reducing gas
-  double k0CO = 1.0e-4;       ///< m/s (n = 1)
-  double eCO = 20.0e3;        ///< J/mol
-  double nCO = 1.0;           ///< −
-  double k0H2 = 9.0e-4;       ///< mol^(1−n) m^(3n−2) s⁻¹
-  double eH2 = 24.0e3;        ///< J/mol
-  double nH2 = 0.8;           ///< −
+  double b = 3.0;              ///< mol Fe2O3 per mol reducing gas
+  double k0CO = 1.0e-4;        ///< m/s (n = 1)
+  double eCO = 20.0e3;         ///< J/mol
+  double nCO = 1.0;            ///< −
+  double k0H2 = 9.0e-4;        ///< mol^(1−n) m^(3n−2) s⁻¹
+  double eH2 = 24.0e3;         ///< J/mol
+  double nH2 = 0.8;            ///< −
 };
 
 /// Solid species order of an oxygen-carrier particle.
 enum class OcSolid : int { Fe2O3 = 0, Fe3O4 = 1, Al2O3 = 2, Count = 3 };
-DEM_HD constexpr int idx(OcSolid s) { return static_cast<int>(s); }
+DEM_HD constexpr int idx(OcSolid s) {
+  return static_cast<int>(s);
+}
 
 struct OcReductionRates {
   double nR4;                       ///< mol/s

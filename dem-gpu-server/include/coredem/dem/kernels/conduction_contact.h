@@ -15,9 +15,9 @@
 /// whichever particle evaluates the pair. Callers that sum pair terms once per pair (canonical
 /// i < j) and add ±Q get exact energy conservation up to the rounding of the sums.
 
-#include <coredem/dem/kernels/common.h>
-
 #include <cmath>
+
+#include <coredem/dem/kernels/common.h>
 
 namespace coredem::dem::kernels {
 
@@ -74,8 +74,8 @@ DEM_HD double contactConductance(double ki, double kj, double ri, double rj, dou
 }
 
 /// Heat into particle i from contact with j, W (Eq. 22). Antisymmetric bitwise.
-DEM_HD double contactConductionHeat(double ki, double kj, double ri, double rj, double l,
-                                    double ti, double tj) {
+DEM_HD double contactConductionHeat(double ki, double kj, double ri, double rj, double l, double ti,
+                                    double tj) {
   return contactConductance(ki, kj, ri, rj, l) * (tj - ti);
 }
 

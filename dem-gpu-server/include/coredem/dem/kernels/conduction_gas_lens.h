@@ -25,26 +25,26 @@
 ///
 /// The result depends on (R_L, R_S, l) only, so Q_ij = −Q_ji bitwise.
 
+#include <cmath>
+
 #include <coredem/dem/kernels/common.h>
 #include <coredem/dem/kernels/conduction_contact.h>
 #include <coredem/dem/kernels/conduction_quadrature.h>
 
-#include <cmath>
-
 namespace coredem::dem::kernels {
 
 struct GasLensParams {
-  double lensFraction = 0.2;    ///< FLPC: lens radius = (1 + FLPC) R_L, −
+  double lensFraction = 0.2;     ///< FLPC: lens radius = (1 + FLPC) R_L, −
   double minSeparation = 1.0e-6; ///< s_min, m (> 0: the integral diverges at contact otherwise)
-  double relTol = 1.0e-10;      ///< relative tolerance of the quadrature
+  double relTol = 1.0e-10;       ///< relative tolerance of the quadrature
 };
 
 /// Limits of the lens integral.
 struct GasLensGeometry {
-  bool active;    ///< false if the lens does not reach the smaller sphere
-  bool contact;   ///< l < R_i + R_j
-  double rIn;     ///< m (Eq. 25)
-  double rOut;    ///< m (Eq. 26)
+  bool active;  ///< false if the lens does not reach the smaller sphere
+  bool contact; ///< l < R_i + R_j
+  double rIn;   ///< m (Eq. 25)
+  double rOut;  ///< m (Eq. 26)
 };
 
 DEM_HD GasLensGeometry gasLensGeometry(const GasLensParams& p, double ri, double rj, double l) {

@@ -11,9 +11,9 @@
 /// the standard 15-point Kronrod extension of the 7-point Gauss–Legendre rule (exact for
 /// polynomials of degree ≤ 22 on one interval).
 
-#include <coredem/dem/kernels/common.h>
-
 #include <cmath>
+
+#include <coredem/dem/kernels/common.h>
 
 namespace coredem::dem::kernels {
 
@@ -21,25 +21,28 @@ namespace coredem::dem::kernels {
 inline constexpr int kGkMaxIntervals = 64;
 
 struct QuadratureResult {
-  double value;     ///< integral estimate
-  double error;     ///< summed error estimate (|K15 − G7| per interval)
-  int intervals;    ///< number of sub-intervals used
-  bool converged;   ///< error ≤ requested tolerance
+  double value;   ///< integral estimate
+  double error;   ///< summed error estimate (|K15 − G7| per interval)
+  int intervals;  ///< number of sub-intervals used
+  bool converged; ///< error ≤ requested tolerance
 };
 
 /// One G7/K15 panel on [a, b]; returns the K15 value and writes |K15 − G7| to err.
 template <typename F>
 DEM_HD double gaussKronrod15(const F& f, double a, double b, double& err) {
-  constexpr double xgk[8] = {0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
-                             0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
-                             0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
-                             0.207784955007898467600689403773245, 0.0};
-  constexpr double wgk[8] = {0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
-                             0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
-                             0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
-                             0.204432940075298892414161999234649, 0.209482141084727828012999174891714};
-  constexpr double wg[4] = {0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
-                            0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
+  constexpr double xgk[8] = {
+      0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
+      0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
+      0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
+      0.207784955007898467600689403773245, 0.0};
+  constexpr double wgk[8] = {
+      0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
+      0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
+      0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
+      0.204432940075298892414161999234649, 0.209482141084727828012999174891714};
+  constexpr double wg[4] = {
+      0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
+      0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
   const double c = 0.5 * (a + b);
   const double h = 0.5 * (b - a);
   const double fc = f(c);

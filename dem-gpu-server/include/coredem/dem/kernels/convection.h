@@ -20,9 +20,9 @@
 ///   (H T_p)_c = Σ_{i∈c} G_i T_p,i / V_c  (W/m³, explicit part),
 /// which equals (1/V_c) Σ Q_gp,i exactly when T_g is the cell value (PCM).
 
-#include <coredem/dem/kernels/common.h>
-
 #include <cmath>
+
+#include <coredem/dem/kernels/common.h>
 
 namespace coredem::dem::kernels {
 
@@ -53,7 +53,9 @@ DEM_HD double particleReynolds(double rhoG, double muG, double dP, double slip, 
 }
 
 /// Prandtl number, −.
-DEM_HD double prandtl(double muG, double cpG, double kG) { return muG * cpG / kG; }
+DEM_HD double prandtl(double muG, double cpG, double kG) {
+  return muG * cpG / kG;
+}
 
 /// Li–Mason Nusselt number (Eq. 21), −.
 DEM_HD double nusseltLiMason(double re, double pr, double eps, double n) {

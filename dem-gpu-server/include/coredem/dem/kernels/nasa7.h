@@ -15,9 +15,9 @@
 /// range the first / last interval is extrapolated [C] (device code cannot throw; host code
 /// can check nasa7InRange() first).
 
-#include <coredem/dem/kernels/common.h>
-
 #include <cmath>
+
+#include <coredem/dem/kernels/common.h>
 
 namespace coredem::dem::kernels {
 
@@ -34,8 +34,12 @@ inline constexpr int kSpeciesCount = static_cast<int>(Species::Count);
 enum class GasSpecies : int { CO = 0, CO2 = 1, H2 = 2, H2O = 3, N2 = 4, Count = 5 };
 inline constexpr int kGasSpeciesCount = static_cast<int>(GasSpecies::Count);
 
-DEM_HD constexpr Species toSpecies(GasSpecies g) { return static_cast<Species>(static_cast<int>(g)); }
-DEM_HD constexpr int idx(GasSpecies g) { return static_cast<int>(g); }
+DEM_HD constexpr Species toSpecies(GasSpecies g) {
+  return static_cast<Species>(static_cast<int>(g));
+}
+DEM_HD constexpr int idx(GasSpecies g) {
+  return static_cast<int>(g);
+}
 
 /// One polynomial interval.
 struct Nasa7Interval {
@@ -64,21 +68,34 @@ inline constexpr double kAtomAl = 26.982e-3;
 /// Molar mass, kg/mol.
 DEM_HD constexpr double molarMass(Species s) {
   switch (s) {
-  case Species::CO: return kAtomC + kAtomO;
-  case Species::CO2: return kAtomC + 2.0 * kAtomO;
-  case Species::H2: return 2.0 * kAtomH;
-  case Species::H2O: return 2.0 * kAtomH + kAtomO;
-  case Species::N2: return 2.0 * kAtomN;
-  case Species::C: return kAtomC;
-  case Species::Fe2O3: return 2.0 * kAtomFe + 3.0 * kAtomO;
-  case Species::Fe3O4: return 3.0 * kAtomFe + 4.0 * kAtomO;
-  case Species::Al2O3: return 2.0 * kAtomAl + 3.0 * kAtomO;
-  default: return 0.0;
+  case Species::CO:
+    return kAtomC + kAtomO;
+  case Species::CO2:
+    return kAtomC + 2.0 * kAtomO;
+  case Species::H2:
+    return 2.0 * kAtomH;
+  case Species::H2O:
+    return 2.0 * kAtomH + kAtomO;
+  case Species::N2:
+    return 2.0 * kAtomN;
+  case Species::C:
+    return kAtomC;
+  case Species::Fe2O3:
+    return 2.0 * kAtomFe + 3.0 * kAtomO;
+  case Species::Fe3O4:
+    return 3.0 * kAtomFe + 4.0 * kAtomO;
+  case Species::Al2O3:
+    return 2.0 * kAtomAl + 3.0 * kAtomO;
+  default:
+    return 0.0;
   }
 }
-DEM_HD constexpr double molarMass(GasSpecies g) { return molarMass(toSpecies(g)); }
+DEM_HD constexpr double molarMass(GasSpecies g) {
+  return molarMass(toSpecies(g));
+}
 
 /// Coefficient table (PHYSICS Appendix A; Burcat/MFiX).
+// clang-format off
 DEM_HD constexpr Nasa7Data nasa7Data(Species s) {
   switch (s) {
   case Species::CO:
@@ -129,6 +146,7 @@ DEM_HD constexpr Nasa7Data nasa7Data(Species s) {
   default: return {0, {}};
   }
 }
+// clang-format on
 
 /// Index of the interval used at temperature T (see file comment for the rule).
 DEM_HD constexpr int nasa7IntervalIndex(const Nasa7Data& d, double T) {
@@ -157,15 +175,16 @@ DEM_HD double nasa7EnthalpyMolar(Species s, double T) {
   const Nasa7Data d = nasa7Data(s);
   const double* a = d.iv[nasa7IntervalIndex(d, T)].a;
   return kGasConstant *
-         (T * (a[0] + T * (a[1] / 2.0 + T * (a[2] / 3.0 + T * (a[3] / 4.0 + T * a[4] / 5.0)))) + a[5]);
+         (T * (a[0] + T * (a[1] / 2.0 + T * (a[2] / 3.0 + T * (a[3] / 4.0 + T * a[4] / 5.0)))) +
+          a[5]);
 }
 
 /// Molar entropy at p° = 1 bar, J/(mol K).
 DEM_HD double nasa7EntropyMolar(Species s, double T) {
   const Nasa7Data d = nasa7Data(s);
   const double* a = d.iv[nasa7IntervalIndex(d, T)].a;
-  return kGasConstant *
-         (a[0] * std::log(T) + T * (a[1] + T * (a[2] / 2.0 + T * (a[3] / 3.0 + T * a[4] / 4.0))) + a[6]);
+  return kGasConstant * (a[0] * std::log(T) +
+                         T * (a[1] + T * (a[2] / 2.0 + T * (a[3] / 3.0 + T * a[4] / 4.0))) + a[6]);
 }
 
 /// Standard molar Gibbs energy G° = H − T S°, J/mol.
@@ -174,7 +193,9 @@ DEM_HD double nasa7GibbsMolar(Species s, double T) {
 }
 
 /// Specific heat capacity, J/(kg K).
-DEM_HD double nasa7CpMass(Species s, double T) { return nasa7CpMolar(s, T) / molarMass(s); }
+DEM_HD double nasa7CpMass(Species s, double T) {
+  return nasa7CpMolar(s, T) / molarMass(s);
+}
 
 /// Specific enthalpy (formation included), J/kg.
 DEM_HD double nasa7EnthalpyMass(Species s, double T) {

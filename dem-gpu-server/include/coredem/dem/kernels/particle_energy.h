@@ -34,8 +34,8 @@ DEM_HD double particleTemperatureRate(const ParticleHeatSources& s, double m, do
 }
 
 /// Explicit Euler update of T_p over dt (s), K.
-DEM_HD double particleTemperatureEuler(double tP, const ParticleHeatSources& s, double m,
-                                       double cp, double dt) {
+DEM_HD double particleTemperatureEuler(double tP, const ParticleHeatSources& s, double m, double cp,
+                                       double dt) {
   return tP + dt * particleTemperatureRate(s, m, cp);
 }
 

@@ -14,9 +14,9 @@
 /// The caller accumulates the sum and the count of the chosen set; the kernels below turn
 /// them into T_env and Q_rad.
 
-#include <coredem/dem/kernels/common.h>
-
 #include <cmath>
+
+#include <coredem/dem/kernels/common.h>
 
 namespace coredem::dem::kernels {
 

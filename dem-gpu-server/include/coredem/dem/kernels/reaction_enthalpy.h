@@ -8,10 +8,10 @@
 ///
 /// Here ν_n < 0 for reactants and > 0 for products, so both sums are one signed sum.
 
+#include <cmath>
+
 #include <coredem/dem/kernels/common.h>
 #include <coredem/dem/kernels/nasa7.h>
-
-#include <cmath>
 
 namespace coredem::dem::kernels {
 
@@ -36,7 +36,8 @@ enum class ClgReaction : int {
 
 DEM_HD constexpr Stoichiometry clgStoichiometry(ClgReaction r) {
   switch (r) {
-  case ClgReaction::R1: return {3, {Species::C, Species::CO2, Species::CO}, {-1.0, -1.0, 2.0}};
+  case ClgReaction::R1:
+    return {3, {Species::C, Species::CO2, Species::CO}, {-1.0, -1.0, 2.0}};
   case ClgReaction::R2:
     return {4, {Species::C, Species::H2O, Species::CO, Species::H2}, {-1.0, -1.0, 1.0, 1.0}};
   case ClgReaction::R3:
@@ -45,7 +46,8 @@ DEM_HD constexpr Stoichiometry clgStoichiometry(ClgReaction r) {
     return {4, {Species::Fe2O3, Species::CO, Species::Fe3O4, Species::CO2}, {-3.0, -1.0, 2.0, 1.0}};
   case ClgReaction::R5:
     return {4, {Species::Fe2O3, Species::H2, Species::Fe3O4, Species::H2O}, {-3.0, -1.0, 2.0, 1.0}};
-  default: return {0, {}, {}};
+  default:
+    return {0, {}, {}};
   }
 }
 

@@ -16,9 +16,9 @@
 ///
 /// Mass is conserved to round-off when Σ ν_k M_k = 0 (checked by heterogeneousMassImbalance).
 
-#include <coredem/dem/kernels/common.h>
-
 #include <cmath>
+
+#include <coredem/dem/kernels/common.h>
 
 namespace coredem::dem::kernels {
 
@@ -28,18 +28,18 @@ enum class ReactionPhase : int { Gas = 0, Solid = 1 };
 enum class RateLaw : int { Constant = 0, Arrhenius = 1 };
 
 struct HeterogeneousReaction {
-  int n = 0;                                 ///< number of terms
+  int n = 0;                                   ///< number of terms
   ReactionPhase phase[kMaxReactionTerms] = {}; ///< phase of each term
-  int index[kMaxReactionTerms] = {};         ///< index into particle solids / cell gas species
-  double nu[kMaxReactionTerms] = {};         ///< mol per mol of reaction (< 0 reactants)
-  double molarMass[kMaxReactionTerms] = {};  ///< kg/mol
+  int index[kMaxReactionTerms] = {};           ///< index into particle solids / cell gas species
+  double nu[kMaxReactionTerms] = {};           ///< mol per mol of reaction (< 0 reactants)
+  double molarMass[kMaxReactionTerms] = {};    ///< kg/mol
   RateLaw law = RateLaw::Constant;
-  double A = 0.0;         ///< Constant: mol/s; Arrhenius: mol/s · K^−β · (m³/mol)^order
-  double beta = 0.0;      ///< temperature exponent, −
-  double E = 0.0;         ///< activation energy, J/mol
-  int orderTerm = -1;     ///< term whose gas concentration enters the rate (−1: none)
-  double order = 0.0;     ///< its reaction order, −
-  double dH = 0.0;        ///< heat of reaction, J per mol of reaction (> 0 endothermic)
+  double A = 0.0;     ///< Constant: mol/s; Arrhenius: mol/s · K^−β · (m³/mol)^order
+  double beta = 0.0;  ///< temperature exponent, −
+  double E = 0.0;     ///< activation energy, J/mol
+  int orderTerm = -1; ///< term whose gas concentration enters the rate (−1: none)
+  double order = 0.0; ///< its reaction order, −
+  double dH = 0.0;    ///< heat of reaction, J per mol of reaction (> 0 endothermic)
 };
 
 /// Rate before availability limits, mol/s. gasConc: cell concentrations (mol/m³) indexed by
@@ -105,6 +105,8 @@ DEM_HD double heterogeneousMassImbalance(const HeterogeneousReaction& r) {
 }
 
 /// Heat into the particle from this reaction, W.
-DEM_HD double heterogeneousHeat(const HeterogeneousReaction& r, double w) { return -r.dH * w; }
+DEM_HD double heterogeneousHeat(const HeterogeneousReaction& r, double w) {
+  return -r.dH * w;
+}
 
 } // namespace coredem::dem::kernels

@@ -9,9 +9,9 @@
 ///
 /// Update order in the DEM step [S]: rates → mass/diameter → motion → temperature.
 
-#include <coredem/dem/kernels/common.h>
-
 #include <cmath>
+
+#include <coredem/dem/kernels/common.h>
 
 namespace coredem::dem::kernels {
 
@@ -70,7 +70,9 @@ DEM_HD double moleFractionsFromMassFractions(const double* y, const double* mola
 }
 
 /// Molar concentration C = ρ Y / M, mol/m³.
-DEM_HD double molarConcentration(double rho, double y, double molar) { return rho * y / molar; }
+DEM_HD double molarConcentration(double rho, double y, double molar) {
+  return rho * y / molar;
+}
 
 /// Ideal-gas density ρ = p M_mix / (R T), kg/m³ (R = 8.314462618 J/(mol K)).
 DEM_HD double idealGasDensity(double p, double molarMix, double t) {

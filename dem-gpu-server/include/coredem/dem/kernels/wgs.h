@@ -12,19 +12,19 @@
 /// The seed's extracted rate is not equilibrium-consistent (PHYSICS §0.3); this form is.
 /// ω already contains ε_g: do not multiply by ε_g again (§1).
 
+#include <cmath>
+
 #include <coredem/dem/kernels/common.h>
 #include <coredem/dem/kernels/nasa7.h>
 #include <coredem/dem/kernels/reaction_enthalpy.h>
-
-#include <cmath>
 
 namespace coredem::dem::kernels {
 
 enum class WgsEquilibrium : int { YoonDenn = 0, Seed = 1, Thermodynamic = 2 };
 
 struct WgsParams {
-  double kf0 = 2.78e-3;       ///< m³/(mol s)
-  double efOverR = 1510.0;    ///< K
+  double kf0 = 2.78e-3;    ///< m³/(mol s)
+  double efOverR = 1510.0; ///< K
   WgsEquilibrium equilibrium = WgsEquilibrium::YoonDenn;
   bool enabled = true;
 };
@@ -32,11 +32,13 @@ struct WgsParams {
 /// K_eq(T) of CO + H2O ⇌ CO2 + H2, −.
 DEM_HD double wgsEquilibriumConstant(const WgsParams& p, double t) {
   switch (p.equilibrium) {
-  case WgsEquilibrium::Seed: return std::exp(-4.33 + 4577.8 / t);
+  case WgsEquilibrium::Seed:
+    return std::exp(-4.33 + 4577.8 / t);
   case WgsEquilibrium::Thermodynamic:
     return equilibriumConstant(clgStoichiometry(ClgReaction::R3), t);
   case WgsEquilibrium::YoonDenn:
-  default: return 0.0265 * std::exp(3968.0 / t);
+  default:
+    return 0.0265 * std::exp(3968.0 / t);
   }
 }
 
@@ -51,9 +53,9 @@ DEM_HD double wgsRate(const WgsParams& p, double t, double epsG, double cCO, dou
 }
 
 struct WgsCellSources {
-  double omega;                         ///< mol/(m³ s)
-  double massSource[kGasSpeciesCount];  ///< kg/(m³ s), GasSpecies order
-  double heatSource;                    ///< W/m³ into the gas
+  double omega;                        ///< mol/(m³ s)
+  double massSource[kGasSpeciesCount]; ///< kg/(m³ s), GasSpecies order
+  double heatSource;                   ///< W/m³ into the gas
 };
 
 /// Sources of one cell. T_g (K), ε_g (−), ρ_g (kg/m³), mass fractions Y in GasSpecies order.
@@ -69,8 +71,11 @@ DEM_HD WgsCellSources wgsCellSources(const WgsParams& p, double tG, double epsG,
                      c[idx(GasSpecies::CO2)], c[idx(GasSpecies::H2)]);
   if (dt > 0.0) {
     // ω dt ≤ ε_g C of the species consumed (per m³ of cell).
-    const double a = w > 0.0 ? (c[idx(GasSpecies::CO)] < c[idx(GasSpecies::H2O)] ? c[idx(GasSpecies::CO)] : c[idx(GasSpecies::H2O)])
-                             : (c[idx(GasSpecies::CO2)] < c[idx(GasSpecies::H2)] ? c[idx(GasSpecies::CO2)] : c[idx(GasSpecies::H2)]);
+    const double a =
+        w > 0.0 ? (c[idx(GasSpecies::CO)] < c[idx(GasSpecies::H2O)] ? c[idx(GasSpecies::CO)]
+                                                                    : c[idx(GasSpecies::H2O)])
+                : (c[idx(GasSpecies::CO2)] < c[idx(GasSpecies::H2)] ? c[idx(GasSpecies::CO2)]
+                                                                    : c[idx(GasSpecies::H2)]);
     const double wMax = epsG * a / dt;
     if (std::fabs(w) > wMax) {
       w = w > 0.0 ? wMax : -wMax;

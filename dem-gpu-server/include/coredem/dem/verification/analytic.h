@@ -15,16 +15,16 @@
 ///      m(t) = m0 − (−r_B)(1 − M_D/(2M_B)) t,   t ≤ t_end = m0 X_B0/(−r_B),   −r_B = 2 M_B ω
 ///      X_B = (m0 X_B0 − (−r_B) t)/m,  X_D = (m0 X_D0 + M_D ω t)/m,  X_I = m0 X_I0/m
 
+#include <cmath>
+#include <cstddef>
+#include <span>
+#include <vector>
+
 #include <coredem/common/check.h>
 #include <coredem/dem/kernels/conduction_contact.h>
 #include <coredem/dem/kernels/conduction_gas_lens.h>
 #include <coredem/dem/kernels/convection.h>
 #include <coredem/dem/kernels/radiation.h>
-
-#include <cmath>
-#include <cstddef>
-#include <span>
-#include <vector>
 
 namespace coredem::dem::verification {
 
@@ -51,14 +51,17 @@ inline Material musserMaterialB() {
 inline constexpr double kMusserLensGasConductivity = 1.239e-4 * kCalPerSCmKToWPerMK;
 /// Gas of the convection test (ρ, μ, κ, C_p; T and ε are set by the case).
 inline kernels::GasState musserConvectionGas(double tG, double eps) {
-  return {1.1854, 1.8603e-5, 1.2396e-4 * kCalPerSCmKToWPerMK, 0.23878 * kCalPerGKToJPerKgK, tG, eps};
+  return {1.1854, 1.8603e-5, 1.2396e-4 * kCalPerSCmKToWPerMK, 0.23878 * kCalPerGKToJPerKgK,
+          tG,     eps};
 }
 
 inline double sphereVolume(double d) {
   constexpr double pi = 3.141592653589793;
   return pi / 6.0 * d * d * d;
 }
-inline double sphereMass(const Material& m, double d) { return m.rho * sphereVolume(d); }
+inline double sphereMass(const Material& m, double d) {
+  return m.rho * sphereVolume(d);
+}
 
 struct TwoTemperatures {
   double t1; ///< K
@@ -105,19 +108,20 @@ inline ExchangeCoefficients gasLensCoefficients(double d1, const Material& m1, d
 
 /// A pair of fixed particles exchanging heat by conduction (§8.1, §8.2).
 struct TwoParticleCase {
-  double d1;   ///< m
+  double d1; ///< m
   Material m1;
-  double d2;   ///< m
+  double d2; ///< m
   Material m2;
-  double l;    ///< centre distance, m
-  double t10;  ///< K
-  double t20;  ///< K
+  double l;   ///< centre distance, m
+  double t10; ///< K
+  double t20; ///< K
 };
 
 /// MFiX-CC (§8.1): A at y = 1.499864 mm (298.15 K), B at y = 4.799731 mm (453.15 K).
 inline TwoParticleCase mfixContactConductionCase() {
-  return {3.0e-3, musserMaterialA(), 3.6e-3, musserMaterialB(), (0.4799731 - 0.1499864) * 1e-2,
-          298.15, 453.15};
+  return {
+      3.0e-3, musserMaterialA(), 3.6e-3, musserMaterialB(), (0.4799731 - 0.1499864) * 1e-2, 298.15,
+      453.15};
 }
 
 /// Seed contact variants (§8.1): A (3.0 mm, 373.15 K) and material B of diameter d2 at
@@ -214,9 +218,8 @@ inline TwoTemperatures radiationRates(const RadiationCase& c, double t1, double 
 
 /// RK4 reference (seed Eqs. 47–48) at the requested output times (ascending, ≥ 0), with
 /// step dt (the last step before an output time is shortened to land on it exactly).
-inline std::vector<TwoTemperatures> radiationReferenceRK4(const RadiationCase& c,
-                                                          std::span<const double> times,
-                                                          double dt = 1.0e-3) {
+inline std::vector<TwoTemperatures>
+radiationReferenceRK4(const RadiationCase& c, std::span<const double> times, double dt = 1.0e-3) {
   COREDEM_CHECK(dt > 0.0, "radiation RK4 step must be positive (got {} s)", dt);
   std::vector<TwoTemperatures> out;
   out.reserve(times.size());
@@ -224,8 +227,9 @@ inline std::vector<TwoTemperatures> radiationReferenceRK4(const RadiationCase& c
   double x1 = c.t10;
   double x2 = c.t20;
   for (const double target : times) {
-    COREDEM_CHECK(target >= t, "radiation RK4 output times must be ascending and >= 0 (got {} after {})",
-                  target, t);
+    COREDEM_CHECK(target >= t,
+                  "radiation RK4 output times must be ascending and >= 0 (got {} after {})", target,
+                  t);
     while (t < target) {
       const double remaining = target - t;
       const bool last = remaining <= dt * (1.0 + 1e-9);
@@ -245,15 +249,15 @@ inline std::vector<TwoTemperatures> radiationReferenceRK4(const RadiationCase& c
 
 /// The reaction A(g) + 2B(s) → C(g) + D(s) with inert I (§8.5), constant extent rate.
 struct ReactionCase {
-  double m0;    ///< kg
-  double xB0;   ///< −
-  double xD0;   ///< −
-  double xI0;   ///< −
+  double m0;     ///< kg
+  double xB0;    ///< −
+  double xD0;    ///< −
+  double xI0;    ///< −
   double molarA; ///< kg/mol
   double molarB; ///< kg/mol
   double molarC; ///< kg/mol
   double molarD; ///< kg/mol
-  double omega; ///< mol/s while B remains
+  double omega;  ///< mol/s while B remains
 };
 
 /// MFiX reactive-chemistry case (§8.5): d = 3 mm, ρ = 2500 kg/m³, X_B0 = X_I0 = 0.5,
@@ -270,7 +274,9 @@ struct ReactionState {
 };
 
 /// −r_B = 2 M_B ω, kg/s.
-inline double reactionSolidConsumption(const ReactionCase& c) { return 2.0 * c.molarB * c.omega; }
+inline double reactionSolidConsumption(const ReactionCase& c) {
+  return 2.0 * c.molarB * c.omega;
+}
 
 /// Time at which B is exhausted, s.
 inline double reactionEndTime(const ReactionCase& c) {
