@@ -319,6 +319,7 @@ struct Participant::Impl {
     fill(body.mutable_ledger()->mutable_mass(), ledgers.mass);
     fill(body.mutable_ledger()->mutable_energy(), ledgers.energy);
     fill(body.mutable_ledger()->mutable_species(), ledgers.species);
+    fill(body.mutable_diagnostics(), ledgers.diagnostics);
     if (!checkpointDir.empty()) {
       body.mutable_checkpoint()->set_directory(checkpointDir);
       for (const auto& f : files) {

@@ -137,6 +137,8 @@ struct Ledgers {
   std::vector<std::pair<std::string, double>> mass;    ///< kg
   std::vector<std::pair<std::string, double>> energy;  ///< J
   std::vector<std::pair<std::string, double>> species; ///< kg
+  /// Other figures for O's time series (StepDone.diagnostics), e.g. ("gas.solid_volume_m3", v).
+  std::vector<std::pair<std::string, double>> diagnostics;
 };
 
 class Participant {

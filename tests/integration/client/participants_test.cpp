@@ -1,0 +1,186 @@
+// The participants against a real coredem-dem process over tcp loopback: the C API program,
+// coredem-gas (checkpoint + restart with identical ledgers) and the C++ client's argument checks.
+#include "mini_orchestrator.h"
+#include "process.h"
+
+#include "coredem/client/participant.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+
+using namespace coredem::testing;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path tempDir(const std::string& name) {
+  const auto d = fs::temp_directory_path() / ("coredem-participants-" + name + "-" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+constexpr int kParticles = 50;
+constexpr double kD = 1e-3;
+constexpr double kBox = 6e-3;
+constexpr int kCells = 3;
+const double kVp = kParticles * std::numbers::pi * kD * kD * kD / 6.0;
+
+std::map<std::string, std::string> env(const MiniOrchestrator& o, const std::string& dem) {
+  return {{"COREDEM_CONTROL_ENDPOINT", o.controlEndpoint()},
+          {"COREDEM_DEM_ENDPOINT", dem},
+          {"COREDEM_SESSION", o.session()},
+          {"COREDEM_TIMEOUT_S", "20"}};
+}
+
+} // namespace
+
+TEST(Participants, CApiProgramRunsStepsAgainstARealServer) {
+  const auto dir = tempDir("capi");
+  DemProcess dem(dir);
+  MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2", "O2"}));
+  Child program({COREDEM_C_API_TEST_BIN}, env(o, dem.endpoint()));
+  const auto res = o.run(4, 2e-4);
+  EXPECT_EQ(program.wait(std::chrono::seconds(20)), 0);
+  ASSERT_EQ(res.cfd.size(), 4u);
+  ASSERT_EQ(res.dem.size(), 4u);
+  for (const auto& done : res.cfd) {
+    // Σ (1 − ε_g) V_c computed by the C program equals the particle volume (round-off).
+    EXPECT_NEAR(named(done.ledger().energy(), "c_api.solid_volume_m3"), kVp, 1e-12 * kVp);
+  }
+  EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0) << "coredem-dem --exit-after-session did not exit cleanly";
+  fs::remove_all(dir);
+}
+
+TEST(Participants, CoredemGasRunsCheckpointsAndRestartsWithIdenticalLedgers) {
+  const auto dir = tempDir("gas");
+  const auto caseFile = dir / "case.yaml";
+  {
+    std::ofstream out(caseFile);
+    out << "gas:\n"
+           "  u_g: [0.0, 0.0, 0.4]\n"
+           "  T_g: {table: [[0.0, 300.0], [0.01, 400.0]]}\n"
+           "  Y_g: {N2: 1.0}\n"
+           "  regions:\n"
+           "    - name: top\n"
+           "      box: {min: [0, 0, 0.004], max: [0.006, 0.006, 0.006]}\n"
+           "      u_g: [0.0, 0.0, 0.1]\n";
+  }
+  const std::vector<std::string> gasArgs = {COREDEM_GAS_BIN, "--case", caseFile.string(), "--key", "gas"};
+  const double dt = 2e-4;
+  const auto ck = (dir / "ck6").string();
+  std::vector<v1::StepDone> straight;
+  {
+    DemProcess dem(dir);
+    MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2"}));
+    Child gas(gasArgs, env(o, dem.endpoint()));
+    straight = o.run(12, dt, {{6, ck}}).cfd;
+    EXPECT_EQ(gas.wait(std::chrono::seconds(20)), 0);
+    EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0);
+  }
+  ASSERT_EQ(straight.size(), 12u);
+  for (const auto& d : straight) {
+    EXPECT_NEAR(named(d.diagnostics(), "gas.solid_volume_m3"), kVp, 1e-12 * kVp);
+  }
+  // Gas flowing up through the beads loses momentum to them.
+  EXPECT_LT(named(straight.back().diagnostics(), "gas.momentum_from_particles_z_Ns"), 0.0);
+  // Courant number: dt · 0.4 m/s / 2 mm in the fastest cell.
+  EXPECT_NEAR(straight.back().cfl(), dt * 0.4 / (kBox / kCells), 1e-15);
+  ASSERT_TRUE(straight[5].has_checkpoint());
+  EXPECT_EQ(straight[5].checkpoint().files(0), "gas.h5");
+  ASSERT_TRUE(fs::exists(fs::path(ck) / "gas.h5"));
+  ASSERT_TRUE(fs::exists(fs::path(ck) / "dem.h5"));
+
+  // Restart from step 6: D reads dem.h5, coredem-gas reads gas.h5; steps 7..12 again.
+  std::vector<v1::StepDone> resumed;
+  {
+    DemProcess dem(dir);
+    auto cfg = smallCase(kParticles, kD, kBox, kCells, {"N2"});
+    cfg.set_initial_state_file((fs::path(ck) / "dem.h5").string());
+    cfg.set_start_step(6);
+    cfg.set_start_time(6 * dt);
+    MiniOrchestrator o(dem.endpoint(), cfg);
+    auto args = gasArgs;
+    args.push_back("--restart");
+    args.push_back((fs::path(ck) / "gas.h5").string());
+    Child gas(args, env(o, dem.endpoint()));
+    resumed = o.run(6, dt).cfd;
+    EXPECT_EQ(gas.wait(std::chrono::seconds(20)), 0);
+    EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0);
+  }
+  ASSERT_EQ(resumed.size(), 6u);
+  // Bitwise: the DEM state restarts exactly and the ledgers' Kahan sums restart with their
+  // compensation terms.
+  const auto& a = straight.back();
+  const auto& b = resumed.back();
+  for (const char* name : {"gas.momentum_from_particles_x_Ns", "gas.momentum_from_particles_z_Ns",
+                           "gas.solid_volume_m3"}) {
+    EXPECT_EQ(named(a.diagnostics(), name), named(b.diagnostics(), name)) << name;
+  }
+  EXPECT_EQ(named(a.ledger().energy(), "gas.heat_from_particles_J"),
+            named(b.ledger().energy(), "gas.heat_from_particles_J"));
+  fs::remove_all(dir);
+}
+
+TEST(Participants, CppClientChecksArgumentsBeforeSending) {
+  const auto dir = tempDir("cpp");
+  DemProcess dem(dir);
+  MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2"}));
+  std::string failure;
+  std::thread cfd([&] {
+    try {
+      coredem::client::Options opt;
+      opt.controlEndpoint = o.controlEndpoint();
+      opt.demEndpoint = dem.endpoint();
+      opt.sessionId = o.session();
+      opt.timeoutSeconds = 20;
+      coredem::client::Participant p(opt);
+      p.initialize();
+      const auto n = static_cast<std::size_t>(p.grid().cellCount());
+      std::vector<double> v3(3 * n, 0.0), t(n, 300.0), rho(n, 1.2), mu(n, 1.8e-5), k(n, 0.03),
+          cp(n, 1000.0), y(n, 1.0);
+      std::vector<coredem::client::NamedField> fields = {
+          {"u_g", v3}, {"grad_p", v3}, {"T_g", t}, {"rho_g", rho}, {"mu_g", mu},
+          {"kappa_g", k}, {"cp_g", cp}, {"Y_g", y}};
+      auto expectArgument = [&](auto&& call, const char* what, const char* mentions) {
+        try {
+          call();
+          failure += std::string(what) + ": no error; ";
+        } catch (const coredem::client::ClientError& e) {
+          if (e.code() != coredem::client::ErrorCode::Argument ||
+              std::string(e.what()).find(mentions) == std::string::npos) {
+            failure += std::string(what) + ": " + e.what() + "; ";
+          }
+        }
+      };
+      expectArgument([&] { p.exchange(p.step(), 2 * p.dt(), fields); }, "other dt", "granted dt");
+      expectArgument([&] { p.exchange(p.step() + 1, p.dt(), fields); }, "other step", "granted step");
+      auto missing = fields;
+      missing.pop_back();
+      expectArgument([&] { p.exchange(p.step(), p.dt(), missing); }, "missing Y_g", "'Y_g'");
+      auto unknown = fields;
+      unknown.push_back({"T_gas", t});
+      expectArgument([&] { p.exchange(p.step(), p.dt(), unknown); }, "unknown name", "T_gas");
+      auto shortT = fields;
+      shortT[2].values.size -= 1;
+      expectArgument([&] { p.exchange(p.step(), p.dt(), shortT); }, "short T_g", "needs");
+      while (p.isRunning()) {
+        const auto& s = p.exchange(p.step(), p.dt(), fields);
+        if (s.field("eps_g").size != n) failure += "eps_g size; ";
+        p.advance(0.0);
+      }
+      p.finalize();
+    } catch (const std::exception& e) {
+      failure += std::string("unexpected: ") + e.what();
+    }
+  });
+  const auto res = o.run(2, 2e-4);
+  cfd.join();
+  EXPECT_EQ(failure, "");
+  EXPECT_EQ(res.cfd.size(), 2u);
+  EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0);
+  fs::remove_all(dir);
+}
