@@ -158,11 +158,21 @@ Acquire::http::Timeout "30";
 Acquire::https::Timeout "30";
 EOF
 export APT_CONFIG="$apt_dir/apt.conf"
+# apt reads APT_CONFIG before the system's apt.conf.d (kept: it may hold the proxy or mirror
+# settings this machine needs), so the private locations are repeated on the command line,
+# which nothing in a configuration file can override.
+apt_opts=(
+  -o "Dir::Etc::SourceList=/dev/null"
+  -o "Dir::Etc::SourceParts=$apt_dir/sources.list.d"
+  -o "Dir::State::Lists=$apt_dir/lists"
+  -o "Dir::Cache=$apt_dir/cache"
+  -o "APT::Sandbox::User=$(id -un)"
+)
 
 say "apt-get update (private lists, $n_entries source entries as deb-src)"
 t0=$(date +%s)
 update_ok=true
-if ! timeout 600 apt-get -q update >"$apt_dir/update.log" 2>&1; then
+if ! timeout 600 apt-get -q "${apt_opts[@]}" update >"$apt_dir/update.log" 2>&1; then
   update_ok=false
   say "warning: apt-get update reported errors (see $apt_dir/update.log); trying the download anyway"
 fi
@@ -177,9 +187,9 @@ dl_dir="$cache_dir/download"
 mkdir -p "$dl_dir"
 say "apt-get source --download-only $src_package=$src_version"
 t0=$(date +%s)
-if ! (cd "$dl_dir" && timeout 900 apt-get -q source --download-only "$src_package=$src_version") >"$apt_dir/source.log" 2>&1; then
+if ! (cd "$dl_dir" && timeout 900 apt-get -q "${apt_opts[@]}" source --download-only "$src_package=$src_version") >"$apt_dir/source.log" 2>&1; then
   if grep -qE "Can not find version|Unable to find a source package" "$apt_dir/source.log"; then
-    available=$(apt-cache showsrc "$src_package" 2>/dev/null | sed -n 's/^Version: //p' | sort -u | tr '\n' ' ')
+    available=$(apt-cache "${apt_opts[@]}" showsrc "$src_package" 2>/dev/null | sed -n 's/^Version: //p' | sort -u | tr '\n' ' ')
     if [[ -n "$available" ]]; then
       die 4 "Debian's source archive has $src_package version(s) [ ${available}] but not the installed $src_version. Install a matching binary (apt-get install openfoam=<one of those>) or configure with -DCOREDEM_OPENFOAM=OFF."
     fi
