@@ -1,0 +1,219 @@
+// coredem-bench protocol --cells N --fields F [--json] [--seconds S] [--transports tcp,ipc]
+//
+// Round trip of N cells x F float64 arrays through the protocol transport (a Client sends a
+// message with F arrays of N doubles, an echo Server thread sends the same arrays back) over
+// tcp loopback and over ipc, compared with a plain memcpy of the same bytes measured in the
+// same run. Figures:
+//   gbps          = 2 * N*F*8 bytes / median round-trip time   (bytes moved per second)
+//   memcpy_gbps   = N*F*8 bytes / median memcpy time
+//   memcpy_ratio  = gbps / memcpy_gbps
+// Both sides use the library's zero-copy paths (addArrayShared on send, frame views on
+// receive), so the figure is the cost of the transport itself (no validation).
+#include "commands.h"
+
+#include <coredem/protocol/message.h>
+#include <coredem/protocol/transport.h>
+
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include <unistd.h>
+
+namespace {
+
+using namespace coredem::protocol;
+namespace v1 = coredem::v1;
+using Clock = std::chrono::steady_clock;
+
+struct Result {
+  std::string transport;
+  double medianSeconds = 0;
+  double minSeconds = 0;
+  std::size_t iterations = 0;
+};
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+/// Echo server: answers every message with the same arrays (no copy: the reply's arrays
+/// keep the received message alive).
+void echo(Server& server, const std::atomic<bool>& stop) {
+  while (!stop) {
+    auto req = server.receive(std::chrono::milliseconds(50));
+    if (!req) {
+      continue;
+    }
+    auto keep = std::make_shared<Message>(std::move(req->message));
+    Message reply(v1::MESSAGE_TYPE_ACK);
+    reply.envelope().mutable_ack();
+    reply.setSequence(keep->envelope().sequence());
+    for (std::size_t i = 0; i < keep->arrayCount(); ++i) {
+      ArrayView v = keep->array(i);
+      reply.addArraySharedBytes(v.name(), v.dtype(), v.shape(), keep, v.bytes);
+    }
+    server.reply(req->peer, std::move(reply));
+  }
+}
+
+Result measureTransport(const std::string& name, const std::string& bindEndpoint,
+                        const std::vector<std::shared_ptr<std::vector<double>>>& arrays,
+                        std::uint64_t cells, double minSeconds) {
+  Server server;
+  std::string endpoint = server.bind(bindEndpoint);
+  std::atomic<bool> stop{false};
+  std::thread thread([&] { echo(server, stop); });
+
+  Client client;
+  client.connect(endpoint);
+  std::vector<double> times;
+  auto start = Clock::now();
+  const std::size_t warmup = 2;
+  for (std::size_t it = 0;; ++it) {
+    Message m(v1::MESSAGE_TYPE_ACK);
+    m.envelope().mutable_ack();
+    for (std::size_t f = 0; f < arrays.size(); ++f) {
+      m.addArrayShared<double>("f" + std::to_string(f), arrays[f],
+                               std::span<const double>(*arrays[f]), {cells});
+    }
+    auto t0 = Clock::now();
+    Message reply = client.request(std::move(m), std::chrono::seconds(60));
+    auto t1 = Clock::now();
+    if (reply.arrayCount() != arrays.size() ||
+        reply.array(arrays.size() - 1).bytes.size() != cells * sizeof(double)) {
+      throw coredem::UserError("echo reply is incomplete");
+    }
+    if (it >= warmup) {
+      times.push_back(std::chrono::duration<double>(t1 - t0).count());
+    }
+    double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (times.size() >= 5 && elapsed >= minSeconds) {
+      break;
+    }
+  }
+  stop = true;
+  thread.join();
+  return Result{name, median(times), *std::min_element(times.begin(), times.end()),
+                times.size()};
+}
+
+double measureMemcpy(std::size_t bytes, double minSeconds) {
+  std::vector<char> src(bytes, 1), dst(bytes, 0);
+  std::vector<double> times;
+  auto start = Clock::now();
+  for (int it = 0;; ++it) {
+    auto t0 = Clock::now();
+    std::memcpy(dst.data(), src.data(), bytes);
+    auto t1 = Clock::now();
+    src[static_cast<std::size_t>(it) % bytes] = dst[(static_cast<std::size_t>(it) * 7) % bytes];
+    if (it >= 2) {
+      times.push_back(std::chrono::duration<double>(t1 - t0).count());
+    }
+    if (times.size() >= 5 &&
+        std::chrono::duration<double>(Clock::now() - start).count() >= minSeconds) {
+      break;
+    }
+  }
+  return median(times);
+}
+
+int runProtocolBench(int argc, char** argv) {
+  CLI::App app{"Round-trip throughput of the coupling transport vs memcpy", "protocol"};
+  std::uint64_t cells = 100000;
+  std::size_t nFields = 16;
+  bool json = false;
+  double seconds = 1.0;
+  std::vector<std::string> transports{"tcp", "ipc"};
+  app.add_option("--cells", cells, "cells N (doubles per array)")->check(CLI::PositiveNumber);
+  app.add_option("--fields", nFields, "arrays F per message")->check(CLI::PositiveNumber);
+  app.add_flag("--json", json, "print one JSON object");
+  app.add_option("--seconds", seconds, "minimum measuring time per transport");
+  app.add_option("--transports", transports, "tcp and/or ipc")->delimiter(',');
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  std::vector<std::shared_ptr<std::vector<double>>> arrays;
+  for (std::size_t f = 0; f < nFields; ++f) {
+    auto a = std::make_shared<std::vector<double>>(cells);
+    for (std::uint64_t i = 0; i < cells; ++i) {
+      (*a)[i] = static_cast<double>(f) + 1e-6 * static_cast<double>(i);
+    }
+    arrays.push_back(std::move(a));
+  }
+  const std::size_t bytes = cells * nFields * sizeof(double);
+
+  std::vector<Result> results;
+  const std::string ipcPath = (std::filesystem::temp_directory_path() /
+                               ("coredem-bench-" + std::to_string(::getpid()) + ".sock"))
+                                  .string();
+  try {
+    for (const auto& t : transports) {
+      if (t == "tcp") {
+        results.push_back(measureTransport("tcp", "tcp://127.0.0.1:*", arrays, cells, seconds));
+      } else if (t == "ipc") {
+        results.push_back(measureTransport("ipc", "ipc://" + ipcPath, arrays, cells, seconds));
+        std::filesystem::remove(ipcPath);
+      } else {
+        std::fprintf(stderr, "coredem-bench protocol: unknown transport '%s' (tcp, ipc)\n",
+                     t.c_str());
+        return 2;
+      }
+    }
+  } catch (const coredem::UserError& e) {
+    std::fprintf(stderr, "coredem-bench protocol: %s\n", e.what());
+    return 1;
+  }
+  const double memcpySeconds = measureMemcpy(bytes, std::min(seconds, 0.5));
+  const double memcpyGbps = static_cast<double>(bytes) / memcpySeconds / 1e9;
+
+  if (json) {
+    std::ostringstream os;
+    os.precision(6);
+    os << "{\"benchmark\": \"protocol\", \"cells\": " << cells << ", \"fields\": " << nFields
+       << ", \"bytes_per_direction\": " << bytes << ", \"memcpy_gbps\": " << memcpyGbps
+       << ", \"hardware_threads\": " << std::thread::hardware_concurrency()
+       << ", \"transports\": {";
+    for (std::size_t i = 0; i < results.size(); ++i) {
+      const auto& r = results[i];
+      double gbps = 2.0 * static_cast<double>(bytes) / r.medianSeconds / 1e9;
+      os << (i ? ", " : "") << "\"" << r.transport << "\": {\"gbps\": " << gbps
+         << ", \"memcpy_ratio\": " << gbps / memcpyGbps
+         << ", \"round_trip_ms\": " << r.medianSeconds * 1e3
+         << ", \"round_trip_min_ms\": " << r.minSeconds * 1e3
+         << ", \"iterations\": " << r.iterations << "}";
+    }
+    os << "}}";
+    std::printf("%s\n", os.str().c_str());
+    return 0;
+  }
+  std::printf("protocol round trip: %llu cells x %zu float64 arrays = %.2f MB each way\n",
+              static_cast<unsigned long long>(cells), nFields, static_cast<double>(bytes) / 1e6);
+  std::printf("memcpy of the same bytes: %.3f ms = %.2f GB/s\n", memcpySeconds * 1e3, memcpyGbps);
+  std::printf("%-9s %14s %10s %14s %12s\n", "transport", "round trip ms", "GB/s", "memcpy ratio",
+              "iterations");
+  for (const auto& r : results) {
+    double gbps = 2.0 * static_cast<double>(bytes) / r.medianSeconds / 1e9;
+    std::printf("%-9s %14.3f %10.3f %14.3f %12zu\n", r.transport.c_str(), r.medianSeconds * 1e3,
+                gbps, gbps / memcpyGbps, r.iterations);
+  }
+  std::printf("(GB/s = 2 x bytes each way / median round trip; ratio = GB/s / memcpy GB/s)\n");
+  return 0;
+}
+
+} // namespace
+
+COREDEM_BENCH_COMMAND("protocol", "round trip of N cells x F doubles over tcp and ipc vs memcpy",
+                      runProtocolBench);
