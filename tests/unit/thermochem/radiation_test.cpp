@@ -1,5 +1,6 @@
 // Radiation kernel (PHYSICS §3.4) and the RK4 reference of the MFiX radiation case (§8.4).
 #include <cmath>
+#include <iterator>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -90,4 +91,14 @@ TEST(Radiation, Rk4RejectsBadInput) {
   EXPECT_THROW(v::radiationReferenceRK4(v::mfixRadiationCase(), back, 1e-3), coredem::UserError);
   const std::vector<double> one = {1.0};
   EXPECT_THROW(v::radiationReferenceRK4(v::mfixRadiationCase(), one, 0.0), coredem::UserError);
+}
+
+TEST(ModelNames, RadiationEnvironmentNames) {
+  EXPECT_STREQ(k::kRadiationEnvironmentNames[static_cast<int>(
+                   k::RadiationEnvironment::CellMeanIncludingSelf)],
+               "cell_mean");
+  EXPECT_STREQ(k::kRadiationEnvironmentNames[static_cast<int>(
+                   k::RadiationEnvironment::NeighbourMeanExcludingSelf)],
+               "neighbour_mean");
+  EXPECT_EQ(std::size(k::kRadiationEnvironmentNames), 2u);
 }

@@ -1,5 +1,6 @@
 // Homogeneous water–gas shift (PHYSICS §6.2): equilibrium consistency, sources, limiter.
 #include <cmath>
+#include <iterator>
 
 #include <gtest/gtest.h>
 
@@ -112,4 +113,12 @@ TEST(Wgs, SourcesHeatAndLimiter) {
   k::WgsParams off;
   off.enabled = false;
   EXPECT_EQ(k::wgsCellSources(off, t, 0.8, 0.3, y).omega, 0.0);
+}
+
+TEST(ModelNames, WgsEquilibriumNames) {
+  EXPECT_STREQ(k::kWgsEquilibriumNames[static_cast<int>(k::WgsEquilibrium::YoonDenn)], "yoon_denn");
+  EXPECT_STREQ(k::kWgsEquilibriumNames[static_cast<int>(k::WgsEquilibrium::Seed)], "seed");
+  EXPECT_STREQ(k::kWgsEquilibriumNames[static_cast<int>(k::WgsEquilibrium::Thermodynamic)],
+               "thermodynamic");
+  EXPECT_EQ(std::size(k::kWgsEquilibriumNames), 3u);
 }

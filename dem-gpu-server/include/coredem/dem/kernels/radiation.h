@@ -27,6 +27,8 @@ enum class RadiationEnvironment : int {
   CellMeanIncludingSelf = 0,     ///< (a) MFiX
   NeighbourMeanExcludingSelf = 1 ///< (b) Zhou / Kratos
 };
+/// Case-file names of RadiationEnvironment (index = enum value).
+inline constexpr const char* kRadiationEnvironmentNames[] = {"cell_mean", "neighbour_mean"};
 
 struct RadiationParams {
   RadiationEnvironment environment = RadiationEnvironment::CellMeanIncludingSelf;

@@ -26,6 +26,9 @@ inline constexpr int kMaxReactionTerms = 6;
 
 enum class ReactionPhase : int { Gas = 0, Solid = 1 };
 enum class RateLaw : int { Constant = 0, Arrhenius = 1 };
+/// Case-file names of ReactionPhase and RateLaw (index = enum value).
+inline constexpr const char* kReactionPhaseNames[] = {"gas", "solid"};
+inline constexpr const char* kRateLawNames[] = {"constant", "arrhenius"};
 
 struct HeterogeneousReaction {
   int n = 0;                                   ///< number of terms

@@ -55,10 +55,12 @@ inline kernels::GasState musserConvectionGas(double tG, double eps) {
           tG,     eps};
 }
 
+/// Volume of a sphere of diameter d, m³.
 inline double sphereVolume(double d) {
   constexpr double pi = 3.141592653589793;
   return pi / 6.0 * d * d * d;
 }
+/// Mass of a sphere of diameter d, kg.
 inline double sphereMass(const Material& m, double d) {
   return m.rho * sphereVolume(d);
 }
