@@ -202,13 +202,14 @@ if ! (cd "$dl_dir" && timeout 900 apt-get -q "${apt_opts[@]}" source --download-
 fi
 t_download=$(($(date +%s) - t0))
 
-dsc=$(ls "$dl_dir"/"${src_package}_"*.dsc 2>/dev/null | head -n 1)
+first_file() { find "$dl_dir" -maxdepth 1 -name "$1" -print -quit; }
+dsc=$(first_file "${src_package}_*.dsc")
 [[ -n "$dsc" ]] || die 3 "apt-get source reported success but left no .dsc in $dl_dir"
 dsc_version=$(sed -n 's/^Version: //p' "$dsc" | head -n 1)
 [[ "$dsc_version" == "$src_version" ]] ||
   die 4 "downloaded $dsc has version '$dsc_version', the installed package needs '$src_version'"
-orig=$(ls "$dl_dir"/"${src_package}_"*.orig.tar.* 2>/dev/null | head -n 1)
-debian_tar=$(ls "$dl_dir"/"${src_package}_"*.debian.tar.* 2>/dev/null | head -n 1)
+orig=$(first_file "${src_package}_*.orig.tar.*")
+debian_tar=$(first_file "${src_package}_*.debian.tar.*")
 [[ -n "$orig" && -n "$debian_tar" ]] ||
   die 3 "expected ${src_package}_*.orig.tar.* and ${src_package}_*.debian.tar.* in $dl_dir (a 3.0 (quilt) source package)"
 say "downloaded $(basename "$orig") ($(du -m "$orig" | cut -f1) MB) in ${t_download}s (index update ${t_update}s)"
