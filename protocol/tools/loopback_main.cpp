@@ -184,6 +184,7 @@ int exchange(const std::string& endpoint, std::vector<std::uint64_t> grid, std::
 } // namespace
 
 int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0); // keep lines in order with the server's output
   CLI::App app{"CoReDEM protocol loopback server and exchange client"};
   app.require_subcommand(1);
   std::string endpoint = "tcp://127.0.0.1:*";
