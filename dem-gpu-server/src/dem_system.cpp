@@ -541,6 +541,8 @@ void DemSystem::setVelocities(std::span<const double> velocityByGid, std::span<c
                 "setVelocities: {} angular velocity values, expected {}", omegaByGid.size(), 3 * s.n);
   for (std::size_t i = 0; i < s.n; ++i) {
     const std::size_t g = static_cast<std::size_t>(s.gid[i]);
+    COREDEM_CHECK(s.gid[i] >= 0 && g < s.n, "setVelocities: global ids are not 0..N-1 (state read from a file "
+                                            "with other ids); set velocities through ParticleSet instead");
     for (int d = 0; d < 3; ++d) {
       if (!velocityByGid.empty()) s.vel[3 * i + d] = velocityByGid[3 * g + d];
       if (!omegaByGid.empty()) s.omega[3 * i + d] = omegaByGid[3 * g + d];

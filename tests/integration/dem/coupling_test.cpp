@@ -19,7 +19,7 @@ DemConfig coupledBox(std::size_t n) {
 } // namespace
 
 TEST(Coupling, GasFractionSumsToParticleVolume) {
-  DemSystem sys(coupledBox(512), BackendKind::Cpu, 2);
+  DemSystem sys(coupledBox(512), BackendKind::Cpu, 1);
   const std::size_t nc = sys.cellCount();
   ASSERT_EQ(nc, 36u);
   std::vector<double> ug(3 * nc), gp(3 * nc, 0.0), rho(nc, 1.2), mu(nc, 1.8e-5);
