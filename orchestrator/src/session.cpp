@@ -17,6 +17,7 @@
 #include <ctime>
 #include <fstream>
 #include <numbers>
+#include <regex>
 #include <sstream>
 #include <thread>
 #include <unistd.h>
@@ -800,9 +801,15 @@ void checkParticipantInput(const CaseConfig& config) {
       std::stringstream s;
       s << in.rdbuf();
       ::unlink(tmpl);
-      std::string msg = s.str();
-      while (!msg.empty() && msg.back() == '\n') {
-        msg.pop_back();
+      // Keep the messages, drop the participant's log prefix "[time] [name] [level] ".
+      std::string msg;
+      std::string line;
+      const std::regex prefix(R"(^\[[^\]]*\] \[[^\]]*\] \[[^\]]*\] )");
+      while (std::getline(s, line)) {
+        line = std::regex_replace(line, prefix, "");
+        if (!line.empty()) {
+          msg += (msg.empty() ? "" : "\n") + line;
+        }
       }
       if (check.exitCode() == 2) {
         throw CaseError(msg.empty() ? config.caseFile.string() + ": gas section invalid" : msg);
