@@ -21,7 +21,7 @@ const double kMfixPfpDistance = (1.498 - 1.150) * 1e-2;        // §8.2 position
 
 // Independent reference for the lens integral: direct gap formula in long double (64-bit
 // mantissa), root of gap = s_min by bisection, the clipped part integrated exactly, the rest by
-// 10-point Gauss–Legendre on panels graded geometrically towards R_in (ratio 1.02).
+// 10-point Gauss–Legendre on panels graded geometrically towards both ends (ratio 1.02).
 long double fineLensIntegral(long double r1, long double r2, long double l, long double flpc,
                              long double sMin) {
   const long double big = std::max(r1, r2);
@@ -31,7 +31,8 @@ long double fineLensIntegral(long double r1, long double r2, long double l, long
     const long double x = (ra * ra - rb * rb + d * d) / (2 * d);
     return std::sqrt(ra * ra - x * x);
   };
-  const long double rOut = chord(rLens, small, l);
+  // R_out: Eq. 26, or R_S once the lens covers the small sphere's facing hemisphere ([C]).
+  const long double rOut = l * l <= rLens * rLens - small * small ? small : chord(rLens, small, l);
   const long double rIn = l < big + small ? chord(big, small, l) : 0.0L;
   auto gap = [&](long double r) {
     return l - std::sqrt(big * big - r * r) - std::sqrt(small * small - r * r);
@@ -64,15 +65,25 @@ long double fineLensIntegral(long double r1, long double r2, long double l, long
     }
     return s * h;
   };
-  // Panels: first width grows geometrically from 1e-4·(distance to the singular point).
-  const long double origin = rIn;
+  // Panels graded geometrically (ratio 1.02) towards R_in from the first half of [r*, R_out]
+  // and towards R_out in the second half (when R_out = R_S the gap has a square-root branch
+  // point there).
+  const long double mid = 0.5L * (rStar + rOut);
   long double a = rStar;
-  long double width = std::max((rStar - origin) * 0.02L, (rOut - rIn) * 1e-9L);
-  while (a < rOut) {
-    const long double b = std::min(rOut, a + width);
+  long double width = std::max((rStar - rIn) * 0.02L, (rOut - rIn) * 1e-12L);
+  while (a < mid) {
+    const long double b = std::min(mid, a + width);
     total += panel(a, b);
     a = b;
-    width = std::max(width, (a - origin) * 0.02L);
+    width = std::max(width, (a - rIn) * 0.02L);
+  }
+  long double b = rOut;
+  width = (rOut - mid) * 1e-12L;
+  while (b > mid) {
+    const long double a2 = std::max(mid, b - width);
+    total += panel(a2, b);
+    b = a2;
+    width = std::max(width, (rOut - b) * 0.02L);
   }
   return total;
 }
@@ -271,6 +282,49 @@ TEST(GasLens, QuadratureAccurateToBetterThan1e8) {
       EXPECT_NEAR(un.value, static_cast<double>(fine), 1e-10 * un.value);
     }
   }
+}
+
+// Very polydisperse pairs (R_S/R_L = 0.1, 0.2), where R_out = R_S and the gap has a
+// square-root branch point at the outer limit, in and out of contact: 1e-10 as well.
+TEST(GasLens, QuadratureAccurateForSmallSizeRatios) {
+  for (double ratio : {0.1, 0.2}) {
+    for (double rel : {-0.05, -1e-6, 1e-6, 1e-2, 0.05}) {
+      for (double sMin : {4e-10, 1e-6}) {
+        SCOPED_TRACE(ratio);
+        SCOPED_TRACE(rel);
+        SCOPED_TRACE(sMin);
+        k::GasLensParams p;
+        p.minSeparation = sMin;
+        const double big = 1e-3;
+        const double small = ratio * big;
+        const double l = (big + small) * (1.0 + rel);
+        const auto in = k::gasLensIntegral(p, big, small, l);
+        const long double fine = fineLensIntegral(big, small, l, 0.2L, sMin);
+        EXPECT_TRUE(in.converged);
+        EXPECT_GT(in.value, 0.0);
+        EXPECT_NEAR(in.value, static_cast<double>(fine), 1e-10 * in.value);
+      }
+    }
+  }
+}
+
+// R_out is continuous in l where it switches from Eq. 26 to R_S ([C], l² = R_lens² − R_S²).
+TEST(GasLens, OuterRadiusContinuousAtHemisphereSwitch) {
+  const k::GasLensParams p;
+  const double big = 1e-3;
+  const double small = 0.1e-3;
+  const double rLens = 1.2 * big;
+  const double lSwitch = std::sqrt(rLens * rLens - small * small);
+  const auto below = k::gasLensGeometry(p, big, small, lSwitch * (1.0 - 1e-12));
+  const auto above = k::gasLensGeometry(p, big, small, lSwitch * (1.0 + 1e-12));
+  EXPECT_EQ(below.rOut, small);
+  EXPECT_NEAR(above.rOut, small, 1e-5 * small); // chord radius → R_S as √(Δl)
+  EXPECT_LE(above.rOut, small);
+  // Beyond the switch: Eq. 26.
+  const double l = 1.01 * lSwitch;
+  const double x = (rLens * rLens - small * small + l * l) / (2.0 * l);
+  const double eq26 = std::sqrt(rLens * rLens - x * x);
+  EXPECT_NEAR(k::gasLensGeometry(p, big, small, l).rOut, eq26, 1e-12 * eq26);
 }
 
 // Closed form when the whole lens is clipped (s_min ≥ max gap): I = π(R_out² − R_in²)/s_min.

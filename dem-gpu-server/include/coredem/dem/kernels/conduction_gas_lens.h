@@ -9,7 +9,10 @@
 ///   (25) R_in  = 0 if l ≥ R_i + R_j (no contact), r_c (Eq. 23) if in contact
 ///   (26) R_out = √(R_lens² − ((R_lens² − R_S² + l²)/(2 l))²)
 ///        no pfp if the lens does not reach the smaller sphere (l ≥ R_lens + R_S).
-///        [C] If the smaller sphere lies entirely inside the lens (l ≤ R_lens − R_S), R_out = R_S.
+///        [C] R_out = R_S once l² ≤ R_lens² − R_S² (the intersection plane is at or beyond the
+///        small sphere's centre, so its whole facing hemisphere is inside the lens). Eq. 26
+///        agrees at the switch, so R_out stays continuous in l. This only matters for size
+///        ratios R_S/R_L < 0.19 (FLPC = 0.2).
 ///   s_min: minimum conduction distance; MFiX code default DES_MIN_COND_DIST = 1e-6 m [C].
 ///
 /// Numerics [C] (target: 1e-8 relative or better):
@@ -21,7 +24,8 @@
 ///    with r* the root of gap(r*) = s_min (safeguarded Newton).
 ///  * The rest: adaptive Gauss–Kronrod (conduction_quadrature.h). In contact, with the
 ///    substitution r = R_in + e^u, which removes the near-logarithmic singularity at R_in;
-///    otherwise in v = r² (I = π ∫ dv / gap).
+///    otherwise with u = ln(g0 + c0 r²), c0 = 1/(2R_L) + 1/(2R_S), for the same reason when the
+///    surface gap g0 is small.
 ///
 /// The result depends on (R_L, R_S, l) only, so Q_ij = −Q_ji bitwise.
 
@@ -55,7 +59,12 @@ DEM_HD GasLensGeometry gasLensGeometry(const GasLensParams& p, double ri, double
   if (!(l < rLens + small)) {
     return {false, contact, 0.0, 0.0};
   }
-  const double rOut = intersectionCircleRadius(rLens, small, l);
+  // [C] Once the lens/small-sphere intersection plane lies at or beyond the small sphere's
+  // centre (l² ≤ R_lens² − R_S²), its whole facing hemisphere is inside the lens: R_out = R_S.
+  // Eq. 26 alone would shrink R_out towards 0 there; this keeps R_out continuous in l.
+  const double rOut = (l * l <= (rLens - small) * (rLens + small))
+                          ? small
+                          : intersectionCircleRadius(rLens, small, l);
   const double rIn = contact ? intersectionCircleRadius(big, small, l) : 0.0;
   return {rOut > rIn, contact, rIn, rOut};
 }
@@ -142,12 +151,18 @@ DEM_HD GasLensIntegral gasLensIntegral(const GasLensParams& p, double ri, double
     };
     q = integrateAdaptive(f, std::log(dStar), std::log(dOut), p.relTol);
   } else {
-    // v = r²:  π ∫ dv / max(gap, s_min)
-    auto f = [=](double v) {
+    // v = r², then u = ln(g0 + c0 v) with c0 = 1/(2R_L) + 1/(2R_S) (gap ≈ g0 + c0 v near the
+    // axis):  I = π ∫ dv / max(gap, s_min) = (π/c0) ∫ e^u / max(gap, s_min) du, whose integrand
+    // is ≈ 1 wherever the gap is small.
+    const double c0 = 0.5 / big + 0.5 / small;
+    auto f = [=](double u) {
+      const double eu = std::exp(u);
+      const double v = std::fmax((eu - g0) / c0, 0.0);
       const double g = gapOf(std::sqrt(v));
-      return pi / (g > sMin ? g : sMin);
+      return pi / c0 * eu / (g > sMin ? g : sMin);
     };
-    q = integrateAdaptive(f, dStar * dStar, dOut * dOut, p.relTol);
+    q = integrateAdaptive(f, std::log(g0 + c0 * dStar * dStar), std::log(g0 + c0 * dOut * dOut),
+                          p.relTol);
   }
   return {clipped + q.value, q.error, q.converged};
 }
