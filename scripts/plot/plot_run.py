@@ -109,16 +109,27 @@ def plot_particles(run_dir, out):
             if "/particles/" + name in f:
                 radius = f["/particles/" + name][()] * (1.0 if name == "radius" else 0.5)
                 break
-    fig, axes = plt.subplots(1, 2, figsize=(10, 5))
-    for ax, (i, j, lx, ly) in zip(axes, [(0, 2, "x", "z"), (1, 2, "y", "z")]):
-        sc = ax.scatter(pos[:, i], pos[:, j], c=colour if colour is not None else "tab:blue",
-                        s=6, cmap="inferno")
-        ax.set_xlabel(f"{lx} [m]")
-        ax.set_ylabel(f"{ly} [m]")
-        ax.set_aspect("equal")
-        ax.set_title(f"step {step}, t = {time:.4g} s ({len(pos)} particles)")
+    lo, hi = pos.min(axis=0), pos.max(axis=0)
+    span = float(max(hi - lo)) or 1e-3
+    pad = 0.05 * span
+    kw = {"s": 8}
     if colour is not None:
-        fig.colorbar(sc, ax=axes, label="T_p [K]")
+        vmin, vmax = float(colour.min()), float(colour.max())
+        if vmax - vmin < 1e-9:
+            vmin, vmax = vmin - 1.0, vmax + 1.0
+        kw.update(c=colour, cmap="inferno", vmin=vmin, vmax=vmax)
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), constrained_layout=True)
+    for ax, (i, lx) in zip(axes, [(0, "x"), (1, "y")]):
+        sc = ax.scatter(pos[:, i], pos[:, 2], **kw)
+        ax.set_xlim(lo[i] - pad, lo[i] + span + pad)
+        ax.set_ylim(lo[2] - pad, lo[2] + 0.5 * span + pad)
+        ax.set_aspect("equal")
+        ax.set_xlabel(f"{lx} [m]")
+        ax.set_ylabel("z [m]")
+        ax.set_title(f"side view ({lx}-z), step {step}, t = {time:.4g} s, {len(pos)} particles",
+                     fontsize=9)
+    if colour is not None:
+        fig.colorbar(sc, ax=axes, label="T_p [K]", shrink=0.8)
     path_out = os.path.join(out, "particles.png")
     fig.savefig(path_out, dpi=110)
     plt.close(fig)
