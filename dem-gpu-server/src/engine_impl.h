@@ -584,7 +584,7 @@ public:
       using namespace kernels;
       const long long ii = static_cast<long long>(i);
       const double invM = 1.0 / m[i];
-      const Vec3 vn = load3(v, ii) + dt * (invM * load3(f, ii) + g);
+      const Vec3 vn = load3(v, ii) + (dt * invM) * (load3(f, ii) + gravityForce(m[i], g));  // Eq. 6
       const double invI = 1.0 / (0.4 * m[i] * r[i] * r[i]);  // I = 2/5 m R² (Eq. 7)
       store3(w, ii, load3(w, ii) + (dt * invI) * load3(tq, ii));
       store3(v, ii, vn);

@@ -61,7 +61,7 @@ struct ParticleSet {
   std::string name = "particles";
   int material = 0;                            ///< index into DemConfig::materials
   Packing packing = Packing::Lattice;
-  std::array<double, 3> regionMin{0, 0, 0};    ///< region (m); particles lie fully inside
+  std::array<double, 3> regionMin{0, 0, 0};    ///< region (m): Random keeps spheres inside, Lattice its site centres
   std::array<double, 3> regionMax{0, 0, 0};
   std::size_t count = 0;                       ///< number of particles (Explicit: positions.size()/3)
   double diameter = 1e-3;                      ///< d_p (m)
