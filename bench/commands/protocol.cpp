@@ -7,12 +7,15 @@
 //   gbps          = 2 * N*F*8 bytes / median round-trip time   (bytes moved per second)
 //   memcpy_gbps   = N*F*8 bytes / median memcpy time
 //   memcpy_ratio  = gbps / memcpy_gbps
+//   validate_gbps = N*F*8 bytes / median time of validate() on such a message (structure
+//                   and NaN/Inf scan: the receiver-side check every message gets)
 // Both sides use the library's zero-copy paths (addArrayShared on send, frame views on
 // receive), so the figure is the cost of the transport itself (no validation).
 #include "commands.h"
 
 #include <coredem/protocol/message.h>
 #include <coredem/protocol/transport.h>
+#include <coredem/protocol/validate.h>
 
 #include <CLI/CLI.hpp>
 
@@ -127,6 +130,34 @@ double measureMemcpy(std::size_t bytes, double minSeconds) {
   return median(times);
 }
 
+double measureValidate(const std::vector<std::shared_ptr<std::vector<double>>>& arrays,
+                       std::uint64_t cells, double minSeconds) {
+  Message m(v1::MESSAGE_TYPE_ACK);
+  m.envelope().mutable_ack();
+  for (std::size_t f = 0; f < arrays.size(); ++f) {
+    m.addArrayShared<double>("f" + std::to_string(f), arrays[f],
+                             std::span<const double>(*arrays[f]), {cells});
+  }
+  std::vector<double> times;
+  auto start = Clock::now();
+  for (int it = 0;; ++it) {
+    auto t0 = Clock::now();
+    Status s = validate(m, Expectation{});
+    auto t1 = Clock::now();
+    if (!s.ok()) {
+      throw coredem::UserError("validate failed: " + s.toString());
+    }
+    if (it >= 1) {
+      times.push_back(std::chrono::duration<double>(t1 - t0).count());
+    }
+    if (times.size() >= 5 &&
+        std::chrono::duration<double>(Clock::now() - start).count() >= minSeconds) {
+      break;
+    }
+  }
+  return median(times);
+}
+
 int runProtocolBench(int argc, char** argv) {
   CLI::App app{"Round-trip throughput of the coupling transport vs memcpy", "protocol"};
   std::uint64_t cells = 100000;
@@ -178,12 +209,15 @@ int runProtocolBench(int argc, char** argv) {
   }
   const double memcpySeconds = measureMemcpy(bytes, std::min(seconds, 0.5));
   const double memcpyGbps = static_cast<double>(bytes) / memcpySeconds / 1e9;
+  const double validateGbps =
+      static_cast<double>(bytes) / measureValidate(arrays, cells, std::min(seconds, 0.5)) / 1e9;
 
   if (json) {
     std::ostringstream os;
     os.precision(6);
     os << "{\"benchmark\": \"protocol\", \"cells\": " << cells << ", \"fields\": " << nFields
        << ", \"bytes_per_direction\": " << bytes << ", \"memcpy_gbps\": " << memcpyGbps
+       << ", \"validate_gbps\": " << validateGbps
        << ", \"hardware_threads\": " << std::thread::hardware_concurrency()
        << ", \"transports\": {";
     for (std::size_t i = 0; i < results.size(); ++i) {
@@ -202,6 +236,8 @@ int runProtocolBench(int argc, char** argv) {
   std::printf("protocol round trip: %llu cells x %zu float64 arrays = %.2f MB each way\n",
               static_cast<unsigned long long>(cells), nFields, static_cast<double>(bytes) / 1e6);
   std::printf("memcpy of the same bytes: %.3f ms = %.2f GB/s\n", memcpySeconds * 1e3, memcpyGbps);
+  std::printf("validate() of such a message (structure + NaN/Inf scan): %.2f GB/s\n",
+              validateGbps);
   std::printf("%-9s %14s %10s %14s %12s\n", "transport", "round trip ms", "GB/s", "memcpy ratio",
               "iterations");
   for (const auto& r : results) {
