@@ -56,8 +56,9 @@ template <> constexpr v1::DType dtypeOf<std::uint8_t>() { return v1::DTYPE_UINT8
 template <> constexpr v1::DType dtypeOf<std::uint32_t>() { return v1::DTYPE_UINT32; }
 template <> constexpr v1::DType dtypeOf<std::uint64_t>() { return v1::DTYPE_UINT64; }
 
-/// Read-only view of one array of a message. Valid while the Message lives (and is not moved
-/// from... moving keeps the data in place, so views stay valid after a move).
+/// Read-only view of one array of a message. Valid while the Message (or the message it was
+/// moved into: moving does not relocate array data) lives; with a BufferProvider, while the
+/// caller's buffer lives.
 struct ArrayView {
   const v1::ArrayDescriptor* descriptor = nullptr;
   std::span<const std::byte> bytes;
