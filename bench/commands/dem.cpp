@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -80,8 +81,12 @@ int runDem(int argc, char** argv) {
     if (warmup > 0) sys.advance(warmup * dt, warmup);
     sys.resetStageTimes();
     const auto t1 = std::chrono::steady_clock::now();
+    const std::clock_t c1 = std::clock();
     sys.advance(steps * dt, steps);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    // Process CPU time (all threads): cpu / (wall·threads) < 1 shows a shared/loaded machine.
+    const double cpu = static_cast<double>(std::clock() - c1) / CLOCKS_PER_SEC;
+    const int usedThreads = threads > 0 ? threads : 1;
     const StageTimes st = sys.stageTimes();
     const double pairsPer = 2.0 * static_cast<double>(sys.pairContactCount()) / static_cast<double>(n);
     const double wallPer = static_cast<double>(sys.contactCount() - sys.pairContactCount()) / static_cast<double>(n);
@@ -93,10 +98,10 @@ int runDem(int argc, char** argv) {
                   "\"particle_steps_per_s\":%.6e,\"contacts_per_particle\":%.4f,"
                   "\"wall_contacts_per_particle\":%.4f,\"bytes_per_particle\":%.1f,"
                   "\"stage_s\":{\"neighbour\":%.6f,\"contact\":%.6f,\"integrate\":%.6f,\"coupling\":%.6f},"
-                  "\"rebuilds\":%llu}\n",
+                  "\"rebuilds\":%llu,\"cpu_s\":%.6f,\"cpu_utilisation\":%.3f}\n",
                   deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt, cfg.neighbour.skinFactor,
                   wall, setup, rate, pairsPer, wallPer, bytesPer, st.neighbour, st.contact, st.integrate,
-                  st.coupling, static_cast<unsigned long long>(st.rebuilds));
+                  st.coupling, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads));
     } else {
       std::printf("case %s, backend %s, threads %d, N = %zu, %d steps of dt_DEM = %.4e s (skin %.3g d)\n",
                   deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt, cfg.neighbour.skinFactor);
@@ -104,6 +109,8 @@ int runDem(int argc, char** argv) {
       std::printf("contacts_per_particle    %.3f  (+ %.3f wall contacts)\n", pairsPer, wallPer);
       std::printf("bytes_per_particle       %.0f\n", bytesPer);
       std::printf("wall time                %.3f s  (set-up %.3f s)\n", wall, setup);
+      std::printf("cpu time                 %.3f s  (utilisation %.0f %% of %d threads)\n", cpu,
+                  100.0 * cpu / (wall * usedThreads), usedThreads);
       std::printf("stage neighbour search   %.3f s  (%llu rebuilds)\n", st.neighbour,
                   static_cast<unsigned long long>(st.rebuilds));
       std::printf("stage contact forces     %.3f s\n", st.contact);

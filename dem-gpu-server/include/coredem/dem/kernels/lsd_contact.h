@@ -33,7 +33,6 @@ struct LsdResult {
   Vec3 force;    ///< f_n + f_t on particle i (N)
   Vec3 torque;   ///< torque on i (N m)
   Vec3 deltaT;   ///< updated accumulated tangential displacement (m), to store
-  double fnMag;  ///< |f_n| (N)
 };
 
 /// Contact point velocity difference v_ij (m/s).
@@ -52,11 +51,11 @@ DEM_HD LsdResult lsdContact(const LsdParams& p, Vec3 n, double deltaN, Vec3 vij,
   const Vec3 vn = dot(vij, n) * n;
   const Vec3 vt = vij - vn;
   const Vec3 fn = (-p.kn * deltaN) * n - p.etan * vn;
-  const double fnMag = norm(fn);
   Vec3 dT = (deltaTOld - dot(deltaTOld, n) * n) + dt * vt;
   Vec3 fs = -p.kt * dT;
-  const double fsMag = norm(fs);
-  if (fsMag > p.mu * fnMag) {
+  // |k_t δ_t| > μ|f_n| compared squared: no square root unless the contact slides.
+  if (dot(fs, fs) > p.mu * p.mu * dot(fn, fn)) {
+    const double fnMag = norm(fn);
     const double dMag = norm(dT);
     const Vec3 t = dMag > 0.0 ? (1.0 / dMag) * dT : Vec3{0, 0, 0};
     fs = (-p.mu * fnMag) * t;
@@ -67,7 +66,6 @@ DEM_HD LsdResult lsdContact(const LsdParams& p, Vec3 n, double deltaN, Vec3 vij,
   r.force = fn + ft;
   r.torque = lij * cross(n, ft);
   r.deltaT = dT;
-  r.fnMag = fnMag;
   return r;
 }
 
