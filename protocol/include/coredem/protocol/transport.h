@@ -77,6 +77,9 @@ struct TransportOptions {
   std::chrono::milliseconds linger{2000};
   /// CURVE encryption (required for non-loopback binds).
   CurveKeys curve;
+  /// Server only: allow a non-loopback bind without CURVE (an explicit user opt-out, e.g.
+  /// `coredem-dem --insecure` on a trusted network). Default: refuse.
+  bool allowInsecure = false;
   /// Free text put into Envelope.sender of outgoing messages when empty.
   std::string sender;
 };
