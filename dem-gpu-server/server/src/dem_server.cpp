@@ -69,6 +69,7 @@ std::string readKey(const fs::path& p) {
 proto::TransportOptions transportOptions(const ServerOptions& o) {
   proto::TransportOptions t;
   t.sender = kSoftware;
+  t.allowInsecure = o.insecure;
   if (!o.curveKeysDir.empty()) {
     t.curve.serverPublicKey = readKey(fs::path(o.curveKeysDir) / "server.public");
     t.curve.serverSecretKey = readKey(fs::path(o.curveKeysDir) / "server.secret");

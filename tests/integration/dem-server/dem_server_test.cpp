@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <thread>
 
@@ -346,5 +347,53 @@ TEST(DemServer, RestartFromCheckpointIsBitwiseIdentical) {
                             " " + (dir / "b200" / "dem.h5").string() + " " + group + " " + group;
     EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
   }
+  fs::remove_all(dir);
+}
+
+TEST(DemServer, NonLoopbackBindNeedsCurveKeysOrInsecure) {
+  coredem::server::ServerOptions o;
+  o.bind = "tcp://0.0.0.0:*";
+  try {
+    coredem::server::DemServer s(o);
+    FAIL() << "a non-loopback bind without CURVE keys must be refused";
+  } catch (const coredem::UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("--curve-keys"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--insecure"), std::string::npos) << e.what();
+  }
+}
+
+TEST(DemServer, CurveKeysAdmitOnlyClientsWithTheServerKey) {
+  const auto dir = tempDir("curve");
+  coredem::server::generateCurveKeys(dir.string());
+  std::string pub;
+  std::ifstream(dir / "server.public") >> pub;
+  ASSERT_EQ(pub.size(), 40u);
+  coredem::server::ServerOptions o;
+  o.bind = "tcp://127.0.0.1:*";
+  o.curveKeysDir = dir.string();
+  coredem::server::DemServer server(o);
+  std::thread t([&] { server.run(); });
+  // With the server's public key: welcome.
+  proto::TransportOptions good;
+  const auto pair = proto::generateCurveKeyPair();
+  good.curve.serverPublicKey = pub;
+  good.curve.clientPublicKey = pair.first;
+  good.curve.clientSecretKey = pair.second;
+  proto::Client withKey(good);
+  withKey.connect(server.endpoint());
+  auto w = withKey.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "keyed"), 10s);
+  EXPECT_EQ(w.type(), v1::MESSAGE_TYPE_WELCOME);
+  // Without keys (plain text) or with a wrong server key: the CURVE handshake fails and no
+  // message reaches the server, so the request times out.
+  proto::Client plain;
+  plain.connect(server.endpoint());
+  EXPECT_THROW(plain.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "plain"), 1s), proto::TimeoutError);
+  proto::TransportOptions wrong = good;
+  wrong.curve.serverPublicKey = proto::generateCurveKeyPair().first;
+  proto::Client wrongKey(wrong);
+  wrongKey.connect(server.endpoint());
+  EXPECT_THROW(wrongKey.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "wrong"), 1s), proto::TimeoutError);
+  server.stop();
+  t.join();
   fs::remove_all(dir);
 }
