@@ -266,6 +266,27 @@ PairProps pairProps(const Material& a, const Material& b) {
   return PairProps{kn, ktf * kn, kernels::dampingFactor(en), etf, std::min(a.mu, b.mu)};
 }
 
+/// Δt_DEM,max = min t_col / dtFactor over present material pairs and walls (Eqs. 12–13),
+/// with the lightest particle of each material (t_col grows with m_eff).
+double dtDemMaxFor(const DemConfig& config, const std::vector<double>& minMass) {
+  const std::size_t nm = config.materials.size();
+  double tcol = std::numeric_limits<double>::infinity();
+  for (std::size_t a = 0; a < nm; ++a) {
+    if (!std::isfinite(minMass[a])) continue;
+    for (std::size_t b = 0; b < nm; ++b) {
+      if (!std::isfinite(minMass[b])) continue;
+      const PairProps pp = pairProps(config.materials[a], config.materials[b]);
+      const double meff = kernels::effectiveMass(minMass[a], minMass[b]);
+      tcol = std::min(tcol, kernels::collisionTime(pp.kn, meff, pp.dampFactor * std::sqrt(pp.kn * meff)));
+    }
+    if (!config.walls.empty()) {
+      const PairProps pp = pairProps(config.materials[a], config.materials[a]);
+      tcol = std::min(tcol, kernels::collisionTime(pp.kn, minMass[a], pp.dampFactor * std::sqrt(pp.kn * minMass[a])));
+    }
+  }
+  return std::isfinite(tcol) ? tcol / config.dtFactor : std::numeric_limits<double>::infinity();
+}
+
 } // namespace
 
 struct DemSystem::Impl {
@@ -347,23 +368,8 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   st.listValid = 0;
   m.nParticles = n;
 
-  // Δt_DEM,max = min t_col / dtFactor over present material pairs and walls (Eqs. 12–13).
   const std::size_t nm = config.materials.size();
-  double tcol = std::numeric_limits<double>::infinity();
-  for (std::size_t a = 0; a < nm; ++a) {
-    if (!std::isfinite(minMass[a])) continue;
-    for (std::size_t b = 0; b < nm; ++b) {
-      if (!std::isfinite(minMass[b])) continue;
-      const PairProps pp = pairProps(config.materials[a], config.materials[b]);
-      const double meff = kernels::effectiveMass(minMass[a], minMass[b]);
-      tcol = std::min(tcol, kernels::collisionTime(pp.kn, meff, pp.dampFactor * std::sqrt(pp.kn * meff)));
-    }
-    if (!config.walls.empty()) {
-      const PairProps pp = pairProps(config.materials[a], config.materials[a]);
-      tcol = std::min(tcol, kernels::collisionTime(pp.kn, minMass[a], pp.dampFactor * std::sqrt(pp.kn * minMass[a])));
-    }
-  }
-  m.dtMax = std::isfinite(tcol) ? tcol / config.dtFactor : std::numeric_limits<double>::infinity();
+  m.dtMax = dtDemMaxFor(config, minMass);
 
   // Engine set-up.
   EngineSetup& es = m.setup;
@@ -484,8 +490,11 @@ void DemSystem::readState(const std::string& path) {
                 "state file '{}' has {} solid species, the config {}", path, st.nSpecies, m.config.solidSpecies.size());
   COREDEM_CHECK(st.historySlots >= 1, "state file '{}': bad history_slots", path);
   double rmax = 0;
+  std::vector<double> minMass(m.config.materials.size(), std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < st.n; ++i) {
     rmax = std::max(rmax, st.radius[i]);
+    if (st.material[i] >= 0 && st.material[i] < static_cast<int>(minMass.size()))
+      minMass[st.material[i]] = std::min(minMass[st.material[i]], st.mass[i]);
     COREDEM_CHECK(st.material[i] >= 0 && st.material[i] < static_cast<int>(m.config.materials.size()),
                   "state file '{}': particle {} has material {} not in the config", path, i, st.material[i]);
   }
@@ -501,6 +510,7 @@ void DemSystem::readState(const std::string& path) {
   }
   m.engine->setState(st);
   m.nParticles = st.n;
+  m.dtMax = dtDemMaxFor(m.config, minMass);
   m.time.restore(meta.time, meta.timeCompensation);
   m.step = meta.step;
 }

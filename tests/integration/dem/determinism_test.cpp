@@ -100,6 +100,19 @@ TEST(Restart, WriteReadContinueIsBitwiseIdentical) {
   EXPECT_EQ(straight.time(), restarted.time());
   EXPECT_EQ(straight.step(), restarted.step());
 
+  // A system configured without particle sets takes everything from the file (server restart).
+  DemConfig noParticles = mixedDeck();
+  noParticles.particleSets.clear();
+  DemSystem fromFile(noParticles, BackendKind::Cpu, 1);
+  EXPECT_EQ(fromFile.particleCount(), 0u);
+  fromFile.readState(file);
+  EXPECT_EQ(fromFile.dtDemMax(), straight.dtDemMax());
+  setGas(fromFile);
+  std::vector<double> s3;
+  run(fromFile, 8, &s3);
+  expectBitwiseEqual(straight.particles(), fromFile.particles());
+  EXPECT_EQ(s1, s3);
+
   // A state written with another configuration is refused with a clear error.
   DemConfig other = mixedDeck();
   other.materials[0].mu = 0.5;
