@@ -482,7 +482,8 @@ struct DemServer::Impl {
       }
       ledgers.speciesToGas[k] += sum * cellVolume * dt;
     }
-    v1::Ledger ledger = ledgerMessage();
+    const auto particles = system->particles();
+    v1::Ledger ledger = ledgerMessage(particles);
 
     // Sources to C.
     auto src = proto::makeSources(env.step(), env.time(), dt, cells, species, grant->nSub);
@@ -516,7 +517,7 @@ struct DemServer::Impl {
         checkpointError = e.what();
       }
     }
-    addDiagnostics(done);
+    addDiagnostics(done, particles);
     done.set_wall_seconds(std::chrono::duration<double>(Clock::now() - t0).count());
     if (checkpointOk) {
       send(grant->peer, proto::makeStepDone(grant->step, grant->time, done), grant->sequence, grant->step);
@@ -535,9 +536,8 @@ struct DemServer::Impl {
     grant.reset();
   }
 
-  v1::Ledger ledgerMessage() const {
+  v1::Ledger ledgerMessage(const dem::ParticleData& p) const {
     v1::Ledger l;
-    const auto p = system->particles();
     double mass = 0.0, kinetic = 0.0;
     for (std::size_t i = 0; i < p.count; ++i) {
       const double m = p.mass[i];
@@ -558,8 +558,7 @@ struct DemServer::Impl {
     return l;
   }
 
-  void addDiagnostics(v1::StepDone& done) const {
-    const auto p = system->particles();
+  void addDiagnostics(v1::StepDone& done, const dem::ParticleData& p) const {
     double sum = 0.0, lo = p.count > 0 ? p.temperature[0] : 0.0, hi = lo;
     for (std::size_t i = 0; i < p.count; ++i) {
       sum += p.temperature[i];

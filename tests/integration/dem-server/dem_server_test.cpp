@@ -22,12 +22,13 @@ namespace {
 /// A DemServer running in its own thread (the real server loop).
 class ServerThread {
 public:
-  ServerThread() {
+  explicit ServerThread(double sessionTimeout = 600.0, double grantWait = 5.0) {
     coredem::server::ServerOptions o;
     o.bind = "tcp://127.0.0.1:*";
     o.backend = "cpu";
     o.threads = 1;
-    o.grantWaitSeconds = 5;
+    o.grantWaitSeconds = grantWait;
+    o.sessionTimeoutSeconds = sessionTimeout;
     _server = std::make_unique<coredem::server::DemServer>(o);
     _thread = std::thread([this] { _server->run(); });
   }
@@ -216,10 +217,56 @@ TEST(DemServer, OneSessionAtATime) {
   EXPECT_EQ(rv.envelope().reject().code(), v1::ERROR_CODE_VERSION);
   EXPECT_NE(rv.envelope().reject().reason().find("2.0"), std::string::npos);
   EXPECT_NE(rv.envelope().reject().reason().find("1.0"), std::string::npos);
+  // Heartbeats are answered to anyone, with the server's state.
+  auto hb = future.request(proto::makeHeartbeat("probe"), 10s);
+  ASSERT_EQ(hb.type(), v1::MESSAGE_TYPE_HEARTBEAT);
+  EXPECT_EQ(hb.envelope().heartbeat().state(), "configured");
   // After the session ends, the next orchestrator is welcome.
   o.shutdown();
   auto w = second.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "second orchestrator"), 10s);
   EXPECT_EQ(w.type(), v1::MESSAGE_TYPE_WELCOME);
+}
+
+TEST(DemServer, GasFieldsBeforeTheGrantWaitForIt) {
+  // C's GasFields may overtake O's grant (two connections): D holds them until the grant
+  // arrives; without a grant they are refused with TIMEOUT after the grant wait.
+  ServerThread server(600.0, 1.0);
+  MiniOrchestrator o(server.endpoint(), smallCase(kParticles, kD, kBox, kCells));
+  Cfd c(server.endpoint(), o.session());
+  const std::size_t n = kCells * kCells * kCells;
+  Gas gas(n, 1);
+  const double dt = 2e-4;
+  const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
+  c.client.send(gas.message(1, 0.0, dt, n, 1, o.session()));
+  EXPECT_FALSE(c.client.receive(200ms).has_value()) << "Sources before the grant";
+  grant(o, {1, 0.0, dt, nSub});
+  auto src = c.client.receive(20s);
+  ASSERT_TRUE(src.has_value());
+  EXPECT_EQ(src->type(), v1::MESSAGE_TYPE_SOURCES);
+  EXPECT_EQ(src->envelope().step(), 1);
+  stepDone(o);
+  // Step 2's fields without a grant: refused after the 1 s grant wait, nothing done.
+  auto e = c.client.request(gas.message(2, dt, dt, n, 1, o.session()), 10s);
+  ASSERT_EQ(e.type(), v1::MESSAGE_TYPE_ERROR);
+  EXPECT_EQ(e.envelope().error().code(), v1::ERROR_CODE_TIMEOUT) << e.envelope().error().message();
+  // The step can still be run normally.
+  grant(o, {2, dt, dt, nSub});
+  auto again = c.client.request(gas.message(2, dt, dt, n, 1, o.session()), 20s);
+  EXPECT_EQ(again.type(), v1::MESSAGE_TYPE_SOURCES);
+  stepDone(o);
+  o.shutdown();
+}
+
+TEST(DemServer, SilentSessionEndsAndFreesTheServer) {
+  ServerThread server(0.5);
+  MiniOrchestrator o(server.endpoint(), smallCase(kParticles, kD, kBox, kCells));
+  // The orchestrator falls silent; after the session timeout another one is welcome.
+  std::this_thread::sleep_for(1200ms);
+  proto::Client next;
+  next.connect(server.endpoint());
+  auto w = next.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "next orchestrator"), 10s);
+  EXPECT_EQ(w.type(), v1::MESSAGE_TYPE_WELCOME);
+  EXPECT_NE(w.envelope().welcome().session_id(), o.session());
 }
 
 TEST(DemServer, InvalidGasFieldsGetAnErrorAndChangeNothing) {
