@@ -36,6 +36,8 @@ namespace coredem::dem {
 /// Compile-time bound on history slots (local arrays in the contact kernel).
 constexpr int kMaxHistorySlots = 32;
 constexpr std::uint32_t kEmptyCell = 0xffffffffu;
+/// Columns moved per pass when particles are reordered (scratch = N·4 doubles).
+constexpr int kReorderBlock = 4;
 
 template <class Exec>
 class EngineImpl final : public Engine {
@@ -60,6 +62,7 @@ public:
   Dev<double> _kcoef;
   Dev<unsigned char> _scratch;
   bool _listValid = false;
+  int _maxUsedSlots = kMaxHistorySlots;  ///< max contacts of a particle in the last sub-step (≥ slots in use)
   StageTimes _t;
 
   explicit EngineImpl(const EngineSetup& s) : _s(s) {
@@ -104,6 +107,7 @@ public:
     put(_p.histDisp, s.histDisp); put(_p.nbCount, s.nbCount); put(_p.nbList, s.nbList);
     put(_p.wallContacts, s.wallContacts);
     _p.toDevice(kAllFields);
+    _maxUsedSlots = _p.K;
     _listValid = s.listValid != 0 && s.nbList.size() == s.n * static_cast<std::size_t>(s.neighbourSlots);
     reserveScratch();
   }
@@ -147,7 +151,7 @@ public:
     _perm.reserve(n);
     _pcell.reserve(n);
     _kcoef.reserve(n);
-    _scratch.reserve(n * sizeof(double));
+    _scratch.reserve(n * kReorderBlock * sizeof(double));
   }
 
   std::size_t memoryBytes() const override {
@@ -158,19 +162,24 @@ public:
   }
 
   // ---------------------------------------------------------------- neighbour search
-  /// Reorders one per-particle array of `width` entries per particle by _perm, a column at
-  /// a time through an N-element scratch buffer.
+  /// Reorders the first `columns` of the `width` entries per particle of one array by _perm,
+  /// kReorderBlock columns at a time through an N·kReorderBlock scratch buffer.
   template <class T>
-  void reorder(Dual<T>& arr, int width) {
+  void reorder(Dual<T>& arr, int width, int columns = -1) {
     const std::size_t n = _p.n;
+    if (columns < 0 || columns > width) columns = width;
     T* a = arr.d();
     T* tmp = reinterpret_cast<T*>(_scratch.d());
     const std::uint32_t* perm = _perm.d();
-    for (int c = 0; c < width; ++c) {
+    for (int c0 = 0; c0 < columns; c0 += kReorderBlock) {
+      const int w = columns - c0 < kReorderBlock ? columns - c0 : kReorderBlock;
       _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
-        tmp[i] = a[static_cast<std::size_t>(perm[i]) * width + c];
+        const T* src = a + static_cast<std::size_t>(perm[i]) * width + c0;
+        for (int q = 0; q < w; ++q) tmp[i * w + q] = src[q];
       });
-      _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) { a[i * width + c] = tmp[i]; });
+      _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+        for (int q = 0; q < w; ++q) a[i * width + c0 + q] = tmp[i * w + q];
+      });
     }
   }
 
@@ -232,14 +241,15 @@ public:
     NbGrid g = neighbourGrid();
     computeKeys(g);
     _exec.sortByKey(_keys.d(), n, g.cells, _perm.d());
-    reorder(_p.pos, 3); reorder(_p.vel, 3); reorder(_p.omega, 3); reorder(_p.force, 3);
-    reorder(_p.torque, 3); reorder(_p.fwall, 3);
+    // force, torque, fwall are recomputed right after the rebuild and xref is reset: not moved.
+    // History slots at or beyond the largest count in use are empty in every row: not moved.
+    reorder(_p.pos, 3); reorder(_p.vel, 3); reorder(_p.omega, 3);
     reorder(_p.radius, 1); reorder(_p.mass, 1); reorder(_p.density, 1);
     reorder(_p.temperature, 1); reorder(_p.material, 1); reorder(_p.contacts, 1);
     reorder(_p.wallContacts, 1); reorder(_p.gid, 1);
     if (_p.nSpecies > 0) reorder(_p.species, _p.nSpecies);
-    reorder(_p.histKey, _p.K);
-    reorder(_p.histDisp, 3 * _p.K);
+    reorder(_p.histKey, _p.K, _maxUsedSlots);
+    reorder(_p.histDisp, 3 * _p.K, 3 * _maxUsedSlots);
     computeKeys(g);  // keys of the sorted order (ascending)
 
     _cellStart.reserve(g.cells);
@@ -560,6 +570,7 @@ public:
       return static_cast<double>(pairCount + wallCount);
     }, 0.0);
     _p.produced(kForce | kTorque | kFwall | kHistKey | kHistDisp | kContacts | kWallContacts);
+    _maxUsedSlots = maxSlots < K ? static_cast<int>(maxSlots) : K;
     if (maxSlots > K) {
       backend::raiseUserError("a particle has " + std::to_string(static_cast<int>(maxSlots)) +
                               " simultaneous contacts but only " + std::to_string(K) +
