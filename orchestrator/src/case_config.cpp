@@ -472,7 +472,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   }
 
   if (top.has("dem")) {
-    const Section d = top.section("dem", {"endpoint", "backend", "threads", "timeout_s"});
+    const Section d = top.section("dem", {"endpoint", "backend", "threads", "timeout_s", "server_key"});
     c.dem.endpoint = d.string("endpoint", std::string(),
                               "endpoint of a running coredem-dem, e.g. tcp://127.0.0.1:5555");
     if (!c.dem.endpoint.empty() && c.dem.endpoint.rfind("tcp://", 0) != 0 &&
@@ -482,10 +482,30 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     c.dem.backend = d.choice("backend", std::string("cpu"), {"cpu", "cuda", "auto"});
     c.dem.threads = int(d.integer("threads", 0, 0, 4096, "OpenMP threads, 0 = default"));
     c.dem.timeoutSeconds = d.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
+    if (d.has("server_key")) {
+      const std::string rel = d.string("server_key", std::nullopt,
+                                       "file with the DEM server's CURVE public key (server.public)");
+      c.dem.serverKey = fs::absolute(caseDir / rel);
+      if (!fs::is_regular_file(c.dem.serverKey)) {
+        d.fail(d.markOf("server_key"), "dem.server_key",
+               fmt::format("file '{}' not found (looked for {}); give the server.public file that "
+                           "'coredem-dem --generate-curve-keys DIR' wrote",
+                           rel, c.dem.serverKey.string()));
+      }
+      if (c.dem.endpoint.empty()) {
+        d.fail(d.markOf("server_key"), "dem.server_key",
+               "only used with dem.endpoint (a server started elsewhere with --curve-keys)");
+      }
+    }
   }
   if (top.has("cfd")) {
-    const Section f = top.section("cfd", {"participant", "gas_key", "timeout_s"});
-    c.cfd.participant = f.choice("participant", std::string("coredem-gas"), {"coredem-gas"});
+    const Section f = top.section("cfd", {"participant", "gas_key", "case", "timeout_s"});
+    c.cfd.participant =
+        f.choice("participant", std::string("coredem-gas"), {"coredem-gas", "coredemFoam"});
+    if (c.cfd.participant == "coredemFoam") {
+      c.cfd.foamCase = f.string("case", std::nullopt,
+                                "OpenFOAM case folder of coredemFoam, relative to the case folder");
+    }
     c.cfd.gasKey = f.string("gas_key", std::string("gas"), "key of the coredem-gas section");
     c.cfd.timeoutSeconds = f.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
   }

@@ -231,7 +231,7 @@ private:
   std::unique_ptr<ChildProcess> _demProc, _cfdProc;
   std::unique_ptr<protocol::Client> _dem;
   std::unique_ptr<protocol::Server> _ctrl;
-  std::string _demEndpoint, _ctrlEndpoint, _session;
+  std::string _demEndpoint, _ctrlEndpoint, _session, _serverKey;
   v1::Configure _configure;
   double _dtDemMax = 0.0;
   std::uint64_t _cells = 0;
@@ -247,7 +247,8 @@ private:
   std::unique_ptr<TimeseriesWriter> _timeseries;
 
   // overhead measurement
-  double _overheadSum = 0.0, _stepWallSum = 0.0, _demWallSum = 0.0;
+  double _overheadSum = 0.0, _stepWallSum = 0.0, _demWallSum = 0.0, _checkpointSum = 0.0,
+         _snapshotSum = 0.0;
   std::int64_t _measured = 0;
 };
 
@@ -272,7 +273,20 @@ void Session::checkAlive() {
 }
 
 void Session::startDem() {
-  _dem = std::make_unique<protocol::Client>();
+  protocol::TransportOptions transport;
+  if (!_c.dem.serverKey.empty()) {
+    std::ifstream in(_c.dem.serverKey);
+    std::string key;
+    in >> key;
+    COREDEM_CHECK(key.size() == 40, "{}: not a Z85 CURVE public key (40 characters)",
+                  _c.dem.serverKey.string());
+    _serverKey = key;
+    const auto pair = protocol::generateCurveKeyPair();
+    transport.curve.serverPublicKey = key;
+    transport.curve.clientPublicKey = pair.first;
+    transport.curve.clientSecretKey = pair.second;
+  }
+  _dem = std::make_unique<protocol::Client>(transport);
   if (!_c.dem.endpoint.empty()) {
     _demEndpoint = _c.dem.endpoint;
     _log->info("using the DEM server at {}", _demEndpoint);
@@ -310,8 +324,21 @@ void Session::startDem() {
   _dem->connect(_demEndpoint);
   Message hello = protocol::makeHello(v1::ROLE_ORCHESTRATOR, COREDEM_SOFTWARE_VERSION);
   _dem->send(std::move(hello));
-  Message welcome = receiveFromDem(std::chrono::milliseconds(int(_c.dem.timeoutSeconds * 1000)),
-                                   "Welcome");
+  Message welcome;
+  try {
+    welcome = receiveFromDem(std::chrono::milliseconds(int(_c.dem.timeoutSeconds * 1000)),
+                             "Welcome");
+  } catch (const ParticipantFault& e) {
+    if (_demProc) {
+      throw;
+    }
+    throw ParticipantFault(
+        kDemName, fmt::format("no Welcome from {} within {} s: the server is not running there, "
+                              "or it refused the connection (CURVE: dem.server_key must be the "
+                              "server's public key{})",
+                              _demEndpoint, _c.dem.timeoutSeconds,
+                              _serverKey.empty() ? "; this case gives none" : ""));
+  }
   try {
     protocol::expectType(welcome, v1::MESSAGE_TYPE_WELCOME);
   } catch (const protocol::ProtocolError& e) {
@@ -422,6 +449,32 @@ void Session::startCfd(const fs::path& gasRestart) {
   const fs::path exe = findProgram(_c.cfd.participant);
   COREDEM_CHECK(!exe.empty(), "{} not found next to coredem ({}) or on PATH", _c.cfd.participant,
                 executableDir().string());
+  if (_c.cfd.participant == "coredemFoam") {
+    // coredemFoam runs in a copy of the OpenFOAM case inside the run folder (made once; a
+    // resumed run keeps it) and learns its peers from the environment (docs/client.md).
+    const fs::path foamDir = _o.runDir / "openfoam";
+    if (!fs::exists(foamDir / "system" / "controlDict")) {
+      const fs::path src = _c.caseDir / _c.cfd.foamCase;
+      COREDEM_CHECK(fs::is_regular_file(src / "system" / "controlDict"),
+                    "cfd.case: {} is not an OpenFOAM case folder (no system/controlDict)",
+                    src.string());
+      fs::create_directories(foamDir);
+      fs::copy(src, foamDir, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+    }
+    std::vector<std::string> foamArgv = {exe.string(), "-case", foamDir.string()};
+    if (!gasRestart.empty()) {
+      foamArgv.insert(foamArgv.end(), {"-restart", gasRestart.string()});
+    }
+    const std::map<std::string, std::string> env = {
+        {"COREDEM_CONTROL_ENDPOINT", _ctrlEndpoint},
+        {"COREDEM_DEM_ENDPOINT", _demEndpoint},
+        {"COREDEM_SESSION", _session},
+        {"COREDEM_TIMEOUT_S", fmt::format("{}", _c.cfd.timeoutSeconds)}};
+    _cfdProc = std::make_unique<ChildProcess>(cfdName(_c), foamArgv, env,
+                                              _o.runDir / "logs" / "cfd.log");
+    _log->info("started {} (pid {})", _c.cfd.participant, _cfdProc->pid());
+    return;
+  }
   std::vector<std::string> argv = {exe.string(),
                                    "--case",
                                    (_o.runDir / "case.yaml").string(),
@@ -438,8 +491,11 @@ void Session::startCfd(const fs::path& gasRestart) {
   if (!gasRestart.empty()) {
     argv.insert(argv.end(), {"--restart", gasRestart.string()});
   }
-  _cfdProc = std::make_unique<ChildProcess>(cfdName(_c), argv,
-                                            std::map<std::string, std::string>{},
+  std::map<std::string, std::string> env;
+  if (!_serverKey.empty()) {
+    env["COREDEM_DEM_SERVER_KEY"] = _serverKey;
+  }
+  _cfdProc = std::make_unique<ChildProcess>(cfdName(_c), argv, env,
                                             _o.runDir / "logs" / "cfd.log");
   _log->info("started {} (pid {})", _c.cfd.participant, _cfdProc->pid());
 }
@@ -593,6 +649,7 @@ void Session::stepLoop(std::int64_t startStep) {
     const auto& cd = cfdDone.message.envelope().step_done();
     _lastCourant = cd.cfl();
 
+    const auto tIo0 = Clock::now();
     if (checkpoint) {
       std::vector<std::pair<std::string, std::string>> files;
       for (const auto& f : dd.checkpoint().files()) {
@@ -620,9 +677,13 @@ void Session::stepLoop(std::int64_t startStep) {
       lastCheckpointWall = Clock::now();
       _log->debug("checkpoint {} written", ckDir.string());
     }
+    const auto tIo1 = Clock::now();
     if (_c.output.snapshotEvery > 0 && (step % _c.output.snapshotEvery == 0 || last)) {
       takeSnapshot(step, _time.time());
     }
+    const auto tIo2 = Clock::now();
+    _checkpointSum += std::chrono::duration<double>(tIo1 - tIo0).count();
+    _snapshotSum += std::chrono::duration<double>(tIo2 - tIo1).count();
     if (step % _c.output.timeseriesEvery == 0 || last) {
       std::vector<std::pair<std::string, double>> row = {
           {"step", double(step)}, {"t", _time.time()}, {"dt", dt}, {"n_sub", double(plan.nSub)},
@@ -631,6 +692,13 @@ void Session::stepLoop(std::int64_t startStep) {
           {"wall_dem_s", dd.wall_seconds()}};
       collect(dd, row);
       collect(cd, row);
+      // Heat balance: what the particles got from the gas (DEM) plus what the gas got from
+      // the particles (CFD) is zero when both sides agree.
+      const auto demHeat = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_from_gas_J");
+      const auto gasHeat = protocol::findNamedValue(cd.ledger().energy(), "gas.heat_from_particles_J");
+      if (demHeat && gasHeat) {
+        row.emplace_back("balance.heat_residual_J", *demHeat + *gasHeat);
+      }
       _timeseries->write(row);
     }
     _stepWallSum += std::chrono::duration<double>(tDone - t0).count();
@@ -639,6 +707,8 @@ void Session::stepLoop(std::int64_t startStep) {
     progress.update(_step, _time.time());
     _pendingCfd = std::move(cfdDone);
     afterPrevious = Clock::now();
+    _overheadSum += std::chrono::duration<double>(afterPrevious - tDone).count() -
+                    std::chrono::duration<double>(tIo2 - tIo0).count();
   }
   progress.finish(_step, _time.time());
 }
@@ -756,13 +826,19 @@ int Session::run() {
   shutdownAll(clean);
   if (_measured > 0) {
     const double n = double(_measured);
-    _log->info("{} steps: wall {:.3f} ms/step, DEM compute {:.3f} ms/step, orchestrator "
-               "bookkeeping {:.1f} us/step",
-               _measured, 1e3 * _stepWallSum / n, 1e3 * _demWallSum / n, 1e6 * _overheadSum / n);
+    _log->info("{} steps: step wall {:.3f} ms, DEM compute {:.3f} ms, coupling overhead (wall - "
+               "DEM) {:.3f} ms, orchestrator bookkeeping {:.1f} us per step; checkpoints {:.3f} s, "
+               "snapshots {:.3f} s in total",
+               _measured, 1e3 * _stepWallSum / n, 1e3 * _demWallSum / n,
+               1e3 * (_stepWallSum - _demWallSum) / n, 1e6 * _overheadSum / n, _checkpointSum,
+               _snapshotSum);
     writeFileAtomic(_o.runDir / "logs" / "overhead.json",
-                    fmt::format("{{\"steps\": {}, \"wall_per_step_s\": {:.9g}, "
-                                "\"dem_wall_per_step_s\": {:.9g}, \"orchestrator_per_step_s\": {:.9g}}}\n",
-                                _measured, _stepWallSum / n, _demWallSum / n, _overheadSum / n));
+                    fmt::format("{{\"steps\": {}, \"step_wall_s\": {:.9g}, \"dem_compute_s\": {:.9g}, "
+                                "\"coupling_overhead_s\": {:.9g}, \"orchestrator_bookkeeping_s\": {:.9g}, "
+                                "\"checkpoints_total_s\": {:.9g}, \"snapshots_total_s\": {:.9g}}}\n",
+                                _measured, _stepWallSum / n, _demWallSum / n,
+                                (_stepWallSum - _demWallSum) / n, _overheadSum / n, _checkpointSum,
+                                _snapshotSum));
   }
   return kExitOk;
 }
@@ -780,6 +856,14 @@ void checkParticipantInput(const CaseConfig& config) {
   COREDEM_CHECK(!exe.empty(), "{} not found next to coredem ({}) or on PATH; build it (cmake --build "
                               "build --target {})",
                 config.cfd.participant, executableDir().string(), config.cfd.participant);
+  if (config.cfd.participant == "coredemFoam") {
+    const fs::path src = config.caseDir / config.cfd.foamCase;
+    COREDEM_CHECK(fs::is_regular_file(src / "system" / "controlDict") ||
+                      fs::is_regular_file(config.caseDir / "openfoam" / "system" / "controlDict"),
+                  "{}: cfd.case: {} is not an OpenFOAM case folder (no system/controlDict)",
+                  config.caseFile.string(), src.string());
+    return;
+  }
   if (config.cfd.participant != "coredem-gas") {
     return;
   }

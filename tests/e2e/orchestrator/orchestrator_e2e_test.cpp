@@ -360,3 +360,71 @@ TEST(CoredemCli, MissingCaseFolderExitsTwo) {
   EXPECT_FALSE(fs::exists(d / "run"));
   fs::remove_all(d);
 }
+
+// A DEM server started elsewhere with CURVE keys: the orchestrator (and coredem-gas) connect
+// with the server's public key; with another key the connection is refused (named, exit 1).
+TEST_F(CoredemE2E, CurveRemoteServer) {
+  ASSERT_EQ(std::system(((kBin / "coredem-dem").string() + " --generate-curve-keys " +
+                         (dir / "keys").string() + " > /dev/null")
+                            .c_str()),
+            0);
+  ASSERT_EQ(std::system(((kBin / "coredem-dem").string() + " --generate-curve-keys " +
+                         (dir / "other").string() + " > /dev/null")
+                            .c_str()),
+            0);
+  // Server: CURVE on an ephemeral loopback port, serving sessions one after the other.
+  std::vector<std::string> argv = {(kBin / "coredem-dem").string(), "--bind", "tcp://127.0.0.1:*",
+                                   "--curve-keys", (dir / "keys").string(), "--threads", "1",
+                                   "--endpoint-file", (dir / "endpoint").string()};
+  std::vector<char*> c;
+  for (auto& a : argv) {
+    c.push_back(a.data());
+  }
+  c.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, (dir / "server.log").c_str(),
+                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  pid_t server = -1;
+  ASSERT_EQ(posix_spawn(&server, c[0], &fa, nullptr, c.data(), environ), 0);
+  posix_spawn_file_actions_destroy(&fa);
+  const auto end = std::chrono::steady_clock::now() + 20s;
+  while (!fs::exists(dir / "endpoint") && std::chrono::steady_clock::now() < end) {
+    std::this_thread::sleep_for(10ms);
+  }
+  std::string endpoint = readAll(dir / "endpoint");
+  while (!endpoint.empty() && std::isspace(static_cast<unsigned char>(endpoint.back()))) {
+    endpoint.pop_back();
+  }
+  ASSERT_FALSE(endpoint.empty()) << readAll(dir / "server.log");
+
+  auto writeCase = [&](const std::string& name, const fs::path& key) {
+    std::string text = readAll(restartCase / "case.yaml");
+    text.replace(text.find("  end: 0.1"), 10, "  end: 0.01"); // 20 steps
+    text.replace(text.find("dem:\n"), 5,
+                 "dem:\n  endpoint: " + endpoint + "\n  server_key: " + key.string() + "\n");
+    text.replace(text.find("  timeout_s: 20"), 15, "  timeout_s: 3");
+    fs::create_directories(dir / name);
+    std::ofstream(dir / name / "case.yaml") << text;
+  };
+  writeCase("good", dir / "keys" / "server.public");
+  writeCase("bad", dir / "other" / "server.public");
+
+  EXPECT_EQ(runCoredem({"run", (dir / "good").string(), "--out", (dir / "run-good").string()},
+                       dir / "good.log"),
+            0)
+      << readAll(dir / "good.log") << readAll(dir / "server.log");
+  EXPECT_TRUE(fs::exists(dir / "run-good/checkpoints/00000020/manifest.json"));
+
+  EXPECT_EQ(runCoredem({"run", (dir / "bad").string(), "--out", (dir / "run-bad").string()},
+                       dir / "bad.log"),
+            1);
+  const std::string log = readAll(dir / "bad.log");
+  EXPECT_NE(log.find("DEM server coredem-dem: no Welcome from " + endpoint), std::string::npos)
+      << log;
+  EXPECT_NE(log.find("CURVE"), std::string::npos) << log;
+  ::kill(server, SIGTERM);
+  int status = 0;
+  ::waitpid(server, &status, 0);
+}

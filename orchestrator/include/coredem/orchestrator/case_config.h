@@ -76,11 +76,13 @@ struct DemConfig {
   std::string backend = "cpu";
   int threads = 0;             ///< 0: let the server choose
   double timeoutSeconds = 60;  ///< deadline of every request to D
+  std::filesystem::path serverKey; ///< file with D's CURVE public key (Z85); empty: no CURVE
 };
 
 struct CfdConfig {
   std::string participant = "coredem-gas";
   std::string gasKey = "gas";  ///< key of the coredem-gas section
+  std::string foamCase;        ///< coredemFoam: OpenFOAM case folder, relative to the case folder
   double timeoutSeconds = 60;  ///< deadline for C's next StepDone
 };
 
