@@ -1,8 +1,8 @@
 // coredem-bench protocol --cells N --fields F [--json] [--seconds S] [--transports tcp,ipc]
 //
 // Round trip of N cells x F float64 arrays through the protocol transport (a Client sends a
-// message with F arrays of N doubles, an echo Server thread sends the same arrays back) over
-// tcp loopback and over ipc, compared with a plain memcpy of the same bytes measured in the
+// message with F arrays of N doubles, an echo Server in a child process - or, with
+// --same-process, in a thread - sends the same arrays back) over tcp loopback and over ipc, compared with a plain memcpy of the same bytes measured in the
 // same run. Figures:
 //   gbps          = 2 * N*F*8 bytes / median round-trip time   (bytes moved per second)
 //   memcpy_gbps   = N*F*8 bytes / median memcpy time
@@ -29,6 +29,9 @@
 #include <thread>
 #include <vector>
 
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 namespace {
@@ -50,14 +53,23 @@ double median(std::vector<double> v) {
 }
 
 /// Echo server: answers every message with the same arrays (no copy: the reply's arrays
-/// keep the received message alive).
-void echo(Server& server, const std::atomic<bool>& stop) {
-  while (!stop) {
+/// keep the received message alive). Returns on Shutdown, on `stop`, or after 60 s idle.
+void echo(Server& server, const std::atomic<bool>* stop) {
+  auto lastRequest = Clock::now();
+  while (!(stop && *stop)) {
     auto req = server.receive(std::chrono::milliseconds(50));
     if (!req) {
+      if (Clock::now() - lastRequest > std::chrono::seconds(60)) {
+        return;
+      }
       continue;
     }
+    lastRequest = Clock::now();
     auto keep = std::make_shared<Message>(std::move(req->message));
+    if (keep->type() == v1::MESSAGE_TYPE_SHUTDOWN) {
+      server.reply(req->peer, std::move(makeAck().setSequence(keep->envelope().sequence())));
+      return;
+    }
     Message reply(v1::MESSAGE_TYPE_ACK);
     reply.envelope().mutable_ack();
     reply.setSequence(keep->envelope().sequence());
@@ -69,43 +81,107 @@ void echo(Server& server, const std::atomic<bool>& stop) {
   }
 }
 
+/// The echo server in a child process (as in a real coupling: two processes, each with its
+/// own ZeroMQ I/O thread). Returns the child's pid; the bound endpoint comes through a pipe.
+pid_t startEchoProcess(const std::string& bindEndpoint, std::string* endpoint) {
+  int fds[2];
+  if (::pipe(fds) != 0) {
+    throw coredem::UserError("pipe() failed");
+  }
+  pid_t pid = ::fork();
+  if (pid < 0) {
+    throw coredem::UserError("fork() failed");
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    int rc = 0;
+    try {
+      Server server;
+      std::string ep = server.bind(bindEndpoint) + "\n";
+      if (::write(fds[1], ep.data(), ep.size()) != static_cast<ssize_t>(ep.size())) {
+        rc = 1;
+      }
+      ::close(fds[1]);
+      if (rc == 0) {
+        echo(server, nullptr);
+      }
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "echo server: %s\n", e.what());
+      rc = 1;
+    }
+    std::fflush(stderr);
+    ::_exit(rc);
+  }
+  ::close(fds[1]);
+  std::string ep;
+  char c = 0;
+  pollfd pfd{fds[0], POLLIN, 0};
+  while (::poll(&pfd, 1, 10000) > 0 && ::read(fds[0], &c, 1) == 1 && c != '\n') {
+    ep.push_back(c);
+  }
+  ::close(fds[0]);
+  if (ep.empty()) {
+    ::kill(pid, SIGTERM);
+    ::waitpid(pid, nullptr, 0);
+    throw coredem::UserError("the echo server process did not report its endpoint");
+  }
+  *endpoint = ep;
+  return pid;
+}
+
 Result measureTransport(const std::string& name, const std::string& bindEndpoint,
                         const std::vector<std::shared_ptr<std::vector<double>>>& arrays,
-                        std::uint64_t cells, double minSeconds) {
-  Server server;
-  std::string endpoint = server.bind(bindEndpoint);
-  std::atomic<bool> stop{false};
-  std::thread thread([&] { echo(server, stop); });
-
-  Client client;
-  client.connect(endpoint);
+                        std::uint64_t cells, double minSeconds, bool sameProcess) {
   std::vector<double> times;
-  auto start = Clock::now();
-  const std::size_t warmup = 2;
-  for (std::size_t it = 0;; ++it) {
-    Message m(v1::MESSAGE_TYPE_ACK);
-    m.envelope().mutable_ack();
-    for (std::size_t f = 0; f < arrays.size(); ++f) {
-      m.addArrayShared<double>("f" + std::to_string(f), arrays[f],
-                               std::span<const double>(*arrays[f]), {cells});
+  std::string endpoint;
+  pid_t child = -1;
+  std::unique_ptr<Server> server;
+  std::atomic<bool> stop{false};
+  std::thread thread;
+  if (sameProcess) {
+    server = std::make_unique<Server>();
+    endpoint = server->bind(bindEndpoint);
+    thread = std::thread([&] { echo(*server, &stop); });
+  } else {
+    child = startEchoProcess(bindEndpoint, &endpoint);
+  }
+  {
+    Client client;
+    client.connect(endpoint);
+    auto start = Clock::now();
+    const std::size_t warmup = 2;
+    for (std::size_t it = 0;; ++it) {
+      Message m(v1::MESSAGE_TYPE_ACK);
+      m.envelope().mutable_ack();
+      for (std::size_t f = 0; f < arrays.size(); ++f) {
+        m.addArrayShared<double>("f" + std::to_string(f), arrays[f],
+                                 std::span<const double>(*arrays[f]), {cells});
+      }
+      auto t0 = Clock::now();
+      Message reply = client.request(std::move(m), std::chrono::seconds(60));
+      auto t1 = Clock::now();
+      if (reply.arrayCount() != arrays.size() ||
+          reply.array(arrays.size() - 1).bytes.size() != cells * sizeof(double)) {
+        throw coredem::UserError("echo reply is incomplete");
+      }
+      if (it >= warmup) {
+        times.push_back(std::chrono::duration<double>(t1 - t0).count());
+      }
+      double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+      if (times.size() >= 5 && elapsed >= minSeconds) {
+        break;
+      }
     }
-    auto t0 = Clock::now();
-    Message reply = client.request(std::move(m), std::chrono::seconds(60));
-    auto t1 = Clock::now();
-    if (reply.arrayCount() != arrays.size() ||
-        reply.array(arrays.size() - 1).bytes.size() != cells * sizeof(double)) {
-      throw coredem::UserError("echo reply is incomplete");
-    }
-    if (it >= warmup) {
-      times.push_back(std::chrono::duration<double>(t1 - t0).count());
-    }
-    double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-    if (times.size() >= 5 && elapsed >= minSeconds) {
-      break;
+    if (!sameProcess) {
+      (void)client.request(makeShutdown("bench done"), std::chrono::seconds(10));
     }
   }
-  stop = true;
-  thread.join();
+  if (sameProcess) {
+    stop = true;
+    thread.join();
+  } else {
+    ::waitpid(child, nullptr, 0);
+  }
   return Result{name, median(times), *std::min_element(times.begin(), times.end()),
                 times.size()};
 }
@@ -165,11 +241,14 @@ int runProtocolBench(int argc, char** argv) {
   bool json = false;
   double seconds = 1.0;
   std::vector<std::string> transports{"tcp", "ipc"};
+  bool sameProcess = false;
   app.add_option("--cells", cells, "cells N (doubles per array)")->check(CLI::PositiveNumber);
   app.add_option("--fields", nFields, "arrays F per message")->check(CLI::PositiveNumber);
   app.add_flag("--json", json, "print one JSON object");
   app.add_option("--seconds", seconds, "minimum measuring time per transport");
   app.add_option("--transports", transports, "tcp and/or ipc")->delimiter(',');
+  app.add_flag("--same-process", sameProcess,
+               "run the echo server as a thread of this process (default: a child process)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -193,9 +272,11 @@ int runProtocolBench(int argc, char** argv) {
   try {
     for (const auto& t : transports) {
       if (t == "tcp") {
-        results.push_back(measureTransport("tcp", "tcp://127.0.0.1:*", arrays, cells, seconds));
+        results.push_back(measureTransport("tcp", "tcp://127.0.0.1:*", arrays, cells, seconds,
+                                           sameProcess));
       } else if (t == "ipc") {
-        results.push_back(measureTransport("ipc", "ipc://" + ipcPath, arrays, cells, seconds));
+        results.push_back(measureTransport("ipc", "ipc://" + ipcPath, arrays, cells, seconds,
+                                           sameProcess));
         std::filesystem::remove(ipcPath);
       } else {
         std::fprintf(stderr, "coredem-bench protocol: unknown transport '%s' (tcp, ipc)\n",
@@ -219,6 +300,7 @@ int runProtocolBench(int argc, char** argv) {
        << ", \"bytes_per_direction\": " << bytes << ", \"memcpy_gbps\": " << memcpyGbps
        << ", \"validate_gbps\": " << validateGbps
        << ", \"hardware_threads\": " << std::thread::hardware_concurrency()
+       << ", \"echo_server\": \"" << (sameProcess ? "thread" : "process") << "\""
        << ", \"transports\": {";
     for (std::size_t i = 0; i < results.size(); ++i) {
       const auto& r = results[i];
@@ -233,8 +315,10 @@ int runProtocolBench(int argc, char** argv) {
     std::printf("%s\n", os.str().c_str());
     return 0;
   }
-  std::printf("protocol round trip: %llu cells x %zu float64 arrays = %.2f MB each way\n",
-              static_cast<unsigned long long>(cells), nFields, static_cast<double>(bytes) / 1e6);
+  std::printf("protocol round trip: %llu cells x %zu float64 arrays = %.2f MB each way, echo "
+              "server in %s\n",
+              static_cast<unsigned long long>(cells), nFields, static_cast<double>(bytes) / 1e6,
+              sameProcess ? "a thread of this process" : "a child process");
   std::printf("memcpy of the same bytes: %.3f ms = %.2f GB/s\n", memcpySeconds * 1e3, memcpyGbps);
   std::printf("validate() of such a message (structure + NaN/Inf scan): %.2f GB/s\n",
               validateGbps);

@@ -7,6 +7,7 @@
 #include <zmq.hpp>
 
 #include <cstring>
+#include <mutex>
 #include <regex>
 
 namespace coredem::protocol {
@@ -191,6 +192,21 @@ std::string describe(const Message& m) {
          ", step " + std::to_string(env.step()) + ")";
 }
 
+/// One ZeroMQ context (one I/O thread) per process, shared by every Server and Client and
+/// destroyed with the last of them. Measured: a client and a server in one process move data
+/// about twice as fast through one shared I/O thread as through two contexts.
+std::shared_ptr<zmq::context_t> sharedContext() {
+  static std::mutex mutex;
+  static std::weak_ptr<zmq::context_t> weak;
+  std::lock_guard lock(mutex);
+  auto context = weak.lock();
+  if (!context) {
+    context = std::make_shared<zmq::context_t>(1);
+    weak = context;
+  }
+  return context;
+}
+
 } // namespace
 
 bool isLoopbackEndpoint(std::string_view endpoint) {
@@ -233,8 +249,8 @@ std::pair<std::string, std::string> generateCurveKeyPair() {
 
 struct Server::Impl {
   TransportOptions options;
-  zmq::context_t context{1};
-  zmq::socket_t socket{context, zmq::socket_type::router};
+  std::shared_ptr<zmq::context_t> context = sharedContext(); // outlives the socket
+  zmq::socket_t socket{*context, zmq::socket_type::router};
   std::string endpoint;
   std::shared_ptr<spdlog::logger> log = transportLog();
 };
@@ -322,8 +338,8 @@ void Server::replyFrames(const PeerId& peer, const Frames& frames) {
 
 struct Client::Impl {
   TransportOptions options;
-  zmq::context_t context{1};
-  zmq::socket_t socket{context, zmq::socket_type::dealer};
+  std::shared_ptr<zmq::context_t> context = sharedContext(); // outlives the socket
+  zmq::socket_t socket{*context, zmq::socket_type::dealer};
   std::string endpoint;
   std::uint64_t nextSequence = 1;
   std::shared_ptr<spdlog::logger> log = transportLog();
