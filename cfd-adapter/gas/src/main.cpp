@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -137,14 +138,24 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
 
   gas::GasFieldArrays f;
   std::int64_t steps = 0;
+  // Wall time split, reported at the end: evaluating the gas, the exchange with D (includes
+  // D's n_sub sub-steps), the ledgers, and advance (StepDone -> next grant from O).
+  using Clock = std::chrono::steady_clock;
+  double tEval = 0.0, tExchange = 0.0, tLedger = 0.0, tAdvance = 0.0;
+  auto since = [](Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); };
   while (p.isRunning()) {
     const double t = p.time();
     const double dt = p.dt();
+    auto t0 = Clock::now();
     model.evaluate(t, f);
+    tEval += since(t0);
+    t0 = Clock::now();
     const auto& s = p.exchange(p.step(), dt,
                                {{"u_g", f.u_g}, {"grad_p", f.grad_p}, {"T_g", f.T_g},
                                 {"rho_g", f.rho_g}, {"mu_g", f.mu_g}, {"kappa_g", f.kappa_g},
                                 {"cp_g", f.cp_g}, {"Y_g", f.Y_g}});
+    tExchange += since(t0);
+    t0 = Clock::now();
     const auto eps = s.field("eps_g"), k = s.field("K_sl"), kus = s.field("K_sl_Us"),
                h = s.field("H"), htp = s.field("H_Tp"), r = s.field("R_species"),
                q = s.field("Q_hom");
@@ -184,10 +195,21 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
       files.push_back("gas.h5");
       log->info("checkpoint of step {} written to {}/gas.h5", p.step(), dir);
     }
-    p.advance(courant(f.u_g, dt), ledgers.report(), files);
+    const double co = courant(f.u_g, dt);
+    const auto report = ledgers.report();
+    tLedger += since(t0);
+    t0 = Clock::now();
+    p.advance(co, report, files);
+    tAdvance += since(t0);
     ++steps;
   }
   log->info("run finished after {} steps: {}", steps, p.shutdownReason());
+  if (steps > 0) {
+    const double k = 1e3 / static_cast<double>(steps);
+    log->info("per step ({} cells): gas evaluation {:.3f} ms, exchange with D {:.3f} ms (incl. "
+              "D's sub-steps), ledgers+checkpoints {:.3f} ms, advance (StepDone -> grant) {:.3f} ms",
+              n, tEval * k, tExchange * k, tLedger * k, tAdvance * k);
+  }
   p.finalize();
   return 0;
 }

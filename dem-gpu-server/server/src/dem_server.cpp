@@ -455,6 +455,7 @@ struct DemServer::Impl {
              fmt::format("GasFields of step {}: {}", env.step(), e.what()));
       return;
     }
+    const auto tGas = Clock::now();
     const dem::CellSources* s = nullptr;
     try {
       s = &system->advance(grant->dtCfd, static_cast<int>(grant->nSub));
@@ -467,6 +468,7 @@ struct DemServer::Impl {
       return;
     }
     const double dt = grant->dtCfd;
+    const auto tAdvanced = Clock::now();
 
     // Ledgers: what the particles took from / gave to the gas during this step.
     const auto n = static_cast<std::size_t>(cells);
@@ -499,6 +501,14 @@ struct DemServer::Impl {
     add(f::kHomogeneousHeat, s->qHom);
     *src.envelope().mutable_sources()->mutable_ledger() = ledger;
     send(r.peer, std::move(src), env.sequence(), env.step());
+    {
+      auto ms = [](Clock::time_point a, Clock::time_point b) {
+        return std::chrono::duration<double, std::milli>(b - a).count();
+      };
+      log->debug("session {}: step {}: setGasFields {:.3f} ms, advance ({} sub-steps) {:.3f} ms, "
+                 "ledgers + Sources {:.3f} ms", session, env.step(), ms(t0, tGas), grant->nSub,
+                 ms(tGas, tAdvanced), ms(tAdvanced, Clock::now()));
+    }
 
     // Checkpoint requested with the grant, then StepDone to O.
     v1::StepDone done;
