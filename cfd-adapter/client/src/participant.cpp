@@ -263,9 +263,9 @@ struct Participant::Impl {
                     "({} per cell)", name, it->second.size, cells, n,
                     proto::fields::componentsOf(spec.extent, ns));
       COREDEM_CHECK(n == 0 || it->second.data != nullptr, "exchange: '{}' points to null", name);
-      // No copy: request() returns only after D replied, i.e. after the frames were sent.
-      msg.addArrayShared<double>(name, std::shared_ptr<const void>(it->second.data, [](const void*) {}),
-                                 std::span<const double>(it->second.data, it->second.size), shape);
+      // One copy into the message: zero-copy would leave ZeroMQ pointing into the caller's
+      // arrays after a timed-out request, when the caller may already have freed them.
+      msg.addArray<double>(name, std::span<const double>(it->second.data, it->second.size), shape);
     }
     // Receive the sources straight into our vectors (one copy).
     Sources next;
