@@ -98,10 +98,12 @@ int runDem(int argc, char** argv) {
                   "\"particle_steps_per_s\":%.6e,\"contacts_per_particle\":%.4f,"
                   "\"wall_contacts_per_particle\":%.4f,\"bytes_per_particle\":%.1f,"
                   "\"stage_s\":{\"neighbour\":%.6f,\"contact\":%.6f,\"integrate\":%.6f,\"coupling\":%.6f},"
-                  "\"rebuilds\":%llu,\"cpu_s\":%.6f,\"cpu_utilisation\":%.3f}\n",
+                  "\"rebuilds\":%llu,\"cpu_s\":%.6f,\"cpu_utilisation\":%.3f,"
+                  "\"particle_steps_per_cpu_s\":%.6e}\n",
                   deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt, cfg.neighbour.skinFactor,
                   wall, setup, rate, pairsPer, wallPer, bytesPer, st.neighbour, st.contact, st.integrate,
-                  st.coupling, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads));
+                  st.coupling, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads),
+                  static_cast<double>(n) * steps / cpu);
     } else {
       std::printf("case %s, backend %s, threads %d, N = %zu, %d steps of dt_DEM = %.4e s (skin %.3g d)\n",
                   deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt, cfg.neighbour.skinFactor);
@@ -109,8 +111,8 @@ int runDem(int argc, char** argv) {
       std::printf("contacts_per_particle    %.3f  (+ %.3f wall contacts)\n", pairsPer, wallPer);
       std::printf("bytes_per_particle       %.0f\n", bytesPer);
       std::printf("wall time                %.3f s  (set-up %.3f s)\n", wall, setup);
-      std::printf("cpu time                 %.3f s  (utilisation %.0f %% of %d threads)\n", cpu,
-                  100.0 * cpu / (wall * usedThreads), usedThreads);
+      std::printf("cpu time                 %.3f s  (utilisation %.0f %% of %d threads; %.4e particle steps per cpu s)\n",
+                  cpu, 100.0 * cpu / (wall * usedThreads), usedThreads, static_cast<double>(n) * steps / cpu);
       std::printf("stage neighbour search   %.3f s  (%llu rebuilds)\n", st.neighbour,
                   static_cast<unsigned long long>(st.rebuilds));
       std::printf("stage contact forces     %.3f s\n", st.contact);
