@@ -184,3 +184,25 @@ TEST(Participants, CppClientChecksArgumentsBeforeSending) {
   EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0);
   fs::remove_all(dir);
 }
+
+TEST(Participants, CommandLinesRefuseBadInputWithExitCode2) {
+  const auto dir = tempDir("cli");
+  // coredem-dem: a non-loopback bind without CURVE keys or --insecure.
+  Child dem({COREDEM_DEM_BIN, "--bind", "tcp://0.0.0.0:*"});
+  EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 2);
+  // coredem-gas --check: valid -> 0, unknown key -> 2, missing file -> 2.
+  const auto good = dir / "good.yaml", bad = dir / "bad.yaml";
+  std::ofstream(good) << "gas:\n  T_g: 500\n";
+  std::ofstream(bad) << "gas:\n  T_g: 500\n  temperature: 3\n";
+  Child ok({COREDEM_GAS_BIN, "--case", good.string(), "--check"});
+  EXPECT_EQ(ok.wait(std::chrono::seconds(20)), 0);
+  Child unknown({COREDEM_GAS_BIN, "--case", bad.string(), "--check"});
+  EXPECT_EQ(unknown.wait(std::chrono::seconds(20)), 2);
+  Child missing({COREDEM_GAS_BIN, "--case", (dir / "nope.yaml").string(), "--check"});
+  EXPECT_EQ(missing.wait(std::chrono::seconds(20)), 2);
+  // coredem-gas without peers: exit 2 naming the variable (stderr), not a hang.
+  Child noPeers({COREDEM_GAS_BIN, "--case", good.string()},
+                {{"COREDEM_CONTROL_ENDPOINT", ""}, {"COREDEM_DEM_ENDPOINT", ""}, {"COREDEM_SESSION", ""}});
+  EXPECT_EQ(noPeers.wait(std::chrono::seconds(20)), 2);
+  fs::remove_all(dir);
+}

@@ -101,3 +101,21 @@ TEST(ParticipantState, CApiReportsStateErrorsWithAMessage) {
   coredem_client_destroy(c);
   EXPECT_EQ(coredem_client_initialize(nullptr), COREDEM_ERROR_ARGUMENT);
 }
+
+TEST(ParticipantState, AnAbsentOrchestratorIsATimeoutNamingTheEndpoint) {
+  coredem::client::Options o;
+  o.controlEndpoint = "tcp://127.0.0.1:9"; // nothing listens there (discard port, no server)
+  o.demEndpoint = "tcp://127.0.0.1:9";
+  o.sessionId = "s";
+  o.timeoutSeconds = 0.3;
+  Participant p(o);
+  try {
+    p.initialize();
+    FAIL() << "initialize() must time out";
+  } catch (const ClientError& e) {
+    EXPECT_EQ(e.code(), ErrorCode::Timeout) << e.what();
+    EXPECT_NE(std::string(e.what()).find("tcp://127.0.0.1:9"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(p.state(), State::Created);
+  p.finalize();
+}
