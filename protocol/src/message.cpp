@@ -78,7 +78,10 @@ namespace {
 std::string shapeString(const google::protobuf::RepeatedField<std::uint64_t>& shape) {
   std::string s = "[";
   for (int i = 0; i < shape.size(); ++i) {
-    s += (i ? "," : "") + std::to_string(shape[i]);
+    if (i) {
+      s += ',';
+    }
+    s += std::to_string(shape[i]);
   }
   return s + "]";
 }

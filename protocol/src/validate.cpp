@@ -16,7 +16,10 @@ namespace {
 std::string shapeString(const std::vector<std::uint64_t>& shape) {
   std::string s = "[";
   for (std::size_t i = 0; i < shape.size(); ++i) {
-    s += (i ? "," : "") + std::to_string(shape[i]);
+    if (i) {
+      s += ',';
+    }
+    s += std::to_string(shape[i]);
   }
   return s + "]";
 }
@@ -197,7 +200,10 @@ Status validate(const Message& message, const Expectation& e) {
   if (!e.types.empty() && std::find(e.types.begin(), e.types.end(), type) == e.types.end()) {
     std::string allowed;
     for (auto t : e.types) {
-      allowed += (allowed.empty() ? "" : ", ") + messageTypeName(t);
+      if (!allowed.empty()) {
+        allowed += ", ";
+      }
+      allowed += messageTypeName(t);
     }
     return Status::error(v1::ERROR_CODE_UNEXPECTED_MESSAGE,
                          "a " + messageTypeName(type) + " message is not expected now; expected " +

@@ -134,7 +134,10 @@ int exchange(const std::string& endpoint, std::vector<std::uint64_t> grid, std::
         auto v = gas.array(i);
         std::string shape;
         for (auto d : v.shape()) {
-          shape += (shape.empty() ? "" : ",") + std::to_string(d);
+          if (!shape.empty()) {
+            shape += ',';
+          }
+          shape += std::to_string(d);
         }
         std::printf("  %-8s [%s]  %llu bytes\n", v.name().c_str(), shape.c_str(),
                     static_cast<unsigned long long>(v.bytes.size()));
