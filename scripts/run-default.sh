@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs the default case (cases/settling-heated, DEM-only: particles settling in a box of
-# prescribed hot gas) with the binaries of BUILD_DIR (default: build), makes its plots and
-# prints where the results and the plots are.
+# prescribed hot gas) with the binaries of BUILD_DIR (default: build) and prints where the
+# results and the plots are.
 #   scripts/run-default.sh [BUILD_DIR]
 set -euo pipefail
 build=${1:-build}
@@ -14,14 +14,9 @@ for exe in coredem coredem-dem coredem-gas; do
   fi
 done
 
-# The interpreter CMake found with matplotlib/h5py/numpy (DESIGN §7), else Debian's.
-python=$(sed -n 's/^COREDEM_PYTHON:FILEPATH=//p' "$build/CMakeCache.txt" 2>/dev/null || true)
-python=${python:-/usr/bin/python3}
-
 run_dir="$top/runs/settling-heated-$(date +%Y%m%d-%H%M%S)"
+# coredem makes the plots itself at the end (scripts/plot/plot_run.py with COREDEM_PYTHON).
 "$coredem" run "$top/cases/settling-heated" --out "$run_dir"
-
-"$python" "$top/scripts/plot/plot_run.py" "$run_dir" >/dev/null
 echo
 echo "run-default: results in $run_dir"
 echo "  timeseries : $run_dir/timeseries.csv"

@@ -6,6 +6,7 @@
 #include <coredem/common/log.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/outputs.h>
+#include <coredem/orchestrator/processes.h>
 #include <coredem/orchestrator/session.h>
 
 #include <CLI/CLI.hpp>
@@ -17,6 +18,33 @@
 using namespace coredem::orchestrator;
 namespace fs = std::filesystem;
 
+namespace {
+
+/// Runs scripts/plot/plot_run.py with the Python that CMake found (COREDEM_PYTHON); a failure
+/// is a warning, never an error of the run.
+void makePlots(const fs::path& runDir) {
+  auto log = coredem::logger("orchestrator");
+  const fs::path python = COREDEM_PYTHON;
+  const fs::path script = COREDEM_PLOT_SCRIPT;
+  if (python.empty() || !fs::exists(python) || !fs::exists(script)) {
+    log->warn("no plots: python with matplotlib/h5py ('{}') or {} not found", python.string(),
+              script.string());
+    return;
+  }
+  ChildProcess plot("plot script", {python.string(), script.string(), runDir.string()}, {},
+                    runDir / "logs" / "plot.log");
+  if (!plot.waitFor(std::chrono::seconds(120))) {
+    plot.stop();
+  }
+  if (plot.exitCode() != 0) {
+    log->warn("plot script failed (see {})", (runDir / "logs" / "plot.log").string());
+    return;
+  }
+  std::printf("plots: %s\n", (runDir / "plots").string().c_str());
+}
+
+} // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"coredem: orchestrates a coupled CFD-DEM run (DEM server + CFD participant)"};
   app.set_version_flag("--version", std::string("coredem ") + COREDEM_SOFTWARE_VERSION);
@@ -25,6 +53,7 @@ int main(int argc, char** argv) {
   std::string caseDir, out, runDir, file;
   int autoRestart = 0;
   std::int64_t stopAfter = -1;
+  bool noPlots = false;
 
   auto* run = app.add_subcommand("run", "validate CASE_DIR/case.yaml and run it");
   run->add_option("CASE_DIR", caseDir, "case folder with case.yaml (or a case file)")->required();
@@ -35,11 +64,13 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   run->add_option("--stop-after", stopAfter,
                   "stop after this step with a checkpoint (continue with coredem resume)");
+  run->add_flag("--no-plots", noPlots, "do not make the PNG plots at the end");
 
   auto* resume = app.add_subcommand("resume", "continue a run from its latest complete checkpoint");
   resume->add_option("RUN_DIR", runDir, "run folder created by coredem run")->required();
   resume->add_option("--auto-restart", autoRestart, "as for run")->check(CLI::NonNegativeNumber);
   resume->add_option("--stop-after", stopAfter, "as for run");
+  resume->add_flag("--no-plots", noPlots, "as for run");
 
   auto* inspect = app.add_subcommand("inspect", "summarise a snapshot/state HDF5 file or a checkpoint");
   inspect->add_option("FILE", file, "HDF5 file, manifest.json or checkpoint folder")->required();
@@ -86,6 +117,9 @@ int main(int argc, char** argv) {
     if (rc == kExitOk) {
       std::printf("results: %s (timeseries.csv, particles.xdmf, checkpoints/)\n",
                   opts.runDir.string().c_str());
+      if (!noPlots) {
+        makePlots(opts.runDir);
+      }
     }
     return rc;
   } catch (const CaseError& e) {

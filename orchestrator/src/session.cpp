@@ -469,7 +469,10 @@ void Session::startCfd(const fs::path& gasRestart) {
         {"COREDEM_CONTROL_ENDPOINT", _ctrlEndpoint},
         {"COREDEM_DEM_ENDPOINT", _demEndpoint},
         {"COREDEM_SESSION", _session},
-        {"COREDEM_TIMEOUT_S", fmt::format("{}", _c.cfd.timeoutSeconds)}};
+        {"COREDEM_TIMEOUT_S", fmt::format("{}", _c.cfd.timeoutSeconds)},
+        // OpenFOAM reads its etc tree while its libraries load: Debian's unless set.
+        {"WM_PROJECT_DIR", std::getenv("WM_PROJECT_DIR") ? std::getenv("WM_PROJECT_DIR")
+                                                         : "/usr/share/openfoam"}};
     _cfdProc = std::make_unique<ChildProcess>(cfdName(_c), foamArgv, env,
                                               _o.runDir / "logs" / "cfd.log");
     _log->info("started {} (pid {})", _c.cfd.participant, _cfdProc->pid());

@@ -52,6 +52,10 @@ double DtPolicy::next(double courant, double remaining) {
   if (remaining <= dt * (1.0 + 1e-6)) {
     return remaining;
   }
+  // Adaptive steps: split the last two steps evenly instead of leaving a sliver at the end.
+  if (_config.kind == DtPolicyConfig::Kind::Courant && remaining < 2.0 * dt) {
+    return 0.5 * remaining;
+  }
   return dt;
 }
 

@@ -214,13 +214,13 @@ TEST_F(CoredemE2E, RestartIdentity) {
   const fs::path a = dir / "straight", b = dir / "split";
   ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", a.string()}, dir / "a.log"), 0)
       << readAll(dir / "a.log");
-  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", b.string(), "--stop-after", "100"},
+  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", b.string(), "--stop-after", "100", "--no-plots"},
                        dir / "b1.log"),
             0)
       << readAll(dir / "b1.log");
   ASSERT_TRUE(fs::exists(b / "checkpoints/00000100/manifest.json"));
   ASSERT_FALSE(fs::exists(b / finalCheckpoint));
-  ASSERT_EQ(runCoredem({"resume", b.string()}, dir / "b2.log"), 0) << readAll(dir / "b2.log");
+  ASSERT_EQ(runCoredem({"resume", b.string(), "--no-plots"}, dir / "b2.log"), 0) << readAll(dir / "b2.log");
   EXPECT_NE(readAll(dir / "b2.log").find("resuming"), std::string::npos);
   expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(b / finalCheckpoint));
   // Same number of rows, and the simulated time column identical.
@@ -228,6 +228,9 @@ TEST_F(CoredemE2E, RestartIdentity) {
   EXPECT_EQ(std::count(ta.begin(), ta.end(), '\n'), 201);
   EXPECT_EQ(std::count(tb.begin(), tb.end(), '\n'), 201);
   EXPECT_TRUE(leftovers(b).empty());
+  // The straight run made its plots.
+  EXPECT_TRUE(fs::exists(a / "plots" / "timeseries.png")) << readAll(a / "logs" / "plot.log");
+  EXPECT_TRUE(fs::exists(a / "plots" / "particles.png"));
   // Snapshots: 0, 50, 100, 150, 200 in both, listed in particles.xdmf.
   for (const auto& run : {a, b}) {
     for (int s : {0, 50, 100, 150, 200}) {
@@ -244,10 +247,12 @@ TEST_F(CoredemE2E, RestartIdentity) {
 // checkpoint and ends in the same state as an uninterrupted run.
 TEST_F(CoredemE2E, KillDemServerAutoRestart) {
   const fs::path a = dir / "straight", k = dir / "killed";
-  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", a.string()}, dir / "a.log"), 0)
+  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", a.string(), "--no-plots"},
+                       dir / "a.log"),
+            0)
       << readAll(dir / "a.log");
   const pid_t o = startCoredem(
-      {"run", restartCase.string(), "--out", k.string(), "--auto-restart", "1"}, dir / "k.log");
+      {"run", restartCase.string(), "--out", k.string(), "--auto-restart", "1", "--no-plots"}, dir / "k.log");
   // Kill D once the checkpoint of step 40 is complete (the run is then mid-way).
   const auto end = std::chrono::steady_clock::now() + 40s;
   pid_t killed = 0;
@@ -411,7 +416,7 @@ TEST_F(CoredemE2E, CurveRemoteServer) {
   writeCase("good", dir / "keys" / "server.public");
   writeCase("bad", dir / "other" / "server.public");
 
-  EXPECT_EQ(runCoredem({"run", (dir / "good").string(), "--out", (dir / "run-good").string()},
+  EXPECT_EQ(runCoredem({"run", (dir / "good").string(), "--out", (dir / "run-good").string(), "--no-plots"},
                        dir / "good.log"),
             0)
       << readAll(dir / "good.log") << readAll(dir / "server.log");

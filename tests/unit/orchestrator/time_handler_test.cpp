@@ -91,6 +91,7 @@ TEST(DtPolicy, CourantAdaptsWithinBounds) {
   }
   EXPECT_DOUBLE_EQ(p.next(0.0, 10.0), 2e-3);   // clamped to dt_max
   EXPECT_DOUBLE_EQ(p.next(0.5, 1e-3), 1e-3);   // clipped to the remaining time
+  EXPECT_DOUBLE_EQ(p.next(0.5, 3e-3), 1.5e-3); // < 2 steps left: two equal steps, no sliver
 }
 
 TEST(SubcyclePlan, CeilAndExactProduct) {

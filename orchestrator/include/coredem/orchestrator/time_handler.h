@@ -46,7 +46,8 @@ struct DtPolicyConfig {
 
 /// Chooses Δt_CFD step by step. Fixed: always dt. Courant: dt·C_target/C_reported, growth
 /// limited to maxGrowth per step (no limit on decrease), clamped to [dtMin, dtMax].
-/// Each step is finally shortened so that the run lands exactly on tEnd.
+/// Each step is finally shortened so that the run lands exactly on tEnd (adaptive: when less
+/// than two steps remain, the rest is split into two equal steps, so no sliver step is left).
 class DtPolicy {
 public:
   explicit DtPolicy(const DtPolicyConfig& config, double lastDt = 0.0);
