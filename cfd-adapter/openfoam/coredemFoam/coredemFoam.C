@@ -1,0 +1,632 @@
+// coredemFoam — the OpenFOAM participant of a coupled CoReDEM run (DESIGN §5,
+// docs/coredemFoam.md).
+//
+// Transient, incompressible, volume-averaged gas (PHYSICS §1, "Model A", constant properties)
+// solved with PIMPLE in the DPMFoam manner: the particles reach the gas only through the gas
+// volume fraction alphac and source fields. Every step the orchestrator grants (Δt, step):
+//
+//   1. send the gas at the start of the step (U, grad p, T, properties, Y) to the DEM server,
+//      which sub-cycles its particles over Δt and answers with sub-step-averaged sources:
+//      eps_g, K_sl, K_sl*U_s, H, H*T_p, R_k, Q_hom (PCM cells = this mesh's cells);
+//   2. advance the gas over the same Δt with them: alphac (including d(alphac)/dt in
+//      continuity), implicit drag Sp(K_sl/rho) + explicit K_sl U_s/rho, particle heat implicit
+//      in T, species sources;
+//   3. report the Courant number (for the next Δt) and the cumulative ledgers in StepDone, and
+//      on a checkpoint grant write the state as a binary time directory and list it.
+//
+// Command line: coredemFoam -case DIR [-restart FILE] [-control EP] [-dem EP] [-session ID]
+// (endpoints default to COREDEM_CONTROL_ENDPOINT, COREDEM_DEM_ENDPOINT, COREDEM_SESSION).
+
+#include "fvCFD.H"
+#include "singlePhaseTransportModel.H"
+#include "PhaseIncompressibleTurbulenceModel.H"
+#include "pimpleControl.H"
+#include "fvOptions.H"
+#include "OFstream.H"
+#include "IFstream.H"
+
+#include "couplingGrid.H"
+
+#include "coredem/client/participant.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace
+{
+
+// Cumulative ledgers with compensated (Kahan) summation, in a fixed order; saved bit-exactly
+// in checkpoints so that a resumed run sums exactly as an uninterrupted one.
+class Ledgers
+{
+public:
+    enum Kind { Mass, Energy, Species, Diagnostic };
+
+    void define(const std::string& name, Kind kind)
+    {
+        names_.push_back(name);
+        kinds_.push_back(kind);
+        sum_.push_back(0.0);
+        comp_.push_back(0.0);
+    }
+
+    void add(std::size_t i, double v)
+    {
+        const double y = v - comp_[i];
+        const double t = sum_[i] + y;
+        comp_[i] = (t - sum_[i]) - y;
+        sum_[i] = t;
+    }
+
+    void set(std::size_t i, double v)
+    {
+        sum_[i] = v;
+        comp_[i] = 0.0;
+    }
+
+    std::size_t index(const std::string& name) const
+    {
+        for (std::size_t i = 0; i < names_.size(); ++i)
+        {
+            if (names_[i] == name) return i;
+        }
+        return names_.size();
+    }
+
+    ::coredem::client::Ledgers report() const
+    {
+        ::coredem::client::Ledgers l;
+        for (std::size_t i = 0; i < names_.size(); ++i)
+        {
+            const std::pair<std::string, double> e(names_[i], sum_[i]);
+            switch (kinds_[i])
+            {
+                case Mass: l.mass.push_back(e); break;
+                case Energy: l.energy.push_back(e); break;
+                case Species: l.species.push_back(e); break;
+                case Diagnostic: l.diagnostics.push_back(e); break;
+            }
+        }
+        return l;
+    }
+
+    std::size_t size() const { return names_.size(); }
+    const std::string& name(std::size_t i) const { return names_[i]; }
+    double& sum(std::size_t i) { return sum_[i]; }
+    double& comp(std::size_t i) { return comp_[i]; }
+
+private:
+    std::vector<std::string> names_;
+    std::vector<Kind> kinds_;
+    std::vector<double> sum_, comp_;
+};
+
+std::string hexDouble(double v)
+{
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%a", v);
+    return buf;
+}
+
+// Writes a field as <dir>/<name> in binary (full precision) with its usual FoamFile header.
+template<class FieldType>
+void writeBinary(const FieldType& f, const Foam::fileName& dir)
+{
+    Foam::OFstream os(dir/f.name(), Foam::IOstream::BINARY);
+    f.writeHeader(os);
+    f.writeData(os);
+    Foam::IOobject::writeEndDivider(os);
+    if (!os.good())
+    {
+        FatalErrorInFunction
+            << "cannot write checkpoint file " << os.name() << Foam::exit(Foam::FatalError);
+    }
+}
+
+// What a checkpoint's coredemFoam.restart holds (besides the fields of its time directory).
+struct RestartInfo
+{
+    long long step = 0;
+    double time = 0.0;
+    Foam::label timeIndex = 0;
+    std::string instance;
+    std::vector<std::string> ledgerNames;
+    std::vector<double> ledgerSum, ledgerComp;
+};
+
+RestartInfo readRestart(const std::string& file)
+{
+    std::ifstream in(file);
+    if (!in)
+    {
+        FatalErrorInFunction
+            << "cannot read restart file " << file << " (pass the coredemFoam.restart of a "
+            << "checkpoint that coredemFoam wrote)" << Foam::exit(Foam::FatalError);
+    }
+    RestartInfo r;
+    std::string line;
+    bool haveStep = false, haveTime = false, haveInstance = false;
+    while (std::getline(in, line))
+    {
+        std::istringstream ls(line);
+        std::string key;
+        ls >> key;
+        if (key.empty() || key[0] == '#') continue;
+        std::string a, b, c;
+        ls >> a >> b >> c;
+        if (key == "step") { r.step = std::stoll(a); haveStep = true; }
+        else if (key == "time") { r.time = std::strtod(a.c_str(), nullptr); haveTime = true; }
+        else if (key == "timeIndex") { r.timeIndex = Foam::label(std::stol(a)); }
+        else if (key == "instance") { r.instance = a; haveInstance = true; }
+        else if (key == "ledger")
+        {
+            r.ledgerNames.push_back(a);
+            r.ledgerSum.push_back(std::strtod(b.c_str(), nullptr));
+            r.ledgerComp.push_back(std::strtod(c.c_str(), nullptr));
+        }
+    }
+    if (!haveStep || !haveTime || !haveInstance)
+    {
+        FatalErrorInFunction
+            << "restart file " << file << " lacks step, time or instance: it is not a "
+            << "coredemFoam checkpoint" << Foam::exit(Foam::FatalError);
+    }
+    return r;
+}
+
+} // namespace
+
+
+int main(int argc, char* argv[])
+{
+    // Note: OpenFOAM's libraries read the etc tree while they load, before main: the
+    // environment must already have WM_PROJECT_DIR (the orchestrator sets it).
+    argList::addNote
+    (
+        "CoReDEM's OpenFOAM participant: volume-averaged incompressible PIMPLE gas coupled to"
+        " the DEM server every step (docs/coredemFoam.md)."
+    );
+    argList::noParallel();
+    argList::addOption("restart", "file", "coredemFoam.restart of a checkpoint to resume from");
+    argList::addOption("control", "endpoint", "orchestrator endpoint (else COREDEM_CONTROL_ENDPOINT)");
+    argList::addOption("dem", "endpoint", "DEM server endpoint (else COREDEM_DEM_ENDPOINT)");
+    argList::addOption("session", "id", "session id (else COREDEM_SESSION)");
+    argList::addOption("timeout", "s", "per-request deadline in s (else COREDEM_TIMEOUT_S or 60)");
+
+    #include "setRootCase.H"
+    #include "createTime.H"
+
+    // A case folder with a blockMeshDict but no mesh yet gets one from Debian's blockMesh.
+    if
+    (
+        !isFile(runTime.constantPath()/"polyMesh"/"faces")
+     && !isFile(runTime.constantPath()/"polyMesh"/"faces.gz")
+    )
+    {
+        const fileName dict(runTime.path()/"system"/"blockMeshDict");
+        if (!isFile(dict))
+        {
+            FatalErrorInFunction
+                << "no mesh in " << runTime.constantPath()/"polyMesh" << " and no " << dict
+                << " to make one" << exit(FatalError);
+        }
+        const std::string cmd =
+            std::string(COREDEM_OPENFOAM_BIN_DIR) + "/blockMesh -case '" + runTime.path()
+          + "' > '" + runTime.path() + "/log.blockMesh' 2>&1";
+        Info<< "No mesh yet: " << cmd.c_str() << nl << endl;
+        if (Foam::system(cmd) != 0)
+        {
+            FatalErrorInFunction
+                << "blockMesh failed; see " << runTime.path()/"log.blockMesh" << exit(FatalError);
+        }
+    }
+
+    #include "createMesh.H"
+    pimpleControl pimple(mesh);
+    #include "readGravitationalAcceleration.H"
+
+    // ---- coupling: handshake, grid, restart ------------------------------------------------
+    ::coredem::client::Options options;
+    options.name = "coredemFoam";
+    options.softwareVersion = "coredemFoam 0.1.0 (OpenFOAM " + std::to_string(OPENFOAM) + ")";
+    {
+        string s;
+        if (args.readIfPresent("control", s)) options.controlEndpoint = s;
+        if (args.readIfPresent("dem", s)) options.demEndpoint = s;
+        if (args.readIfPresent("session", s)) options.sessionId = s;
+        scalar t = 0;
+        if (args.readIfPresent("timeout", t)) options.timeoutSeconds = t;
+    }
+    ::coredem::client::Participant coupling(options);
+    try
+    {
+        coupling.initialize();
+    }
+    catch (const ::coredem::client::ClientError& e)
+    {
+        FatalErrorInFunction << "coupling: " << e.what() << exit(FatalError);
+    }
+    if (!coupling.isRunning())
+    {
+        Info<< "The orchestrator ended the run before the first step: "
+            << coupling.shutdownReason().c_str() << nl << "End" << endl;
+        coupling.finalize();
+        return 0;
+    }
+
+    const ::coredem::client::Grid& grid = coupling.grid();
+    const Foam::CoredemGrid couplingGrid
+    (
+        mesh,
+        vector(grid.origin[0], grid.origin[1], grid.origin[2]),
+        vector(grid.spacing[0], grid.spacing[1], grid.spacing[2]),
+        label(grid.counts[0]), label(grid.counts[1]), label(grid.counts[2])
+    );
+    Info<< "Coupling grid: " << grid.counts[0] << " x " << grid.counts[1] << " x "
+        << grid.counts[2] << " cells of " << couplingGrid.spacing() << " m, "
+        << label(grid.species.size()) << " gas species; mesh checked (uniform Cartesian)\n"
+        << endl;
+
+    const bool restarting = args.found("restart");
+    RestartInfo restart;
+    fileName fieldInstance = runTime.timeName();
+    if (restarting)
+    {
+        const fileName file(args.get<fileName>("restart"));
+        restart = readRestart(file);
+        if (restart.step != coupling.startStep())
+        {
+            FatalErrorInFunction
+                << "restart file " << file << " is of step " << label(restart.step)
+                << " but the orchestrator restarts from step " << label(coupling.startStep())
+                << exit(FatalError);
+        }
+        fieldInstance = file.path()/restart.instance;
+        runTime.setTime(restart.time, restart.timeIndex);
+        Info<< "Restarting from " << fieldInstance << " (step " << label(restart.step)
+            << ", t = " << restart.time << " s)\n" << endl;
+    }
+    else if (mag(coupling.startTime() - runTime.value()) > 1e-12*max(1.0, runTime.value()))
+    {
+        FatalErrorInFunction
+            << "the orchestrator starts at t = " << coupling.startTime() << " s but the case "
+            << "starts at " << runTime.value() << " s (controlDict startTime) and no -restart "
+            << "was given" << exit(FatalError);
+    }
+
+    #include "createFields.H"
+
+    // Old-time values exist from the start so that d(alphac)/dt of the first step after a
+    // restart uses the checkpoint's fraction, as an uninterrupted run does.
+    alphac.oldTime();
+
+    turbulence->validate();
+
+    // ---- ledgers (docs/coredemFoam.md) ---------------------------------------------------------
+    Ledgers ledgers;
+    ledgers.define("gas.heat_from_particles_J", Ledgers::Energy);
+    ledgers.define("gas.heat_homogeneous_J", Ledgers::Energy);
+    ledgers.define("gas.enthalpy_inflow_J", Ledgers::Energy);
+    ledgers.define("gas.mass_from_particles_kg", Ledgers::Mass);
+    for (const std::string& s : speciesNames)
+    {
+        ledgers.define("gas.species." + s + "_kg", Ledgers::Species);
+    }
+    const char* axes[3] = {"x", "y", "z"};
+    for (const char* a : axes)
+    {
+        ledgers.define(std::string("gas.momentum_from_particles_") + a + "_Ns", Ledgers::Diagnostic);
+    }
+    ledgers.define("gas.solid_volume_m3", Ledgers::Diagnostic);
+    ledgers.define("gas.enthalpy_J", Ledgers::Diagnostic);
+    ledgers.define("gas.pressure_drop_Pa", Ledgers::Diagnostic);
+    const std::size_t lHeat = 0, lHom = 1, lInflow = 2, lMass = 3, lSpecies0 = 4;
+    const std::size_t lMom0 = lSpecies0 + speciesNames.size();
+    const std::size_t lSolid = lMom0 + 3, lEnthalpy = lSolid + 1, lDp = lSolid + 2;
+    if (restarting)
+    {
+        for (std::size_t i = 0; i < restart.ledgerNames.size(); ++i)
+        {
+            const std::size_t j = ledgers.index(restart.ledgerNames[i]);
+            if (j == ledgers.size())
+            {
+                FatalErrorInFunction
+                    << "the restart file has ledger " << restart.ledgerNames[i].c_str()
+                    << ", which this case does not produce (another species list?)"
+                    << exit(FatalError);
+            }
+            ledgers.sum(j) = restart.ledgerSum[i];
+            ledgers.comp(j) = restart.ledgerComp[i];
+        }
+    }
+
+    const label nCells = mesh.nCells();
+    const label nSpecies = label(speciesNames.size());
+    const scalar Vc = couplingGrid.cellVolume();
+    const scalar rhoCp = rhog.value()*cpg.value();
+
+    // Pressure-drop diagnostic: mean p over the inlet patches minus mean p over the outlets
+    // (patches named in transportProperties: pressureDropPatches (inlet outlet)), in Pa.
+    labelList dpPatches(2, -1);
+    {
+        wordList names(laminarTransport.getOrDefault<wordList>("pressureDropPatches", wordList()));
+        if (names.size() == 2)
+        {
+            for (label i = 0; i < 2; ++i)
+            {
+                dpPatches[i] = mesh.boundaryMesh().findPatchID(names[i]);
+                if (dpPatches[i] < 0)
+                {
+                    FatalErrorInFunction
+                        << "pressureDropPatches: no patch " << names[i] << exit(FatalError);
+                }
+            }
+        }
+    }
+    auto patchMeanP = [&](label patchi)
+    {
+        const scalarField& pb = p.boundaryField()[patchi];
+        const scalarField& a = mesh.magSf().boundaryField()[patchi];
+        return gSum(pb*a)/gSum(a);
+    };
+
+    std::vector<double> uG, gradPG, TG, rhoG, muG, kappaG, cpG, YG, cellY;
+    std::vector<scalar> cellBuf;
+    const volScalarField nuField(laminarTransport.nu());
+    bool firstStep = true;
+    scalar cumulativeContErr = 0;
+    label steps = 0;
+
+    Info<< "\nStarting time loop\n" << endl;
+
+    while (coupling.isRunning())
+    {
+        const label step = label(coupling.step());
+        const scalar dt = coupling.dt();
+
+        // 1. gas at the start of the step -> DEM, sources of the step <- DEM.
+        couplingGrid.gather(reinterpret_cast<const scalar*>(U.primitiveField().cdata()), 3, uG);
+        {
+            const volVectorField gradP(fvc::grad(p)*rhog);
+            couplingGrid.gather
+            (
+                reinterpret_cast<const scalar*>(gradP.primitiveField().cdata()), 3, gradPG
+            );
+        }
+        couplingGrid.gather(T.primitiveField().cdata(), 1, TG);
+        rhoG.assign(nCells, rhog.value());
+        {
+            const scalarField mu(nuField.primitiveField()*rhog.value());
+            couplingGrid.gather(mu.cdata(), 1, muG);
+        }
+        kappaG.assign(nCells, kappag.value());
+        cpG.assign(nCells, cpg.value());
+        cellY.assign(std::size_t(nCells)*nSpecies, 0.0);
+        for (label k = 0; k < nSpecies; ++k)
+        {
+            const scalarField& yk = Y[k].primitiveField();
+            for (label c = 0; c < nCells; ++c) cellY[std::size_t(c)*nSpecies + k] = yk[c];
+        }
+        couplingGrid.gather(cellY.data(), nSpecies, YG);
+
+        const ::coredem::client::Sources* src = nullptr;
+        try
+        {
+            src = &coupling.exchange
+            (
+                coupling.step(), dt,
+                {
+                    {"u_g", uG}, {"grad_p", gradPG}, {"T_g", TG}, {"rho_g", rhoG},
+                    {"mu_g", muG}, {"kappa_g", kappaG}, {"cp_g", cpG}, {"Y_g", YG}
+                }
+            );
+        }
+        catch (const ::coredem::client::ClientError& e)
+        {
+            FatalErrorInFunction << "coupling, step " << step << ": " << e.what()
+                << exit(FatalError);
+        }
+
+        // Sources -> cell fields. The gas fraction is clipped to [alphacMin, 1].
+        auto toCells = [&](const char* name, label nComp, scalar* dest)
+        {
+            const ::coredem::client::ConstView v = src->field(name);
+            if (v.size != std::size_t(couplingGrid.gridCells())*nComp)
+            {
+                FatalErrorInFunction
+                    << "DEM source " << name << " has " << label(v.size) << " values, expected "
+                    << couplingGrid.gridCells()*nComp << exit(FatalError);
+            }
+            couplingGrid.scatter(v.data, nComp, dest);
+        };
+        scalarField epsNew(nCells);
+        toCells("eps_g", 1, epsNew.data());
+        epsNew = max(min(epsNew, scalar(1)), alphacMin);
+        if (firstStep && !restarting)
+        {
+            // The particles were there before the first step: no d(alphac)/dt from "1 -> eps".
+            alphac.primitiveFieldRef() = epsNew;
+            alphac.correctBoundaryConditions();
+        }
+
+        runTime.setDeltaT(dt, false);
+        ++runTime;
+        Info<< "Step " << step << "  Time = " << runTime.timeName() << "  deltaT = " << dt
+            << nl << endl;
+
+        alphac.primitiveFieldRef() = epsNew;
+        alphac.correctBoundaryConditions();
+        alphacf = fvc::interpolate(alphac);
+
+        toCells("K_sl", 1, Ksl.primitiveFieldRef().data());
+        toCells("K_sl_Us", 3, reinterpret_cast<scalar*>(KslUs.primitiveFieldRef().data()));
+        toCells("H", 1, Hheat.primitiveFieldRef().data());
+        toCells("H_Tp", 1, HTp.primitiveFieldRef().data());
+        toCells("Q_hom", 1, Qhom.primitiveFieldRef().data());
+        Rsum.primitiveFieldRef() = Zero;
+        if (nSpecies > 0)
+        {
+            cellBuf.assign(std::size_t(nCells)*nSpecies, 0.0);
+            toCells("R_species", nSpecies, cellBuf.data());
+            for (label k = 0; k < nSpecies; ++k)
+            {
+                scalarField& rk = Rspecies[k].primitiveFieldRef();
+                for (label c = 0; c < nCells; ++c) rk[c] = cellBuf[std::size_t(c)*nSpecies + k];
+                Rsum.primitiveFieldRef() += rk;
+            }
+        }
+        for (volScalarField* f : {&Ksl, &Hheat, &HTp, &Qhom, &Rsum})
+        {
+            f->correctBoundaryConditions();
+        }
+        KslUs.correctBoundaryConditions();
+
+        // 2. the gas over the same step.
+        while (pimple.loop())
+        {
+            #include "UEqn.H"
+
+            while (pimple.correct())
+            {
+                #include "pEqn.H"
+            }
+
+            if (pimple.turbCorr())
+            {
+                laminarTransport.correct();
+                turbulence->correct();
+            }
+        }
+        #include "TEqn.H"
+        #include "YEqn.H"
+        #include "alphacContinuityErrs.H"
+
+        // 3. ledgers (cumulative) and the Courant number of this step.
+        {
+            const scalarField& Tc = T.primitiveField();
+            const scalarField& ac = alphac.primitiveField();
+            const vectorField& Uc = U.primitiveField();
+            double heat = 0, hom = 0, solid = 0, enthalpy = 0;
+            double mom[3] = {0, 0, 0};
+            std::vector<double> spec(nSpecies, 0.0);
+            for (label c = 0; c < nCells; ++c)
+            {
+                heat += HTp[c] - Hheat[c]*Tc[c];
+                hom += Qhom[c];
+                solid += 1.0 - ac[c];
+                enthalpy += ac[c]*Tc[c];
+                for (direction a = 0; a < 3; ++a)
+                {
+                    mom[a] += KslUs[c][a] - Ksl[c]*Uc[c][a];
+                }
+                for (label k = 0; k < nSpecies; ++k) spec[k] += Rspecies[k][c];
+            }
+            ledgers.add(lHeat, heat*Vc*dt);
+            ledgers.add(lHom, hom*Vc*dt);
+            double mass = 0;
+            for (label k = 0; k < nSpecies; ++k)
+            {
+                ledgers.add(lSpecies0 + k, spec[k]*Vc*dt);
+                mass += spec[k];
+            }
+            ledgers.add(lMass, mass*Vc*dt);
+            for (direction a = 0; a < 3; ++a) ledgers.add(lMom0 + a, mom[a]*Vc*dt);
+            ledgers.set(lSolid, solid*Vc);
+            ledgers.set(lEnthalpy, rhoCp*enthalpy*Vc);
+
+            // Advected enthalpy entering through the boundary (J, relative to 0 K).
+            double inflow = 0;
+            forAll(mesh.boundary(), patchi)
+            {
+                const scalarField& ap = alphaPhi.boundaryField()[patchi];
+                const scalarField& Tp = T.boundaryField()[patchi];
+                forAll(ap, facei) inflow -= ap[facei]*Tp[facei];
+            }
+            ledgers.add(lInflow, rhoCp*inflow*dt);
+            if (dpPatches[0] >= 0)
+            {
+                ledgers.set
+                (
+                    lDp, rhog.value()*(patchMeanP(dpPatches[0]) - patchMeanP(dpPatches[1]))
+                );
+            }
+        }
+        scalar CoNum = 0;
+        {
+            const scalarField sumPhi(fvc::surfaceSum(mag(phi))().primitiveField());
+            CoNum = 0.5*gMax(sumPhi/mesh.V().field())*dt;
+        }
+        Info<< "Courant Number max: " << CoNum << endl;
+
+        // 4. checkpoint: binary time directory <dir>/openfoam/<time>/ + coredemFoam.restart.
+        std::vector<std::string> files;
+        if (coupling.requiresCheckpoint())
+        {
+            const fileName base(fileName(coupling.checkpointDir())/"openfoam");
+            const word inst(runTime.timeName());
+            const fileName dir(base/inst);
+            mkDir(dir);
+            writeBinary(U, dir);
+            writeBinary(p, dir);
+            writeBinary(T, dir);
+            writeBinary(phi, dir);
+            writeBinary(alphac, dir);
+            forAll(Y, k) writeBinary(Y[k], dir);
+            std::vector<std::string> names{"U", "p", "T", "phi", "alphac"};
+            for (const std::string& s : speciesNames) names.push_back(s);
+
+            const fileName tmp(base/"coredemFoam.restart.tmp");
+            {
+                std::ofstream out(tmp.c_str());
+                out << "# coredemFoam checkpoint (times and ledgers as exact hex floats)\n"
+                    << "step " << coupling.step() << "\n"
+                    << "time " << hexDouble(runTime.value()) << "\n"
+                    << "timeIndex " << runTime.timeIndex() << "\n"
+                    << "instance " << inst.c_str() << "\n";
+                for (std::size_t i = 0; i < ledgers.size(); ++i)
+                {
+                    out << "ledger " << ledgers.name(i) << ' ' << hexDouble(ledgers.sum(i))
+                        << ' ' << hexDouble(ledgers.comp(i)) << "\n";
+                }
+                out.flush();
+                if (!out)
+                {
+                    FatalErrorInFunction << "cannot write " << tmp << exit(FatalError);
+                }
+            }
+            Foam::mv(tmp, base/"coredemFoam.restart");
+            // The restart file first: coredem resume passes the first file back (-restart).
+            files.push_back("openfoam/coredemFoam.restart");
+            for (const std::string& n : names)
+            {
+                files.push_back("openfoam/" + std::string(inst) + "/" + n);
+            }
+            Info<< "Checkpoint of step " << step << " written to " << dir << endl;
+        }
+
+        try
+        {
+            coupling.advance(CoNum, ledgers.report(), files);
+        }
+        catch (const ::coredem::client::ClientError& e)
+        {
+            FatalErrorInFunction << "coupling, step " << step << ": " << e.what()
+                << exit(FatalError);
+        }
+
+        runTime.write();
+        runTime.printExecutionTime(Info);
+        firstStep = false;
+        ++steps;
+    }
+
+    runTime.writeNow();
+    Info<< "Run finished after " << steps << " steps: " << coupling.shutdownReason().c_str()
+        << nl << "End\n" << endl;
+    coupling.finalize();
+    return 0;
+}
