@@ -3,6 +3,7 @@
 // (cuda skips when it is not built or no device is present).
 #include "backend/cpu/cpu_exec.h"
 
+#include "coredem/common/check.h"
 #include "coredem/dem/dem_system.h"
 
 #include <gtest/gtest.h>
@@ -142,4 +143,21 @@ TYPED_TEST(BackendConformance, HeadOnCollisionRestitution) {
   const std::size_t i0 = p.globalId[0] == 0 ? 0 : 1;
   const double rel = p.velocity[3 * (1 - i0)] - p.velocity[3 * i0];
   EXPECT_NEAR(rel / (2 * v), 0.97, 1e-3);
+}
+
+TEST(BackendChoice, AutoPicksCudaOnlyWithADevice) {
+  DemConfig c;
+  ParticleSet s;
+  s.packing = Packing::Explicit;
+  s.positions = {0, 0, 0};
+  c.particleSets.push_back(s);
+  DemSystem sys(c, BackendKind::Auto, 1);
+  EXPECT_EQ(sys.backendName(), cudaDeviceCount() > 0 ? "cuda" : "cpu");
+  EXPECT_EQ(parseBackend("cpu"), BackendKind::Cpu);
+  EXPECT_EQ(parseBackend("cuda"), BackendKind::Cuda);
+  EXPECT_EQ(parseBackend("auto"), BackendKind::Auto);
+  EXPECT_THROW(parseBackend("gpu"), coredem::UserError);
+  if (cudaDeviceCount() == 0) {
+    EXPECT_THROW(DemSystem(c, BackendKind::Cuda, 1), coredem::UserError);  // clear error, no crash
+  }
 }

@@ -1,4 +1,5 @@
 // Kernel unit tests on the CPU against PHYSICS.md §1.1 and §2 (Eqs. 9–17).
+#include "coredem/dem/kernels/body_force.h"
 #include "coredem/dem/kernels/cell_sources.h"
 #include "coredem/dem/kernels/collision_time.h"
 #include "coredem/dem/kernels/damping.h"
@@ -202,4 +203,10 @@ TEST(CellSources, AveragesOverSubSteps) {
   EXPECT_DOUBLE_EQ(a.kSl, 6e-3 / 2e-6);
   EXPECT_DOUBLE_EQ(a.kSlUs.x, 2e-3 / 2e-6);
   EXPECT_DOUBLE_EQ(a.kSlUs.y, 4e-3 / 2e-6);
+}
+
+TEST(BodyForce, GravityIsMassTimesG) {
+  const Vec3 f = gravityForce(kMass, Vec3{0, 0, -9.81});
+  EXPECT_DOUBLE_EQ(f.z, -9.81 * kMass);
+  EXPECT_EQ(f.x, 0.0);
 }
