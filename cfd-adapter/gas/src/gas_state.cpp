@@ -8,6 +8,9 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 namespace coredem::gas {
 
 namespace {
@@ -88,6 +91,9 @@ void writeGasState(const std::string& path, const GasState& s) {
                   "cannot write /ledgers/names in {}", tmp);
     H5Fflush(file.id, H5F_SCOPE_GLOBAL);
   }
+  const int fd = ::open(tmp.c_str(), O_RDONLY);
+  COREDEM_CHECK(fd >= 0 && ::fsync(fd) == 0, "cannot flush {} to disk", tmp);
+  ::close(fd);
   std::filesystem::rename(tmp, path);
 }
 

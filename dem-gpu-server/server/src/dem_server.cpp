@@ -17,7 +17,9 @@
 #include <map>
 #include <optional>
 #include <random>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 namespace coredem::server {
 
@@ -75,6 +77,15 @@ proto::TransportOptions transportOptions(const ServerOptions& o) {
     t.curve.serverSecretKey = readKey(fs::path(o.curveKeysDir) / "server.secret");
   }
   return t;
+}
+
+/// Flushes a written file to disk before it is renamed into place.
+void syncFile(const fs::path& p) {
+  const int fd = ::open(p.c_str(), O_RDONLY);
+  COREDEM_CHECK(fd >= 0, "cannot open {} to flush it", p.string());
+  const int rc = ::fsync(fd);
+  ::close(fd);
+  COREDEM_CHECK(rc == 0, "fsync of {} failed", p.string());
 }
 
 struct Grant {
@@ -593,6 +604,7 @@ struct DemServer::Impl {
     system->writeState(tmp.string());
     ServerLedgers l = ledgers;
     writeServerLedgers(tmp.string(), l, step, session);
+    syncFile(tmp);
     fs::rename(tmp, final);
     log->info("session {}: checkpoint of step {} written to {}", session, step, final.string());
     return {"dem.h5"};
