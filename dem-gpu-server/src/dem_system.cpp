@@ -524,21 +524,8 @@ std::string DemSystem::configHash() const { return _impl->hash; }
 const DemConfig& DemSystem::config() const { return _impl->config; }
 
 ParticleData DemSystem::particles() const {
-  HostState s = _impl->engine->state();
   ParticleData p;
-  p.count = s.n;
-  p.nSpecies = s.nSpecies;
-  p.position = std::move(s.pos);
-  p.velocity = std::move(s.vel);
-  p.angularVelocity = std::move(s.omega);
-  p.force = std::move(s.force);
-  p.radius = std::move(s.radius);
-  p.mass = std::move(s.mass);
-  p.density = std::move(s.density);
-  p.temperature = std::move(s.temperature);
-  p.species = std::move(s.species);
-  p.material = std::move(s.material);
-  p.globalId = std::move(s.gid);
+  _impl->engine->particles(p);
   return p;
 }
 

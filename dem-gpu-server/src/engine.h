@@ -68,6 +68,8 @@ public:
   virtual ~Engine() = default;
   virtual void setState(const HostState& s) = 0;
   virtual HostState state() = 0;
+  /// Host copy of the particle fields only (no contacts / neighbour lists): cheap snapshot.
+  virtual void particles(ParticleData& out) = 0;
   virtual void setGas(const GasArrays& g) = 0;
   /// Freezes ε_g (PCM at the current positions) and clears the source accumulators.
   virtual void beginWindow() = 0;

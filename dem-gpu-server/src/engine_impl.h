@@ -130,6 +130,19 @@ public:
     return s;
   }
 
+  void particles(ParticleData& out) override {
+    const std::uint32_t mask = kPos | kVel | kOmega | kForce | kRadius | kMass | kDensity |
+                               kTemperature | kSpecies | kMaterial | kGid;
+    _p.toHost(mask);
+    out.count = _p.n;
+    out.nSpecies = _p.nSpecies;
+    auto get = [](const auto& arr, auto& vec) { vec.assign(arr.h(), arr.h() + arr.size()); };
+    get(_p.pos, out.position); get(_p.vel, out.velocity); get(_p.omega, out.angularVelocity);
+    get(_p.force, out.force); get(_p.radius, out.radius); get(_p.mass, out.mass);
+    get(_p.density, out.density); get(_p.temperature, out.temperature);
+    get(_p.species, out.species); get(_p.material, out.material); get(_p.gid, out.globalId);
+  }
+
   void setGas(const GasArrays& g) override {
     _gasHost = g;
     auto put = [](Dual<double>& arr, const std::vector<double>& v) {
