@@ -112,6 +112,7 @@ void ChildProcess::stop(std::chrono::milliseconds grace) {
     return;
   }
   ::kill(_pid, SIGTERM);
+  ::kill(_pid, SIGCONT); // a stopped (hung) process must run to act on SIGTERM
   if (!waitFor(grace)) {
     ::kill(_pid, SIGKILL);
     waitFor(std::chrono::milliseconds(5000));

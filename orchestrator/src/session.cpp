@@ -238,6 +238,7 @@ private:
   std::uint32_t _species = 0;
   protocol::PeerId _cfdPeer;
   std::optional<protocol::Request> _pendingCfd; ///< C's request awaiting O's reply
+  bool _demUnresponsive = false;                ///< D missed a deadline: do not wait on it
 
   TimeHandler _time;
   DtPolicy _policy{DtPolicyConfig{}};
@@ -373,6 +374,7 @@ Message Session::receiveFromDem(std::chrono::milliseconds timeout, const std::st
     }
     checkAlive();
     if (Clock::now() > deadline) {
+      _demUnresponsive = true;
       throw ParticipantFault(kDemName, fmt::format("stopped answering: no {} within {} s",
                                                    awaited, timeout.count() / 1000.0));
     }
@@ -740,7 +742,11 @@ void Session::shutdownAll(bool clean) {
     }
   }
   // D: Shutdown request when it is alive (ends the session; a server we started exits).
-  if (_dem && (!_demProc || !_demProc->exitReason())) {
+  if (_demUnresponsive && _demProc) {
+    _log->warn("stopping the unresponsive DEM server (pid {})", _demProc->pid());
+    _demProc->stop(1000ms);
+  }
+  if (_dem && !_demUnresponsive && (!_demProc || !_demProc->exitReason())) {
     try {
       Message s = protocol::makeShutdown(clean ? "run finished" : "run aborted");
       s.setSessionId(_session);

@@ -310,6 +310,45 @@ TEST_F(CoredemE2E, KillDemServerReportsAndStops) {
   }
 }
 
+// A DEM server that stops answering (SIGSTOP) is reported after dem.timeout_s by name and
+// reason; the CFD participant is shut down, exit code 1, only complete checkpoints remain.
+TEST_F(CoredemE2E, HungDemServerMissesDeadline) {
+  std::string text = readAll(restartCase / "case.yaml");
+  text.replace(text.find("  timeout_s: 20\ncfd"), 15, "  timeout_s: 2");
+  fs::create_directories(dir / "case");
+  std::ofstream(dir / "case" / "case.yaml") << text;
+  const fs::path k = dir / "hung";
+  const pid_t o = startCoredem({"run", (dir / "case").string(), "--out", k.string(), "--no-plots"},
+                               dir / "k.log");
+  const auto end = std::chrono::steady_clock::now() + 40s;
+  pid_t dem = 0, gas = 0;
+  while (std::chrono::steady_clock::now() < end && !dem) {
+    if (fs::exists(k / "checkpoints/00000020/manifest.json")) {
+      const auto dems = childrenNamed(o, "coredem-dem");
+      const auto gases = childrenNamed(o, "coredem-gas");
+      ASSERT_EQ(dems.size(), 1u);
+      ASSERT_EQ(gases.size(), 1u);
+      gas = gases[0];
+      dem = dems[0];
+      ::kill(dem, SIGSTOP);
+    }
+    std::this_thread::sleep_for(2ms);
+  }
+  ASSERT_NE(dem, 0);
+  EXPECT_EQ(waitExit(o, 50s), 1);
+  const std::string log = readAll(dir / "k.log");
+  EXPECT_NE(log.find("DEM server coredem-dem: stopped answering: no StepDone of step"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("within 2 s"), std::string::npos) << log;
+  EXPECT_NE(::kill(gas, 0), 0) << "coredem-gas (pid " << gas << ") still runs";
+  EXPECT_NE(::kill(dem, 0), 0) << "coredem-dem (pid " << dem << ") still runs";
+  EXPECT_TRUE(leftovers(k).empty());
+  for (const auto& e : fs::directory_iterator(k / "checkpoints")) {
+    EXPECT_TRUE(fs::exists(e.path() / "manifest.json")) << "incomplete checkpoint left: " << e.path();
+  }
+}
+
 // Bad case files: a clear message naming file, line and key; exit code 2; nothing written.
 namespace {
 struct BadCase {
