@@ -47,6 +47,12 @@ struct Result {
   std::size_t iterations = 0;
 };
 
+std::string arrayName(std::size_t f) {
+  std::string name = std::to_string(f);
+  name.insert(name.begin(), 'f');
+  return name;
+}
+
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
@@ -154,7 +160,7 @@ Result measureTransport(const std::string& name, const std::string& bindEndpoint
       Message m(v1::MESSAGE_TYPE_ACK);
       m.envelope().mutable_ack();
       for (std::size_t f = 0; f < arrays.size(); ++f) {
-        m.addArrayShared<double>("f" + std::to_string(f), arrays[f],
+        m.addArrayShared<double>(arrayName(f), arrays[f],
                                  std::span<const double>(*arrays[f]), {cells});
       }
       auto t0 = Clock::now();
@@ -211,7 +217,7 @@ double measureValidate(const std::vector<std::shared_ptr<std::vector<double>>>& 
   Message m(v1::MESSAGE_TYPE_ACK);
   m.envelope().mutable_ack();
   for (std::size_t f = 0; f < arrays.size(); ++f) {
-    m.addArrayShared<double>("f" + std::to_string(f), arrays[f],
+    m.addArrayShared<double>(arrayName(f), arrays[f],
                              std::span<const double>(*arrays[f]), {cells});
   }
   std::vector<double> times;
