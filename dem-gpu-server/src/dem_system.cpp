@@ -473,8 +473,8 @@ void DemSystem::writeState(const std::string& path) const {
   meta.step = m.step;
   meta.backend = m.engine->name();
   meta.configHash = m.hash;
-  meta.softwareVersion = COREDEM_VERSION;
-  meta.protocolVersion = "1";
+  meta.softwareVersion = std::string(COREDEM_VERSION);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
+  meta.protocolVersion = std::string("1");
   writeStateFile(path, m.engine->state(), meta);
 }
 
