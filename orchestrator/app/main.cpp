@@ -3,17 +3,17 @@
 //   coredem resume RUN_DIR [--auto-restart N] [--stop-after STEP]
 //   coredem inspect FILE
 //   coredem check CASE_DIR
+#include <cstdio>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <unistd.h>
+
 #include <coredem/common/log.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/outputs.h>
 #include <coredem/orchestrator/processes.h>
 #include <coredem/orchestrator/session.h>
-
-#include <CLI/CLI.hpp>
-
-#include <cstdio>
-#include <iostream>
-#include <unistd.h>
 
 using namespace coredem::orchestrator;
 namespace fs = std::filesystem;
@@ -72,7 +72,8 @@ int main(int argc, char** argv) {
   resume->add_option("--stop-after", stopAfter, "as for run");
   resume->add_flag("--no-plots", noPlots, "as for run");
 
-  auto* inspect = app.add_subcommand("inspect", "summarise a snapshot/state HDF5 file or a checkpoint");
+  auto* inspect =
+      app.add_subcommand("inspect", "summarise a snapshot/state HDF5 file or a checkpoint");
   inspect->add_option("FILE", file, "HDF5 file, manifest.json or checkpoint folder")->required();
 
   auto* check = app.add_subcommand("check", "validate a case file and exit (0 valid, 2 invalid)");
@@ -104,9 +105,10 @@ int main(int argc, char** argv) {
     opts.tty = ::isatty(STDERR_FILENO) != 0;
     CaseConfig config;
     if (*run) {
-      config = loadCase(caseDir);      // throws CaseError: nothing written yet
-      checkParticipantInput(config);   // the gas section, by the participant itself
-      opts.runDir = prepareRunDir(config, out.empty() ? std::nullopt : std::optional<fs::path>(out));
+      config = loadCase(caseDir);    // throws CaseError: nothing written yet
+      checkParticipantInput(config); // the gas section, by the participant itself
+      opts.runDir =
+          prepareRunDir(config, out.empty() ? std::nullopt : std::optional<fs::path>(out));
       log->info("run folder {}", opts.runDir.string());
     } else {
       opts.runDir = fs::absolute(runDir);

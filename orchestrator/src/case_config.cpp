@@ -1,14 +1,13 @@
-#include <coredem/orchestrator/case_config.h>
-
-#include <coredem/orchestrator/sha256.h>
-
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <set>
 #include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include <coredem/orchestrator/case_config.h>
+#include <coredem/orchestrator/sha256.h>
 
 namespace fs = std::filesystem;
 
@@ -25,11 +24,16 @@ std::string join(const std::vector<std::string>& items) {
 
 std::string describe(const YAML::Node& n) {
   switch (n.Type()) {
-  case YAML::NodeType::Null: return "nothing (null)";
-  case YAML::NodeType::Sequence: return "a list";
-  case YAML::NodeType::Map: return "a mapping";
-  case YAML::NodeType::Scalar: return "'" + n.Scalar() + "'";
-  default: return "an undefined value";
+  case YAML::NodeType::Null:
+    return "nothing (null)";
+  case YAML::NodeType::Sequence:
+    return "a list";
+  case YAML::NodeType::Map:
+    return "a mapping";
+  case YAML::NodeType::Scalar:
+    return "'" + n.Scalar() + "'";
+  default:
+    return "an undefined value";
   }
 }
 
@@ -39,13 +43,14 @@ class Section {
 public:
   Section(YAML::Node node, std::string file, std::string path, std::vector<std::string> allowed,
           const YAML::Mark& parentMark)
-      : _node(std::move(node)), _file(std::move(file)), _path(std::move(path)),
-        _allowed(std::move(allowed)) {
+      : _node(std::move(node))
+      , _file(std::move(file))
+      , _path(std::move(path))
+      , _allowed(std::move(allowed)) {
     const YAML::Mark mark = _node.IsDefined() && !_node.IsNull() ? _node.Mark() : parentMark;
     if (!_node.IsMap()) {
       fail(mark, _path.empty() ? "the case file" : _path,
-           fmt::format("expected a mapping with keys {}, got {}", join(_allowed),
-                       describe(_node)));
+           fmt::format("expected a mapping with keys {}, got {}", join(_allowed), describe(_node)));
     }
     for (const auto& kv : _node) {
       const std::string key = kv.first.Scalar();
@@ -167,7 +172,8 @@ public:
                      const std::vector<std::string>& options) const {
     const std::string v = string(key, def, "one of " + join(options));
     if (std::find(options.begin(), options.end(), v) == options.end()) {
-      fail(markOf(key), full(key), fmt::format("'{}' is not allowed; allowed: {}", v, join(options)));
+      fail(markOf(key), full(key),
+           fmt::format("'{}' is not allowed; allowed: {}", v, join(options)));
     }
     return v;
   }
@@ -257,9 +263,9 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   c.configHash = sha256Hex(text);
 
   const Section top(root, fileName, "",
-                    {"name", "description", "time", "grid", "gravity", "species",
-                     "gas_properties", "materials", "particles", "initial_state", "walls",
-                     "models", "dem", "cfd", "gas", "checkpoint", "output"},
+                    {"name", "description", "time", "grid", "gravity", "species", "gas_properties",
+                     "materials", "particles", "initial_state", "walls", "models", "dem", "cfd",
+                     "gas", "checkpoint", "output"},
                     YAML::Mark());
   c.name = top.string("name", std::nullopt, "the case name, used for the run folder");
   if (c.name.empty() || c.name.find('/') != std::string::npos) {
@@ -324,8 +330,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   }
 
   if (top.has("gas_properties")) {
-    const Section g = top.section("gas_properties", {"density", "viscosity", "conductivity",
-                                                      "cp", "temperature", "pressure"});
+    const Section g = top.section("gas_properties", {"density", "viscosity", "conductivity", "cp",
+                                                     "temperature", "pressure"});
     auto& p = c.gasProperties;
     p.density = g.number("density", p.density, 0.0, kBig, "kg/m3, > 0", true);
     p.viscosity = g.number("viscosity", p.viscosity, 0.0, kBig, "Pa s, > 0", true);
@@ -344,7 +350,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     mc.name = m.string("name", std::nullopt, "material name");
     mc.density = m.number("density", std::nullopt, 0.0, kBig, "kg/m3, > 0", true);
     mc.kN = m.number("k_n", std::nullopt, 0.0, kBig, "normal spring stiffness in N/m, > 0", true);
-    mc.eN = m.number("e_n", std::nullopt, 0.0, 1.0, "normal restitution coefficient in (0, 1]", true);
+    mc.eN =
+        m.number("e_n", std::nullopt, 0.0, 1.0, "normal restitution coefficient in (0, 1]", true);
     mc.friction = m.number("friction", 0.3, 0.0, kBig, "Coulomb friction coefficient, >= 0");
     if (m.has("kt_factor")) {
       mc.ktFactor = m.number("kt_factor", std::nullopt, 0.0, kBig, "k_t/k_n (default 2/7)", true);
@@ -365,8 +372,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   }
 
   if (top.has("initial_state")) {
-    const std::string rel = top.string("initial_state", std::nullopt,
-                                       "HDF5 state file, relative to the case folder");
+    const std::string rel =
+        top.string("initial_state", std::nullopt, "HDF5 state file, relative to the case folder");
     c.initialState = fs::absolute(caseDir / rel);
     if (!fs::is_regular_file(c.initialState)) {
       top.fail(top.markOf("initial_state"), "initial_state",
@@ -376,11 +383,11 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     }
   }
   if (top.has("particles")) {
-    for (const auto& p : top.list("particles",
-                                  {"name", "material", "count", "diameter", "density",
-                                   "temperature", "composition", "packing", "region", "seed",
-                                   "velocity"},
-                                  "particle sets")) {
+    for (const auto& p :
+         top.list("particles",
+                  {"name", "material", "count", "diameter", "density", "temperature", "composition",
+                   "packing", "region", "seed", "velocity"},
+                  "particle sets")) {
       ParticleSetConfig ps;
       ps.name = p.string("name", std::string("set") + std::to_string(c.particles.size()),
                          "label for outputs");
@@ -393,7 +400,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
         p.fail(p.markOf("material"), p.full("material"),
                fmt::format("unknown material '{}'; allowed: {}", ps.material, join(names)));
       }
-      ps.count = std::uint64_t(p.integer("count", std::nullopt, 1, 100000000, "number of particles"));
+      ps.count =
+          std::uint64_t(p.integer("count", std::nullopt, 1, 100000000, "number of particles"));
       ps.diameter = p.number("diameter", std::nullopt, 0.0, kBig, "m, > 0", true);
       ps.density = p.number("density", 0.0, 0.0, kBig, "kg/m3 (0 = the material's)");
       ps.temperature = p.number("temperature", 293.15, 0.0, kBig, "initial temperature in K", true);
@@ -425,8 +433,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
           r.fail(r.markOf("max"), r.full("max"), "every component must exceed the one of 'min'");
         }
       }
-      ps.seed = std::uint64_t(p.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max(),
-                                        "random seed"));
+      ps.seed = std::uint64_t(
+          p.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max(), "random seed"));
       ps.velocity = p.vec3("velocity", Vec3{0, 0, 0}, "initial velocity in m/s");
       c.particles.push_back(ps);
     }
@@ -440,7 +448,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     const Section w = top.section("walls", {"box", "planes", "material", "temperature"});
     if (w.has("box")) {
       const Section b = w.section("box", {"min", "max"});
-      c.walls.box = std::make_pair(b.vec3("min", std::nullopt, "m"), b.vec3("max", std::nullopt, "m"));
+      c.walls.box =
+          std::make_pair(b.vec3("min", std::nullopt, "m"), b.vec3("max", std::nullopt, "m"));
     }
     if (w.has("planes")) {
       for (const auto& pl : w.list("planes", {"point", "normal"}, "planar walls")) {
@@ -461,7 +470,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   if (top.has("models")) {
     const YAML::Node m = top.raw("models");
     if (!m.IsMap()) {
-      top.fail(top.markOf("models"), "models", "expected a mapping name -> model, e.g. {drag: gidaspow}");
+      top.fail(top.markOf("models"), "models",
+               "expected a mapping name -> model, e.g. {drag: gidaspow}");
     }
     for (const auto& kv : m) {
       if (!kv.second.IsScalar()) {
@@ -472,7 +482,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   }
 
   if (top.has("dem")) {
-    const Section d = top.section("dem", {"endpoint", "backend", "threads", "timeout_s", "server_key"});
+    const Section d =
+        top.section("dem", {"endpoint", "backend", "threads", "timeout_s", "server_key"});
     c.dem.endpoint = d.string("endpoint", std::string(),
                               "endpoint of a running coredem-dem, e.g. tcp://127.0.0.1:5555");
     if (!c.dem.endpoint.empty() && c.dem.endpoint.rfind("tcp://", 0) != 0 &&
@@ -483,8 +494,9 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     c.dem.threads = int(d.integer("threads", 0, 0, 4096, "OpenMP threads, 0 = default"));
     c.dem.timeoutSeconds = d.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
     if (d.has("server_key")) {
-      const std::string rel = d.string("server_key", std::nullopt,
-                                       "file with the DEM server's CURVE public key (server.public)");
+      const std::string rel =
+          d.string("server_key", std::nullopt,
+                   "file with the DEM server's CURVE public key (server.public)");
       c.dem.serverKey = fs::absolute(caseDir / rel);
       if (!fs::is_regular_file(c.dem.serverKey)) {
         d.fail(d.markOf("server_key"), "dem.server_key",
@@ -513,8 +525,9 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
 
   if (top.has("checkpoint")) {
     const Section k = top.section("checkpoint", {"every_steps", "every_seconds", "keep"});
-    c.checkpoint.everySteps = k.integer("every_steps", 0, 0, std::numeric_limits<std::int64_t>::max(),
-                                        "steps between checkpoints, 0 = off");
+    c.checkpoint.everySteps =
+        k.integer("every_steps", 0, 0, std::numeric_limits<std::int64_t>::max(),
+                  "steps between checkpoints, 0 = off");
     c.checkpoint.everySeconds = k.number("every_seconds", 0.0, 0.0, kBig,
                                          "wall-clock seconds between checkpoints, 0 = off");
     c.checkpoint.keep = int(k.integer("keep", 3, 1, 1000000, "checkpoints to keep"));
@@ -523,9 +536,9 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     const Section o = top.section("output", {"every", "timeseries_every"});
     c.output.snapshotEvery = o.integer("every", 0, 0, std::numeric_limits<std::int64_t>::max(),
                                        "steps between particle snapshots, 0 = none");
-    c.output.timeseriesEvery = o.integer("timeseries_every", 1, 1,
-                                         std::numeric_limits<std::int64_t>::max(),
-                                         "steps between timeseries.csv rows");
+    c.output.timeseriesEvery =
+        o.integer("timeseries_every", 1, 1, std::numeric_limits<std::int64_t>::max(),
+                  "steps between timeseries.csv rows");
   }
   return c;
 }

@@ -1,20 +1,19 @@
-#include <coredem/orchestrator/checkpoint.h>
-
-#include <coredem/common/check.h>
-#include <coredem/orchestrator/sha256.h>
-
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
-#include <fcntl.h>
 #include <fstream>
 #include <sstream>
+
+#include <fcntl.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <coredem/common/check.h>
+#include <coredem/orchestrator/checkpoint.h>
+#include <coredem/orchestrator/sha256.h>
 
 namespace fs = std::filesystem;
 
@@ -34,10 +33,18 @@ std::string jsonEscape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-    case '"': out += "\\\""; break;
-    case '\\': out += "\\\\"; break;
-    case '\n': out += "\\n"; break;
-    case '\t': out += "\\t"; break;
+    case '"':
+      out += "\\\"";
+      break;
+    case '\\':
+      out += "\\\\";
+      break;
+    case '\n':
+      out += "\\n";
+      break;
+    case '\t':
+      out += "\\t";
+      break;
     default:
       if (static_cast<unsigned char>(c) < 0x20) {
         char buf[8];
@@ -51,7 +58,9 @@ std::string jsonEscape(const std::string& s) {
   return out;
 }
 
-std::string quoted(const std::string& s) { return "\"" + jsonEscape(s) + "\""; }
+std::string quoted(const std::string& s) {
+  return "\"" + jsonEscape(s) + "\"";
+}
 
 std::string formatDouble(double v) {
   char buf[64];
@@ -62,8 +71,8 @@ std::string formatDouble(double v) {
 } // namespace
 
 void writeFileAtomic(const fs::path& path, const std::string& content) {
-  const fs::path tmp = path.parent_path() / (path.filename().string() + ".tmp." +
-                                             std::to_string(::getpid()));
+  const fs::path tmp =
+      path.parent_path() / (path.filename().string() + ".tmp." + std::to_string(::getpid()));
   {
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
     COREDEM_CHECK(fd >= 0, "cannot create '{}': {}", tmp.string(), std::strerror(errno));

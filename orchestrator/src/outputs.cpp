@@ -1,19 +1,18 @@
-#include <coredem/orchestrator/outputs.h>
-
-#include <coredem/common/check.h>
-#include <coredem/orchestrator/checkpoint.h>
-
-#include <hdf5.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <fcntl.h>
 #include <fstream>
 #include <limits>
 #include <sstream>
+
+#include <fcntl.h>
+#include <hdf5.h>
 #include <unistd.h>
+
+#include <coredem/common/check.h>
+#include <coredem/orchestrator/checkpoint.h>
+#include <coredem/orchestrator/outputs.h>
 
 namespace fs = std::filesystem;
 
@@ -131,13 +130,16 @@ std::string typeName(hid_t type) {
   const H5T_class_t cls = H5Tget_class(type);
   const std::size_t size = H5Tget_size(type);
   switch (cls) {
-  case H5T_FLOAT: return size == 8 ? "float64" : "float32";
+  case H5T_FLOAT:
+    return size == 8 ? "float64" : "float32";
   case H5T_INTEGER: {
     const bool isSigned = H5Tget_sign(type) == H5T_SGN_2;
     return fmt::format("{}int{}", isSigned ? "" : "u", size * 8);
   }
-  case H5T_STRING: return "string";
-  default: return "other";
+  case H5T_STRING:
+    return "string";
+  default:
+    return "other";
   }
 }
 
@@ -188,8 +190,8 @@ void scanAttributes(hid_t obj, const std::string& path, ScanState& st) {
   H5Oget_info2(obj, &info, H5O_INFO_NUM_ATTRS);
 #endif
   for (hsize_t i = 0; i < info.num_attrs; ++i) {
-    const hid_t attr = H5Aopen_by_idx(obj, ".", H5_INDEX_NAME, H5_ITER_INC, i, H5P_DEFAULT,
-                                      H5P_DEFAULT);
+    const hid_t attr =
+        H5Aopen_by_idx(obj, ".", H5_INDEX_NAME, H5_ITER_INC, i, H5P_DEFAULT, H5P_DEFAULT);
     if (attr < 0) {
       continue;
     }
@@ -331,8 +333,10 @@ std::string inspectSummary(const fs::path& file) {
     dir = file.parent_path();
   }
   if (fs::is_directory(file) && dir.empty()) {
-    COREDEM_CHECK(false, "'{}' is a folder without manifest.json: give a checkpoint folder, a "
-                         "manifest.json or an HDF5 file", file.string());
+    COREDEM_CHECK(false,
+                  "'{}' is a folder without manifest.json: give a checkpoint folder, a "
+                  "manifest.json or an HDF5 file",
+                  file.string());
   }
   if (!dir.empty()) {
     const Manifest m = readManifest(dir);

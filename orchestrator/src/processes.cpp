@@ -1,18 +1,18 @@
-#include <coredem/orchestrator/processes.h>
-
-#include <coredem/common/check.h>
-#include <coredem/common/log.h>
-
 #include <cerrno>
 #include <csignal>
 #include <cstring>
 #include <deque>
-#include <fcntl.h>
 #include <fstream>
+#include <thread>
+
+#include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
-#include <thread>
 #include <unistd.h>
+
+#include <coredem/common/check.h>
+#include <coredem/common/log.h>
+#include <coredem/orchestrator/processes.h>
 
 extern char** environ;
 
@@ -22,7 +22,8 @@ namespace coredem::orchestrator {
 
 ChildProcess::ChildProcess(std::string name, std::vector<std::string> argv,
                            const std::map<std::string, std::string>& env, const fs::path& logFile)
-    : _name(std::move(name)), _log(logFile) {
+    : _name(std::move(name))
+    , _log(logFile) {
   COREDEM_CHECK(!argv.empty(), "no program given for {}", _name);
   std::vector<std::string> envStrings;
   for (char** e = environ; *e; ++e) {
@@ -47,7 +48,8 @@ ChildProcess::ChildProcess(std::string name, std::vector<std::string> argv,
 
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, logFile.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_addopen(&actions, 1, logFile.c_str(), O_WRONLY | O_CREAT | O_APPEND,
+                                   0644);
   posix_spawn_file_actions_adddup2(&actions, 1, 2);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
   posix_spawnattr_t attr;

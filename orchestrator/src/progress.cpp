@@ -1,10 +1,9 @@
-#include <coredem/orchestrator/progress.h>
-
-#include <coredem/common/log.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+
+#include <coredem/common/log.h>
+#include <coredem/orchestrator/progress.h>
 
 namespace coredem::orchestrator {
 
@@ -25,8 +24,13 @@ std::string formatDuration(double s) {
 
 Progress::Progress(double startTime, double endTime, std::int64_t startStep, bool tty,
                    double logIntervalSeconds)
-    : _t0(startTime), _tEnd(endTime), _step0(startStep), _tty(tty),
-      _interval(logIntervalSeconds), _start(Clock::now()), _lastPrint(_start) {
+    : _t0(startTime)
+    , _tEnd(endTime)
+    , _step0(startStep)
+    , _tty(tty)
+    , _interval(logIntervalSeconds)
+    , _start(Clock::now())
+    , _lastPrint(_start) {
   _sink = [](const std::string& text, bool inPlace) {
     if (inPlace) {
       std::fprintf(stderr, "\r%s\033[K", text.c_str());
@@ -52,8 +56,8 @@ std::string Progress::line(std::int64_t step, double time, Clock::time_point now
   if (done > 0.0 && wall > 0.0) {
     eta = formatDuration(wall * (1.0 - done) / done);
   }
-  return fmt::format("step {}  t = {:.4e} / {:.4e} s ({:.1f}%)  {:.1f} steps/s  ETA {}", step,
-                     time, _tEnd, pct, rate, eta);
+  return fmt::format("step {}  t = {:.4e} / {:.4e} s ({:.1f}%)  {:.1f} steps/s  ETA {}", step, time,
+                     _tEnd, pct, rate, eta);
 }
 
 void Progress::update(std::int64_t step, double time, Clock::time_point now) {

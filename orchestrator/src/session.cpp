@@ -1,16 +1,3 @@
-#include <coredem/orchestrator/session.h>
-
-#include <coredem/common/log.h>
-#include <coredem/orchestrator/checkpoint.h>
-#include <coredem/orchestrator/outputs.h>
-#include <coredem/orchestrator/processes.h>
-#include <coredem/orchestrator/progress.h>
-#include <coredem/orchestrator/sha256.h>
-#include <coredem/orchestrator/time_handler.h>
-#include <coredem/protocol/protocol.h>
-
-#include <yaml-cpp/yaml.h>
-
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -20,7 +7,19 @@
 #include <regex>
 #include <sstream>
 #include <thread>
+
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <coredem/common/log.h>
+#include <coredem/orchestrator/checkpoint.h>
+#include <coredem/orchestrator/outputs.h>
+#include <coredem/orchestrator/processes.h>
+#include <coredem/orchestrator/progress.h>
+#include <coredem/orchestrator/session.h>
+#include <coredem/orchestrator/sha256.h>
+#include <coredem/orchestrator/time_handler.h>
+#include <coredem/protocol/protocol.h>
 
 #ifndef COREDEM_SOFTWARE_VERSION
 #define COREDEM_SOFTWARE_VERSION "0.0.0"
@@ -37,16 +36,21 @@ using protocol::Message;
 using Clock = std::chrono::steady_clock;
 
 std::atomic<bool> gInterrupted{false};
-extern "C" void onSignal(int) { gInterrupted = true; }
+extern "C" void onSignal(int) {
+  gInterrupted = true;
+}
 
 class Interrupted : public UserError {
 public:
-  Interrupted() : UserError("interrupted (SIGINT/SIGTERM)") {}
+  Interrupted()
+      : UserError("interrupted (SIGINT/SIGTERM)") {}
 };
 
 const std::string kDemName = "DEM server coredem-dem";
 
-std::string cfdName(const CaseConfig& c) { return "CFD participant " + c.cfd.participant; }
+std::string cfdName(const CaseConfig& c) {
+  return "CFD participant " + c.cfd.participant;
+}
 
 v1::Vec3 vec(const Vec3& v) {
   v1::Vec3 out;
@@ -66,8 +70,8 @@ double estimateDtDemMax(const CaseConfig& c) {
     const double rho = p.density > 0 ? p.density : m.density;
     const double mass = rho * std::numbers::pi * std::pow(p.diameter, 3) / 6.0;
     const double le = std::log(m.eN);
-    const double t = std::sqrt(std::numbers::pi * std::numbers::pi + le * le) /
-                     std::sqrt(m.kN / (0.5 * mass));
+    const double t =
+        std::sqrt(std::numbers::pi * std::numbers::pi + le * le) / std::sqrt(m.kN / (0.5 * mass));
     tMin = std::min(tMin, t);
   }
   return std::isfinite(tMin) ? tMin / 50.0 : c.dt.dt;
@@ -164,7 +168,8 @@ void collect(const v1::StepDone& done, std::vector<std::pair<std::string, double
   for (const auto& d : done.diagnostics()) {
     row.emplace_back(d.name(), d.value());
   }
-  for (const auto* list : {&done.ledger().mass(), &done.ledger().energy(), &done.ledger().species()}) {
+  for (const auto* list :
+       {&done.ledger().mass(), &done.ledger().energy(), &done.ledger().species()}) {
     for (const auto& v : *list) {
       row.emplace_back(v.name(), v.value());
     }
@@ -208,7 +213,9 @@ void writeSnapshotIndex(const fs::path& runDir, const std::vector<SnapshotEntry>
 class Session {
 public:
   Session(const CaseConfig& config, const RunOptions& options)
-      : _c(config), _o(options), _log(logger("orchestrator.session")) {}
+      : _c(config)
+      , _o(options)
+      , _log(logger("orchestrator.session")) {}
 
   int run();
 
@@ -259,9 +266,9 @@ void Session::checkAlive() {
   }
   if (_demProc) {
     if (auto why = _demProc->exitReason()) {
-      throw ParticipantFault(kDemName, fmt::format("process {} {} (log {}):\n{}", _demProc->pid(),
-                                                   *why, _demProc->logFile().string(),
-                                                   _demProc->logTail()));
+      throw ParticipantFault(kDemName,
+                             fmt::format("process {} {} (log {}):\n{}", _demProc->pid(), *why,
+                                         _demProc->logFile().string(), _demProc->logTail()));
     }
   }
   if (_cfdProc) {
@@ -293,15 +300,23 @@ void Session::startDem() {
     _log->info("using the DEM server at {}", _demEndpoint);
   } else {
     const fs::path exe = findProgram("coredem-dem");
-    COREDEM_CHECK(!exe.empty(), "coredem-dem not found next to coredem ({}) or on PATH; build it "
-                                "(cmake --build build --target coredem-dem)",
+    COREDEM_CHECK(!exe.empty(),
+                  "coredem-dem not found next to coredem ({}) or on PATH; build it "
+                  "(cmake --build build --target coredem-dem)",
                   executableDir().string());
     const fs::path epFile = _o.runDir / "logs" / "dem.endpoint";
     fs::remove(epFile);
-    std::vector<std::string> argv = {exe.string(),   "--bind",       "tcp://127.0.0.1:*",
-                                     "--backend",    _c.dem.backend, "--exit-after-session",
-                                     "--endpoint-file", epFile.string(), "--timeout-s",
-                                     fmt::format("{}", std::max(_c.dem.timeoutSeconds, _c.cfd.timeoutSeconds) * 2)};
+    std::vector<std::string> argv = {
+        exe.string(),
+        "--bind",
+        "tcp://127.0.0.1:*",
+        "--backend",
+        _c.dem.backend,
+        "--exit-after-session",
+        "--endpoint-file",
+        epFile.string(),
+        "--timeout-s",
+        fmt::format("{}", std::max(_c.dem.timeoutSeconds, _c.cfd.timeoutSeconds) * 2)};
     if (_c.dem.threads > 0) {
       argv.insert(argv.end(), {"--threads", std::to_string(_c.dem.threads)});
     }
@@ -327,8 +342,8 @@ void Session::startDem() {
   _dem->send(std::move(hello));
   Message welcome;
   try {
-    welcome = receiveFromDem(std::chrono::milliseconds(int(_c.dem.timeoutSeconds * 1000)),
-                             "Welcome");
+    welcome =
+        receiveFromDem(std::chrono::milliseconds(int(_c.dem.timeoutSeconds * 1000)), "Welcome");
   } catch (const ParticipantFault& e) {
     if (_demProc) {
       throw;
@@ -375,8 +390,8 @@ Message Session::receiveFromDem(std::chrono::milliseconds timeout, const std::st
     checkAlive();
     if (Clock::now() > deadline) {
       _demUnresponsive = true;
-      throw ParticipantFault(kDemName, fmt::format("stopped answering: no {} within {} s",
-                                                   awaited, timeout.count() / 1000.0));
+      throw ParticipantFault(kDemName, fmt::format("stopped answering: no {} within {} s", awaited,
+                                                   timeout.count() / 1000.0));
     }
   }
 }
@@ -389,7 +404,8 @@ protocol::Request Session::receiveFromCfd(std::chrono::milliseconds timeout,
     if (r) {
       if (!r->status.ok()) {
         _ctrl->reply(r->peer, protocol::makeError(r->status, r->message.envelope().sequence()));
-        _log->warn("refused an undecodable message on the control socket: {}", r->status.toString());
+        _log->warn("refused an undecodable message on the control socket: {}",
+                   r->status.toString());
         continue;
       }
       if (r->message.type() == v1::MESSAGE_TYPE_HEARTBEAT) {
@@ -399,9 +415,10 @@ protocol::Request Session::receiveFromCfd(std::chrono::milliseconds timeout,
         continue;
       }
       if (r->message.type() == v1::MESSAGE_TYPE_ERROR) {
-        throw ParticipantFault(cfdName(_c), fmt::format("reported Error {}: {}",
-                                                        protocol::errorCodeName(r->message.envelope().error().code()),
-                                                        r->message.envelope().error().message()));
+        throw ParticipantFault(
+            cfdName(_c), fmt::format("reported Error {}: {}",
+                                     protocol::errorCodeName(r->message.envelope().error().code()),
+                                     r->message.envelope().error().message()));
       }
       return std::move(*r);
     }
@@ -425,8 +442,8 @@ void Session::configureDem(std::int64_t startStep, double startTime, const fs::p
   Message msg = protocol::makeConfigure(_configure);
   msg.setSessionId(_session).setStep(startStep).setTime(startTime);
   _dem->send(std::move(msg));
-  Message reply = receiveFromDem(std::chrono::milliseconds(int(_c.dem.timeoutSeconds * 1000)),
-                                 "Configured");
+  Message reply =
+      receiveFromDem(std::chrono::milliseconds(int(_c.dem.timeoutSeconds * 1000)), "Configured");
   if (reply.type() != v1::MESSAGE_TYPE_CONFIGURED) {
     throw ParticipantFault(kDemName, fmt::format("answered Configure with {}",
                                                  protocol::messageTypeName(reply.type())));
@@ -473,10 +490,10 @@ void Session::startCfd(const fs::path& gasRestart) {
         {"COREDEM_SESSION", _session},
         {"COREDEM_TIMEOUT_S", fmt::format("{}", _c.cfd.timeoutSeconds)},
         // OpenFOAM reads its etc tree while its libraries load: Debian's unless set.
-        {"WM_PROJECT_DIR", std::getenv("WM_PROJECT_DIR") ? std::getenv("WM_PROJECT_DIR")
-                                                         : "/usr/share/openfoam"}};
-    _cfdProc = std::make_unique<ChildProcess>(cfdName(_c), foamArgv, env,
-                                              _o.runDir / "logs" / "cfd.log");
+        {"WM_PROJECT_DIR",
+         std::getenv("WM_PROJECT_DIR") ? std::getenv("WM_PROJECT_DIR") : "/usr/share/openfoam"}};
+    _cfdProc =
+        std::make_unique<ChildProcess>(cfdName(_c), foamArgv, env, _o.runDir / "logs" / "cfd.log");
     _log->info("started {} (pid {})", _c.cfd.participant, _cfdProc->pid());
     return;
   }
@@ -500,8 +517,7 @@ void Session::startCfd(const fs::path& gasRestart) {
   if (!_serverKey.empty()) {
     env["COREDEM_DEM_SERVER_KEY"] = _serverKey;
   }
-  _cfdProc = std::make_unique<ChildProcess>(cfdName(_c), argv, env,
-                                            _o.runDir / "logs" / "cfd.log");
+  _cfdProc = std::make_unique<ChildProcess>(cfdName(_c), argv, env, _o.runDir / "logs" / "cfd.log");
   _log->info("started {} (pid {})", _c.cfd.participant, _cfdProc->pid());
 }
 
@@ -514,8 +530,8 @@ void Session::handshakeCfd() {
     const auto seq = env.sequence();
     if (r.message.type() == v1::MESSAGE_TYPE_HELLO) {
       const auto& h = env.hello();
-      const auto nego = protocol::negotiate(protocol::kProtocolVersion,
-                                            {h.protocol_major(), h.protocol_minor()});
+      const auto nego =
+          protocol::negotiate(protocol::kProtocolVersion, {h.protocol_major(), h.protocol_minor()});
       if (!nego.accepted) {
         Message rej = protocol::makeReject(v1::ERROR_CODE_VERSION, nego.status.message);
         rej.setSequence(seq);
@@ -537,15 +553,16 @@ void Session::handshakeCfd() {
       welcomed = true;
     } else if (r.message.type() == v1::MESSAGE_TYPE_CONFIGURE && welcomed) {
       Message cfg = protocol::makeConfigure(_configure);
-      cfg.setSequence(seq).setSessionId(_session).setStep(_configure.start_step())
+      cfg.setSequence(seq)
+          .setSessionId(_session)
+          .setStep(_configure.start_step())
           .setTime(_configure.start_time());
       _ctrl->reply(r.peer, std::move(cfg));
     } else if (r.message.type() == v1::MESSAGE_TYPE_CONFIGURED && welcomed) {
       const auto& cd = env.configured();
       if (cd.cell_count() != _cells) {
-        throw ParticipantFault(cfdName(_c),
-                               fmt::format("has {} coupling cells, the DEM server {}",
-                                           cd.cell_count(), _cells));
+        throw ParticipantFault(cfdName(_c), fmt::format("has {} coupling cells, the DEM server {}",
+                                                        cd.cell_count(), _cells));
       }
       _pendingCfd = std::move(r); // answered with the first grant
       configured = true;
@@ -569,7 +586,8 @@ void Session::takeSnapshot(std::int64_t step, double time) {
   _dem->send(std::move(req));
   Message done = receiveFromDem(std::chrono::milliseconds(int(_c.dem.timeoutSeconds * 1000)),
                                 "CheckpointDone of a snapshot");
-  if (done.type() != v1::MESSAGE_TYPE_CHECKPOINT_DONE || done.envelope().checkpoint_done().files().empty()) {
+  if (done.type() != v1::MESSAGE_TYPE_CHECKPOINT_DONE ||
+      done.envelope().checkpoint_done().files().empty()) {
     throw ParticipantFault(kDemName, "answered a snapshot request without a file");
   }
   const std::string rel = fmt::format("snapshots/particles_{:08d}.h5", step);
@@ -603,8 +621,8 @@ void Session::stepLoop(std::int64_t startStep) {
     const bool wallDue = _c.checkpoint.everySeconds > 0 &&
                          std::chrono::duration<double>(Clock::now() - lastCheckpointWall).count() >=
                              _c.checkpoint.everySeconds;
-    const bool checkpoint = last || wallDue ||
-                            (_c.checkpoint.everySteps > 0 && step % _c.checkpoint.everySteps == 0);
+    const bool checkpoint =
+        last || wallDue || (_c.checkpoint.everySteps > 0 && step % _c.checkpoint.everySteps == 0);
     fs::path ckDir;
     if (checkpoint) {
       ckDir = fs::absolute(checkpointDir(_o.runDir, step));
@@ -630,21 +648,24 @@ void Session::stepLoop(std::int64_t startStep) {
 
     Message demDone = receiveFromDem(demTimeout, fmt::format("StepDone of step {}", step));
     if (demDone.type() != v1::MESSAGE_TYPE_STEP_DONE || demDone.envelope().step() != step) {
-      throw ParticipantFault(kDemName, fmt::format("answered the grant of step {} with {} of step {}",
-                                                   step, protocol::messageTypeName(demDone.type()),
-                                                   demDone.envelope().step()));
+      throw ParticipantFault(kDemName,
+                             fmt::format("answered the grant of step {} with {} of step {}", step,
+                                         protocol::messageTypeName(demDone.type()),
+                                         demDone.envelope().step()));
     }
     protocol::Request cfdDone;
     while (true) {
       cfdDone = receiveFromCfd(cfdTimeout, fmt::format("StepDone of step {}", step));
-      if (cfdDone.message.type() == v1::MESSAGE_TYPE_STEP_DONE && cfdDone.message.envelope().step() == step) {
+      if (cfdDone.message.type() == v1::MESSAGE_TYPE_STEP_DONE &&
+          cfdDone.message.envelope().step() == step) {
         break;
       }
-      Message err = protocol::makeError(
-          v1::ERROR_CODE_OUT_OF_ORDER,
-          fmt::format("expected StepDone of step {}, got {} of step {}", step,
-                      protocol::messageTypeName(cfdDone.message.type()), cfdDone.message.envelope().step()),
-          cfdDone.message.envelope().sequence(), cfdDone.message.type());
+      Message err =
+          protocol::makeError(v1::ERROR_CODE_OUT_OF_ORDER,
+                              fmt::format("expected StepDone of step {}, got {} of step {}", step,
+                                          protocol::messageTypeName(cfdDone.message.type()),
+                                          cfdDone.message.envelope().step()),
+                              cfdDone.message.envelope().sequence(), cfdDone.message.type());
       _ctrl->reply(cfdDone.peer, std::move(err));
     }
     const auto tDone = Clock::now();
@@ -691,8 +712,12 @@ void Session::stepLoop(std::int64_t startStep) {
     _snapshotSum += std::chrono::duration<double>(tIo2 - tIo1).count();
     if (step % _c.output.timeseriesEvery == 0 || last) {
       std::vector<std::pair<std::string, double>> row = {
-          {"step", double(step)}, {"t", _time.time()}, {"dt", dt}, {"n_sub", double(plan.nSub)},
-          {"dt_dem", plan.dtDem}, {"courant", cd.cfl()},
+          {"step", double(step)},
+          {"t", _time.time()},
+          {"dt", dt},
+          {"n_sub", double(plan.nSub)},
+          {"dt_dem", plan.dtDem},
+          {"courant", cd.cfl()},
           {"wall_step_s", std::chrono::duration<double>(tDone - t0).count()},
           {"wall_dem_s", dd.wall_seconds()}};
       collect(dd, row);
@@ -700,7 +725,8 @@ void Session::stepLoop(std::int64_t startStep) {
       // Heat balance: what the particles got from the gas (DEM) plus what the gas got from
       // the particles (CFD) is zero when both sides agree.
       const auto demHeat = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_from_gas_J");
-      const auto gasHeat = protocol::findNamedValue(cd.ledger().energy(), "gas.heat_from_particles_J");
+      const auto gasHeat =
+          protocol::findNamedValue(cd.ledger().energy(), "gas.heat_from_particles_J");
       if (demHeat && gasHeat) {
         row.emplace_back("balance.heat_residual_J", *demHeat + *gasHeat);
       }
@@ -785,7 +811,8 @@ int Session::run() {
     COREDEM_CHECK(m.configHash == _c.configHash,
                   "{}: case.yaml of the run folder changed since checkpoint {} (config hash {} vs "
                   "{}); resume needs the case the run started with",
-                  _o.runDir.string(), m.step, _c.configHash.substr(0, 12), m.configHash.substr(0, 12));
+                  _o.runDir.string(), m.step, _c.configHash.substr(0, 12),
+                  m.configHash.substr(0, 12));
     for (const auto& f : m.files) {
       if (f.participant == "dem" && initialState.empty()) {
         initialState = *choice.dir / f.path;
@@ -794,7 +821,8 @@ int Session::run() {
         gasRestart = *choice.dir / f.path;
       }
     }
-    COREDEM_CHECK(!initialState.empty(), "checkpoint {} has no DEM state file", choice.dir->string());
+    COREDEM_CHECK(!initialState.empty(), "checkpoint {} has no DEM state file",
+                  choice.dir->string());
     startStep = m.step;
     _time = TimeHandler(m.time, m.timeCompensation);
     _policy = DtPolicy(_c.dt, m.lastDt);
@@ -841,13 +869,13 @@ int Session::run() {
                _measured, 1e3 * _stepWallSum / n, 1e3 * _demWallSum / n,
                1e3 * (_stepWallSum - _demWallSum) / n, 1e6 * _overheadSum / n, _checkpointSum,
                _snapshotSum);
-    writeFileAtomic(_o.runDir / "logs" / "overhead.json",
-                    fmt::format("{{\"steps\": {}, \"step_wall_s\": {:.9g}, \"dem_compute_s\": {:.9g}, "
-                                "\"coupling_overhead_s\": {:.9g}, \"orchestrator_bookkeeping_s\": {:.9g}, "
-                                "\"checkpoints_total_s\": {:.9g}, \"snapshots_total_s\": {:.9g}}}\n",
-                                _measured, _stepWallSum / n, _demWallSum / n,
-                                (_stepWallSum - _demWallSum) / n, _overheadSum / n, _checkpointSum,
-                                _snapshotSum));
+    writeFileAtomic(
+        _o.runDir / "logs" / "overhead.json",
+        fmt::format("{{\"steps\": {}, \"step_wall_s\": {:.9g}, \"dem_compute_s\": {:.9g}, "
+                    "\"coupling_overhead_s\": {:.9g}, \"orchestrator_bookkeeping_s\": {:.9g}, "
+                    "\"checkpoints_total_s\": {:.9g}, \"snapshots_total_s\": {:.9g}}}\n",
+                    _measured, _stepWallSum / n, _demWallSum / n, (_stepWallSum - _demWallSum) / n,
+                    _overheadSum / n, _checkpointSum, _snapshotSum));
   }
   return kExitOk;
 }
@@ -862,8 +890,9 @@ void checkParticipantInput(const CaseConfig& config) {
                   executableDir().string());
   }
   const fs::path exe = findProgram(config.cfd.participant);
-  COREDEM_CHECK(!exe.empty(), "{} not found next to coredem ({}) or on PATH; build it (cmake --build "
-                              "build --target {})",
+  COREDEM_CHECK(!exe.empty(),
+                "{} not found next to coredem ({}) or on PATH; build it (cmake --build "
+                "build --target {})",
                 config.cfd.participant, executableDir().string(), config.cfd.participant);
   if (config.cfd.participant == "coredemFoam") {
     const fs::path src = config.caseDir / config.cfd.foamCase;
@@ -881,10 +910,10 @@ void checkParticipantInput(const CaseConfig& config) {
   COREDEM_CHECK(fd >= 0, "cannot create a temporary file");
   ::close(fd);
   {
-    ChildProcess check("coredem-gas --check",
-                       {exe.string(), "--case", config.caseFile.string(), "--key",
-                        config.cfd.gasKey, "--check"},
-                       {}, tmpl);
+    ChildProcess check(
+        "coredem-gas --check",
+        {exe.string(), "--case", config.caseFile.string(), "--key", config.cfd.gasKey, "--check"},
+        {}, tmpl);
     if (!check.waitFor(30000ms)) {
       check.stop();
     }
@@ -946,7 +975,8 @@ fs::path prepareRunDir(const CaseConfig& config, const std::optional<fs::path>& 
 }
 
 CaseConfig loadRunCase(const fs::path& runDir) {
-  COREDEM_CHECK(fs::is_regular_file(runDir / "case.yaml") && fs::is_regular_file(runDir / "run.json"),
+  COREDEM_CHECK(fs::is_regular_file(runDir / "case.yaml") &&
+                    fs::is_regular_file(runDir / "run.json"),
                 "{} is not a run folder (no case.yaml/run.json); give the folder that "
                 "'coredem run' created",
                 runDir.string());

@@ -1,9 +1,8 @@
-#include <coredem/orchestrator/time_handler.h>
-
-#include <coredem/common/check.h>
-
 #include <algorithm>
 #include <cmath>
+
+#include <coredem/common/check.h>
+#include <coredem/orchestrator/time_handler.h>
 
 namespace coredem::orchestrator {
 
@@ -12,7 +11,9 @@ bool timeEquals(double a, double b, double tol) {
   return std::abs(a - b) <= tol * scale;
 }
 
-TimeHandler::TimeHandler(double time, double compensation) : _sum(time), _carry(compensation) {}
+TimeHandler::TimeHandler(double time, double compensation)
+    : _sum(time)
+    , _carry(compensation) {}
 
 void TimeHandler::advance(double dt) {
   COREDEM_ASSERT(dt > 0.0 && std::isfinite(dt));
@@ -32,7 +33,8 @@ bool TimeHandler::reached(double tEnd) const {
 }
 
 DtPolicy::DtPolicy(const DtPolicyConfig& config, double lastDt)
-    : _config(config), _last(lastDt > 0.0 ? lastDt : config.dt) {}
+    : _config(config)
+    , _last(lastDt > 0.0 ? lastDt : config.dt) {}
 
 double DtPolicy::next(double courant, double remaining) {
   COREDEM_ASSERT(remaining > 0.0);
@@ -40,8 +42,8 @@ double DtPolicy::next(double courant, double remaining) {
   if (_config.kind == DtPolicyConfig::Kind::Courant) {
     dt = _last;
     if (courant >= 0.0) {
-      const double factor =
-          courant > 0.0 ? std::min(_config.courant / courant, _config.maxGrowth) : _config.maxGrowth;
+      const double factor = courant > 0.0 ? std::min(_config.courant / courant, _config.maxGrowth)
+                                          : _config.maxGrowth;
       dt = _last * factor;
     }
     dt = std::clamp(dt, _config.dtMin, _config.dtMax);

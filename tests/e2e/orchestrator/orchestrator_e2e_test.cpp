@@ -1,25 +1,25 @@
 // End-to-end tests of `coredem run/resume` with the real DEM server and coredem-gas:
 // restart identity (200 straight == 100 + resume + 100, bitwise DEM state on the cpu
 // backend), kill -9 of the DEM server (with and without --auto-restart), bad case files.
-#include <gtest/gtest.h>
-#include <hdf5.h>
-
 #include <algorithm>
 #include <chrono>
 #include <csignal>
-#include <fcntl.h>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <regex>
-#include <spawn.h>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 #include <thread>
-#include <unistd.h>
 #include <vector>
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 extern char** environ;
 namespace fs = std::filesystem;
@@ -31,8 +31,8 @@ const fs::path kBin = COREDEM_BIN_DIR;
 const fs::path kCases = COREDEM_E2E_CASES;
 
 fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() /
-                     ("coredem-e2e-" + std::to_string(::getpid()) + "-" + name);
+  const fs::path d =
+      fs::temp_directory_path() / ("coredem-e2e-" + std::to_string(::getpid()) + "-" + name);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -171,7 +171,8 @@ void expectSameDemState(const fs::path& a, const fs::path& b) {
       continue;
     }
     ASSERT_TRUE(db.count(name)) << name << " missing in " << b;
-    EXPECT_TRUE(bytes == db.at(name)) << "dataset " << name << " differs between " << a << " and " << b;
+    EXPECT_TRUE(bytes == db.at(name))
+        << "dataset " << name << " differs between " << a << " and " << b;
     ++compared;
   }
   EXPECT_GE(compared, 5u);
@@ -214,13 +215,15 @@ TEST_F(CoredemE2E, RestartIdentity) {
   const fs::path a = dir / "straight", b = dir / "split";
   ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", a.string()}, dir / "a.log"), 0)
       << readAll(dir / "a.log");
-  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", b.string(), "--stop-after", "100", "--no-plots"},
+  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", b.string(), "--stop-after", "100",
+                        "--no-plots"},
                        dir / "b1.log"),
             0)
       << readAll(dir / "b1.log");
   ASSERT_TRUE(fs::exists(b / "checkpoints/00000100/manifest.json"));
   ASSERT_FALSE(fs::exists(b / finalCheckpoint));
-  ASSERT_EQ(runCoredem({"resume", b.string(), "--no-plots"}, dir / "b2.log"), 0) << readAll(dir / "b2.log");
+  ASSERT_EQ(runCoredem({"resume", b.string(), "--no-plots"}, dir / "b2.log"), 0)
+      << readAll(dir / "b2.log");
   EXPECT_NE(readAll(dir / "b2.log").find("resuming"), std::string::npos);
   expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(b / finalCheckpoint));
   // Same number of rows, and the simulated time column identical.
@@ -247,12 +250,13 @@ TEST_F(CoredemE2E, RestartIdentity) {
 // checkpoint and ends in the same state as an uninterrupted run.
 TEST_F(CoredemE2E, KillDemServerAutoRestart) {
   const fs::path a = dir / "straight", k = dir / "killed";
-  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", a.string(), "--no-plots"},
-                       dir / "a.log"),
-            0)
+  ASSERT_EQ(
+      runCoredem({"run", restartCase.string(), "--out", a.string(), "--no-plots"}, dir / "a.log"),
+      0)
       << readAll(dir / "a.log");
   const pid_t o = startCoredem(
-      {"run", restartCase.string(), "--out", k.string(), "--auto-restart", "1", "--no-plots"}, dir / "k.log");
+      {"run", restartCase.string(), "--out", k.string(), "--auto-restart", "1", "--no-plots"},
+      dir / "k.log");
   // Kill D once the checkpoint of step 40 is complete (the run is then mid-way).
   const auto end = std::chrono::steady_clock::now() + 40s;
   pid_t killed = 0;
@@ -268,9 +272,9 @@ TEST_F(CoredemE2E, KillDemServerAutoRestart) {
   ASSERT_NE(killed, 0) << "never saw checkpoint 40";
   ASSERT_EQ(waitExit(o, 50s), 0) << readAll(dir / "k.log");
   const std::string log = readAll(dir / "k.log");
-  EXPECT_NE(log.find("DEM server coredem-dem: process " + std::to_string(killed) +
-                     " killed by signal 9"),
-            std::string::npos)
+  EXPECT_NE(
+      log.find("DEM server coredem-dem: process " + std::to_string(killed) + " killed by signal 9"),
+      std::string::npos)
       << log;
   EXPECT_NE(log.find("auto-restart"), std::string::npos) << log;
   expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(k / finalCheckpoint));
@@ -306,7 +310,8 @@ TEST_F(CoredemE2E, KillDemServerReportsAndStops) {
   EXPECT_NE(::kill(gas, 0), 0) << "coredem-gas (pid " << gas << ") still runs";
   EXPECT_TRUE(leftovers(k).empty());
   for (const auto& e : fs::directory_iterator(k / "checkpoints")) {
-    EXPECT_TRUE(fs::exists(e.path() / "manifest.json")) << "incomplete checkpoint left: " << e.path();
+    EXPECT_TRUE(fs::exists(e.path() / "manifest.json"))
+        << "incomplete checkpoint left: " << e.path();
   }
 }
 
@@ -345,7 +350,8 @@ TEST_F(CoredemE2E, HungDemServerMissesDeadline) {
   EXPECT_NE(::kill(dem, 0), 0) << "coredem-dem (pid " << dem << ") still runs";
   EXPECT_TRUE(leftovers(k).empty());
   for (const auto& e : fs::directory_iterator(k / "checkpoints")) {
-    EXPECT_TRUE(fs::exists(e.path() / "manifest.json")) << "incomplete checkpoint left: " << e.path();
+    EXPECT_TRUE(fs::exists(e.path() / "manifest.json"))
+        << "incomplete checkpoint left: " << e.path();
   }
 }
 
@@ -353,8 +359,8 @@ TEST_F(CoredemE2E, HungDemServerMissesDeadline) {
 namespace {
 struct BadCase {
   std::string name;
-  std::string from, to;       // textual edit of the restart case
-  std::string expected;       // message fragment
+  std::string from, to; // textual edit of the restart case
+  std::string expected; // message fragment
 };
 
 std::string editedCase(const std::string& from, const std::string& to) {
@@ -384,21 +390,21 @@ TEST_P(BadCaseTest, ClearMessageExitTwoNothingWritten) {
 
 INSTANTIATE_TEST_SUITE_P(
     Orchestrator, BadCaseTest,
-    ::testing::Values(
-        BadCase{"UnknownKey", "  every_steps: 20", "  every_step: 20",
-                "case.yaml:40:3: checkpoint.every_step: unknown key; allowed keys in "
-                "'checkpoint': every_steps, every_seconds, keep"},
-        BadCase{"WrongType", "  dt: 5.0e-4", "  dt: fast",
-                "case.yaml:6:7: time.dt: expected a number"},
-        BadCase{"MissingFile", "particles:", "initial_state: beads-at-rest.h5\nparticles:",
-                "initial_state: file 'beads-at-rest.h5' not found"},
-        BadCase{"GasSectionUnknownKey", "  T_g: 500.0", "  T_gas: 500.0", "T_gas"}),
+    ::testing::Values(BadCase{"UnknownKey", "  every_steps: 20", "  every_step: 20",
+                              "case.yaml:40:3: checkpoint.every_step: unknown key; allowed keys in "
+                              "'checkpoint': every_steps, every_seconds, keep"},
+                      BadCase{"WrongType", "  dt: 5.0e-4", "  dt: fast",
+                              "case.yaml:6:7: time.dt: expected a number"},
+                      BadCase{"MissingFile",
+                              "particles:", "initial_state: beads-at-rest.h5\nparticles:",
+                              "initial_state: file 'beads-at-rest.h5' not found"},
+                      BadCase{"GasSectionUnknownKey", "  T_g: 500.0", "  T_gas: 500.0", "T_gas"}),
     [](const auto& info) { return info.param.name; });
 
 TEST(CoredemCli, MissingCaseFolderExitsTwo) {
   const fs::path d = tempDir("nocase");
-  const int rc = runCoredem({"run", (d / "nope").string(), "--out", (d / "run").string()},
-                            d / "log", 30s);
+  const int rc =
+      runCoredem({"run", (d / "nope").string(), "--out", (d / "run").string()}, d / "log", 30s);
   EXPECT_EQ(rc, 2);
   EXPECT_NE(readAll(d / "log").find("case file not found"), std::string::npos);
   EXPECT_FALSE(fs::exists(d / "run"));
@@ -417,9 +423,15 @@ TEST_F(CoredemE2E, CurveRemoteServer) {
                             .c_str()),
             0);
   // Server: CURVE on an ephemeral loopback port, serving sessions one after the other.
-  std::vector<std::string> argv = {(kBin / "coredem-dem").string(), "--bind", "tcp://127.0.0.1:*",
-                                   "--curve-keys", (dir / "keys").string(), "--threads", "1",
-                                   "--endpoint-file", (dir / "endpoint").string()};
+  std::vector<std::string> argv = {(kBin / "coredem-dem").string(),
+                                   "--bind",
+                                   "tcp://127.0.0.1:*",
+                                   "--curve-keys",
+                                   (dir / "keys").string(),
+                                   "--threads",
+                                   "1",
+                                   "--endpoint-file",
+                                   (dir / "endpoint").string()};
   std::vector<char*> c;
   for (auto& a : argv) {
     c.push_back(a.data());
@@ -455,7 +467,8 @@ TEST_F(CoredemE2E, CurveRemoteServer) {
   writeCase("good", dir / "keys" / "server.public");
   writeCase("bad", dir / "other" / "server.public");
 
-  EXPECT_EQ(runCoredem({"run", (dir / "good").string(), "--out", (dir / "run-good").string(), "--no-plots"},
+  EXPECT_EQ(runCoredem({"run", (dir / "good").string(), "--out", (dir / "run-good").string(),
+                        "--no-plots"},
                        dir / "good.log"),
             0)
       << readAll(dir / "good.log") << readAll(dir / "server.log");

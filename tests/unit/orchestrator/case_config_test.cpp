@@ -1,11 +1,11 @@
 // Case schema validation: good cases parse; each kind of error names file, line, key and
 // what is allowed.
-#include <coredem/orchestrator/case_config.h>
+#include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
-#include <fstream>
+#include <coredem/orchestrator/case_config.h>
 
 using namespace coredem::orchestrator;
 namespace fs = std::filesystem;
@@ -120,7 +120,8 @@ TEST(CaseConfig, MissingCaseFolder) {
     loadCase(fs::temp_directory_path() / "coredem-no-such-case");
     FAIL() << "no error";
   } catch (const CaseError& e) {
-    EXPECT_NE(std::string(e.what()).find("coredem-no-such-case: case file not found"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("coredem-no-such-case: case file not found"),
+              std::string::npos)
         << e.what();
   }
 }

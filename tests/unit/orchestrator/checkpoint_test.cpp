@@ -1,12 +1,12 @@
 // Checkpoint manifests: atomic write, verification, resume selection, pruning.
-#include <coredem/orchestrator/checkpoint.h>
-#include <coredem/orchestrator/sha256.h>
-
-#include <gtest/gtest.h>
-
 #include <filesystem>
 #include <fstream>
+
+#include <gtest/gtest.h>
 #include <unistd.h>
+
+#include <coredem/orchestrator/checkpoint.h>
+#include <coredem/orchestrator/sha256.h>
 
 using namespace coredem::orchestrator;
 namespace fs = std::filesystem;

@@ -1,15 +1,15 @@
 // Outputs: timeseries.csv (incl. truncation on resume), XDMF of particle snapshots, inspect.
-#include <coredem/common/check.h>
-#include <coredem/orchestrator/outputs.h>
-#include <coredem/orchestrator/progress.h>
-
-#include <gtest/gtest.h>
-#include <hdf5.h>
-
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+
+#include <gtest/gtest.h>
+#include <hdf5.h>
 #include <unistd.h>
+
+#include <coredem/common/check.h>
+#include <coredem/orchestrator/outputs.h>
+#include <coredem/orchestrator/progress.h>
 
 using namespace coredem::orchestrator;
 namespace fs = std::filesystem;
@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("coredem-out-test-" + std::to_string(::getpid()) + name);
+  const fs::path d =
+      fs::temp_directory_path() / ("coredem-out-test-" + std::to_string(::getpid()) + name);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;

@@ -1,17 +1,16 @@
 // SHA-256 against the FIPS 180-2 example vectors (Appendix B) and the empty string.
-#include <coredem/orchestrator/sha256.h>
-
-#include <gtest/gtest.h>
-
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include <gtest/gtest.h>
+
+#include <coredem/orchestrator/sha256.h>
+
 using namespace coredem::orchestrator;
 
 TEST(Sha256, Fips180_2_OneBlockMessage) {
-  EXPECT_EQ(sha256Hex("abc"),
-            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
 }
 
 TEST(Sha256, Fips180_2_MultiBlockMessage) {

@@ -1,9 +1,9 @@
 // TimeHandler (Kahan summation), dt policy and sub-cycling plan (STYLE §9, §10).
-#include <coredem/orchestrator/time_handler.h>
+#include <cmath>
 
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <coredem/orchestrator/time_handler.h>
 
 using namespace coredem::orchestrator;
 

@@ -4,9 +4,6 @@
 /// and the parsed configuration. Every error names the file, line, key and what is allowed,
 /// and is thrown as CaseError (exit code 2 in the CLI).
 
-#include <coredem/common/check.h>
-#include <coredem/orchestrator/time_handler.h>
-
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -14,6 +11,9 @@
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <coredem/common/check.h>
+#include <coredem/orchestrator/time_handler.h>
 
 namespace coredem::orchestrator {
 
@@ -72,23 +72,23 @@ struct WallsConfig {
 };
 
 struct DemConfig {
-  std::string endpoint;        ///< empty: coredem starts coredem-dem itself
+  std::string endpoint; ///< empty: coredem starts coredem-dem itself
   std::string backend = "cpu";
-  int threads = 0;             ///< 0: let the server choose
-  double timeoutSeconds = 60;  ///< deadline of every request to D
+  int threads = 0;                 ///< 0: let the server choose
+  double timeoutSeconds = 60;      ///< deadline of every request to D
   std::filesystem::path serverKey; ///< file with D's CURVE public key (Z85); empty: no CURVE
 };
 
 struct CfdConfig {
   std::string participant = "coredem-gas";
-  std::string gasKey = "gas";  ///< key of the coredem-gas section
-  std::string foamCase;        ///< coredemFoam: OpenFOAM case folder, relative to the case folder
-  double timeoutSeconds = 60;  ///< deadline for C's next StepDone
+  std::string gasKey = "gas"; ///< key of the coredem-gas section
+  std::string foamCase;       ///< coredemFoam: OpenFOAM case folder, relative to the case folder
+  double timeoutSeconds = 60; ///< deadline for C's next StepDone
 };
 
 struct CheckpointConfig {
-  std::int64_t everySteps = 0;  ///< 0 = off
-  double everySeconds = 0.0;    ///< wall-clock seconds, 0 = off
+  std::int64_t everySteps = 0; ///< 0 = off
+  double everySeconds = 0.0;   ///< wall-clock seconds, 0 = off
   int keep = 3;
 };
 
@@ -99,10 +99,10 @@ struct OutputConfig {
 
 /// A validated case.
 struct CaseConfig {
-  std::filesystem::path caseDir;   ///< absolute
-  std::filesystem::path caseFile;  ///< absolute path of case.yaml
-  std::string text;                ///< the case file's bytes (hashed into the config hash)
-  std::string configHash;          ///< SHA-256 of text
+  std::filesystem::path caseDir;  ///< absolute
+  std::filesystem::path caseFile; ///< absolute path of case.yaml
+  std::string text;               ///< the case file's bytes (hashed into the config hash)
+  std::string configHash;         ///< SHA-256 of text
 
   std::string name;
   std::string description;

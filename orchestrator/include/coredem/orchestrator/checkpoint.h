@@ -34,8 +34,8 @@ struct Manifest {
   double lastCourant = -1.0;     ///< Courant number reported for `step` (-1: none)
   std::string softwareVersion;
   std::string protocolVersion;
-  std::string configHash;        ///< SHA-256 of the run's case.yaml
-  std::string created;           ///< UTC ISO-8601
+  std::string configHash; ///< SHA-256 of the run's case.yaml
+  std::string created;    ///< UTC ISO-8601
   std::vector<ManifestFile> files;
 };
 
@@ -63,7 +63,7 @@ struct SkippedCheckpoint {
 struct ResumeChoice {
   std::optional<std::filesystem::path> dir; ///< the latest complete, verified checkpoint
   std::optional<Manifest> manifest;
-  std::vector<SkippedCheckpoint> skipped;   ///< newer ones that were incomplete or corrupted
+  std::vector<SkippedCheckpoint> skipped; ///< newer ones that were incomplete or corrupted
 };
 
 /// Latest checkpoint under runDir/checkpoints whose manifest exists and whose hashes verify.

@@ -33,9 +33,9 @@ private:
 
 /// One dataset of an HDF5 file.
 struct DatasetInfo {
-  std::string path;                 ///< e.g. "/particles/position"
+  std::string path; ///< e.g. "/particles/position"
   std::vector<std::uint64_t> dims;
-  std::string type;                 ///< "float64", "int64", "string", ...
+  std::string type; ///< "float64", "int64", "string", ...
   bool numeric = false;
   double min = 0, max = 0, mean = 0; ///< for numeric datasets
 };

@@ -26,7 +26,8 @@ public:
 
   const std::string& name() const { return _name; }
   int pid() const { return _pid; }
-  /// nullopt while running; else why it ended ("exited with code 1", "killed by signal 9 (SIGKILL)").
+  /// nullopt while running; else why it ended ("exited with code 1", "killed by signal 9
+  /// (SIGKILL)").
   std::optional<std::string> exitReason();
   /// Exit code when it exited normally (after exitReason() reported an end), else -1.
   int exitCode() const { return _exitCode; }

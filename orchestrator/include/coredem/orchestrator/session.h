@@ -5,13 +5,13 @@
 /// sub-cycling plan, coordinated checkpoints, snapshots, timeseries and progress. Faults of a
 /// participant (death, missed deadline, Error reply) are reported by name and reason.
 
-#include <coredem/common/check.h>
-#include <coredem/orchestrator/case_config.h>
-
 #include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
+
+#include <coredem/common/check.h>
+#include <coredem/orchestrator/case_config.h>
 
 namespace coredem::orchestrator {
 
@@ -20,7 +20,8 @@ namespace coredem::orchestrator {
 class ParticipantFault : public UserError {
 public:
   ParticipantFault(std::string participant, const std::string& reason)
-      : UserError(participant + ": " + reason), _participant(std::move(participant)) {}
+      : UserError(participant + ": " + reason)
+      , _participant(std::move(participant)) {}
   const std::string& participant() const { return _participant; }
 
 private:
@@ -28,18 +29,18 @@ private:
 };
 
 struct RunOptions {
-  std::filesystem::path runDir;         ///< created by prepareRunDir
-  int autoRestart = 0;                  ///< relaunch + resume this many times after a fault
+  std::filesystem::path runDir;              ///< created by prepareRunDir
+  int autoRestart = 0;                       ///< relaunch + resume this many times after a fault
   std::optional<std::int64_t> stopAfterStep; ///< stop (with a checkpoint) after this step
-  bool resume = false;                  ///< continue from the latest complete checkpoint
-  bool tty = false;                     ///< progress as an updating line
+  bool resume = false;                       ///< continue from the latest complete checkpoint
+  bool tty = false;                          ///< progress as an updating line
 };
 
 /// Exit codes of `coredem`.
 enum ExitCode : int {
   kExitOk = 0,
-  kExitFault = 1,      ///< a participant failed, or another run-time error
-  kExitBadInput = 2,   ///< case file or command line invalid; nothing written
+  kExitFault = 1,    ///< a participant failed, or another run-time error
+  kExitBadInput = 2, ///< case file or command line invalid; nothing written
   kExitInterrupted = 130,
 };
 

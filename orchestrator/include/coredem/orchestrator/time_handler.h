@@ -37,11 +37,11 @@ private:
 struct DtPolicyConfig {
   enum class Kind { Fixed, Courant };
   Kind kind = Kind::Fixed;
-  double dt = 1e-4;            ///< fixed Δt_CFD, and the first Δt of the adaptive policy [s]
-  double dtMin = 0.0;          ///< lower bound of the adaptive policy [s]
-  double dtMax = 0.0;          ///< upper bound of the adaptive policy [s]
-  double courant = 0.5;        ///< target Courant number of the adaptive policy
-  double maxGrowth = 1.2;      ///< largest step-to-step increase factor of the adaptive policy
+  double dt = 1e-4;       ///< fixed Δt_CFD, and the first Δt of the adaptive policy [s]
+  double dtMin = 0.0;     ///< lower bound of the adaptive policy [s]
+  double dtMax = 0.0;     ///< upper bound of the adaptive policy [s]
+  double courant = 0.5;   ///< target Courant number of the adaptive policy
+  double maxGrowth = 1.2; ///< largest step-to-step increase factor of the adaptive policy
 };
 
 /// Chooses Δt_CFD step by step. Fixed: always dt. Courant: dt·C_target/C_reported, growth
