@@ -295,6 +295,7 @@ struct DemServer::Impl {
       return;
     }
     std::unique_ptr<dem::DemSystem> next;
+    std::uint32_t nSub = 0;
     ServerLedgers restored;
     std::vector<std::string> ignored;
     try {
@@ -311,6 +312,10 @@ struct DemServer::Impl {
                     "no stable DEM time step can be derived (dt_dem_max = {}): give the particle "
                     "sets (with an initial state file too, they define the sizes and materials)",
                     next->dtDemMax());
+      if (c.sub_cycling().dt_cfd() > 0.0) {
+        nSub = static_cast<std::uint32_t>(
+            dem::TimeHandler::subStepsFor(c.sub_cycling().dt_cfd(), next->dtDemMax()));
+      }
     } catch (const coredem::UserError& e) {
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION, e.what());
       return;
@@ -334,10 +339,6 @@ struct DemServer::Impl {
     lastStep = c.start_step();
     state = SessionState::Configured;
     const double dtMax = system->dtDemMax();
-    std::uint32_t nSub = 0;
-    if (c.sub_cycling().dt_cfd() > 0.0) {
-      nSub = static_cast<std::uint32_t>(dem::TimeHandler::subStepsFor(c.sub_cycling().dt_cfd(), dtMax));
-    }
     log->info("session {}: configured by '{}': {} particles{}, grid {} x {} x {}, {} gas species, "
               "backend {}, dt_dem_max {:.4g} s, start step {}", session, oName,
               system->particleCount(),
