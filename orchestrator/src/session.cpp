@@ -1,6 +1,7 @@
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <ctime>
 #include <fstream>
 #include <numbers>
@@ -817,7 +818,12 @@ int Session::run() {
       if (f.participant == "dem" && initialState.empty()) {
         initialState = *choice.dir / f.path;
       }
-      if (f.participant == "cfd" && gasRestart.empty()) {
+      // The CFD participant's restart file: coredem-gas's gas.h5, coredemFoam's
+      // coredemFoam.restart (the files of its time directory are listed as well).
+      const bool restartFile = _c.cfd.participant == "coredemFoam"
+                                   ? fs::path(f.path).filename() == "coredemFoam.restart"
+                                   : fs::path(f.path).extension() == ".h5";
+      if (f.participant == "cfd" && gasRestart.empty() && restartFile) {
         gasRestart = *choice.dir / f.path;
       }
     }
@@ -896,10 +902,13 @@ void checkParticipantInput(const CaseConfig& config) {
                 config.cfd.participant, executableDir().string(), config.cfd.participant);
   if (config.cfd.participant == "coredemFoam") {
     const fs::path src = config.caseDir / config.cfd.foamCase;
-    COREDEM_CHECK(fs::is_regular_file(src / "system" / "controlDict") ||
-                      fs::is_regular_file(config.caseDir / "openfoam" / "system" / "controlDict"),
-                  "{}: cfd.case: {} is not an OpenFOAM case folder (no system/controlDict)",
-                  config.caseFile.string(), src.string());
+    if (!fs::is_regular_file(src / "system" / "controlDict") &&
+        !fs::is_regular_file(config.caseDir / "openfoam" / "system" / "controlDict")) {
+      throw CaseError(fmt::format("{}: cfd.case: {} is not an OpenFOAM case folder (no "
+                                  "system/controlDict); give the folder with system/, constant/ "
+                                  "and 0/, relative to the case folder",
+                                  config.caseFile.string(), src.string()));
+    }
     return;
   }
   if (config.cfd.participant != "coredem-gas") {
