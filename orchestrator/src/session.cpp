@@ -451,8 +451,8 @@ void Session::configureDem(std::int64_t startStep, double startTime, const fs::p
   }
   const auto& cd = reply.envelope().configured();
   COREDEM_CHECK(cd.n_sub() >= 1 && cd.dt_dem() > 0, "DEM server replied an invalid plan");
-  // D's Δt_DEM for the first Δt_CFD; used as the Δt_DEM,max bound for all later plans
-  // (exact for fixed Δt, conservative for adaptive Δt).
+  // Configured.dt_dem is D's Δt_DEM,max = t_col,min/50 (its n_sub is for the first Δt_CFD);
+  // every later plan is n_sub = ceil(Δt_CFD/Δt_DEM,max).
   _dtDemMax = cd.dt_dem();
   _cells = cd.cell_count();
   _species = cd.species_count();
@@ -955,10 +955,11 @@ fs::path prepareRunDir(const CaseConfig& config, const std::optional<fs::path>& 
   fs::path dir;
   if (out) {
     dir = *out;
-    COREDEM_CHECK(!fs::exists(dir / "case.yaml"),
-                  "{} already holds a run; continue it with 'coredem resume {}' or choose another "
-                  "--out",
-                  dir.string(), dir.string());
+    if (fs::exists(dir / "case.yaml")) {
+      throw CaseError(fmt::format("{} already holds a run; continue it with 'coredem resume {}' "
+                                  "or choose another --out",
+                                  dir.string(), dir.string()));
+    }
   } else {
     dir = fs::path("runs") / config.name;
     if (fs::exists(dir)) {
