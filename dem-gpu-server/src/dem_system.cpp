@@ -116,6 +116,8 @@ void validate(const DemConfig& c) {
       COREDEM_CHECK(s.positions.size() % 3 == 0 && !s.positions.empty(),
                     "particle set '{}': Explicit packing needs positions as x,y,z triples", s.name);
       const std::size_t n = s.positions.size() / 3;
+      for (double v : s.positions) COREDEM_CHECK(std::isfinite(v), "particle set '{}': a position is not finite", s.name);
+      for (double v : s.velocities) COREDEM_CHECK(std::isfinite(v), "particle set '{}': a velocity is not finite", s.name);
       COREDEM_CHECK(s.velocities.empty() || s.velocities.size() == 3 * n,
                     "particle set '{}': velocities must have 3 values per particle ({}), got {}", s.name, 3 * n, s.velocities.size());
       COREDEM_CHECK(s.angularVelocities.empty() || s.angularVelocities.size() == 3 * n,
@@ -536,6 +538,8 @@ void DemSystem::setVelocities(std::span<const double> velocityByGid, std::span<c
                 "setVelocities: {} velocity values, expected {}", velocityByGid.size(), 3 * s.n);
   COREDEM_CHECK(omegaByGid.empty() || omegaByGid.size() == 3 * s.n,
                 "setVelocities: {} angular velocity values, expected {}", omegaByGid.size(), 3 * s.n);
+  for (double v : velocityByGid) COREDEM_CHECK(std::isfinite(v), "setVelocities: a velocity is not finite");
+  for (double v : omegaByGid) COREDEM_CHECK(std::isfinite(v), "setVelocities: an angular velocity is not finite");
   for (std::size_t i = 0; i < s.n; ++i) {
     const std::size_t g = static_cast<std::size_t>(s.gid[i]);
     COREDEM_CHECK(s.gid[i] >= 0 && g < s.n, "setVelocities: global ids are not 0..N-1 (state read from a file "

@@ -210,8 +210,15 @@ public:
     NbGrid g{};
     double hi[3];
     for (int c = 0; c < 3; ++c) {
-      hi[c] = _exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) { return x[3 * i + c]; }, -HUGE_VAL);
-      g.lo[c] = -_exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) { return -x[3 * i + c]; }, -HUGE_VAL);
+      // NaN → +inf, so a non-finite position is reported below instead of being skipped by max.
+      hi[c] = _exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) {
+        const double v = x[3 * i + c];
+        return v == v ? v : HUGE_VAL;
+      }, -HUGE_VAL);
+      g.lo[c] = -_exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) {
+        const double v = x[3 * i + c];
+        return v == v ? -v : HUGE_VAL;
+      }, -HUGE_VAL);
       if (!std::isfinite(hi[c]) || !std::isfinite(g.lo[c])) {
         backend::raiseUserError("a particle position is not finite (NaN/inf): the DEM step is "
                                 "unstable; reduce the time step (dtCfd/nSub) or check the forces");
@@ -221,11 +228,19 @@ public:
     const double limit = 4.0 * static_cast<double>(n) + 4096.0;
     for (;;) {
       double total = 1.0;
+      double dims[3];
       for (int c = 0; c < 3; ++c) {
-        g.dims[c] = static_cast<int>(std::floor((hi[c] - g.lo[c]) / cs)) + 1;
-        total *= g.dims[c];
+        dims[c] = std::floor((hi[c] - g.lo[c]) / cs) + 1.0;
+        total *= dims[c];
       }
-      if (total <= limit) break;
+      if (!std::isfinite(total)) {
+        backend::raiseUserError("the particles spread over a non-representable region (a particle "
+                                "flew off): the DEM step is unstable; check the forces and time step");
+      }
+      if (total <= limit) {
+        for (int c = 0; c < 3; ++c) g.dims[c] = static_cast<int>(dims[c]);
+        break;
+      }
       cs *= 1.25 * std::cbrt(total / limit);  // sparse domain: coarser cells, still correct
     }
     g.inv = 1.0 / cs;
@@ -615,7 +630,8 @@ public:
       const Vec3 xn = load3(x, ii) + dt * vn;
       store3(x, ii, xn);
       const Vec3 d = xn - load3(xr, ii);
-      return dot(d, d);
+      const double d2 = dot(d, d);
+      return d2 == d2 ? d2 : HUGE_VAL;  // NaN forces a rebuild, which reports it
     }, 0.0);
     _p.produced(kPos | kVel | kOmega);
     return maxDisp2;

@@ -98,3 +98,24 @@ TEST(ParticleCollisions, ConserveMomentumToRoundOff) {
   const auto m1 = momentum(sys.particles());
   for (int d = 0; d < 3; ++d) EXPECT_NEAR(m1[d], m0[d], 1e-13 * scale) << "component " << d;
 }
+
+TEST(BadInput, NonFinitePositionsAreRefusedAndRunawaysSurvive) {
+  DemConfig c;
+  c.gravity = {0, 0, 0};
+  ParticleSet s;
+  s.packing = Packing::Explicit;
+  s.positions = {0, 0, NAN};
+  c.particleSets.push_back(s);
+  EXPECT_THROW(DemSystem(c, BackendKind::Cpu, 1), coredem::UserError);
+  // A particle flung at 1e300 m/s ends ~1e294 m away: the neighbour grid coarsens its cells
+  // (bounded cell count) instead of allocating or overflowing; the run continues.
+  c.particleSets[0].positions = {0, 0, 0, 0.01, 0, 0};
+  c.particleSets[0].velocities = {0, 0, 0, 1e300, 0, 0};
+  DemSystem sys(c, BackendKind::Cpu, 1);
+  for (int k = 0; k < 3; ++k) sys.advance(sys.dtDemMax(), 1);
+  EXPECT_GE(sys.stageTimes().rebuilds, 2u);
+  const ParticleData p = sys.particles();
+  const auto idx = indexByGid(p);
+  EXPECT_GT(p.position[3 * idx[1]], 1e290);
+  EXPECT_EQ(p.position[3 * idx[0]], 0.0);
+}
