@@ -246,6 +246,45 @@ TEST_F(CoredemE2E, RestartIdentity) {
   }
 }
 
+// The same with the CFL-adaptive Δt (Courant number from coredem-gas): the resumed run takes
+// the same Δt sequence (dt policy state in the manifest) and ends in the same state.
+TEST_F(CoredemE2E, AdaptiveRestartIdentity) {
+  const fs::path c = kCases / "restart-adaptive";
+  const fs::path a = dir / "straight", b = dir / "split";
+  ASSERT_EQ(runCoredem({"run", c.string(), "--out", a.string(), "--no-plots"}, dir / "a.log"), 0)
+      << readAll(dir / "a.log");
+  ASSERT_EQ(runCoredem({"run", c.string(), "--out", b.string(), "--stop-after", "30", "--no-plots"},
+                       dir / "b1.log"),
+            0)
+      << readAll(dir / "b1.log");
+  ASSERT_EQ(runCoredem({"resume", b.string(), "--no-plots"}, dir / "b2.log"), 0)
+      << readAll(dir / "b2.log");
+  auto lastCheckpoint = [](const fs::path& run) {
+    fs::path last;
+    for (const auto& e : fs::directory_iterator(run / "checkpoints")) {
+      if (last.empty() || e.path().filename() > last.filename()) {
+        last = e.path();
+      }
+    }
+    return last;
+  };
+  const fs::path la = lastCheckpoint(a), lb = lastCheckpoint(b);
+  ASSERT_EQ(la.filename(), lb.filename());
+  // Δt really adapted: more than one distinct dt in the timeseries.
+  const std::string ts = readAll(a / "timeseries.csv");
+  EXPECT_NE(ts.find("\n2,0.0010999999999999998,0.00059999999999999995,"), std::string::npos)
+      << ts.substr(0, 400);
+  expectSameDemState(demStateOf(la), demStateOf(lb));
+}
+
+TEST(CoredemCli, DefaultCaseIsValid) {
+  const fs::path d = tempDir("check-default");
+  const fs::path defaultCase =
+      kCases.parent_path().parent_path().parent_path().parent_path() / "cases" / "settling-heated";
+  EXPECT_EQ(runCoredem({"check", defaultCase.string()}, d / "log", 30s), 0) << readAll(d / "log");
+  fs::remove_all(d);
+}
+
 // kill -9 of the DEM server mid-run with --auto-restart 1: the run completes from the last
 // checkpoint and ends in the same state as an uninterrupted run.
 TEST_F(CoredemE2E, KillDemServerAutoRestart) {
