@@ -71,13 +71,16 @@ void Progress::update(std::int64_t step, double time, Clock::time_point now) {
   }
   _printedOnce = true;
   _lastPrint = now;
+  _lastPrintedStep = step;
   _sink(line(step, time, now), _tty);
 }
 
 void Progress::finish(std::int64_t step, double time, Clock::time_point now) {
   const std::string text = line(step, time, now);
   if (_tty) {
-    _sink(text, true);
+    if (_lastPrintedStep != step) {
+      _sink(text, true);
+    }
     std::fprintf(stderr, "\n");
   } else {
     _sink(text, false);

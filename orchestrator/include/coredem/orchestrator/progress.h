@@ -40,6 +40,7 @@ private:
   double _interval;
   Clock::time_point _start, _lastPrint;
   bool _printedOnce = false;
+  std::int64_t _lastPrintedStep = -1;
   std::function<void(const std::string&, bool)> _sink;
 };
 
