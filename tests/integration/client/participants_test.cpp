@@ -206,3 +206,23 @@ TEST(Participants, CommandLinesRefuseBadInputWithExitCode2) {
   EXPECT_EQ(noPeers.wait(std::chrono::seconds(20)), 2);
   fs::remove_all(dir);
 }
+
+TEST(Participants, PythonCtypesParticipantRunsAgainstARealServer) {
+  if (std::string(COREDEM_PYTHON).empty()) {
+    GTEST_SKIP() << "no python3 with numpy (COREDEM_PYTHON)";
+  }
+  const auto dir = tempDir("python");
+  DemProcess dem(dir);
+  MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2", "O2"}));
+  auto e = env(o, dem.endpoint());
+  e["COREDEM_CLIENT_LIB"] = COREDEM_CLIENT_SHARED_LIB;
+  Child program({COREDEM_PYTHON, COREDEM_CTYPES_SCRIPT}, e);
+  const auto res = o.run(3, 2e-4);
+  EXPECT_EQ(program.wait(std::chrono::seconds(30)), 0);
+  ASSERT_EQ(res.cfd.size(), 3u);
+  for (const auto& done : res.cfd) {
+    EXPECT_NEAR(named(done.ledger().energy(), "py.solid_volume_m3"), kVp, 1e-12 * kVp);
+  }
+  EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0);
+  fs::remove_all(dir);
+}
