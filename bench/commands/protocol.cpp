@@ -2,8 +2,10 @@
 //
 // Round trip of N cells x F float64 arrays through the protocol transport (a Client sends a
 // message with F arrays of N doubles, an echo Server in a child process - or, with
-// --same-process, in a thread - sends the same arrays back) over tcp loopback and over ipc, compared with a plain memcpy of the same bytes measured in the
-// same run. Figures:
+// --same-process, in a thread - sends the same arrays back) over tcp loopback and over ipc,
+// compared with a plain memcpy of the same bytes measured in the same run. Transport
+// "tcp-raw" (opt-in: --transports tcp,ipc,tcp-raw) does the same exchange with bare cppzmq
+// sockets, bypassing the library, to show the library's own overhead. Figures:
 //   gbps          = 2 * N*F*8 bytes / median round-trip time   (bytes moved per second)
 //   memcpy_gbps   = N*F*8 bytes / median memcpy time
 //   memcpy_ratio  = gbps / memcpy_gbps
@@ -18,6 +20,7 @@
 #include <coredem/protocol/validate.h>
 
 #include <CLI/CLI.hpp>
+#include <zmq.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -192,6 +195,107 @@ Result measureTransport(const std::string& name, const std::string& bindEndpoint
                 times.size()};
 }
 
+/// The same round trip with bare cppzmq (DEALER -> ROUTER echo in a child process): no
+/// envelope, no Message, no validation - the floor set by ZeroMQ and the kernel.
+Result measureRawZmq(const std::vector<std::shared_ptr<std::vector<double>>>& arrays,
+                     std::uint64_t cells, double minSeconds) {
+  int fds[2];
+  if (::pipe(fds) != 0) {
+    throw coredem::UserError("pipe() failed");
+  }
+  pid_t pid = ::fork();
+  if (pid == 0) {
+    ::close(fds[0]);
+    try {
+      zmq::context_t ctx(1);
+      zmq::socket_t router(ctx, zmq::socket_type::router);
+      router.bind("tcp://127.0.0.1:*");
+      std::string ep = router.get(zmq::sockopt::last_endpoint) + "\n";
+      (void)!::write(fds[1], ep.data(), ep.size());
+      ::close(fds[1]);
+      for (;;) {
+        zmq::pollitem_t item{router.handle(), 0, ZMQ_POLLIN, 0};
+        if (zmq::poll(&item, 1, std::chrono::milliseconds(60000)) == 0) {
+          break;
+        }
+        std::vector<zmq::message_t> frames;
+        do {
+          frames.emplace_back();
+          (void)router.recv(frames.back());
+        } while (frames.back().more());
+        bool stop = frames.size() == 2 && frames[1].to_string_view() == "stop";
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+          router.send(std::move(frames[i]),
+                      i + 1 < frames.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
+        }
+        if (stop) {
+          break;
+        }
+      }
+      router.set(zmq::sockopt::linger, 1000);
+    } catch (const zmq::error_t& e) {
+      std::fprintf(stderr, "raw echo: %s\n", e.what());
+      ::_exit(1);
+    }
+    ::_exit(0);
+  }
+  ::close(fds[1]);
+  std::string ep;
+  char c = 0;
+  pollfd pfd{fds[0], POLLIN, 0};
+  while (::poll(&pfd, 1, 10000) > 0 && ::read(fds[0], &c, 1) == 1 && c != '\n') {
+    ep.push_back(c);
+  }
+  ::close(fds[0]);
+  std::vector<double> times;
+  try {
+    zmq::context_t ctx(1);
+    zmq::socket_t dealer(ctx, zmq::socket_type::dealer);
+    dealer.set(zmq::sockopt::linger, 1000);
+    dealer.connect(ep);
+    auto start = Clock::now();
+    for (std::size_t it = 0;; ++it) {
+      auto t0 = Clock::now();
+      dealer.send(zmq::str_buffer("x"), zmq::send_flags::sndmore);
+      for (std::size_t f = 0; f < arrays.size(); ++f) {
+        zmq::message_t m(arrays[f]->data(), cells * sizeof(double), nullptr, nullptr);
+        dealer.send(std::move(m),
+                    f + 1 < arrays.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
+      }
+      zmq::pollitem_t item{dealer.handle(), 0, ZMQ_POLLIN, 0};
+      if (zmq::poll(&item, 1, std::chrono::milliseconds(60000)) == 0) {
+        throw coredem::UserError("raw echo did not answer within 60 s");
+      }
+      std::vector<zmq::message_t> frames;
+      do {
+        frames.emplace_back();
+        (void)dealer.recv(frames.back());
+      } while (frames.back().more());
+      auto t1 = Clock::now();
+      if (it >= 2) {
+        times.push_back(std::chrono::duration<double>(t1 - t0).count());
+      }
+      if (times.size() >= 5 &&
+          std::chrono::duration<double>(Clock::now() - start).count() >= minSeconds) {
+        break;
+      }
+    }
+    dealer.send(zmq::str_buffer("stop"), zmq::send_flags::none);
+    zmq::message_t reply;
+    zmq::pollitem_t item{dealer.handle(), 0, ZMQ_POLLIN, 0};
+    if (zmq::poll(&item, 1, std::chrono::milliseconds(10000)) > 0) {
+      (void)dealer.recv(reply);
+    }
+  } catch (const zmq::error_t& e) {
+    ::kill(pid, SIGTERM);
+    ::waitpid(pid, nullptr, 0);
+    throw coredem::UserError(std::string("raw zmq: ") + e.what());
+  }
+  ::waitpid(pid, nullptr, 0);
+  return Result{"tcp-raw", median(times), *std::min_element(times.begin(), times.end()),
+                times.size()};
+}
+
 double measureMemcpy(std::size_t bytes, double minSeconds) {
   std::vector<char> src(bytes, 1), dst(bytes, 0);
   std::vector<double> times;
@@ -252,7 +356,7 @@ int runProtocolBench(int argc, char** argv) {
   app.add_option("--fields", nFields, "arrays F per message")->check(CLI::PositiveNumber);
   app.add_flag("--json", json, "print one JSON object");
   app.add_option("--seconds", seconds, "minimum measuring time per transport");
-  app.add_option("--transports", transports, "tcp and/or ipc")->delimiter(',');
+  app.add_option("--transports", transports, "tcp, ipc, tcp-raw (bare cppzmq)")->delimiter(',');
   app.add_flag("--same-process", sameProcess,
                "run the echo server as a thread of this process (default: a child process)");
   try {
@@ -284,8 +388,11 @@ int runProtocolBench(int argc, char** argv) {
         results.push_back(measureTransport("ipc", "ipc://" + ipcPath, arrays, cells, seconds,
                                            sameProcess));
         std::filesystem::remove(ipcPath);
+      } else if (t == "tcp-raw") {
+        results.push_back(measureRawZmq(arrays, cells, seconds));
       } else {
-        std::fprintf(stderr, "coredem-bench protocol: unknown transport '%s' (tcp, ipc)\n",
+        std::fprintf(stderr,
+                     "coredem-bench protocol: unknown transport '%s' (tcp, ipc, tcp-raw)\n",
                      t.c_str());
         return 2;
       }
