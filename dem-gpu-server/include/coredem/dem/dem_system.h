@@ -67,7 +67,7 @@ struct ParticleSet {
   double diameter = 1e-3;                      ///< d_p (m)
   double density = 2500.0;                     ///< ρ_p (kg/m³)
   double temperature = 293.15;                 ///< T_p (K)
-  std::vector<double> composition;             ///< solid species mass fractions (sum 1), size = solidSpecies
+  std::vector<double> composition;             ///< solid species mass fractions (sum 1), size = solidSpecies; empty: all in the first
   double spacing = 0.0;                        ///< Lattice spacing (m); 0 = diameter
   std::array<double, 3> velocity{0, 0, 0};     ///< initial velocity (m/s), added to the jitter
   double velocityJitter = 0.0;                 ///< each component + uniform[-a, a] (m/s)
@@ -171,7 +171,10 @@ struct StageTimes {
 };
 
 /// The DEM system: particles, contacts and the sub-cycled integrator on one backend.
-/// Not thread-safe: call from one thread.
+/// Not thread-safe: call from one thread. On the cpu backend results are bitwise
+/// reproducible run to run and independent of the thread count (every particle gathers its
+/// own forces from a full neighbour list; no atomics, no order-dependent reductions).
+/// Integrator: symplectic Euler (v, ω first, then x), one force evaluation per sub-step.
 class DemSystem {
 public:
   /// @pre config valid (UserError otherwise: what is wrong and how to fix it).
@@ -199,7 +202,9 @@ public:
   /// Writes the full state (particles, contact history, neighbour lists, time) to HDF5.
   void writeState(const std::string& path) const;
   /// Replaces the state by the one in `path`; continuing is bitwise identical to not
-  /// having stopped. @pre written by a system with the same config hash.
+  /// having stopped (cpu backend; gas fields must be set again). A system configured without
+  /// particle sets takes all particles from the file; Δt_DEM,max is recomputed from them.
+  /// @pre written by a system with the same config hash (else UserError naming both).
   void readState(const std::string& path);
 
   double time() const;                 ///< simulated time (s)
