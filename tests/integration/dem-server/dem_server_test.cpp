@@ -444,3 +444,43 @@ TEST(DemServer, CurveKeysAdmitOnlyClientsWithTheServerKey) {
   t.join();
   fs::remove_all(dir);
 }
+
+TEST(DemServer, InvalidConfigureIsRefusedAndTheSessionStaysUsable) {
+  ServerThread server;
+  proto::Client o;
+  o.connect(server.endpoint());
+  auto w = o.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "test orchestrator"), 10s);
+  ASSERT_EQ(w.type(), v1::MESSAGE_TYPE_WELCOME);
+  const auto session = w.envelope().welcome().session_id();
+  auto configure = [&](const v1::Configure& c) {
+    auto m = proto::makeConfigure(c);
+    m.setSessionId(session);
+    return o.request(std::move(m), 20s);
+  };
+  // A particle set with a material id that does not exist.
+  auto bad = smallCase(kParticles, kD, kBox, kCells);
+  bad.mutable_particle_sets(0)->set_material_id(7);
+  auto e = configure(bad);
+  ASSERT_EQ(e.type(), v1::MESSAGE_TYPE_ERROR);
+  EXPECT_EQ(e.envelope().error().code(), v1::ERROR_CODE_INVALID_CONFIGURATION) << e.envelope().error().message();
+  // More particles than fit in the region (random packing cannot place them).
+  auto crowded = smallCase(500, kD, kBox, kCells);  // 500 beads need 1.2 times the region
+  auto e2 = configure(crowded);
+  ASSERT_EQ(e2.type(), v1::MESSAGE_TYPE_ERROR);
+  EXPECT_EQ(e2.envelope().error().code(), v1::ERROR_CODE_INVALID_CONFIGURATION) << e2.envelope().error().message();
+  // An initial state file that does not exist.
+  auto missing = smallCase(kParticles, kD, kBox, kCells);
+  missing.set_initial_state_file("/nonexistent/dem.h5");
+  auto e3 = configure(missing);
+  ASSERT_EQ(e3.type(), v1::MESSAGE_TYPE_ERROR);
+  EXPECT_NE(e3.envelope().error().message().find("/nonexistent/dem.h5"), std::string::npos);
+  // A grant before a successful Configure is refused; the valid Configure then works.
+  auto g = proto::makeStepGrant(1, 0.0, 1e-4, 100, 1e-6);
+  g.setSessionId(session);
+  auto e4 = o.request(std::move(g), 10s);
+  ASSERT_EQ(e4.type(), v1::MESSAGE_TYPE_ERROR);
+  EXPECT_EQ(e4.envelope().error().code(), v1::ERROR_CODE_NOT_CONFIGURED);
+  auto ok = configure(smallCase(kParticles, kD, kBox, kCells));
+  ASSERT_EQ(ok.type(), v1::MESSAGE_TYPE_CONFIGURED);
+  EXPECT_EQ(ok.envelope().configured().particle_count(), static_cast<std::uint64_t>(kParticles));
+}
