@@ -149,6 +149,30 @@ std::vector<zmq::message_t> receiveFrames(zmq::socket_t& socket, const std::stri
   return frames;
 }
 
+/// Copies each array for which the BufferProvider returns a buffer into it and releases the
+/// ZeroMQ frame; the message's views then point into the caller's buffers.
+void applyBufferProvider(Message& message, const ReceiveOptions& options) {
+  if (!options.buffers) {
+    return;
+  }
+  auto& impl = MessageAccess::impl(message);
+  for (std::size_t i = 0; i < impl.arrays.size(); ++i) {
+    const auto& d = impl.envelope.arrays(static_cast<int>(i));
+    std::span<std::byte> dst = options.buffers(d);
+    if (dst.empty()) {
+      continue;
+    }
+    Buffer& b = impl.arrays[i];
+    COREDEM_CHECK(dst.size() >= b.size,
+                  "BufferProvider returned {} bytes for array '{}' of {} bytes", dst.size(),
+                  d.name(), b.size);
+    if (b.size) {
+      std::memcpy(dst.data(), b.data, b.size);
+    }
+    b = Buffer{nullptr, dst.data(), b.size};
+  }
+}
+
 /// Decodes received frames [first, end) into a Message; applies the BufferProvider.
 Status decodeFrames(std::vector<zmq::message_t>& frames, std::size_t first, Message& out,
                     const ReceiveOptions& options) {
@@ -165,23 +189,8 @@ Status decodeFrames(std::vector<zmq::message_t>& frames, std::size_t first, Mess
   }
   Status s = decodeInto(out, static_cast<const std::byte*>(keepEnv->data()), keepEnv->size(),
                         std::move(arrays));
-  if (s.ok() && options.buffers) {
-    auto& impl = MessageAccess::impl(out);
-    for (std::size_t i = 0; i < impl.arrays.size(); ++i) {
-      const auto& d = impl.envelope.arrays(static_cast<int>(i));
-      std::span<std::byte> dst = options.buffers(d);
-      if (dst.empty()) {
-        continue;
-      }
-      Buffer& b = impl.arrays[i];
-      COREDEM_CHECK(dst.size() >= b.size,
-                    "BufferProvider returned {} bytes for array '{}' of {} bytes", dst.size(),
-                    d.name(), b.size);
-      if (b.size) {
-        std::memcpy(dst.data(), b.data, b.size);
-      }
-      b = Buffer{nullptr, dst.data(), b.size};
-    }
+  if (s.ok()) {
+    applyBufferProvider(out, options);
   }
   return s;
 }
@@ -428,7 +437,7 @@ Message Client::request(Message message, std::chrono::milliseconds timeout,
     auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
     std::optional<Message> reply;
     if (left.count() > 0) {
-      reply = receive(left, options);
+      reply = receive(left, ReceiveOptions{}); // caller buffers only for the matching reply
     }
     if (!reply) {
       throw TimeoutError(_impl->endpoint, "reply to " + what,
@@ -441,6 +450,7 @@ Message Client::request(Message message, std::chrono::milliseconds timeout,
     const auto& env = reply->envelope();
     if (env.sequence() == seq ||
         (env.sequence() == 0 && reply->type() == v1::MESSAGE_TYPE_ERROR)) {
+      applyBufferProvider(*reply, options);
       return std::move(*reply);
     }
     _impl->log->debug("discarding stale reply {} from {} (awaiting sequence {})",

@@ -162,6 +162,40 @@ TEST(Transport, ReceiveIntoCallerProvidedBuffers) {
   EXPECT_EQ(reply.values<double>("checksum").size(), 8u);
 }
 
+TEST(Transport, BufferProviderSeesOnlyTheMatchingReply) {
+  Server server;
+  std::string ep = server.bind("tcp://127.0.0.1:*");
+  Client client;
+  client.connect(ep);
+  std::thread responder([&] {
+    auto r = server.receive(std::chrono::milliseconds(5000));
+    ASSERT_TRUE(r.has_value());
+    std::vector<double> stale{-1.0, -1.0};
+    std::vector<double> fresh{4.0, 5.0};
+    Message old = makeAck("stale");
+    old.setSequence(r->message.envelope().sequence() + 100); // not the awaited sequence
+    old.addArray<double>("x", stale, {2});
+    server.reply(r->peer, std::move(old));
+    Message match = makeAck("match");
+    match.setSequence(r->message.envelope().sequence());
+    match.addArray<double>("x", fresh, {2});
+    server.reply(r->peer, std::move(match));
+  });
+  std::vector<double> buffer(2, 0.0);
+  int calls = 0;
+  ReceiveOptions options;
+  options.buffers = [&](const v1::ArrayDescriptor&) -> std::span<std::byte> {
+    ++calls;
+    return std::as_writable_bytes(std::span<double>(buffer));
+  };
+  Message m = client.request(makeHeartbeat(), kTimeout, options);
+  responder.join();
+  EXPECT_EQ(m.envelope().ack().note(), "match");
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(buffer, (std::vector<double>{4.0, 5.0}));
+  EXPECT_EQ(m.array("x").bytes.data(), reinterpret_cast<const std::byte*>(buffer.data()));
+}
+
 TEST(Transport, SmallFramesFromTheWireAreAligned) {
   // Tiny arrays travel inside ZeroMQ's receive buffer at arbitrary offsets; the Message
   // must still hand out 8-byte aligned views.

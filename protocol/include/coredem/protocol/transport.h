@@ -159,7 +159,8 @@ public:
   /// (or an Error reply with sequence 0). Assigns the next sequence number when the message's
   /// is 0. Stale replies to earlier timed-out requests are discarded. Returns the reply
   /// whatever its type (use expectType()); throws TimeoutError naming the endpoint and what
-  /// was awaited.
+  /// was awaited. `options.buffers` is applied to the returned reply only (never to
+  /// discarded stale replies).
   Message request(Message message, std::chrono::milliseconds timeout,
                   const ReceiveOptions& options = {});
 
