@@ -216,7 +216,15 @@ bool LoopbackService::serveOne(std::chrono::milliseconds timeout) {
   if (_impl->shutdown) {
     return false;
   }
-  auto req = _impl->server.receive(timeout);
+  std::optional<Request> req;
+  try {
+    req = _impl->server.receive(timeout);
+  } catch (const TransportError& e) {
+    // A socket-level failure must not end the service: log it and go on serving.
+    _impl->log->error("receive failed: {}", e.what());
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    return !_impl->shutdown;
+  }
   if (req) {
     try {
       _impl->handle(*req);
