@@ -790,14 +790,15 @@ void generateCurveKeys(const std::string& dir) {
   const auto pair = proto::generateCurveKeyPair();
   const auto write = [](const fs::path& p, const std::string& key, bool secret) {
     const auto tmp = p.string() + ".tmp";
-    {
-      std::ofstream out(tmp, std::ios::trunc);
-      COREDEM_CHECK(out.good(), "cannot write {}", tmp);
-      out << key << "\n";
-    }
-    if (secret) {
-      ::chmod(tmp.c_str(), 0600);
-    }
+    ::unlink(tmp.c_str());
+    // The secret key is created with mode 0600 (never readable by others, not even briefly).
+    const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL, secret ? 0600 : 0644);
+    COREDEM_CHECK(fd >= 0, "cannot create {}", tmp);
+    const std::string line = key + "\n";
+    const bool ok = ::write(fd, line.data(), line.size()) == static_cast<ssize_t>(line.size()) &&
+                    ::fsync(fd) == 0;
+    ::close(fd);
+    COREDEM_CHECK(ok, "cannot write {}", tmp);
     fs::rename(tmp, p);
   };
   write(fs::path(dir) / "server.public", pair.first, false);
