@@ -106,6 +106,12 @@ void writeFileAtomic(const fs::path& path, const std::string& content) {
   fsyncPath(path.parent_path().empty() ? fs::path(".") : path.parent_path(), true);
 }
 
+bool checkpointDue(std::int64_t step, bool lastStep, std::int64_t everySteps, double everySeconds,
+                   double wallSecondsSinceLast) {
+  return lastStep || (everySteps > 0 && step % everySteps == 0) ||
+         (everySeconds > 0.0 && wallSecondsSinceLast >= everySeconds);
+}
+
 fs::path checkpointDir(const fs::path& runDir, std::int64_t step) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%08lld", static_cast<long long>(step));

@@ -619,11 +619,9 @@ void Session::stepLoop(std::int64_t startStep) {
     TimeHandler probe = _time;
     probe.advance(dt);
     const bool last = probe.reached(_c.endTime) || (_o.stopAfterStep && step >= *_o.stopAfterStep);
-    const bool wallDue = _c.checkpoint.everySeconds > 0 &&
-                         std::chrono::duration<double>(Clock::now() - lastCheckpointWall).count() >=
-                             _c.checkpoint.everySeconds;
     const bool checkpoint =
-        last || wallDue || (_c.checkpoint.everySteps > 0 && step % _c.checkpoint.everySteps == 0);
+        checkpointDue(step, last, _c.checkpoint.everySteps, _c.checkpoint.everySeconds,
+                      std::chrono::duration<double>(Clock::now() - lastCheckpointWall).count());
     fs::path ckDir;
     if (checkpoint) {
       ckDir = fs::absolute(checkpointDir(_o.runDir, step));

@@ -125,6 +125,15 @@ TEST(Checkpoint, AtomicWriteReplaces) {
   EXPECT_EQ(s, "two");
 }
 
+TEST(Checkpoint, DueByStepsWallTimeAndLastStep) {
+  EXPECT_TRUE(checkpointDue(100, false, 50, 0.0, 0.0));
+  EXPECT_FALSE(checkpointDue(101, false, 50, 0.0, 1e9));  // wall-time trigger off
+  EXPECT_TRUE(checkpointDue(101, false, 50, 30.0, 30.0)); // 30 s passed
+  EXPECT_FALSE(checkpointDue(101, false, 50, 30.0, 29.9));
+  EXPECT_TRUE(checkpointDue(7, true, 0, 0.0, 0.0));   // the last step always
+  EXPECT_FALSE(checkpointDue(7, false, 0, 0.0, 0.0)); // all off
+}
+
 TEST(Checkpoint, HexDoubleRoundTrip) {
   for (double v : {0.0, 1e-4, 0.1, -3.5e-300, 1.0 / 3.0}) {
     EXPECT_EQ(doubleFromHex(doubleToHex(v)), v);
