@@ -172,16 +172,16 @@ struct DemServer::Impl {
   }
 
   // ---- session ---------------------------------------------------------------------------
-  void endSession(const std::string& reason) {
+  void endSession(const std::string& reason,
+                  v1::ErrorCode code = v1::ERROR_CODE_UNEXPECTED_MESSAGE) {
     if (state == SessionState::Idle) {
       return;
     }
     if (held) {
-      refuse(held->request, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
-             "the session ended before this step was granted (" + reason + ")");
+      refuse(held->request, code, "the session ended before this step was granted (" + reason + ")");
     }
     if (grant) {
-      auto m = proto::makeError(v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+      auto m = proto::makeError(code,
                                 "the session ended during step " + std::to_string(grant->step) +
                                     " (" + reason + ")",
                                 grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT);
@@ -724,7 +724,8 @@ struct DemServer::Impl {
         std::chrono::duration<double>(now - lastActivity).count() > opt.sessionTimeoutSeconds) {
       endSession(fmt::format("no message from orchestrator '{}' or CFD participant '{}' for {} s "
                              "(--timeout-s)", oName, cName.empty() ? "-" : cName,
-                             opt.sessionTimeoutSeconds));
+                             opt.sessionTimeoutSeconds),
+                 v1::ERROR_CODE_TIMEOUT);
     }
   }
 };
