@@ -1,7 +1,9 @@
 #pragma once
 /// @file
-/// The cpu backend (the reference): OpenMP static schedules over index ranges. Every
-/// parallel loop writes only its own index, so results do not depend on the thread count.
+/// The cpu backend (the reference): OpenMP loops over index ranges. Every parallel loop
+/// writes only its own index, so results do not depend on the thread count or on which
+/// thread runs which index. Dynamic scheduling in chunks of 512 lets a running thread take
+/// over the work of a descheduled one (shared/oversubscribed machines).
 
 #include "../exec_common.h"
 
@@ -27,7 +29,7 @@ struct CpuExec {
   template <class F>
   void parallelFor(std::size_t n, F f) const {
     const std::int64_t m = static_cast<std::int64_t>(n);
-#pragma omp parallel for schedule(static) num_threads(threadCount()) if (m > 256)
+#pragma omp parallel for schedule(dynamic, 512) num_threads(threadCount()) if (m > 256)
     for (std::int64_t i = 0; i < m; ++i) f(static_cast<std::size_t>(i));
   }
 
@@ -35,7 +37,7 @@ struct CpuExec {
   double reduceMax(std::size_t n, F f, double init) const {
     const std::int64_t m = static_cast<std::int64_t>(n);
     double r = init;
-#pragma omp parallel for schedule(static) num_threads(threadCount()) reduction(max : r) if (m > 256)
+#pragma omp parallel for schedule(dynamic, 512) num_threads(threadCount()) reduction(max : r) if (m > 256)
     for (std::int64_t i = 0; i < m; ++i) r = std::max(r, f(static_cast<std::size_t>(i)));
     return r;
   }
