@@ -19,18 +19,29 @@ namespace coredem::testing {
 class Child {
 public:
   Child(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env = {}) {
+    // Everything is prepared before fork(): the child of a multithreaded parent only execs.
+    std::vector<std::string> envStrings;
+    for (char** e = environ; *e != nullptr; ++e) {
+      const std::string entry(*e);
+      const auto eq = entry.find('=');
+      if (env.count(entry.substr(0, eq)) == 0) {
+        envStrings.push_back(entry);
+      }
+    }
+    for (const auto& [k, v] : env) {
+      envStrings.push_back(k + "=" + v);
+    }
+    std::vector<char*> envp, args;
+    for (auto& e : envStrings) envp.push_back(e.data());
+    envp.push_back(nullptr);
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
     _pid = ::fork();
     if (_pid < 0) {
       throw std::runtime_error("fork failed");
     }
     if (_pid == 0) {
-      for (const auto& [k, v] : env) {
-        ::setenv(k.c_str(), v.c_str(), 1);
-      }
-      std::vector<char*> args;
-      for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-      args.push_back(nullptr);
-      ::execv(args[0], args.data());
+      ::execve(args[0], args.data(), envp.data());
       std::_Exit(127);
     }
   }
