@@ -11,6 +11,10 @@
 ///   2. forces: gas (PCM cell: Gidaspow drag, −V_p∇p), particle–particle LSD, walls
 ///   3. cell sources deposited (PCM, sorted by cell, gathered per cell)
 ///   4. motion: v += Δt (F/m + g), ω += Δt T/I, x += Δt v
+/// Why symplectic Euler: one force evaluation per step (the cost is all in the forces), it is
+/// MFiX's default DEM integrator, it is second order in x for conservative forces (leapfrog),
+/// and for the velocity-dependent LSD law velocity Verlet (LIGGGHTS) gave the same rebound
+/// ratios in a binary-collision check (docs/performance.md "Integrator").
 
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
