@@ -113,9 +113,12 @@ std::string hexDouble(double v)
 }
 
 // Writes a field as <dir>/<name> in binary (full precision) with its usual FoamFile header.
+// The header's location is the time name (not where the field was read from), so a restarted
+// run writes the same bytes as an uninterrupted one.
 template<class FieldType>
-void writeBinary(const FieldType& f, const Foam::fileName& dir)
+void writeBinary(FieldType& f, const Foam::fileName& dir)
 {
+    f.instance() = f.time().timeName();
     Foam::OFstream os(dir/f.name(), Foam::IOstream::BINARY);
     f.writeHeader(os);
     f.writeData(os);
