@@ -499,7 +499,7 @@ TEST_F(CoredemE2E, CurveRemoteServer) {
     text.replace(text.find("  end: 0.1"), 10, "  end: 0.01"); // 20 steps
     text.replace(text.find("dem:\n"), 5,
                  "dem:\n  endpoint: " + endpoint + "\n  server_key: " + key.string() + "\n");
-    text.replace(text.find("  timeout_s: 20"), 15, "  timeout_s: 3");
+    text.replace(text.find("  timeout_s: 20"), 15, "  timeout_s: 5");
     fs::create_directories(dir / name);
     std::ofstream(dir / name / "case.yaml") << text;
   };
