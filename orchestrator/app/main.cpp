@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <coredem/common/log.h>
+#include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/outputs.h>
 #include <coredem/orchestrator/processes.h>
@@ -46,6 +47,9 @@ void makePlots(const fs::path& runDir) {
 } // namespace
 
 int main(int argc, char** argv) {
+  if (argc >= 2 && std::string(argv[1]) == "campaign") { // docs/campaigns.md
+    return campaignMain(argc - 1, argv + 1);
+  }
   CLI::App app{"coredem: orchestrates a coupled CFD-DEM run (DEM server + CFD participant)"};
   app.set_version_flag("--version", std::string("coredem ") + COREDEM_SOFTWARE_VERSION);
   app.require_subcommand(1);
@@ -72,6 +76,7 @@ int main(int argc, char** argv) {
   resume->add_option("--stop-after", stopAfter, "as for run");
   resume->add_flag("--no-plots", noPlots, "as for run");
 
+  app.add_subcommand("campaign", "parameter sweeps: campaign run|resume|status|collect ...");
   auto* inspect =
       app.add_subcommand("inspect", "summarise a snapshot/state HDF5 file or a checkpoint");
   inspect->add_option("FILE", file, "HDF5 file, manifest.json or checkpoint folder")->required();

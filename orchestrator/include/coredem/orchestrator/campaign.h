@@ -1,0 +1,59 @@
+#pragma once
+/// @file
+/// Campaigns (docs/campaigns.md): a sweep file names a base case and the case keys to vary;
+/// every member is a complete case folder run by a child `coredem run`, with its state in
+/// SQLite (campaign_db.h) so that `coredem campaign resume` continues after any crash.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace coredem::orchestrator {
+
+/// One scalar result per member, taken from its timeseries.csv: `final` (last row), `max`,
+/// `min` or `mean` of a column. Written as "reduce:column" in the sweep file ("column" alone
+/// means final).
+struct ScalarSpec {
+  std::string reduce = "final";
+  std::string column;
+  std::string label() const { return reduce == "final" ? column : reduce + ":" + column; }
+};
+
+/// One member: the value (YAML text, flow style) of every varied key, in sweep order.
+struct SweepMember {
+  std::string id; ///< m000, m001, ...
+  std::vector<std::pair<std::string, std::string>> values; ///< key path -> YAML value text
+};
+
+/// A validated sweep file.
+struct Sweep {
+  std::filesystem::path file;     ///< absolute
+  std::string text;               ///< its bytes
+  std::string name;               ///< campaign name
+  std::filesystem::path baseCase; ///< absolute case folder
+  std::string executor = "local";
+  int concurrency = 1;
+  int retries = 0; ///< failed attempts tolerated per member beyond the first
+  std::vector<std::string> parameters; ///< key paths, in file order
+  std::vector<SweepMember> members;
+  std::vector<ScalarSpec> scalars;
+  std::string plotX, plotY; ///< summary columns of the plot (default: first key, first scalar)
+  std::vector<std::string> resolvedCases; ///< case.yaml text of every member (validated)
+};
+
+/// Loads SWEEP.yaml, resolves every member's case.yaml from the base case and validates it
+/// with the case schema. Throws CaseError naming the file, line and key; writes nothing.
+Sweep loadSweep(const std::filesystem::path& sweepFile);
+
+/// Sets the key `path` ("gas.T_g", "particles[0].diameter") to the YAML value `valueYaml`
+/// in the case text `caseText`; returns the new case text. Missing mapping keys are created,
+/// sequence indices must exist. Throws CaseError (message names the path) otherwise.
+std::string setCaseKey(const std::string& caseText, const std::string& path,
+                       const std::string& valueYaml);
+
+/// `coredem campaign run|resume|status|collect ...` (argv[0] is "campaign"). Returns the
+/// exit code: 0 all members done, 1 some failed or a run-time error, 2 bad input (nothing
+/// written), 130 interrupted (resumable).
+int campaignMain(int argc, char** argv);
+
+} // namespace coredem::orchestrator

@@ -1,0 +1,762 @@
+// `coredem campaign run|resume|status|collect` (campaign.h, docs/campaigns.md): the local
+// executor runs every member as a child `coredem run` / `coredem resume` process, at most
+// `concurrency` at once, and records every transition in DIR/campaign.db.
+#include <coredem/orchestrator/campaign.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/file.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <coredem/common/check.h>
+#include <coredem/common/log.h>
+#include <coredem/orchestrator/campaign_db.h>
+#include <coredem/orchestrator/case_config.h>
+#include <coredem/orchestrator/checkpoint.h>
+#include <coredem/orchestrator/sha256.h>
+
+extern char** environ;
+
+namespace coredem::orchestrator {
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+constexpr int kOk = 0, kFault = 1, kBadInput = 2, kInterrupted = 130;
+
+std::atomic<int> gSignal{0};
+extern "C" void onCampaignSignal(int sig) { gSignal = sig; }
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path selfDir() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? fs::current_path() : exe.parent_path();
+}
+
+/// Holds an exclusive flock on DIR/campaign.lock for the life of the process: two campaign
+/// processes never work on one folder. The kernel drops it when the process dies (kill -9).
+class FolderLock {
+public:
+  explicit FolderLock(const fs::path& dir) {
+    _fd = ::open((dir / "campaign.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    COREDEM_CHECK(_fd >= 0, "cannot create {}/campaign.lock", dir.string());
+    COREDEM_CHECK(::flock(_fd, LOCK_EX | LOCK_NB) == 0,
+                  "another coredem campaign process is working on {} (wait for it, or stop it "
+                  "and run coredem campaign resume {})",
+                  dir.string(), dir.string());
+  }
+  ~FolderLock() { ::close(_fd); }
+  FolderLock(const FolderLock&) = delete;
+  FolderLock& operator=(const FolderLock&) = delete;
+
+private:
+  int _fd = -1;
+};
+
+/// True when `pid` is a live (not zombie) process whose command line mentions `runDir`.
+bool memberProcessAlive(std::int64_t pid, const std::string& runDir) {
+  if (pid <= 0 || ::kill(static_cast<pid_t>(pid), 0) != 0) {
+    return false;
+  }
+  const fs::path proc = fs::path("/proc") / std::to_string(pid);
+  const std::string stat = readFile(proc / "stat");
+  const auto close = stat.rfind(')');
+  if (close == std::string::npos || close + 2 >= stat.size() || stat[close + 2] == 'Z') {
+    return false;
+  }
+  std::string cmd = readFile(proc / "cmdline");
+  for (auto& c : cmd) {
+    c = c == '\0' ? ' ' : c;
+  }
+  return cmd.find(runDir) != std::string::npos;
+}
+
+/// Newest checkpoint folder with a manifest (no hash check; for the status display).
+std::string newestCheckpointName(const fs::path& runDir) {
+  std::string best;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(runDir / "checkpoints", ec)) {
+    if (fs::exists(e.path() / "manifest.json") && e.path().filename().string() > best) {
+      best = e.path().filename().string();
+    }
+  }
+  return best;
+}
+
+/// The last "[error]" line of the member log after the latest attempt marker.
+std::string lastErrorLine(const fs::path& log) {
+  const std::string text = readFile(log);
+  const auto start = text.rfind("=== campaign attempt");
+  std::istringstream in(start == std::string::npos ? text : text.substr(start));
+  std::string line, err;
+  while (std::getline(in, line)) {
+    if (line.find("[error]") != std::string::npos) {
+      err = line;
+    }
+  }
+  const auto tag = err.find("[error] ");
+  return tag == std::string::npos ? err : err.substr(tag + 8);
+}
+
+std::string csvField(const std::string& v) {
+  if (v.find_first_of(",\"\n") == std::string::npos) {
+    return v;
+  }
+  std::string q = "\"";
+  for (char c : v) {
+    q += c == '"' ? std::string("\"\"") : std::string(1, c);
+  }
+  return q + "\"";
+}
+
+std::string jsonString(const std::string& v) {
+  std::string o = "\"";
+  for (char c : v) {
+    if (c == '"' || c == '\\') {
+      o += '\\';
+      o += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      o += fmt::format("\\u{:04x}", static_cast<int>(c));
+    } else {
+      o += c;
+    }
+  }
+  return o + "\"";
+}
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  std::stringstream ss(line);
+  while (std::getline(ss, cur, ',')) {
+    out.push_back(cur);
+  }
+  if (!line.empty() && line.back() == ',') {
+    out.emplace_back();
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// the local executor
+
+class Runner {
+public:
+  Runner(fs::path dir, CampaignDb& db) : _dir(std::move(dir)), _db(db), _log(logger("campaign")) {
+    _concurrency = std::stoi(_db.setting("concurrency", "1"));
+    _retries = std::stoi(_db.setting("retries", "0"));
+    _coredem = selfDir() / "coredem";
+  }
+
+  /// Runs until every member is done or failed (or a signal arrives). Returns the exit code.
+  int run() {
+    adoptOrRelease();
+    auto lastScan = std::chrono::steady_clock::now();
+    while (true) {
+      if (gSignal != 0) {
+        return interrupt();
+      }
+      reap();
+      startPending();
+      if (_running.empty()) {
+        break;
+      }
+      if (std::chrono::steady_clock::now() - lastScan > 1s) {
+        lastScan = std::chrono::steady_clock::now();
+        for (auto& [id, r] : _running) {
+          const std::string c = newestCheckpointName(r.runDir);
+          if (c != r.lastCheckpoint) {
+            r.lastCheckpoint = c;
+            _db.setLastCheckpoint(id, c);
+          }
+        }
+      }
+      std::this_thread::sleep_for(50ms);
+    }
+    int done = 0, failed = 0, total = 0;
+    for (const auto& m : _db.members()) {
+      ++total;
+      done += m.status == "done";
+      failed += m.status == "failed";
+    }
+    std::printf("campaign %s: %d of %d members done, %d failed; results: coredem campaign "
+                "collect %s\n",
+                _dir.string().c_str(), done, total, failed, _dir.string().c_str());
+    return failed == 0 && done == total ? kOk : kFault;
+  }
+
+private:
+  struct Running {
+    std::int64_t pid = 0;
+    bool adopted = false; ///< started by a previous campaign process: not our child
+    fs::path runDir;
+    std::string lastCheckpoint;
+  };
+
+  /// Members left 'running' by a campaign process that died: a member process that still
+  /// runs is adopted (watched until it ends), the others go back to pending.
+  void adoptOrRelease() {
+    for (const auto& m : _db.members()) {
+      if (m.status != "running") {
+        continue;
+      }
+      if (memberProcessAlive(m.pid, m.runDir)) {
+        _log->info("member {}: process {} of a previous campaign process still runs; waiting "
+                   "for it",
+                   m.id, m.pid);
+        _running[m.id] = {m.pid, true, m.runDir, m.lastCheckpoint};
+        continue;
+      }
+      _db.transaction([&] {
+        if (_db.markInterrupted(m.id, "the campaign process ended while it ran")) {
+          _db.addEvent(m.id, "interrupted", fmt::format("process {} gone", m.pid));
+        }
+      });
+      _log->info("member {}: its process is gone; it continues from its last complete "
+                 "checkpoint",
+                 m.id);
+    }
+  }
+
+  void startPending() {
+    if (gSignal != 0 || static_cast<int>(_running.size()) >= _concurrency) {
+      return;
+    }
+    for (const auto& m : _db.members()) {
+      if (static_cast<int>(_running.size()) >= _concurrency) {
+        return;
+      }
+      if (m.status == "pending" && !_running.count(m.id)) {
+        start(m);
+      }
+    }
+  }
+
+  void start(const MemberRecord& m) {
+    const fs::path runDir = m.runDir;
+    std::vector<std::string> args{_coredem.string()};
+    std::string how;
+    if (selectResumeCheckpoint(runDir).dir) {
+      args.insert(args.end(), {"resume", runDir.string(), "--no-plots"});
+      how = "resume";
+    } else {
+      std::error_code ec;
+      fs::remove_all(runDir, ec);
+      args.insert(args.end(), {"run", m.caseDir, "--out", runDir.string(), "--no-plots"});
+      how = "run";
+    }
+    bool claimed = false;
+    _db.transaction([&] {
+      claimed = _db.markRunning(m.id, "pending");
+      if (claimed) {
+        _db.addEvent(m.id, "start", fmt::format("attempt {}: coredem {}", m.attempts + 1, how));
+      }
+    });
+    if (!claimed) {
+      return;
+    }
+    const fs::path log = fs::path(m.caseDir).parent_path() / "coredem.log";
+    {
+      std::ofstream out(log, std::ios::app);
+      out << "=== campaign attempt " << m.attempts + 1 << " " << utcNow() << ": coredem " << how
+          << "\n";
+    }
+    std::vector<char*> c;
+    for (auto& a : args) {
+      c.push_back(a.data());
+    }
+    c.push_back(nullptr);
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    posix_spawn_file_actions_adddup2(&fa, 1, 2);
+    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
+    posix_spawnattr_t attr;
+    posix_spawnattr_init(&attr);
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP); // own group: stopped as a whole
+    posix_spawnattr_setpgroup(&attr, 0);
+    pid_t pid = -1;
+    const int rc = posix_spawn(&pid, c[0], &fa, &attr, c.data(), environ);
+    posix_spawn_file_actions_destroy(&fa);
+    posix_spawnattr_destroy(&attr);
+    if (rc != 0) {
+      const std::string reason =
+          fmt::format("cannot start {}: {}", _coredem.string(), std::strerror(rc));
+      _db.transaction([&] {
+        _db.markFailed(m.id, reason, _retries);
+        _db.addEvent(m.id, "failed", reason);
+      });
+      return;
+    }
+    _db.setPid(m.id, pid);
+    _log->info("member {}: coredem {} (pid {}, attempt {})", m.id, how, pid, m.attempts + 1);
+    _running[m.id] = {pid, false, runDir, m.lastCheckpoint};
+  }
+
+  void reap() {
+    for (auto it = _running.begin(); it != _running.end();) {
+      const std::string id = it->first;
+      Running& r = it->second;
+      if (r.adopted) {
+        if (memberProcessAlive(r.pid, r.runDir.string())) {
+          ++it;
+          continue;
+        }
+        // Its exit code is lost with the old campaign process: `coredem resume` finds out
+        // (a finished run resumes to its end at once).
+        _db.transaction([&] {
+          if (_db.markInterrupted(id, "adopted process ended")) {
+            _db.addEvent(id, "interrupted", "adopted process ended; continues with resume");
+          }
+        });
+        it = _running.erase(it);
+        continue;
+      }
+      int status = 0;
+      const pid_t w = ::waitpid(static_cast<pid_t>(r.pid), &status, WNOHANG);
+      if (w == 0) {
+        ++it;
+        continue;
+      }
+      finish(id, r, w < 0 ? -1 : status);
+      it = _running.erase(it);
+    }
+  }
+
+  void finish(const std::string& id, const Running& r, int status) {
+    const auto m = _db.member(id);
+    const bool ok = status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    if (ok) {
+      const ResumeChoice c = selectResumeCheckpoint(r.runDir);
+      std::string ckpt, sw, proto;
+      if (c.dir && c.manifest) {
+        ckpt = c.dir->filename().string();
+        sw = c.manifest->softwareVersion;
+        proto = c.manifest->protocolVersion;
+        if (m && c.manifest->configHash != m->caseHash) {
+          _log->warn("member {}: config hash {} of the run differs from the campaign's {}", id,
+                     c.manifest->configHash, m->caseHash);
+        }
+      }
+      _db.transaction([&] {
+        if (_db.markDone(id, ckpt, sw, proto)) {
+          _db.addEvent(id, "done", ckpt);
+        }
+      });
+      _log->info("member {}: done", id);
+      return;
+    }
+    std::string reason;
+    if (status < 0) {
+      reason = "lost track of the process";
+    } else if (WIFEXITED(status)) {
+      reason = fmt::format("exited with code {}", WEXITSTATUS(status));
+    } else if (WIFSIGNALED(status)) {
+      reason = fmt::format("killed by signal {}", WTERMSIG(status));
+    }
+    const std::string err = lastErrorLine(fs::path(m ? m->caseDir : "").parent_path() /
+                                          "coredem.log");
+    if (!err.empty()) {
+      reason += ": " + err;
+    }
+    bool final = false;
+    _db.transaction([&] {
+      _db.markFailed(id, reason, _retries);
+      const auto after = _db.member(id);
+      final = after && after->status == "failed";
+      _db.addEvent(id, final ? "failed" : "retry", reason);
+    });
+    if (final) {
+      _log->error("member {} failed for good ({} attempts): {}", id, m ? m->failures + 1 : 0,
+                  reason);
+    } else {
+      _log->warn("member {} failed ({}); it will be retried", id, reason);
+    }
+  }
+
+  /// SIGINT/SIGTERM: stop our members (they stop at a step and stay resumable), record them
+  /// as pending, exit 130.
+  int interrupt() {
+    _log->warn("signal {}: stopping the running members", gSignal.load());
+    for (auto& [id, r] : _running) {
+      if (!r.adopted) {
+        ::kill(-static_cast<pid_t>(r.pid), SIGTERM);
+      }
+    }
+    const auto deadline = std::chrono::steady_clock::now() + 30s;
+    for (auto& [id, r] : _running) {
+      if (r.adopted) {
+        continue;
+      }
+      int status = 0;
+      while (::waitpid(static_cast<pid_t>(r.pid), &status, WNOHANG) == 0) {
+        if (std::chrono::steady_clock::now() > deadline) {
+          ::kill(-static_cast<pid_t>(r.pid), SIGKILL);
+          ::waitpid(static_cast<pid_t>(r.pid), &status, 0);
+          break;
+        }
+        std::this_thread::sleep_for(50ms);
+      }
+      _db.transaction([&] {
+        if (_db.markInterrupted(id, "campaign interrupted")) {
+          _db.addEvent(id, "interrupted", "campaign interrupted");
+        }
+      });
+    }
+    std::printf("campaign interrupted; continue with: coredem campaign resume %s\n",
+                _dir.string().c_str());
+    return kInterrupted;
+  }
+
+  fs::path _dir;
+  CampaignDb& _db;
+  std::shared_ptr<spdlog::logger> _log;
+  int _concurrency = 1;
+  int _retries = 0;
+  fs::path _coredem;
+  std::map<std::string, Running> _running;
+};
+
+// ---------------------------------------------------------------------------------------
+// commands
+
+/// Creates DIR with one case folder per member and DIR/campaign.db (built as a temp file and
+/// renamed, so a crash during set-up leaves no half campaign).
+void createCampaign(const Sweep& sw, const fs::path& dir) {
+  COREDEM_CHECK(!fs::exists(dir / "campaign.db"),
+                "{} already holds a campaign; continue it with coredem campaign resume {} or "
+                "choose another --out",
+                dir.string(), dir.string());
+  fs::create_directories(dir / "members");
+  writeFileAtomic(dir / "sweep.yaml", sw.text);
+  const fs::path tmp = dir / "campaign.db.tmp";
+  fs::remove(tmp);
+  fs::remove(dir / "campaign.db.tmp-wal");
+  fs::remove(dir / "campaign.db.tmp-shm");
+  {
+    CampaignDb db(tmp, true);
+    db.createSchema();
+    db.transaction([&] {
+      db.setSetting("name", sw.name);
+      db.setSetting("sweep_file", sw.file.string());
+      db.setSetting("base_case", sw.baseCase.string());
+      db.setSetting("executor", sw.executor);
+      db.setSetting("concurrency", std::to_string(sw.concurrency));
+      db.setSetting("retries", std::to_string(sw.retries));
+      db.setSetting("software_version", COREDEM_SOFTWARE_VERSION);
+      db.setSetting("created", utcNow());
+      std::string scalars;
+      for (const auto& s : sw.scalars) {
+        scalars += (scalars.empty() ? "" : "\n") + s.label();
+      }
+      db.setSetting("scalars", scalars);
+      db.setSetting("plot_x", sw.plotX);
+      db.setSetting("plot_y", sw.plotY);
+      for (std::size_t i = 0; i < sw.members.size(); ++i) {
+        const auto& mem = sw.members[i];
+        const fs::path mdir = dir / "members" / mem.id;
+        const fs::path caseDir = mdir / "case";
+        fs::remove_all(mdir);
+        fs::create_directories(caseDir);
+        // the base case's other files (initial_state, cfd.case, ...) as links
+        for (const auto& e : fs::directory_iterator(sw.baseCase)) {
+          if (e.path().filename() != "case.yaml") {
+            fs::create_symlink(e.path(), caseDir / e.path().filename());
+          }
+        }
+        const std::string& text = sw.resolvedCases[i];
+        writeFileAtomic(caseDir / "case.yaml", text);
+        MemberRecord rec;
+        rec.id = mem.id;
+        rec.index = static_cast<int>(i);
+        rec.caseDir = caseDir.string();
+        rec.runDir = (mdir / "run").string();
+        rec.caseHash = sha256Hex(text);
+        rec.values = mem.values;
+        db.addMember(rec);
+        db.addEvent(mem.id, "created", "");
+      }
+    });
+    db.transaction([&] { db.addEvent("", "campaign created", sw.file.string()); });
+  }
+  // fold the WAL into the file before the rename (a -wal file must follow its database)
+  {
+    CampaignDb db(tmp, false);
+    db.setSetting("state", "ready");
+  }
+  fs::remove(dir / "campaign.db.tmp-wal");
+  fs::remove(dir / "campaign.db.tmp-shm");
+  fs::rename(tmp, dir / "campaign.db");
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY);
+  if (fd >= 0) {
+    ::fsync(fd);
+    ::close(fd);
+  }
+}
+
+int runCampaign(const fs::path& dir, bool retryFailed) {
+  FolderLock lock(dir);
+  CampaignDb db(dir / "campaign.db", false);
+  if (retryFailed) {
+    for (const auto& m : db.members()) {
+      if (m.status == "failed") {
+        db.transaction([&] {
+          if (db.resetFailed(m.id)) {
+            db.addEvent(m.id, "retry", "resume --retry-failed");
+          }
+        });
+      }
+    }
+  }
+  std::signal(SIGINT, onCampaignSignal);
+  std::signal(SIGTERM, onCampaignSignal);
+  Runner runner(dir, db);
+  return runner.run();
+}
+
+std::string valuesText(const MemberRecord& m) {
+  std::string s;
+  for (const auto& [path, value] : m.values) {
+    s += (s.empty() ? "" : " ") + path + "=" + value;
+  }
+  return s;
+}
+
+int status(const fs::path& dir, bool json) {
+  CampaignDb db(dir / "campaign.db", false);
+  const auto members = db.members();
+  if (json) {
+    std::ostringstream o;
+    o << "{\"campaign\": " << jsonString(db.setting("name"))
+      << ", \"dir\": " << jsonString(dir.string())
+      << ", \"concurrency\": " << db.setting("concurrency")
+      << ", \"retries\": " << db.setting("retries") << ", \"members\": [";
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      const auto& m = members[i];
+      o << (i ? ", " : "") << "{\"id\": " << jsonString(m.id)
+        << ", \"status\": " << jsonString(m.status) << ", \"attempts\": " << m.attempts
+        << ", \"failures\": " << m.failures << ", \"done_count\": " << m.doneCount
+        << ", \"pid\": " << m.pid << ", \"started\": " << jsonString(m.started)
+        << ", \"finished\": " << jsonString(m.finished)
+        << ", \"last_checkpoint\": " << jsonString(m.lastCheckpoint)
+        << ", \"exit_reason\": " << jsonString(m.exitReason)
+        << ", \"case_hash\": " << jsonString(m.caseHash)
+        << ", \"software_version\": " << jsonString(m.softwareVersion)
+        << ", \"protocol_version\": " << jsonString(m.protocolVersion)
+        << ", \"run_dir\": " << jsonString(m.runDir) << ", \"values\": {";
+      for (std::size_t k = 0; k < m.values.size(); ++k) {
+        o << (k ? ", " : "") << jsonString(m.values[k].first) << ": "
+          << jsonString(m.values[k].second);
+      }
+      o << "}}";
+    }
+    o << "]}\n";
+    std::cout << o.str();
+    return kOk;
+  }
+  std::map<std::string, int> counts;
+  std::printf("campaign %s (%s): concurrency %s, retries %s\n", db.setting("name").c_str(),
+              dir.string().c_str(), db.setting("concurrency").c_str(),
+              db.setting("retries").c_str());
+  std::printf("%-6s %-8s %8s %8s %-10s %-40s %s\n", "member", "status", "attempts", "failures",
+              "checkpoint", "values", "exit reason");
+  for (const auto& m : members) {
+    ++counts[m.status];
+    std::printf("%-6s %-8s %8d %8d %-10s %-40s %s\n", m.id.c_str(), m.status.c_str(),
+                m.attempts, m.failures, m.lastCheckpoint.c_str(), valuesText(m).c_str(),
+                m.exitReason.c_str());
+  }
+  std::printf("%zu members: %d done, %d running, %d pending, %d failed\n", members.size(),
+              counts["done"], counts["running"], counts["pending"], counts["failed"]);
+  return kOk;
+}
+
+/// One scalar of a member's timeseries.csv; "" when the run has no rows yet.
+std::string scalarOf(const fs::path& timeseries, const ScalarSpec& spec) {
+  std::ifstream in(timeseries);
+  std::string header;
+  if (!in || !std::getline(in, header)) {
+    return "";
+  }
+  const auto cols = splitCsvLine(header);
+  const auto at = std::find(cols.begin(), cols.end(), spec.column);
+  COREDEM_CHECK(at != cols.end(), "{}: no column '{}' (collect.scalars); columns: {}",
+                timeseries.string(), spec.column, fmt::join(cols, ", "));
+  const std::size_t c = static_cast<std::size_t>(at - cols.begin());
+  std::string line, last;
+  double sum = 0.0, mx = -HUGE_VAL, mn = HUGE_VAL;
+  std::size_t n = 0;
+  while (std::getline(in, line)) {
+    const auto f = splitCsvLine(line);
+    if (f.size() <= c) {
+      continue;
+    }
+    last = f[c];
+    const double v = std::strtod(f[c].c_str(), nullptr);
+    sum += v;
+    mx = std::max(mx, v);
+    mn = std::min(mn, v);
+    ++n;
+  }
+  if (n == 0) {
+    return "";
+  }
+  if (spec.reduce == "final") {
+    return last;
+  }
+  const double v = spec.reduce == "max" ? mx : spec.reduce == "min" ? mn : sum / n;
+  return fmt::format("{:.17g}", v);
+}
+
+int collect(const fs::path& dir, bool noPlot) {
+  CampaignDb db(dir / "campaign.db", false);
+  const auto members = db.members();
+  std::vector<ScalarSpec> scalars;
+  {
+    std::stringstream ss(db.setting("scalars", "mean_T_p"));
+    std::string t;
+    while (std::getline(ss, t)) {
+      const auto colon = t.find(':');
+      scalars.push_back(colon == std::string::npos
+                            ? ScalarSpec{"final", t}
+                            : ScalarSpec{t.substr(0, colon), t.substr(colon + 1)});
+    }
+  }
+  std::ostringstream csv;
+  csv << "member,status";
+  if (!members.empty()) {
+    for (const auto& [path, value] : members.front().values) {
+      csv << "," << csvField(path);
+    }
+  }
+  for (const auto& s : scalars) {
+    csv << "," << csvField(s.label());
+  }
+  csv << "\n";
+  int done = 0;
+  for (const auto& m : members) {
+    csv << m.id << "," << m.status;
+    for (const auto& [path, value] : m.values) {
+      csv << "," << csvField(value);
+    }
+    for (const auto& s : scalars) {
+      csv << ","
+          << (m.status == "done" ? csvField(scalarOf(fs::path(m.runDir) / "timeseries.csv", s))
+                                 : "");
+    }
+    csv << "\n";
+    done += m.status == "done";
+  }
+  writeFileAtomic(dir / "summary.csv", csv.str());
+  std::printf("summary: %s (%d of %zu members done)\n", (dir / "summary.csv").string().c_str(),
+              done, members.size());
+  if (noPlot) {
+    return kOk;
+  }
+  const fs::path python = COREDEM_PYTHON;
+  const fs::path script = COREDEM_CAMPAIGN_PLOT_SCRIPT;
+  if (python.empty() || !fs::exists(python) || !fs::exists(script)) {
+    logger("campaign")->warn("no plot: python ('{}') or {} not found", python.string(),
+                             script.string());
+    return kOk;
+  }
+  fs::create_directories(dir / "plots");
+  const fs::path png = dir / "plots" / "campaign.png";
+  std::string groups;
+  if (!members.empty()) {
+    for (const auto& [path, value] : members.front().values) {
+      if (path != db.setting("plot_x")) {
+        groups += fmt::format(" --group '{}'", path);
+      }
+    }
+  }
+  const std::string cmd = fmt::format(
+      "'{}' '{}' '{}' --x '{}' --y '{}'{} --title '{}' --out '{}' > '{}' 2>&1", python.string(),
+      script.string(), (dir / "summary.csv").string(), db.setting("plot_x"),
+      db.setting("plot_y"), groups, db.setting("name"), png.string(),
+      (dir / "plots" / "plot.log").string());
+  const int rc = std::system(cmd.c_str());
+  if (rc != 0) {
+    logger("campaign")->warn("plot script failed (see {})", (dir / "plots" / "plot.log").string());
+    return kOk;
+  }
+  std::printf("plot: %s\n", png.string().c_str());
+  return kOk;
+}
+
+} // namespace
+
+int campaignMain(int argc, char** argv) {
+  CLI::App app{"coredem campaign: parameter sweeps of coredem runs that survive crashes "
+               "(docs/campaigns.md)"};
+  app.require_subcommand(1);
+  std::string sweep, out, dir;
+  bool json = false, retryFailed = false, noPlot = false;
+  auto* run = app.add_subcommand("run", "create a campaign from SWEEP.yaml in DIR and run it");
+  run->add_option("SWEEP", sweep, "sweep file")->required();
+  run->add_option("--out", out, "campaign folder (must not hold a campaign)")->required();
+  auto* resume = app.add_subcommand("resume", "continue a campaign after any crash");
+  resume->add_option("DIR", dir, "campaign folder")->required();
+  resume->add_flag("--retry-failed", retryFailed,
+                   "give members that failed for good another round of attempts");
+  auto* st = app.add_subcommand("status", "print the members' state");
+  st->add_option("DIR", dir, "campaign folder")->required();
+  st->add_flag("--json", json, "as JSON");
+  auto* col = app.add_subcommand("collect", "write DIR/summary.csv and DIR/plots/campaign.png");
+  col->add_option("DIR", dir, "campaign folder")->required();
+  col->add_flag("--no-plot", noPlot, "summary.csv only");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kOk : kBadInput;
+  }
+  auto log = logger("campaign");
+  try {
+    if (*run) {
+      const Sweep sw = loadSweep(sweep); // throws CaseError: nothing written
+      const fs::path d = fs::absolute(out);
+      createCampaign(sw, d);
+      log->info("campaign {}: {} members in {}", sw.name, sw.members.size(), d.string());
+      return runCampaign(d, false);
+    }
+    if (*resume) {
+      return runCampaign(fs::absolute(dir), retryFailed);
+    }
+    if (*st) {
+      return status(fs::absolute(dir), json);
+    }
+    return collect(fs::absolute(dir), noPlot);
+  } catch (const CaseError& e) {
+    log->error("{}", e.what());
+    return kBadInput;
+  } catch (const UserError& e) {
+    log->error("{}", e.what());
+    return kFault;
+  } catch (const std::exception& e) {
+    log->error("internal error: {}", e.what());
+    return kFault;
+  }
+}
+
+} // namespace coredem::orchestrator

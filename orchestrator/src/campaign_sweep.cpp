@@ -1,0 +1,400 @@
+// Sweep files: parsing, validation, member expansion and case-key substitution (campaign.h).
+#include <coredem/orchestrator/campaign.h>
+
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include <coredem/orchestrator/case_config.h>
+
+namespace coredem::orchestrator {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// One step of a key path: a mapping key, or (index >= 0) a sequence index.
+struct PathStep {
+  std::string key;
+  long index = -1;
+};
+
+std::vector<PathStep> parsePath(const std::string& path) {
+  static const std::regex segment(R"(([A-Za-z_][A-Za-z0-9_\-]*)((\[[0-9]+\])*))");
+  static const std::regex index(R"(\[([0-9]+)\])");
+  std::vector<PathStep> steps;
+  std::stringstream ss(path);
+  std::string part;
+  bool any = false;
+  while (std::getline(ss, part, '.')) {
+    any = true;
+    std::smatch m;
+    if (!std::regex_match(part, m, segment)) {
+      throw CaseError(fmt::format("'{}': not a case key path (write keys separated by '.', "
+                                  "list entries as [i], e.g. particles[0].diameter)",
+                                  path));
+    }
+    steps.push_back({m[1].str(), -1});
+    const std::string idx = m[2].str();
+    for (std::sregex_iterator it(idx.begin(), idx.end(), index), end; it != end; ++it) {
+      steps.push_back({"", std::stol((*it)[1].str())});
+    }
+  }
+  if (!any || path.back() == '.') {
+    throw CaseError(fmt::format("'{}': not a case key path", path));
+  }
+  return steps;
+}
+
+std::string flowYaml(const YAML::Node& n) {
+  YAML::Emitter e;
+  e.SetMapFormat(YAML::Flow);
+  e.SetSeqFormat(YAML::Flow);
+  e << n;
+  return e.c_str();
+}
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// Error helper for the sweep file: "file:line:col: key: what".
+struct SweepReader {
+  std::string file;
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& key,
+                         const std::string& what) const {
+    const YAML::Mark mk = at.Mark();
+    if (mk.line >= 0) {
+      throw CaseError(fmt::format("{}:{}:{}: {}: {}", file, mk.line + 1, mk.column + 1, key, what));
+    }
+    throw CaseError(fmt::format("{}: {}: {}", file, key, what));
+  }
+  int integer(const YAML::Node& n, const std::string& key, int min, const std::string& what) const {
+    try {
+      const long v = std::stol(n.as<std::string>());
+      std::size_t used = 0;
+      (void)std::stol(n.as<std::string>(), &used);
+      if (used != n.as<std::string>().size() || v < min || v > 100000) {
+        throw std::invalid_argument("range");
+      }
+      return static_cast<int>(v);
+    } catch (const std::exception&) {
+      fail(n, key, fmt::format("expected an integer >= {} ({}), got '{}'", min, what,
+                               n.IsScalar() ? n.as<std::string>() : flowYaml(n)));
+    }
+  }
+};
+
+const std::set<std::string> kTopKeys = {"name",    "description", "base_case", "executor",
+                                        "concurrency", "retries", "grid",      "members",
+                                        "collect"};
+const std::set<std::string> kReduces = {"final", "max", "min", "mean"};
+
+} // namespace
+
+std::string setCaseKey(const std::string& caseText, const std::string& path,
+                       const std::string& valueYaml) {
+  const auto steps = parsePath(path);
+  YAML::Node root = YAML::Load(caseText);
+  const YAML::Node value = YAML::Load(valueYaml);
+  YAML::Node cur = root;
+  std::string walked;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const bool last = i + 1 == steps.size();
+    const PathStep& s = steps[i];
+    const std::string here =
+        walked.empty() ? s.key : (s.index >= 0 ? walked + fmt::format("[{}]", s.index)
+                                               : walked + "." + s.key);
+    if (s.index >= 0) {
+      if (!cur.IsSequence()) {
+        throw CaseError(fmt::format("'{}': '{}' is not a list in the base case", path, walked));
+      }
+      if (static_cast<std::size_t>(s.index) >= cur.size()) {
+        throw CaseError(fmt::format("'{}': index {} out of range ('{}' has {} entries in the "
+                                    "base case)",
+                                    path, s.index, walked, cur.size()));
+      }
+      if (last) {
+        cur[s.index] = YAML::Clone(value);
+      } else {
+        YAML::Node next = cur[s.index];
+        cur.reset(next);
+      }
+    } else {
+      if (!(cur.IsMap() || cur.IsNull())) {
+        throw CaseError(fmt::format("'{}': '{}' is not a mapping in the base case", path,
+                                    walked.empty() ? "the case file" : walked));
+      }
+      if (last) {
+        cur[s.key] = YAML::Clone(value);
+      } else {
+        if (!cur[s.key]) {
+          cur[s.key] = YAML::Node(YAML::NodeType::Map);
+        }
+        YAML::Node next = cur[s.key];
+        cur.reset(next);
+      }
+    }
+    walked = here;
+  }
+  YAML::Emitter e;
+  e << root;
+  return std::string(e.c_str()) + "\n";
+}
+
+Sweep loadSweep(const fs::path& sweepFile) {
+  Sweep sw;
+  sw.file = fs::absolute(sweepFile);
+  SweepReader r{sweepFile.string()};
+  if (!fs::is_regular_file(sw.file)) {
+    throw CaseError(fmt::format("{}: sweep file not found", sweepFile.string()));
+  }
+  sw.text = readFile(sw.file);
+  YAML::Node root;
+  try {
+    root = YAML::Load(sw.text);
+  } catch (const YAML::Exception& e) {
+    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", r.file, e.mark.line + 1,
+                                e.mark.column + 1, e.msg));
+  }
+  if (!root.IsMap()) {
+    throw CaseError(fmt::format("{}: a sweep file is a mapping with base_case and grid or "
+                                "members (docs/campaigns.md)",
+                                r.file));
+  }
+  for (const auto& kv : root) {
+    const std::string k = kv.first.as<std::string>();
+    if (!kTopKeys.count(k)) {
+      r.fail(kv.first, k,
+             "unknown key; allowed keys: name, description, base_case, executor, concurrency, "
+             "retries, grid, members, collect");
+    }
+  }
+  // base case
+  if (!root["base_case"] || !root["base_case"].IsScalar()) {
+    r.fail(root, "base_case", "required: the case folder (or case.yaml) to vary, relative to "
+                              "the sweep file");
+  }
+  fs::path base = root["base_case"].as<std::string>();
+  if (base.is_relative()) {
+    base = sw.file.parent_path() / base;
+  }
+  if (fs::is_regular_file(base)) {
+    base = base.parent_path();
+  }
+  base = fs::weakly_canonical(base);
+  if (!fs::is_regular_file(base / "case.yaml")) {
+    r.fail(root["base_case"], "base_case",
+           fmt::format("no case.yaml in '{}'", base.string()));
+  }
+  sw.baseCase = base;
+  sw.name = root["name"] ? root["name"].as<std::string>() : sw.file.stem().string();
+  if (sw.name.empty() || sw.name.find('/') != std::string::npos) {
+    r.fail(root["name"], "name", "expected a name without '/'");
+  }
+  if (root["executor"]) {
+    sw.executor = root["executor"].as<std::string>();
+    if (sw.executor == "slurm") {
+      r.fail(root["executor"], "executor",
+             "'slurm' is not implemented yet (docs/campaigns.md says how it would work); use "
+             "'local'");
+    }
+    if (sw.executor != "local") {
+      r.fail(root["executor"], "executor",
+             fmt::format("unknown executor '{}'; allowed: local", sw.executor));
+    }
+  }
+  if (root["concurrency"]) {
+    sw.concurrency = r.integer(root["concurrency"], "concurrency", 1, "members run at once");
+  }
+  if (root["retries"]) {
+    sw.retries = r.integer(root["retries"], "retries", 0, "failed attempts retried per member");
+  }
+
+  // parameters: grid (cartesian product, first key varies slowest) or explicit members
+  const YAML::Node grid = root["grid"], members = root["members"];
+  if (static_cast<bool>(grid) == static_cast<bool>(members)) {
+    r.fail(root, grid ? "grid" : "members",
+           "give exactly one of 'grid' (key: [values], all combinations) or 'members' (a list "
+           "of {key: value} mappings)");
+  }
+  auto checkPath = [&](const YAML::Node& keyNode, const std::string& where) {
+    const std::string path = keyNode.as<std::string>();
+    try {
+      parsePath(path);
+    } catch (const CaseError& e) {
+      r.fail(keyNode, where + "." + path, e.what());
+    }
+    return path;
+  };
+  std::vector<std::vector<std::string>> gridValues;
+  if (grid) {
+    if (!grid.IsMap() || grid.size() == 0) {
+      r.fail(grid, "grid", "expected a mapping of case keys to lists of values");
+    }
+    for (const auto& kv : grid) {
+      const std::string path = checkPath(kv.first, "grid");
+      if (!kv.second.IsSequence() || kv.second.size() == 0) {
+        r.fail(kv.second, "grid." + path, "expected a non-empty list of values");
+      }
+      sw.parameters.push_back(path);
+      gridValues.emplace_back();
+      for (const auto& v : kv.second) {
+        gridValues.back().push_back(flowYaml(v));
+      }
+    }
+    std::size_t total = 1;
+    for (const auto& g : gridValues) {
+      total *= g.size();
+    }
+    if (total > 10000) {
+      r.fail(grid, "grid", fmt::format("{} members; at most 10000 per campaign", total));
+    }
+    for (std::size_t m = 0; m < total; ++m) {
+      SweepMember mem;
+      std::size_t rest = m;
+      std::vector<std::size_t> idx(gridValues.size());
+      for (std::size_t k = gridValues.size(); k-- > 0;) {
+        idx[k] = rest % gridValues[k].size();
+        rest /= gridValues[k].size();
+      }
+      for (std::size_t k = 0; k < gridValues.size(); ++k) {
+        mem.values.emplace_back(sw.parameters[k], gridValues[k][idx[k]]);
+      }
+      sw.members.push_back(std::move(mem));
+    }
+  } else {
+    if (!members.IsSequence() || members.size() == 0) {
+      r.fail(members, "members", "expected a non-empty list of {key: value} mappings");
+    }
+    for (std::size_t i = 0; i < members.size(); ++i) {
+      const YAML::Node m = members[i];
+      const std::string where = fmt::format("members[{}]", i);
+      if (!m.IsMap() || m.size() == 0) {
+        r.fail(m, where, "expected a mapping {case key: value}");
+      }
+      SweepMember mem;
+      for (const auto& kv : m) {
+        const std::string path = checkPath(kv.first, where);
+        if (std::find(sw.parameters.begin(), sw.parameters.end(), path) == sw.parameters.end()) {
+          sw.parameters.push_back(path);
+        }
+        mem.values.emplace_back(path, flowYaml(kv.second));
+      }
+      sw.members.push_back(std::move(mem));
+    }
+  }
+  for (std::size_t i = 0; i < sw.members.size(); ++i) {
+    sw.members[i].id = fmt::format("m{:03d}", i);
+  }
+
+  // results
+  sw.scalars = {{"final", "mean_T_p"}};
+  if (const YAML::Node c = root["collect"]) {
+    if (!c.IsMap()) {
+      r.fail(c, "collect", "expected a mapping with scalars and plot");
+    }
+    for (const auto& kv : c) {
+      const std::string k = kv.first.as<std::string>();
+      if (k != "scalars" && k != "plot") {
+        r.fail(kv.first, "collect." + k, "unknown key; allowed keys in 'collect': scalars, plot");
+      }
+    }
+    if (const YAML::Node s = c["scalars"]) {
+      if (!s.IsSequence() || s.size() == 0) {
+        r.fail(s, "collect.scalars", "expected a list like [mean_T_p, max:dem.kinetic_energy_J]");
+      }
+      sw.scalars.clear();
+      for (const auto& v : s) {
+        const std::string t = v.as<std::string>();
+        ScalarSpec spec;
+        const auto colon = t.find(':');
+        spec.column = colon == std::string::npos ? t : t.substr(colon + 1);
+        spec.reduce = colon == std::string::npos ? "final" : t.substr(0, colon);
+        if (!kReduces.count(spec.reduce) || spec.column.empty()) {
+          r.fail(v, "collect.scalars",
+                 fmt::format("'{}': write COLUMN or REDUCE:COLUMN with REDUCE one of final, "
+                             "max, min, mean (COLUMN from timeseries.csv)",
+                             t));
+        }
+        sw.scalars.push_back(spec);
+      }
+    }
+    if (const YAML::Node p = c["plot"]) {
+      if (!p.IsMap()) {
+        r.fail(p, "collect.plot", "expected {x: <swept key>, y: <scalar>}");
+      }
+      if (p["x"]) {
+        sw.plotX = p["x"].as<std::string>();
+        if (std::find(sw.parameters.begin(), sw.parameters.end(), sw.plotX) ==
+            sw.parameters.end()) {
+          r.fail(p["x"], "collect.plot.x",
+                 fmt::format("'{}' is not a swept key; swept: {}", sw.plotX,
+                             fmt::join(sw.parameters, ", ")));
+        }
+      }
+      if (p["y"]) {
+        sw.plotY = p["y"].as<std::string>();
+        bool found = false;
+        for (const auto& s : sw.scalars) {
+          found = found || s.label() == sw.plotY;
+        }
+        if (!found) {
+          r.fail(p["y"], "collect.plot.y",
+                 fmt::format("'{}' is not one of collect.scalars", sw.plotY));
+        }
+      }
+    }
+  }
+  if (sw.plotX.empty()) {
+    sw.plotX = sw.parameters.front();
+  }
+  if (sw.plotY.empty()) {
+    sw.plotY = sw.scalars.front().label();
+  }
+
+  // resolve and validate every member's case (nothing is written)
+  const fs::path baseFile = sw.baseCase / "case.yaml";
+  const std::string baseText = readFile(baseFile);
+  for (const auto& mem : sw.members) {
+    std::string text = baseText;
+    for (const auto& [path, value] : mem.values) {
+      try {
+        text = setCaseKey(text, path, value);
+      } catch (const CaseError& e) {
+        throw CaseError(fmt::format("{}: member {} ({} = {}): {}", r.file, mem.id, path, value,
+                                    e.what()));
+      } catch (const YAML::Exception& e) {
+        throw CaseError(fmt::format("{}: member {} ({} = {}): {}", r.file, mem.id, path, value,
+                                    e.what()));
+      }
+    }
+    std::string header = fmt::format("# campaign {}, member {} of the base case {}:\n", sw.name,
+                                     mem.id, sw.baseCase.string());
+    for (const auto& [path, value] : mem.values) {
+      header += fmt::format("#   {} = {}\n", path, value);
+    }
+    text = header + text;
+    try {
+      // named as the file it becomes, so that line numbers match
+      parseCase(text, fs::path("members") / mem.id / "case" / "case.yaml", sw.baseCase);
+    } catch (const CaseError& e) {
+      std::string vals;
+      for (const auto& [path, value] : mem.values) {
+        vals += (vals.empty() ? "" : ", ") + path + " = " + value;
+      }
+      throw CaseError(fmt::format("{}: member {} ({}) gives an invalid case: {}", r.file,
+                                  mem.id, vals, e.what()));
+    }
+    sw.resolvedCases.push_back(std::move(text));
+  }
+  return sw;
+}
+
+} // namespace coredem::orchestrator

@@ -1,0 +1,75 @@
+#!/usr/bin/env python3
+"""Plot one result of a campaign against one swept key (docs/campaigns.md).
+
+    campaign_plot.py DIR/summary.csv --x gas.T_g --y mean_T_p --out DIR/plots/campaign.png
+
+Reads summary.csv written by `coredem campaign collect`; members that are not done (empty
+result) are left out. When more than one key was swept, one line per combination of the
+other keys.
+"""
+import argparse
+import csv
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def number(text):
+    try:
+        return float(text)
+    except ValueError:
+        return None
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    ap.add_argument("summary")
+    ap.add_argument("--x", required=True, help="swept key (a column of summary.csv)")
+    ap.add_argument("--y", required=True, help="result (a column of summary.csv)")
+    ap.add_argument("--out", required=True, help="PNG file")
+    ap.add_argument("--title", default="campaign")
+    ap.add_argument("--group", action="append", default=[],
+                    help="another swept key: one line per value (repeatable)")
+    a = ap.parse_args()
+
+    with open(a.summary, newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        sys.exit(f"{a.summary}: no members")
+    for col in (a.x, a.y):
+        if col not in rows[0]:
+            sys.exit(f"{a.summary}: no column '{col}'; columns: {', '.join(rows[0].keys())}")
+    for g in a.group:
+        if g not in rows[0]:
+            sys.exit(f"{a.summary}: no column '{g}' (--group)")
+    groups = {}
+    for r in rows:
+        y = number(r[a.y])
+        if y is None:
+            continue
+        x = number(r[a.x])
+        label = ", ".join(f"{g}={r[g]}" for g in a.group)
+        groups.setdefault(label, []).append((x if x is not None else r[a.x], y))
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for label, pts in sorted(groups.items()):
+        numeric = all(isinstance(p[0], float) for p in pts)
+        pts.sort(key=lambda p: p[0] if numeric else str(p[0]))  # noqa: E501
+        xs = [p[0] for p in pts] if numeric else [str(p[0]) for p in pts]
+        ax.plot(xs, [p[1] for p in pts], "o-", label=label or None)
+    ax.set_xlabel(a.x)
+    ax.set_ylabel(a.y)
+    ax.set_title(f"{a.title}: {a.y} vs {a.x}")
+    ax.grid(True, alpha=0.3)
+    if any(groups.keys()):
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(a.out, dpi=120)
+    print(f"wrote {a.out}")
+
+
+if __name__ == "__main__":
+    main()

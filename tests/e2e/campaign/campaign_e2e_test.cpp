@@ -1,0 +1,417 @@
+// End-to-end tests of `coredem campaign` (docs/campaigns.md) with the real coredem,
+// coredem-dem and coredem-gas: a 4-member sweep completes; kill -9 of the campaign process
+// (alone, or together with the running member as in a machine crash) followed by `campaign
+// resume` finishes every member exactly once with results identical to an uninterrupted
+// campaign; a deterministically failing member ends failed after the retry limit while the
+// others finish; malformed sweep files are refused (exit 2, naming the key, nothing written).
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sqlite3.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace {
+
+const fs::path kBin = COREDEM_BIN_DIR;
+const fs::path kCases = COREDEM_CAMPAIGN_CASES;
+
+fs::path tempDir(const std::string& name) {
+  const fs::path d =
+      fs::temp_directory_path() / ("coredem-camp-" + std::to_string(::getpid()) + "-" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string readAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+pid_t start(const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<std::string> argv = {(kBin / "coredem").string()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> c;
+  for (auto& a : argv) {
+    c.push_back(a.data());
+  }
+  c.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, c[0], &fa, nullptr, c.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  EXPECT_EQ(rc, 0) << "cannot start " << argv[0];
+  return pid;
+}
+
+int waitExit(pid_t pid, std::chrono::seconds timeout) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  int status = 0;
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > end) {
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      ADD_FAILURE() << "coredem did not finish within " << timeout.count() << " s";
+      return -1000;
+    }
+    std::this_thread::sleep_for(10ms);
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+}
+
+int coredem(const std::vector<std::string>& args, const fs::path& log,
+            std::chrono::seconds timeout = 50s) {
+  return waitExit(start(args, log), timeout);
+}
+
+/// A member row read straight from campaign.db (read-only, as a second process would).
+struct Row {
+  std::string status, exitReason, lastCheckpoint, caseHash, softwareVersion, protocolVersion;
+  int attempts = 0, failures = 0, doneCount = 0, doneEvents = 0;
+  long pid = 0;
+};
+
+std::map<std::string, Row> readDb(const fs::path& dir) {
+  std::map<std::string, Row> rows;
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2((dir / "campaign.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr) !=
+      SQLITE_OK) {
+    sqlite3_close(db);
+    return rows;
+  }
+  sqlite3_busy_timeout(db, 5000);
+  sqlite3_stmt* s = nullptr;
+  const char* sql =
+      "SELECT id, status, attempts, failures, done_count, pid, ifnull(exit_reason,''), "
+      "ifnull(last_checkpoint,''), case_hash, ifnull(software_version,''), "
+      "ifnull(protocol_version,''), (SELECT count(*) FROM events e WHERE e.member = m.id AND "
+      "e.event = 'done') FROM members m ORDER BY idx";
+  if (sqlite3_prepare_v2(db, sql, -1, &s, nullptr) == SQLITE_OK) {
+    auto text = [&](int c) {
+      const auto* p = sqlite3_column_text(s, c);
+      return p ? std::string(reinterpret_cast<const char*>(p)) : std::string();
+    };
+    while (sqlite3_step(s) == SQLITE_ROW) {
+      Row r;
+      r.status = text(1);
+      r.attempts = sqlite3_column_int(s, 2);
+      r.failures = sqlite3_column_int(s, 3);
+      r.doneCount = sqlite3_column_int(s, 4);
+      r.pid = static_cast<long>(sqlite3_column_int64(s, 5));
+      r.exitReason = text(6);
+      r.lastCheckpoint = text(7);
+      r.caseHash = text(8);
+      r.softwareVersion = text(9);
+      r.protocolVersion = text(10);
+      r.doneEvents = sqlite3_column_int(s, 11);
+      rows[text(0)] = r;
+    }
+  }
+  sqlite3_finalize(s);
+  sqlite3_close(db);
+  return rows;
+}
+
+/// The `step` column of a member's timeseries.csv.
+std::vector<long> stepsOf(const fs::path& runDir) {
+  std::ifstream in(runDir / "timeseries.csv");
+  std::string line;
+  std::getline(in, line);
+  std::vector<long> steps;
+  while (std::getline(in, line)) {
+    steps.push_back(std::stol(line.substr(0, line.find(','))));
+  }
+  return steps;
+}
+
+/// Every member done exactly once (status, done_count, one 'done' event) and its timeseries
+/// holds each step 1..N exactly once.
+void expectAllDoneOnce(const fs::path& dir, std::size_t members, long steps) {
+  const auto rows = readDb(dir);
+  ASSERT_EQ(rows.size(), members);
+  for (const auto& [id, r] : rows) {
+    EXPECT_EQ(r.status, "done") << id << ": " << r.exitReason;
+    EXPECT_EQ(r.doneCount, 1) << id;
+    EXPECT_EQ(r.doneEvents, 1) << id;
+    EXPECT_EQ(r.pid, 0) << id;
+    EXPECT_FALSE(r.softwareVersion.empty()) << id;
+    EXPECT_FALSE(r.protocolVersion.empty()) << id;
+    const auto s = stepsOf(dir / "members" / id / "run");
+    ASSERT_EQ(static_cast<long>(s.size()), steps) << id;
+    for (long i = 0; i < steps; ++i) {
+      EXPECT_EQ(s[static_cast<std::size_t>(i)], i + 1) << id;
+    }
+  }
+}
+
+/// summary.csv of an uninterrupted run of cases/kill.yaml (computed once).
+const std::string& referenceKillSummary() {
+  static const std::string summary = [] {
+    const fs::path d = tempDir("kill-reference");
+    EXPECT_EQ(coredem({"campaign", "run", (kCases / "kill.yaml").string(), "--out",
+                       (d / "c").string()},
+                      d / "log.txt"),
+              0)
+        << readAll(d / "log.txt");
+    EXPECT_EQ(coredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"), 0);
+    expectAllDoneOnce(d / "c", 4, 160);
+    return readAll(d / "c" / "summary.csv");
+  }();
+  return summary;
+}
+
+/// Starts the kill campaign, waits until member m001 runs and has a complete checkpoint,
+/// then kill -9s the campaign process (and with `alsoMember` the member's whole process
+/// group: coredem, coredem-dem, coredem-gas, as a machine crash would).
+void killMidway(const fs::path& d, bool alsoMember) {
+  const fs::path dir = d / "c";
+  const pid_t campaign = start(
+      {"campaign", "run", (kCases / "kill.yaml").string(), "--out", dir.string()}, d / "log.txt");
+  const auto deadline = std::chrono::steady_clock::now() + 40s;
+  long memberPid = 0;
+  while (std::chrono::steady_clock::now() < deadline) {
+    const auto rows = readDb(dir);
+    if (rows.count("m001") && rows.at("m001").status == "running" && rows.at("m001").pid > 0) {
+      bool checkpoint = false;
+      std::error_code ec;
+      for (const auto& e : fs::directory_iterator(dir / "members/m001/run/checkpoints", ec)) {
+        checkpoint = checkpoint || fs::exists(e.path() / "manifest.json");
+      }
+      if (checkpoint) {
+        memberPid = rows.at("m001").pid;
+        break;
+      }
+    }
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_GT(memberPid, 0) << "m001 never ran with a checkpoint: " << readAll(d / "log.txt");
+  ::kill(campaign, SIGKILL);
+  if (alsoMember) {
+    ::kill(-static_cast<pid_t>(memberPid), SIGKILL);
+  }
+  EXPECT_EQ(waitExit(campaign, 10s), -SIGKILL);
+  const auto rows = readDb(dir);
+  EXPECT_EQ(rows.at("m000").status, "done");
+  EXPECT_EQ(rows.at("m001").status, "running"); // left behind by the killed campaign
+  EXPECT_EQ(rows.at("m003").status, "pending");
+}
+
+} // namespace
+
+TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
+  const fs::path d = tempDir("grid4");
+  const fs::path dir = d / "c";
+  ASSERT_EQ(coredem({"campaign", "run", (kCases / "grid4.yaml").string(), "--out", dir.string()},
+                    d / "log.txt"),
+            0)
+      << readAll(d / "log.txt");
+  expectAllDoneOnce(dir, 4, 40);
+  // the member case is complete and carries its values (grid order: first key slowest)
+  const std::string m1 = readAll(dir / "members/m001/case/case.yaml");
+  EXPECT_NE(m1.find("T_g: 400.0"), std::string::npos) << m1;
+  EXPECT_NE(m1.find("diameter: 1.2e-3"), std::string::npos) << m1;
+  const std::string m2 = readAll(dir / "members/m002/case/case.yaml");
+  EXPECT_NE(m2.find("T_g: 600.0"), std::string::npos) << m2;
+  EXPECT_NE(m2.find("diameter: 1.0e-3"), std::string::npos) << m2;
+
+  ASSERT_EQ(coredem({"campaign", "status", dir.string(), "--json"}, d / "status.json"), 0);
+  const std::string js = readAll(d / "status.json");
+  EXPECT_NE(js.find("\"id\": \"m003\", \"status\": \"done\""), std::string::npos) << js;
+  EXPECT_NE(js.find("\"particles[0].diameter\": \"1.2e-3\""), std::string::npos) << js;
+  ASSERT_EQ(coredem({"campaign", "status", dir.string()}, d / "status.txt"), 0);
+  EXPECT_NE(readAll(d / "status.txt").find("4 members: 4 done, 0 running, 0 pending, 0 failed"),
+            std::string::npos)
+      << readAll(d / "status.txt");
+
+  ASSERT_EQ(coredem({"campaign", "collect", dir.string()}, d / "collect.txt"), 0)
+      << readAll(d / "collect.txt");
+  std::ifstream in(dir / "summary.csv");
+  std::string header, line;
+  std::getline(in, header);
+  EXPECT_EQ(header, "member,status,gas.T_g,particles[0].diameter,mean_T_p,"
+                    "dem.kinetic_energy_J,max:dem.kinetic_energy_J");
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream ss(line);
+    std::string x;
+    while (std::getline(ss, x, ',')) {
+      f.push_back(x);
+    }
+    ASSERT_EQ(f.size(), 7u) << line;
+    rows.push_back(f);
+  }
+  ASSERT_EQ(rows.size(), 4u);
+  // the final kinetic energy is each member's own timeseries' last value, exactly
+  for (const auto& r : rows) {
+    std::ifstream ts(dir / "members" / r[0] / "run/timeseries.csv");
+    std::string h, l, last;
+    std::getline(ts, h);
+    while (std::getline(ts, l)) {
+      last = l;
+    }
+    std::vector<std::string> hc, lc;
+    std::stringstream hs(h), ls(last);
+    for (std::string x; std::getline(hs, x, ',');) {
+      hc.push_back(x);
+    }
+    for (std::string x; std::getline(ls, x, ',');) {
+      lc.push_back(x);
+    }
+    const auto k = std::find(hc.begin(), hc.end(), "dem.kinetic_energy_J") - hc.begin();
+    EXPECT_EQ(r[5], lc.at(static_cast<std::size_t>(k))) << r[0];
+    EXPECT_GE(std::stod(r[6]), std::stod(r[5])) << r[0];
+  }
+  // the diameter really reached the members: larger beads, other kinetic energy
+  EXPECT_NE(rows[0][5], rows[1][5]);
+  EXPECT_TRUE(fs::is_regular_file(dir / "plots/campaign.png")) << readAll(dir / "plots/plot.log");
+  EXPECT_GT(fs::file_size(dir / "plots/campaign.png"), 5000u);
+
+  // a member re-runs alone from its case folder with the same result
+  ASSERT_EQ(coredem({"run", (dir / "members/m001/case").string(), "--out",
+                     (d / "alone").string(), "--no-plots"},
+                    d / "alone.txt"),
+            0)
+      << readAll(d / "alone.txt");
+  const auto tail = [](const fs::path& f) {
+    std::ifstream i(f);
+    std::string l, last;
+    while (std::getline(i, l)) {
+      last = l;
+    }
+    // drop the wall-time columns (7 and 8) that differ from run to run
+    std::vector<std::string> c;
+    std::stringstream ss(last);
+    for (std::string x; std::getline(ss, x, ',');) {
+      c.push_back(x);
+    }
+    c.erase(c.begin() + 6, c.begin() + 8);
+    return c;
+  };
+  EXPECT_EQ(tail(d / "alone/timeseries.csv"), tail(dir / "members/m001/run/timeseries.csv"));
+
+  // a second `run` into the same folder is refused
+  EXPECT_EQ(coredem({"campaign", "run", (kCases / "grid4.yaml").string(), "--out", dir.string()},
+                    d / "again.txt"),
+            1);
+  EXPECT_NE(readAll(d / "again.txt").find("already holds a campaign"), std::string::npos);
+}
+
+TEST(CampaignE2E, KillCampaignThenResumeFinishesEveryMemberOnceWithIdenticalResults) {
+  const std::string& reference = referenceKillSummary();
+  ASSERT_FALSE(reference.empty());
+  const fs::path d = tempDir("kill-campaign");
+  killMidway(d, /*alsoMember=*/false);
+  // the orphaned member process may still run: resume adopts it, then finishes the rest
+  ASSERT_EQ(coredem({"campaign", "resume", (d / "c").string()}, d / "resume.txt"), 0)
+      << readAll(d / "resume.txt");
+  expectAllDoneOnce(d / "c", 4, 160);
+  ASSERT_EQ(coredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"), 0);
+  EXPECT_EQ(readAll(d / "c" / "summary.csv"), reference);
+}
+
+TEST(CampaignE2E, MachineCrashThenResumeContinuesFromTheMembersCheckpoint) {
+  const std::string& reference = referenceKillSummary();
+  ASSERT_FALSE(reference.empty());
+  const fs::path d = tempDir("kill-all");
+  killMidway(d, /*alsoMember=*/true);
+  ASSERT_EQ(coredem({"campaign", "resume", (d / "c").string()}, d / "resume.txt"), 0)
+      << readAll(d / "resume.txt");
+  expectAllDoneOnce(d / "c", 4, 160);
+  // m001 was continued with `coredem resume`, not started over
+  const std::string log = readAll(d / "c/members/m001/coredem.log");
+  EXPECT_NE(log.find("=== campaign attempt 2"), std::string::npos) << log;
+  EXPECT_NE(log.find("coredem resume"), std::string::npos) << log;
+  const auto rows = readDb(d / "c");
+  EXPECT_EQ(rows.at("m001").attempts, 2);
+  EXPECT_EQ(rows.at("m001").failures, 0);
+  EXPECT_EQ(rows.at("m000").attempts, 1);
+  ASSERT_EQ(coredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"), 0);
+  EXPECT_EQ(readAll(d / "c" / "summary.csv"), reference);
+}
+
+TEST(CampaignE2E, DeterministicallyFailingMemberEndsFailedAfterRetries) {
+  const fs::path d = tempDir("failing");
+  const fs::path dir = d / "c";
+  EXPECT_EQ(coredem({"campaign", "run", (kCases / "failing.yaml").string(), "--out",
+                     dir.string()},
+                    d / "log.txt"),
+            1)
+      << readAll(d / "log.txt");
+  const auto rows = readDb(dir);
+  ASSERT_EQ(rows.size(), 4u);
+  for (const char* id : {"m000", "m001", "m003"}) {
+    EXPECT_EQ(rows.at(id).status, "done") << id;
+    EXPECT_EQ(rows.at(id).attempts, 1) << id;
+  }
+  const Row& bad = rows.at("m002");
+  EXPECT_EQ(bad.status, "failed");
+  EXPECT_EQ(bad.attempts, 3); // first attempt + retries: 2
+  EXPECT_EQ(bad.failures, 3);
+  EXPECT_EQ(bad.doneCount, 0);
+  EXPECT_NE(bad.exitReason.find("exited with code 2"), std::string::npos) << bad.exitReason;
+  EXPECT_NE(bad.exitReason.find("T_g"), std::string::npos) << bad.exitReason;
+  // a resume does not retry a member that failed for good
+  EXPECT_EQ(coredem({"campaign", "resume", dir.string()}, d / "resume.txt"), 1);
+  EXPECT_EQ(readDb(dir).at("m002").attempts, 3);
+  // collect leaves its results empty
+  ASSERT_EQ(coredem({"campaign", "collect", dir.string(), "--no-plot"}, d / "log.txt"), 0);
+  EXPECT_NE(readAll(dir / "summary.csv").find("m002,failed,-5.0,\n"), std::string::npos)
+      << readAll(dir / "summary.csv");
+}
+
+TEST(CampaignE2E, MalformedSweepIsRefusedNamingTheKey) {
+  const fs::path d = tempDir("bad");
+  fs::create_directories(d / "tiny");
+  fs::copy_file(kCases / "tiny/case.yaml", d / "tiny/case.yaml");
+  struct Bad {
+    std::string body, expect;
+  };
+  const std::vector<Bad> cases = {
+      {"base_case: tiny\nconcurrency: two\ngrid: {gas.T_g: [400]}\n",
+       "bad.yaml:2:14: concurrency: expected an integer >= 1"},
+      {"base_case: tiny\ngrid: {time.ennd: [0.1]}\n", "time.ennd: unknown key"},
+      {"base_case: tiny\ngrid:\n  particles[3].diameter: [1.0e-3]\n",
+       "'particles[3].diameter': index 3 out of range"},
+      {"base_case: tiny\ngrid:\n  particles[0].diameter: [-1.0e-3]\n", "particles[0].diameter"},
+      {"base_case: tiny\ngrid: {gas.T_g: []}\n", "grid.gas.T_g: expected a non-empty list"},
+      {"base_case: tiny\ngrids: {gas.T_g: [1]}\n", "grids: unknown key"},
+      {"base_case: nowhere\ngrid: {gas.T_g: [1]}\n", "base_case: no case.yaml"},
+      {"base_case: tiny\ngrid: {gas.T_g: [1]}\nexecutor: slurm\n", "executor: 'slurm'"},
+      {"base_case: tiny\ngrid: {gas.T_g: [1]}\ncollect: {scalars: [median:mean_T_p]}\n",
+       "collect.scalars"},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    {
+      std::ofstream(d / "bad.yaml") << cases[i].body;
+    }
+    const fs::path out = d / ("out" + std::to_string(i));
+    const fs::path log = d / ("log" + std::to_string(i));
+    EXPECT_EQ(coredem({"campaign", "run", (d / "bad.yaml").string(), "--out", out.string()}, log),
+              2)
+        << cases[i].body;
+    EXPECT_NE(readAll(log).find(cases[i].expect), std::string::npos)
+        << "expected '" << cases[i].expect << "' in: " << readAll(log);
+    EXPECT_FALSE(fs::exists(out)) << "something was written for: " << cases[i].body;
+  }
+}

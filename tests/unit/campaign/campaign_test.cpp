@@ -1,0 +1,147 @@
+// Unit tests: setCaseKey, loadSweep (grid order, explicit members, errors) and CampaignDb
+// (transitions are exact: done counted once, failures up to the retry limit).
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+#include <unistd.h>
+
+#include <coredem/orchestrator/campaign.h>
+#include <coredem/orchestrator/campaign_db.h>
+#include <coredem/orchestrator/case_config.h>
+
+namespace fs = std::filesystem;
+using namespace coredem::orchestrator;
+
+namespace {
+
+const fs::path kCases = COREDEM_CAMPAIGN_CASES;
+
+fs::path tempDir(const std::string& name) {
+  const fs::path d =
+      fs::temp_directory_path() / ("coredem-campu-" + std::to_string(::getpid()) + "-" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+} // namespace
+
+TEST(CampaignKeys, SetsNestedKeysAndListEntries) {
+  const std::string base = "a:\n  b: 1\n  c: [1, 2]\nl:\n  - {x: 1}\n  - {x: 2}\n";
+  std::string t = setCaseKey(base, "a.b", "5.5e-3");
+  t = setCaseKey(t, "l[1].x", "7");
+  t = setCaseKey(t, "a.c[0]", "[9, 8]");
+  t = setCaseKey(t, "new.key", "hello");
+  const YAML::Node n = YAML::Load(t);
+  EXPECT_EQ(n["a"]["b"].as<std::string>(), "5.5e-3"); // the value's text is kept exactly
+  EXPECT_EQ(n["l"][0]["x"].as<int>(), 1);
+  EXPECT_EQ(n["l"][1]["x"].as<int>(), 7);
+  EXPECT_EQ(n["a"]["c"][0][1].as<int>(), 8);
+  EXPECT_EQ(n["a"]["c"][1].as<int>(), 2);
+  EXPECT_EQ(n["new"]["key"].as<std::string>(), "hello");
+}
+
+TEST(CampaignKeys, BadPathsNameThePath) {
+  const std::string base = "a:\n  b: 1\nl: [1, 2]\n";
+  auto msg = [&](const std::string& path) {
+    try {
+      setCaseKey(base, path, "1");
+    } catch (const CaseError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(msg("l[2]").find("'l[2]': index 2 out of range ('l' has 2 entries"),
+            std::string::npos)
+      << msg("l[2]");
+  EXPECT_NE(msg("a.b.c").find("'a.b.c': 'a.b' is not a mapping"), std::string::npos)
+      << msg("a.b.c");
+  EXPECT_NE(msg("a[0]").find("'a[0]': 'a' is not a list"), std::string::npos) << msg("a[0]");
+  EXPECT_NE(msg("a..b").find("not a case key path"), std::string::npos) << msg("a..b");
+}
+
+TEST(CampaignSweep, GridExpandsWithTheFirstKeySlowest) {
+  const Sweep sw = loadSweep(kCases / "grid4.yaml");
+  EXPECT_EQ(sw.name, "e2e-grid4");
+  EXPECT_EQ(sw.concurrency, 2);
+  EXPECT_EQ(sw.retries, 0);
+  ASSERT_EQ(sw.members.size(), 4u);
+  ASSERT_EQ(sw.parameters, (std::vector<std::string>{"gas.T_g", "particles[0].diameter"}));
+  const std::vector<std::pair<std::string, std::string>> expect[] = {
+      {{"gas.T_g", "400.0"}, {"particles[0].diameter", "1.0e-3"}},
+      {{"gas.T_g", "400.0"}, {"particles[0].diameter", "1.2e-3"}},
+      {{"gas.T_g", "600.0"}, {"particles[0].diameter", "1.0e-3"}},
+      {{"gas.T_g", "600.0"}, {"particles[0].diameter", "1.2e-3"}}};
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(sw.members[i].values, expect[i]) << i;
+    EXPECT_EQ(sw.members[i].id, "m00" + std::to_string(i));
+  }
+  // the resolved cases parse and carry the values
+  const CaseConfig c = parseCase(sw.resolvedCases[3], "case.yaml", sw.baseCase);
+  EXPECT_EQ(c.particles.at(0).diameter, 1.2e-3);
+  EXPECT_EQ(YAML::Load(sw.resolvedCases[3])["gas"]["T_g"].as<double>(), 600.0);
+  EXPECT_EQ(sw.plotX, "particles[0].diameter");
+  EXPECT_EQ(sw.plotY, "dem.kinetic_energy_J");
+  ASSERT_EQ(sw.scalars.size(), 3u);
+  EXPECT_EQ(sw.scalars[2].reduce, "max");
+  EXPECT_EQ(sw.scalars[2].column, "dem.kinetic_energy_J");
+}
+
+TEST(CampaignSweep, ExplicitMembers) {
+  const Sweep sw = loadSweep(kCases / "failing.yaml");
+  ASSERT_EQ(sw.members.size(), 4u);
+  EXPECT_EQ(sw.members[2].values.at(0).second, "-5.0");
+  EXPECT_EQ(sw.retries, 2);
+  EXPECT_EQ(sw.scalars.at(0).column, "mean_T_p"); // default result
+}
+
+TEST(CampaignDbTest, TransitionsAreCountedExactly) {
+  const fs::path d = tempDir("db");
+  CampaignDb db(d / "campaign.db", true);
+  db.createSchema();
+  MemberRecord m;
+  m.id = "m000";
+  m.caseDir = "c";
+  m.runDir = "r";
+  m.caseHash = "h";
+  m.values = {{"gas.T_g", "400"}};
+  db.transaction([&] { db.addMember(m); });
+  EXPECT_FALSE(db.markDone("m000", "", "", "")); // not running
+  EXPECT_TRUE(db.markRunning("m000", "pending"));
+  EXPECT_FALSE(db.markRunning("m000", "pending")); // claimed once
+  // retries = 1: the first failure goes back to pending, the second is final
+  EXPECT_TRUE(db.markFailed("m000", "exited with code 1", 1));
+  EXPECT_EQ(db.member("m000")->status, "pending");
+  EXPECT_TRUE(db.markRunning("m000", "pending"));
+  EXPECT_TRUE(db.markFailed("m000", "exited with code 1", 1));
+  EXPECT_EQ(db.member("m000")->status, "failed");
+  EXPECT_EQ(db.member("m000")->failures, 2);
+  EXPECT_EQ(db.member("m000")->attempts, 2);
+  EXPECT_TRUE(db.resetFailed("m000"));
+  EXPECT_TRUE(db.markRunning("m000", "pending"));
+  db.setPid("m000", 4242);
+  EXPECT_EQ(db.member("m000")->pid, 4242);
+  db.transaction([&] {
+    EXPECT_TRUE(db.markDone("m000", "00000040", "0.1.0", "1.0"));
+    db.addEvent("m000", "done", "");
+  });
+  EXPECT_FALSE(db.markDone("m000", "00000040", "0.1.0", "1.0")); // never twice
+  const auto r = db.member("m000");
+  EXPECT_EQ(r->status, "done");
+  EXPECT_EQ(r->doneCount, 1);
+  EXPECT_EQ(r->pid, 0);
+  EXPECT_EQ(r->attempts, 3);
+  EXPECT_EQ(r->protocolVersion, "1.0");
+  EXPECT_EQ(db.doneEvents("m000"), 1);
+  EXPECT_EQ(r->values, m.values);
+  // a transaction that throws leaves nothing behind
+  EXPECT_THROW(db.transaction([&] {
+    db.addEvent("m000", "done", "");
+    throw std::runtime_error("crash");
+  }),
+               std::runtime_error);
+  EXPECT_EQ(db.doneEvents("m000"), 1);
+  fs::remove_all(d);
+}
