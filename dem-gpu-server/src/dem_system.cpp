@@ -93,6 +93,11 @@ void validate(const DemConfig& c) {
     COREDEM_CHECK(mat.mu >= 0, "material '{}': mu = {} must be >= 0", mat.name, mat.mu);
     COREDEM_CHECK(mat.ktFactor > 0, "material '{}': ktFactor = {} must be > 0", mat.name, mat.ktFactor);
     COREDEM_CHECK(mat.etatFactor >= 0, "material '{}': etatFactor = {} must be >= 0", mat.name, mat.etatFactor);
+    COREDEM_CHECK(mat.cp > 0 && std::isfinite(mat.cp), "material '{}': cp = {} J/kg/K must be > 0", mat.name, mat.cp);
+    COREDEM_CHECK(mat.conductivity >= 0 && std::isfinite(mat.conductivity),
+                  "material '{}': conductivity = {} W/m/K must be >= 0", mat.name, mat.conductivity);
+    COREDEM_CHECK(mat.emissivity >= 0 && mat.emissivity <= 1, "material '{}': emissivity = {} must be in [0, 1]",
+                  mat.name, mat.emissivity);
   }
   for (const ParticleSet& s : c.particleSets) {
     COREDEM_CHECK(s.material >= 0 && s.material < static_cast<int>(c.materials.size()),
@@ -146,6 +151,9 @@ void validate(const DemConfig& c) {
   COREDEM_CHECK(c.neighbour.initialNeighbourSlots >= 1, "neighbour.initialNeighbourSlots must be >= 1");
   COREDEM_CHECK(c.dtFactor >= 1, "dtFactor {} must be >= 1 (PHYSICS: 50)", c.dtFactor);
   COREDEM_CHECK(c.epsMinDrag > 0 && c.epsMinDrag < 1, "epsMinDrag {} must be in (0, 1)", c.epsMinDrag);
+  COREDEM_CHECK(c.heat.minSeparation > 0, "heat: s_min = {} m must be > 0", c.heat.minSeparation);
+  COREDEM_CHECK(c.heat.lensFraction >= 0, "heat: flpc = {} must be >= 0", c.heat.lensFraction);
+  COREDEM_CHECK(c.heat.lensRelTol > 0, "heat: lens_rel_tol = {} must be > 0", c.heat.lensRelTol);
   for (const Species& sp : c.gasSpecies)
     COREDEM_CHECK(sp.molarMass > 0, "gas species '{}': molar mass must be > 0 (kg/mol)", sp.name);
   for (const Species& sp : c.solidSpecies)
@@ -238,6 +246,7 @@ std::string hashConfig(const DemConfig& c) {
   for (const Material& m : c.materials) {
     t += m.name + ":";
     for (double v : {m.kn, m.en, m.mu, m.ktFactor, m.etatFactor}) num(v);
+    if (c.heat.enabled) num(m.cp), num(m.conductivity), num(m.emissivity);
   }
   t += "|walls:";
   for (const Wall& w : c.walls)
@@ -252,6 +261,14 @@ std::string hashConfig(const DemConfig& c) {
   for (const Species& s : c.gasSpecies) t += s.name + ":", num(s.molarMass);
   t += "|opts:";
   num(c.neighbour.skinFactor), num(c.neighbour.historySlots), num(c.epsMinDrag), num(c.dtFactor);
+  if (c.heat.enabled) {  // heat off keeps the hash of configurations without heat transfer
+    const HeatOptions& h = c.heat;
+    t += "|heat:";
+    for (double v : {double(h.convection), double(h.ranzMarshall), double(h.reynoldsWithVoidage),
+                     h.voidageExponent, double(h.contactConduction), double(h.lensConduction),
+                     h.lensFraction, h.minSeparation, h.lensRelTol, double(h.radiation)})
+      num(v);
+  }
   std::uint64_t h = 0xcbf29ce484222325ull;
   for (unsigned char ch : t) {
     h ^= ch;
@@ -400,6 +417,29 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   es.historySlots = config.neighbour.historySlots;
   es.neighbourSlots = config.neighbour.initialNeighbourSlots;
   es.threads = threads;
+  {
+    // Heat transfer (heat.h): the lens needs the neighbour list to reach FLPC·R_max further.
+    const HeatOptions& h = config.heat;
+    HeatSetup& hs = es.heat;
+    hs.enabled = h.enabled;
+    hs.convection = h.convection;
+    hs.contactConduction = h.contactConduction;
+    hs.lensConduction = h.lensConduction && es.coupled;
+    bool anyEmissive = false;
+    for (const Material& mat : config.materials) {
+      hs.materials.push_back(HeatMaterial{mat.cp, mat.conductivity, mat.emissivity});
+      anyEmissive = anyEmissive || mat.emissivity > 0;
+    }
+    hs.radiation = h.radiation && anyEmissive;
+    hs.convectionParams.model = h.ranzMarshall ? kernels::NusseltModel::RanzMarshall : kernels::NusseltModel::LiMason;
+    hs.convectionParams.voidageExponent = h.voidageExponent;
+    hs.convectionParams.reynoldsWithVoidage = h.reynoldsWithVoidage;
+    hs.convectionParams.epsMin = config.epsMinDrag;
+    hs.lensParams.lensFraction = h.lensFraction;
+    hs.lensParams.minSeparation = h.minSeparation;
+    hs.lensParams.relTol = h.lensRelTol;
+    es.reach = (h.enabled && hs.lensConduction) ? h.lensFraction * rmax : 0.0;
+  }
 
   BackendKind kind = backend;
   if (kind == BackendKind::Auto) kind = cudaDeviceCount() > 0 ? BackendKind::Cuda : BackendKind::Cpu;
@@ -477,6 +517,8 @@ void DemSystem::writeState(const std::string& path) const {
   meta.configHash = m.hash;
   meta.softwareVersion = std::string(COREDEM_VERSION);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
   meta.protocolVersion = std::string("1");
+  meta.heatConvection = m.engine->heatTotals().convection;
+  meta.heatRadiation = m.engine->heatTotals().radiation;
   writeStateFile(path, m.engine->state(), meta);
 }
 
@@ -507,10 +549,12 @@ void DemSystem::readState(const std::string& path) {
     // Built without particle sets: take the neighbour cell size from the file.
     m.setup.maxRadius = rmax;
     m.setup.skin = m.config.neighbour.skinFactor * 2.0 * rmax;
+    if (m.config.heat.enabled && m.setup.heat.lensConduction) m.setup.reach = m.config.heat.lensFraction * rmax;
     m.engine.reset();
     m.engine = m.makeEngine();
   }
   m.engine->setState(st);
+  m.engine->heatTotals() = HeatTotals{meta.heatConvection, meta.heatRadiation};
   m.nParticles = st.n;
   m.dtMax = dtDemMaxFor(m.config, minMass);
   m.time.restore(meta.time, meta.timeCompensation);
@@ -560,5 +604,14 @@ std::array<double, 3> DemSystem::wallForce() const { return _impl->engine->wallF
 std::size_t DemSystem::memoryBytes() const { return _impl->engine->memoryBytes(); }
 StageTimes DemSystem::stageTimes() const { return _impl->engine->times(); }
 void DemSystem::resetStageTimes() { _impl->engine->times() = StageTimes{}; }
+HeatTotals DemSystem::heatTotals() const { return _impl->engine->heatTotals(); }
+
+double DemSystem::thermalEnergy() const {
+  const ParticleData p = particles();
+  double e = 0.0;
+  for (std::size_t i = 0; i < p.count; ++i)
+    e += p.mass[i] * _impl->config.materials[static_cast<std::size_t>(p.material[i])].cp * p.temperature[i];
+  return e;
+}
 
 } // namespace coredem::dem

@@ -4,6 +4,7 @@
 /// templated engine that runs the kernels (engine_impl.h, instantiated once per backend).
 
 #include "coredem/dem/dem_system.h"
+#include "heat_setup.h"
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_contact.h"
@@ -37,6 +38,8 @@ struct EngineSetup {
   int historySlots = 12;
   int neighbourSlots = 16;
   int threads = 0;
+  HeatSetup heat;                        ///< particle heat transfer (heat.h)
+  double reach = 0;                      ///< m, neighbour-list reach beyond R_i+R_j+skin (gas lens)
 };
 
 /// Host copy of the full engine state (particles in internal order, contact history,
@@ -83,6 +86,8 @@ public:
   virtual std::size_t memoryBytes() const = 0;
   virtual StageTimes& times() = 0;
   virtual const char* name() const = 0;
+  /// Heat received by the particles since construction (heat.h); settable for restarts.
+  virtual HeatTotals& heatTotals() = 0;
 };
 
 std::unique_ptr<Engine> makeCpuEngine(const EngineSetup& setup);

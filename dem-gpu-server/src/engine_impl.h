@@ -19,6 +19,7 @@
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
 #include "engine.h"
+#include "heat.h"
 #include "particle_store.h"
 
 #include "coredem/dem/kernels/body_force.h"
@@ -68,6 +69,7 @@ public:
   bool _listValid = false;
   int _maxUsedSlots = kMaxHistorySlots;  ///< max contacts of a particle in the last sub-step (≥ slots in use)
   StageTimes _t;
+  HeatModule<Exec> _heat;  ///< particle heat transfer (heat.h)
 
   explicit EngineImpl(const EngineSetup& s) : _s(s) {
     _exec.threads = s.threads;
@@ -92,10 +94,12 @@ public:
       _cStart.reserve(_s.nCells + 1);
       _cEnd.reserve(_s.nCells + 1);
     }
+    _heat.setup(_s.heat, _s.coupled ? _s.nCells : 0);
   }
 
   const char* name() const override { return Exec::name; }
   StageTimes& times() override { return _t; }
+  HeatTotals& heatTotals() override { return _heat._totals; }
 
   // ---------------------------------------------------------------- state transfer
   void setState(const HostState& s) override {
@@ -160,6 +164,7 @@ public:
     put(_rhoG, g.rhoG);
     put(_muG, g.muG);
     _hasGas = true;
+    _heat.setGas(g);
   }
 
   void reserveScratch() {
@@ -175,7 +180,8 @@ public:
     auto& self = const_cast<EngineImpl&>(*this);
     return self._p.bytes() + _keys.bytes() + _perm.bytes() + _cellStart.bytes() +
            _cellEnd.bytes() + _pcell.bytes() + _kcoef.bytes() + _scratch.bytes() +
-           _cStart.bytes() + _cEnd.bytes() + self._epsFrozen.bytes() + self._acc.bytes();
+           _cStart.bytes() + _cEnd.bytes() + self._epsFrozen.bytes() + self._acc.bytes() +
+           _heat.bytes();
   }
 
   // ---------------------------------------------------------------- neighbour search
@@ -228,7 +234,7 @@ public:
                                 "unstable; reduce the time step (dtCfd/nSub) or check the forces");
       }
     }
-    double cs = 2.0 * _s.maxRadius + _s.skin;
+    double cs = 2.0 * _s.maxRadius + _s.skin + _s.reach;
     const double limit = 4.0 * static_cast<double>(n) + 4096.0;
     for (;;) {
       double total = 1.0;
@@ -301,7 +307,7 @@ public:
       const double* r = _p.radius.d();
       std::int32_t* cnt = _p.nbCount.d();
       std::int32_t* list = _p.nbList.d();
-      const double skin = _s.skin;
+      const double skin = _s.skin + _s.reach;
       const NbGrid gg = g;
       _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
         const kernels::Vec3 xi = kernels::load3(x, static_cast<long long>(i));
@@ -402,6 +408,7 @@ public:
     });
     _epsFrozen.markDeviceModified();
     _acc.markDeviceModified();
+    _heat.beginWindow(_exec, _s.nCells);
     Exec::synchronize();
     _t.coupling += std::chrono::duration<double>(Clock::now() - t0).count();
   }
@@ -456,6 +463,7 @@ public:
       out.kSlUs[3 * c + 1] = avg.kSlUs.y;
       out.kSlUs[3 * c + 2] = avg.kSlUs.z;
     }
+    _heat.endWindow(nSub, _s, out);
   }
 
   // ---------------------------------------------------------------- forces
@@ -663,8 +671,19 @@ public:
       _t.coupling += std::chrono::duration<double>(t2 - t1).count();
       t1 = t2;
     }
+    if (_heat.enabled()) {
+      const bool gas = _hasGas && _s.coupled;
+      _heat.sources(_exec, _p, _s, gas, _pcell.d(), _perm.d(), _cStart.d(), _cEnd.d(),
+                    _s.coupled ? _epsFrozen.d() : nullptr, gas ? _ug.d() : nullptr,
+                    gas ? _rhoG.d() : nullptr, gas ? _muG.d() : nullptr, dt);
+      Exec::synchronize();
+      auto t2 = Clock::now();
+      _t.heat += std::chrono::duration<double>(t2 - t1).count();
+      t1 = t2;
+    }
     const double half = 0.5 * _s.skin;
     if (integrate(dt) > half * half) _listValid = false;
+    _heat.updateTemperature(_exec, _p, dt);
     Exec::synchronize();
     _t.integrate += std::chrono::duration<double>(Clock::now() - t1).count();
   }

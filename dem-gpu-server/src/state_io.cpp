@@ -150,6 +150,8 @@ void writeStateFile(const std::string& path, const HostState& s, const StateMeta
   writeAttr(g.id, "history_slots", static_cast<std::int32_t>(s.historySlots));
   writeAttr(g.id, "neighbour_slots", static_cast<std::int32_t>(s.neighbourSlots));
   writeAttr(g.id, "neighbour_list_valid", static_cast<std::int32_t>(s.listValid));
+  writeAttr(g.id, "heat_convection_J", meta.heatConvection);
+  writeAttr(g.id, "heat_radiation_J", meta.heatRadiation);
   COREDEM_CHECK(H5Fflush(file.id, H5F_SCOPE_GLOBAL) >= 0, "cannot flush state file '{}'", path);
 }
 
@@ -175,6 +177,9 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
   s.historySlots = readAttr<std::int32_t>(gm.id, "history_slots", path);
   s.neighbourSlots = readAttr<std::int32_t>(gm.id, "neighbour_slots", path);
   s.listValid = readAttr<std::int32_t>(gm.id, "neighbour_list_valid", path);
+  // Heat totals: absent in files written before heat transfer was integrated.
+  meta.heatConvection = H5Aexists(gm.id, "heat_convection_J") > 0 ? readAttr<double>(gm.id, "heat_convection_J", path) : 0.0;
+  meta.heatRadiation = H5Aexists(gm.id, "heat_radiation_J") > 0 ? readAttr<double>(gm.id, "heat_radiation_J", path) : 0.0;
   const hsize_t n = s.n, K = static_cast<hsize_t>(s.historySlots),
                 M = static_cast<hsize_t>(s.neighbourSlots), ns = static_cast<hsize_t>(s.nSpecies);
   {

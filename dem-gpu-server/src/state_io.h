@@ -17,6 +17,8 @@ struct StateMeta {
   std::string configHash;
   std::string softwareVersion;
   std::string protocolVersion;
+  double heatConvection = 0;  ///< HeatTotals (J); optional in the file (0 when absent)
+  double heatRadiation = 0;
 };
 
 void writeStateFile(const std::string& path, const HostState& s, const StateMeta& meta);

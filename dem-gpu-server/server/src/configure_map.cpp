@@ -40,6 +40,9 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
     d.mu = m.friction();
     d.ktFactor = m.has_kt_factor() ? m.kt_factor() : 2.0 / 7.0;
     d.etatFactor = m.has_etat_factor() ? m.etat_factor() : 0.5;
+    if (m.cp() > 0.0) d.cp = m.cp();  // 0 (unset): the default 840 J/kg/K, as in the case schema
+    d.conductivity = m.conductivity();
+    d.emissivity = m.emissivity();
     materialIndex[m.id()] = static_cast<int>(cfg.materials.size());
     materialDensity[m.id()] = m.density();
     cfg.materials.push_back(d);
@@ -143,6 +146,8 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
       cfg.neighbour.skinFactor = parseDouble(kv.key(), kv.value());
     } else if (kv.key() == "dem.history_slots") {
       cfg.neighbour.historySlots = static_cast<int>(parseDouble(kv.key(), kv.value()));
+    } else if (dem::setHeatOption(cfg.heat, kv.key(), kv.value())) {
+      // heat-transfer switch (docs/heat-coupling.md)
     } else if (kv.key() == "drag") {
       COREDEM_CHECK(kv.value() == "gidaspow", "Configure option drag = '{}': this server "
                     "implements 'gidaspow' only", kv.value());

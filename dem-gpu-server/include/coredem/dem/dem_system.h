@@ -14,6 +14,8 @@
 /// Units are SI everywhere. Coupling cells are numbered cell = i + nx*(j + ny*k).
 /// All methods throw coredem::UserError on bad input, with a message that says what to fix.
 
+#include "coredem/dem/heat_options.h"
+
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -47,6 +49,9 @@ struct Material {
   double mu = 0.1;                 ///< Coulomb friction coefficient μ (-)
   double ktFactor = 2.0 / 7.0;     ///< k_t = ktFactor·k_n (MFiX KT_FAC)
   double etatFactor = 0.5;         ///< η_t = etatFactor·η_n (MFiX DES_ETAT_FAC)
+  double cp = 840.0;               ///< specific heat c_p (J/kg/K), > 0 (Eq. 18)
+  double conductivity = 1.0;       ///< k_p (W/m/K), ≥ 0 (contact conduction, Eq. 22)
+  double emissivity = 0.0;         ///< e_p (-), in [0, 1]; 0: the particle does not radiate (Eq. 27)
 };
 
 /// How a ParticleSet places its particles.
@@ -119,6 +124,7 @@ struct DemConfig {
   NeighbourOptions neighbour;
   double epsMinDrag = 0.35;            ///< ε_min clip in drag (PHYSICS §1.1 [C])
   double dtFactor = 50.0;              ///< Δt_DEM,max = t_col,min / dtFactor (PHYSICS Eq. 12)
+  HeatOptions heat;                    ///< particle heat transfer (docs/heat-coupling.md)
 
   /// Adds the six planes of the axis-aligned box [lo, hi] (normals pointing inwards).
   void addBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi);
@@ -138,7 +144,8 @@ struct GasFieldsView {
 };
 
 /// Per-cell sources for the CFD, averaged over the sub-steps of one advance() (PHYSICS §1.1).
-/// Heat and species entries stay zero until the thermochemistry kernels are integrated.
+/// Heat: gas energy source −(H T_g − H_Tp) (W/m³), H = Σ h_i A_i/V_c, H_Tp = Σ h_i A_i T_p,i/V_c
+/// (docs/heat-coupling.md). Species and Q_hom entries stay zero until chemistry is integrated.
 struct CellSources {
   std::vector<double> epsG;      ///< ε_g (-), N
   std::vector<double> kSl;       ///< K_sl = (1/V_c) Σ β V_p/(1-ε) (kg/m³/s), N
@@ -167,6 +174,7 @@ struct StageTimes {
   double contact = 0;    ///< contact + wall + gas forces
   double integrate = 0;  ///< motion update
   double coupling = 0;   ///< PCM ε_g and cell-source deposition
+  double heat = 0;       ///< heat sources (conduction, convection, radiation) and their deposition
   std::uint64_t rebuilds = 0;
 };
 
@@ -223,6 +231,11 @@ public:
   std::array<double, 3> wallForce() const;  ///< Σ force exerted by all walls on particles, last sub-step (N)
   std::size_t memoryBytes() const;     ///< bytes of particle, neighbour and contact storage
   StageTimes stageTimes() const;
+  /// Heat the particles received from the gas and from radiation since construction (kept
+  /// across writeState/readState), J.
+  HeatTotals heatTotals() const;
+  /// Σ m_i c_p,i T_p,i over the particles (J, with the material's constant c_p).
+  double thermalEnergy() const;
   void resetStageTimes();
 
 private:

@@ -1,0 +1,41 @@
+#pragma once
+/// @file
+/// Model switches of the particle heat transfer integrated in the DEM step (PHYSICS §3,
+/// docs/heat-coupling.md). Plain data; set from `Configure.options` (case.yaml `models:`)
+/// through setHeatOption().
+
+#include <string>
+
+namespace coredem::dem {
+
+/// Which heat-transfer terms the DEM step evaluates (Eq. 18). The material properties
+/// (c_p, k_p, emissivity) are in `Material`; the gas properties come per cell with the gas fields.
+struct HeatOptions {
+  bool enabled = true;              ///< `heat: on|off` — off: temperatures stay constant, H = H_Tp = 0
+  bool convection = true;           ///< particle–gas convection (Eqs. 19–21); needs T_g, κ_g, c_p,g
+  bool ranzMarshall = false;        ///< `convection: li-mason|ranz-marshall` (default Li–Mason)
+  bool reynoldsWithVoidage = true;  ///< `convection_reynolds: with-voidage|without-voidage`
+  double voidageExponent = 3.5;     ///< `nusselt_exponent`: n of ε^n in Li–Mason (Eq. 21)
+  bool contactConduction = true;    ///< `contact_conduction: on|off` (Eqs. 22–23)
+  bool lensConduction = true;       ///< `lens_conduction: on|off` (Eqs. 24–26); needs κ_g
+  double lensFraction = 0.2;        ///< `flpc`: lens radius (1 + FLPC) R_L
+  double minSeparation = 1.0e-6;    ///< `s_min` (m): minimum conduction distance in the lens
+  double lensRelTol = 1.0e-8;       ///< `lens_rel_tol`: quadrature tolerance of the lens integral
+  bool radiation = true;            ///< `radiation: on|off`; only particles with emissivity > 0 radiate
+};
+
+/// Applies one `Configure.options` entry if it is a heat option. Returns false when `key` is not
+/// a heat option (the caller handles or ignores it); throws coredem::UserError when the key is a
+/// heat option but the value is not allowed (the message lists the allowed values).
+/// Keys: heat, convection, convection_reynolds, nusselt_exponent, contact_conduction,
+/// lens_conduction, flpc, s_min, lens_rel_tol, radiation, radiation_environment.
+bool setHeatOption(HeatOptions& options, const std::string& key, const std::string& value);
+
+/// Heat the particles received since the system was built (or restarted from a state file
+/// written by it), J. Conduction moves heat between particles only and is not listed.
+struct HeatTotals {
+  double convection = 0.0;  ///< from the gas (Σ_c (H T_g − H_Tp) V_c Δt), the gas loses the same
+  double radiation = 0.0;   ///< from the radiative environment (Eq. 27)
+};
+
+} // namespace coredem::dem

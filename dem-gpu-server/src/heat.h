@@ -1,0 +1,279 @@
+#pragma once
+/// @file
+/// Particle heat transfer in the DEM sub-step (PHYSICS §3, Eq. 18; DESIGN §4), written once
+/// for every backend like engine_impl.h. Per sub-step, after the contact forces and the drag
+/// deposition (which leaves the particles sorted by PCM cell):
+///   1. cell means of T_p for the radiation environment (§3.4 (a), including the particle)
+///   2. per particle (full neighbour list, gather, no atomics): contact conduction (Eqs. 22–23)
+///      and gas-lens conduction (Eqs. 24–26) over the neighbours, convection with the gas of
+///      its PCM cell (Eqs. 19–21), radiation (Eqs. 27–28); the sum Q_i (W) is stored
+///   3. per cell: H = Σ G_i/V_c, H_Tp = Σ G_i T_i/V_c (G_i = h_i A_i) and Σ Q_rad,i, added to
+///      the window accumulators (averaged over the sub-steps at the window end)
+///   4. after the motion update: T_i += Δt Q_i/(m_i c_p,i) (explicit Euler, Eq. 18)
+/// Heat sources are evaluated on the configuration and temperatures of the contact forces
+/// (start of the sub-step), as MFiX does (CALC_THERMO_DES before CFNEWVALUES), so that the
+/// neighbour list is exact for them and they share the PCM cells of the drag deposition.
+///
+/// Pair terms: each particle evaluates each of its pairs with the arguments in canonical
+/// order (smaller global id first), so both particles of a pair compute bitwise the same
+/// conductance G_ab and temperature difference T_b − T_a and add ±G_ab (T_b − T_a):
+/// Q_ab = −Q_ba exactly on every backend, whatever the evaluation order or FMA contraction.
+
+#include "backend/arrays.h"
+#include "backend/exec_common.h"
+#include "engine.h"
+#include "heat_setup.h"
+#include "particle_store.h"
+
+#include "coredem/dem/kernels/conduction_contact.h"
+#include "coredem/dem/kernels/conduction_gas_lens.h"
+#include "coredem/dem/kernels/convection.h"
+#include "coredem/dem/kernels/particle_energy.h"
+#include "coredem/dem/kernels/pcm.h"
+#include "coredem/dem/kernels/radiation.h"
+#include "coredem/dem/kernels/vec3.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace coredem::dem {
+
+template <class Exec>
+class HeatModule {
+public:
+  template <class T>
+  using Dual = backend::DualArray<T, Exec>;
+  template <class T>
+  using Dev = backend::DeviceArray<T, Exec>;
+
+  HeatSetup _h;
+  Dual<HeatMaterial> _mat;
+  Dual<double> _tg, _kappa, _cp;  ///< gas fields (per cell), present when the CFD sent them
+  bool _hasTg = false, _hasKappa = false, _hasCp = false;
+  Dev<double> _q, _g, _qrad;      ///< per particle: Q_i (W), G_i (W/K), Q_rad,i (W)
+  Dev<double> _cellT;             ///< per cell: Σ T_p (radiation environment)
+  Dual<double> _acc;              ///< per cell: Σ_sub H, Σ_sub H_Tp, Σ_sub Q_rad/V_c
+  double _dt = 0.0;               ///< sub-step length of the current window
+  HeatTotals _totals;
+
+  void setup(const HeatSetup& h, std::size_t nCells) {
+    _h = h;
+    _mat.allocate(h.materials.size());
+    for (std::size_t k = 0; k < h.materials.size(); ++k) _mat.h()[k] = h.materials[k];
+    _mat.markHostModified();
+    _mat.toDevice();
+    if (nCells > 0) {
+      _acc.allocate(3 * nCells);
+      for (std::size_t k = 0; k < 3 * nCells; ++k) _acc.h()[k] = 0.0;
+      _acc.markHostModified();
+      _acc.toDevice();
+      _cellT.reserve(nCells);
+    }
+  }
+
+  bool enabled() const { return _h.enabled; }
+
+  void setGas(const GasArrays& g) {
+    auto put = [](Dual<double>& arr, const std::vector<double>& v) {
+      arr.allocate(v.size());
+      for (std::size_t k = 0; k < v.size(); ++k) arr.h()[k] = v[k];
+      arr.markHostModified();
+      arr.toDevice();
+      return !v.empty();
+    };
+    _hasTg = put(_tg, g.Tg);
+    _hasKappa = put(_kappa, g.kappaG);
+    _hasCp = put(_cp, g.cpG);
+  }
+
+  std::size_t bytes() const {
+    auto& s = const_cast<HeatModule&>(*this);
+    return s._mat.bytes() + s._tg.bytes() + s._kappa.bytes() + s._cp.bytes() + _q.bytes() +
+           _g.bytes() + _qrad.bytes() + _cellT.bytes() + s._acc.bytes();
+  }
+
+  void beginWindow(Exec& exec, std::size_t nCells) {
+    if (!_h.enabled || nCells == 0) return;
+    double* acc = _acc.d();
+    exec.parallelFor(3 * nCells, [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
+    _acc.markDeviceModified();
+  }
+
+  /// Heat sources of one sub-step. `gasPresent`: the gas fields were set. When coupled, the
+  /// particles must be sorted by PCM cell (perm, cStart, cEnd, pcell) as deposit() leaves them.
+  /// Reads pos, vel, radius, temperature, material, gid, nbCount, nbList; writes _q, _g, _qrad, _acc.
+  void sources(Exec& exec, ParticleStore<Exec>& p, const EngineSetup& s, bool gasPresent,
+               const std::uint32_t* pcell, const std::uint32_t* perm, const std::uint32_t* cStart,
+               const std::uint32_t* cEnd, const double* epsFrozen, const double* ug,
+               const double* rhoG, const double* muG, double dt) {
+    if (!_h.enabled) return;
+    const std::size_t n = p.n;
+    _dt = dt;
+    _q.reserve(n);
+    _g.reserve(n);
+    _qrad.reserve(n);
+    const bool coupled = s.coupled && gasPresent;
+    const bool conv = coupled && _h.convection && _hasTg && _hasKappa && _hasCp;
+    const bool rad = coupled && _h.radiation && _hasTg;
+    const bool lens = coupled && _h.lensConduction && _hasKappa;
+    const bool contact = _h.contactConduction;
+    const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
+
+    // 1. Σ T_p per cell (radiation environment, variant (a)).
+    double* cellT = _cellT.d();
+    const double* T = p.temperature.d();
+    if (rad) {
+      exec.parallelFor(nCells, [=] DEM_LAMBDA(std::size_t c) {
+        double sum = 0.0;
+        for (std::uint32_t k = cStart[c]; k < cEnd[c]; ++k) sum += T[perm[k]];
+        cellT[c] = sum;
+      });
+    }
+
+    // 2. Per-particle heat rate.
+    const double* x = p.pos.d();
+    const double* v = p.vel.d();
+    const double* r = p.radius.d();
+    const std::int32_t* mat = p.material.d();
+    const std::int64_t* gid = p.gid.d();
+    const std::int32_t* cnt = p.nbCount.d();
+    const std::int32_t* list = p.nbList.d();
+    const int M = p.M;
+    const HeatMaterial* hm = _mat.d();
+    const double* tg = _hasTg ? _tg.d() : nullptr;
+    const double* kap = _hasKappa ? _kappa.d() : nullptr;
+    const double* cpg = _hasCp ? _cp.d() : nullptr;
+    double* q = _q.d();
+    double* gOut = _g.d();
+    double* qr = _qrad.d();
+    const kernels::ConvectionParams cp = _h.convectionParams;
+    const kernels::GasLensParams lp = _h.lensParams;
+    const std::uint32_t* cs = cStart;
+    const std::uint32_t* ce = cEnd;
+    const double lensFactor = 1.0 + lp.lensFraction;
+    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+      using namespace kernels;
+      const long long ii = static_cast<long long>(i);
+      const double ti = T[i];
+      const HeatMaterial mi = hm[mat[i]];
+      const std::int64_t gi = gid[i];
+      const std::uint32_t celli = coupled ? pcell[i] : nCells;
+      ParticleHeatSources src;
+      if (contact || lens) {
+        double qc = 0.0, ql = 0.0;
+        const int nb = cnt[i];
+        for (int a = 0; a < nb; ++a) {
+          const std::int32_t j = list[i * M + a];
+          // Canonical order: (lo, hi) by global id.
+          const bool iFirst = gi < gid[j];
+          const long long lo = iFirst ? ii : static_cast<long long>(j);
+          const long long hi = iFirst ? static_cast<long long>(j) : ii;
+          const Vec3 d = load3(x, hi) - load3(x, lo);
+          const double l2 = dot(d, d);
+          const double rlo = r[lo], rhi = r[hi];
+          const double big = rlo > rhi ? rlo : rhi;
+          const double small = rlo > rhi ? rhi : rlo;
+          const double reach = lens ? lensFactor * big + small : rlo + rhi;
+          if (!(l2 < reach * reach)) continue;
+          const double l = ::sqrt(l2);
+          const double dT = T[hi] - T[lo];  // heat into lo = G (T_hi − T_lo)
+          if (contact && l < rlo + rhi) {
+            const double klo = hm[mat[lo]].k, khi = hm[mat[hi]].k;
+            if (klo + khi > 0.0) {
+              const double qab = contactConductance(klo, khi, rlo, rhi, l) * dT;
+              qc += iFirst ? qab : -qab;
+            }
+          }
+          if (lens) {
+            // κ_g of the pair: mean of the two PCM cells (a particle outside the grid uses
+            // the other's; both outside: no lens) [C].
+            const std::uint32_t clo = pcell[lo], chi = pcell[hi];
+            double kg = 0.0;
+            if (clo < nCells && chi < nCells) kg = 0.5 * (kap[clo] + kap[chi]);
+            else if (clo < nCells) kg = kap[clo];
+            else if (chi < nCells) kg = kap[chi];
+            if (kg > 0.0) {
+              const double qab = kg * gasLensIntegral(lp, rlo, rhi, l).value * dT;
+              ql += iFirst ? qab : -qab;
+            }
+          }
+        }
+        src.contactConduction = qc;
+        src.lensConduction = ql;
+      }
+      double g = 0.0;
+      if (celli < nCells && (conv || rad)) {
+        const double eps = epsFrozen[celli];
+        if (conv) {
+          const double slip = norm(load3(ug, celli) - load3(v, ii));
+          const GasState gs{rhoG[celli], muG[celli], kap[celli], cpg[celli], tg[celli], eps};
+          const ConvectionResult cr = convection(cp, gs, 2.0 * r[i], slip, ti);
+          g = cr.conductance;
+          src.convection = cr.heat;
+        }
+        if (rad && mi.emissivity > 0.0) {
+          const int count = static_cast<int>(ce[celli] - cs[celli]);
+          const double tEnv = radiationEnvironmentTemperature(eps, tg[celli], cellT[celli], count);
+          src.radiation = radiationHeat(mi.emissivity, 2.0 * r[i], tEnv, ti);
+        }
+      }
+      q[i] = particleHeatRate(src);
+      gOut[i] = g;
+      qr[i] = src.radiation;
+    });
+
+    // 3. Cell sources (gather per cell in the PCM order of deposit()).
+    if (s.coupled) {
+      double* acc = _acc.d();
+      const double invVc = 1.0 / s.cellVolume;
+      exec.parallelFor(nCells, [=] DEM_LAMBDA(std::size_t c) {
+        kernels::ConvectionCellSource cellSrc;
+        double rs = 0.0;
+        for (std::uint32_t k = cs[c]; k < ce[c]; ++k) {
+          const std::uint32_t i = perm[k];
+          kernels::addConvectionToCell(cellSrc, gOut[i], T[i], invVc);
+          rs += qr[i];
+        }
+        acc[3 * c] += cellSrc.H;
+        acc[3 * c + 1] += cellSrc.HTp;
+        acc[3 * c + 2] += rs * invVc;
+      });
+      _acc.markDeviceModified();
+    }
+  }
+
+  /// T_i += Δt Q_i/(m_i c_p,i) (Eq. 18, explicit Euler). Reads _q, mass, material; writes temperature.
+  void updateTemperature(Exec& exec, ParticleStore<Exec>& p, double dt) {
+    if (!_h.enabled) return;
+    const double* q = _q.d();
+    const double* m = p.mass.d();
+    const std::int32_t* mat = p.material.d();
+    const HeatMaterial* hm = _mat.d();
+    double* T = p.temperature.d();
+    exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
+      T[i] = T[i] + dt * (q[i] / (m[i] * hm[mat[i]].cp));
+    });
+    p.produced(kTemperature);
+  }
+
+  /// Averages the heat sources over nSub sub-steps into out.heatH / out.heatHTp (already sized)
+  /// and adds the window's energies to the totals (host).
+  void endWindow(int nSub, const EngineSetup& s, CellSources& out) {
+    if (!_h.enabled || !s.coupled) return;
+    _acc.toHost();
+    const double* acc = _acc.h();
+    const double w = 1.0 / static_cast<double>(nSub);
+    const double window = _dt * nSub;
+    double conv = 0.0, rad = 0.0;
+    for (std::size_t c = 0; c < s.nCells; ++c) {
+      out.heatH[c] = acc[3 * c] * w;
+      out.heatHTp[c] = acc[3 * c + 1] * w;
+      if (_hasTg) conv += out.heatH[c] * _tg.h()[c] - out.heatHTp[c];
+      rad += acc[3 * c + 2] * w;
+    }
+    _totals.convection += conv * s.cellVolume * window;
+    _totals.radiation += rad * s.cellVolume * window;
+  }
+};
+
+} // namespace coredem::dem

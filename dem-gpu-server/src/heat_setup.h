@@ -1,0 +1,30 @@
+#pragma once
+/// @file
+/// What the engine's heat module needs besides the particles (plain data, filled by DemSystem).
+
+#include "coredem/dem/kernels/conduction_gas_lens.h"
+#include "coredem/dem/kernels/convection.h"
+
+#include <vector>
+
+namespace coredem::dem {
+
+/// Thermal properties of one material (index = material index).
+struct HeatMaterial {
+  double cp;          ///< J/(kg K), > 0
+  double k;           ///< W/(m K), ≥ 0
+  double emissivity;  ///< −
+};
+
+struct HeatSetup {
+  bool enabled = false;            ///< master switch; false: the heat module does nothing
+  bool convection = false;         ///< Eqs. 19–21 (needs coupling and T_g, κ_g, c_p,g)
+  bool contactConduction = false;  ///< Eqs. 22–23
+  bool lensConduction = false;     ///< Eqs. 24–26 (needs coupling and κ_g)
+  bool radiation = false;          ///< Eqs. 27–28 (a) (needs coupling and T_g)
+  kernels::ConvectionParams convectionParams{};
+  kernels::GasLensParams lensParams{};
+  std::vector<HeatMaterial> materials;
+};
+
+} // namespace coredem::dem
