@@ -541,13 +541,22 @@ int main(int argc, char* argv[])
             ledgers.set(lSolid, solid*Vc);
             ledgers.set(lEnthalpy, rhoCp*enthalpy*Vc);
 
-            // Advected enthalpy entering through the boundary (J, relative to 0 K).
+            // Enthalpy entering through the boundary (J, relative to 0 K): advected, plus
+            // conducted (the discrete flux of the laplacian term, a fixed-temperature inlet
+            // heats the first cells by conduction too).
             double inflow = 0;
             forAll(mesh.boundary(), patchi)
             {
                 const scalarField& ap = alphaPhi.boundaryField()[patchi];
-                const scalarField& Tp = T.boundaryField()[patchi];
-                forAll(ap, facei) inflow -= ap[facei]*Tp[facei];
+                const fvPatchScalarField& Tp = T.boundaryField()[patchi];
+                const scalarField snGradT(Tp.snGrad());
+                const scalarField& af = alphacf.boundaryField()[patchi];
+                const scalarField& magSf = mesh.magSf().boundaryField()[patchi];
+                forAll(ap, facei)
+                {
+                    inflow -= ap[facei]*Tp[facei];
+                    inflow += af[facei]*DT.value()*snGradT[facei]*magSf[facei];
+                }
             }
             ledgers.add(lInflow, rhoCp*inflow*dt);
             if (dpPatches[0] >= 0)
