@@ -92,6 +92,24 @@ bool memberProcessAlive(std::int64_t pid, const std::string& runDir) {
   return cmd.find(runDir) != std::string::npos;
 }
 
+/// A live `coredem` process working on `runDir` (found through /proc), or 0. Covers the
+/// moment between a member's start and the record of its pid.
+std::int64_t findMemberProcess(const std::string& runDir) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator("/proc", ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) {
+      continue;
+    }
+    const std::int64_t pid = std::stoll(name);
+    if (pid != ::getpid() && readFile(e.path() / "comm") == "coredem\n" &&
+        memberProcessAlive(pid, runDir)) {
+      return pid;
+    }
+  }
+  return 0;
+}
+
 /// Newest checkpoint folder with a manifest (no hash check; for the status display).
 std::string newestCheckpointName(const fs::path& runDir) {
   std::string best;
@@ -221,11 +239,13 @@ private:
       if (m.status != "running") {
         continue;
       }
-      if (memberProcessAlive(m.pid, m.runDir)) {
+      const std::int64_t pid =
+          memberProcessAlive(m.pid, m.runDir) ? m.pid : findMemberProcess(m.runDir);
+      if (pid > 0) {
         _log->info("member {}: process {} of a previous campaign process still runs; waiting "
                    "for it",
-                   m.id, m.pid);
-        _running[m.id] = {m.pid, true, m.runDir, m.lastCheckpoint};
+                   m.id, pid);
+        _running[m.id] = {pid, true, m.runDir, m.lastCheckpoint};
         continue;
       }
       _db.transaction([&] {

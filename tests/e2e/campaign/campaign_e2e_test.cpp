@@ -84,6 +84,30 @@ int coredem(const std::vector<std::string>& args, const fs::path& log,
   return waitExit(start(args, log), timeout);
 }
 
+/// Direct children of `parent` (from /proc/<pid>/stat).
+std::vector<pid_t> childrenOf(pid_t parent) {
+  std::vector<pid_t> out;
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string name = e.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) {
+      continue;
+    }
+    const std::string stat = readAll(e.path() / "stat");
+    const auto close = stat.rfind(')');
+    if (close == std::string::npos) {
+      continue;
+    }
+    std::istringstream rest(stat.substr(close + 2));
+    char state;
+    pid_t ppid = 0;
+    rest >> state >> ppid;
+    if (ppid == parent) {
+      out.push_back(std::stoi(name));
+    }
+  }
+  return out;
+}
+
 /// A member row read straight from campaign.db (read-only, as a second process would).
 struct Row {
   std::string status, exitReason, lastCheckpoint, caseHash, softwareVersion, protocolVersion;
@@ -207,7 +231,12 @@ void killMidway(const fs::path& d, bool alsoMember) {
   ASSERT_GT(memberPid, 0) << "m001 never ran with a checkpoint: " << readAll(d / "log.txt");
   ::kill(campaign, SIGKILL);
   if (alsoMember) {
-    ::kill(-static_cast<pid_t>(memberPid), SIGKILL);
+    // the member's coredem and its participants (they run in process groups of their own)
+    const auto participants = childrenOf(static_cast<pid_t>(memberPid));
+    ::kill(static_cast<pid_t>(memberPid), SIGKILL);
+    for (pid_t p : participants) {
+      ::kill(p, SIGKILL);
+    }
   }
   EXPECT_EQ(waitExit(campaign, 10s), -SIGKILL);
   const auto rows = readDb(dir);
