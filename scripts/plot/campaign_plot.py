@@ -45,6 +45,8 @@ def main():
     for g in a.group:
         if g not in rows[0]:
             sys.exit(f"{a.summary}: no column '{g}' (--group)")
+    # keys with a single value in the whole campaign do not split the lines
+    a.group = [g for g in a.group if len({r[g] for r in rows}) > 1]
     groups = {}
     for r in rows:
         y = number(r[a.y])
