@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -74,6 +75,13 @@ DemConfig twoParticles(const va::TwoParticleCase& c) {
 
 double mc(const va::Material& m, double d) { return va::sphereMass(m, d) * m.cp; }
 
+/// Three significant digits for RecordProperty.
+std::string sci(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
 } // namespace
 
 // PHYSICS §8.1 seed variant d2 = 3.6 mm, δ = 4e-5 m, in vacuum (no coupling: no gas, so only
@@ -96,8 +104,8 @@ TEST(HeatStep, TwoTouchingParticlesConserveEnergyAndFollowTheAnalyticSolution) {
   EXPECT_NEAR(sys.time(), 50.0, 1e-9);
   EXPECT_LT(worst, 6e-6) << "dt " << dt;
   EXPECT_LT(worstEnergy, 1e-12);
-  RecordProperty("contact_max_rel_error", std::to_string(worst));
-  RecordProperty("contact_energy_drift", std::to_string(worstEnergy));
+  RecordProperty("contact_max_rel_error", sci(worst));
+  RecordProperty("contact_energy_drift", sci(worstEnergy));
   // Heated towards T_∞ (not frozen): after 50 s both are within 0.01 K of it.
   const std::vector<double> t = temperatures(sys);
   const double tInf = va::twoParticleEquilibrium(k.a, k.b, c.t10, c.t20);
@@ -131,7 +139,8 @@ TEST(HeatStep, GasLensPairFollowsTheAnalyticSolution) {
   }
   EXPECT_LT(worst, 1.5e-6);
   EXPECT_LT(worstEnergy, 1e-12);
-  RecordProperty("lens_max_rel_error", std::to_string(worst));
+  RecordProperty("lens_max_rel_error", sci(worst));
+  RecordProperty("lens_energy_drift", sci(worstEnergy));
   const CellSources& s = sys.advance(0.1, 1000);
   EXPECT_EQ(s.heatH[0], 0.0);  // convection off: no exchange with the gas
 }
@@ -187,7 +196,7 @@ TEST(HeatStep, SingleParticleInHotGasFollowsTheConvectiveHeatingCurve) {
   }
   EXPECT_LT(worst, 1e-4);
   EXPECT_LT(worstDiff, 2e-4);  // relative to T_g − T_p as well (Euler: ≈ k²Δt t/2 = 9e-5)
-  RecordProperty("convection_max_rel_error", std::to_string(worst));
+  RecordProperty("convection_max_rel_error", sci(worst));
   const ParticleData p = sys.particles();
   EXPECT_LT(std::fabs(p.velocity[1]), 1e-12);  // the particle did not move
 }
@@ -271,7 +280,7 @@ TEST(HeatStep, RadiationOfTwoParticlesFollowsTheRk4Reference) {
     worst = std::max({worst, std::fabs(t[0] - ref[w].t1) / ref[w].t1, std::fabs(t[1] - ref[w].t2) / ref[w].t2});
   }
   EXPECT_LT(worst, 2e-7);
-  RecordProperty("radiation_max_rel_error", std::to_string(worst));
+  RecordProperty("radiation_max_rel_error", sci(worst));
   // Radiation is the only heat term: the particles' energy changed by exactly the total.
   const double e = sys.thermalEnergy();
   const double e0 = mc(rc.m1, rc.d1) * rc.t10 + mc(rc.m2, rc.d2) * rc.t20;
