@@ -1,6 +1,8 @@
 // SQLite state of a campaign (campaign_db.h).
 #include <coredem/orchestrator/campaign_db.h>
 
+#include <map>
+
 #include <sqlite3.h>
 
 #include <coredem/common/check.h>
@@ -176,11 +178,15 @@ std::vector<MemberRecord> CampaignDb::members() const {
     m.protocolVersion = s.text(16);
     out.push_back(std::move(m));
   }
-  for (auto& m : out) {
-    Stmt v(_impl->db, "SELECT path, value FROM member_values WHERE member = ?1 ORDER BY pos");
-    v.bind(1, m.id);
-    while (v.step()) {
-      m.values.emplace_back(v.text(0), v.text(1));
+  std::map<std::string, std::size_t> index;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    index[out[i].id] = i;
+  }
+  Stmt v(_impl->db, "SELECT member, path, value FROM member_values ORDER BY member, pos");
+  while (v.step()) {
+    const auto it = index.find(v.text(0));
+    if (it != index.end()) {
+      out[it->second].values.emplace_back(v.text(1), v.text(2));
     }
   }
   return out;
