@@ -52,6 +52,7 @@ public:
   bool _hasTg = false, _hasKappa = false, _hasCp = false;
   Dev<double> _q, _g, _qrad;      ///< per particle: Q_i (W), G_i (W/K), Q_rad,i (W)
   Dev<double> _cellT;             ///< per cell: Σ T_p (radiation environment)
+  Dev<double> _lensI;             ///< per neighbour slot: lens integral I (m), owner = smaller gid
   Dual<double> _acc;              ///< per cell: Σ_sub H, Σ_sub H_Tp, Σ_sub Q_rad/V_c
   double _dt = 0.0;               ///< sub-step length of the current window
   HeatTotals _totals;
@@ -89,7 +90,7 @@ public:
   std::size_t bytes() const {
     auto& s = const_cast<HeatModule&>(*this);
     return s._mat.bytes() + s._tg.bytes() + s._kappa.bytes() + s._cp.bytes() + _q.bytes() +
-           _g.bytes() + _qrad.bytes() + _cellT.bytes() + s._acc.bytes();
+           _g.bytes() + _qrad.bytes() + _cellT.bytes() + _lensI.bytes() + s._acc.bytes();
   }
 
   void beginWindow(Exec& exec, std::size_t nCells) {
@@ -130,7 +131,6 @@ public:
       });
     }
 
-    // 2. Per-particle heat rate.
     const double* x = p.pos.d();
     const double* v = p.vel.d();
     const double* r = p.radius.d();
@@ -151,6 +151,34 @@ public:
     const std::uint32_t* cs = cStart;
     const std::uint32_t* ce = cEnd;
     const double lensFactor = 1.0 + lp.lensFraction;
+
+    // 2. Lens integrals, once per pair: the particle with the smaller global id evaluates the
+    //    pair (canonical order) and stores I in its neighbour slot; the partner reads it there.
+    double* li = nullptr;
+    if (lens) {
+      _lensI.reserve(n * static_cast<std::size_t>(M));
+      li = _lensI.d();
+      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+        using namespace kernels;
+        const long long ii = static_cast<long long>(i);
+        const int nb = cnt[i];
+        for (int a = 0; a < nb; ++a) {
+          const std::int32_t j = list[i * M + a];
+          double value = 0.0;
+          if (gid[i] < gid[j]) {
+            const Vec3 d = load3(x, j) - load3(x, ii);
+            const double l2 = dot(d, d);
+            const double big = r[i] > r[j] ? r[i] : r[j];
+            const double small = r[i] > r[j] ? r[j] : r[i];
+            const double reach = lensFactor * big + small;
+            if (l2 < reach * reach) value = gasLensIntegral(lp, r[i], r[j], ::sqrt(l2)).value;
+          }
+          li[i * M + a] = value;
+        }
+      });
+    }
+
+    // 3. Per-particle heat rate.
     exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
       const long long ii = static_cast<long long>(i);
@@ -193,7 +221,19 @@ public:
             else if (clo < nCells) kg = kap[clo];
             else if (chi < nCells) kg = kap[chi];
             if (kg > 0.0) {
-              const double qab = kg * gasLensIntegral(lp, rlo, rhi, l).value * dT;
+              double lensIntegral = 0.0;
+              if (iFirst) {
+                lensIntegral = li[i * M + a];
+              } else {  // the partner's slot that holds i (the lists are symmetric)
+                const int nbj = cnt[j];
+                for (int b = 0; b < nbj; ++b) {
+                  if (list[static_cast<std::size_t>(j) * M + b] == static_cast<std::int32_t>(i)) {
+                    lensIntegral = li[static_cast<std::size_t>(j) * M + b];
+                    break;
+                  }
+                }
+              }
+              const double qab = kg * lensIntegral * dT;
               ql += iFirst ? qab : -qab;
             }
           }
@@ -222,7 +262,7 @@ public:
       qr[i] = src.radiation;
     });
 
-    // 3. Cell sources (gather per cell in the PCM order of deposit()).
+    // 4. Cell sources (gather per cell in the PCM order of deposit()).
     if (s.coupled) {
       double* acc = _acc.d();
       const double invVc = 1.0 / s.cellVolume;
