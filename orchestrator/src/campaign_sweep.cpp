@@ -160,8 +160,12 @@ Sweep loadSweep(const fs::path& sweepFile) {
   try {
     root = YAML::Load(sw.text);
   } catch (const YAML::Exception& e) {
-    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", r.file, e.mark.line + 1,
-                                e.mark.column + 1, e.msg));
+    const bool flow = e.msg.find("flow") != std::string::npos;
+    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}{}", r.file, e.mark.line + 1,
+                                e.mark.column + 1, e.msg,
+                                flow ? " (a key like particles[0].diameter must be written in "
+                                       "a block mapping, one key per line, not inside { })"
+                                     : ""));
   }
   if (!root.IsMap()) {
     throw CaseError(fmt::format("{}: a sweep file is a mapping with base_case and grid or "
