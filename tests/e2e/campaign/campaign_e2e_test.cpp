@@ -425,7 +425,10 @@ TEST(CampaignE2E, SigtermStopsTheMembersResumably) {
   bool running = false;
   while (!running && std::chrono::steady_clock::now() < deadline) {
     const auto rows = readDb(dir);
-    running = rows.count("m001") && rows.at("m001").status == "running" && rows.at("m001").pid > 0;
+    // past its start-up (coredem acts on SIGTERM only once its participants are connected;
+    // during start-up it takes the DEM server's start deadline, ~15 s)
+    running = rows.count("m001") && rows.at("m001").status == "running" &&
+              rows.at("m001").pid > 0 && !stepsOf(dir / "members/m001/run").empty();
     std::this_thread::sleep_for(5ms);
   }
   ASSERT_TRUE(running) << readAll(d / "log.txt");
