@@ -8,26 +8,26 @@
 //   and a mesh that is not the Cartesian coupling grid is refused naming the cell.
 //   (c) hot gas through a fixed bed: the gas's energy ledger closes (the particle side once the
 //       DEM server computes heat exchange);
-#include <gtest/gtest.h>
-#include <hdf5.h>
-
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
-#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <numbers>
 #include <regex>
-#include <spawn.h>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 #include <thread>
-#include <unistd.h>
 #include <vector>
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 extern char** environ;
 namespace fs = std::filesystem;
@@ -44,8 +44,8 @@ constexpr double kRhoP = 2500.0, kDp = 1.0e-3;
 constexpr double kArea = 0.01 * 0.01, kHeight = 0.04;
 
 fs::path tempDir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() /
-                     ("coredemfoam-e2e-" + std::to_string(::getpid()) + "-" + name);
+  const fs::path d =
+      fs::temp_directory_path() / ("coredemfoam-e2e-" + std::to_string(::getpid()) + "-" + name);
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -264,7 +264,7 @@ particles:
   const auto& dp = ts["gas.pressure_drop_Pa"];
   ASSERT_EQ(dp.size(), 12u);
   // The bed did not move (it is well below minimum fluidization).
-  EXPECT_LT(ts["dem.kinetic_energy_J"].back(), 1e-7);  // mean speed below ~1 cm/s
+  EXPECT_LT(ts["dem.kinetic_energy_J"].back(), 1e-7); // mean speed below ~1 cm/s
   // PCM solid volume = the particles' volume (coredemFoam's diagnostic of the DEM's eps_g).
   const double vp = std::numbers::pi / 6.0 * kDp * kDp * kDp;
   EXPECT_NEAR(ts["gas.solid_volume_m3"].back(), 1600 * vp, 1e-9 * 1600 * vp);
@@ -280,18 +280,24 @@ particles:
   EXPECT_NEAR(dp[9] / dp[11], 1.0, 0.01);
 }
 
-// (c) Hot gas (400 K) through the packed bed of the Ergun test (beads at 293.15 K): the gas's
-// enthalpy ledger closes, Δ(Σ V α ρ c_p T) = enthalpy advected and conducted in − out + heat
-// from the particles (+ homogeneous heat), within 1e-6 of the enthalpy that came in (the T
-// solver's tolerance is 1e-9; observed ~1e-8). When the DEM server reports
-// heat exchange with the gas, the particles' enthalpy gain must also equal the gas's loss within
-// 1%; the DEM server does not compute it yet (dem.heat_from_gas_J stays 0), which this test
-// then says.
+// (c) Hot gas (400 K) through the packed lattice bed of the Ergun test (beads at 293.15 K; a
+// soft spring, k_n = 10 N/m, is enough for a bed at rest and makes dt_DEM 3x longer):
+//  * the gas's enthalpy ledger closes, Δ(Σ V α ρ c_p T) = enthalpy advected and conducted in −
+//    out + heat from the particles (+ homogeneous heat), within 1e-6 of the enthalpy that came in
+//    (the T solver's tolerance is 1e-9; observed ~2e-7);
+//  * the particles' enthalpy gain (DEM ledger dem.heat_from_gas_J) equals the heat the gas gave
+//    them within 1% (issue 6). The two differ by the coupling's splitting error: the DEM
+//    integrates h A (T_g − T_p) with T_g frozen at the start of the step, the gas takes the
+//    exchange implicitly, so each step differs by H (T_g,old − T_g,new) Δt. That is largest while
+//    the hot front crosses the bed (H Δt/(ε ρ c_p) ≈ 0.35 at Δt = 0.25 ms) and fades as the gas
+//    temperature settles: observed 0.75% after 50 ms, 1.8% after 30 ms, 8% after 10 ms.
+//    When the DEM server reports no heat exchange (dem.heat_from_gas_J = 0) this part is not
+//    checked and the test says so.
 TEST_F(CoredemFoamE2E, HotGasThroughFixedBedEnergyLedgerCloses) {
   const double tIn = 400.0, t0 = 293.15, cp = 1006.0;
-  const fs::path c = makeCase(dir, 0.3, tIn, R"(time: {end: 0.03, dt: 1.0e-3}
+  const fs::path c = makeCase(dir, 0.3, tIn, R"(time: {end: 0.05, dt: 2.5e-4}
 materials:
-  - {name: glass, density: 2500.0, k_n: 100.0, e_n: 0.5, friction: 0.3, cp: 840.0}
+  - {name: glass, density: 2500.0, k_n: 10.0, e_n: 0.5, friction: 0.3, cp: 840.0}
 particles:
   - {name: bed, material: glass, count: 1600, diameter: 1.0e-3, packing: lattice,
      temperature: 293.15, region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.020, 0.01]}}
@@ -319,6 +325,9 @@ particles:
     std::cout << "note: the DEM server reports no heat exchange with the gas (dem.heat_from_gas_J"
                  " = 0): the particle side of the ledger is not checked yet\n";
   } else {
+    std::cout << "particles gained " << demHeat << " J, the gas gave " << -fromParticles << " J ("
+              << 100.0 * (demHeat / -fromParticles - 1.0) << " %)\n";
+    EXPECT_GT(demHeat, 0.0);
     EXPECT_NEAR(demHeat, -fromParticles, 0.01 * std::abs(demHeat))
         << "particle enthalpy gain vs gas loss";
   }
@@ -370,10 +379,9 @@ TEST_F(CoredemFoamE2E, FluidizedBedPressureDropCarriesTheBedWeight) {
       << "the test's velocity does not fluidize this bed";
   const double expected = weight + kRhoG * kG * kHeight;
   const double measured = sum / span;
-  std::cout << "fluidized bed: time-averaged pressure drop " << measured << " Pa over "
-            << span << " s, bed weight/area " << weight << " Pa + gas column "
-            << kRhoG * kG * kHeight << " Pa = " << expected << " Pa ("
-            << 100.0 * (measured / expected - 1.0) << " %)\n";
+  std::cout << "fluidized bed: time-averaged pressure drop " << measured << " Pa over " << span
+            << " s, bed weight/area " << weight << " Pa + gas column " << kRhoG * kG * kHeight
+            << " Pa = " << expected << " Pa (" << 100.0 * (measured / expected - 1.0) << " %)\n";
   EXPECT_NEAR(measured / expected, 1.0, 0.05);
 }
 
@@ -388,9 +396,8 @@ TEST_F(CoredemFoamE2E, RestartContinuesWithTheSameFieldsAndDemState) {
   const fs::path a = dir / "straight", b = dir / "resumed";
   ASSERT_EQ(runCoredem({"run", c.string(), "--out", a.string()}, dir / "a.log"), 0)
       << readAll(dir / "a.log") << logTail(a);
-  ASSERT_EQ(runCoredem({"run", c.string(), "--out", b.string(), "--stop-after", "12"},
-                       dir / "b.log"),
-            0)
+  ASSERT_EQ(
+      runCoredem({"run", c.string(), "--out", b.string(), "--stop-after", "12"}, dir / "b.log"), 0)
       << readAll(dir / "b.log") << logTail(b);
   ASSERT_TRUE(fs::exists(b / "checkpoints" / "00000012" / "manifest.json"));
   ASSERT_FALSE(fs::exists(b / "checkpoints" / "00000024"));
@@ -449,7 +456,8 @@ particles:
   const std::string log = readAll(dir / "coredem.log");
   EXPECT_NE(log.find("coredemFoam"), std::string::npos) << log;
   EXPECT_TRUE(std::regex_search(log, std::regex("mesh cell [0-9]+ \\(centre")))
-      << "the error does not name the cell:\n" << log;
+      << "the error does not name the cell:\n"
+      << log;
   EXPECT_NE(log.find("uniform Cartesian"), std::string::npos) << log;
 }
 
