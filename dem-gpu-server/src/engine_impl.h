@@ -10,7 +10,10 @@
 ///      (cell keys → stable sort → particles reordered → 27-cell search)
 ///   2. forces: gas (PCM cell: Gidaspow drag, −V_p∇p), particle–particle LSD, walls
 ///   3. cell sources deposited (PCM, sorted by cell, gathered per cell)
+///   3b. heat sources on the same configuration: conduction, lens, convection, radiation,
+///      H and H_Tp deposited (heat.h; the lens widens the neighbour cut-off by EngineSetup::reach)
 ///   4. motion: v += Δt (F/m + g), ω += Δt T/I, x += Δt v
+///   5. temperatures: T += Δt Q/(m c_p) (heat.h)
 /// Why symplectic Euler: one force evaluation per step (the cost is all in the forces), it is
 /// MFiX's default DEM integrator, it is second order in x for conservative forces (leapfrog),
 /// and for the velocity-dependent LSD law velocity Verlet (LIGGGHTS) gave the same rebound
