@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -356,8 +357,8 @@ BedRun runBed(int threads, int windows, const std::string& stateIn = "", const s
 } // namespace
 
 TEST(HeatStep, OneAndTwoThreadsAreBitwiseIdenticalWithHeatOn) {
-  const BedRun a = runBed(1, 6);
-  const BedRun b = runBed(2, 6);
+  const BedRun a = runBed(1, 4);
+  const BedRun b = runBed(2, 4);
   ASSERT_EQ(a.t.size(), b.t.size());
   for (std::size_t i = 0; i < a.t.size(); ++i) {
     ASSERT_EQ(a.t[i], b.t[i]) << "particle " << i;
@@ -373,7 +374,7 @@ TEST(HeatStep, OneAndTwoThreadsAreBitwiseIdenticalWithHeatOn) {
     EXPECT_LT(t, 600.0);
     mean += t / static_cast<double>(a.t.size());
   }
-  EXPECT_GT(mean, 300.2);
+  EXPECT_GT(mean, 300.1);
   EXPECT_GT(a.totals.convection, 0.0);
   EXPECT_GT(a.totals.radiation, 0.0);
   // Heat balance of the run: Δ Σ m c_p T = convection + radiation (conduction moves heat
@@ -427,4 +428,17 @@ TEST(HeatOptions, ParseAndRejectWithAClearMessage) {
   EXPECT_THROW(setHeatOption(o, "s_min", "-1"), coredem::UserError);
   EXPECT_THROW(setHeatOption(o, "heat", "maybe"), coredem::UserError);
   EXPECT_THROW(setHeatOption(o, "radiation_environment", "neighbour-mean"), coredem::UserError);
+}
+
+// The 1-vs-2-thread and restart cases run two OpenMP threads on a machine shared with other
+// jobs; libgomp's default spinning barriers then stall on a descheduled thread (docs/
+// performance.md "DEM core"). OMP_WAIT_POLICY is read when libgomp starts, so an unset policy
+// is set to PASSIVE and the test re-executes itself once. Results do not depend on it.
+int main(int argc, char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") == nullptr) {
+    ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
+    ::execv("/proc/self/exe", argv);  // returns only on failure: then run as is
+  }
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
 }
