@@ -485,7 +485,7 @@ void Session::startCfd(const fs::path& gasRestart) {
     if (!gasRestart.empty()) {
       foamArgv.insert(foamArgv.end(), {"-restart", gasRestart.string()});
     }
-    const std::map<std::string, std::string> env = {
+    std::map<std::string, std::string> env = {
         {"COREDEM_CONTROL_ENDPOINT", _ctrlEndpoint},
         {"COREDEM_DEM_ENDPOINT", _demEndpoint},
         {"COREDEM_SESSION", _session},
@@ -493,6 +493,9 @@ void Session::startCfd(const fs::path& gasRestart) {
         // OpenFOAM reads its etc tree while its libraries load: Debian's unless set.
         {"WM_PROJECT_DIR",
          std::getenv("WM_PROJECT_DIR") ? std::getenv("WM_PROJECT_DIR") : "/usr/share/openfoam"}};
+    if (!_serverKey.empty()) {
+      env["COREDEM_DEM_SERVER_KEY"] = _serverKey; // remote DEM behind CURVE
+    }
     _cfdProc =
         std::make_unique<ChildProcess>(cfdName(_c), foamArgv, env, _o.runDir / "logs" / "cfd.log");
     _log->info("started {} (pid {})", _c.cfd.participant, _cfdProc->pid());
@@ -674,6 +677,30 @@ void Session::stepLoop(std::int64_t startStep) {
     const auto& cd = cfdDone.message.envelope().step_done();
     _lastCourant = cd.cfl();
 
+    // The timeseries row of a step is written before its checkpoint manifest: a resume from
+    // that checkpoint must find the row (a crash between the two would otherwise lose it).
+    if (step % _c.output.timeseriesEvery == 0 || last) {
+      std::vector<std::pair<std::string, double>> row = {
+          {"step", double(step)},
+          {"t", _time.time()},
+          {"dt", dt},
+          {"n_sub", double(plan.nSub)},
+          {"dt_dem", plan.dtDem},
+          {"courant", cd.cfl()},
+          {"wall_step_s", std::chrono::duration<double>(tDone - t0).count()},
+          {"wall_dem_s", dd.wall_seconds()}};
+      collect(dd, row);
+      collect(cd, row);
+      // Heat balance: what the particles got from the gas (DEM) plus what the gas got from
+      // the particles (CFD) is zero when both sides agree.
+      const auto demHeat = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_from_gas_J");
+      const auto gasHeat =
+          protocol::findNamedValue(cd.ledger().energy(), "gas.heat_from_particles_J");
+      if (demHeat && gasHeat) {
+        row.emplace_back("balance.heat_residual_J", *demHeat + *gasHeat);
+      }
+      _timeseries->write(row);
+    }
     const auto tIo0 = Clock::now();
     if (checkpoint) {
       std::vector<std::pair<std::string, std::string>> files;
@@ -709,28 +736,6 @@ void Session::stepLoop(std::int64_t startStep) {
     const auto tIo2 = Clock::now();
     _checkpointSum += std::chrono::duration<double>(tIo1 - tIo0).count();
     _snapshotSum += std::chrono::duration<double>(tIo2 - tIo1).count();
-    if (step % _c.output.timeseriesEvery == 0 || last) {
-      std::vector<std::pair<std::string, double>> row = {
-          {"step", double(step)},
-          {"t", _time.time()},
-          {"dt", dt},
-          {"n_sub", double(plan.nSub)},
-          {"dt_dem", plan.dtDem},
-          {"courant", cd.cfl()},
-          {"wall_step_s", std::chrono::duration<double>(tDone - t0).count()},
-          {"wall_dem_s", dd.wall_seconds()}};
-      collect(dd, row);
-      collect(cd, row);
-      // Heat balance: what the particles got from the gas (DEM) plus what the gas got from
-      // the particles (CFD) is zero when both sides agree.
-      const auto demHeat = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_from_gas_J");
-      const auto gasHeat =
-          protocol::findNamedValue(cd.ledger().energy(), "gas.heat_from_particles_J");
-      if (demHeat && gasHeat) {
-        row.emplace_back("balance.heat_residual_J", *demHeat + *gasHeat);
-      }
-      _timeseries->write(row);
-    }
     _stepWallSum += std::chrono::duration<double>(tDone - t0).count();
     _demWallSum += dd.wall_seconds();
     ++_measured;
