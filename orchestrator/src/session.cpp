@@ -321,8 +321,14 @@ void Session::startDem() {
     if (_c.dem.threads > 0) {
       argv.insert(argv.end(), {"--threads", std::to_string(_c.dem.threads)});
     }
-    _demProc = std::make_unique<ChildProcess>(kDemName, argv, std::map<std::string, std::string>{},
-                                              _o.runDir / "logs" / "dem.log");
+    // OpenMP threads that spin at barriers stall every parallel region when the DEM shares
+    // its cores with the CFD participant (docs/performance.md, "DEM core"); passive waiting
+    // is the default here, and a policy set in the user's environment wins.
+    std::map<std::string, std::string> demEnv;
+    if (std::getenv("OMP_WAIT_POLICY") == nullptr) {
+      demEnv["OMP_WAIT_POLICY"] = "PASSIVE";
+    }
+    _demProc = std::make_unique<ChildProcess>(kDemName, argv, demEnv, _o.runDir / "logs" / "dem.log");
     const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                              std::chrono::duration<double>(_c.dem.timeoutSeconds));
     while (!fs::exists(epFile)) {
