@@ -21,7 +21,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-extern char** environ;
+#include "coredem_e2e.h"
+
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
@@ -30,56 +31,16 @@ namespace {
 const fs::path kBin = COREDEM_BIN_DIR;
 const fs::path kCases = COREDEM_CAMPAIGN_CASES;
 
-fs::path tempDir(const std::string& name) {
-  const fs::path d =
-      fs::temp_directory_path() / ("coredem-camp-" + std::to_string(::getpid()) + "-" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+using coredem::e2e::readAll;
 
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+fs::path tempDir(const std::string& name) { return coredem::e2e::tempDir("coredem-camp", name); }
 
 pid_t start(const std::vector<std::string>& args, const fs::path& log) {
-  std::vector<std::string> argv = {(kBin / "coredem").string()};
-  argv.insert(argv.end(), args.begin(), args.end());
-  std::vector<char*> c;
-  for (auto& a : argv) {
-    c.push_back(a.data());
-  }
-  c.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, c[0], &fa, nullptr, c.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  EXPECT_EQ(rc, 0) << "cannot start " << argv[0];
-  return pid;
+  return coredem::e2e::startProgram(kBin / "coredem", args, log);
 }
+using coredem::e2e::waitExit;
 
-int waitExit(pid_t pid, std::chrono::seconds timeout) {
-  const auto end = std::chrono::steady_clock::now() + timeout;
-  int status = 0;
-  while (::waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() > end) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      ADD_FAILURE() << "coredem did not finish within " << timeout.count() << " s";
-      return -1000;
-    }
-    std::this_thread::sleep_for(10ms);
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
-}
-
-int coredem(const std::vector<std::string>& args, const fs::path& log,
+int runCoredem(const std::vector<std::string>& args, const fs::path& log,
             std::chrono::seconds timeout = 50s) {
   return waitExit(start(args, log), timeout);
 }
@@ -192,12 +153,12 @@ void expectAllDoneOnce(const fs::path& dir, std::size_t members, long steps) {
 const std::string& referenceKillSummary() {
   static const std::string summary = [] {
     const fs::path d = tempDir("kill-reference");
-    EXPECT_EQ(coredem({"campaign", "run", (kCases / "kill.yaml").string(), "--out",
+    EXPECT_EQ(runCoredem({"campaign", "run", (kCases / "kill.yaml").string(), "--out",
                        (d / "c").string()},
                       d / "log.txt"),
               0)
         << readAll(d / "log.txt");
-    EXPECT_EQ(coredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"), 0);
+    EXPECT_EQ(runCoredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"), 0);
     expectAllDoneOnce(d / "c", 4, 160);
     const std::string text = readAll(d / "c" / "summary.csv");
     fs::remove_all(d);
@@ -276,7 +237,7 @@ void killMidway(const fs::path& d, bool alsoMember) {
 TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
   const fs::path d = tempDir("grid4");
   const fs::path dir = d / "c";
-  ASSERT_EQ(coredem({"campaign", "run", (kCases / "grid4.yaml").string(), "--out", dir.string()},
+  ASSERT_EQ(runCoredem({"campaign", "run", (kCases / "grid4.yaml").string(), "--out", dir.string()},
                     d / "log.txt"),
             0)
       << readAll(d / "log.txt");
@@ -289,16 +250,16 @@ TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
   EXPECT_NE(m2.find("T_g: 600.0"), std::string::npos) << m2;
   EXPECT_NE(m2.find("diameter: 1.0e-3"), std::string::npos) << m2;
 
-  ASSERT_EQ(coredem({"campaign", "status", dir.string(), "--json"}, d / "status.json"), 0);
+  ASSERT_EQ(runCoredem({"campaign", "status", dir.string(), "--json"}, d / "status.json"), 0);
   const std::string js = readAll(d / "status.json");
   EXPECT_NE(js.find("\"id\": \"m003\", \"status\": \"done\""), std::string::npos) << js;
   EXPECT_NE(js.find("\"particles[0].diameter\": \"1.2e-3\""), std::string::npos) << js;
-  ASSERT_EQ(coredem({"campaign", "status", dir.string()}, d / "status.txt"), 0);
+  ASSERT_EQ(runCoredem({"campaign", "status", dir.string()}, d / "status.txt"), 0);
   EXPECT_NE(readAll(d / "status.txt").find("4 members: 4 done, 0 running, 0 pending, 0 failed"),
             std::string::npos)
       << readAll(d / "status.txt");
 
-  ASSERT_EQ(coredem({"campaign", "collect", dir.string()}, d / "collect.txt"), 0)
+  ASSERT_EQ(runCoredem({"campaign", "collect", dir.string()}, d / "collect.txt"), 0)
       << readAll(d / "collect.txt");
   std::ifstream in(dir / "summary.csv");
   std::string header, line;
@@ -343,7 +304,7 @@ TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
   EXPECT_GT(fs::file_size(dir / "plots/campaign.png"), 5000u);
 
   // a member re-runs alone from its case folder with the same result
-  ASSERT_EQ(coredem({"run", (dir / "members/m001/case").string(), "--out",
+  ASSERT_EQ(runCoredem({"run", (dir / "members/m001/case").string(), "--out",
                      (d / "alone").string(), "--no-plots"},
                     d / "alone.txt"),
             0)
@@ -366,7 +327,7 @@ TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
   EXPECT_EQ(tail(d / "alone/timeseries.csv"), tail(dir / "members/m001/run/timeseries.csv"));
 
   // a second `run` into the same folder is refused
-  EXPECT_EQ(coredem({"campaign", "run", (kCases / "grid4.yaml").string(), "--out", dir.string()},
+  EXPECT_EQ(runCoredem({"campaign", "run", (kCases / "grid4.yaml").string(), "--out", dir.string()},
                     d / "again.txt"),
             1);
   EXPECT_NE(readAll(d / "again.txt").find("already holds a campaign"), std::string::npos);
@@ -381,10 +342,10 @@ TEST(CampaignE2E, KillCampaignThenResumeFinishesEveryMemberOnceWithIdenticalResu
   const fs::path d = tempDir("kill-campaign");
   killMidway(d, /*alsoMember=*/false);
   // the orphaned member process may still run: resume adopts it, then finishes the rest
-  ASSERT_EQ(coredem({"campaign", "resume", (d / "c").string()}, d / "resume.txt"), 0)
+  ASSERT_EQ(runCoredem({"campaign", "resume", (d / "c").string()}, d / "resume.txt"), 0)
       << readAll(d / "resume.txt");
   expectAllDoneOnce(d / "c", 4, 160);
-  ASSERT_EQ(coredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"), 0);
+  ASSERT_EQ(runCoredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"), 0);
   EXPECT_EQ(readAll(d / "c" / "summary.csv"), reference);
   if (!HasFailure()) {
     fs::remove_all(d);
@@ -396,7 +357,7 @@ TEST(CampaignE2E, MachineCrashThenResumeContinuesFromTheMembersCheckpoint) {
   ASSERT_FALSE(reference.empty());
   const fs::path d = tempDir("kill-all");
   killMidway(d, /*alsoMember=*/true);
-  ASSERT_EQ(coredem({"campaign", "resume", (d / "c").string()}, d / "resume.txt"), 0)
+  ASSERT_EQ(runCoredem({"campaign", "resume", (d / "c").string()}, d / "resume.txt"), 0)
       << readAll(d / "resume.txt");
   expectAllDoneOnce(d / "c", 4, 160);
   // m001 was continued with `coredem resume`, not started over
@@ -407,7 +368,7 @@ TEST(CampaignE2E, MachineCrashThenResumeContinuesFromTheMembersCheckpoint) {
   EXPECT_EQ(rows.at("m001").attempts, 2);
   EXPECT_EQ(rows.at("m001").failures, 0);
   EXPECT_EQ(rows.at("m000").attempts, 1);
-  ASSERT_EQ(coredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"), 0);
+  ASSERT_EQ(runCoredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"), 0);
   EXPECT_EQ(readAll(d / "c" / "summary.csv"), reference);
   if (!HasFailure()) {
     fs::remove_all(d);
@@ -439,10 +400,10 @@ TEST(CampaignE2E, SigtermStopsTheMembersResumably) {
   EXPECT_EQ(rows.at("m001").status, "pending"); // stopped, not failed
   EXPECT_EQ(rows.at("m001").failures, 0);
   EXPECT_EQ(rows.at("m001").exitReason, "campaign interrupted");
-  ASSERT_EQ(coredem({"campaign", "resume", dir.string()}, d / "resume.txt"), 0)
+  ASSERT_EQ(runCoredem({"campaign", "resume", dir.string()}, d / "resume.txt"), 0)
       << readAll(d / "resume.txt");
   expectAllDoneOnce(dir, 4, 160);
-  ASSERT_EQ(coredem({"campaign", "collect", dir.string(), "--no-plot"}, d / "log.txt"), 0);
+  ASSERT_EQ(runCoredem({"campaign", "collect", dir.string(), "--no-plot"}, d / "log.txt"), 0);
   EXPECT_EQ(readAll(dir / "summary.csv"), reference);
   if (!HasFailure()) {
     fs::remove_all(d);
@@ -452,7 +413,7 @@ TEST(CampaignE2E, SigtermStopsTheMembersResumably) {
 TEST(CampaignE2E, DeterministicallyFailingMemberEndsFailedAfterRetries) {
   const fs::path d = tempDir("failing");
   const fs::path dir = d / "c";
-  EXPECT_EQ(coredem({"campaign", "run", (kCases / "failing.yaml").string(), "--out",
+  EXPECT_EQ(runCoredem({"campaign", "run", (kCases / "failing.yaml").string(), "--out",
                      dir.string()},
                     d / "log.txt"),
             1)
@@ -471,10 +432,10 @@ TEST(CampaignE2E, DeterministicallyFailingMemberEndsFailedAfterRetries) {
   EXPECT_NE(bad.exitReason.find("exited with code 2"), std::string::npos) << bad.exitReason;
   EXPECT_NE(bad.exitReason.find("T_g"), std::string::npos) << bad.exitReason;
   // a resume does not retry a member that failed for good
-  EXPECT_EQ(coredem({"campaign", "resume", dir.string()}, d / "resume.txt"), 1);
+  EXPECT_EQ(runCoredem({"campaign", "resume", dir.string()}, d / "resume.txt"), 1);
   EXPECT_EQ(readDb(dir).at("m002").attempts, 3);
   // collect leaves its results empty
-  ASSERT_EQ(coredem({"campaign", "collect", dir.string(), "--no-plot"}, d / "log.txt"), 0);
+  ASSERT_EQ(runCoredem({"campaign", "collect", dir.string(), "--no-plot"}, d / "log.txt"), 0);
   EXPECT_NE(readAll(dir / "summary.csv").find("m002,failed,-5.0,\n"), std::string::npos)
       << readAll(dir / "summary.csv");
   if (!HasFailure()) {
@@ -509,7 +470,7 @@ TEST(CampaignE2E, MalformedSweepIsRefusedNamingTheKey) {
     }
     const fs::path out = d / ("out" + std::to_string(i));
     const fs::path log = d / ("log" + std::to_string(i));
-    EXPECT_EQ(coredem({"campaign", "run", (d / "bad.yaml").string(), "--out", out.string()}, log),
+    EXPECT_EQ(runCoredem({"campaign", "run", (d / "bad.yaml").string(), "--out", out.string()}, log),
               2)
         << cases[i].body;
     EXPECT_NE(readAll(log).find(cases[i].expect), std::string::npos)

@@ -29,7 +29,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-extern char** environ;
+#include "coredem_e2e.h"
+#include "coredem_e2e_hdf5.h"
+
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
@@ -38,30 +40,18 @@ namespace {
 const fs::path kBin = COREDEM_BIN_DIR;
 const fs::path kTemplate = COREDEM_FOAM_E2E_TEMPLATE;
 
+using coredem::e2e::readAll;
+
+fs::path tempDir(const std::string& name) {
+  return coredem::e2e::tempDir("coredemfoam-e2e", name);
+}
+using coredem::e2e::datasetsOf;
+using coredem::e2e::writeAll;
+
 // Gas and bed of every test (air at 20 °C, 1 mm glass), as in the template and case.yaml below.
 constexpr double kRhoG = 1.204, kMuG = 1.81e-5, kG = 9.81;
 constexpr double kRhoP = 2500.0, kDp = 1.0e-3;
 constexpr double kArea = 0.01 * 0.01, kHeight = 0.04;
-
-fs::path tempDir(const std::string& name) {
-  const fs::path d =
-      fs::temp_directory_path() / ("coredemfoam-e2e-" + std::to_string(::getpid()) + "-" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-void writeAll(const fs::path& p, const std::string& text) {
-  std::ofstream out(p, std::ios::binary);
-  out << text;
-}
 
 std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
   for (std::size_t i = s.find(from); i != std::string::npos; i = s.find(from, i + to.size())) {
@@ -98,42 +88,11 @@ dem: {backend: cpu, threads: 1, timeout_s: 120}
   return c;
 }
 
-/// Runs `coredem args...` with output into `log`, with a deadline; returns the exit code.
-int runCoredem(const std::vector<std::string>& args, const fs::path& log,
+/// Runs `coredem args... --no-plots` with output into `log`, with a deadline; returns the exit code.
+int runCoredem(std::vector<std::string> args, const fs::path& log,
                std::chrono::seconds timeout = 150s) {
-  std::vector<std::string> argv = {(kBin / "coredem").string()};
-  argv.insert(argv.end(), args.begin(), args.end());
-  argv.push_back("--no-plots");
-  std::vector<char*> c;
-  for (auto& a : argv) {
-    c.push_back(a.data());
-  }
-  c.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, c[0], &fa, nullptr, c.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) {
-    ADD_FAILURE() << "cannot start " << argv[0];
-    return -1;
-  }
-  const auto end = std::chrono::steady_clock::now() + timeout;
-  int status = 0;
-  while (::waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() > end) {
-      ::kill(pid, SIGTERM);
-      std::this_thread::sleep_for(2s);
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      ADD_FAILURE() << "coredem did not finish within " << timeout.count() << " s";
-      return -1000;
-    }
-    std::this_thread::sleep_for(10ms);
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+  args.push_back("--no-plots");
+  return coredem::e2e::waitExit(coredem::e2e::startProgram(kBin / "coredem", args, log), timeout);
 }
 
 /// timeseries.csv of a run: column name -> values (one per row).
@@ -172,46 +131,6 @@ std::vector<std::string> manifestFiles(const fs::path& checkpoint, const std::st
   const std::regex re("\\{\"path\": \"([^\"]+)\", \"participant\": \"" + who + "\"");
   for (std::sregex_iterator it(m.begin(), m.end(), re), end; it != end; ++it) {
     out.push_back((*it)[1].str());
-  }
-  return out;
-}
-
-herr_t collectDataset(hid_t g, const char* name, const H5L_info_t*, void* data) {
-  auto& out = *static_cast<std::map<std::string, std::string>*>(data);
-  H5O_info_t info;
-#if H5_VERSION_GE(1, 12, 0)
-  H5Oget_info_by_name3(g, name, &info, H5O_INFO_BASIC, H5P_DEFAULT);
-#else
-  H5Oget_info_by_name2(g, name, &info, H5O_INFO_BASIC, H5P_DEFAULT);
-#endif
-  if (info.type != H5O_TYPE_DATASET) {
-    return 0;
-  }
-  const hid_t ds = H5Dopen2(g, name, H5P_DEFAULT);
-  const hid_t type = H5Dget_type(ds);
-  if (H5Tis_variable_str(type) <= 0) {
-    const hid_t space = H5Dget_space(ds);
-    const std::size_t bytes = std::size_t(H5Sget_simple_extent_npoints(space)) * H5Tget_size(type);
-    std::string buf(bytes, '\0');
-    if (bytes > 0) {
-      H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data());
-    }
-    out[name] = buf;
-    H5Sclose(space);
-  }
-  H5Tclose(type);
-  H5Dclose(ds);
-  return 0;
-}
-
-/// Every dataset of an HDF5 file as raw bytes, by path.
-std::map<std::string, std::string> datasetsOf(const fs::path& file) {
-  std::map<std::string, std::string> out;
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  EXPECT_GE(f, 0) << "cannot open " << file;
-  if (f >= 0) {
-    H5Lvisit(f, H5_INDEX_NAME, H5_ITER_INC, collectDataset, &out);
-    H5Fclose(f);
   }
   return out;
 }

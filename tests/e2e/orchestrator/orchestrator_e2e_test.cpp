@@ -21,7 +21,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-extern char** environ;
+#include "coredem_e2e.h"
+#include "coredem_e2e_hdf5.h"
+
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
@@ -30,56 +32,16 @@ namespace {
 const fs::path kBin = COREDEM_BIN_DIR;
 const fs::path kCases = COREDEM_E2E_CASES;
 
-fs::path tempDir(const std::string& name) {
-  const fs::path d =
-      fs::temp_directory_path() / ("coredem-e2e-" + std::to_string(::getpid()) + "-" + name);
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+using coredem::e2e::readAll;
 
-std::string readAll(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+fs::path tempDir(const std::string& name) { return coredem::e2e::tempDir("coredem-e2e", name); }
 
 /// Starts coredem with `args`, output into `log`. Returns the pid.
 pid_t startCoredem(const std::vector<std::string>& args, const fs::path& log) {
-  std::vector<std::string> argv = {(kBin / "coredem").string()};
-  argv.insert(argv.end(), args.begin(), args.end());
-  std::vector<char*> c;
-  for (auto& a : argv) {
-    c.push_back(a.data());
-  }
-  c.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, c[0], &fa, nullptr, c.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  EXPECT_EQ(rc, 0) << "cannot start " << argv[0];
-  return pid;
+  return coredem::e2e::startProgram(kBin / "coredem", args, log);
 }
-
-/// Waits for pid with a deadline (kills it on timeout); returns the exit code (-signal).
-int waitExit(pid_t pid, std::chrono::seconds timeout) {
-  const auto end = std::chrono::steady_clock::now() + timeout;
-  int status = 0;
-  while (::waitpid(pid, &status, WNOHANG) == 0) {
-    if (std::chrono::steady_clock::now() > end) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      ADD_FAILURE() << "coredem did not finish within " << timeout.count() << " s";
-      return -1000;
-    }
-    std::this_thread::sleep_for(5ms);
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
-}
+using coredem::e2e::datasetsOf;
+using coredem::e2e::waitExit;
 
 int runCoredem(const std::vector<std::string>& args, const fs::path& log,
                std::chrono::seconds timeout = 50s) {
@@ -118,46 +80,6 @@ fs::path demStateOf(const fs::path& checkpoint) {
   const std::regex re("\\{\"path\": \"([^\"]+)\", \"participant\": \"dem\"");
   EXPECT_TRUE(std::regex_search(m, match, re)) << "no DEM file in " << checkpoint;
   return checkpoint / match[1].str();
-}
-
-/// Every dataset of an HDF5 file as raw bytes (in its own file type), by path.
-herr_t collectDataset(hid_t g, const char* name, const H5L_info_t*, void* data) {
-  auto& out = *static_cast<std::map<std::string, std::string>*>(data);
-  H5O_info_t info;
-#if H5_VERSION_GE(1, 12, 0)
-  H5Oget_info_by_name3(g, name, &info, H5O_INFO_BASIC, H5P_DEFAULT);
-#else
-  H5Oget_info_by_name2(g, name, &info, H5O_INFO_BASIC, H5P_DEFAULT);
-#endif
-  if (info.type != H5O_TYPE_DATASET) {
-    return 0;
-  }
-  const hid_t ds = H5Dopen2(g, name, H5P_DEFAULT);
-  const hid_t type = H5Dget_type(ds);
-  if (H5Tis_variable_str(type) <= 0) {
-    const hid_t space = H5Dget_space(ds);
-    const std::size_t bytes = std::size_t(H5Sget_simple_extent_npoints(space)) * H5Tget_size(type);
-    std::string buf(bytes, '\0');
-    if (bytes > 0) {
-      H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data());
-    }
-    out[name] = buf;
-    H5Sclose(space);
-  }
-  H5Tclose(type);
-  H5Dclose(ds);
-  return 0;
-}
-
-std::map<std::string, std::string> datasetsOf(const fs::path& file) {
-  std::map<std::string, std::string> out;
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  EXPECT_GE(f, 0) << "cannot open " << file;
-  if (f >= 0) {
-    H5Lvisit(f, H5_INDEX_NAME, H5_ITER_INC, collectDataset, &out);
-    H5Fclose(f);
-  }
-  return out;
 }
 
 /// Asserts that two DEM state files hold bitwise identical particle and contact datasets.

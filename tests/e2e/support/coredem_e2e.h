@@ -1,0 +1,96 @@
+#pragma once
+/// @file
+/// Helpers shared by the end-to-end tests: temporary folders, whole-file I/O, and running
+/// `coredem` as a child process with a deadline (a test never waits forever on it).
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+extern char** environ;
+
+namespace coredem::e2e {
+
+namespace fs = std::filesystem;
+
+/// A fresh, empty folder `<tmp>/<prefix>-<pid>-<name>` (removed first if it exists).
+inline fs::path tempDir(const std::string& prefix, const std::string& name) {
+  const fs::path d =
+      fs::temp_directory_path() / (prefix + "-" + std::to_string(::getpid()) + "-" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+inline std::string readAll(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+inline void writeAll(const fs::path& p, const std::string& text) {
+  std::ofstream out(p, std::ios::binary);
+  out << text;
+}
+
+/// Starts `program args...` with stdout and stderr appended to `log`; returns the pid (-1 and
+/// a test failure when it cannot be started).
+inline pid_t startProgram(const fs::path& program, const std::vector<std::string>& args,
+                          const fs::path& log) {
+  std::vector<std::string> argv = {program.string()};
+  argv.insert(argv.end(), args.begin(), args.end());
+  std::vector<char*> c;
+  for (auto& a : argv) {
+    c.push_back(a.data());
+  }
+  c.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&fa, 1, 2);
+  pid_t pid = -1;
+  const int rc = posix_spawn(&pid, c[0], &fa, nullptr, c.data(), environ);
+  posix_spawn_file_actions_destroy(&fa);
+  if (rc != 0) {
+    ADD_FAILURE() << "cannot start " << argv[0];
+    return -1;
+  }
+  return pid;
+}
+
+/// Waits for `pid` until `timeout`; past it the process gets SIGTERM, then SIGKILL two seconds
+/// later, and the test fails. Returns the exit code, or −signal when it was killed.
+inline int waitExit(pid_t pid, std::chrono::seconds timeout) {
+  using namespace std::chrono_literals;
+  if (pid <= 0) {
+    return -1;
+  }
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  int status = 0;
+  while (::waitpid(pid, &status, WNOHANG) == 0) {
+    if (std::chrono::steady_clock::now() > end) {
+      ::kill(pid, SIGTERM);
+      std::this_thread::sleep_for(2s);
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, &status, 0);
+      ADD_FAILURE() << "process " << pid << " did not finish within " << timeout.count() << " s";
+      return -1000;
+    }
+    std::this_thread::sleep_for(5ms);
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
+}
+
+} // namespace coredem::e2e
