@@ -362,15 +362,19 @@ public:
 
   // ---------------------------------------------------------------- coupling
   /// Sorts particles by PCM cell (_pcell, sentinel nCells outside) into _cStart/_cEnd ranges.
+  /// Cost O(particles), independent of the grid size: only the entries of OCCUPIED cells (and
+  /// of the sentinel) are written; those of the other cells are stale and must not be read.
+  /// Per-cell work therefore runs over segment heads (k is a
+  /// head when k == 0 or pcell[perm[k-1]] differs), summing cs[c]..ce[c] in sorted order, which
+  /// is the same order as a loop over all cells, so the sums are bitwise the same.
   void sortByCouplingCell() {
     const std::size_t n = _p.n;
     const std::uint32_t nc = static_cast<std::uint32_t>(_s.nCells);
-    _exec.sortByKey(_pcell.d(), n, nc + 1, _perm.d());
+    _exec.sortByKeyRadix(_pcell.d(), n, nc + 1, _perm.d());
     std::uint32_t* cs = _cStart.d();
     std::uint32_t* ce = _cEnd.d();
     const std::uint32_t* pc = _pcell.d();
     const std::uint32_t* perm = _perm.d();
-    _exec.parallelFor(nc + 1, [=] DEM_LAMBDA(std::size_t c) { cs[c] = 0; ce[c] = 0; });
     _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t k) {
       const std::uint32_t c = pc[perm[k]];
       if (k == 0 || pc[perm[k - 1]] != c) cs[c] = static_cast<std::uint32_t>(k);
@@ -403,11 +407,20 @@ public:
     double* eps = _epsFrozen.d();
     double* acc = _acc.d();
     const double vc = _s.cellVolume;
+    const std::uint32_t* pc = _pcell.d();
+    const std::uint32_t nc = static_cast<std::uint32_t>(_s.nCells);
+    // Per window: every cell (empty ones get ε_g of zero solid volume) ...
     _exec.parallelFor(_s.nCells, [=] DEM_LAMBDA(std::size_t c) {
+      eps[c] = kernels::pcmGasFraction(0.0, vc);
+      for (int q = 0; q < 5; ++q) acc[5 * c + q] = 0.0;
+    });
+    // ... then the occupied cells, one segment head each (cs/ce are valid only there).
+    _exec.parallelFor(_p.n, [=] DEM_LAMBDA(std::size_t h) {
+      const std::size_t c = pc[perm[h]];
+      if (c >= nc || (h > 0 && pc[perm[h - 1]] == c)) return;
       double vs = 0.0;
       for (std::uint32_t k = cs[c]; k < ce[c]; ++k) vs += kernels::sphereVolume(r[perm[k]]);
       eps[c] = kernels::pcmGasFraction(vs, vc);
-      for (int q = 0; q < 5; ++q) acc[5 * c + q] = 0.0;
     });
     _epsFrozen.markDeviceModified();
     _acc.markDeviceModified();
@@ -426,7 +439,12 @@ public:
     const double* v = _p.vel.d();
     const double* kc = _kcoef.d();
     double* acc = _acc.d();
-    _exec.parallelFor(_s.nCells, [=] DEM_LAMBDA(std::size_t c) {
+    const std::uint32_t* pc = _pcell.d();
+    const std::uint32_t nc = static_cast<std::uint32_t>(_s.nCells);
+    // One segment head per occupied cell; segments are disjoint, so no atomics.
+    _exec.parallelFor(_p.n, [=] DEM_LAMBDA(std::size_t h) {
+      const std::size_t c = pc[perm[h]];
+      if (c >= nc || (h > 0 && pc[perm[h - 1]] == c)) return;
       kernels::CellAccumulator a{0.0, 0.0, {0.0, 0.0, 0.0}};
       for (std::uint32_t k = cs[c]; k < ce[c]; ++k) {
         const std::uint32_t i = perm[k];

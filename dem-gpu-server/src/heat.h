@@ -124,7 +124,10 @@ public:
     double* cellT = _cellT.d();
     const double* T = p.temperature.d();
     if (rad) {
-      exec.parallelFor(nCells, [=] DEM_LAMBDA(std::size_t c) {
+      // Occupied cells only (one segment head each); cellT is read only at a particle's cell.
+      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
+        const std::size_t c = pcell[perm[h]];
+        if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c)) return;
         double sum = 0.0;
         for (std::uint32_t k = cStart[c]; k < cEnd[c]; ++k) sum += T[perm[k]];
         cellT[c] = sum;
@@ -266,7 +269,10 @@ public:
     if (s.coupled) {
       double* acc = _acc.d();
       const double invVc = 1.0 / s.cellVolume;
-      exec.parallelFor(nCells, [=] DEM_LAMBDA(std::size_t c) {
+      // Occupied cells only: one segment head each, same order as a loop over all cells.
+      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
+        const std::size_t c = pcell[perm[h]];
+        if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c)) return;
         kernels::ConvectionCellSource cellSrc;
         double rs = 0.0;
         for (std::uint32_t k = cs[c]; k < ce[c]; ++k) {

@@ -6,6 +6,7 @@
 ///   reduceMax(n, f, init)        max(init, max_i f(i)); exact, so order-independent. f may
 ///                                write outputs of its own index i (fused kernel + reduction)
 ///   sortByKey(keys, n, numKeys, perm)   stable permutation sorting keys ascending
+///   sortByKeyRadix(keys, n, numKeys, perm)   same permutation, cost independent of numKeys
 ///   exclusiveScan(in, out, n)    out[i] = Σ_{k<i} in[k]
 ///   allocHost/freeHost (pinned for CUDA), allocDevice/freeDevice, copyToDevice/copyToHost,
 ///   synchronize(); separateDevice tells whether device memory differs from host memory.

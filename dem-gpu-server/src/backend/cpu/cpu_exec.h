@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <new>
+#include <utility>
 #include <vector>
 
 namespace coredem::dem::backend {
@@ -63,6 +64,28 @@ struct CpuExec {
     for (std::size_t i = 0; i < n; ++i) perm[_offsets[keys[i]]++] = static_cast<std::uint32_t>(i);
   }
 
+  /// Stable LSD radix sort (8-bit digits over the bits numKeys needs): the same permutation as
+  /// sortByKey, at a cost O(n · bits/8) that does not depend on numKeys (no histogram of
+  /// numKeys buckets). For sparse keys, e.g. a few particles on a large coupling grid.
+  /// @pre keys[i] < numKeys.
+  void sortByKeyRadix(const std::uint32_t* keys, std::size_t n, std::uint32_t numKeys,
+                      std::uint32_t* perm) const {
+    int bits = 1;
+    while (bits < 32 && (std::uint64_t{1} << bits) < numKeys) ++bits;
+    _radixTmp.resize(n);
+    std::uint32_t* src = perm;
+    std::uint32_t* dst = _radixTmp.data();
+    for (std::size_t i = 0; i < n; ++i) src[i] = static_cast<std::uint32_t>(i);
+    for (int shift = 0; shift < bits; shift += 8) {
+      std::size_t count[257] = {};
+      for (std::size_t i = 0; i < n; ++i) ++count[((keys[src[i]] >> shift) & 255u) + 1];
+      for (int d = 0; d < 256; ++d) count[d + 1] += count[d];
+      for (std::size_t i = 0; i < n; ++i) dst[count[(keys[src[i]] >> shift) & 255u]++] = src[i];
+      std::swap(src, dst);
+    }
+    if (src != perm && n) std::memcpy(perm, src, n * sizeof(std::uint32_t));
+  }
+
   static void* allocHost(std::size_t bytes) { return bytes ? ::operator new(bytes, std::align_val_t{64}) : nullptr; }
   static void freeHost(void* p) { if (p) ::operator delete(p, std::align_val_t{64}); }
   static void* allocDevice(std::size_t bytes) { return allocHost(bytes); }
@@ -73,7 +96,7 @@ struct CpuExec {
   static void synchronize() {}
 
 private:
-  mutable std::vector<std::uint32_t> _hist, _offsets;
+  mutable std::vector<std::uint32_t> _hist, _offsets, _radixTmp;
 };
 
 } // namespace coredem::dem::backend

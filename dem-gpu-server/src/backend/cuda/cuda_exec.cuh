@@ -109,6 +109,12 @@ struct CudaExec {
                                                    static_cast<int>(n), 0, bits));
   }
 
+  /// Same as sortByKey: CUB's radix sort already costs O(n · bits), independent of numKeys.
+  void sortByKeyRadix(const std::uint32_t* keys, std::size_t n, std::uint32_t numKeys,
+                      std::uint32_t* perm) const {
+    sortByKey(keys, n, numKeys, perm);
+  }
+
   static void* allocHost(std::size_t bytes) {
     void* p = nullptr;
     if (bytes) DEM_CUDA_CHECK(cudaMallocHost(&p, bytes));
