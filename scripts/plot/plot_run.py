@@ -90,6 +90,18 @@ def last_snapshot(run_dir):
     return int(step), float.fromhex(time_hex), os.path.join(run_dir, rel)
 
 
+def vertical_axis(run_dir):
+    """Index of the axis gravity points along in the run's case.yaml (z when unknown)."""
+    try:
+        import yaml
+
+        with open(os.path.join(run_dir, "case.yaml")) as f:
+            g = (yaml.safe_load(f) or {}).get("gravity", [0.0, 0.0, -9.81])
+        return int(np.argmax(np.abs(np.asarray(g, dtype=float))))
+    except Exception:  # no case file or no PyYAML: the usual z-up convention
+        return 2
+
+
 def plot_particles(run_dir, out):
     snap = last_snapshot(run_dir)
     if snap is None:
@@ -109,9 +121,11 @@ def plot_particles(run_dir, out):
             if "/particles/" + name in f:
                 radius = f["/particles/" + name][()] * (1.0 if name == "radius" else 0.5)
                 break
+    up = vertical_axis(run_dir)
+    across = [i for i in range(3) if i != up]
+    names = "xyz"
     lo, hi = pos.min(axis=0), pos.max(axis=0)
-    span = float(max(hi - lo)) or 1e-3
-    pad = 0.05 * span
+    pad = 0.05 * (float(max(hi - lo)) or 1e-3)
     kw = {"s": 8}
     if colour is not None:
         vmin, vmax = float(colour.min()), float(colour.max())
@@ -119,15 +133,15 @@ def plot_particles(run_dir, out):
             vmin, vmax = vmin - 1.0, vmax + 1.0
         kw.update(c=colour, cmap="inferno", vmin=vmin, vmax=vmax)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5), constrained_layout=True)
-    for ax, (i, lx) in zip(axes, [(0, "x"), (1, "y")]):
-        sc = ax.scatter(pos[:, i], pos[:, 2], **kw)
-        ax.set_xlim(lo[i] - pad, lo[i] + span + pad)
-        ax.set_ylim(lo[2] - pad, lo[2] + 0.5 * span + pad)
+    for ax, i in zip(axes, across):
+        sc = ax.scatter(pos[:, i], pos[:, up], **kw)
+        ax.set_xlim(lo[i] - pad, hi[i] + pad)
+        ax.set_ylim(lo[up] - pad, hi[up] + pad)
         ax.set_aspect("equal")
-        ax.set_xlabel(f"{lx} [m]")
-        ax.set_ylabel("z [m]")
-        ax.set_title(f"side view ({lx}-z), step {step}, t = {time:.4g} s, {len(pos)} particles",
-                     fontsize=9)
+        ax.set_xlabel(f"{names[i]} [m]")
+        ax.set_ylabel(f"{names[up]} [m]")
+        ax.set_title(f"side view ({names[i]}-{names[up]}), step {step}, t = {time:.4g} s, "
+                     f"{len(pos)} particles", fontsize=9)
     if colour is not None:
         fig.colorbar(sc, ax=axes, label="T_p [K]", shrink=0.8)
     path_out = os.path.join(out, "particles.png")
