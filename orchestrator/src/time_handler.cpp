@@ -2,14 +2,12 @@
 #include <cmath>
 
 #include <coredem/common/check.h>
+#include <coredem/common/time.h>
 #include <coredem/orchestrator/time_handler.h>
 
 namespace coredem::orchestrator {
 
-bool timeEquals(double a, double b, double tol) {
-  const double scale = std::max({1.0, std::abs(a), std::abs(b)});
-  return std::abs(a - b) <= tol * scale;
-}
+bool timeEquals(double a, double b, double tol) { return coredem::timeEquals(a, b, tol); }
 
 TimeHandler::TimeHandler(double time, double compensation)
     : _sum(time)
@@ -64,13 +62,8 @@ double DtPolicy::next(double courant, double remaining) {
 SubcyclePlan planSubcycles(double dtCfd, double dtDemMax) {
   COREDEM_ASSERT(dtCfd > 0.0 && std::isfinite(dtCfd));
   COREDEM_ASSERT(dtDemMax > 0.0 && std::isfinite(dtDemMax));
-  const double ratio = dtCfd / dtDemMax;
-  double n = std::ceil(ratio);
-  if (n > 1.0 && ratio - (n - 1.0) <= 1e-12 * ratio) {
-    n -= 1.0; // ratio is an integer up to round-off
-  }
   SubcyclePlan plan;
-  plan.nSub = std::max<std::int64_t>(1, static_cast<std::int64_t>(n));
+  plan.nSub = coredem::subStepsFor(dtCfd, dtDemMax); // the same plan the DEM server checks
   plan.dtDem = dtCfd / static_cast<double>(plan.nSub);
   return plan;
 }

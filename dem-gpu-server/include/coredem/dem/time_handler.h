@@ -4,7 +4,7 @@
 /// simulated time accumulated with Kahan (compensated) summation, so 10^6 tiny steps do
 /// not drift.
 
-#include "coredem/common/check.h"
+#include "coredem/common/time.h"
 
 #include <algorithm>
 #include <cmath>
@@ -12,26 +12,15 @@
 
 namespace coredem::dem {
 
-/// |a - b| <= tol·max(1, |a|, |b|).
-inline bool timeEquals(double a, double b, double tol = 1e-12) {
-  return std::fabs(a - b) <= tol * std::fmax(1.0, std::fmax(std::fabs(a), std::fabs(b)));
-}
+using coredem::timeEquals;
 
 class TimeHandler {
 public:
   explicit TimeHandler(double t0 = 0.0) : _sum(t0) {}
 
-  /// n_sub = ceil(Δt_CFD/Δt_DEM,max) (at least 1), so that Δt_CFD/n_sub <= Δt_DEM,max.
-  /// A ratio within 1e-12 of an integer counts as that integer.
+  /// n_sub = ceil(Δt_CFD/Δt_DEM,max) (at least 1): the plan the orchestrator grants too.
   static int subStepsFor(double dtCfd, double dtDemMax) {
-    COREDEM_CHECK(dtCfd > 0 && std::isfinite(dtCfd), "dtCfd must be > 0 and finite (got {})", dtCfd);
-    COREDEM_CHECK(dtDemMax > 0 && std::isfinite(dtDemMax),
-                  "dtDemMax must be > 0 and finite (got {})", dtDemMax);
-    const double ratio = dtCfd / dtDemMax;
-    COREDEM_CHECK(ratio < 2.0e9, "dtCfd/dtDemMax = {} sub-steps is too many; reduce dtCfd", ratio);
-    double n = std::ceil(ratio);
-    if (n - ratio > 1.0 - 1e-12 * ratio && n > 1) n -= 1;  // ratio is an integer up to round-off
-    return std::max(1, static_cast<int>(n));
+    return coredem::subStepsFor(dtCfd, dtDemMax);
   }
 
   /// Adds dt to the time with compensated summation.
