@@ -42,9 +42,6 @@ const fs::path kTemplate = COREDEM_FOAM_E2E_TEMPLATE;
 
 using coredem::e2e::readAll;
 
-fs::path tempDir(const std::string& name) {
-  return coredem::e2e::tempDir("coredemfoam-e2e", name);
-}
 using coredem::e2e::datasetsOf;
 using coredem::e2e::writeAll;
 
@@ -88,7 +85,8 @@ dem: {backend: cpu, threads: 1, timeout_s: 120}
   return c;
 }
 
-/// Runs `coredem args... --no-plots` with output into `log`, with a deadline; returns the exit code.
+/// Runs `coredem args... --no-plots` with output into `log`, with a deadline; returns the exit
+/// code.
 int runCoredem(std::vector<std::string> args, const fs::path& log,
                std::chrono::seconds timeout = 150s) {
   args.push_back("--no-plots");
@@ -142,23 +140,10 @@ double ergunGradient(double eps, double u) {
          1.75 * s * kRhoG * u * u / (eps * eps * eps * kDp);
 }
 
-class CoredemFoamE2E : public ::testing::Test {
+class CoredemFoamE2E : public coredem::e2e::RunFolderTest {
 protected:
-  void SetUp() override {
-    for (const char* exe : {"coredem", "coredem-dem", "coredemFoam"}) {
-      ASSERT_EQ(::access((kBin / exe).c_str(), X_OK), 0)
-          << (kBin / exe) << " is not built: build all targets first";
-    }
-    dir = tempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
-  }
-  void TearDown() override {
-    if (!HasFailure()) {
-      fs::remove_all(dir);
-    } else {
-      std::cerr << "kept " << dir << " for inspection\n";
-    }
-  }
-  fs::path dir;
+  CoredemFoamE2E()
+      : RunFolderTest(kBin, {"coredem", "coredem-dem", "coredemFoam"}, "coredemfoam-e2e") {}
 };
 
 // A simple-cubic lattice of 1 mm beads (10 x 16 x 10, 16 mm high, voidage 1 - pi/6 in every

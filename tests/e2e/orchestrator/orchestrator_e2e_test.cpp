@@ -34,7 +34,9 @@ const fs::path kCases = COREDEM_E2E_CASES;
 
 using coredem::e2e::readAll;
 
-fs::path tempDir(const std::string& name) { return coredem::e2e::tempDir("coredem-e2e", name); }
+fs::path tempDir(const std::string& name) {
+  return coredem::e2e::tempDir("coredem-e2e", name);
+}
 
 /// Starts coredem with `args`, output into `log`. Returns the pid.
 pid_t startCoredem(const std::vector<std::string>& args, const fs::path& log) {
@@ -110,21 +112,10 @@ std::vector<fs::path> leftovers(const fs::path& runDir) {
   return out;
 }
 
-class CoredemE2E : public ::testing::Test {
+class CoredemE2E : public coredem::e2e::RunFolderTest {
 protected:
-  void SetUp() override {
-    for (const char* exe : {"coredem", "coredem-dem", "coredem-gas"}) {
-      ASSERT_EQ(::access((kBin / exe).c_str(), X_OK), 0)
-          << (kBin / exe) << " is not built: build all targets first";
-    }
-    dir = tempDir(::testing::UnitTest::GetInstance()->current_test_info()->name());
-  }
-  void TearDown() override {
-    if (!HasFailure()) {
-      fs::remove_all(dir);
-    }
-  }
-  fs::path dir;
+  CoredemE2E()
+      : RunFolderTest(kBin, {"coredem", "coredem-dem", "coredem-gas"}, "coredem-e2e") {}
   const fs::path restartCase = kCases / "restart";
   const fs::path finalCheckpoint = "checkpoints/00000200";
 };

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -92,5 +93,37 @@ inline int waitExit(pid_t pid, std::chrono::seconds timeout) {
   }
   return WIFEXITED(status) ? WEXITSTATUS(status) : -WTERMSIG(status);
 }
+
+/// A test with a fresh temporary folder `dir` (named after the test), kept for inspection when
+/// the test fails. Set-up fails when one of `programs` is not built in `bin`.
+class RunFolderTest : public ::testing::Test {
+protected:
+  RunFolderTest(fs::path bin, std::vector<std::string> programs, std::string prefix)
+      : _bin(std::move(bin))
+      , _programs(std::move(programs))
+      , _prefix(std::move(prefix)) {}
+
+  void SetUp() override {
+    for (const auto& exe : _programs) {
+      ASSERT_EQ(::access((_bin / exe).c_str(), X_OK), 0)
+          << (_bin / exe) << " is not built: build all targets first";
+    }
+    dir = tempDir(_prefix, ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+  void TearDown() override {
+    if (!HasFailure()) {
+      fs::remove_all(dir);
+    } else {
+      std::cerr << "kept " << dir << " for inspection\n";
+    }
+  }
+
+  fs::path dir;
+
+private:
+  fs::path _bin;
+  std::vector<std::string> _programs;
+  std::string _prefix;
+};
 
 } // namespace coredem::e2e
