@@ -11,6 +11,7 @@
 #include <coredem/dem/kernels/reaction_enthalpy.h>
 #include <coredem/dem/kernels/reaction_generic.h>
 #include <coredem/dem/kernels/species_particle.h>
+#include <coredem/dem/kernels/wall_conduction.h>
 #include <coredem/dem/kernels/wgs.h>
 
 namespace k = coredem::dem::kernels;
@@ -28,6 +29,8 @@ __global__ void thermochemKernelsCompileCheck(const double* in, double* out, int
   acc += k::contactConductionHeat(1.0, 2.0, 1e-3, 1e-3, 1.99e-3, t, 300.0);
   k::GasLensParams lp;
   acc += k::gasLensHeat(lp, 0.05, 1e-3, 1e-3, 2.01e-3, t, 300.0);
+  k::WallConductionParams wp;
+  acc += k::wallConductionHeat(wp, 1.0, 1.0, 0.03, 1e-3, 0.99e-3, 300.0, t);
   acc +=
       k::radiationHeat(0.8, 1e-3, k::radiationEnvironmentTemperature(0.9, 1000.0, 2.0 * t, 2), t);
   acc += k::nasa7EnthalpyMolar(k::Species::Fe3O4, t) + k::reactionEnthalpy(k::ClgReaction::R4, t);
