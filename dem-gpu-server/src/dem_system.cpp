@@ -268,6 +268,12 @@ std::string hashConfig(const DemConfig& c) {
                      h.voidageExponent, double(h.contactConduction), double(h.lensConduction),
                      h.lensFraction, h.minSeparation, h.lensRelTol, double(h.radiation)})
       num(v);
+    if (c.wallTemperature > 0.0) {  // absent for adiabatic walls: earlier hashes unchanged
+      t += "|wallT:";
+      for (double v : {c.wallTemperature, double(c.wallMaterial), double(h.wallConduction),
+                       double(h.wallLensConduction)})
+        num(v);
+    }
   }
   std::uint64_t h = 0xcbf29ce484222325ull;
   for (unsigned char ch : t) {
@@ -438,6 +444,18 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
     hs.lensParams.lensFraction = h.lensFraction;
     hs.lensParams.minSeparation = h.minSeparation;
     hs.lensParams.relTol = h.lensRelTol;
+    // Fixed-temperature walls (kernels/wall_conduction.h): every wall at config.wallTemperature.
+    COREDEM_CHECK(std::isfinite(config.wallTemperature) && config.wallTemperature >= 0.0,
+                  "wall temperature {} K: give a temperature > 0 K, or 0 for adiabatic walls",
+                  config.wallTemperature);
+    COREDEM_CHECK(config.wallMaterial >= 0 && config.wallMaterial < static_cast<int>(nm),
+                  "wall material index {} is not one of the {} materials", config.wallMaterial, nm);
+    if (h.enabled && config.wallTemperature > 0.0 && (h.wallConduction || h.wallLensConduction)) {
+      const double kw = config.materials[static_cast<std::size_t>(config.wallMaterial)].conductivity;
+      for (const kernels::PlaneWall& w : es.walls) hs.walls.push_back(ThermalWall{w, config.wallTemperature, kw});
+      hs.wallParams = kernels::WallConductionParams{h.wallConduction, h.wallLensConduction && es.coupled,
+                                                    h.lensFraction, h.minSeparation};
+    }
     es.reach = (h.enabled && hs.lensConduction) ? h.lensFraction * rmax : 0.0;
   }
 
@@ -519,6 +537,7 @@ void DemSystem::writeState(const std::string& path) const {
   meta.protocolVersion = std::string("1");
   meta.heatConvection = m.engine->heatTotals().convection;
   meta.heatRadiation = m.engine->heatTotals().radiation;
+  meta.heatWall = m.engine->heatTotals().wall;
   writeStateFile(path, m.engine->state(), meta);
 }
 
@@ -554,7 +573,7 @@ void DemSystem::readState(const std::string& path) {
     m.engine = m.makeEngine();
   }
   m.engine->setState(st);
-  m.engine->heatTotals() = HeatTotals{meta.heatConvection, meta.heatRadiation};
+  m.engine->heatTotals() = HeatTotals{meta.heatConvection, meta.heatRadiation, meta.heatWall};
   m.nParticles = st.n;
   m.dtMax = dtDemMaxFor(m.config, minMass);
   m.time.restore(meta.time, meta.timeCompensation);

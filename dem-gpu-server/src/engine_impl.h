@@ -463,6 +463,7 @@ public:
   void endWindow(int nSub, CellSources& out) override {
     if (!_s.coupled) {
       out = CellSources{};
+      _heat.endWindow(nSub, _s, out);  // wall heat totals only
       return;
     }
     _acc.toHost();

@@ -10,6 +10,9 @@
 ///   3. per cell: H = Σ G_i/V_c, H_Tp = Σ G_i T_i/V_c (G_i = h_i A_i) and Σ Q_rad,i, added to
 ///      the window accumulators (averaged over the sub-steps at the window end)
 ///   4. after the motion update: T_i += Δt Q_i/(m_i c_p,i) (explicit Euler, Eq. 18)
+/// Fixed-temperature walls (HeatSetup::walls, kernels/wall_conduction.h) add their contact and
+/// gas-lens conduction to Q_i in step 2; their heat Σ_i Q_w,i Δt is summed in kWallSlots fixed
+/// slots per sub-step (deterministic) and booked in HeatTotals::wall at the window end.
 /// Heat sources are evaluated on the configuration and temperatures of the contact forces
 /// (start of the sub-step), as MFiX does (CALC_THERMO_DES before CFNEWVALUES), so that the
 /// neighbour list is exact for them and they share the PCM cells of the drag deposition.
@@ -31,12 +34,16 @@
 #include "coredem/dem/kernels/particle_energy.h"
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/radiation.h"
+#include "coredem/dem/kernels/wall_conduction.h"
 #include "coredem/dem/kernels/vec3.h"
 
 #include <cstdint>
 #include <vector>
 
 namespace coredem::dem {
+
+/// Partial-sum slots of the wall heat (fixed count, so the sum order does not depend on threads).
+constexpr std::size_t kWallSlots = 64;
 
 template <class Exec>
 class HeatModule {
@@ -54,6 +61,9 @@ public:
   Dev<double> _cellT;             ///< per cell: Σ T_p (radiation environment)
   Dev<double> _lensI;             ///< per neighbour slot: lens integral I (m), owner = smaller gid
   Dual<double> _acc;              ///< per cell: Σ_sub H, Σ_sub H_Tp, Σ_sub Q_rad/V_c
+  Dual<ThermalWall> _walls;       ///< fixed-temperature walls
+  Dev<double> _qw;                ///< per particle: Q_wall,i (W)
+  Dual<double> _wallAcc;          ///< kWallSlots partial sums of Σ_sub Σ_i Q_wall,i Δt (J)
   double _dt = 0.0;               ///< sub-step length of the current window
   HeatTotals _totals;
 
@@ -63,6 +73,16 @@ public:
     for (std::size_t k = 0; k < h.materials.size(); ++k) _mat.h()[k] = h.materials[k];
     _mat.markHostModified();
     _mat.toDevice();
+    if (!h.walls.empty()) {
+      _walls.allocate(h.walls.size());
+      for (std::size_t k = 0; k < h.walls.size(); ++k) _walls.h()[k] = h.walls[k];
+      _walls.markHostModified();
+      _walls.toDevice();
+      _wallAcc.allocate(kWallSlots);
+      for (std::size_t k = 0; k < kWallSlots; ++k) _wallAcc.h()[k] = 0.0;
+      _wallAcc.markHostModified();
+      _wallAcc.toDevice();
+    }
     if (nCells > 0) {
       _acc.allocate(3 * nCells);
       for (std::size_t k = 0; k < 3 * nCells; ++k) _acc.h()[k] = 0.0;
@@ -90,7 +110,8 @@ public:
   std::size_t bytes() const {
     auto& s = const_cast<HeatModule&>(*this);
     return s._mat.bytes() + s._tg.bytes() + s._kappa.bytes() + s._cp.bytes() + _q.bytes() +
-           _g.bytes() + _qrad.bytes() + _cellT.bytes() + _lensI.bytes() + s._acc.bytes();
+           _g.bytes() + _qrad.bytes() + _cellT.bytes() + _lensI.bytes() + s._acc.bytes() +
+           s._walls.bytes() + _qw.bytes() + s._wallAcc.bytes();
   }
 
   void beginWindow(Exec& exec, std::size_t nCells) {
@@ -154,6 +175,14 @@ public:
     const std::uint32_t* cs = cStart;
     const std::uint32_t* ce = cEnd;
     const double lensFactor = 1.0 + lp.lensFraction;
+    const int nWalls = static_cast<int>(_h.walls.size());
+    const ThermalWall* tw = nWalls > 0 ? _walls.d() : nullptr;
+    const kernels::WallConductionParams wp = _h.wallParams;
+    const bool wallLens = wp.lens && coupled && _hasKappa;
+    // A wall is reached within R (contact) or (1 + FLPC) R (lens).
+    const double wallReach = wallLens ? 1.0 + wp.lensFraction : 1.0;
+    if (nWalls > 0) _qw.reserve(n);
+    double* qwOut = nWalls > 0 ? _qw.d() : nullptr;
 
     // 2. Lens integrals, once per pair: the particle with the smaller global id evaluates the
     //    pair (canonical order) and stores I in its neighbour slot; the partner reads it there.
@@ -260,10 +289,34 @@ public:
           src.radiation = radiationHeat(mi.emissivity, 2.0 * r[i], tEnv, ti);
         }
       }
-      q[i] = particleHeatRate(src);
+      double qw = 0.0;
+      if (nWalls > 0) {
+        const Vec3 xi = load3(x, ii);
+        const double kgw = (wallLens && celli < nCells) ? kap[celli] : 0.0;
+        for (int k = 0; k < nWalls; ++k) {
+          const double h = dot(xi - tw[k].plane.point, tw[k].plane.normal);
+          if (!(h < wallReach * r[i])) continue;
+          qw += wallConductionHeat(wp, mi.k, tw[k].k, kgw, r[i], h, tw[k].temperature, ti);
+        }
+        qwOut[i] = qw;
+      }
+      q[i] = particleHeatRate(src) + qw;
       gOut[i] = g;
       qr[i] = src.radiation;
     });
+
+    // Wall heat of this sub-step, in kWallSlots fixed partial sums (J).
+    if (nWalls > 0) {
+      double* wa = _wallAcc.d();
+      const double* qwIn = _qw.d();
+      exec.parallelFor(kWallSlots, [=] DEM_LAMBDA(std::size_t sl) {
+        const std::size_t lo = n * sl / kWallSlots, hi = n * (sl + 1) / kWallSlots;
+        double sum = 0.0;
+        for (std::size_t i = lo; i < hi; ++i) sum += qwIn[i];
+        wa[sl] += sum * dt;
+      });
+      _wallAcc.markDeviceModified();
+    }
 
     // 4. Cell sources (gather per cell in the PCM order of deposit()).
     if (s.coupled) {
@@ -305,6 +358,17 @@ public:
   /// Averages the heat sources over nSub sub-steps into out.heatH / out.heatHTp (already sized)
   /// and adds the window's energies to the totals (host).
   void endWindow(int nSub, const EngineSetup& s, CellSources& out) {
+    if (_h.enabled && !_h.walls.empty()) {
+      _wallAcc.toHost();
+      double wall = 0.0;
+      for (std::size_t k = 0; k < kWallSlots; ++k) {
+        wall += _wallAcc.h()[k];
+        _wallAcc.h()[k] = 0.0;
+      }
+      _wallAcc.markHostModified();
+      _wallAcc.toDevice();
+      _totals.wall += wall;
+    }
     if (!_h.enabled || !s.coupled) return;
     _acc.toHost();
     const double* acc = _acc.h();

@@ -65,6 +65,10 @@ bool setHeatOption(HeatOptions& o, const std::string& key, const std::string& va
     o.minSeparation = number(key, value, 0.0, true, 1.0e-3, "a length in (0, 1e-3] m (1e-6)");
   } else if (key == "lens_rel_tol") {
     o.lensRelTol = number(key, value, 1.0e-14, false, 1.0e-3, "a tolerance in [1e-14, 1e-3] (1e-8)");
+  } else if (key == "wall_conduction") {
+    o.wallConduction = onOff(key, value);
+  } else if (key == "wall_lens_conduction") {
+    o.wallLensConduction = onOff(key, value);
   } else if (key == "radiation") {
     o.radiation = onOff(key, value);
   } else if (key == "radiation_environment") {

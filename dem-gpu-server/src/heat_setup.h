@@ -4,6 +4,8 @@
 
 #include "coredem/dem/kernels/conduction_gas_lens.h"
 #include "coredem/dem/kernels/convection.h"
+#include "coredem/dem/kernels/wall_conduction.h"
+#include "coredem/dem/kernels/wall_contact.h"
 
 #include <vector>
 
@@ -16,6 +18,13 @@ struct HeatMaterial {
   double emissivity;  ///< −
 };
 
+/// A wall held at a fixed temperature (kernels/wall_conduction.h); adiabatic walls are not listed.
+struct ThermalWall {
+  kernels::PlaneWall plane;  ///< unit inward normal
+  double temperature;        ///< K, > 0
+  double k;                  ///< wall material conductivity, W/(m K)
+};
+
 struct HeatSetup {
   bool enabled = false;            ///< master switch; false: the heat module does nothing
   bool convection = false;         ///< Eqs. 19–21 (needs coupling and T_g, κ_g, c_p,g)
@@ -25,6 +34,8 @@ struct HeatSetup {
   kernels::ConvectionParams convectionParams{};
   kernels::GasLensParams lensParams{};
   std::vector<HeatMaterial> materials;
+  std::vector<ThermalWall> walls;             ///< fixed-temperature walls (empty: adiabatic)
+  kernels::WallConductionParams wallParams{}; ///< contact / lens switches, FLPC, s_min
 };
 
 } // namespace coredem::dem

@@ -152,6 +152,7 @@ void writeStateFile(const std::string& path, const HostState& s, const StateMeta
   writeAttr(g.id, "neighbour_list_valid", static_cast<std::int32_t>(s.listValid));
   writeAttr(g.id, "heat_convection_J", meta.heatConvection);
   writeAttr(g.id, "heat_radiation_J", meta.heatRadiation);
+  writeAttr(g.id, "heat_wall_J", meta.heatWall);
   COREDEM_CHECK(H5Fflush(file.id, H5F_SCOPE_GLOBAL) >= 0, "cannot flush state file '{}'", path);
 }
 
@@ -180,6 +181,7 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
   // Heat totals: absent in files written before heat transfer was integrated.
   meta.heatConvection = H5Aexists(gm.id, "heat_convection_J") > 0 ? readAttr<double>(gm.id, "heat_convection_J", path) : 0.0;
   meta.heatRadiation = H5Aexists(gm.id, "heat_radiation_J") > 0 ? readAttr<double>(gm.id, "heat_radiation_J", path) : 0.0;
+  meta.heatWall = H5Aexists(gm.id, "heat_wall_J") > 0 ? readAttr<double>(gm.id, "heat_wall_J", path) : 0.0;
   const hsize_t n = s.n, K = static_cast<hsize_t>(s.historySlots),
                 M = static_cast<hsize_t>(s.neighbourSlots), ns = static_cast<hsize_t>(s.nSpecies);
   {

@@ -17,8 +17,11 @@ struct StateMeta {
   std::string configHash;
   std::string softwareVersion;
   std::string protocolVersion;
+  double heatWall = 0;        ///< HeatTotals::wall (J); optional in the file
   double heatConvection = 0;  ///< HeatTotals (J); optional in the file (0 when absent)
   double heatRadiation = 0;
+  bool hasChemistry = false;   ///< write/read the chemistry ledgers (/chemistry)
+  ChemistryTotals chemistry;   ///< ledgers; read only when the file has /chemistry
 };
 
 void writeStateFile(const std::string& path, const HostState& s, const StateMeta& meta);

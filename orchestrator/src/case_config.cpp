@@ -445,7 +445,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   }
 
   if (top.has("walls")) {
-    const Section w = top.section("walls", {"box", "planes", "material", "temperature"});
+    const Section w = top.section("walls", {"box", "planes", "material", "thermal", "temperature"});
     if (w.has("box")) {
       const Section b = w.section("box", {"min", "max"});
       c.walls.box =
@@ -462,7 +462,21 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
       w.fail(w.markOf("material"), "walls.material",
              fmt::format("unknown material '{}'", c.walls.material));
     }
-    c.walls.temperature = w.number("temperature", 0.0, 0.0, kBig, "K; 0 = adiabatic");
+    // Thermal condition (docs/heat-coupling.md "Walls"): adiabatic (default) or every wall held
+    // at `temperature` with particle–wall conduction. Configure carries it as temperature (0 =
+    // adiabatic).
+    const std::string thermal = w.choice("thermal", std::string("adiabatic"), {"adiabatic", "fixed_temperature"});
+    if (thermal == "fixed_temperature") {
+      c.walls.temperature = w.number("temperature", std::nullopt, 0.0, kBig,
+                                     "K, > 0 (the temperature the walls are held at)", true);
+    } else {
+      if (w.has("temperature")) {
+        w.fail(w.markOf("temperature"), "walls.temperature",
+               "walls are adiabatic (walls.thermal: adiabatic, the default), so a wall temperature "
+               "has no effect; add 'thermal: fixed_temperature' to hold the walls at it, or remove it");
+      }
+      c.walls.temperature = 0.0;
+    }
   } else {
     c.walls.material = c.materials.front().name;
   }

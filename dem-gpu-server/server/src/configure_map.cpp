@@ -121,6 +121,13 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   for (const auto& p : c.walls().planes()) {
     cfg.walls.push_back(dem::Wall{vec(p.point()), vec(p.normal())});
   }
+  cfg.wallTemperature = c.walls().temperature();  // 0 = adiabatic (docs/heat-coupling.md "Walls")
+  if (c.walls().temperature() > 0.0) {
+    const auto wm = materialIndex.find(c.walls().material_id());
+    COREDEM_CHECK(wm != materialIndex.end(), "Configure: walls use material id {}, which is not "
+                  "among the materials", c.walls().material_id());
+    cfg.wallMaterial = wm->second;
+  }
   cfg.gravity = vec(c.gravity());
 
   // Coupling grid.

@@ -575,6 +575,7 @@ struct DemServer::Impl {
     proto::addNamedValue(l.mutable_energy(), "dem.heat_from_gas_J", ledgers.heatFromGas);
     // Particle heat balance (docs/heat-coupling.md): Δ thermal energy = heat from gas + radiation.
     proto::addNamedValue(l.mutable_energy(), "dem.heat_radiation_J", system->heatTotals().radiation);
+    proto::addNamedValue(l.mutable_energy(), "dem.heat_wall_J", system->heatTotals().wall);
     proto::addNamedValue(l.mutable_energy(), "dem.thermal_energy_J", system->thermalEnergy());
     for (std::size_t k = 0; k < speciesNames.size(); ++k) {
       proto::addNamedValue(l.mutable_species(), "dem.species_to_gas." + speciesNames[k] + "_kg",

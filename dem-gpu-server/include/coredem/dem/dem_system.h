@@ -125,6 +125,10 @@ struct DemConfig {
   double epsMinDrag = 0.35;            ///< ε_min clip in drag (PHYSICS §1.1 [C])
   double dtFactor = 50.0;              ///< Δt_DEM,max = t_col,min / dtFactor (PHYSICS Eq. 12)
   HeatOptions heat;                    ///< particle heat transfer (docs/heat-coupling.md)
+  /// Wall thermal condition (docs/heat-coupling.md "Walls"): > 0 holds every wall at this
+  /// temperature (K) with particle–wall conduction (kernels/wall_conduction.h); 0 = adiabatic.
+  double wallTemperature = 0.0;
+  int wallMaterial = 0;                ///< material of the walls (its conductivity is k_w)
 
   /// Adds the six planes of the axis-aligned box [lo, hi] (normals pointing inwards).
   void addBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi);

@@ -22,20 +22,25 @@ struct HeatOptions {
   double minSeparation = 1.0e-6;    ///< `s_min` (m): minimum conduction distance in the lens
   double lensRelTol = 1.0e-8;       ///< `lens_rel_tol`: quadrature tolerance of the lens integral
   bool radiation = true;            ///< `radiation: on|off`; only particles with emissivity > 0 radiate
+  bool wallConduction = true;       ///< `wall_conduction: on|off`: contact conduction to fixed-temperature walls
+  bool wallLensConduction = true;   ///< `wall_lens_conduction: on|off`: gas-lens conduction to them (needs κ_g)
 };
 
 /// Applies one `Configure.options` entry if it is a heat option. Returns false when `key` is not
 /// a heat option (the caller handles or ignores it); throws coredem::UserError when the key is a
 /// heat option but the value is not allowed (the message lists the allowed values).
 /// Keys: heat, convection, convection_reynolds, nusselt_exponent, contact_conduction,
-/// lens_conduction, flpc, s_min, lens_rel_tol, radiation, radiation_environment.
+/// lens_conduction, flpc, s_min, lens_rel_tol, radiation, radiation_environment, wall_conduction,
+/// wall_lens_conduction.
 bool setHeatOption(HeatOptions& options, const std::string& key, const std::string& value);
 
 /// Heat the particles received since the system was built (or restarted from a state file
-/// written by it), J. Conduction moves heat between particles only and is not listed.
+/// written by it), J. Conduction between particles moves heat between particles only and is
+/// not listed; conduction from fixed-temperature walls is (`wall`).
 struct HeatTotals {
   double convection = 0.0;  ///< from the gas (Σ_c (H T_g − H_Tp) V_c Δt), the gas loses the same
   double radiation = 0.0;   ///< from the radiative environment (Eq. 27)
+  double wall = 0.0;        ///< from fixed-temperature walls (kernels/wall_conduction.h)
 };
 
 } // namespace coredem::dem
