@@ -3,6 +3,7 @@
 // Prints particle_steps_per_s, contacts per particle, bytes per particle and the time per
 // stage. Figures are measured, never asserted.
 #include "commands.h"
+#include "dem.h"
 
 #include "coredem/common/check.h"
 #include "coredem/dem/dem_system.h"
@@ -21,38 +22,9 @@
 namespace {
 
 using namespace coredem::dem;
-
-/// The decks of bench/decks.md (material: Patil glass, PHYSICS §7).
-DemConfig deck(const std::string& name, std::size_t n) {
-  DemConfig c;
-  c.materials[0] = Material{"glass", 1000.0, 0.97, 0.1, 2.0 / 7.0, 0.5};
-  const double d = 1e-3;
-  const bool packed = name == "packed";
-  const double s = packed ? 0.9999 * d : 1.2 * d;
-  const long long nx = std::llround(std::cbrt(static_cast<double>(n)));
-  const long long ny = nx;
-  const long long nz = (static_cast<long long>(n) + nx * ny - 1) / (nx * ny);
-  ParticleSet p;
-  p.name = name;
-  p.packing = Packing::Lattice;
-  p.spacing = s;
-  p.count = n;
-  p.diameter = d;
-  p.density = 2500.0;
-  p.regionMin = {0, 0, 0};
-  p.regionMax = {nx * s, ny * s, nz * s};
-  if (packed) {
-    c.gravity = {0, 0, -9.81};
-    c.addBox({0, 0, 0}, {nx * s, ny * s, 2.0 * nz * s});
-  } else {
-    c.gravity = {0, 0, 0};
-    p.velocityJitter = 0.5;
-    p.seed = 20240611;
-    c.addBox({0, 0, 0}, {nx * s, ny * s, nz * s});
-  }
-  c.particleSets.push_back(p);
-  return c;
-}
+using coredem::bench::addCouplingGrid;
+using coredem::bench::BenchGas;
+using coredem::bench::deck;
 
 int runDem(int argc, char** argv) {
   CLI::App app{"DEM core throughput on the packed / agitated decks (bench/decks.md)", "coredem-bench dem"};
@@ -60,7 +32,7 @@ int runDem(int argc, char** argv) {
   std::size_t n = 10000;
   int steps = 500, threads = 2, warmup = 20;
   double skin = -1;
-  bool json = false, coupled = false;
+  bool json = false, coupled = false, heat = false;
   int nSub = 50;
   app.add_option("--case", deckName, "deck: packed | agitated")->check(CLI::IsMember({"packed", "agitated"}));
   app.add_option("--particles", n, "number of particles")->check(CLI::Range(1.0, 2.0e9));
@@ -71,6 +43,8 @@ int runDem(int argc, char** argv) {
   app.add_option("--skin", skin, "Verlet skin as a fraction of d_max (default: the library's)");
   app.add_flag("--json", json, "print one JSON object");
   app.add_flag("--coupled", coupled, "add a PCM coupling grid (cells of 4 d_p) with air rising at 0.5 m/s");
+  app.add_flag("--heat", heat, "switch the heat module on (the decks are mechanics only; with --coupled: "
+               "conduction, convection with the gas, lens; radiation needs an emissivity)");
   app.add_option("--nsub", nSub, "with --coupled: DEM sub-steps per CFD step")->check(CLI::PositiveNumber);
   try {
     app.parse(argc, argv);
@@ -80,31 +54,15 @@ int runDem(int argc, char** argv) {
   try {
     DemConfig cfg = deck(deckName, n);
     if (skin >= 0) cfg.neighbour.skinFactor = skin;
-    if (coupled) {
-      // PCM grid over the particles' box, cells ≈ 4 d_p (PHYSICS §1.1: Δx ≈ 3–5 d_p).
-      const Wall& top = cfg.walls[5];  // addBox order: x lo/hi, y lo/hi, z lo/hi
-      const std::array<double, 3> hi{cfg.walls[1].point[0], cfg.walls[3].point[1], top.point[2]};
-      for (int d = 0; d < 3; ++d) {
-        cfg.grid.counts[d] = std::max(1, static_cast<int>(hi[d] / 4e-3));
-        cfg.grid.spacing[d] = hi[d] / cfg.grid.counts[d];
-      }
-    }
+    if (heat) cfg.heat.enabled = true;  // default options: contact conduction; the rest needs gas
+    if (coupled) addCouplingGrid(cfg, 4e-3);
     const auto t0 = std::chrono::steady_clock::now();
     DemSystem sys(cfg, parseBackend(backend), threads);
     const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double dt = sys.dtDemMax();
-    std::vector<double> ug, gp, rho, mu;
     if (coupled) {
-      const std::size_t nc = sys.cellCount();
-      ug.assign(3 * nc, 0.0);
-      gp.assign(3 * nc, 0.0);
-      for (std::size_t c = 0; c < nc; ++c) {
-        ug[3 * c + 2] = 0.5;
-        gp[3 * c + 2] = -1.204 * 9.81;
-      }
-      rho.assign(nc, 1.204);
-      mu.assign(nc, 1.81e-5);
-      sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}});
+      const BenchGas gas(sys.cellCount(), 0.5, 293.15);
+      sys.setGasFields(gas.view());
     }
     // Without coupling one advance() covers all steps; with it, CFD windows of nSub steps.
     auto runSteps = [&](int count) {
@@ -133,12 +91,13 @@ int runDem(int argc, char** argv) {
                   "\"steps\":%d,\"dt_dem\":%.6e,\"skin_factor\":%.4g,\"wall_s\":%.6f,\"setup_s\":%.6f,"
                   "\"particle_steps_per_s\":%.6e,\"contacts_per_particle\":%.4f,"
                   "\"wall_contacts_per_particle\":%.4f,\"bytes_per_particle\":%.1f,"
-                  "\"stage_s\":{\"neighbour\":%.6f,\"contact\":%.6f,\"integrate\":%.6f,\"coupling\":%.6f},"
+                  "\"heat\":%s,\"stage_s\":{\"neighbour\":%.6f,\"contact\":%.6f,\"integrate\":%.6f,\"coupling\":%.6f,"
+                  "\"heat\":%.6f},"
                   "\"rebuilds\":%llu,\"cpu_s\":%.6f,\"cpu_utilisation\":%.3f,"
                   "\"particle_steps_per_cpu_s\":%.6e}\n",
                   deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt, cfg.neighbour.skinFactor,
-                  wall, setup, rate, pairsPer, wallPer, bytesPer, st.neighbour, st.contact, st.integrate,
-                  st.coupling, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads),
+                  wall, setup, rate, pairsPer, wallPer, bytesPer, heat ? "true" : "false", st.neighbour,
+                  st.contact, st.integrate, st.coupling, st.heat, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads),
                   static_cast<double>(n) * steps / cpu);
     } else {
       std::printf("case %s, backend %s, threads %d, N = %zu, %d steps of dt_DEM = %.4e s (skin %.3g d)\n",
@@ -153,6 +112,7 @@ int runDem(int argc, char** argv) {
                   static_cast<unsigned long long>(st.rebuilds));
       std::printf("stage contact forces     %.3f s\n", st.contact);
       std::printf("stage integration        %.3f s\n", st.integrate);
+      if (heat) std::printf("stage heat               %.3f s\n", st.heat);
       if (coupled) std::printf("stage coupling (PCM)     %.3f s  (%zu cells, %d sub-steps per CFD step)\n", st.coupling, sys.cellCount(), nSub);
     }
     return 0;
