@@ -92,12 +92,12 @@ int runDem(int argc, char** argv) {
                   "\"particle_steps_per_s\":%.6e,\"contacts_per_particle\":%.4f,"
                   "\"wall_contacts_per_particle\":%.4f,\"bytes_per_particle\":%.1f,"
                   "\"heat\":%s,\"stage_s\":{\"neighbour\":%.6f,\"contact\":%.6f,\"integrate\":%.6f,\"coupling\":%.6f,"
-                  "\"heat\":%.6f},"
+                  "\"heat\":%.6f,\"drag\":%.6f},"
                   "\"rebuilds\":%llu,\"cpu_s\":%.6f,\"cpu_utilisation\":%.3f,"
                   "\"particle_steps_per_cpu_s\":%.6e}\n",
                   deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt, cfg.neighbour.skinFactor,
                   wall, setup, rate, pairsPer, wallPer, bytesPer, heat ? "true" : "false", st.neighbour,
-                  st.contact, st.integrate, st.coupling, st.heat, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads),
+                  st.contact, st.integrate, st.coupling, st.heat, st.drag, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads),
                   static_cast<double>(n) * steps / cpu);
     } else {
       std::printf("case %s, backend %s, threads %d, N = %zu, %d steps of dt_DEM = %.4e s (skin %.3g d)\n",
@@ -112,6 +112,7 @@ int runDem(int argc, char** argv) {
                   static_cast<unsigned long long>(st.rebuilds));
       std::printf("stage contact forces     %.3f s\n", st.contact);
       std::printf("stage integration        %.3f s\n", st.integrate);
+      if (coupled) std::printf("stage drag (gas forces)  %.3f s\n", st.drag);
       if (heat) std::printf("stage heat               %.3f s\n", st.heat);
       if (coupled) std::printf("stage coupling (PCM)     %.3f s  (%zu cells, %d sub-steps per CFD step)\n", st.coupling, sys.cellCount(), nSub);
     }

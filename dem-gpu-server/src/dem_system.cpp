@@ -2,6 +2,7 @@
 // Everything that runs per particle per step is in the backend engine (engine_impl.h).
 #include "coredem/dem/dem_system.h"
 
+#include "chemistry_config.h"
 #include "engine.h"
 #include "state_io.h"
 
@@ -13,6 +14,7 @@
 #include "coredem/dem/time_handler.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -275,6 +277,7 @@ std::string hashConfig(const DemConfig& c) {
         num(v);
     }
   }
+  t += chemistryHashText(c);  // empty without chemistry
   std::uint64_t h = 0xcbf29ce484222325ull;
   for (unsigned char ch : t) {
     h ^= ch;
@@ -310,6 +313,13 @@ double dtDemMaxFor(const DemConfig& config, const std::vector<double>& minMass) 
     }
   }
   return std::isfinite(tcol) ? tcol / config.dtFactor : std::numeric_limits<double>::infinity();
+}
+
+/// Mass of particle i for Δt_DEM,max after a restart. With chemistry, the mass at the initial
+/// diameter: shrinking particles keep the step of the run that wrote the file (docs/thermochemistry.md).
+double restartMass(const DemConfig& c, const HostState& st, std::size_t i) {
+  if (!c.chemistry.active() || st.d0.size() != st.n) return st.mass[i];
+  return st.density[i] * kernels::sphereVolume(0.5 * st.d0[i]);
 }
 
 } // namespace
@@ -391,6 +401,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   st.nbCount.assign(n, 0);
   st.nbList.assign(n * st.neighbourSlots, 0);
   st.listValid = 0;
+  initChemistryReferences(config, st);  // d_p0, initial C / Fe2O3-equivalent masses
   m.nParticles = n;
 
   const std::size_t nm = config.materials.size();
@@ -459,6 +470,8 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
     es.reach = (h.enabled && hs.lensConduction) ? h.lensFraction * rmax : 0.0;
   }
 
+  es.chem = makeChemistrySetup(config);  // chemistry (chemistry.h); validates the options
+
   BackendKind kind = backend;
   if (kind == BackendKind::Auto) kind = cudaDeviceCount() > 0 ? BackendKind::Cuda : BackendKind::Cpu;
   if (kind == BackendKind::Cuda) {
@@ -522,6 +535,21 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
     ++m.step;
   }
   m.engine->endWindow(nSub, m.sources);
+  if (m.engine->takePendingRemoval()) {
+    // Particles below removalFraction·d_p0: removed at the CFD-step boundary (host compaction).
+    const auto t0 = std::chrono::steady_clock::now();
+    HostState st = m.engine->state();
+    ChemistryTotals& totals = m.engine->chemistryTotals();
+    const double before = totals.removedMass();
+    const std::size_t removed = removeSmallParticles(m.config.chemistry.removalFraction, st, totals);
+    if (removed > 0) {
+      m.engine->setState(st);
+      m.nParticles = st.n;
+      m.log->info("t = {:.6g} s: removed {} particle(s) below {} of their initial diameter ({:.6g} kg); {} left",
+                  m.time.time(), removed, m.config.chemistry.removalFraction, totals.removedMass() - before, st.n);
+    }
+    m.engine->times().chemistry += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
   return m.sources;
 }
 
@@ -538,6 +566,8 @@ void DemSystem::writeState(const std::string& path) const {
   meta.heatConvection = m.engine->heatTotals().convection;
   meta.heatRadiation = m.engine->heatTotals().radiation;
   meta.heatWall = m.engine->heatTotals().wall;
+  meta.hasChemistry = m.config.chemistry.active();
+  meta.chemistry = m.engine->chemistryTotals();
   writeStateFile(path, m.engine->state(), meta);
 }
 
@@ -557,7 +587,7 @@ void DemSystem::readState(const std::string& path) {
   for (std::size_t i = 0; i < st.n; ++i) {
     rmax = std::max(rmax, st.radius[i]);
     if (st.material[i] >= 0 && st.material[i] < static_cast<int>(minMass.size()))
-      minMass[st.material[i]] = std::min(minMass[st.material[i]], st.mass[i]);
+      minMass[st.material[i]] = std::min(minMass[st.material[i]], restartMass(m.config, st, i));
     COREDEM_CHECK(st.material[i] >= 0 && st.material[i] < static_cast<int>(m.config.materials.size()),
                   "state file '{}': particle {} has material {} not in the config", path, i, st.material[i]);
   }
@@ -574,6 +604,7 @@ void DemSystem::readState(const std::string& path) {
   }
   m.engine->setState(st);
   m.engine->heatTotals() = HeatTotals{meta.heatConvection, meta.heatRadiation, meta.heatWall};
+  if (meta.hasChemistry) m.engine->chemistryTotals() = meta.chemistry;
   m.nParticles = st.n;
   m.dtMax = dtDemMaxFor(m.config, minMass);
   m.time.restore(meta.time, meta.timeCompensation);
@@ -624,6 +655,7 @@ std::size_t DemSystem::memoryBytes() const { return _impl->engine->memoryBytes()
 StageTimes DemSystem::stageTimes() const { return _impl->engine->times(); }
 void DemSystem::resetStageTimes() { _impl->engine->times() = StageTimes{}; }
 HeatTotals DemSystem::heatTotals() const { return _impl->engine->heatTotals(); }
+ChemistryTotals DemSystem::chemistryTotals() const { return _impl->engine->chemistryTotals(); }
 
 double DemSystem::thermalEnergy() const {
   const ParticleData p = particles();

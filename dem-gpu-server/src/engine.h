@@ -5,6 +5,7 @@
 
 #include "coredem/dem/dem_system.h"
 #include "heat_setup.h"
+#include "chemistry_setup.h"
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_contact.h"
@@ -40,6 +41,7 @@ struct EngineSetup {
   int threads = 0;
   HeatSetup heat;                        ///< particle heat transfer (heat.h)
   double reach = 0;                      ///< m, neighbour-list reach beyond R_i+R_j+skin (gas lens)
+  ChemistrySetup chem;                   ///< chemistry in the sub-step (chemistry.h)
 };
 
 /// Host copy of the full engine state (particles in internal order, contact history,
@@ -59,6 +61,8 @@ struct HostState {
   std::vector<std::int32_t> nbCount;                               // N
   std::vector<std::int32_t> nbList;                                // N*M
   std::int32_t listValid = 0;                                      // 1: nbList usable as is
+  std::vector<double> d0;                                          // N: initial diameter (chemistry)
+  std::vector<double> chemRef;                                     // N*2: initial C mass, initial Fe2O3-eq. mass
 };
 
 /// Host copies of the gas fields (per cell).
@@ -88,6 +92,10 @@ public:
   virtual const char* name() const = 0;
   /// Heat received by the particles since construction (heat.h); settable for restarts.
   virtual HeatTotals& heatTotals() = 0;
+  /// Chemistry ledgers since construction (chemistry.h); settable for restarts.
+  virtual ChemistryTotals& chemistryTotals() = 0;
+  /// True when a particle fell below the removal diameter since the last call (clears the flag).
+  virtual bool takePendingRemoval() = 0;
 };
 
 std::unique_ptr<Engine> makeCpuEngine(const EngineSetup& setup);

@@ -489,9 +489,55 @@ public:
   }
 
   // ---------------------------------------------------------------- forces
+  /// Gas forces of coupled runs (PHYSICS §1.1, §2.2): PCM cell, Gidaspow drag and −V_p ∇p.
+  /// Reads pos, vel, radius (+ gas fields, _epsFrozen); writes force (the gas force, which
+  /// computeForces then adds the contacts to), _kcoef, _pcell. A pass of its own so that drag
+  /// has its own stage time; the sums are in the order of the former fused kernel (bitwise
+  /// the same forces).
+  void computeDrag() {
+    const double* x = _p.pos.d();
+    const double* v = _p.vel.d();
+    const double* r = _p.radius.d();
+    double* f = _p.force.d();
+    const bool gas = _hasGas;
+    const kernels::GridParams grid = _s.grid;
+    const std::uint32_t nCells = static_cast<std::uint32_t>(_s.nCells);
+    const double* ug = gas ? _ug.d() : nullptr;
+    const double* gp = gas ? _gradP.d() : nullptr;
+    const double* rho = gas ? _rhoG.d() : nullptr;
+    const double* mu = gas ? _muG.d() : nullptr;
+    const double* eps = _epsFrozen.d();
+    double* kc = _kcoef.d();
+    std::uint32_t* pc = _pcell.d();
+    kernels::GidaspowParams drag;
+    drag.epsMin = _s.epsMin;
+    _exec.parallelFor(_p.n, [=] DEM_LAMBDA(std::size_t i) {
+      using namespace kernels;
+      const long long ii = static_cast<long long>(i);
+      const Vec3 xi = load3(x, ii);
+      const long long cell = pcmCell(grid, xi);
+      Vec3 F{0.0, 0.0, 0.0};
+      double kcoef = 0.0;
+      if (gas && cell >= 0) {
+        const double ri = r[i];
+        const Vec3 vi = load3(v, ii);
+        const double vol = sphereVolume(ri);
+        const Vec3 u = load3(ug, cell);
+        const double slip = norm(u - vi);
+        kcoef = gidaspowParticleCoefficient(drag, eps[cell], rho[cell], mu[cell], 2.0 * ri, vol, slip);
+        F += dragForce(kcoef, u, vi);
+        F += pressureGradientForce(vol, load3(gp, cell));
+      }
+      store3(f, ii, F);
+      kc[i] = kcoef;
+      pc[i] = cell < 0 ? nCells : static_cast<std::uint32_t>(cell);
+    });
+    _p.produced(kForce);
+  }
+
   /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, nbCount, nbList
-  /// (+ gas fields); writes force, torque, fwall, histKey, histDisp, contacts, wallContacts,
-  /// _kcoef, _pcell.
+  /// (+ the gas force of computeDrag in coupled runs); writes force, torque, fwall, histKey,
+  /// histDisp, contacts, wallContacts.
   void computeForces(double dt) {
     const std::size_t n = _p.n;
     const double* x = _p.pos.d();
@@ -516,19 +562,7 @@ public:
     const int nMat = _s.nMaterials;
     const int K = _p.K;
     const int M = _p.M;
-    const bool gas = _hasGas && _s.coupled;
-    const bool coupled = _s.coupled;
-    const kernels::GridParams grid = _s.grid;
-    const std::uint32_t nCells = static_cast<std::uint32_t>(_s.nCells);
-    const double* ug = gas ? _ug.d() : nullptr;
-    const double* gp = gas ? _gradP.d() : nullptr;
-    const double* rho = gas ? _rhoG.d() : nullptr;
-    const double* mu = gas ? _muG.d() : nullptr;
-    const double* eps = coupled ? _epsFrozen.d() : nullptr;
-    double* kc = _kcoef.d();
-    std::uint32_t* pc = _pcell.d();
-    kernels::GidaspowParams drag;
-    drag.epsMin = _s.epsMin;
+    const bool coupled = _s.coupled;  // force holds the gas force of computeDrag
 
     // reduceMax runs the kernel body once per index (side effects on index i only) and
     // returns the largest number of contacts of a particle, in the same pass.
@@ -562,23 +596,8 @@ public:
         }
         ++slot;
       };
-      Vec3 F{0.0, 0.0, 0.0};
+      Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
       Vec3 T{0.0, 0.0, 0.0};
-      // Gas: PCM cell, Gidaspow drag and −V_p ∇p (PHYSICS §1.1, §2.2).
-      const long long cell = coupled ? pcmCell(grid, xi) : -1;
-      double kcoef = 0.0;
-      if (gas && cell >= 0) {
-        const double vol = sphereVolume(ri);
-        const Vec3 u = load3(ug, cell);
-        const double slip = norm(u - vi);
-        kcoef = gidaspowParticleCoefficient(drag, eps[cell], rho[cell], mu[cell], 2.0 * ri, vol, slip);
-        F += dragForce(kcoef, u, vi);
-        F += pressureGradientForce(vol, load3(gp, cell));
-      }
-      if (coupled) {
-        kc[i] = kcoef;
-        pc[i] = cell < 0 ? nCells : static_cast<std::uint32_t>(cell);
-      }
       // Particle–particle LSD (Eqs. 7–13), gathered over the full neighbour list.
       int pairCount = 0;
       const int nb = cnt[i];
@@ -682,6 +701,13 @@ public:
       t0 = t1;
     }
     _p.require(kAllFields);
+    if (_s.coupled) {
+      computeDrag();
+      Exec::synchronize();
+      auto t1 = Clock::now();
+      _t.drag += std::chrono::duration<double>(t1 - t0).count();
+      t0 = t1;
+    }
     computeForces(dt);
     Exec::synchronize();
     auto t1 = Clock::now();

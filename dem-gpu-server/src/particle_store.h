@@ -17,7 +17,8 @@ enum FieldMask : std::uint32_t {
   kTemperature = 1u << 10, kSpecies = 1u << 11, kMaterial = 1u << 12, kContacts = 1u << 13,
   kWallContacts = 1u << 14, kGid = 1u << 15, kHistKey = 1u << 16, kHistDisp = 1u << 17,
   kNbCount = 1u << 18, kNbList = 1u << 19,
-  kAllFields = (1u << 20) - 1
+  kD0 = 1u << 20, kChemRef = 1u << 21,  // chemistry references (chemistry.h)
+  kAllFields = (1u << 22) - 1
 };
 
 template <class Exec>
@@ -43,6 +44,8 @@ struct ParticleStore {
   Arr<double> histDisp;          ///< N*K*3: accumulated tangential displacement δ_t (m)
   Arr<std::int32_t> nbCount;     ///< N
   Arr<std::int32_t> nbList;      ///< N*M: neighbour indices (internal order)
+  Arr<double> d0;                ///< N: initial diameter d_p0 (m), removal reference
+  Arr<double> chemRef;           ///< N*2: initial char (C) mass, initial Fe2O3-equivalent mass (kg)
 
   /// Calls f(array) for every array selected by mask.
   template <class F>
@@ -67,6 +70,8 @@ struct ParticleStore {
     if (mask & kHistDisp) f(histDisp);
     if (mask & kNbCount) f(nbCount);
     if (mask & kNbList) f(nbList);
+    if (mask & kD0) f(d0);
+    if (mask & kChemRef) f(chemRef);
   }
   /// Makes the device copies of `mask` current (before a kernel reads them).
   void require(std::uint32_t mask) { forEach(mask, [](auto& a) { a.toDevice(); }); }
@@ -95,6 +100,8 @@ struct ParticleStore {
     histKey.allocate(n * static_cast<std::size_t>(K));
     histDisp.allocate(3 * n * static_cast<std::size_t>(K));
     nbList.allocate(n * static_cast<std::size_t>(M));
+    d0.allocate(n);
+    chemRef.allocate(2 * n);
   }
 
   std::size_t bytes() {

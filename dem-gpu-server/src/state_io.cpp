@@ -127,6 +127,20 @@ void writeStateFile(const std::string& path, const HostState& s, const StateMeta
     writeArray(g.id, "species", s.species, {n, ns});
     writeArray(g.id, "material", s.material, {n});
     writeArray(g.id, "global_id", s.gid, {n});
+    // Chemistry references (initial diameter; initial C and Fe2O3-equivalent masses).
+    if (s.d0.size() == n) writeArray(g.id, "initial_diameter", s.d0, {n});
+    if (s.chemRef.size() == 2 * n) writeArray(g.id, "chemistry_reference", s.chemRef, {n, 2});
+  }
+  if (meta.hasChemistry) {
+    const ChemistryTotals& c = meta.chemistry;
+    Handle g{H5Gcreate2(file.id, "chemistry", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
+    writeArray(g.id, "gas_produced_kg", c.gasProduced, {c.gasProduced.size()});
+    writeArray(g.id, "solid_change_kg", c.solidChange, {c.solidChange.size()});
+    writeArray(g.id, "removed_solid_kg", c.removedSolid, {c.removedSolid.size()});
+    writeArray(g.id, "homogeneous_source_kg", c.homogeneousSource, {c.homogeneousSource.size()});
+    writeAttr(g.id, "reaction_heat_J", c.reactionHeat);
+    writeAttr(g.id, "homogeneous_heat_J", c.homogeneousHeat);
+    writeAttr(g.id, "removed_count", static_cast<std::uint64_t>(c.removedCount));
   }
   {
     Handle g{H5Gcreate2(file.id, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
@@ -200,6 +214,37 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
     readArray(g.id, "species", s.species, n * ns, path);
     readArray(g.id, "material", s.material, n, path);
     readArray(g.id, "global_id", s.gid, n, path);
+    // Chemistry references: absent in files written before chemistry was integrated.
+    if (H5Lexists(g.id, "initial_diameter", H5P_DEFAULT) > 0) {
+      readArray(g.id, "initial_diameter", s.d0, n, path);
+    } else {
+      s.d0.resize(n);
+      for (std::size_t i = 0; i < n; ++i) s.d0[i] = 2.0 * s.radius[i];
+    }
+    if (H5Lexists(g.id, "chemistry_reference", H5P_DEFAULT) > 0) {
+      readArray(g.id, "chemistry_reference", s.chemRef, 2 * n, path);
+    } else {
+      s.chemRef.assign(2 * n, 0.0);
+    }
+  }
+  meta.hasChemistry = H5Lexists(file.id, "chemistry", H5P_DEFAULT) > 0;
+  if (meta.hasChemistry) {
+    Handle gc{H5Gopen2(file.id, "chemistry", H5P_DEFAULT), H5Gclose};
+    auto vec = [&](const char* name, std::vector<double>& v) {
+      Handle ds{H5Dopen2(gc.id, name, H5P_DEFAULT), H5Dclose};
+      COREDEM_CHECK(ds.id >= 0, "state file '{}': /chemistry has no dataset '{}'", path, name);
+      Handle space{H5Dget_space(ds.id), H5Sclose};
+      const hssize_t count = H5Sget_simple_extent_npoints(space.id);
+      readArray(gc.id, name, v, static_cast<hsize_t>(count < 0 ? 0 : count), path);
+    };
+    ChemistryTotals& c = meta.chemistry;
+    vec("gas_produced_kg", c.gasProduced);
+    vec("solid_change_kg", c.solidChange);
+    vec("removed_solid_kg", c.removedSolid);
+    vec("homogeneous_source_kg", c.homogeneousSource);
+    c.reactionHeat = readAttr<double>(gc.id, "reaction_heat_J", path);
+    c.homogeneousHeat = readAttr<double>(gc.id, "homogeneous_heat_J", path);
+    c.removedCount = readAttr<std::uint64_t>(gc.id, "removed_count", path);
   }
   Handle g{H5Gopen2(file.id, "contacts", H5P_DEFAULT), H5Gclose};
   readArray(g.id, "history_key", s.histKey, n * K, path);

@@ -175,7 +175,8 @@ struct ParticleData {
 /// Wall-clock seconds spent per stage since construction (or resetStageTimes()).
 struct StageTimes {
   double neighbour = 0;  ///< cell keys, sort, reorder, neighbour lists
-  double contact = 0;    ///< contact + wall + gas forces
+  double contact = 0;    ///< particle–particle and wall contact forces
+  double drag = 0;       ///< gas forces: PCM cell, Gidaspow drag, −V_p∇p (coupled runs only)
   double integrate = 0;  ///< motion update
   double coupling = 0;   ///< PCM ε_g and cell-source deposition
   double heat = 0;       ///< heat sources (conduction, convection, radiation) and their deposition

@@ -1,0 +1,357 @@
+#pragma once
+/// @file
+/// Chemistry in the DEM sub-step (PHYSICS §3.5, §4, §6; docs/thermochemistry.md), written once
+/// for every backend like engine_impl.h and heat.h. Per sub-step, after the forces, the drag
+/// deposition (particles sorted by PCM cell) and the heat sources, before the motion update:
+///   1. rates, per particle, with the gas of its PCM cell frozen for the CFD step (ρ_g, Y_g and
+///      the constant pressure): the data-defined reactions (reaction_generic.h), R1 + R2
+///      (clg_char_gasification.h) and R4 + R5 (clg_oc_reduction.h) at T_p
+///   2. one availability limiter per particle: every rate of the particle is scaled by the same
+///      s ∈ [0, 1] so that no solid species mass goes negative within Δt and the particle does not
+///      shrink below half the removal diameter (stoichiometry, hence mass balance, is kept)
+///   3. species masses m_k += Δt ṁ_k (Eq. 31; inert species unchanged), m = Σ m_k, X_k = m_k/m,
+///      radius from the mass at constant density (Eq. 32): the contact model uses it from the
+///      next force evaluation on, the motion update of this sub-step uses the new mass
+///   4. per cell (segment heads of the PCM order): Σ ṁ_gas Δt, Σ Δm_solid, Σ Q_rxn Δt added to the
+///      window accumulators (row nCells: particles outside the grid, ledgers only)
+///   5. after the heat module's temperature update: T += Δt Q_rxn/(m c_p) (when reaction heat is on)
+/// At the window end R_species = Σ ṁ Δt/(V_c t_window) and the WGS (R3) of every cell is added
+/// from the frozen gas (host, once per CFD step). A particle whose diameter fell below
+/// removalFraction·d_0 stops reacting and is reported (pendingRemoval) so that DemSystem removes
+/// it at the CFD-step boundary.
+///
+/// Every loop writes only its own index (gather per cell over sorted segments, no atomics), so
+/// results are bitwise independent of the thread count.
+
+#include "backend/arrays.h"
+#include "backend/exec_common.h"
+#include "chemistry_setup.h"
+#include "engine.h"
+#include "particle_store.h"
+
+#include "coredem/dem/chemistry_options.h"
+#include "coredem/dem/kernels/pressure_gradient.h"
+#include "coredem/dem/kernels/species_particle.h"
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+namespace coredem::dem {
+
+template <class Exec>
+class ChemistryModule {
+public:
+  template <class T>
+  using Dual = backend::DualArray<T, Exec>;
+  template <class T>
+  using Dev = backend::DeviceArray<T, Exec>;
+
+  ChemistrySetup _c;
+  Dual<kernels::HeterogeneousReaction> _reactions;
+  Dual<kernels::Stoichiometry> _nasa;
+  Dual<double> _gasM, _cp;
+  Dual<double> _rhoG, _yg;       ///< gas fields (per cell)
+  bool _hasRho = false, _hasY = false;
+  std::vector<double> _tgHost, _rhoHost, _ygHost;
+  Dev<double> _gdot;             ///< per particle: gas mass rates (kg/s), N*nGas
+  Dev<double> _dsolid;           ///< per particle: solid mass change in this sub-step (kg), N*nSolid
+  Dev<double> _q;                ///< per particle: Q_rxn (W)
+  Dual<double> _acc;             ///< (nCells+1)*W: Σ gas kg, Σ solid kg, Σ Q_rxn J over the window
+  int _width = 0;                ///< W = nGas + nSolid + 1
+  double _dt = 0.0;
+  bool _pending = false;         ///< a particle is below the removal diameter
+  ChemistryTotals _totals;
+
+  void setup(const ChemistrySetup& c, std::size_t nCells) {
+    _c = c;
+    _c.params.nReactions = static_cast<int>(c.reactions.size());
+    auto put = [](auto& arr, const auto& v) {
+      arr.allocate(v.size());
+      for (std::size_t k = 0; k < v.size(); ++k) arr.h()[k] = v[k];
+      arr.markHostModified();
+      arr.toDevice();
+    };
+    put(_reactions, c.reactions);
+    put(_nasa, c.reactionNasa7);
+    put(_gasM, c.gasMolarMass);
+    put(_cp, c.materialCp);
+    _width = c.params.nGas + c.params.nSolid + 1;
+    _acc.allocate((nCells + 1) * static_cast<std::size_t>(_width));
+    for (std::size_t k = 0; k < _acc.size(); ++k) _acc.h()[k] = 0.0;
+    _acc.markHostModified();
+    _acc.toDevice();
+    _totals.gasProduced.assign(static_cast<std::size_t>(c.params.nGas), 0.0);
+    _totals.homogeneousSource.assign(static_cast<std::size_t>(c.params.nGas), 0.0);
+    _totals.solidChange.assign(static_cast<std::size_t>(c.params.nSolid), 0.0);
+    _totals.removedSolid.assign(static_cast<std::size_t>(c.params.nSolid), 0.0);
+  }
+
+  bool enabled() const { return _c.enabled; }
+  bool pendingRemoval() const { return _pending; }
+
+  void setGas(const GasArrays& g) {
+    auto put = [](Dual<double>& arr, const std::vector<double>& v) {
+      arr.allocate(v.size());
+      for (std::size_t k = 0; k < v.size(); ++k) arr.h()[k] = v[k];
+      arr.markHostModified();
+      arr.toDevice();
+      return !v.empty();
+    };
+    _hasRho = put(_rhoG, g.rhoG);
+    _hasY = put(_yg, g.Yg);
+    _tgHost = g.Tg;
+    _rhoHost = g.rhoG;
+    _ygHost = g.Yg;
+  }
+
+  std::size_t bytes() const {
+    auto& s = const_cast<ChemistryModule&>(*this);
+    return s._reactions.bytes() + s._nasa.bytes() + s._gasM.bytes() + s._cp.bytes() + s._rhoG.bytes() +
+           s._yg.bytes() + _gdot.bytes() + _dsolid.bytes() + _q.bytes() + s._acc.bytes();
+  }
+
+  void beginWindow(Exec& exec) {
+    if (!_c.enabled) return;
+    double* acc = _acc.d();
+    exec.parallelFor(_acc.size(), [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
+    _acc.markDeviceModified();
+  }
+
+  /// Steps 1–4 of the file comment. When coupled, the particles must be sorted by PCM cell
+  /// (perm, cStart, cEnd, pcell) as deposit() leaves them. Reads temperature, material, radius,
+  /// mass, density, species, d0, chemRef; writes mass, species, radius, _gdot, _dsolid, _q, _acc.
+  void react(Exec& exec, ParticleStore<Exec>& p, const EngineSetup& s, bool gasPresent,
+             const std::uint32_t* pcell, const std::uint32_t* perm, const std::uint32_t* cStart,
+             const std::uint32_t* cEnd, double dt) {
+    if (!_c.enabled) return;
+    const std::size_t n = p.n;
+    _dt = dt;
+    const ChemParams cp = _c.params;
+    const int nG = cp.nGas, nS = cp.nSolid, W = _width;
+    _gdot.reserve(n * static_cast<std::size_t>(nG > 0 ? nG : 1));
+    _dsolid.reserve(n * static_cast<std::size_t>(nS > 0 ? nS : 1));
+    _q.reserve(n);
+    const bool coupled = s.coupled;
+    const bool gas = coupled && gasPresent && _hasRho && _hasY;
+    const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
+    const double* T = p.temperature.d();
+    const double* rho = p.density.d();
+    const double* d0 = p.d0.d();
+    const double* ref = p.chemRef.d();
+    double* m = p.mass.d();
+    double* X = p.species.d();
+    double* r = p.radius.d();
+    double* gdot = _gdot.d();
+    double* dsol = _dsolid.d();
+    double* q = _q.d();
+    const kernels::HeterogeneousReaction* reac = _reactions.d();
+    const kernels::Stoichiometry* nasa = _nasa.d();
+    const double* gasM = _gasM.d();
+    const double* rhoG = gas ? _rhoG.d() : nullptr;
+    const double* yg = gas ? _yg.d() : nullptr;
+
+    const double below = exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) {
+      using namespace kernels;
+      const double mi = m[i];
+      const double frac = cp.removalFraction;
+      double sm[kChemMaxSolids];
+      for (int k = 0; k < nS; ++k) sm[k] = X[i * nS + k] * mi;
+      double solidRate[kChemMaxSolids];
+      double gasRate[kChemMaxGas];
+      for (int k = 0; k < nS; ++k) solidRate[k] = 0.0;
+      for (int k = 0; k < nG; ++k) gasRate[k] = 0.0;
+      double heat = 0.0;
+      const bool active = !(2.0 * r[i] < frac * d0[i]);
+      if (active) {
+        const double tp = T[i];
+        // Gas of the particle's PCM cell (no gas: gas-dependent rates are zero).
+        double conc[kChemMaxGas];
+        double pBar[kGasSpeciesCount];
+        for (int k = 0; k < nG; ++k) conc[k] = 0.0;
+        for (int k = 0; k < kGasSpeciesCount; ++k) pBar[k] = 0.0;
+        const std::uint32_t cell = coupled ? pcell[i] : nCells;
+        if (gas && cell < nCells) {
+          const double rg = rhoG[cell];
+          double moles = 0.0;
+          for (int k = 0; k < nG; ++k) {
+            conc[k] = molarConcentration(rg, yg[static_cast<std::size_t>(cell) * nG + k], gasM[k]);
+            moles += conc[k];
+          }
+          // P_j = x_j p (bar), x_j = C_j / Σ C.
+          if (moles > 0.0) {
+            for (int g = 0; g < kGasSpeciesCount; ++g) {
+              const int k = cp.gasIndex[g];
+              if (k >= 0) pBar[g] = conc[k] / moles * cp.pressure * 1.0e-5;
+            }
+          }
+        }
+        // Data-defined reactions.
+        for (int a = 0; a < cp.nReactions; ++a) {
+          const HeterogeneousReaction& rx = reac[a];
+          const double w = heterogeneousExtentRate(rx, tp, conc, sm, dt);
+          addHeterogeneousSources(rx, w, solidRate, gasRate);
+          const double dH = nasa[a].n > 0 ? reactionEnthalpy(nasa[a], tp) : rx.dH;
+          heat -= dH * w;
+        }
+        // R1 + R2 (char).
+        if (cp.charOn && cp.solidC >= 0) {
+          const CharGasificationRates cr = charGasification(cp.charParams, tp, pBar, sm[cp.solidC], ref[2 * i]);
+          solidRate[cp.solidC] += cr.mdotC;
+          for (int g = 0; g < kGasSpeciesCount; ++g)
+            if (cp.gasIndex[g] >= 0) gasRate[cp.gasIndex[g]] += cr.mdotGas[g];
+          heat += cr.heat;
+        }
+        // R4 + R5 (oxygen carrier).
+        if (cp.ocOn && cp.solidFe2O3 >= 0 && cp.solidFe3O4 >= 0 && mi > 0.0) {
+          const double mf[3] = {sm[cp.solidFe2O3] / mi, sm[cp.solidFe3O4] / mi, 0.0};
+          const int iCO = cp.gasIndex[idx(GasSpecies::CO)], iH2 = cp.gasIndex[idx(GasSpecies::H2)];
+          const OcReductionRates orr = ocReduction(cp.ocParams, tp, mi, mf, iCO >= 0 ? conc[iCO] : 0.0,
+                                                   iH2 >= 0 ? conc[iH2] : 0.0);
+          solidRate[cp.solidFe2O3] += orr.mdotSolid[idx(OcSolid::Fe2O3)];
+          solidRate[cp.solidFe3O4] += orr.mdotSolid[idx(OcSolid::Fe3O4)];
+          for (int g = 0; g < kGasSpeciesCount; ++g)
+            if (cp.gasIndex[g] >= 0) gasRate[cp.gasIndex[g]] += orr.mdotGas[g];
+          heat += orr.heat;
+        }
+      }
+      // One limiter for the particle: no species below zero, no shrinking below half the
+      // removal diameter within the step.
+      double sc = 1.0;
+      double mdot = 0.0;
+      for (int k = 0; k < nS; ++k) {
+        mdot += solidRate[k];
+        const double loss = -solidRate[k] * dt;
+        if (loss > sm[k]) sc = sm[k] > 0.0 ? (sm[k] / loss < sc ? sm[k] / loss : sc) : 0.0;
+      }
+      if (mdot < 0.0) {
+        const double dFloor = 0.5 * frac * d0[i];
+        const double mFloor = rho[i] * sphereVolume(0.5 * dFloor);
+        const double allowed = mi - mFloor;
+        const double loss = -mdot * dt * sc;
+        if (!(allowed > 0.0)) sc = 0.0;
+        else if (loss > allowed) sc *= allowed / loss;
+      }
+      // Eq. 31: species masses, total mass, fractions; Eq. 32: radius.
+      double mNew = 0.0;
+      double mk[kChemMaxSolids];
+      for (int k = 0; k < nS; ++k) {
+        mk[k] = sm[k] + dt * (sc * solidRate[k]);
+        if (mk[k] < 0.0) mk[k] = 0.0;  // round-off only (the limiter keeps it ≥ 0)
+        mNew += mk[k];
+      }
+      if (mNew > 0.0) {  // unchanged particles keep their bits
+        bool changed = false;
+        for (int k = 0; k < nS; ++k) changed = changed || mk[k] != sm[k];
+        if (changed) {
+          for (int k = 0; k < nS; ++k) X[i * nS + k] = mk[k] / mNew;
+          m[i] = mNew;
+          r[i] = 0.5 * shrinkingDiameter(mNew, rho[i]);
+        }
+      }
+      for (int k = 0; k < nS; ++k) dsol[i * nS + k] = mk[k] - sm[k];
+      for (int k = 0; k < nG; ++k) gdot[i * nG + k] = sc * gasRate[k];
+      q[i] = cp.reactionHeat ? sc * heat : 0.0;
+      return 2.0 * r[i] < frac * d0[i] ? 1.0 : 0.0;
+    }, 0.0);
+    p.produced(kMass | kSpecies | kRadius);
+    if (below > 0.0) _pending = true;
+
+    // Window accumulators per cell (+ one row for particles outside the grid).
+    double* acc = _acc.d();
+    if (coupled) {
+      const std::uint32_t* cs = cStart;
+      const std::uint32_t* ce = cEnd;
+      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
+        const std::uint32_t c = pcell[perm[h]];
+        if (h > 0 && pcell[perm[h - 1]] == c) return;
+        // Particles outside the grid share key nCells; their segment starts at the first of them.
+        std::uint32_t b = c < nCells ? cs[c] : static_cast<std::uint32_t>(h);
+        std::uint32_t e = c < nCells ? ce[c] : static_cast<std::uint32_t>(n);
+        const std::size_t row = static_cast<std::size_t>(c < nCells ? c : nCells) * W;
+        for (std::uint32_t k = b; k < e; ++k) {
+          const std::uint32_t i = perm[k];
+          for (int g = 0; g < nG; ++g) acc[row + g] += gdot[static_cast<std::size_t>(i) * nG + g] * dt;
+          for (int a = 0; a < nS; ++a) acc[row + nG + a] += dsol[static_cast<std::size_t>(i) * nS + a];
+          acc[row + nG + nS] += q[i] * dt;
+        }
+      });
+    } else {
+      exec.parallelFor(1, [=] DEM_LAMBDA(std::size_t) {
+        for (std::size_t i = 0; i < n; ++i) {
+          for (int g = 0; g < nG; ++g) acc[g] += gdot[i * nG + g] * dt;
+          for (int a = 0; a < nS; ++a) acc[nG + a] += dsol[i * nS + a];
+          acc[nG + nS] += q[i] * dt;
+        }
+      });
+    }
+    _acc.markDeviceModified();
+  }
+
+  /// T_i += Δt Q_rxn,i/(m_i c_p,i) (Eq. 18 with Q_rxn only; the heat module adds the rest).
+  void updateTemperature(Exec& exec, ParticleStore<Exec>& p, double dt) {
+    if (!_c.enabled || !_c.params.reactionHeat) return;
+    const double* q = _q.d();
+    const double* m = p.mass.d();
+    const std::int32_t* mat = p.material.d();
+    const double* cpm = _cp.d();
+    double* T = p.temperature.d();
+    exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
+      if (q[i] != 0.0) T[i] = T[i] + dt * (q[i] / (m[i] * cpm[mat[i]]));
+    });
+    p.produced(kTemperature);
+  }
+
+  /// Window end (host): R_species from the particle sources, WGS per cell, ledgers.
+  /// out.rSpecies / out.qHom are sized (zeros) by the engine. epsFrozen: host ε_g per cell.
+  void endWindow(int nSub, const EngineSetup& s, const double* epsFrozen, CellSources& out) {
+    if (!_c.enabled) return;
+    _acc.toHost();
+    const ChemParams& cp = _c.params;
+    const int nG = cp.nGas, nS = cp.nSolid, W = _width;
+    const double window = _dt * nSub;
+    const std::size_t nc = s.coupled ? s.nCells : 0;
+    const double* acc = _acc.h();
+    std::vector<double> gasSum(static_cast<std::size_t>(nG), 0.0), solidSum(static_cast<std::size_t>(nS), 0.0);
+    double heatSum = 0.0;
+    for (std::size_t c = 0; c <= nc; ++c) {
+      const double* row = acc + c * W;
+      for (int g = 0; g < nG; ++g) {
+        gasSum[g] += row[g];
+        if (c < nc && window > 0.0) out.rSpecies[c * nG + g] += row[g] / (s.cellVolume * window);
+      }
+      for (int a = 0; a < nS; ++a) solidSum[a] += row[nG + a];
+      heatSum += row[nG + nS];
+    }
+    for (int g = 0; g < nG; ++g) _totals.gasProduced[g] += gasSum[g];
+    for (int a = 0; a < nS; ++a) _totals.solidChange[a] += solidSum[a];
+    _totals.reactionHeat += heatSum;
+
+    // R3, homogeneous water–gas shift: once per CFD step per cell from the frozen gas.
+    if (cp.wgsOn && nc > 0 && window > 0.0 && !_tgHost.empty() && !_rhoHost.empty() && !_ygHost.empty()) {
+      std::vector<double> srcSum(static_cast<std::size_t>(nG), 0.0);
+      double heat = 0.0;
+      for (std::size_t c = 0; c < nc; ++c) {
+        double y[kernels::kGasSpeciesCount];
+        for (int g = 0; g < kernels::kGasSpeciesCount; ++g) {
+          const int k = cp.gasIndex[g];
+          y[g] = k >= 0 ? _ygHost[c * nG + k] : 0.0;
+        }
+        const kernels::WgsCellSources w =
+            kernels::wgsCellSources(cp.wgsParams, _tgHost[c], epsFrozen[c], _rhoHost[c], y, window);
+        for (int g = 0; g < kernels::kGasSpeciesCount; ++g) {
+          const int k = cp.gasIndex[g];
+          if (k < 0) continue;
+          out.rSpecies[c * nG + k] += w.massSource[g];
+          srcSum[k] += w.massSource[g];
+        }
+        out.qHom[c] += w.heatSource;
+        heat += w.heatSource;
+      }
+      for (int g = 0; g < nG; ++g) _totals.homogeneousSource[g] += srcSum[g] * s.cellVolume * window;
+      _totals.homogeneousHeat += heat * s.cellVolume * window;
+    }
+  }
+};
+
+} // namespace coredem::dem
