@@ -327,9 +327,16 @@ int main(int argc, char* argv[])
     ledgers.define("gas.solid_volume_m3", Ledgers::Diagnostic);
     ledgers.define("gas.enthalpy_J", Ledgers::Diagnostic);
     ledgers.define("gas.pressure_drop_Pa", Ledgers::Diagnostic);
+    // Species leaving through the boundary (faces with outward flux), kg/s at the step end:
+    // the outlet gas composition of reacting cases (docs/validation.md).
+    for (const std::string& s : speciesNames)
+    {
+        ledgers.define("gas.outflow." + s + "_kg_per_s", Ledgers::Diagnostic);
+    }
     const std::size_t lHeat = 0, lHom = 1, lInflow = 2, lMass = 3, lSpecies0 = 4;
     const std::size_t lMom0 = lSpecies0 + speciesNames.size();
     const std::size_t lSolid = lMom0 + 3, lEnthalpy = lSolid + 1, lDp = lSolid + 2;
+    const std::size_t lOut0 = lDp + 1;
     if (restarting)
     {
         for (std::size_t i = 0; i < restart.ledgerNames.size(); ++i)
@@ -559,6 +566,20 @@ int main(int argc, char* argv[])
                 }
             }
             ledgers.add(lInflow, rhoCp*inflow*dt);
+            for (label k = 0; k < nSpecies; ++k)
+            {
+                double out = 0;
+                forAll(mesh.boundary(), patchi)
+                {
+                    const scalarField& ap = alphaPhi.boundaryField()[patchi];
+                    const scalarField& yp = Y[k].boundaryField()[patchi];
+                    forAll(ap, facei)
+                    {
+                        if (ap[facei] > 0) out += ap[facei]*yp[facei];
+                    }
+                }
+                ledgers.set(lOut0 + k, rhog.value()*out);
+            }
             if (dpPatches[0] >= 0)
             {
                 ledgers.set
