@@ -263,6 +263,7 @@ std::string hashConfig(const DemConfig& c) {
   for (const Species& s : c.gasSpecies) t += s.name + ":", num(s.molarMass);
   t += "|opts:";
   num(c.neighbour.skinFactor), num(c.neighbour.historySlots), num(c.epsMinDrag), num(c.dtFactor);
+  if (c.frozenMotion) t += "|frozen";  // absent otherwise: earlier hashes unchanged
   if (c.heat.enabled) {  // heat off keeps the hash of configurations without heat transfer
     const HeatOptions& h = c.heat;
     t += "|heat:";
@@ -312,6 +313,7 @@ double dtDemMaxFor(const DemConfig& config, const std::vector<double>& minMass) 
       tcol = std::min(tcol, kernels::collisionTime(pp.kn, minMass[a], pp.dampFactor * std::sqrt(pp.kn * minMass[a])));
     }
   }
+  if (config.frozenMotion) return std::numeric_limits<double>::max();  // held: no collision limit
   return std::isfinite(tcol) ? tcol / config.dtFactor : std::numeric_limits<double>::infinity();
 }
 
@@ -434,6 +436,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   es.historySlots = config.neighbour.historySlots;
   es.neighbourSlots = config.neighbour.initialNeighbourSlots;
   es.threads = threads;
+  es.frozen = config.frozenMotion;
   {
     // Heat transfer (heat.h): the lens needs the neighbour list to reach FLPC·R_max further.
     const HeatOptions& h = config.heat;

@@ -41,6 +41,7 @@ struct EngineSetup {
   int threads = 0;
   HeatSetup heat;                        ///< particle heat transfer (heat.h)
   double reach = 0;                      ///< m, neighbour-list reach beyond R_i+R_j+skin (gas lens)
+  bool frozen = false;                   ///< DemConfig::frozenMotion: positions fixed, velocities zeroed
   ChemistrySetup chem;                   ///< chemistry in the sub-step (chemistry.h)
 };
 

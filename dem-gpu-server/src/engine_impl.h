@@ -672,6 +672,15 @@ public:
     double* w = _p.omega.d();
     const double* xr = _p.xref.d();
     const kernels::Vec3 g = _s.gravity;
+    if (_s.frozen) {  // held in place (MFiX verification cases): no motion, zero velocities
+      _exec.parallelFor(_p.n, [=] DEM_LAMBDA(std::size_t i) {
+        const long long ii = static_cast<long long>(i);
+        store3(v, ii, kernels::Vec3{0.0, 0.0, 0.0});
+        store3(w, ii, kernels::Vec3{0.0, 0.0, 0.0});
+      });
+      _p.produced(kVel | kOmega);
+      return 0.0;
+    }
     const double maxDisp2 = _exec.reduceMax(_p.n, [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
       const long long ii = static_cast<long long>(i);

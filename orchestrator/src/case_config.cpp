@@ -276,7 +276,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   // time
   top.require("time", "end time and time step");
   {
-    const Section t = top.section("time", {"end", "dt", "adaptive"});
+    const Section t = top.section("time", {"end", "dt", "adaptive", "dt_dem"});
     c.endTime = t.number("end", std::nullopt, 0.0, kBig, "simulated end time in s, > 0", true);
     c.dt.dt = t.number("dt", std::nullopt, 0.0, kBig,
                        "CFD time step in s, > 0 (the first step when adaptive)", true);
@@ -296,6 +296,22 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
         t.fail(t.markOf("dt"), "time.dt",
                fmt::format("{} must lie in [dt_min, dt_max] = [{}, {}] when adaptive", c.dt.dt,
                            c.dt.dtMin, c.dt.dtMax));
+      }
+    }
+    if (t.has("dt_dem")) {
+      c.dtDem = t.number("dt_dem", std::nullopt, 0.0, kBig,
+                         "forced DEM step in s, > 0; time.dt must be an integer multiple", true);
+      if (t.has("adaptive")) {
+        t.fail(t.markOf("dt_dem"), "time.dt_dem",
+               "a forced DEM step needs a fixed time.dt; remove 'adaptive' or 'dt_dem'");
+      }
+      const double ratio = c.dt.dt / c.dtDem;
+      const double n = std::round(ratio);
+      if (n < 1.0 || std::abs(ratio - n) > 1e-9 * n) {
+        t.fail(t.markOf("dt_dem"), "time.dt_dem",
+               fmt::format("time.dt / time.dt_dem = {} / {} = {:.12g} is not an integer >= 1; "
+                           "choose dt_dem = dt / n_sub for an integer n_sub (e.g. {:.6g})",
+                           c.dt.dt, c.dtDem, ratio, c.dt.dt / std::max(1.0, std::ceil(ratio))));
       }
     }
   }
@@ -386,7 +402,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     for (const auto& p :
          top.list("particles",
                   {"name", "material", "count", "diameter", "density", "temperature", "composition",
-                   "packing", "region", "seed", "velocity"},
+                   "packing", "region", "seed", "velocity", "positions"},
                   "particle sets")) {
       ParticleSetConfig ps;
       ps.name = p.string("name", std::string("set") + std::to_string(c.particles.size()),
@@ -400,8 +416,36 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
         p.fail(p.markOf("material"), p.full("material"),
                fmt::format("unknown material '{}'; allowed: {}", ps.material, join(names)));
       }
-      ps.count =
-          std::uint64_t(p.integer("count", std::nullopt, 1, 100000000, "number of particles"));
+      if (p.has("positions")) { // explicit packing: one centre per particle
+        const YAML::Node pos = p.raw("positions");
+        if (!pos.IsSequence() || pos.size() == 0) {
+          p.fail(p.markOf("positions"), p.full("positions"),
+                 "expected a non-empty list of particle centres [[x, y, z], ...] in m");
+        }
+        for (std::size_t k = 0; k < pos.size(); ++k) {
+          const std::string key = fmt::format("{}[{}]", p.full("positions"), k);
+          if (!pos[k].IsSequence() || pos[k].size() != 3) {
+            p.fail(pos[k].Mark(), key,
+                   fmt::format("expected a centre [x, y, z] in m, got {}", describe(pos[k])));
+          }
+          Vec3 x{};
+          for (std::size_t d = 0; d < 3; ++d) {
+            x[d] = p.numberOf(pos[k][d], fmt::format("{}[{}]", key, d), -kBig, kBig, "m");
+          }
+          ps.positions.push_back(x);
+        }
+      }
+      ps.count = ps.positions.empty()
+                     ? std::uint64_t(p.integer("count", std::nullopt, 1, 100000000,
+                                               "number of particles"))
+                     : std::uint64_t(p.integer("count", std::int64_t(ps.positions.size()), 1,
+                                               100000000, "number of particles"));
+      if (!ps.positions.empty() && ps.count != ps.positions.size()) {
+        p.fail(p.markOf("count"), p.full("count"),
+               fmt::format("{} particles but {} positions; with 'positions' leave 'count' out "
+                           "(it is the number of positions)",
+                           ps.count, ps.positions.size()));
+      }
       ps.diameter = p.number("diameter", std::nullopt, 0.0, kBig, "m, > 0", true);
       ps.density = p.number("density", 0.0, 0.0, kBig, "kg/m3 (0 = the material's)");
       ps.temperature = p.number("temperature", 293.15, 0.0, kBig, "initial temperature in K", true);
@@ -423,14 +467,22 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
                  fmt::format("mass fractions sum to {}, must sum to 1", sum));
         }
       }
-      ps.packing = p.choice("packing", std::string("lattice"), {"lattice", "random"});
-      p.require("region", "box {min: [x,y,z], max: [x,y,z]} in m to fill");
-      const Section r = p.section("region", {"min", "max"});
-      ps.regionMin = r.vec3("min", std::nullopt, "m");
-      ps.regionMax = r.vec3("max", std::nullopt, "m");
-      for (int i = 0; i < 3; ++i) {
-        if (ps.regionMax[i] <= ps.regionMin[i]) {
-          r.fail(r.markOf("max"), r.full("max"), "every component must exceed the one of 'min'");
+      if (!ps.positions.empty()) {
+        ps.packing = p.choice("packing", std::string("explicit"), {"explicit"});
+        if (p.has("region")) {
+          p.fail(p.markOf("region"), p.full("region"),
+                 "not used with 'positions' (explicit packing); remove one of them");
+        }
+      } else {
+        ps.packing = p.choice("packing", std::string("lattice"), {"lattice", "random"});
+        p.require("region", "box {min: [x,y,z], max: [x,y,z]} in m to fill, or 'positions'");
+        const Section r = p.section("region", {"min", "max"});
+        ps.regionMin = r.vec3("min", std::nullopt, "m");
+        ps.regionMax = r.vec3("max", std::nullopt, "m");
+        for (int i = 0; i < 3; ++i) {
+          if (ps.regionMax[i] <= ps.regionMin[i]) {
+            r.fail(r.markOf("max"), r.full("max"), "every component must exceed the one of 'min'");
+          }
         }
       }
       ps.seed = std::uint64_t(

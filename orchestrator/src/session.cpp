@@ -78,6 +78,20 @@ double estimateDtDemMax(const CaseConfig& c) {
   return std::isfinite(tMin) ? tMin / 50.0 : c.dt.dt;
 }
 
+/// The sub-cycling plan of a step: from the forced DEM step time.dt_dem when given (n_sub =
+/// dt/dt_dem; a step shortened to land on time.end gets n_sub = ceil), else from Δt_DEM,max.
+SubcyclePlan planFor(const CaseConfig& c, double dt, double dtDemMax) {
+  if (c.dtDem > 0.0) {
+    const double ratio = dt / c.dtDem;
+    double n = std::round(ratio);
+    if (n < 1.0 || std::abs(ratio - n) > 1e-9 * n) {
+      n = std::max(1.0, std::ceil(ratio));
+    }
+    return SubcyclePlan{std::int64_t(n), dt / n};
+  }
+  return planSubcycles(dt, dtDemMax);
+}
+
 v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double dtCfd,
                              const SubcyclePlan& plan) {
   v1::Configure cfg;
@@ -131,6 +145,12 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
       protocol::addNamedValue(ps->mutable_composition(), name, f);
     }
     ps->set_packing(p.packing == "random" ? v1::PACKING_RANDOM : v1::PACKING_LATTICE);
+    if (!p.positions.empty()) { // explicit packing (time.dt_dem / positions: docs/case-schema.md)
+      ps->set_packing(v1::PACKING_EXPLICIT);
+      for (const auto& x : p.positions) {
+        *ps->add_positions() = vec(x);
+      }
+    }
     *ps->mutable_region_min() = vec(p.regionMin);
     *ps->mutable_region_max() = vec(p.regionMax);
     ps->set_seed(p.seed);
@@ -439,7 +459,7 @@ protocol::Request Session::receiveFromCfd(std::chrono::milliseconds timeout,
 
 void Session::configureDem(std::int64_t startStep, double startTime, const fs::path& initialState) {
   const double dt0 = _policy.lastDt();
-  const SubcyclePlan provisional = planSubcycles(dt0, estimateDtDemMax(_c));
+  const SubcyclePlan provisional = planFor(_c, dt0, estimateDtDemMax(_c));
   _configure = buildConfigure(_c, _o.runDir, dt0, provisional);
   _configure.set_start_step(startStep);
   _configure.set_start_time(startTime);
@@ -460,6 +480,13 @@ void Session::configureDem(std::int64_t startStep, double startTime, const fs::p
   // Configured.dt_dem is D's Δt_DEM,max = t_col,min/50 (its n_sub is for the first Δt_CFD);
   // every later plan is n_sub = ceil(Δt_CFD/Δt_DEM,max).
   _dtDemMax = cd.dt_dem();
+  if (_c.dtDem > _dtDemMax * (1.0 + 1e-12)) {
+    throw CaseError(fmt::format(
+        "time.dt_dem = {:.6g} s exceeds the DEM server's stable step dt_dem_max = {:.6g} s "
+        "(t_col/50); use time.dt_dem <= {:.6g} s, or hold the particles with models: "
+        "{{motion: frozen}}",
+        _c.dtDem, _dtDemMax, _dtDemMax));
+  }
   _cells = cd.cell_count();
   _species = cd.species_count();
   _configure.mutable_sub_cycling()->set_n_sub(cd.n_sub());
@@ -624,7 +651,7 @@ void Session::stepLoop(std::int64_t startStep) {
     const std::int64_t step = _step + 1;
     const double tStart = _time.time();
     const double dt = _policy.next(_lastCourant, _time.remaining(_c.endTime));
-    const SubcyclePlan plan = planSubcycles(dt, _dtDemMax);
+    const SubcyclePlan plan = planFor(_c, dt, _dtDemMax);
     TimeHandler probe = _time;
     probe.advance(dt);
     const bool last = probe.reached(_c.endTime) || (_o.stopAfterStep && step >= *_o.stopAfterStep);

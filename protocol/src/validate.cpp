@@ -327,12 +327,19 @@ Status validateConfigure(const v1::Configure& c) {
         return bad(which + " needs count >= 1, diameter > 0, density >= 0 (0 = material's) "
                            "and temperature > 0 K");
       }
-      if (!(p.region_min().x() < p.region_max().x() && p.region_min().y() < p.region_max().y() &&
-            p.region_min().z() < p.region_max().z())) {
+      if (p.packing() == v1::PACKING_EXPLICIT) {
+        if (static_cast<std::uint64_t>(p.positions_size()) != p.count()) {
+          return bad(which + " explicit packing needs one position per particle (count " +
+                     std::to_string(p.count()) + ", positions " +
+                     std::to_string(p.positions_size()) + ")");
+        }
+      } else if (!(p.region_min().x() < p.region_max().x() &&
+                   p.region_min().y() < p.region_max().y() &&
+                   p.region_min().z() < p.region_max().z())) {
         return bad(which + " region_min must be below region_max on every axis");
       }
       if (p.packing() == v1::PACKING_UNSPECIFIED) {
-        return bad(which + " packing must be LATTICE or RANDOM");
+        return bad(which + " packing must be LATTICE, RANDOM or EXPLICIT");
       }
       if (p.composition_size() > 0) {
         double sum = 0;

@@ -88,11 +88,20 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
       d.material = it->second;
       switch (ps.packing()) {
       case v1::PACKING_RANDOM: d.packing = dem::Packing::Random; break;
+      case v1::PACKING_EXPLICIT:
+        d.packing = dem::Packing::Explicit;
+        COREDEM_CHECK(ps.positions_size() > 0 && static_cast<std::uint64_t>(ps.positions_size()) == ps.count(),
+                      "Configure: particle set '{}' has explicit packing with {} positions but "
+                      "count {}; give one position per particle", d.name, ps.positions_size(), ps.count());
+        for (const auto& p : ps.positions()) {
+          d.positions.insert(d.positions.end(), {p.x(), p.y(), p.z()});
+        }
+        break;
       case v1::PACKING_LATTICE:
       case v1::PACKING_UNSPECIFIED: d.packing = dem::Packing::Lattice; break;
       default:
         COREDEM_CHECK(false, "Configure: particle set '{}' has an unknown packing {}; use "
-                      "LATTICE or RANDOM", d.name, static_cast<int>(ps.packing()));
+                      "LATTICE, RANDOM or EXPLICIT", d.name, static_cast<int>(ps.packing()));
       }
       d.regionMin = vec(ps.region_min());
       d.regionMax = vec(ps.region_max());
@@ -155,6 +164,11 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
       cfg.neighbour.historySlots = static_cast<int>(parseDouble(kv.key(), kv.value()));
     } else if (dem::setHeatOption(cfg.heat, kv.key(), kv.value())) {
       // heat-transfer switch (docs/heat-coupling.md)
+    } else if (kv.key() == "motion") {
+      COREDEM_CHECK(kv.value() == "free" || kv.value() == "frozen",
+                    "Configure option motion = '{}': use free (default) or frozen (particles held "
+                    "in place, as in MFiX's verification cases)", kv.value());
+      cfg.frozenMotion = kv.value() == "frozen";
     } else if (kv.key() == "drag") {
       COREDEM_CHECK(kv.value() == "gidaspow", "Configure option drag = '{}': this server "
                     "implements 'gidaspow' only", kv.value());

@@ -125,6 +125,11 @@ struct DemConfig {
   double epsMinDrag = 0.35;            ///< ε_min clip in drag (PHYSICS §1.1 [C])
   double dtFactor = 50.0;              ///< Δt_DEM,max = t_col,min / dtFactor (PHYSICS Eq. 12)
   HeatOptions heat;                    ///< particle heat transfer (docs/heat-coupling.md)
+  /// Hold every particle in place (`models: {motion: frozen}`, as MFiX's verification cases do):
+  /// forces, torques and gravity do not move it, positions stay fixed, velocities are zeroed
+  /// every sub-step. Contacts and heat transfer are evaluated as usual; the collision time then
+  /// does not limit Δt_DEM (dtDemMax() returns the largest finite double).
+  bool frozenMotion = false;
   /// Wall thermal condition (docs/heat-coupling.md "Walls"): > 0 holds every wall at this
   /// temperature (K) with particle–wall conduction (kernels/wall_conduction.h); 0 = adiabatic.
   double wallTemperature = 0.0;

@@ -58,6 +58,7 @@ struct ParticleSetConfig {
   Vec3 regionMin{}, regionMax{};
   std::uint64_t seed = 1;
   Vec3 velocity{};
+  std::vector<Vec3> positions; ///< packing "explicit": one centre per particle (count = size)
 };
 
 struct PlaneConfig {
@@ -108,6 +109,7 @@ struct CaseConfig {
   std::string description;
   double endTime = 0.0;
   DtPolicyConfig dt;
+  double dtDem = 0.0; ///< time.dt_dem: forced Δt_DEM (s), n_sub = dt/dt_dem; 0 = from t_col/50
   GridConfig grid;
   Vec3 gravity{0.0, 0.0, -9.81};
   std::vector<SpeciesConfig> species;
