@@ -3,6 +3,7 @@
 //   coredem resume RUN_DIR [--auto-restart N] [--stop-after STEP]
 //   coredem inspect FILE
 //   coredem check CASE_DIR
+//   coredem verify [--out DIR] [--only NAME[,NAME]] [--list] [--cases DIR] [--no-plots]
 #include <cstdio>
 #include <iostream>
 
@@ -15,6 +16,7 @@
 #include <coredem/orchestrator/outputs.h>
 #include <coredem/orchestrator/processes.h>
 #include <coredem/orchestrator/session.h>
+#include <coredem/orchestrator/verify.h>
 
 using namespace coredem::orchestrator;
 namespace fs = std::filesystem;
@@ -81,6 +83,19 @@ int main(int argc, char** argv) {
       app.add_subcommand("inspect", "summarise a snapshot/state HDF5 file or a checkpoint");
   inspect->add_option("FILE", file, "HDF5 file, manifest.json or checkpoint folder")->required();
 
+  VerifyOptions verifyOpts;
+  std::vector<std::string> only;
+  auto* verify = app.add_subcommand(
+      "verify", "run the verification cases (PHYSICS §8) against the analytic solutions");
+  verify->add_option("--out", verifyOpts.outDir, "output folder (default runs/verify)");
+  verify->add_option("--only", only, "only these cases (comma-separated names)")->delimiter(',');
+  verify->add_flag("--list", verifyOpts.list, "list the cases and exit");
+  verify->add_option("--cases", verifyOpts.casesDir,
+                     "folder of verification cases (default: the installed or source-tree "
+                     "cases/verification)");
+  verify->add_flag("--no-plots", noPlots, "do not make the PNG plots");
+  verify->add_flag("--verbose", verifyOpts.verbose, "keep the runs' info log");
+
   auto* check = app.add_subcommand("check", "validate a case file and exit (0 valid, 2 invalid)");
   check->add_option("CASE_DIR", caseDir, "case folder with case.yaml (or a case file)")->required();
 
@@ -95,6 +110,14 @@ int main(int argc, char** argv) {
     if (*inspect) {
       std::cout << inspectSummary(file);
       return kExitOk;
+    }
+    if (*verify) {
+      verifyOpts.only = only;
+      verifyOpts.plots = !noPlots;
+      if (verifyOpts.outDir.empty()) {
+        verifyOpts.outDir = "runs/verify";
+      }
+      return runVerify(verifyOpts);
     }
     if (*check) {
       const CaseConfig c = loadCase(caseDir);

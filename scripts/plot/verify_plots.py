@@ -1,0 +1,107 @@
+#!/usr/bin/env python3
+"""Plots of `coredem verify` (docs/verification.md), like the seed's Figs. 5-12.
+
+Usage: verify_plots.py DIR [--dpi N]
+
+Reads DIR/<case>/verify.csv (written by `coredem verify`: a comment line
+"# case=...;family=...;quantity=...", a header with t, sim:X / ref:X pairs and error columns)
+and writes one figure per family to DIR/plots/<family>.png: on the left the simulated values
+(markers) over the analytic solution (lines), on the right the relative error against time.
+"""
+import argparse
+import csv
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+TITLES = {
+    "contact-conduction": "Particle-particle contact conduction (PHYSICS 8.1)",
+    "gas-lens": "Particle-fluid-particle conduction through the gas lens (PHYSICS 8.2)",
+    "convection": "Particle-gas convection (PHYSICS 8.3)",
+    "radiation": "Radiation, RK4 reference (PHYSICS 8.4)",
+    "reaction": "Heterogeneous reaction A(g) + 2B(s) -> C(g) + D(s) (PHYSICS 8.5)",
+}
+
+
+def read_case(path):
+    with open(path) as f:
+        meta_line = f.readline().lstrip("#").strip()
+        meta = dict(kv.split("=", 1) for kv in meta_line.split(";"))
+        rows = list(csv.reader(f))
+    header, data = rows[0], rows[1:]
+    cols = {h: [float(r[i]) for r in data] for i, h in enumerate(header)}
+    return meta, cols
+
+
+def thin(xs, n=60):
+    """Every k-th index so that about n markers are drawn."""
+    k = max(1, len(xs) // n)
+    return list(range(0, len(xs), k))
+
+
+def plot_family(family, cases, out, dpi):
+    reaction = family == "reaction"
+    fig, (ax, axe) = plt.subplots(1, 2, figsize=(11, 4.4))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for ci, (name, cols) in enumerate(sorted(cases.items())):
+        t = cols["t"]
+        idx = thin(t)
+        colour = colours[ci % len(colours)]
+        quantities = [h[4:] for h in cols if h.startswith("sim:")]
+        if reaction:
+            quantities = ["m"]
+        for qi, q in enumerate(quantities):
+            label = f"{name}" if qi == 0 else None
+            ax.plot(t, cols["ref:" + q], "-", color=colour, lw=1.0, label=label)
+            ax.plot([t[i] for i in idx], [cols["sim:" + q][i] for i in idx],
+                    "o" if qi == 0 else "s", ms=3, mfc="none", color=colour)
+        err = [max(e, 1e-18) for e in cols["error"]]
+        axe.semilogy(t, err, "-", color=colour, lw=1.0, label=name)
+        if reaction and "fraction_error" in cols:
+            axe.semilogy(t, [max(e, 1e-18) for e in cols["fraction_error"]], "--", color=colour,
+                         lw=1.0, label=name + " (mass fractions, absolute)")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("particle mass (kg)" if reaction else "T (K)")
+    ax.set_title("simulation (markers) vs analytic (lines)", fontsize=9)
+    axe.set_xlabel("t (s)")
+    axe.set_ylabel("relative error")
+    axe.set_title("error vs time", fontsize=9)
+    n = len(cases)
+    ax.legend(fontsize=6 if n > 4 else 7, loc="best")
+    if n <= 6:
+        axe.legend(fontsize=6, loc="best")
+    fig.suptitle(TITLES.get(family, family), fontsize=10)
+    fig.tight_layout()
+    path = os.path.join(out, f"{family}.png")
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("dir")
+    ap.add_argument("--dpi", type=int, default=90)
+    a = ap.parse_args()
+    families = {}
+    for name in sorted(os.listdir(a.dir)):
+        p = os.path.join(a.dir, name, "verify.csv")
+        if os.path.isfile(p):
+            meta, cols = read_case(p)
+            families.setdefault(meta["family"], {})[meta["case"]] = cols
+    if not families:
+        print(f"{a.dir}: no */verify.csv", file=sys.stderr)
+        return 1
+    out = os.path.join(a.dir, "plots")
+    os.makedirs(out, exist_ok=True)
+    for family, cases in families.items():
+        print(plot_family(family, cases, out, a.dpi))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
