@@ -23,6 +23,7 @@
 #include "backend/exec_common.h"
 #include "engine.h"
 #include "heat.h"
+#include "chemistry.h"
 #include "particle_store.h"
 
 #include "coredem/dem/kernels/body_force.h"
@@ -73,6 +74,7 @@ public:
   int _maxUsedSlots = kMaxHistorySlots;  ///< max contacts of a particle in the last sub-step (≥ slots in use)
   StageTimes _t;
   HeatModule<Exec> _heat;  ///< particle heat transfer (heat.h)
+  ChemistryModule<Exec> _chem;  ///< chemistry (chemistry.h)
 
   explicit EngineImpl(const EngineSetup& s) : _s(s) {
     _exec.threads = s.threads;
@@ -98,11 +100,18 @@ public:
       _cEnd.reserve(_s.nCells + 1);
     }
     _heat.setup(_s.heat, _s.coupled ? _s.nCells : 0);
+    _chem.setup(_s.chem, _s.coupled ? _s.nCells : 0);
   }
 
   const char* name() const override { return Exec::name; }
   StageTimes& times() override { return _t; }
   HeatTotals& heatTotals() override { return _heat._totals; }
+  ChemistryTotals& chemistryTotals() override { return _chem._totals; }
+  bool takePendingRemoval() override {
+    const bool p = _chem._pending;
+    _chem._pending = false;
+    return p;
+  }
 
   // ---------------------------------------------------------------- state transfer
   void setState(const HostState& s) override {
@@ -117,6 +126,7 @@ public:
     put(_p.contacts, s.contacts); put(_p.gid, s.gid); put(_p.histKey, s.histKey);
     put(_p.histDisp, s.histDisp); put(_p.nbCount, s.nbCount); put(_p.nbList, s.nbList);
     put(_p.wallContacts, s.wallContacts);
+    put(_p.d0, s.d0); put(_p.chemRef, s.chemRef);  // chemistry references
     _p.toDevice(kAllFields);
     _maxUsedSlots = _p.K;
     _listValid = s.listValid != 0 && s.nbList.size() == s.n * static_cast<std::size_t>(s.neighbourSlots);
@@ -138,12 +148,13 @@ public:
     get(_p.contacts, s.contacts); get(_p.wallContacts, s.wallContacts); get(_p.gid, s.gid); get(_p.histKey, s.histKey);
     get(_p.histDisp, s.histDisp); get(_p.nbCount, s.nbCount); get(_p.nbList, s.nbList);
     s.listValid = _listValid ? 1 : 0;
+    get(_p.d0, s.d0); get(_p.chemRef, s.chemRef);  // chemistry references
     return s;
   }
 
   void particles(ParticleData& out) override {
     const std::uint32_t mask = kPos | kVel | kOmega | kForce | kRadius | kMass | kDensity |
-                               kTemperature | kSpecies | kMaterial | kGid;
+                               kTemperature | kSpecies | kMaterial | kGid | kD0;
     _p.toHost(mask);
     out.count = _p.n;
     out.nSpecies = _p.nSpecies;
@@ -152,6 +163,7 @@ public:
     get(_p.force, out.force); get(_p.radius, out.radius); get(_p.mass, out.mass);
     get(_p.density, out.density); get(_p.temperature, out.temperature);
     get(_p.species, out.species); get(_p.material, out.material); get(_p.gid, out.globalId);
+    get(_p.d0, out.initialDiameter);
   }
 
   void setGas(const GasArrays& g) override {
@@ -168,6 +180,7 @@ public:
     put(_muG, g.muG);
     _hasGas = true;
     _heat.setGas(g);
+    _chem.setGas(g);
   }
 
   void reserveScratch() {
@@ -184,7 +197,7 @@ public:
     return self._p.bytes() + _keys.bytes() + _perm.bytes() + _cellStart.bytes() +
            _cellEnd.bytes() + _pcell.bytes() + _kcoef.bytes() + _scratch.bytes() +
            _cStart.bytes() + _cEnd.bytes() + self._epsFrozen.bytes() + self._acc.bytes() +
-           _heat.bytes();
+           _heat.bytes() + _chem.bytes();
   }
 
   // ---------------------------------------------------------------- neighbour search
@@ -289,6 +302,7 @@ public:
     reorder(_p.temperature, 1); reorder(_p.material, 1); reorder(_p.contacts, 1);
     reorder(_p.wallContacts, 1); reorder(_p.gid, 1);
     if (_p.nSpecies > 0) reorder(_p.species, _p.nSpecies);
+    reorder(_p.d0, 1); reorder(_p.chemRef, 2);  // chemistry references
     reorder(_p.histKey, _p.K, _maxUsedSlots);
     reorder(_p.histDisp, 3 * _p.K, 3 * _maxUsedSlots);
     computeKeys(g);  // keys of the sorted order (ascending)
@@ -395,6 +409,7 @@ public:
 
   /// Reads pos, radius; writes _epsFrozen (PCM ε_g used by drag during the window).
   void beginWindow() override {
+    _chem.beginWindow(_exec);  // chemistry window accumulators (also uncoupled: ledgers)
     if (!_s.coupled) return;
     const auto t0 = Clock::now();
     _p.require(kPos | kRadius);
@@ -463,7 +478,8 @@ public:
   void endWindow(int nSub, CellSources& out) override {
     if (!_s.coupled) {
       out = CellSources{};
-      _heat.endWindow(nSub, _s, out);  // wall heat totals only
+      _chem.endWindow(nSub, _s, nullptr, out);  // ledgers only
+      _heat.endWindow(nSub, _s, out);           // wall heat totals only
       return;
     }
     _acc.toHost();
@@ -486,6 +502,12 @@ public:
       out.kSlUs[3 * c + 2] = avg.kSlUs.z;
     }
     _heat.endWindow(nSub, _s, out);
+    if (_chem.enabled()) {  // R_species, WGS, chemistry ledgers (chemistry.h)
+      const auto tc = Clock::now();
+      _epsFrozen.toHost();
+      _chem.endWindow(nSub, _s, _epsFrozen.h(), out);
+      _t.chemistry += std::chrono::duration<double>(Clock::now() - tc).count();
+    }
   }
 
   // ---------------------------------------------------------------- forces
@@ -700,6 +722,7 @@ public:
   }
 
   void subStep(double dt) override {
+    _chem._dt = dt;  // window length for the per-cell WGS, also without particles
     if (_p.n == 0) return;
     auto t0 = Clock::now();
     if (!_listValid) {
@@ -738,9 +761,18 @@ public:
       _t.heat += std::chrono::duration<double>(t2 - t1).count();
       t1 = t2;
     }
+    if (_chem.enabled()) {  // rates -> mass/diameter, before the motion (chemistry.h)
+      const bool gas = _hasGas && _s.coupled;
+      _chem.react(_exec, _p, _s, gas, _pcell.d(), _perm.d(), _cStart.d(), _cEnd.d(), dt);
+      Exec::synchronize();
+      auto t2 = Clock::now();
+      _t.chemistry += std::chrono::duration<double>(t2 - t1).count();
+      t1 = t2;
+    }
     const double half = 0.5 * _s.skin;
     if (integrate(dt) > half * half) _listValid = false;
     _heat.updateTemperature(_exec, _p, dt);
+    _chem.updateTemperature(_exec, _p, dt);  // + Δt Q_rxn/(m c_p)
     Exec::synchronize();
     _t.integrate += std::chrono::duration<double>(Clock::now() - t1).count();
   }

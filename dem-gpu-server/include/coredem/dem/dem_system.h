@@ -14,6 +14,7 @@
 /// Units are SI everywhere. Coupling cells are numbered cell = i + nx*(j + ny*k).
 /// All methods throw coredem::UserError on bad input, with a message that says what to fix.
 
+#include "coredem/dem/chemistry_options.h"
 #include "coredem/dem/heat_options.h"
 
 #include <array>
@@ -130,6 +131,7 @@ struct DemConfig {
   /// every sub-step. Contacts and heat transfer are evaluated as usual; the collision time then
   /// does not limit Δt_DEM (dtDemMax() returns the largest finite double).
   bool frozenMotion = false;
+  ChemistryOptions chemistry;          ///< reactions, CLG models, removal (docs/thermochemistry.md)
   /// Wall thermal condition (docs/heat-coupling.md "Walls"): > 0 holds every wall at this
   /// temperature (K) with particle–wall conduction (kernels/wall_conduction.h); 0 = adiabatic.
   double wallTemperature = 0.0;
@@ -154,7 +156,8 @@ struct GasFieldsView {
 
 /// Per-cell sources for the CFD, averaged over the sub-steps of one advance() (PHYSICS §1.1).
 /// Heat: gas energy source −(H T_g − H_Tp) (W/m³), H = Σ h_i A_i/V_c, H_Tp = Σ h_i A_i T_p,i/V_c
-/// (docs/heat-coupling.md). Species and Q_hom entries stay zero until chemistry is integrated.
+/// (docs/heat-coupling.md). Species: R_species = (1/V_c) Σ ṁ_gas,i (heterogeneous, averaged over
+/// the sub-steps) + WGS per cell; Q_hom: WGS heat into the gas (docs/thermochemistry.md).
 struct CellSources {
   std::vector<double> epsG;      ///< ε_g (-), N
   std::vector<double> kSl;       ///< K_sl = (1/V_c) Σ β V_p/(1-ε) (kg/m³/s), N
@@ -175,6 +178,7 @@ struct ParticleData {
   std::vector<double> species;                                     ///< N*nSpecies
   std::vector<std::int32_t> material;                              ///< N
   std::vector<std::int64_t> globalId;                              ///< N
+  std::vector<double> initialDiameter;                             ///< N, d_p0 (m): removal reference
 };
 
 /// Wall-clock seconds spent per stage since construction (or resetStageTimes()).
@@ -185,6 +189,7 @@ struct StageTimes {
   double integrate = 0;  ///< motion update
   double coupling = 0;   ///< PCM ε_g and cell-source deposition
   double heat = 0;       ///< heat sources (conduction, convection, radiation) and their deposition
+  double chemistry = 0;  ///< reaction rates, mass/diameter update, species deposition, WGS, removal
   std::uint64_t rebuilds = 0;
 };
 
@@ -244,6 +249,9 @@ public:
   /// Heat the particles received from the gas and from radiation since construction (kept
   /// across writeState/readState), J.
   HeatTotals heatTotals() const;
+  /// Chemistry ledgers since construction (kept across writeState/readState): gas released by
+  /// particles per species, solid change per species, reaction heat, removed mass (kg, J).
+  ChemistryTotals chemistryTotals() const;
   /// Σ m_i c_p,i T_p,i over the particles (J, with the material's constant c_p).
   double thermalEnergy() const;
   void resetStageTimes();
