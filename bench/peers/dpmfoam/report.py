@@ -1,0 +1,147 @@
+#!/usr/bin/env python3
+"""Summarise a bench/peers/dpmfoam/compare.sh run.
+
+    report.py WORK_DIR N SIM_SECONDS
+
+WORK_DIR holds dpmfoam/ (the DPMFoam case after its run, with time.txt) and coredem-run/ (the
+`coredem run` folder) with coredem.time.txt. Prints wall and CPU seconds per simulated second
+for both, the ratio, and the pressure drop and bed height of both beds averaged over the
+field writes of the second half of the run:
+
+  * pressure drop: rho_g * (mean kinematic p of the bottom cell layer - mean of the top layer)
+    (cell centres, the same for both codes; it includes the gas column, rho_g g H ~ 2.4 Pa);
+  * bed height: 2 x the solid-volume-weighted mean height of the cells,
+    2 sum((1-alpha) y) / sum(1-alpha): the height of a uniform bed with the same centroid.
+"""
+
+import csv
+import math
+import os
+import re
+import sys
+
+CELLS = (12, 60, 3)
+HEIGHT = 0.2
+RHO_G = 1.204
+
+
+def read_internal(path, ncells):
+    with open(path) as f:
+        text = f.read()
+    m = re.search(r"internalField\s+uniform\s+([^;]+);", text)
+    if m:
+        return [float(m.group(1))] * ncells
+    m = re.search(r"internalField\s+nonuniform\s+List<scalar>\s*(\d+)\s*\(", text)
+    if not m:
+        raise ValueError(f"{path}: no scalar internalField")
+    n = int(m.group(1))
+    body = text[m.end():]
+    vals = body[: body.index(")")].split()
+    if n != ncells or len(vals) != n:
+        raise ValueError(f"{path}: {len(vals)} values, expected {ncells}")
+    return [float(v) for v in vals]
+
+
+def time_dirs(case):
+    out = []
+    for d in os.listdir(case):
+        try:
+            t = float(d)
+        except ValueError:
+            continue
+        if t > 0:
+            out.append((t, os.path.join(case, d)))
+    return sorted(out)
+
+
+def bed_figures(case, alpha_name, sim):
+    nx, ny, nz = CELLS
+    ncells = nx * ny * nz
+    h = HEIGHT / ny
+    dps, heights = [], []
+    for t, d in time_dirs(case):
+        if t < 0.5 * sim - 1e-12:
+            continue
+        a_path, p_path = os.path.join(d, alpha_name), os.path.join(d, "p")
+        if not (os.path.exists(a_path) and os.path.exists(p_path)):
+            continue
+        alpha = read_internal(a_path, ncells)
+        p = read_internal(p_path, ncells)
+        bottom = [p[c] for c in range(ncells) if (c // nx) % ny == 0]
+        top = [p[c] for c in range(ncells) if (c // nx) % ny == ny - 1]
+        dps.append(RHO_G * (sum(bottom) / len(bottom) - sum(top) / len(top)))
+        s = sum(1.0 - a for a in alpha)
+        sy = sum((1.0 - a) * ((c // nx) % ny + 0.5) * h for c, a in enumerate(alpha))
+        heights.append(2.0 * sy / s if s > 0 else float("nan"))
+    if not dps:
+        return None
+    return sum(dps) / len(dps), sum(heights) / len(heights), len(dps)
+
+
+def read_time(path):
+    with open(path) as f:
+        wall, user, sys_ = (float(x) for x in f.read().split()[:3])
+    return wall, user + sys_
+
+
+def ours_dp_ledger(run, sim):
+    path = os.path.join(run, "timeseries.csv")
+    if not os.path.exists(path):
+        return None
+    vals = []
+    with open(path) as f:
+        for row in csv.DictReader(f):
+            try:
+                t = float(row.get("time", row.get("t", "nan")))
+                v = float(row["gas.pressure_drop_Pa"])
+            except (KeyError, ValueError):
+                continue
+            if t >= 0.5 * sim:
+                vals.append(v)
+    return sum(vals) / len(vals) if vals else None
+
+
+def dpm_substeps(log):
+    cyc = [int(m.group(1)) for m in re.finditer(r"(\d+) move-collide subCycles", open(log).read())]
+    return (sum(cyc) / len(cyc), max(cyc), len(cyc)) if cyc else None
+
+
+def main():
+    work, n, sim = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
+    rows = {}
+    dpm = os.path.join(work, "dpmfoam")
+    if os.path.exists(os.path.join(dpm, "time.txt")):
+        wall, cpu = read_time(os.path.join(dpm, "time.txt"))
+        rows["DPMFoam"] = (wall, cpu, bed_figures(dpm, "alpha.air", sim))
+    run = os.path.join(work, "coredem-run")
+    if os.path.exists(os.path.join(work, "coredem.time.txt")) and os.path.isdir(run):
+        wall, cpu = read_time(os.path.join(work, "coredem.time.txt"))
+        rows["CoReDEM"] = (wall, cpu, bed_figures(os.path.join(run, "openfoam"), "alphac", sim))
+    if not rows:
+        print("no run finished")
+        return 1
+    print()
+    print(f"N = {n}, {sim} s simulated")
+    print(f"{'code':<8} {'wall s':>9} {'wall s/sim s':>13} {'cpu s/sim s':>12} "
+          f"{'dp [Pa]':>9} {'bed H [m]':>10} {'writes':>6}")
+    for name, (wall, cpu, bed) in rows.items():
+        dp, hb, k = bed if bed else (math.nan, math.nan, 0)
+        print(f"{name:<8} {wall:9.1f} {wall / sim:13.4g} {cpu / sim:12.4g} {dp:9.1f} {hb:10.4f} {k:6d}")
+    mass = 2500.0 * math.pi * 1e-9 / 6.0
+    print(f"bed weight per area: {n * mass * 9.81 / (0.04 * 0.01):.1f} Pa "
+          f"(+ gas column rho_g g H = {RHO_G * 9.81 * HEIGHT:.1f} Pa)")
+    ledger = ours_dp_ledger(run, sim) if "CoReDEM" in rows else None
+    if ledger is not None:
+        print(f"CoReDEM gas.pressure_drop_Pa (inlet - outlet patch means, every step, second half): {ledger:.1f} Pa")
+    if "DPMFoam" in rows:
+        sc = dpm_substeps(os.path.join(dpm, "log.DPMFoam"))
+        if sc:
+            print(f"DPMFoam collision sub-cycles per CFD step: mean {sc[0]:.0f}, max {sc[1]} over {sc[2]} steps")
+    if "DPMFoam" in rows and "CoReDEM" in rows:
+        print(f"ratio DPMFoam/CoReDEM wall time: {rows['DPMFoam'][0] / rows['CoReDEM'][0]:.2f}  "
+              f"(CPU time: {rows['DPMFoam'][1] / rows['CoReDEM'][1]:.2f})")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
