@@ -3,6 +3,7 @@
 #include <coredem/orchestrator/verify.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -597,8 +598,8 @@ std::string jsonNumber(double v) {
     return "null";
   }
   char b[32];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
+  const auto r = std::to_chars(b, b + sizeof b, v); // shortest text that reads back exactly
+  return std::string(b, r.ptr);
 }
 
 void writeSummary(const fs::path& file, const std::vector<Metric>& ms, bool allPass) {

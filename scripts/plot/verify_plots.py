@@ -5,8 +5,9 @@ Usage: verify_plots.py DIR [--dpi N]
 
 Reads DIR/<case>/verify.csv (written by `coredem verify`: a comment line
 "# case=...;family=...;quantity=...", a header with t, sim:X / ref:X pairs and error columns)
-and writes one figure per family to DIR/plots/<family>.png: on the left the simulated values
-(markers) over the analytic solution (lines), on the right the relative error against time.
+and writes one figure per family to DIR/plots/<family>.png: the simulated values (markers)
+over the analytic solution (lines), seed variants and MFiX cases in separate panels, and the
+error against time.
 """
 import argparse
 import csv
@@ -43,37 +44,48 @@ def thin(xs, n=60):
     return list(range(0, len(xs), k))
 
 
-def plot_family(family, cases, out, dpi):
-    reaction = family == "reaction"
-    fig, (ax, axe) = plt.subplots(1, 2, figsize=(11, 4.4))
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    for ci, (name, cols) in enumerate(sorted(cases.items())):
+def draw_curves(ax, cases, colours, reaction, title):
+    for ci, (name, cols) in cases:
         t = cols["t"]
         idx = thin(t)
         colour = colours[ci % len(colours)]
-        quantities = [h[4:] for h in cols if h.startswith("sim:")]
-        if reaction:
-            quantities = ["m"]
+        quantities = ["m"] if reaction else [h[4:] for h in cols if h.startswith("sim:")]
         for qi, q in enumerate(quantities):
-            label = f"{name}" if qi == 0 else None
-            ax.plot(t, cols["ref:" + q], "-", color=colour, lw=1.0, label=label)
+            ax.plot(t, cols["ref:" + q], "-", color=colour, lw=1.0, label=name if qi == 0 else None)
             ax.plot([t[i] for i in idx], [cols["sim:" + q][i] for i in idx],
                     "o" if qi == 0 else "s", ms=3, mfc="none", color=colour)
-        err = [max(e, 1e-18) for e in cols["error"]]
-        axe.semilogy(t, err, "-", color=colour, lw=1.0, label=name)
-        if reaction and "fraction_error" in cols:
-            axe.semilogy(t, [max(e, 1e-18) for e in cols["fraction_error"]], "--", color=colour,
-                         lw=1.0, label=name + " (mass fractions, absolute)")
     ax.set_xlabel("t (s)")
     ax.set_ylabel("particle mass (kg)" if reaction else "T (K)")
-    ax.set_title("simulation (markers) vs analytic (lines)", fontsize=9)
+    ax.set_title(title, fontsize=9)
+    ax.legend(fontsize=6 if len(cases) > 4 else 7, loc="best")
+
+
+def plot_family(family, cases, out, dpi):
+    """MFiX cases and seed variants in separate panels (their time scales differ), errors last."""
+    reaction = family == "reaction"
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    ordered = list(enumerate(sorted(cases.items())))
+    groups = [("seed variants: simulation (markers), analytic (lines)",
+               [c for c in ordered if not c[1][0].startswith("mfix-")]),
+              ("MFiX case: simulation (markers), analytic (lines)",
+               [c for c in ordered if c[1][0].startswith("mfix-")])]
+    groups = [g for g in groups if g[1]]
+    fig, axes = plt.subplots(1, len(groups) + 1, figsize=(5.2 * (len(groups) + 1), 4.2))
+    for ax, (title, group) in zip(axes, groups):
+        draw_curves(ax, group, colours, reaction, title)
+    axe = axes[-1]
+    for ci, (name, cols) in ordered:
+        colour = colours[ci % len(colours)]
+        pts = [(t, e) for t, e in zip(cols["t"], cols["error"]) if e > 0]
+        axe.semilogy([p[0] for p in pts], [p[1] for p in pts], "-", color=colour, lw=1.0, label=name)
+        if reaction and "fraction_error" in cols:
+            pts = [(t, e) for t, e in zip(cols["t"], cols["fraction_error"]) if e > 0]
+            axe.semilogy([p[0] for p in pts], [p[1] for p in pts], "--", color=colour, lw=1.0,
+                         label=name + " (mass fractions, absolute)")
     axe.set_xlabel("t (s)")
-    axe.set_ylabel("relative error")
+    axe.set_ylabel("relative error" + (" (mass); absolute (fractions)" if reaction else ""))
     axe.set_title("error vs time", fontsize=9)
-    n = len(cases)
-    ax.legend(fontsize=6 if n > 4 else 7, loc="best")
-    if n <= 6:
-        axe.legend(fontsize=6, loc="best")
+    axe.legend(fontsize=6, loc="best")
     fig.suptitle(TITLES.get(family, family), fontsize=10)
     fig.tight_layout()
     path = os.path.join(out, f"{family}.png")

@@ -1,6 +1,6 @@
 // Case-file additions of the verification cases (docs/case-schema.md): explicit particle
 // positions, the forced DEM step time.dt_dem, and the DEM option motion: frozen (held particles).
-#include <cfloat>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 
@@ -149,8 +149,6 @@ TEST(CaseAdditions, FrozenMotionHoldsParticles) {
   ASSERT_EQ(after.count, 2u);
   for (std::size_t i = 0; i < after.count; ++i) {
     for (int d = 0; d < 3; ++d) {
-      const std::size_t k = 3 * std::size_t(after.globalId[i]) + std::size_t(d);
-      (void)k;
       EXPECT_EQ(after.velocity[3 * i + d], 0.0);
       EXPECT_EQ(after.angularVelocity[3 * i + d], 0.0);
     }
