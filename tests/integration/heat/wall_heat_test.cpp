@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 using namespace coredem::dem;
@@ -55,6 +57,12 @@ double massHeatCapacity() { return kRho * M_PI * kD * kD * kD / 6.0 * kCp; }
 
 double onlyTemperature(const DemSystem& s) { return s.particles().temperature[0]; }
 
+std::string sci(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g", v);
+  return b;
+}
+
 } // namespace
 
 // No gas: contact conduction only, G = 4 kp kw/(kp + kw) r_c, explicit Euler
@@ -87,8 +95,8 @@ TEST(WallHeat, BeadOnHotWallHeatsAtTheKernelRate) {
   EXPECT_GT(gain, 0.0);
   EXPECT_NEAR(sys.heatTotals().wall, gain, 1e-12 * e0);
   EXPECT_EQ(sys.heatTotals().convection, 0.0);
-  RecordProperty("wall_rate_per_s", std::to_string(rate));
-  RecordProperty("wall_max_error_vs_euler_K", std::to_string(worstDiscrete));
+  RecordProperty("wall_rate_per_s", sci(rate));
+  RecordProperty("wall_max_error_vs_euler_K", sci(worstDiscrete));
 }
 
 // Adiabatic walls (temperature 0, the default) and fixed-temperature walls with both wall
@@ -134,5 +142,5 @@ TEST(WallHeat, CoupledWallLensAddsToContact) {
   EXPECT_NEAR(onlyTemperature(sys), want, 1e-11);
   EXPECT_GT(onlyTemperature(sys) - kT0, 0.1);
   EXPECT_NEAR(sys.heatTotals().wall, sys.thermalEnergy() - e0, 1e-12 * e0);
-  RecordProperty("wall_lens_share", std::to_string(lensShare));
+  RecordProperty("wall_lens_share", sci(lensShare));
 }
