@@ -98,8 +98,8 @@ def main():
     for inv, rate in SEED.items():
         if not any(l.startswith(inv) for l, *_ in runs):
             continue
-        ax.plot(tt, T0_C - rate * tt, color=colors[inv], lw=6, alpha=0.15,
-                label=f"seed trend {inv} (90 − {rate} t °C, ±3 °C)")
+        ax.fill_between(tt, T0_C - rate * tt - 3.0, T0_C - rate * tt + 3.0, color=colors[inv], alpha=0.12,
+                        label=f"seed trend {inv}: 90 − {rate} t °C ± 3 °C")
     rows = []
     for label, d, ts, cn in runs:
         inv = "125g" if label.startswith("125g") else "75g"
@@ -131,7 +131,7 @@ def main():
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="lower left")
     ax.set_xlim(0, max(tmax, 1e-3))
-    lo = min(min(r["Tend"] for r in rows), min(T0_C - SEED[k] * tmax for k in SEED)) - 2
+    lo = min(min(r["Tend"] for r in rows), min(T0_C - SEED[k] * tmax for k in SEED) - 3) - 1
     ax.set_ylim(lo, T0_C + 1)
     fig.tight_layout()
     out1 = os.path.join(args.out, "patil_temperature.png")
