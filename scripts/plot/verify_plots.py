@@ -44,18 +44,23 @@ def thin(xs, n=60):
     return list(range(0, len(xs), k))
 
 
-def draw_curves(ax, cases, colours, reaction, title):
+def draw_curves(ax, cases, colours, reaction, title, fractions=False):
+    markers = "os^v"
     for ci, (name, cols) in cases:
         t = cols["t"]
         idx = thin(t)
         colour = colours[ci % len(colours)]
-        quantities = ["m"] if reaction else [h[4:] for h in cols if h.startswith("sim:")]
+        quantities = [h[4:] for h in cols if h.startswith("sim:")]
+        if reaction:
+            quantities = [q for q in quantities if q.startswith("X_") == fractions]
         for qi, q in enumerate(quantities):
-            ax.plot(t, cols["ref:" + q], "-", color=colour, lw=1.0, label=name if qi == 0 else None)
+            c = colours[(ci + qi) % len(colours)] if fractions else colour
+            label = q if fractions else (name if qi == 0 else None)
+            ax.plot(t, cols["ref:" + q], "-", color=c, lw=1.0, label=label)
             ax.plot([t[i] for i in idx], [cols["sim:" + q][i] for i in idx],
-                    "o" if qi == 0 else "s", ms=3, mfc="none", color=colour)
+                    markers[qi % len(markers)], ms=3, mfc="none", color=c)
     ax.set_xlabel("t (s)")
-    ax.set_ylabel("particle mass (kg)" if reaction else "T (K)")
+    ax.set_ylabel("mass fraction" if fractions else ("particle mass (kg)" if reaction else "T (K)"))
     ax.set_title(title, fontsize=9)
     ax.legend(fontsize=6 if len(cases) > 4 else 7, loc="best")
 
@@ -70,9 +75,14 @@ def plot_family(family, cases, out, dpi):
               ("MFiX case: simulation (markers), analytic (lines)",
                [c for c in ordered if c[1][0].startswith("mfix-")])]
     groups = [g for g in groups if g[1]]
+    if reaction:  # particle mass and the solid mass fractions (seed Figs. 11-12)
+        groups = [("particle mass: simulation (markers), analytic (lines)", ordered, False),
+                  ("solid mass fractions: simulation (markers), analytic (lines)", ordered, True)]
+    else:
+        groups = [(title, group, False) for title, group in groups]
     fig, axes = plt.subplots(1, len(groups) + 1, figsize=(5.2 * (len(groups) + 1), 4.2))
-    for ax, (title, group) in zip(axes, groups):
-        draw_curves(ax, group, colours, reaction, title)
+    for ax, (title, group, fractions) in zip(axes, groups):
+        draw_curves(ax, group, colours, reaction, title, fractions)
     axe = axes[-1]
     for ci, (name, cols) in ordered:
         colour = colours[ci % len(colours)]
