@@ -587,8 +587,14 @@ std::string jsonString(const std::string& s) {
   for (char ch : s) {
     if (ch == '"' || ch == '\\') {
       out += '\\';
+      out += ch;
+    } else if (static_cast<unsigned char>(ch) < 0x20) {
+      char b[8];
+      std::snprintf(b, sizeof b, "\\u%04x", static_cast<unsigned>(ch));
+      out += b;
+    } else {
+      out += ch;
     }
-    out += ch;
   }
   return out + "\"";
 }
@@ -708,7 +714,7 @@ int runVerify(const VerifyOptions& options) {
     spdlog::set_level(spdlog::level::warn);
   }
   std::vector<Metric> metrics;
-  std::vector<std::string> skipped, failedRuns;
+  std::vector<std::string> skipped;
   const auto tAll = Clock::now();
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const CaseSpec& spec = cases[i];
@@ -752,9 +758,8 @@ int runVerify(const VerifyOptions& options) {
         quantity = "m (kg)";
       }
       writeSeries(runDir / "verify.csv", spec, quantity, series);
-    } catch (const UserError& e) {
+    } catch (const std::exception& e) { // UserError, or a malformed value (YAML, number)
       ms = {{spec.name, std::string("run: ") + e.what(), std::nan(""), spec.tolerance, false}};
-      failedRuns.push_back(spec.name);
     }
     const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
     bool pass = true;
