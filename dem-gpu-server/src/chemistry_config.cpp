@@ -262,3 +262,62 @@ std::size_t removeSmallParticles(double removalFraction, HostState& st, Chemistr
 }
 
 } // namespace coredem::dem
+
+namespace coredem::dem {
+namespace {
+
+struct KineticEntry {
+  const char* name;
+  double* (*field)(ClgOptions&);
+};
+
+const KineticEntry kKinetics[] = {
+    {"A_CO2", [](ClgOptions& c) { return &c.charParams.aCO2; }},
+    {"E_CO2", [](ClgOptions& c) { return &c.charParams.eCO2; }},
+    {"K_CO2", [](ClgOptions& c) { return &c.charParams.kCO2.k0; }},
+    {"dH_CO2", [](ClgOptions& c) { return &c.charParams.kCO2.dHads; }},
+    {"K_CO", [](ClgOptions& c) { return &c.charParams.kCO.k0; }},
+    {"dH_CO", [](ClgOptions& c) { return &c.charParams.kCO.dHads; }},
+    {"A_H2O", [](ClgOptions& c) { return &c.charParams.aH2O; }},
+    {"E_H2O", [](ClgOptions& c) { return &c.charParams.eH2O; }},
+    {"K_H2O", [](ClgOptions& c) { return &c.charParams.kH2O.k0; }},
+    {"dH_H2O", [](ClgOptions& c) { return &c.charParams.kH2O.dHads; }},
+    {"K_H2", [](ClgOptions& c) { return &c.charParams.kH2.k0; }},
+    {"dH_H2", [](ClgOptions& c) { return &c.charParams.kH2.dHads; }},
+    {"rho_m", [](ClgOptions& c) { return &c.ocParams.rhoMolar; }},
+    {"r_grain", [](ClgOptions& c) { return &c.ocParams.grainRadius; }},
+    {"k0_CO", [](ClgOptions& c) { return &c.ocParams.k0CO; }},
+    {"E_CO", [](ClgOptions& c) { return &c.ocParams.eCO; }},
+    {"n_CO", [](ClgOptions& c) { return &c.ocParams.nCO; }},
+    {"k0_H2", [](ClgOptions& c) { return &c.ocParams.k0H2; }},
+    {"E_H2", [](ClgOptions& c) { return &c.ocParams.eH2; }},
+    {"n_H2", [](ClgOptions& c) { return &c.ocParams.nH2; }},
+    {"kf0", [](ClgOptions& c) { return &c.wgsParams.kf0; }},
+    {"Ef_over_R", [](ClgOptions& c) { return &c.wgsParams.efOverR; }},
+};
+
+} // namespace
+
+const std::vector<std::string>& clgKineticNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> v;
+    for (const KineticEntry& e : kKinetics) v.emplace_back(e.name);
+    return v;
+  }();
+  return names;
+}
+
+void setClgKinetic(ClgOptions& clg, const std::string& name, double value) {
+  for (const KineticEntry& e : kKinetics) {
+    if (name == e.name) {
+      COREDEM_CHECK(std::isfinite(value), "chemistry.clg.{} = {} is not a finite number", name, value);
+      *e.field(clg) = value;
+      return;
+    }
+  }
+  std::string all;
+  for (const std::string& n : clgKineticNames()) all += (all.empty() ? "" : ", ") + n;
+  throw UserError("chemistry.clg." + name + ": unknown kinetic parameter; allowed: " + all);
+}
+
+} // namespace coredem::dem

@@ -181,6 +181,7 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
     kv->set_value(v);
   }
   cfg.set_output_directory(fs::absolute(runDir).string());
+  addChemistryToConfigure(c, cfg);  // v1.1: solid species, reactions, chemistry
   return cfg;
 }
 
@@ -392,6 +393,15 @@ void Session::startDem() {
              welcome.envelope().welcome().software_version(),
              welcome.envelope().welcome().protocol_major(),
              welcome.envelope().welcome().protocol_minor());
+  // Chemistry travels in Configure fields of protocol v1.1, which a v1.0 server would ignore.
+  if (_c.usesChemistry() && welcome.envelope().welcome().protocol_minor() < 1) {
+    throw ParticipantFault(
+        kDemName, fmt::format("the DEM server speaks protocol {}.{}, but this case uses chemistry "
+                              "(solid_species, reactions or chemistry), which needs protocol 1.1; "
+                              "use a coredem-dem built from this release",
+                              welcome.envelope().welcome().protocol_major(),
+                              welcome.envelope().welcome().protocol_minor()));
+  }
 }
 
 Message Session::receiveFromDem(std::chrono::milliseconds timeout, const std::string& awaited) {

@@ -1,5 +1,8 @@
-// coredem-golden-gen DIR: writes one golden multipart message per message type of protocol
-// v1.0 into DIR (protocol/golden/v1.0). The files are committed and never regenerated for a
+// coredem-golden-gen DIR [MINOR]: writes one golden multipart message per message type of
+// protocol v1.MINOR (default 0) into DIR (protocol/golden/v1.0, protocol/golden/v1.1). The
+// messages of v1.1 are those of v1.0 plus the v1.1 fields (Welcome agreed minor 1; Configure
+// with an explicitly placed particle set, the frozen-motion option, solid species, a reaction
+// and the chemistry switches). The files are committed and never regenerated for a
 // released version: tests/unit/protocol/golden_test.cpp decodes them with the current code
 // forever and checks every value written below. Container format: multipart_file.h.
 #include <coredem/protocol/fields.h>
@@ -7,6 +10,8 @@
 #include <coredem/protocol/multipart_file.h>
 
 #include <cstdio>
+#include <cstdlib>
+#include <utility>
 #include <filesystem>
 
 using namespace coredem::protocol;
@@ -108,6 +113,58 @@ v1::Configure goldenConfigure() {
   return c;
 }
 
+/// v1.1 additions to the golden Configure (tests/unit/protocol/golden_v1_1_test.cpp checks them).
+void addV11(v1::Configure& c) {
+  // Verification-case additions: explicit positions, frozen motion (options), forced dt_dem.
+  auto* p = c.add_particle_sets();
+  p->set_material_id(1);
+  p->set_count(2);
+  p->set_diameter(3e-3);
+  p->set_temperature(298.15);
+  p->set_packing(v1::PACKING_EXPLICIT);
+  auto* a = p->add_positions();
+  a->set_x(0.25);
+  a->set_y(0.5);
+  a->set_z(1.0);
+  auto* b = p->add_positions();
+  b->set_x(-0.25);
+  b->set_y(0.5);
+  b->set_z(1.0);
+  p->set_name("placed");
+  auto* opt = c.add_options();
+  opt->set_key("motion");
+  opt->set_value("frozen");
+  // Chemistry.
+  for (auto [name, molar] : {std::pair{"Fe2O3", 0.159688}, {"Fe3O4", 0.231533}, {"Al2O3", 0.101961}}) {
+    auto* s = c.add_solid_species();
+    s->set_name(name);
+    s->set_molar_mass(molar);
+  }
+  auto* r = c.add_reactions();
+  r->set_name("oxidation");
+  for (auto [sp, nu] : {std::pair{"Fe3O4", -4.0}, {"O2", -1.0}, {"Fe2O3", 6.0}}) {
+    auto* t = r->add_terms();
+    t->set_species(sp);
+    t->set_nu(nu);
+  }
+  r->mutable_rate()->set_law(v1::RATE_LAW_ARRHENIUS);
+  r->mutable_rate()->set_a(2.5e-3);
+  r->mutable_rate()->set_beta(0.5);
+  r->mutable_rate()->set_activation_energy(8.0e4);
+  r->mutable_rate()->set_order_species("O2");
+  r->mutable_rate()->set_order(1.0);
+  r->set_heat_of_reaction(-4.75e5);
+  auto* ch = c.mutable_chemistry();
+  ch->mutable_clg()->set_char_gasification(false);
+  ch->mutable_clg()->set_oc_reduction(true);
+  ch->mutable_clg()->set_wgs(true);
+  ch->mutable_clg()->set_wgs_equilibrium(v1::WGS_EQUILIBRIUM_THERMODYNAMIC);
+  ch->mutable_clg()->set_char_stoichiometry(v1::CHAR_STOICHIOMETRY_CARBON);
+  addNamedValue(ch->mutable_clg()->mutable_kinetics(), "k0_H2", 1.5e-3);
+  ch->set_removal_fraction(0.125);
+  ch->set_reaction_heat(false);
+}
+
 void addFieldArrays(Message& m, std::span<const fields::FieldSpec> specs) {
   std::size_t f = 0;
   for (const auto& spec : specs) {
@@ -123,8 +180,13 @@ void addFieldArrays(Message& m, std::span<const fields::FieldSpec> specs) {
 } // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: coredem-golden-gen OUTPUT_DIR   (e.g. protocol/golden/v1.0)\n");
+  if (argc != 2 && argc != 3) {
+    std::fprintf(stderr, "usage: coredem-golden-gen OUTPUT_DIR [MINOR]   (e.g. protocol/golden/v1.1 1)\n");
+    return 2;
+  }
+  const int minor = argc == 3 ? std::atoi(argv[2]) : 0;
+  if (minor != 0 && minor != 1) {
+    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0 or 1\n");
     return 2;
   }
   std::filesystem::path dir = argv[1];
@@ -143,7 +205,7 @@ int main(int argc, char** argv) {
     all.emplace_back("hello", std::move(m));
   }
   {
-    Message m = makeWelcome(v1::ROLE_DEM, "coredem-dem 0.1.0", 1, 0, "golden-session");
+    Message m = makeWelcome(v1::ROLE_DEM, "coredem-dem 0.1.0", 1, std::uint32_t(minor), "golden-session");
     m.envelope().mutable_welcome()->add_capabilities("cpu");
     stamp(m, 1);
     all.emplace_back("welcome", std::move(m));
@@ -154,7 +216,11 @@ int main(int argc, char** argv) {
     all.emplace_back("reject", std::move(m));
   }
   {
-    Message m = makeConfigure(goldenConfigure());
+    v1::Configure c = goldenConfigure();
+    if (minor >= 1) {
+      addV11(c);
+    }
+    Message m = makeConfigure(c);
     stamp(m, 2);
     all.emplace_back("configure", std::move(m));
   }

@@ -22,6 +22,54 @@ double parseDouble(const std::string& key, const std::string& value) {
   return v;
 }
 
+void addChemistry(const v1::Configure& c, dem::DemConfig& cfg) {
+  dem::ChemistryOptions& o = cfg.chemistry;
+  for (const auto& r : c.reactions()) {
+    dem::ReactionConfig d;
+    d.name = r.name();
+    for (const auto& t : r.terms()) d.terms.push_back({t.species(), t.nu()});
+    switch (r.rate().law()) {
+    case v1::RATE_LAW_CONSTANT: d.law = dem::kernels::RateLaw::Constant; break;
+    case v1::RATE_LAW_ARRHENIUS: d.law = dem::kernels::RateLaw::Arrhenius; break;
+    default:
+      COREDEM_CHECK(false, "Configure: reaction '{}' has no rate law; use RATE_LAW_CONSTANT or "
+                    "RATE_LAW_ARRHENIUS", r.name());
+    }
+    d.A = r.rate().a();
+    d.beta = r.rate().beta();
+    d.E = r.rate().activation_energy();
+    d.orderSpecies = r.rate().order_species();
+    d.order = r.rate().order();
+    d.heatFromNasa7 = r.heat_case() == v1::Reaction::kHeatFromNasa7 && r.heat_from_nasa7();
+    d.heatOfReaction = r.heat_case() == v1::Reaction::kHeatOfReaction ? r.heat_of_reaction() : 0.0;
+    o.reactions.push_back(std::move(d));
+  }
+  if (c.has_chemistry()) {
+    const auto& ch = c.chemistry();
+    const auto& clg = ch.clg();
+    o.clg.charGasification = clg.char_gasification();
+    COREDEM_CHECK(clg.char_stoichiometry() != v1::CHAR_STOICHIOMETRY_SEED,
+                  "Configure: chemistry.clg.char_stoichiometry = seed is not implemented (the seed's "
+                  "pseudo-char lines of R1 and R2 are not mutually consistent, PHYSICS §6.1); use carbon");
+    o.clg.ocReduction = clg.oc_reduction();
+    o.clg.wgs = clg.wgs();
+    switch (clg.wgs_equilibrium()) {
+    case v1::WGS_EQUILIBRIUM_SEED: o.clg.wgsParams.equilibrium = dem::kernels::WgsEquilibrium::Seed; break;
+    case v1::WGS_EQUILIBRIUM_THERMODYNAMIC:
+      o.clg.wgsParams.equilibrium = dem::kernels::WgsEquilibrium::Thermodynamic;
+      break;
+    default: o.clg.wgsParams.equilibrium = dem::kernels::WgsEquilibrium::YoonDenn; break;
+    }
+    for (const auto& kv : clg.kinetics()) dem::setClgKinetic(o.clg, kv.name(), kv.value());
+    if (ch.has_removal_fraction()) o.removalFraction = ch.removal_fraction();
+    if (ch.has_reaction_heat()) o.reactionHeat = ch.reaction_heat();
+  }
+  // Partial pressures use the gas pressure of the constant gas properties (Pa).
+  if (c.gas().has_constant() && c.gas().constant().pressure() > 0.0) {
+    o.pressure = c.gas().constant().pressure();
+  }
+}
+
 } // namespace
 
 dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* warnings) {
@@ -55,9 +103,23 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
     cfg.gasSpecies.push_back({s.name(), s.molar_mass()});
   }
 
-  // Solid species: the names used in particle compositions, in order of first appearance.
+  // Solid species: v1.1 Configure.solid_species when given (chemistry); else the names used in
+  // particle compositions, in order of first appearance.
   std::vector<std::string> solid;
+  for (const auto& s : c.solid_species()) {
+    COREDEM_CHECK(std::find(solid.begin(), solid.end(), s.name()) == solid.end(),
+                  "Configure: solid species '{}' appears twice", s.name());
+    solid.push_back(s.name());
+  }
   for (const auto& ps : c.particle_sets()) {
+    if (c.solid_species_size() > 0) {
+      for (const auto& nv : ps.composition()) {
+        COREDEM_CHECK(std::find(solid.begin(), solid.end(), nv.name()) != solid.end(),
+                      "Configure: particle set '{}' has composition species '{}', which is not among "
+                      "the solid species", ps.name(), nv.name());
+      }
+      continue;
+    }
     for (const auto& nv : ps.composition()) {
       if (std::find(solid.begin(), solid.end(), nv.name()) == solid.end()) {
         solid.push_back(nv.name());
@@ -66,7 +128,7 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   }
   for (const auto& name : solid) {
     double molar = 0.0;
-    for (const auto& s : c.species()) {
+    for (const auto& s : c.solid_species_size() > 0 ? c.solid_species() : c.species()) {
       if (s.name() == name) {
         molar = s.molar_mass();
       }
@@ -151,6 +213,9 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
     cfg.grid.counts = {static_cast<int>(g.counts().x()), static_cast<int>(g.counts().y()),
                        static_cast<int>(g.counts().z())};
   }
+
+  // Chemistry (v1.1): reactions, CLG models, removal, reaction heat (docs/thermochemistry.md).
+  addChemistry(c, cfg);
 
   // Model options by name.
   for (const auto& kv : c.options()) {

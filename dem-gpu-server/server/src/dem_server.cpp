@@ -581,6 +581,18 @@ struct DemServer::Impl {
       proto::addNamedValue(l.mutable_species(), "dem.species_to_gas." + speciesNames[k] + "_kg",
                            ledgers.speciesToGas[k]);
     }
+    // Chemistry ledgers (docs/thermochemistry.md): solid converted to gas by the particles' reactions
+    // per gas species, reaction heat into the particles, WGS heat into the gas, removed particles.
+    if (system->config().chemistry.active()) {
+      const dem::ChemistryTotals c = system->chemistryTotals();
+      for (std::size_t k = 0; k < speciesNames.size() && k < c.gasProduced.size(); ++k) {
+        proto::addNamedValue(l.mutable_species(), "dem.solid_to_gas." + speciesNames[k] + "_kg",
+                             c.gasProduced[k]);
+      }
+      proto::addNamedValue(l.mutable_mass(), "dem.removed_mass_kg", c.removedMass());
+      proto::addNamedValue(l.mutable_energy(), "dem.reaction_heat_J", c.reactionHeat);
+      proto::addNamedValue(l.mutable_energy(), "dem.homogeneous_heat_J", c.homogeneousHeat);
+    }
     return l;
   }
 

@@ -260,7 +260,7 @@ TEST_F(BadInput, WrongMajorVersionFromTheSessionPeer) {
   Message reply = session.client.request(std::move(hello), kTimeout);
   ASSERT_EQ(reply.type(), v1::MESSAGE_TYPE_REJECT);
   EXPECT_EQ(reply.envelope().reject().code(), v1::ERROR_CODE_VERSION);
-  EXPECT_NE(reply.envelope().reject().reason().find("1.0"), std::string::npos);
+  EXPECT_NE(reply.envelope().reject().reason().find(kProtocolVersion.toString()), std::string::npos);
   EXPECT_NE(reply.envelope().reject().reason().find("2.0"), std::string::npos);
   expectStillServing(); // the existing session is untouched
 }

@@ -101,7 +101,7 @@ def main():
             hello.hello.role = common.ROLE_CFD
             welcome, _ = request(hello)
             assert welcome.type == common.MESSAGE_TYPE_WELCOME
-            assert welcome.welcome.protocol_minor == 0
+            assert welcome.welcome.protocol_minor == 1  # min(server 1.1, client 1.7)
             session = welcome.welcome.session_id
 
             nx, ny, nz, ns = 4, 3, 2, 2

@@ -28,7 +28,10 @@ TEST(Version, OtherMajorIsRejectedNamingBothVersions) {
   EXPECT_NE(n.status.message.find("0.9"), std::string::npos);
 }
 
-TEST(Version, ThisBuildSpeaksOneDotZero) {
-  EXPECT_EQ(kProtocolVersion, (Version{1, 0}));
-  EXPECT_EQ(kProtocolVersion.toString(), "1.0");
+TEST(Version, ThisBuildSpeaksOneDotOne) {
+  // v1.1: chemistry in Configure (solid species, reactions, chemistry), explicit positions.
+  EXPECT_EQ(kProtocolVersion, (Version{1, 1}));
+  EXPECT_EQ(kProtocolVersion.toString(), "1.1");
+  // With a v1.0 peer the agreed version is 1.0.
+  EXPECT_EQ(negotiate(kProtocolVersion, {1, 0}).agreed, (Version{1, 0}));
 }

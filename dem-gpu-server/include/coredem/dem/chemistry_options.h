@@ -60,6 +60,13 @@ struct ChemistryOptions {
   bool active() const { return !reactions.empty() || clg.charGasification || clg.ocReduction || clg.wgs; }
 };
 
+/// Names of the CLG kinetic overrides (case.yaml chemistry.clg.<name>): char A_CO2, E_CO2, K_CO2,
+/// dH_CO2, K_CO, dH_CO, A_H2O, E_H2O, K_H2O, dH_H2O, K_H2, dH_H2; oxygen carrier rho_m, r_grain,
+/// k0_CO, E_CO, n_CO, k0_H2, E_H2, n_H2; WGS kf0, Ef_over_R. Units as in the kernel parameter structs.
+const std::vector<std::string>& clgKineticNames();
+/// Sets one override; UserError naming the allowed names when `name` is unknown or the value not finite.
+void setClgKinetic(ClgOptions& clg, const std::string& name, double value);
+
 /// Chemistry ledgers since construction (kept across writeState/readState).
 struct ChemistryTotals {
   std::vector<double> gasProduced;   ///< kg per gas species released by particles (< 0: taken up), DemConfig::gasSpecies order

@@ -15,6 +15,10 @@
 #include <coredem/common/check.h>
 #include <coredem/orchestrator/time_handler.h>
 
+namespace coredem::v1 {
+class Configure;
+}
+
 namespace coredem::orchestrator {
 
 /// A case file that does not follow the schema (or a file it names that is missing).
@@ -98,6 +102,37 @@ struct OutputConfig {
   std::int64_t timeseriesEvery = 1; ///< steps between timeseries rows
 };
 
+/// One term of a reaction (case.yaml reactions[].terms[]): a gas or solid species and ν.
+struct ReactionTermConfig {
+  std::string species;
+  double nu = 0.0; ///< mol per mol of reaction, < 0 reactant
+};
+
+/// A heterogeneous reaction defined by data (docs/case-schema.md "reactions").
+struct ReactionConfig {
+  std::string name;
+  std::vector<ReactionTermConfig> terms;
+  std::string law = "constant"; ///< constant | arrhenius
+  double A = 0.0, beta = 0.0, E = 0.0;
+  std::string orderSpecies;     ///< arrhenius: gas species of the concentration factor (empty: none)
+  double order = 0.0;
+  double heatOfReaction = 0.0;  ///< J/mol (> 0 endothermic)
+  bool heatFromNasa7 = false;   ///< heat_of_reaction: nasa7
+};
+
+/// Built-in models and switches (docs/case-schema.md "chemistry").
+struct ChemistryConfig {
+  bool present = false;                  ///< the case has a chemistry section
+  bool charGasification = false;         ///< clg.char_gasification
+  std::string charStoichiometry = "carbon";
+  bool ocReduction = false;              ///< clg.oc_reduction
+  bool wgs = false;                      ///< clg.wgs
+  std::string wgsEquilibrium = "yoon_denn";
+  std::vector<std::pair<std::string, double>> kinetics; ///< clg kinetic overrides by name
+  std::optional<double> removalFraction; ///< default 0.1
+  std::optional<bool> reactionHeat;      ///< default on
+};
+
 /// A validated case.
 struct CaseConfig {
   std::filesystem::path caseDir;  ///< absolute
@@ -124,6 +159,12 @@ struct CaseConfig {
   CheckpointConfig checkpoint;
   OutputConfig output;
   bool hasGasSection = false;
+  // Chemistry (protocol v1.1; docs/thermochemistry.md).
+  std::vector<SpeciesConfig> solidSpecies; ///< particle species (composition columns)
+  std::vector<ReactionConfig> reactions;
+  ChemistryConfig chemistry;
+  /// True when the case uses chemistry (solid_species, reactions or chemistry): needs a v1.1 server.
+  bool usesChemistry() const { return !solidSpecies.empty() || !reactions.empty() || chemistry.present; }
 };
 
 /// Loads and validates CASE_DIR/case.yaml (or a file path). Throws CaseError.
@@ -132,6 +173,10 @@ CaseConfig loadCase(const std::filesystem::path& caseDirOrFile);
 /// Parses case text as if read from `file` (relative paths resolve against `caseDir`).
 CaseConfig parseCase(const std::string& text, const std::filesystem::path& file,
                      const std::filesystem::path& caseDir);
+
+/// Adds the chemistry of `config` (solid species, reactions, chemistry) to a Configure (v1.1 fields).
+/// Defined in case_chemistry.cpp (library coredem::orchestrator, which links the protocol).
+void addChemistryToConfigure(const CaseConfig& config, v1::Configure& configure);
 
 /// Index of a material by name, or -1.
 int materialIndex(const CaseConfig& config, const std::string& name);

@@ -19,7 +19,7 @@ struct Version {
 };
 
 /// The version this build speaks.
-inline constexpr Version kProtocolVersion{1, 0};
+inline constexpr Version kProtocolVersion{1, 1};
 
 /// Outcome of a handshake.
 struct Negotiation {
