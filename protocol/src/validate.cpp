@@ -291,6 +291,45 @@ Status validateConfigure(const v1::Configure& c) {
                  " kg/mol; it must be > 0 (e.g. 0.044 for CO2)");
     }
   }
+  // v1.1 chemistry: solid species, reactions, switches (the DEM server checks the species
+  // references and the models' needs when it builds the system).
+  for (const auto& s : c.solid_species()) {
+    if (s.name().empty() || !names.insert(s.name()).second) {
+      return bad("solid_species name '" + s.name() + "' is empty or repeated (also among the gas "
+                 "species); names must be unique");
+    }
+    if (!(s.molar_mass() > 0) || !std::isfinite(s.molar_mass())) {
+      return bad("solid_species '" + s.name() + "' has molar_mass " + std::to_string(s.molar_mass()) +
+                 " kg/mol; it must be > 0");
+    }
+  }
+  for (const auto& r : c.reactions()) {
+    if (r.terms_size() < 1 || r.terms_size() > 6) {
+      return bad("reaction '" + r.name() + "' has " + std::to_string(r.terms_size()) +
+                 " terms; give 1 to 6");
+    }
+    for (const auto& t : r.terms()) {
+      if (!(t.nu() != 0.0) || !std::isfinite(t.nu())) {
+        return bad("reaction '" + r.name() + "': term '" + t.species() + "' needs a finite nonzero nu");
+      }
+    }
+    if (r.rate().law() != v1::RATE_LAW_CONSTANT && r.rate().law() != v1::RATE_LAW_ARRHENIUS) {
+      return bad("reaction '" + r.name() + "': rate.law must be RATE_LAW_CONSTANT or RATE_LAW_ARRHENIUS");
+    }
+    if (!(r.rate().a() >= 0.0) || !std::isfinite(r.rate().a()) || !std::isfinite(r.rate().beta()) ||
+        !(r.rate().activation_energy() >= 0.0) || !std::isfinite(r.rate().activation_energy()) ||
+        !std::isfinite(r.rate().order())) {
+      return bad("reaction '" + r.name() + "': rate needs finite a >= 0, beta, activation_energy >= 0, order");
+    }
+    if (r.heat_case() == v1::Reaction::kHeatOfReaction && !std::isfinite(r.heat_of_reaction())) {
+      return bad("reaction '" + r.name() + "': heat_of_reaction is not finite");
+    }
+  }
+  if (c.has_chemistry() && c.chemistry().has_removal_fraction() &&
+      !(c.chemistry().removal_fraction() > 0.0 && c.chemistry().removal_fraction() < 1.0)) {
+    return bad("chemistry.removal_fraction = " + std::to_string(c.chemistry().removal_fraction()) +
+               " must be in (0, 1)");
+  }
   const auto& sc = c.sub_cycling();
   if (!(sc.dt_cfd() > 0) || sc.n_sub() == 0 || !(sc.dt_dem() > 0)) {
     return bad("sub_cycling needs dt_cfd > 0, n_sub >= 1 and dt_dem > 0");

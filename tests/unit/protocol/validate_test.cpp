@@ -275,3 +275,42 @@ TEST(ValidateConfigure, RejectsInconsistentCases) {
   c.set_initial_state_file("state.h5");
   EXPECT_TRUE(validateConfigure(c).ok());
 }
+
+TEST(ValidateConfigure, ChecksTheChemistryFieldsOfV11) {
+  auto withReaction = [] {
+    v1::Configure c = validConfigure();
+    auto* s = c.add_solid_species();
+    s->set_name("B");
+    s->set_molar_mass(0.015);
+    auto* r = c.add_reactions();
+    r->set_name("rc");
+    auto* t = r->add_terms();
+    t->set_species("B");
+    t->set_nu(-1.0);
+    r->mutable_rate()->set_law(v1::RATE_LAW_CONSTANT);
+    r->mutable_rate()->set_a(1e-4);
+    c.mutable_chemistry()->set_removal_fraction(0.1);
+    return c;
+  };
+  EXPECT_TRUE(validateConfigure(withReaction()).ok()) << validateConfigure(withReaction()).message;
+  auto expectBad = [](const v1::Configure& c, const std::string& needle) {
+    Status s = validateConfigure(c);
+    EXPECT_EQ(s.code, v1::ERROR_CODE_INVALID_CONFIGURATION) << needle;
+    EXPECT_NE(s.message.find(needle), std::string::npos) << s.message;
+  };
+  v1::Configure c = withReaction();
+  c.mutable_solid_species(0)->set_molar_mass(0.0);
+  expectBad(c, "solid_species 'B'");
+  c = withReaction();
+  c.mutable_solid_species(0)->set_name(c.species(0).name());
+  expectBad(c, "repeated");
+  c = withReaction();
+  c.mutable_reactions(0)->mutable_terms(0)->set_nu(0.0);
+  expectBad(c, "nonzero nu");
+  c = withReaction();
+  c.mutable_reactions(0)->mutable_rate()->set_law(v1::RATE_LAW_UNSPECIFIED);
+  expectBad(c, "rate.law");
+  c = withReaction();
+  c.mutable_chemistry()->set_removal_fraction(1.5);
+  expectBad(c, "removal_fraction");
+}
