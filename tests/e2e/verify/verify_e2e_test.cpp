@@ -1,5 +1,5 @@
 // End-to-end tests of `coredem verify` (docs/verification.md) with the real coredem-dem and
-// coredem-gas. The full suite takes several minutes on 2 cores, so the pass test runs one
+// coredem-gas. The full suite takes about 10 minutes on 2 cores, so the pass test runs one
 // case per family copied from cases/verification with a shorter end time (the tolerances,
 // geometry, properties and steps are those of the committed cases); the fail test gives the
 // contact case a tolerance it cannot meet (1e-12) in a test-only folder.
@@ -69,6 +69,7 @@ TEST_F(VerifyE2E, OneCasePerFamilyPasses) {
   copyCase("lens-touching-smin4e-10", "5.0");      // 2.5e5 sub-steps, tolerance 1.5e-6
   copyCase("mfix-convection-ranz-marshall", "2.0"); // 2e5 sub-steps, tolerance 1e-6
   copyCase("mfix-radiation", "20.0");              // 4e5 sub-steps, tolerance 2e-7 vs RK4
+  copyCase("mfix-reactive-chemistry", "2.0");      // as committed: B runs out at 1.5 s
   const int rc = verify({"--cases", (dir / "cases").string(), "--out", (dir / "out").string()},
                         240s);
   const std::string log = readAll(dir / "v.log");
@@ -81,6 +82,12 @@ TEST_F(VerifyE2E, OneCasePerFamilyPasses) {
     EXPECT_TRUE(e[0].second && e[1].second) << name;
     EXPECT_NE(e[1].first.find("energy"), std::string::npos);
   }
+  {
+    const auto e = entries(json, "mfix-reactive-chemistry");
+    ASSERT_EQ(e.size(), 2u) << json; // particle mass + mass fractions
+    EXPECT_TRUE(e[0].second && e[1].second);
+    EXPECT_NE(e[1].first.find("mass fractions"), std::string::npos);
+  }
   for (const char* name : {"mfix-convection-ranz-marshall", "mfix-radiation"}) {
     const auto e = entries(json, name);
     ASSERT_EQ(e.size(), 1u) << name << "\n" << json;
@@ -90,12 +97,13 @@ TEST_F(VerifyE2E, OneCasePerFamilyPasses) {
   const std::string csv = readAll(dir / "out" / "mfix-radiation" / "verify.csv");
   EXPECT_EQ(csv.rfind("# case=mfix-radiation;family=radiation;", 0), 0u) << csv.substr(0, 80);
   EXPECT_NE(csv.find("t,sim:T1,ref:T1,sim:T2,ref:T2,error"), std::string::npos);
-  for (const char* family : {"contact-conduction", "gas-lens", "convection", "radiation"}) {
+  for (const char* family :
+       {"contact-conduction", "gas-lens", "convection", "radiation", "reaction"}) {
     EXPECT_TRUE(fs::exists(dir / "out" / "plots" / (std::string(family) + ".png")))
         << family << "\n" << readAll(dir / "out" / "plot.log");
   }
-  // The table: 2 + 2 + 1 + 1 comparisons.
-  EXPECT_NE(log.find("6 comparisons, all pass"), std::string::npos) << log;
+  // The table: 2 + 2 + 1 + 1 + 2 comparisons.
+  EXPECT_NE(log.find("8 comparisons, all pass; 0 skipped"), std::string::npos) << log;
 }
 
 TEST_F(VerifyE2E, FailedComparisonExitsNonZero) {
