@@ -15,7 +15,8 @@
 #   KEEP_DIR       keep both cases, runs and logs here               (default: a temp dir, removed)
 #   SEED           seed of the start positions' jitter               (default: 1)
 #   ONLY           dpmfoam or coredem: run one code only             (default: both)
-#   TIMERS         1: cfd/dem timers on in our case (figures in the run folder)
+#   TIMERS         1: `coredem run --timers` (per-stage timers of both participants,
+#                  timers-cfd.json / timers-dem.json in the run folder)
 #
 # Exit status: 0 both ran; 2 bad usage, a program missing or DPMFoam failed; 3 CoReDEM failed.
 set -euo pipefail
@@ -67,7 +68,7 @@ echo "machine: $(nproc) cores visible, ${cpu_model:-unknown CPU}; load average b
 
 timer_flag=()
 [[ "$TIMERS" == 1 ]] && timer_flag=(--timers)
-python3 "$here/make_case.py" "$N" "$SIM" "$work" --seed "$SEED" "${timer_flag[@]}" >"$work/parameters.txt" ||
+python3 "$here/make_case.py" "$N" "$SIM" "$work" --seed "$SEED" >"$work/parameters.txt" ||
   die "make_case.py failed for N=$N SIM_SECONDS=$SIM"
 sed 's/^/  /' "$work/parameters.txt"
 (cd "$work/dpmfoam" && blockMesh >log.blockMesh 2>&1) || die "blockMesh failed: $work/dpmfoam/log.blockMesh"
@@ -89,7 +90,7 @@ if [[ "$ONLY" != dpmfoam ]]; then
   rm -rf "$work/coredem-run"
   rc=0
   /usr/bin/time -f '%e %U %S' -o "$work/coredem.time.txt" timeout "$RUN_TIMEOUT" \
-    "$BUILD_DIR/bin/coredem" run "$work/coredem" --out "$work/coredem-run" --no-plots \
+    "$BUILD_DIR/bin/coredem" run "$work/coredem" --out "$work/coredem-run" --no-plots "${timer_flag[@]}" \
     >"$work/coredem.log" 2>&1 || rc=$?
   if [[ $rc -ne 0 ]]; then
     tail -n 20 "$work/coredem.log" >&2 || true

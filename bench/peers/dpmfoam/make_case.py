@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write the fluidized bed of the DPMFoam peer comparison for both codes.
 
-    make_case.py N SIM_SECONDS OUTDIR [--seed S] [--timers]
+    make_case.py N SIM_SECONDS OUTDIR [--seed S]
 
 writes
 
@@ -403,7 +403,7 @@ cloudFunctions {{}}
 """)
 
 
-def write_coredem(out, n, sim, wi, pos, timers):
+def write_coredem(out, n, sim, wi, pos):
     c = os.path.join(out, "coredem")
     o = os.path.join(c, "openfoam")
     foam(f"{o}/system/blockMeshDict", n, "dictionary", "system", "blockMeshDict",
@@ -531,15 +531,11 @@ boundaryField
         "  participant: coredemFoam",
         "  case: openfoam",
     ]
-    if timers:
-        lines.append("  timers: true")
     lines += [
         "dem:",
         "  backend: cpu",
         "  threads: 2",
     ]
-    if timers:
-        lines.append("  timers: true")
     lines += [
         "checkpoint:",
         "  every_steps: 0",
@@ -555,7 +551,6 @@ def main():
     ap.add_argument("sim_seconds", type=float)
     ap.add_argument("outdir")
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--timers", action="store_true", help="cfd/dem timers: true in case.yaml")
     a = ap.parse_args()
     if a.n < 1:
         sys.exit("make_case.py: N must be >= 1")
@@ -567,7 +562,7 @@ def main():
     for sub in ("dpmfoam", "coredem"):
         shutil.rmtree(os.path.join(a.outdir, sub), ignore_errors=True)
     write_dpmfoam(a.outdir, a.n, a.sim_seconds, wi, pos, par)
-    write_coredem(a.outdir, a.n, a.sim_seconds, wi, pos, a.timers)
+    write_coredem(a.outdir, a.n, a.sim_seconds, wi, pos)
     bed_weight = a.n * par["mass"] * G / (BOX[0] * BOX[2])
     print(f"N = {a.n}")
     print(f"sim_seconds = {a.sim_seconds}")

@@ -9,6 +9,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <optional>
 #include <set>
 
 namespace coredem::client {
@@ -45,28 +47,27 @@ const char* stateName(State s) {
 }
 
 ConstView Sources::field(const std::string& name) const {
+  if (const auto v = views.find(name); v != views.end()) {
+    return v->second;
+  }
   const auto it = arrays.find(name);
   if (it == arrays.end()) {
-    throw ClientError(ErrorCode::Argument,
-                      "Sources: no array '" + name + "' (D sent: " +
-                          [&] {
-                            std::string s;
-                            for (const auto& kv : arrays) s += (s.empty() ? "" : ", ") + kv.first;
-                            return s;
-                          }() +
-                          ")");
+    std::string sent;
+    for (const auto& n : names()) sent += (sent.empty() ? "" : ", ") + n;
+    throw ClientError(ErrorCode::Argument, "Sources: no array '" + name + "' (D sent: " + sent + ")");
   }
   return ConstView(it->second.data(), it->second.size());
 }
 
-bool Sources::has(const std::string& name) const { return arrays.count(name) == 1; }
+bool Sources::has(const std::string& name) const {
+  return views.count(name) == 1 || arrays.count(name) == 1;
+}
 
 std::vector<std::string> Sources::names() const {
-  std::vector<std::string> n;
-  for (const auto& kv : arrays) {
-    n.push_back(kv.first);
-  }
-  return n;
+  std::set<std::string> n;
+  for (const auto& kv : views) n.insert(kv.first);
+  for (const auto& kv : arrays) n.insert(kv.first);
+  return {n.begin(), n.end()};
 }
 
 struct Participant::Impl {
@@ -89,6 +90,7 @@ struct Participant::Impl {
   std::string shutdownReason;
 
   Sources sources;
+  ExchangeTimes times;
 
   void require(std::initializer_list<State> allowed, const char* call, const char* hint) const {
     for (State s : allowed) {
@@ -232,7 +234,10 @@ struct Participant::Impl {
     }
   }
 
-  const Sources& exchange(std::int64_t s, double d, const std::vector<NamedField>& fields) {
+  const Sources& exchange(std::int64_t s, double d, const std::vector<NamedField>& fields,
+                          const std::vector<NamedBuffer>& into) {
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
     COREDEM_CHECK(s == step, "exchange(step = {}): the granted step is {}; send the fields of the "
                   "granted step", s, step);
     COREDEM_CHECK(std::abs(d - dt) <= kDtTolerance * dt,
@@ -248,6 +253,20 @@ struct Participant::Impl {
                     "exchange: '{}' is not a GasFields array; the names are u_g, grad_p, T_g, "
                     "rho_g, mu_g, kappa_g, cp_g, Y_g", f.name);
       COREDEM_CHECK(given.emplace(f.name, f.values).second, "exchange: field '{}' given twice", f.name);
+    }
+    std::map<std::string, const NamedBuffer*> dest;
+    for (const auto& b : into) {
+      const auto spec = std::find_if(proto::fields::sourceFields().begin(), proto::fields::sourceFields().end(),
+                                     [&](const auto& sp) { return sp.name == b.name; });
+      COREDEM_CHECK(spec != proto::fields::sourceFields().end(),
+                    "exchange: '{}' is not a Sources array; the names are eps_g, K_sl, K_sl_Us, H, "
+                    "H_Tp, R_species, Q_hom", b.name);
+      const std::uint64_t n = cells * proto::fields::componentsOf(spec->extent, ns);
+      COREDEM_CHECK(b.size == n, "exchange: the buffer for '{}' holds {} values; the coupling grid "
+                    "has {} cells, so it needs {} ({} per cell)", b.name, b.size, cells, n,
+                    proto::fields::componentsOf(spec->extent, ns));
+      COREDEM_CHECK(n == 0 || b.data != nullptr, "exchange: buffer for '{}' points to null", b.name);
+      COREDEM_CHECK(dest.emplace(b.name, &b).second, "exchange: buffer for '{}' given twice", b.name);
     }
     auto msg = proto::makeGasFields(step, time, dt, cells, static_cast<std::uint32_t>(ns));
     msg.setSessionId(session);
@@ -267,39 +286,79 @@ struct Participant::Impl {
       // arrays after a timed-out request, when the caller may already have freed them.
       msg.addArray<double>(name, std::span<const double>(it->second.data, it->second.size), shape);
     }
-    // Receive the sources straight into our vectors (one copy).
-    Sources next;
-    proto::ReceiveOptions ro;
-    ro.buffers = [&next](const v1::ArrayDescriptor& d) -> std::span<std::byte> {
-      if (d.dtype() != v1::DTYPE_FLOAT64 || d.byte_length() % sizeof(double) != 0) {
-        return {};
+    const auto t1 = Clock::now();
+    const std::string what = "Sources for step " + std::to_string(step);
+    const auto deadline = t1 + timeout;
+    const std::uint64_t seq = dem->send(std::move(msg));
+    const auto t2 = Clock::now();
+    // The reply's frames are kept (no copy): the arrays are viewed in place, or copied once
+    // into the caller's buffers. Replies to earlier, timed-out requests are skipped.
+    std::optional<proto::Message> reply;
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+      if (left.count() > 0) {
+        reply = dem->receive(left);
       }
-      auto& v = next.arrays[d.name()];
-      v.resize(d.byte_length() / sizeof(double));
-      return std::as_writable_bytes(std::span<double>(v));
-    };
-    auto reply = dem->request(std::move(msg), timeout, ro);
-    proto::expectType(reply, v1::MESSAGE_TYPE_SOURCES);
+      if (!reply) {
+        throw proto::TimeoutError(demEp, what,
+                                  fmt::format("no reply from DEM server {} within {} ms while "
+                                              "awaiting the {}; is it running, reachable and not "
+                                              "stalled?", demEp, timeout.count(), what));
+      }
+      const auto& env = reply->envelope();
+      if (env.sequence() == seq || (env.sequence() == 0 && reply->type() == v1::MESSAGE_TYPE_ERROR)) {
+        break;
+      }
+      log->debug("{}: discarding a stale reply (sequence {}) while awaiting {}", opt.name,
+                 env.sequence(), seq);
+      reply.reset();
+    }
+    const auto t3 = Clock::now();
+    proto::expectType(*reply, v1::MESSAGE_TYPE_SOURCES);
     proto::Expectation e;
     e.types = {v1::MESSAGE_TYPE_SOURCES};
     e.step = step;
     e.cells = cells;
     e.species = ns;
-    if (const auto st = proto::validate(reply, e); !st.ok()) {
+    if (const auto st = proto::validate(*reply, e); !st.ok()) {
       throw proto::ProtocolError(st.code, "DEM server " + demEp + " sent bad Sources for step " +
                                               std::to_string(step) + ": " + st.message);
     }
+    auto kept = std::make_shared<proto::Message>(std::move(*reply));
+    Sources next;
+    std::vector<std::pair<const NamedBuffer*, std::span<const double>>> copies;
     for (const auto& spec : proto::fields::sourceFields()) {
       const std::string name(spec.name);
-      if (next.arrays.count(name) == 0) {  // received without the provider (not float64)
-        const auto v = reply.values<double>(name);
-        next.arrays[name].assign(v.begin(), v.end());
+      if (!kept->findArray(name)) {
+        continue;
+      }
+      const auto v = kept->values<double>(name);
+      if (const auto b = dest.find(name); b != dest.end()) {
+        if (b->second->size != v.size()) {
+          throw proto::ProtocolError(v1::ERROR_CODE_SHAPE,
+                                     fmt::format("DEM server {} sent {} values of '{}' for step {}; "
+                                                 "the buffer given for it holds {}", demEp, v.size(),
+                                                 name, step, b->second->size));
+        }
+        copies.emplace_back(b->second, v);
+      } else {
+        next.views[name] = ConstView(v.data(), v.size());
       }
     }
+    for (const auto& [b, v] : copies) { // only after every size was checked
+      if (!v.empty()) {
+        std::memcpy(b->data, v.data(), v.size() * sizeof(double));
+      }
+      next.views[b->name] = ConstView(b->data, b->size);
+    }
     next.step = step;
-    next.substeps = reply.envelope().sources().substeps();
+    next.substeps = kept->envelope().sources().substeps();
+    next.storage = std::move(kept);
     sources = std::move(next);
     state = State::Exchanged;
+    const auto t4 = Clock::now();
+    auto sec = [](Clock::duration x) { return std::chrono::duration<double>(x).count(); };
+    times = ExchangeTimes{sec(t1 - t0), sec(t2 - t1), sec(t3 - t2), sec(t4 - t3)};
     return sources;
   }
 
@@ -435,8 +494,18 @@ const Sources& Participant::exchange(std::int64_t step, double dt,
                                      const std::vector<NamedField>& fields) {
   _impl->require({State::Granted}, "exchange",
                  "exchange() once per grant, after initialize() or advance() granted a step");
-  return guarded("exchange", [&]() -> const Sources& { return _impl->exchange(step, dt, fields); });
+  return guarded("exchange", [&]() -> const Sources& { return _impl->exchange(step, dt, fields, {}); });
 }
+
+const Sources& Participant::exchange(std::int64_t step, double dt,
+                                     const std::vector<NamedField>& fields,
+                                     const std::vector<NamedBuffer>& into) {
+  _impl->require({State::Granted}, "exchange",
+                 "exchange() once per grant, after initialize() or advance() granted a step");
+  return guarded("exchange", [&]() -> const Sources& { return _impl->exchange(step, dt, fields, into); });
+}
+
+ExchangeTimes Participant::lastExchangeTimes() const { return _impl->times; }
 
 const Sources& Participant::sources() const {
   _impl->require({State::Exchanged}, "sources", "sources exist between exchange() and advance()");

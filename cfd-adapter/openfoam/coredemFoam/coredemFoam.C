@@ -15,7 +15,9 @@
 //      on a checkpoint grant write the state as a binary time directory and list it.
 //
 // Command line: coredemFoam -case DIR [-restart FILE] [-control EP] [-dem EP] [-session ID]
-// (endpoints default to COREDEM_CONTROL_ENDPOINT, COREDEM_DEM_ENDPOINT, COREDEM_SESSION).
+// [-timers] (endpoints default to COREDEM_CONTROL_ENDPOINT, COREDEM_DEM_ENDPOINT,
+// COREDEM_SESSION). -timers: per-stage wall time per CFD step, a table at the end and
+// DIR/../timers-cfd.json (the run folder under `coredem run`).
 
 #include "fvCFD.H"
 #include "singlePhaseTransportModel.H"
@@ -29,6 +31,7 @@
 
 #include "coredem/client/participant.h"
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -181,6 +184,123 @@ RestartInfo readRestart(const std::string& file)
     return r;
 }
 
+// -timers: wall time of each stage of a CFD step, summed over the run.
+class StageTimers
+{
+public:
+    enum Stage
+    {
+        Pack, Serialise, Send, Wait, Receive, Unpack, UEqn, PEqn, TEqn, YEqn, Advance, Rest,
+        NStages
+    };
+
+    using Clock = std::chrono::steady_clock;
+
+    static const char* name(int s)
+    {
+        static const char* names[NStages] =
+        {
+            "pack", "serialise", "send", "wait_dem", "receive", "unpack",
+            "UEqn", "pEqn", "TEqn", "YEqn", "advance", "rest"
+        };
+        return names[s];
+    }
+
+    static double since(Clock::time_point t0)
+    {
+        return std::chrono::duration<double>(Clock::now() - t0).count();
+    }
+
+    void add(Stage s, double seconds) { step_[s] += seconds; }
+
+    //- Closes a step of `seconds` wall time: what no stage took is "rest".
+    void endStep(double seconds)
+    {
+        double staged = 0;
+        for (int s = 0; s < Rest; ++s) staged += step_[s];
+        step_[Rest] = seconds - staged;
+        const double x = exchangeOf(step_);
+        for (int s = 0; s < NStages; ++s)
+        {
+            total_[s] += step_[s];
+            step_[s] = 0;
+        }
+        total_[NStages] += seconds;
+        shareMin_ = steps_ == 0 ? x/seconds : std::min(shareMin_, x/seconds);
+        shareMax_ = steps_ == 0 ? x/seconds : std::max(shareMax_, x/seconds);
+        ++steps_;
+    }
+
+    //- pack + serialise + send + wait + receive + unpack (the wait includes the DEM's work).
+    static double exchangeOf(const double* t)
+    {
+        return t[Pack] + t[Serialise] + t[Send] + t[Wait] + t[Receive] + t[Unpack];
+    }
+
+    //- The exchange without the wait for the DEM: what this side spends on coupling.
+    static double ownOf(const double* t) { return exchangeOf(t) - t[Wait]; }
+
+    std::string table(label nCells, bool direct) const
+    {
+        const double n = std::max<long>(steps_, 1);
+        const double all = total_[NStages];
+        std::ostringstream os;
+        char line[160];
+        std::snprintf
+        (
+            line, sizeof line, "coredemFoam timers: %ld CFD steps, %d cells, %.3f s in steps, "
+            "receive %s\n", steps_, int(nCells), all,
+            direct ? "into the fields" : "by scatter copies"
+        );
+        os << line;
+        std::snprintf(line, sizeof line, "  %-10s %12s %12s %8s\n", "stage", "total s", "ms/step",
+            "share");
+        os << line;
+        for (int s = 0; s < NStages; ++s)
+        {
+            std::snprintf(line, sizeof line, "  %-10s %12.4f %12.4f %7.2f%%\n", name(s),
+                total_[s], 1e3*total_[s]/n, all > 0 ? 100*total_[s]/all : 0.0);
+            os << line;
+        }
+        std::snprintf(line, sizeof line, "  exchange (pack..unpack, incl. wait) %.2f%% of the step "
+            "time (per step %.2f%%..%.2f%%); without the wait %.2f%%\n",
+            all > 0 ? 100*exchangeOf(total_)/all : 0.0, 100*shareMin_, 100*shareMax_,
+            all > 0 ? 100*ownOf(total_)/all : 0.0);
+        os << line;
+        return os.str();
+    }
+
+    std::string json(label nCells, bool direct) const
+    {
+        const double n = std::max<long>(steps_, 1);
+        const double all = total_[NStages];
+        std::ostringstream os;
+        os.precision(9);
+        os << "{\n  \"participant\": \"coredemFoam\",\n  \"cells\": " << nCells
+           << ",\n  \"steps\": " << steps_ << ",\n  \"receive_into_fields\": "
+           << (direct ? "true" : "false") << ",\n  \"step_seconds\": " << all
+           << ",\n  \"stages\": {";
+        for (int s = 0; s < NStages; ++s)
+        {
+            os << (s ? "," : "") << "\n    \"" << name(s) << "\": {\"seconds\": " << total_[s]
+               << ", \"per_step_s\": " << total_[s]/n << ", \"share\": "
+               << (all > 0 ? total_[s]/all : 0.0) << "}";
+        }
+        os << "\n  },\n  \"exchange_share\": " << (all > 0 ? exchangeOf(total_)/all : 0.0)
+           << ",\n  \"exchange_share_min\": " << shareMin_
+           << ",\n  \"exchange_share_max\": " << shareMax_
+           << ",\n  \"exchange_share_without_wait\": " << (all > 0 ? ownOf(total_)/all : 0.0)
+           << "\n}\n";
+        return os.str();
+    }
+
+private:
+    double step_[NStages] = {};
+    double total_[NStages + 1] = {};
+    double shareMin_ = 0, shareMax_ = 0;
+    long steps_ = 0;
+};
+
 } // namespace
 
 
@@ -199,6 +319,12 @@ int main(int argc, char* argv[])
     argList::addOption("dem", "endpoint", "DEM server endpoint (else COREDEM_DEM_ENDPOINT)");
     argList::addOption("session", "id", "session id (else COREDEM_SESSION)");
     argList::addOption("timeout", "s", "per-request deadline in s (else COREDEM_TIMEOUT_S or 60)");
+    argList::addBoolOption
+    (
+        "timers",
+        "per-stage wall time per CFD step (UEqn, pEqn, TEqn, YEqn, exchange split into pack,"
+        " serialise, send, wait, receive, unpack; rest): table at the end, DIR/../timers-cfd.json"
+    );
 
     #include "setRootCase.H"
     #include "createTime.H"
@@ -387,6 +513,23 @@ int main(int argc, char* argv[])
     std::vector<double> uG, gradPG, TG, rhoG, muG, kappaG, cpG, YG, cellY;
     std::vector<scalar> cellBuf;
     const volScalarField nuField(laminarTransport.nu());
+
+    // Constant properties: sent every step, filled once.
+    rhoG.assign(nCells, rhog.value());
+    kappaG.assign(nCells, kappag.value());
+    cpG.assign(nCells, cpg.value());
+    // Mesh cell order = grid order (one blockMesh block): the fields are sent from and the
+    // sources received into the solver's own arrays, with no gather/scatter copies.
+    // COREDEM_FOAM_EXCHANGE=copy forces the gather/scatter path (to measure the difference).
+    const char* exchangeMode = std::getenv("COREDEM_FOAM_EXCHANGE");
+    const bool direct =
+        couplingGrid.identity()
+     && !(exchangeMode != nullptr && std::string(exchangeMode) == "copy");
+    Info<< "Exchange: " << (direct ? "in place (mesh cells in grid order)" : "gather/scatter copies")
+        << nl << endl;
+    const bool timersOn = args.found("timers");
+    StageTimers timers;
+    scalarField epsNew(nCells);
     bool firstStep = true;
     scalar cumulativeContErr = 0;
     label steps = 0;
@@ -399,30 +542,57 @@ int main(int argc, char* argv[])
         const scalar dt = coupling.dt();
 
         // 1. gas at the start of the step -> DEM, sources of the step <- DEM.
-        couplingGrid.gather(reinterpret_cast<const scalar*>(U.primitiveField().cdata()), 3, uG);
-        {
-            const volVectorField gradP(fvc::grad(p)*rhog);
-            couplingGrid.gather
-            (
-                reinterpret_cast<const scalar*>(gradP.primitiveField().cdata()), 3, gradPG
-            );
-        }
-        couplingGrid.gather(T.primitiveField().cdata(), 1, TG);
-        rhoG.assign(nCells, rhog.value());
-        {
-            const scalarField mu(nuField.primitiveField()*rhog.value());
-            couplingGrid.gather(mu.cdata(), 1, muG);
-        }
-        kappaG.assign(nCells, kappag.value());
-        cpG.assign(nCells, cpg.value());
+        const StageTimers::Clock::time_point tStep = StageTimers::Clock::now();
+        StageTimers::Clock::time_point tic = tStep;
+        const volVectorField gradP(fvc::grad(p)*rhog);
+        const scalarField mu(nuField.primitiveField()*rhog.value());
         cellY.assign(std::size_t(nCells)*nSpecies, 0.0);
         for (label k = 0; k < nSpecies; ++k)
         {
             const scalarField& yk = Y[k].primitiveField();
             for (label c = 0; c < nCells; ++c) cellY[std::size_t(c)*nSpecies + k] = yk[c];
         }
-        couplingGrid.gather(cellY.data(), nSpecies, YG);
+        using ::coredem::client::ConstView;
+        const std::size_t nc = std::size_t(nCells);
+        ConstView uV, gradPV, TV, muV, YV;
+        if (direct)
+        {
+            uV = ConstView(reinterpret_cast<const double*>(U.primitiveField().cdata()), 3*nc);
+            gradPV =
+                ConstView(reinterpret_cast<const double*>(gradP.primitiveField().cdata()), 3*nc);
+            TV = ConstView(T.primitiveField().cdata(), nc);
+            muV = ConstView(mu.cdata(), nc);
+            YV = ConstView(cellY.data(), cellY.size());
+        }
+        else
+        {
+            couplingGrid.gather(reinterpret_cast<const scalar*>(U.primitiveField().cdata()), 3, uG);
+            couplingGrid.gather
+            (
+                reinterpret_cast<const scalar*>(gradP.primitiveField().cdata()), 3, gradPG
+            );
+            couplingGrid.gather(T.primitiveField().cdata(), 1, TG);
+            couplingGrid.gather(mu.cdata(), 1, muG);
+            couplingGrid.gather(cellY.data(), nSpecies, YG);
+            uV = uG; gradPV = gradPG; TV = TG; muV = muG; YV = YG;
+        }
+        timers.add(StageTimers::Pack, StageTimers::since(tic));
 
+        // Sources received straight into the fields (in place) or viewed in the received
+        // frames and scattered below.
+        std::vector<::coredem::client::NamedBuffer> into;
+        if (direct)
+        {
+            into =
+            {
+                {"eps_g", epsNew.data(), nc},
+                {"K_sl", Ksl.primitiveFieldRef().data(), nc},
+                {"K_sl_Us", reinterpret_cast<double*>(KslUs.primitiveFieldRef().data()), 3*nc},
+                {"H", Hheat.primitiveFieldRef().data(), nc},
+                {"H_Tp", HTp.primitiveFieldRef().data(), nc},
+                {"Q_hom", Qhom.primitiveFieldRef().data(), nc}
+            };
+        }
         const ::coredem::client::Sources* src = nullptr;
         try
         {
@@ -430,9 +600,10 @@ int main(int argc, char* argv[])
             (
                 coupling.step(), dt,
                 {
-                    {"u_g", uG}, {"grad_p", gradPG}, {"T_g", TG}, {"rho_g", rhoG},
-                    {"mu_g", muG}, {"kappa_g", kappaG}, {"cp_g", cpG}, {"Y_g", YG}
-                }
+                    {"u_g", uV}, {"grad_p", gradPV}, {"T_g", TV}, {"rho_g", rhoG},
+                    {"mu_g", muV}, {"kappa_g", kappaG}, {"cp_g", cpG}, {"Y_g", YV}
+                },
+                into
             );
         }
         catch (const ::coredem::client::ClientError& e)
@@ -440,21 +611,29 @@ int main(int argc, char* argv[])
             FatalErrorInFunction << "coupling, step " << step << ": " << e.what()
                 << exit(FatalError);
         }
+        {
+            const ::coredem::client::ExchangeTimes xt = coupling.lastExchangeTimes();
+            timers.add(StageTimers::Serialise, xt.serialise);
+            timers.add(StageTimers::Send, xt.send);
+            timers.add(StageTimers::Wait, xt.wait);
+            timers.add(StageTimers::Receive, xt.receive);
+        }
+        tic = StageTimers::Clock::now();
 
-        // Sources -> cell fields. The gas fraction is clipped to [alphacMin, 1].
+        // Sources -> cell fields (a no-op for arrays received in place).
         auto toCells = [&](const char* name, label nComp, scalar* dest)
         {
-            const ::coredem::client::ConstView v = src->field(name);
+            const ConstView v = src->field(name);
             if (v.size != std::size_t(couplingGrid.gridCells())*nComp)
             {
                 FatalErrorInFunction
                     << "DEM source " << name << " has " << label(v.size) << " values, expected "
                     << couplingGrid.gridCells()*nComp << exit(FatalError);
             }
-            couplingGrid.scatter(v.data, nComp, dest);
+            if (v.data != dest) couplingGrid.scatter(v.data, nComp, dest);
         };
-        scalarField epsNew(nCells);
         toCells("eps_g", 1, epsNew.data());
+        // The gas fraction is clipped to [alphacMin, 1].
         epsNew = max(min(epsNew, scalar(1)), alphacMin);
         if (firstStep && !restarting)
         {
@@ -462,6 +641,42 @@ int main(int argc, char* argv[])
             alphac.primitiveFieldRef() = epsNew;
             alphac.correctBoundaryConditions();
         }
+        toCells("K_sl", 1, Ksl.primitiveFieldRef().data());
+        toCells("K_sl_Us", 3, reinterpret_cast<scalar*>(KslUs.primitiveFieldRef().data()));
+        toCells("H", 1, Hheat.primitiveFieldRef().data());
+        toCells("H_Tp", 1, HTp.primitiveFieldRef().data());
+        toCells("Q_hom", 1, Qhom.primitiveFieldRef().data());
+        Rsum.primitiveFieldRef() = Zero;
+        if (nSpecies > 0)
+        {
+            // Cell-major (cell, species) -> one field per species: read from the received
+            // array (grid order = cell order) or scattered first.
+            const double* r = src->field("R_species").data;
+            if (src->field("R_species").size != nc*nSpecies)
+            {
+                FatalErrorInFunction
+                    << "DEM source R_species has " << label(src->field("R_species").size)
+                    << " values, expected " << nCells*nSpecies << exit(FatalError);
+            }
+            if (!direct)
+            {
+                cellBuf.assign(nc*nSpecies, 0.0);
+                toCells("R_species", nSpecies, cellBuf.data());
+                r = cellBuf.data();
+            }
+            for (label k = 0; k < nSpecies; ++k)
+            {
+                scalarField& rk = Rspecies[k].primitiveFieldRef();
+                for (label c = 0; c < nCells; ++c) rk[c] = r[std::size_t(c)*nSpecies + k];
+                Rsum.primitiveFieldRef() += rk;
+            }
+        }
+        for (volScalarField* f : {&Ksl, &Hheat, &HTp, &Qhom, &Rsum})
+        {
+            f->correctBoundaryConditions();
+        }
+        KslUs.correctBoundaryConditions();
+        timers.add(StageTimers::Unpack, StageTimers::since(tic));
 
         runTime.setDeltaT(dt, false);
         ++runTime;
@@ -472,37 +687,18 @@ int main(int argc, char* argv[])
         alphac.correctBoundaryConditions();
         alphacf = fvc::interpolate(alphac);
 
-        toCells("K_sl", 1, Ksl.primitiveFieldRef().data());
-        toCells("K_sl_Us", 3, reinterpret_cast<scalar*>(KslUs.primitiveFieldRef().data()));
-        toCells("H", 1, Hheat.primitiveFieldRef().data());
-        toCells("H_Tp", 1, HTp.primitiveFieldRef().data());
-        toCells("Q_hom", 1, Qhom.primitiveFieldRef().data());
-        Rsum.primitiveFieldRef() = Zero;
-        if (nSpecies > 0)
-        {
-            cellBuf.assign(std::size_t(nCells)*nSpecies, 0.0);
-            toCells("R_species", nSpecies, cellBuf.data());
-            for (label k = 0; k < nSpecies; ++k)
-            {
-                scalarField& rk = Rspecies[k].primitiveFieldRef();
-                for (label c = 0; c < nCells; ++c) rk[c] = cellBuf[std::size_t(c)*nSpecies + k];
-                Rsum.primitiveFieldRef() += rk;
-            }
-        }
-        for (volScalarField* f : {&Ksl, &Hheat, &HTp, &Qhom, &Rsum})
-        {
-            f->correctBoundaryConditions();
-        }
-        KslUs.correctBoundaryConditions();
-
         // 2. the gas over the same step.
         while (pimple.loop())
         {
+            tic = StageTimers::Clock::now();
             #include "UEqn.H"
+            timers.add(StageTimers::UEqn, StageTimers::since(tic));
 
             while (pimple.correct())
             {
+                tic = StageTimers::Clock::now();
                 #include "pEqn.H"
+                timers.add(StageTimers::PEqn, StageTimers::since(tic));
             }
 
             if (pimple.turbCorr())
@@ -511,8 +707,12 @@ int main(int argc, char* argv[])
                 turbulence->correct();
             }
         }
+        tic = StageTimers::Clock::now();
         #include "TEqn.H"
+        timers.add(StageTimers::TEqn, StageTimers::since(tic));
+        tic = StageTimers::Clock::now();
         #include "YEqn.H"
+        timers.add(StageTimers::YEqn, StageTimers::since(tic));
         #include "alphacContinuityErrs.H"
 
         // 3. ledgers (cumulative) and the Courant number of this step.
@@ -643,7 +843,10 @@ int main(int argc, char* argv[])
 
         try
         {
+            // StepDone and the wait for the next grant (the orchestrator's side of the step).
+            tic = StageTimers::Clock::now();
             coupling.advance(CoNum, ledgers.report(), files);
+            timers.add(StageTimers::Advance, StageTimers::since(tic));
         }
         catch (const ::coredem::client::ClientError& e)
         {
@@ -655,6 +858,22 @@ int main(int argc, char* argv[])
         runTime.printExecutionTime(Info);
         firstStep = false;
         ++steps;
+        timers.endStep(StageTimers::since(tStep));
+    }
+
+    if (timersOn)
+    {
+        Info<< nl << timers.table(nCells, direct).c_str() << endl;
+        const fileName file(runTime.path().path()/"timers-cfd.json");
+        {
+            std::ofstream out(file.c_str());
+            out << timers.json(nCells, direct);
+            if (!out)
+            {
+                FatalErrorInFunction << "cannot write " << file << exit(FatalError);
+            }
+        }
+        Info<< "Timers written to " << file << endl;
     }
 
     runTime.writeNow();

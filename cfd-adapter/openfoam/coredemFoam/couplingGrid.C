@@ -18,7 +18,8 @@ CoredemGrid::CoredemGrid
     h_(spacing),
     n_{nx, ny, nz},
     nGrid_(nx*ny*nz),
-    gridIndex_(mesh.nCells(), -1)
+    gridIndex_(mesh.nCells(), -1),
+    identity_(false)
 {
     for (direction a = 0; a < 3; ++a)
     {
@@ -109,6 +110,11 @@ CoredemGrid::CoredemGrid
             << " (" << n_[0] << " x " << n_[1] << " x " << n_[2] << "); grid cell (" << i << ' '
             << j << ' ' << k << ") has no mesh cell. Make blockMeshDict match case.yaml's grid."
             << exit(FatalError);
+    }
+    identity_ = true;
+    forAll(gridIndex_, celli)
+    {
+        if (gridIndex_[celli] != celli) identity_ = false;
     }
 }
 

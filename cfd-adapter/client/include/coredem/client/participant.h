@@ -58,6 +58,23 @@ struct NamedField {
   ConstView values;
 };
 
+/// A caller-owned destination for one Sources array (exchange(..., into)): the array is copied
+/// from the received frame straight into data[0, size) (size must equal the array's length),
+/// e.g. a solver's own field storage or a pinned buffer.
+struct NamedBuffer {
+  std::string name;
+  double* data = nullptr;
+  std::size_t size = 0;
+};
+
+/// Wall-clock split of the last exchange() in seconds (coredemFoam -timers).
+struct ExchangeTimes {
+  double serialise = 0.0; ///< argument checks + copying the gas arrays into the message
+  double send = 0.0;      ///< handing the message to the transport
+  double wait = 0.0;      ///< from sent until D's reply was received (D's work + transfer)
+  double receive = 0.0;   ///< validating the reply, copies into NamedBuffers, views
+};
+
 /// What went wrong, for callers that branch on it (and for the C API's status codes).
 enum class ErrorCode {
   Argument = 1, ///< a bad argument or environment (missing endpoint, wrong field size, ...)
@@ -121,6 +138,8 @@ struct Grid {
 
 /// Sources of the last exchange (sub-step averages over the CFD step), valid until the next
 /// exchange() or finalize(). Names: eps_g, K_sl, K_sl_Us, H, H_Tp, R_species, Q_hom.
+/// Arrays are not copied on receipt: field() views the received frames (kept alive by
+/// `storage`), or the caller's NamedBuffer the array was received into.
 class Sources {
 public:
   /// The named array; throws ClientError(Argument) for a name D did not send.
@@ -129,7 +148,9 @@ public:
   std::vector<std::string> names() const;
   std::int64_t step = 0;
   std::uint32_t substeps = 0;   ///< DEM sub-steps averaged
-  std::map<std::string, std::vector<double>> arrays;
+  std::map<std::string, ConstView> views;            ///< every array D sent, by name
+  std::map<std::string, std::vector<double>> arrays; ///< arrays that had to be converted
+  std::shared_ptr<const void> storage;               ///< owns the frames `views` point into
 };
 
 /// Ledgers reported in StepDone (named doubles, docs/client.md).
@@ -182,6 +203,16 @@ public:
   /// @pre state() == Granted, step == this->step(), dt == this->dt() (relative 1e-12)
   /// @post state() == Exchanged
   const Sources& exchange(std::int64_t step, double dt, const std::vector<NamedField>& fields);
+  /// As above; the Sources arrays named in `into` are received straight into those buffers
+  /// (one copy from the received frame, none in between) and field() views them there.
+  /// A name that is not a Sources array or a size other than cells x components throws
+  /// ClientError(Argument) before anything is sent; buffers are written only after D's reply
+  /// passed validation.
+  const Sources& exchange(std::int64_t step, double dt, const std::vector<NamedField>& fields,
+                          const std::vector<NamedBuffer>& into);
+
+  /// Where the last exchange() spent its time (zeros before the first).
+  ExchangeTimes lastExchangeTimes() const;
 
   /// The sources of the last exchange(). @pre state() == Exchanged
   const Sources& sources() const;
