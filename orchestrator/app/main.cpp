@@ -71,12 +71,17 @@ int main(int argc, char** argv) {
   run->add_option("--stop-after", stopAfter,
                   "stop after this step with a checkpoint (continue with coredem resume)");
   run->add_flag("--no-plots", noPlots, "do not make the PNG plots at the end");
+  bool timers = false;
+  run->add_flag("--timers", timers,
+                "per-stage timers in coredem-dem and coredemFoam: RUN/timers-dem.json, "
+                "RUN/timers-cfd.json and tables in logs/ (docs/performance.md)");
 
   auto* resume = app.add_subcommand("resume", "continue a run from its latest complete checkpoint");
   resume->add_option("RUN_DIR", runDir, "run folder created by coredem run")->required();
   resume->add_option("--auto-restart", autoRestart, "as for run")->check(CLI::NonNegativeNumber);
   resume->add_option("--stop-after", stopAfter, "as for run");
   resume->add_flag("--no-plots", noPlots, "as for run");
+  resume->add_flag("--timers", timers, "as for run");
 
   app.add_subcommand("campaign", "parameter sweeps: campaign run|resume|status|collect ...");
   auto* inspect =
@@ -131,6 +136,7 @@ int main(int argc, char** argv) {
       opts.stopAfterStep = stopAfter;
     }
     opts.tty = ::isatty(STDERR_FILENO) != 0;
+    opts.timers = timers;
     CaseConfig config;
     if (*run) {
       config = loadCase(caseDir);    // throws CaseError: nothing written yet

@@ -797,7 +797,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
 
   if (top.has("dem")) {
     const Section d =
-        top.section("dem", {"endpoint", "backend", "threads", "timeout_s", "server_key"});
+        top.section("dem", {"endpoint", "backend", "threads", "timeout_s", "server_key", "timers"});
     c.dem.endpoint = d.string("endpoint", std::string(),
                               "endpoint of a running coredem-dem, e.g. tcp://127.0.0.1:5555");
     if (!c.dem.endpoint.empty() && c.dem.endpoint.rfind("tcp://", 0) != 0 &&
@@ -807,6 +807,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     c.dem.backend = d.choice("backend", std::string("cpu"), {"cpu", "cuda", "auto"});
     c.dem.threads = int(d.integer("threads", 0, 0, 4096, "OpenMP threads, 0 = default"));
     c.dem.timeoutSeconds = d.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
+    const std::string timers = d.choice("timers", std::string("off"), {"on", "off", "true", "false"});
+    c.dem.timers = timers == "on" || timers == "true";
     if (d.has("server_key")) {
       const std::string rel =
           d.string("server_key", std::nullopt,

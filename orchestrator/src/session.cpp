@@ -342,6 +342,9 @@ void Session::startDem() {
     if (_c.dem.threads > 0) {
       argv.insert(argv.end(), {"--threads", std::to_string(_c.dem.threads)});
     }
+    if (_c.dem.timers || _o.timers) {
+      argv.insert(argv.end(), {"--timers", "--timers-file", (_o.runDir / "timers-dem.json").string()});
+    }
     // OpenMP threads that spin at barriers stall every parallel region when the DEM shares
     // its cores with the CFD participant (docs/performance.md, "DEM core"); passive waiting
     // is the default here, and a policy set in the user's environment wins.
@@ -527,6 +530,9 @@ void Session::startCfd(const fs::path& gasRestart) {
     std::vector<std::string> foamArgv = {exe.string(), "-case", foamDir.string()};
     if (!gasRestart.empty()) {
       foamArgv.insert(foamArgv.end(), {"-restart", gasRestart.string()});
+    }
+    if (_o.timers) {
+      foamArgv.push_back("-timers");  // coredemFoam writes RUN/timers-cfd.json
     }
     std::map<std::string, std::string> env = {
         {"COREDEM_CONTROL_ENDPOINT", _ctrlEndpoint},

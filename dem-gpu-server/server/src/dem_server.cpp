@@ -3,6 +3,7 @@
 
 #include "configure_map.h"
 #include "state_meta.h"
+#include "timers.h"
 
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
@@ -130,6 +131,9 @@ struct DemServer::Impl {
   std::optional<Grant> grant;
   std::optional<Held> held;
   ServerLedgers ledgers;
+  ExchangeTimes xt;                       ///< --timers: exchange and advance seconds this session
+  std::optional<Clock::time_point> stepEnd;  ///< when the last StepDone left (wait_for_peer starts)
+  Clock::time_point lastReceived{};          ///< when receive() returned the message being handled
 
   explicit Impl(ServerOptions o) : opt(std::move(o)), server(transportOptions(opt)) {}
 
@@ -190,6 +194,19 @@ struct DemServer::Impl {
     const double secs = std::chrono::duration<double>(Clock::now() - started).count();
     log->info("session {} ended: {} (orchestrator '{}', CFD participant '{}', {} steps, {:.1f} s)",
               session, reason, oName, cName.empty() ? "-" : cName, stepsDone, secs);
+    if (opt.timers && system) {
+      const auto st = system->stageTimes();
+      log->info("session {}: {}", session, timersReport(xt, st, secs, true));
+      const std::string path = opt.timersFile.empty() ? "coredem-dem-timers.json" : opt.timersFile;
+      try {
+        writeTextFile(path, timersJson(xt, st, secs, session, system->backendName(), opt.threads));
+        log->info("session {}: timers written to {}", session, path);
+      } catch (const std::exception& e) {
+        log->error("session {}: {}", session, e.what());
+      }
+    }
+    xt = ExchangeTimes();
+    stepEnd.reset();
     state = SessionState::Idle;
     session.clear();
     oPeer.clear();
@@ -468,6 +485,7 @@ struct DemServer::Impl {
       return;
     }
     const auto tGas = Clock::now();
+    xt.unpack += std::chrono::duration<double>(tGas - t0).count();
     const dem::CellSources* s = nullptr;
     try {
       s = &system->advance(grant->dtCfd, static_cast<int>(grant->nSub));
@@ -481,6 +499,8 @@ struct DemServer::Impl {
     }
     const double dt = grant->dtCfd;
     const auto tAdvanced = Clock::now();
+    xt.advance += std::chrono::duration<double>(tAdvanced - tGas).count();
+    xt.particleSubSteps += static_cast<std::uint64_t>(system->particleCount()) * grant->nSub;
 
     // Ledgers: what the particles took from / gave to the gas during this step.
     const auto n = static_cast<std::size_t>(cells);
@@ -498,6 +518,8 @@ struct DemServer::Impl {
     }
     const auto particles = system->particles();
     v1::Ledger ledger = ledgerMessage(particles);
+    const auto tLedgers = Clock::now();
+    xt.ledgers += std::chrono::duration<double>(tLedgers - tAdvanced).count();
 
     // Sources to C.
     auto src = proto::makeSources(env.step(), env.time(), dt, cells, species, grant->nSub);
@@ -513,6 +535,7 @@ struct DemServer::Impl {
     add(f::kHomogeneousHeat, s->qHom);
     *src.envelope().mutable_sources()->mutable_ledger() = ledger;
     send(r.peer, std::move(src), env.sequence(), env.step());
+    xt.packSend += std::chrono::duration<double>(Clock::now() - tLedgers).count();
     {
       auto ms = [](Clock::time_point a, Clock::time_point b) {
         return std::chrono::duration<double, std::milli>(b - a).count();
@@ -529,7 +552,9 @@ struct DemServer::Impl {
     std::string checkpointError;
     if (!grant->checkpointDir.empty()) {
       try {
+        const auto tc = Clock::now();
         const auto files = writeCheckpoint(grant->checkpointDir, grant->step);
+        xt.checkpoint += std::chrono::duration<double>(Clock::now() - tc).count();
         done.mutable_checkpoint()->set_directory(grant->checkpointDir);
         for (const auto& file : files) {
           done.mutable_checkpoint()->add_files(file);
@@ -539,10 +564,12 @@ struct DemServer::Impl {
         checkpointError = e.what();
       }
     }
+    const auto tDone = Clock::now();
     addDiagnostics(done, particles);
     done.set_wall_seconds(std::chrono::duration<double>(Clock::now() - t0).count());
     if (checkpointOk) {
       send(grant->peer, proto::makeStepDone(grant->step, grant->time, done), grant->sequence, grant->step);
+      xt.packSend += std::chrono::duration<double>(Clock::now() - tDone).count();
     } else {
       log->error("session {}: checkpoint of step {} into {} failed: {}", session, grant->step,
                  grant->checkpointDir, checkpointError);
@@ -556,6 +583,13 @@ struct DemServer::Impl {
     lastStep = grant->step;
     ++stepsDone;
     grant.reset();
+    stepEnd = Clock::now();
+    ++xt.steps;
+    if (opt.timers && opt.timersEvery > 0 && xt.steps % opt.timersEvery == 0) {
+      log->info("session {}: {}", session,
+                timersReport(xt, system->stageTimes(),
+                             std::chrono::duration<double>(Clock::now() - started).count(), false));
+    }
   }
 
   v1::Ledger ledgerMessage(const dem::ParticleData& p) const {
@@ -709,7 +743,15 @@ struct DemServer::Impl {
       e.sessionId = session;
       e.sequenceAfter = lastSequence[r.peer];
     }
-    if (const auto s = proto::validate(r.message, e); !s.ok()) {
+    const auto tValidate = Clock::now();
+    if (type == v1::MESSAGE_TYPE_GAS_FIELDS && stepEnd) {  // the CFD's step and the transfer
+      xt.waitPeer += std::chrono::duration<double>(lastReceived - *stepEnd).count();
+    }
+    const auto s = proto::validate(r.message, e);
+    if (type == v1::MESSAGE_TYPE_GAS_FIELDS) {
+      xt.validate += std::chrono::duration<double>(Clock::now() - tValidate).count();
+    }
+    if (!s.ok()) {
       refuse(r, s.code, s.message);
       return;
     }
@@ -773,6 +815,7 @@ bool DemServer::poll(std::chrono::milliseconds wait) {
     return false;
   }
   auto req = m.server.receive(wait);
+  m.lastReceived = Clock::now();
   if (req) {
     try {
       m.handle(*req);

@@ -57,6 +57,15 @@ int main(int argc, char** argv) {
   app.add_flag("--exit-after-session", o.exitAfterSession,
                "exit when the first session ends (set by the orchestrator that started this server)");
   app.add_option("--endpoint-file", endpointFile, "write the bound endpoint into this file");
+  app.add_flag("--timers", o.timers,
+               "per-stage timers (DEM stages and the exchange): a log line every --timers-every "
+               "steps, a table at the end of each session and a JSON file (--timers-file)");
+  app.add_option("--timers-every", o.timersEvery, "with --timers: log line every N CFD steps (0: only at the end)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--timers-file", o.timersFile,
+                 "with --timers: JSON report path (default: dem-timers.json next to --endpoint-file, "
+                 "else coredem-dem-timers.json in the working directory)");
   app.add_option("--generate-curve-keys", generateKeys,
                  "write a new CURVE key pair into DIR/server.{public,secret} and exit");
   try {
@@ -65,6 +74,11 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   auto log = coredem::logger("dem.server");
+  if (o.timers && o.timersFile.empty()) {
+    o.timersFile = endpointFile.empty()
+                       ? std::string("coredem-dem-timers.json")
+                       : (std::filesystem::path(endpointFile).parent_path() / "dem-timers.json").string();
+  }
   try {
     if (!generateKeys.empty()) {
       coredem::server::generateCurveKeys(generateKeys);

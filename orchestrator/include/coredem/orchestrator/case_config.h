@@ -82,6 +82,7 @@ struct DemConfig {
   int threads = 0;                 ///< 0: let the server choose
   double timeoutSeconds = 60;      ///< deadline of every request to D
   std::filesystem::path serverKey; ///< file with D's CURVE public key (Z85); empty: no CURVE
+  bool timers = false;             ///< dem.timers: coredem-dem --timers (RUN/timers-dem.json)
 };
 
 struct CfdConfig {

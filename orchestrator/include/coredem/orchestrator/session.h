@@ -34,6 +34,10 @@ struct RunOptions {
   std::optional<std::int64_t> stopAfterStep; ///< stop (with a checkpoint) after this step
   bool resume = false;                       ///< continue from the latest complete checkpoint
   bool tty = false;                          ///< progress as an updating line
+  /// Per-stage timers in both participants (`coredem run --timers`; dem.timers in the case does
+  /// it for the DEM server only): coredem-dem --timers writes RUN/timers-dem.json, coredemFoam
+  /// -timers RUN/timers-cfd.json (docs/performance.md "Timers").
+  bool timers = false;
 };
 
 /// Exit codes of `coredem`.

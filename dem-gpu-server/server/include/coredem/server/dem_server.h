@@ -30,6 +30,12 @@ struct ServerOptions {
   std::string curveKeysDir;           ///< DIR/server.public + DIR/server.secret (Z85)
   bool insecure = false;              ///< allow a non-loopback bind without CURVE
   bool exitAfterSession = false;      ///< run() returns when the first session ends
+  /// Per-stage timers (docs/performance.md "Timers"): a report in the log every `timersEvery`
+  /// CFD steps (0: only at the end) and at the end of each session, written as JSON to
+  /// `timersFile` (empty: coredem-dem-timers.json in the working directory).
+  bool timers = false;
+  int timersEvery = 100;
+  std::string timersFile;
 };
 
 /// Session life cycle (one at a time):

@@ -1,0 +1,126 @@
+// coredem-dem --timers: the per-stage report (timers.h).
+#include "timers.h"
+
+#include "coredem/common/check.h"
+
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <fstream>
+#include <utility>
+#include <vector>
+
+namespace coredem::server {
+
+namespace {
+
+/// StageTimes::chemistry when the DEM core has a chemistry stage, else 0.
+template <class T>
+double chemistrySeconds(const T& st) {
+  if constexpr (requires { st.chemistry; }) {
+    return st.chemistry;
+  } else {
+    return 0.0;
+  }
+}
+
+struct Row {
+  const char* name;
+  double seconds;
+};
+
+std::vector<Row> demRows(const ExchangeTimes& x, const dem::StageTimes& st) {
+  const double chem = chemistrySeconds(st);
+  const double named = st.neighbour + st.contact + st.drag + st.heat + chem + st.integrate + st.coupling;
+  return {{"neighbour", st.neighbour},     {"contact", st.contact},
+          {"drag", st.drag},               {"heat", st.heat},
+          {"chemistry", chem},             {"integration", st.integrate},
+          {"pcm_deposition", st.coupling}, {"dem_other", x.advance - named}};
+}
+
+std::vector<Row> exchangeRows(const ExchangeTimes& x) {
+  return {{"wait_for_peer", x.waitPeer}, {"validate", x.validate}, {"unpack", x.unpack},
+          {"pack_send", x.packSend},     {"ledgers", x.ledgers},   {"checkpoint", x.checkpoint}};
+}
+
+} // namespace
+
+std::string timersReport(const ExchangeTimes& x, const dem::StageTimes& st, double sessionSeconds,
+                         bool multiLine) {
+  const auto dem = demRows(x, st);
+  const auto ex = exchangeRows(x);
+  const double total = sessionSeconds > 0 ? sessionSeconds : 1.0;
+  const double rate = x.advance > 0 ? static_cast<double>(x.particleSubSteps) / x.advance : 0.0;
+  std::string s;
+  if (!multiLine) {
+    s = fmt::format("timers after {} steps ({:.1f} s): DEM {:.1f}% [", x.steps, sessionSeconds,
+                    100.0 * x.advance / total);
+    for (std::size_t k = 0; k < dem.size(); ++k) {
+      s += fmt::format("{}{} {:.1f}%", k ? ", " : "", dem[k].name, 100.0 * dem[k].seconds / total);
+    }
+    s += "], exchange [";
+    for (std::size_t k = 0; k < ex.size(); ++k) {
+      s += fmt::format("{}{} {:.1f}%", k ? ", " : "", ex[k].name, 100.0 * ex[k].seconds / total);
+    }
+    s += fmt::format("], {:.3e} particle-steps/s in the DEM", rate);
+    return s;
+  }
+  s = fmt::format("timers: {} CFD steps, {:.3f} s in the session, {:.3e} particle sub-steps per "
+                  "DEM second ({} rebuilds)\n", x.steps, sessionSeconds, rate, st.rebuilds);
+  s += fmt::format("  {:<22} {:>10} {:>7} {:>12}\n", "stage", "s", "%", "ms/step");
+  const double steps = x.steps > 0 ? static_cast<double>(x.steps) : 1.0;
+  auto line = [&](const char* name, double sec) {
+    s += fmt::format("  {:<22} {:>10.3f} {:>6.1f}% {:>12.3f}\n", name, sec, 100.0 * sec / total,
+                     1e3 * sec / steps);
+  };
+  line("DEM advance", x.advance);
+  for (const Row& r : dem) line((std::string("  ") + r.name).c_str(), r.seconds);
+  double exSum = 0.0;
+  for (const Row& r : ex) exSum += r.seconds;
+  line("exchange", exSum);
+  for (const Row& r : ex) line((std::string("  ") + r.name).c_str(), r.seconds);
+  line("other (server)", sessionSeconds - x.advance - exSum);
+  return s;
+}
+
+std::string timersJson(const ExchangeTimes& x, const dem::StageTimes& st, double sessionSeconds,
+                       const std::string& session, const std::string& backend, int threads) {
+  std::string s = fmt::format(
+      "{{\"program\":\"coredem-dem\",\"session\":\"{}\",\"backend\":\"{}\",\"threads\":{},"
+      "\"steps\":{},\"particle_sub_steps\":{},\"rebuilds\":{},\"session_s\":{:.6f},\"advance_s\":{:.6f},"
+      "\"dem_s\":{{",
+      session, backend, threads, x.steps, x.particleSubSteps, st.rebuilds, sessionSeconds, x.advance);
+  const auto dem = demRows(x, st);
+  for (std::size_t k = 0; k < dem.size(); ++k) {
+    s += fmt::format("{}\"{}\":{:.6f}", k ? "," : "", dem[k].name, dem[k].seconds);
+  }
+  s += "},\"exchange_s\":{";
+  const auto ex = exchangeRows(x);
+  double exSum = 0.0;
+  for (std::size_t k = 0; k < ex.size(); ++k) {
+    s += fmt::format("{}\"{}\":{:.6f}", k ? "," : "", ex[k].name, ex[k].seconds);
+    exSum += ex[k].seconds;
+  }
+  s += fmt::format("}},\"exchange_total_s\":{:.6f},\"server_other_s\":{:.6f}}}\n", exSum,
+                   sessionSeconds - x.advance - exSum);
+  return s;
+}
+
+void writeTextFile(const std::string& path, const std::string& text) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  if (p.has_parent_path()) {
+    std::error_code ec;
+    fs::create_directories(p.parent_path(), ec);
+  }
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    COREDEM_CHECK(out.good(), "cannot write the timers file {}: check --timers-file and its folder", tmp);
+    out << text;
+    COREDEM_CHECK(out.good(), "writing {} failed (disk full?)", tmp);
+  }
+  fs::rename(tmp, p);
+}
+
+} // namespace coredem::server
