@@ -8,8 +8,11 @@
 // every sub-model off (the stage's loops and cell deposition: "heat_stage_base"). The
 // temperature update is the motion stage with heat on minus the one with heat off.
 // Reaction rates and the mass/species update are timed as loops of their kernels over the
-// engine's particles (temperatures, masses, PCM cells after the same steps): the engine has no
-// chemistry stage in this build, see docs/performance.md. Figures are measured, never asserted.
+// engine's particles (temperatures, masses, PCM cells after the same steps), which splits rates
+// from the update; the engine's chemistry stage (StageTimes::chemistry: rates, mass/diameter/
+// species update and deposition together) is timed per model as well (chemistry_stage_* rows,
+// one variant each: CLG R1/R2, CLG R4/R5, a generic Arrhenius reaction). Figures are measured,
+// never asserted.
 #include "commands.h"
 #include "dem.h"
 #include "thermochem.h"
@@ -37,6 +40,7 @@ using Clock = std::chrono::steady_clock;
 struct Variant {
   const char* name;
   bool heat, convection, contact, lens, radiation;
+  int chemistry = 0;  ///< 0 none, 1 CLG R1/R2, 2 CLG R4/R5, 3 generic reaction (the engine's chemistry stage)
 };
 
 constexpr Variant kVariants[] = {
@@ -47,12 +51,16 @@ constexpr Variant kVariants[] = {
     {"gas_lens_conduction", true, false, false, true, false},
     {"radiation", true, false, false, false, true},
     {"all_heat", true, true, true, true, true},
+    {"chem_clg_r1_r2", true, false, false, false, false, 1},
+    {"chem_clg_r4_r5", true, false, false, false, false, 2},
+    {"chem_generic", true, false, false, false, false, 3},
 };
+constexpr int kAllHeat = 6;
 constexpr int kVariantCount = static_cast<int>(sizeof(kVariants) / sizeof(kVariants[0]));
 
 /// Median stage seconds of one variant (over repeats), per measured step.
 struct Measured {
-  double neighbour = 0, contact = 0, heat = 0, integrate = 0, coupling = 0, wall = 0;
+  double neighbour = 0, contact = 0, heat = 0, integrate = 0, coupling = 0, wall = 0, chemistry = 0;
   std::uint64_t rebuilds = 0;
 };
 
@@ -83,6 +91,27 @@ DemConfig makeConfig(const Options& o, const Variant& v) {
   h.contactConduction = v.contact;
   h.lensConduction = v.lens;
   h.radiation = v.radiation;
+  // Species for the chemistry variants: a CLG bed (PHYSICS §6) of char + oxygen carrier.
+  if (v.chemistry > 0) {
+    cfg.gasSpecies = {{"CO", 28.0101e-3}, {"CO2", 44.0095e-3}, {"H2", 2.01588e-3}, {"H2O", 18.01528e-3}, {"N2", 28.0134e-3}};
+    cfg.solidSpecies = {{"C", 12.0107e-3}, {"Fe2O3", 159.6882e-3}, {"Fe3O4", 231.5326e-3}, {"Al2O3", 101.9613e-3}};
+    cfg.particleSets[0].composition = {0.3, 0.4, 0.2, 0.1};
+    ChemistryOptions& ch = cfg.chemistry;
+    if (v.chemistry == 1) ch.clg.charGasification = true;
+    if (v.chemistry == 2) ch.clg.ocReduction = true;
+    if (v.chemistry == 3) {  // C + CO2 -> 2 CO, Arrhenius, first order in CO2 (as genericReaction())
+      ReactionConfig r;
+      r.name = "boudouard";
+      r.terms = {{"C", -1.0}, {"CO2", -1.0}, {"CO", 2.0}};
+      r.law = coredem::dem::kernels::RateLaw::Arrhenius;
+      r.A = 1.0e3;
+      r.E = 1.5e5;
+      r.orderSpecies = "CO2";
+      r.order = 1.0;
+      r.heatOfReaction = 1.72e5;
+      ch.reactions.push_back(r);
+    }
+  }
   return cfg;
 }
 
@@ -92,10 +121,21 @@ Measured runVariant(const Options& o, const Variant& v, ParticleData* keep, Coup
   const DemConfig cfg = makeConfig(o, v);
   DemSystem sys(cfg, parseBackend(o.backend), o.threads);
   const coredem::bench::BenchGas gas(sys.cellCount(), o.uGas, o.tGas);
-  sys.setGasFields(gas.view());
+  GasFieldsView view = gas.view();
+  std::vector<double> yg;
+  if (!cfg.gasSpecies.empty()) {  // the gasifier-like mixture of chemistryInput(), as mass fractions
+    const double x[5] = {0.2, 0.2, 0.1, 0.2, 0.3};
+    double mix = 0.0;
+    for (int k = 0; k < 5; ++k) mix += x[k] * cfg.gasSpecies[k].molarMass;
+    yg.resize(sys.cellCount() * 5);
+    for (std::size_t c = 0; c < sys.cellCount(); ++c)
+      for (int k = 0; k < 5; ++k) yg[5 * c + k] = x[k] * cfg.gasSpecies[k].molarMass / mix;
+    view.Yg = yg;
+  }
+  sys.setGasFields(view);
   const double dt = sys.dtDemMax();
   if (o.warmup > 0) sys.advance(o.warmup * dt, o.warmup);
-  std::vector<double> nb, ct, ht, in, cp, wl;
+  std::vector<double> nb, ct, ht, in, cp, wl, chm;
   std::uint64_t rebuilds = 0;
   for (int r = 0; r < o.repeat; ++r) {
     sys.resetStageTimes();
@@ -108,11 +148,12 @@ Measured runVariant(const Options& o, const Variant& v, ParticleData* keep, Coup
     ht.push_back(st.heat / o.steps);
     in.push_back(st.integrate / o.steps);
     cp.push_back(st.coupling / o.steps);
+    chm.push_back(st.chemistry / o.steps);
     rebuilds += st.rebuilds;
   }
   if (keep) *keep = sys.particles();
   if (grid) *grid = cfg.grid;
-  return Measured{median(nb), median(ct), median(ht), median(in), median(cp), median(wl), rebuilds};
+  return Measured{median(nb), median(ct), median(ht), median(in), median(cp), median(wl), median(chm), rebuilds};
 }
 
 /// The cells' gas: a gasifier-like mixture at T_g and 1 bar (mole fractions CO 0.2, CO2 0.2,
@@ -203,7 +244,7 @@ int runThermochem(int argc, char** argv) {
     CouplingGrid grid;
     const auto t0 = Clock::now();
     for (int v = 0; v < kVariantCount; ++v) {
-      const bool last = v == kVariantCount - 1;
+      const bool last = v == kAllHeat;
       m[v] = runVariant(o, kVariants[v], last ? &particles : nullptr, last ? &grid : nullptr);
       if (!json) std::fprintf(stderr, "  variant %-20s done (%.1f s so far)\n", kVariants[v].name,
                               std::chrono::duration<double>(Clock::now() - t0).count());
@@ -231,7 +272,11 @@ int runThermochem(int argc, char** argv) {
       rows.push_back({tc::kChemStageNames[s], "kernels", chem.seconds[s] / chem.reps * per});
     rows.push_back({"temperature_update", "engine", (base.integrate - mech.integrate) * per});
     rows.push_back({"heat_stage_base", "engine", base.heat * per});
-    rows.push_back({"all_heat_stage", "engine", m[6].heat * per});
+    rows.push_back({"all_heat_stage", "engine", m[kAllHeat].heat * per});
+    // The engine's chemistry stage (rates, mass/diameter/species update, deposition), one model a run.
+    rows.push_back({"chemistry_stage_clg_r1_r2", "engine", m[7].chemistry * per});
+    rows.push_back({"chemistry_stage_clg_r4_r5", "engine", m[8].chemistry * per});
+    rows.push_back({"chemistry_stage_generic", "engine", m[9].chemistry * per});
     // Context: the mechanics of the same step.
     std::vector<Row> ctx;
     ctx.push_back({"contact_forces", "engine", mech.contact * per});
@@ -239,7 +284,7 @@ int runThermochem(int argc, char** argv) {
     ctx.push_back({"coupling_pcm", "engine", mech.coupling * per});
     ctx.push_back({"neighbour", "engine", mech.neighbour * per});
     ctx.push_back({"whole_step_mechanics", "engine", mech.wall * per});
-    ctx.push_back({"whole_step_all_heat", "engine", m[6].wall * per});
+    ctx.push_back({"whole_step_all_heat", "engine", m[kAllHeat].wall * per});
     ctx.push_back({"lens_neighbour_list_overhead", "engine",
                    ((m[4].contact + m[4].neighbour) - (base.contact + base.neighbour)) * per});
 
@@ -271,8 +316,9 @@ int runThermochem(int argc, char** argv) {
       std::printf("%-30s %14s   %s\n", "sub-model", "ns/particle", "how");
       for (const Row& r : rows)
         std::printf("%-30s %14.2f   %s\n", r.name.c_str(), r.ns,
-                    r.source == "engine" ? "in the DEM step (difference of stage times)"
-                                         : "kernel loop over the engine's particles");
+                    r.source != "engine" ? "kernel loop over the engine's particles"
+                    : r.name.rfind("chemistry_stage", 0) == 0 ? "in the DEM step (its chemistry stage)"
+                                                               : "in the DEM step (difference of stage times)");
       std::printf("\ncontext (same deck, heat off unless named):\n");
       for (const Row& r : ctx) std::printf("%-30s %14.2f\n", r.name.c_str(), r.ns);
     }
