@@ -172,6 +172,8 @@ TEST(ChemistryStep, MfixReactiveChemistryCaseFollowsTheAnalyticSolution) {
   EXPECT_NEAR(p.species[1], 0.45454545, 3e-5);
   EXPECT_NEAR(p.species[2], 0.54545455, 3e-5);
   EXPECT_NEAR(p.mass[0], 3.23976742e-5, 8e-6 * 3.23976742e-5);
+  EXPECT_GE(p.species[0], 0.0);  // B exhausted, never negative (availability limiter)
+  EXPECT_LT(p.species[0], 1e-15);
   RecordProperty("rc_mass_rel_err", sci(maxMassErr));
   RecordProperty("rc_fraction_abs_err", sci(maxXErr));
 }
@@ -529,6 +531,16 @@ TEST(ChemistryStep, OneAndTwoThreadsAreBitwiseIdenticalWithChemistryOn) {
   const BedRun a = runBed(1, 4);
   const BedRun b = runBed(2, 4);
   expectSame(a, b);
+  // Mass fractions stay in [0, 1] and sum to 1 (limiter; Eq. 31).
+  for (std::size_t i = 0; i < a.p.count; ++i) {
+    double sum = 0.0;
+    for (int k = 0; k < a.p.nSpecies; ++k) {
+      const double x = a.p.species[i * a.p.nSpecies + k];
+      EXPECT_GE(x, 0.0);
+      sum += x;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-14);
+  }
   // Something reacted: char lost carbon, the carrier gained Fe3O4, heat was exchanged.
   EXPECT_LT(a.tot.solidChange[0], 0.0);
   EXPECT_GT(a.tot.solidChange[3], 0.0);
