@@ -1,5 +1,6 @@
 // coredem-loopback: the protocol loopback server and a one-step exchange client.
 //   coredem-loopback serve    [--endpoint tcp://127.0.0.1:*] [--endpoint-file F] [--idle-limit S]
+//                             [--protocol-minor M]  (speak 1.M, e.g. 0 to act as a v1.0 peer)
 //   coredem-loopback exchange --endpoint E [--grid NX NY NZ] [--species N] [--steps K]
 //                             [--timeout S] [--shutdown]
 // `serve` prints the bound endpoint (and writes it to --endpoint-file) and serves until a
@@ -28,10 +29,11 @@ namespace {
 std::atomic<bool> gStop{false};
 void onSignal(int) { gStop = true; }
 
-int serve(const std::string& endpoint, const std::string& endpointFile, double idleLimit) {
+int serve(const std::string& endpoint, const std::string& endpointFile, double idleLimit, int minor) {
   TransportOptions options;
   options.sender = "coredem-loopback";
-  LoopbackService service(options);
+  LoopbackService service(options, minor < 0 ? kProtocolVersion
+                                             : Version{kProtocolVersion.major, std::uint32_t(minor)});
   std::string bound = service.bind(endpoint);
   if (!endpointFile.empty()) {
     // Write to a temporary name and rename, so a reader never sees a partial endpoint.
@@ -197,6 +199,8 @@ int main(int argc, char** argv) {
   serveCmd->add_option("--endpoint", endpoint, "endpoint to bind (loopback or ipc)");
   serveCmd->add_option("--endpoint-file", endpointFile, "write the bound endpoint here");
   serveCmd->add_option("--idle-limit", idleLimit, "stop after this many seconds without requests (0 = never)");
+  int minor = -1;
+  serveCmd->add_option("--protocol-minor", minor, "speak protocol 1.MINOR (default: this build's)");
 
   std::string target;
   std::vector<std::uint64_t> grid{100, 400, 10};
@@ -214,7 +218,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     if (*serveCmd) {
-      return serve(endpoint, endpointFile, idleLimit);
+      return serve(endpoint, endpointFile, idleLimit, minor);
     }
     return exchange(target, grid, species, steps, timeout, shutdown);
   } catch (const coredem::UserError& e) {
