@@ -51,6 +51,9 @@ def main():
     text = text.replace("  adaptive: {courant: 0.5, dt_min: 1.0e-5, dt_max: 1.0e-3, max_growth: 1.2}\n", "")
     text = text.replace("  dt: 5.0e-4\n", f"  dt: {dt}\n")
     text = text.replace(f"name: dpmfoam-peer-{a.particles}", f"name: overhead-{n**3}")
+    # a 10^6-cell step takes minutes on a loaded 2-core machine: generous deadlines
+    text = text.replace("  case: openfoam\n", "  case: openfoam\n  timeout_s: 1800\n")
+    text = text.replace("  threads: 2\n", "  threads: 2\n  timeout_s: 1800\n")
     os.makedirs(a.outdir, exist_ok=True)
     # write_coredem wrote into OUTDIR/coredem: move it up one level
     import shutil

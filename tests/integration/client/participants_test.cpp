@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <numbers>
 
@@ -225,4 +226,132 @@ TEST(Participants, PythonCtypesParticipantRunsAgainstARealServer) {
   }
   EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0);
   fs::remove_all(dir);
+}
+
+namespace {
+
+/// Runs the small case for `steps` steps with one C++ participant; `exchange` is called once
+/// per granted step and returns the Sources arrays to record (name -> values).
+using Recorded = std::vector<std::map<std::string, std::vector<double>>>;
+template <class Exchange>
+Recorded runRecording(const std::string& name, int steps, Exchange&& exchange, std::string& failure) {
+  const auto dir = tempDir(name);
+  DemProcess dem(dir);
+  MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2"}));
+  Recorded rec;
+  std::thread cfd([&] {
+    try {
+      coredem::client::Options opt;
+      opt.controlEndpoint = o.controlEndpoint();
+      opt.demEndpoint = dem.endpoint();
+      opt.sessionId = o.session();
+      opt.timeoutSeconds = 20;
+      coredem::client::Participant p(opt);
+      p.initialize();
+      while (p.isRunning()) {
+        rec.push_back(exchange(p));
+        p.advance(0.0);
+      }
+      p.finalize();
+    } catch (const std::exception& e) {
+      failure += name + ": unexpected: " + e.what() + "; ";
+    }
+  });
+  const auto res = o.run(steps, 2e-4);
+  cfd.join();
+  EXPECT_EQ(res.cfd.size(), static_cast<std::size_t>(steps)) << name;
+  EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0) << name;
+  fs::remove_all(dir);
+  return rec;
+}
+
+std::vector<coredem::client::NamedField> gasFields(std::size_t n, std::vector<std::vector<double>>& keep) {
+  keep = {std::vector<double>(3 * n, 0.0), std::vector<double>(3 * n, 0.0), std::vector<double>(n, 300.0),
+          std::vector<double>(n, 1.2), std::vector<double>(n, 1.8e-5), std::vector<double>(n, 0.03),
+          std::vector<double>(n, 1000.0), std::vector<double>(n, 1.0)};
+  for (std::size_t c = 0; c < n; ++c) keep[0][3 * c + 1] = 0.3; // gas rising: non-zero drag sources
+  return {{"u_g", keep[0]}, {"grad_p", keep[1]}, {"T_g", keep[2]}, {"rho_g", keep[3]},
+          {"mu_g", keep[4]}, {"kappa_g", keep[5]}, {"cp_g", keep[6]}, {"Y_g", keep[7]}};
+}
+
+} // namespace
+
+// exchange(..., into): arrays received straight into caller buffers are bitwise the arrays the
+// default path (views into the received frames) returns for the same run; field() then points
+// into the caller's buffer; a wrong buffer size is refused before any buffer is written.
+TEST(Participants, CppClientReceivesIntoCallerBuffersBitwiseAsViews) {
+  constexpr int kSteps = 3;
+  std::string failure;
+  const Recorded viewed = runRecording("views", kSteps, [&](coredem::client::Participant& p) {
+    std::vector<std::vector<double>> keep;
+    const auto n = static_cast<std::size_t>(p.grid().cellCount());
+    const auto& s = p.exchange(p.step(), p.dt(), gasFields(n, keep));
+    std::map<std::string, std::vector<double>> out;
+    for (const auto& name : s.names()) {
+      const auto v = s.field(name);
+      out[name].assign(v.begin(), v.end());
+    }
+    const auto t = p.lastExchangeTimes();
+    for (double x : {t.serialise, t.send, t.wait, t.receive}) {
+      if (!(std::isfinite(x) && x >= 0.0)) failure += "exchange time not finite and >= 0; ";
+    }
+    return out;
+  }, failure);
+
+  std::vector<double> eps, kus, h;
+  const Recorded buffered = runRecording("buffers", kSteps, [&](coredem::client::Participant& p) {
+    std::vector<std::vector<double>> keep;
+    const auto n = static_cast<std::size_t>(p.grid().cellCount());
+    const auto fields = gasFields(n, keep);
+    eps.assign(n, -7.0);
+    kus.assign(3 * n, -7.0);
+    h.assign(n, -7.0);
+    // Refusals (nothing is sent or written; the step is then exchanged as usual).
+    auto expectArgument = [&](std::vector<coredem::client::NamedBuffer> into, const char* what,
+                              const char* mentions) {
+      try {
+        p.exchange(p.step(), p.dt(), fields, into);
+        failure += std::string(what) + ": no error; ";
+      } catch (const coredem::client::ClientError& e) {
+        if (e.code() != coredem::client::ErrorCode::Argument ||
+            std::string(e.what()).find(mentions) == std::string::npos)
+          failure += std::string(what) + ": " + e.what() + "; ";
+      }
+    };
+    std::vector<double> tooShort(3 * n - 1, -7.0);
+    expectArgument({{"eps_g", eps.data(), eps.size()}, {"K_sl_Us", tooShort.data(), tooShort.size()}},
+                   "short buffer", "'K_sl_Us' holds");
+    expectArgument({{"T_g", eps.data(), eps.size()}}, "gas name as a Sources buffer", "not a Sources array");
+    if (eps[0] != -7.0 || tooShort[0] != -7.0) failure += "a refused call wrote a buffer; ";
+    const auto& s = p.exchange(p.step(), p.dt(), fields,
+                               {{"eps_g", eps.data(), eps.size()}, {"K_sl_Us", kus.data(), kus.size()},
+                                {"H", h.data(), h.size()}});
+    if (s.field("eps_g").data != eps.data() || s.field("K_sl_Us").data != kus.data() ||
+        s.field("H").data != h.data()) {
+      failure += "field() does not view the caller's buffers; ";
+    }
+    std::map<std::string, std::vector<double>> out;
+    for (const auto& name : s.names()) {
+      const auto v = s.field(name);
+      out[name].assign(v.begin(), v.end());
+    }
+    return out;
+  }, failure);
+  EXPECT_EQ(failure, "");
+  ASSERT_EQ(viewed.size(), static_cast<std::size_t>(kSteps));
+  ASSERT_EQ(buffered.size(), viewed.size());
+  bool nonZeroDrag = false;
+  for (std::size_t k = 0; k < viewed.size(); ++k) {
+    EXPECT_EQ(buffered[k].size(), viewed[k].size()) << "step " << k + 1 << ": other array names";
+    for (const auto& [name, v] : viewed[k]) {
+      const auto it = buffered[k].find(name);
+      ASSERT_NE(it, buffered[k].end()) << name;
+      ASSERT_EQ(it->second.size(), v.size()) << name;
+      // Bitwise: the same DEM run, the same bytes (no tolerance).
+      EXPECT_EQ(std::memcmp(it->second.data(), v.data(), v.size() * sizeof(double)), 0)
+          << "step " << k + 1 << ", " << name;
+      if (name == "K_sl") for (double x : v) nonZeroDrag = nonZeroDrag || x > 0.0;
+    }
+  }
+  EXPECT_TRUE(nonZeroDrag) << "the case should give drag (K_sl > 0) somewhere";
 }
