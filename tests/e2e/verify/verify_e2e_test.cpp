@@ -134,3 +134,25 @@ TEST_F(VerifyE2E, ListAndBadNames) {
   EXPECT_NE(readAll(dir / "v.log").find("no such verification case"), std::string::npos)
       << readAll(dir / "v.log");
 }
+
+TEST_F(VerifyE2E, ForcedDemStepAboveTheStableStepIsRefused) {
+  // The contact pair without `motion: frozen`: t_col/50 = 8.6e-7 s, far below dt_dem = 1e-4 s.
+  copyCase("contact-d36-overlap4e-5", "1.0");
+  const fs::path c = dir / "cases" / "contact-d36-overlap4e-5" / "case.yaml";
+  std::string text = readAll(c);
+  const auto pos = text.find("motion: frozen, ");
+  ASSERT_NE(pos, std::string::npos);
+  writeAll(c, text.erase(pos, std::string("motion: frozen, ").size()));
+  const int rc = coredem::e2e::waitExit(
+      coredem::e2e::startProgram(kBin / "coredem",
+                                 {"run", c.parent_path().string(), "--out",
+                                  (dir / "run").string(), "--no-plots"},
+                                 dir / "r.log"),
+      60s);
+  const std::string log = readAll(dir / "r.log");
+  EXPECT_EQ(rc, 2) << log;
+  EXPECT_NE(log.find("time.dt_dem = 0.0001 s exceeds the DEM server's stable step"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("models: {motion: frozen}"), std::string::npos) << log;
+}
