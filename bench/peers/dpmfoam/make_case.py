@@ -403,7 +403,7 @@ cloudFunctions {{}}
 """)
 
 
-def write_coredem(out, n, sim, wi, pos):
+def write_coredem(out, n, sim, wi, pos, heat=False):
     c = os.path.join(out, "coredem")
     o = os.path.join(c, "openfoam")
     foam(f"{o}/system/blockMeshDict", n, "dictionary", "system", "blockMeshDict",
@@ -536,6 +536,9 @@ boundaryField
         "  backend: cpu",
         "  threads: 2",
     ]
+    if not heat:
+        # DPMFoam runs without heat transfer (heatTransferModel none): so does the DEM here
+        lines += ["models:", "  heat: \"off\""]
     lines += [
         "checkpoint:",
         "  every_steps: 0",

@@ -44,7 +44,7 @@ def main():
     for k in range(a.particles):
         i, j = k % per_row, k // per_row
         pos.append(((i + 0.5) * 1.05 * mc.D_P, 0.5 * mc.D_P * 1.02, (j + 0.5) * 1.05 * mc.D_P))
-    mc.write_coredem(a.outdir, a.particles, dt * a.steps, 1e9, pos)
+    mc.write_coredem(a.outdir, a.particles, dt * a.steps, 1e9, pos, heat=True)
     # overwrite the generated case.yaml's time/grid/walls for this cube
     path = os.path.join(a.outdir, "coredem", "case.yaml")
     text = open(path).read()
