@@ -827,7 +827,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     }
   }
   if (top.has("cfd")) {
-    const Section f = top.section("cfd", {"participant", "gas_key", "case", "timeout_s"});
+    const Section f = top.section("cfd", {"participant", "gas_key", "case", "timeout_s", "timers"});
     c.cfd.participant =
         f.choice("participant", std::string("coredem-gas"), {"coredem-gas", "coredemFoam"});
     if (c.cfd.participant == "coredemFoam") {
@@ -836,6 +836,11 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     }
     c.cfd.gasKey = f.string("gas_key", std::string("gas"), "key of the coredem-gas section");
     c.cfd.timeoutSeconds = f.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
+    const std::string cfdTimers = f.choice("timers", std::string("off"), {"on", "off", "true", "false"});
+    c.cfd.timers = cfdTimers == "on" || cfdTimers == "true";
+    if (c.cfd.timers && c.cfd.participant != "coredemFoam") {
+      f.fail(f.markOf("timers"), "cfd.timers", "stage timers exist in coredemFoam only; remove the key");
+    }
   }
   c.hasGasSection = top.has("gas");
 

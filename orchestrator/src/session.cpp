@@ -531,7 +531,7 @@ void Session::startCfd(const fs::path& gasRestart) {
     if (!gasRestart.empty()) {
       foamArgv.insert(foamArgv.end(), {"-restart", gasRestart.string()});
     }
-    if (_o.timers) {
+    if (_o.timers || _c.cfd.timers) {
       foamArgv.push_back("-timers");  // coredemFoam writes RUN/timers-cfd.json
     }
     std::map<std::string, std::string> env = {

@@ -90,6 +90,7 @@ struct CfdConfig {
   std::string gasKey = "gas"; ///< key of the coredem-gas section
   std::string foamCase;       ///< coredemFoam: OpenFOAM case folder, relative to the case folder
   double timeoutSeconds = 60; ///< deadline for C's next StepDone
+  bool timers = false;        ///< cfd.timers: coredemFoam -timers (RUN/timers-cfd.json)
 };
 
 struct CheckpointConfig {
