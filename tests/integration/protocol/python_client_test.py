@@ -3,7 +3,7 @@
 talks to the C++ loopback server and decodes the C++ golden files.
 
 usage: python_client_test.py PROTOC PROTO_DIR GOLDEN_DIR LOOPBACK_BINARY
-Checks: every golden v1.0 file decodes with Python's protobuf and has the type its name says;
+Checks: every golden v1.0 and v1.1 file decodes with Python's protobuf and has the type its name says;
 the golden GasFields arrays hold 0.25 (f+1) + 0.125 i; over tcp loopback a Python DEALER
 handshakes, configures a 4x3x2 grid, sends GasFields built from numpy arrays and receives
 Sources (eps_g = 1, other sources 0, checksums equal to sequential sums of what was sent);
@@ -46,22 +46,34 @@ def main():
         from coredem.v1 import common_pb2 as common
 
         # --- golden files -------------------------------------------------------------
-        gdir = os.path.join(golden_dir, "v1.0")
-        names = sorted(f[:-5] for f in os.listdir(gdir) if f.endswith(".cdmf"))
-        assert len(names) == 15, names
-        for name in names:
-            frames = read_cdmf(os.path.join(gdir, name + ".cdmf"))
-            env = pb.Envelope()
-            env.ParseFromString(frames[0])
-            assert common.MessageType.Name(env.type) == "MESSAGE_TYPE_" + name.upper(), name
-            assert env.WhichOneof("body") == name, (name, env.WhichOneof("body"))
-            assert len(frames) == 1 + len(env.arrays)
-            for f, (d, raw) in enumerate(zip(env.arrays, frames[1:])):
-                assert d.byte_length == len(raw)
-                values = np.frombuffer(raw, dtype="<f8")
-                expected = 0.25 * (f + 1) + 0.125 * np.arange(values.size)
-                assert np.array_equal(values, expected), (name, d.name)
-        print(f"python: decoded {len(names)} golden files")
+        for version in ("v1.0", "v1.1"):
+            gdir = os.path.join(golden_dir, version)
+            names = sorted(f[:-5] for f in os.listdir(gdir) if f.endswith(".cdmf"))
+            assert len(names) == 15, names
+            for name in names:
+                frames = read_cdmf(os.path.join(gdir, name + ".cdmf"))
+                env = pb.Envelope()
+                env.ParseFromString(frames[0])
+                assert common.MessageType.Name(env.type) == "MESSAGE_TYPE_" + name.upper(), name
+                assert env.WhichOneof("body") == name, (name, env.WhichOneof("body"))
+                assert len(frames) == 1 + len(env.arrays)
+                for f, (d, raw) in enumerate(zip(env.arrays, frames[1:])):
+                    assert d.byte_length == len(raw)
+                    values = np.frombuffer(raw, dtype="<f8")
+                    expected = 0.25 * (f + 1) + 0.125 * np.arange(values.size)
+                    assert np.array_equal(values, expected), (name, d.name)
+            print(f"python: decoded {len(names)} golden {version} files")
+        # v1.1 Configure: explicit positions and chemistry, read by Python's protobuf.
+        env = pb.Envelope()
+        env.ParseFromString(read_cdmf(os.path.join(golden_dir, "v1.1", "configure.cdmf"))[0])
+        c = env.configure
+        assert [s.name for s in c.solid_species] == ["Fe2O3", "Fe3O4", "Al2O3"], c.solid_species
+        assert c.particle_sets[1].positions[1].x == -0.25
+        r = c.reactions[0]
+        assert [(t.species, t.nu) for t in r.terms] == [("Fe3O4", -4.0), ("O2", -1.0), ("Fe2O3", 6.0)]
+        assert r.rate.activation_energy == 8.0e4 and r.heat_of_reaction == -4.75e5
+        assert c.chemistry.clg.oc_reduction and c.chemistry.clg.wgs
+        assert c.chemistry.removal_fraction == 0.125 and not c.chemistry.reaction_heat
 
         # --- live exchange with the C++ loopback server ---------------------------------
         ep_file = os.path.join(tmp, "endpoint")
