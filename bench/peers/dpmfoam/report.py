@@ -79,8 +79,17 @@ def bed_figures(case, alpha_name, sim):
 
 
 def read_time(path):
+    """(wall, cpu) from /usr/bin/time -f '%e %U %S', or None while the program runs."""
+    if not os.path.exists(path):
+        return None
     with open(path) as f:
-        wall, user, sys_ = (float(x) for x in f.read().split()[:3])
+        vals = f.read().split()
+    if len(vals) < 3:
+        return None
+    try:
+        wall, user, sys_ = (float(x) for x in vals[-3:])
+    except ValueError:
+        return None
     return wall, user + sys_
 
 
@@ -110,11 +119,23 @@ def main():
     work, n, sim = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
     rows = {}
     dpm = os.path.join(work, "dpmfoam")
-    if os.path.exists(os.path.join(dpm, "time.txt")):
+    if read_time(os.path.join(dpm, "time.txt")):
         wall, cpu = read_time(os.path.join(dpm, "time.txt"))
         rows["DPMFoam"] = (wall, cpu, bed_figures(dpm, "alpha.air", sim))
+    elif os.path.exists(os.path.join(dpm, "log.DPMFoam")):
+        # still running (or stopped): its rate so far from the log, scaled to SIM_SECONDS
+        text = open(os.path.join(dpm, "log.DPMFoam")).read()
+        times = [float(x) for x in re.findall(r"^Time = (\S+)", text, re.M)]
+        ex = re.findall(r"ExecutionTime = (\S+) s\s+ClockTime = (\S+) s", text)
+        if times and ex:
+            t_done = times[-1] if len(ex) == len(times) else times[len(ex) - 1]
+            cpu, wall = float(ex[-1][0]), float(ex[-1][1])
+            print(f"DPMFoam has not finished: {t_done} of {sim} s simulated after {wall:.0f} s "
+                  f"(CPU {cpu:.0f} s); its row is scaled to {sim} s from that rate")
+            rows["DPMFoam"] = (wall * sim / t_done, cpu * sim / t_done,
+                               bed_figures(dpm, "alpha.air", sim))
     run = os.path.join(work, "coredem-run")
-    if os.path.exists(os.path.join(work, "coredem.time.txt")) and os.path.isdir(run):
+    if read_time(os.path.join(work, "coredem.time.txt")) and os.path.isdir(run):
         wall, cpu = read_time(os.path.join(work, "coredem.time.txt"))
         rows["CoReDEM"] = (wall, cpu, bed_figures(os.path.join(run, "openfoam"), "alphac", sim))
     if not rows:
