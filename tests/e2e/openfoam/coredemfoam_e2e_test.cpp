@@ -343,6 +343,85 @@ TEST_F(CoredemFoamE2E, RestartContinuesWithTheSameFieldsAndDemState) {
   }
 }
 
+// Sending from and receiving into the solver's fields (mesh in grid order) gives bit for bit
+// the run of the gather/scatter copies (COREDEM_FOAM_EXCHANGE=copy); -timers (by `coredem run
+// --timers` and by case.yaml cfd.timers) writes RUN/timers-cfd.json whose stages add up to the
+// step time and count every step.
+TEST_F(CoredemFoamE2E, InPlaceExchangeMatchesCopiesAndTimersAddUp) {
+  const fs::path c = makeCase(dir, 0.9, 293.15,
+                              std::string("time: {end: 0.006, dt: 5.0e-4}\n"
+                                          "checkpoint: {every_steps: 12, keep: 1}\n") +
+                                  kFluidizedBed);
+  const fs::path a = dir / "inplace", b = dir / "copies";
+  ASSERT_EQ(runCoredem({"run", c.string(), "--out", a.string(), "--timers"}, dir / "a.log"), 0)
+      << readAll(dir / "a.log") << logTail(a);
+  // Run b: timers from the case file, copies forced through the environment (inherited by the
+  // programs coredem starts).
+  const std::string yaml = readAll(c / "case.yaml");
+  const std::string cfdLine = "cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120}";
+  ASSERT_NE(yaml.find(cfdLine), std::string::npos);
+  writeAll(c / "case.yaml",
+           replaceAll(yaml, cfdLine,
+                      "cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120, timers: on}"));
+  ::setenv("COREDEM_FOAM_EXCHANGE", "copy", 1);
+  const int rcB = runCoredem({"run", c.string(), "--out", b.string()}, dir / "b.log");
+  ::unsetenv("COREDEM_FOAM_EXCHANGE");
+  ASSERT_EQ(rcB, 0) << readAll(dir / "b.log") << logTail(b);
+  EXPECT_NE(readAll(a / "logs" / "cfd.log").find("Exchange: in place"), std::string::npos);
+  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Exchange: gather/scatter copies"), std::string::npos);
+
+  const fs::path ca = a / "checkpoints" / "00000012", cb = b / "checkpoints" / "00000012";
+  const auto fa = manifestFiles(ca, "cfd"), fb = manifestFiles(cb, "cfd");
+  ASSERT_GE(fa.size(), 6u);
+  ASSERT_EQ(fa, fb);
+  for (const auto& f : fa) {
+    EXPECT_TRUE(readAll(ca / f) == readAll(cb / f)) << f << " differs between in place and copies";
+  }
+  const auto da = manifestFiles(ca, "dem"), db = manifestFiles(cb, "dem");
+  ASSERT_EQ(da.size(), 1u);
+  ASSERT_EQ(db.size(), 1u);
+  const auto sa = datasetsOf(ca / da[0]), sb = datasetsOf(cb / db[0]);
+  for (const auto& [name, bytes] : sa) {
+    if (name.rfind("particles/", 0) == 0) {
+      ASSERT_TRUE(sb.count(name)) << name;
+      EXPECT_TRUE(bytes == sb.at(name)) << "DEM dataset " << name << " differs";
+    }
+  }
+  auto ta = readTimeseries(a), tb = readTimeseries(b);
+  ASSERT_EQ(ta["gas.pressure_drop_Pa"].size(), 12u);
+  EXPECT_EQ(ta["gas.pressure_drop_Pa"], tb["gas.pressure_drop_Pa"]);
+
+  for (const auto& [run, inPlace] : {std::pair{a, true}, std::pair{b, false}}) {
+    const std::string j = readAll(run / "timers-cfd.json");
+    ASSERT_FALSE(j.empty()) << "no timers-cfd.json in " << run;
+    auto number = [&](const std::string& key) {
+      const std::regex re("\"" + key + "\": ([-0-9.eE+]+)");
+      std::smatch m;
+      EXPECT_TRUE(std::regex_search(j, m, re)) << key << " missing in " << j;
+      return m.size() > 1 ? std::strtod(m[1].str().c_str(), nullptr) : std::nan("");
+    };
+    EXPECT_EQ(number("steps"), 12.0);
+    EXPECT_EQ(number("cells"), 500.0);
+    EXPECT_NE(j.find(std::string("\"receive_into_fields\": ") + (inPlace ? "true" : "false")),
+              std::string::npos);
+    const double step = number("step_seconds");
+    double sum = 0.0, shares = 0.0;
+    const std::regex stage("\"seconds\": ([-0-9.eE+]+), \"per_step_s\": [-0-9.eE+]+, \"share\": ([-0-9.eE+]+)");
+    int stages = 0;
+    for (std::sregex_iterator it(j.begin(), j.end(), stage), end; it != end; ++it, ++stages) {
+      sum += std::strtod((*it)[1].str().c_str(), nullptr);
+      shares += std::strtod((*it)[2].str().c_str(), nullptr);
+    }
+    EXPECT_EQ(stages, 12) << j;
+    EXPECT_GT(step, 0.0);
+    // The stages partition the step ("rest" is the remainder); 9 digits are printed.
+    EXPECT_NEAR(sum, step, 1e-7 * step + 1e-9) << j;
+    EXPECT_NEAR(shares, 1.0, 1e-7) << j;
+    EXPECT_GT(number("exchange_share"), 0.0);
+    EXPECT_LT(number("exchange_share"), 1.0);
+  }
+}
+
 // Coupling mesh v1: a mesh that is not the uniform Cartesian coupling grid is refused with the
 // first offending cell named (here the block is graded along y).
 TEST_F(CoredemFoamE2E, NonUniformMeshIsRefusedNamingTheCell) {
