@@ -163,7 +163,7 @@ def main():
             for r in rows:
                 f.write(f"| {r['label']} | {r['tend']:.3f} | {r['Tend']:.3f} | {r['seed_end']:.2f} | "
                         f"{r['bound_end']:.3f} ({r['tau']:.1f} s) | {-r['gasq'][-1]:.4f} | "
-                        f"{-r['wall'][-1]:.4f} | {r['part_res'][-1]:.2e} | {r['gas_res'][-1]:.2e} | "
+                        f"{0.0 - r['wall'][-1] + 0.0:.4f} | {r['part_res'][-1]:.2e} | {r['gas_res'][-1]:.2e} | "
                         f"{r['wall_s']:.0f} |\n")
     for p in (out1, out2):
         print(f"plot: {p} ({os.path.getsize(p) // 1024} kB)")
