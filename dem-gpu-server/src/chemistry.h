@@ -29,6 +29,7 @@
 #include "engine.h"
 #include "particle_store.h"
 
+#include "coredem/common/check.h"
 #include "coredem/dem/chemistry_options.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
 #include "coredem/dem/kernels/species_particle.h"
@@ -49,7 +50,9 @@ public:
 
   ChemistrySetup _c;
   Dual<kernels::HeterogeneousReaction> _reactions;
-  Dual<kernels::Stoichiometry> _nasa;
+  /// ΔH_r polynomials (combineReactionEnthalpy): one per data-defined reaction (n = 0: constant
+  /// dH), then R1, R2, R4, R5 at kClgHeat.
+  Dual<kernels::ReactionEnthalpyPoly> _dh;
   Dual<double> _gasM, _cp;
   Dual<double> _rhoG, _yg;       ///< gas fields (per cell)
   bool _hasRho = false, _hasY = false;
@@ -73,7 +76,15 @@ public:
       arr.toDevice();
     };
     put(_reactions, c.reactions);
-    put(_nasa, c.reactionNasa7);
+    std::vector<kernels::ReactionEnthalpyPoly> dh;
+    for (const kernels::Stoichiometry& st : c.reactionNasa7)
+      dh.push_back(st.n > 0 ? kernels::combineReactionEnthalpy(st) : kernels::ReactionEnthalpyPoly{});
+    for (kernels::ClgReaction r : {kernels::ClgReaction::R1, kernels::ClgReaction::R2, kernels::ClgReaction::R4,
+                                   kernels::ClgReaction::R5})
+      dh.push_back(kernels::combineReactionEnthalpy(kernels::clgStoichiometry(r)));
+    for (const kernels::ReactionEnthalpyPoly& h : dh)
+      COREDEM_ASSERT(h.n >= 0);  // all species' breaks together are 850, 960, 1000, 1200 K: 5 pieces
+    put(_dh, dh);
     put(_gasM, c.gasMolarMass);
     put(_cp, c.materialCp);
     _width = c.params.nGas + c.params.nSolid + 1;
@@ -107,7 +118,7 @@ public:
 
   std::size_t bytes() const {
     auto& s = const_cast<ChemistryModule&>(*this);
-    return s._reactions.bytes() + s._nasa.bytes() + s._gasM.bytes() + s._cp.bytes() + s._rhoG.bytes() +
+    return s._reactions.bytes() + s._dh.bytes() + s._gasM.bytes() + s._cp.bytes() + s._rhoG.bytes() +
            s._yg.bytes() + _gdot.bytes() + _dsolid.bytes() + _q.bytes() + s._acc.bytes();
   }
 
@@ -146,7 +157,10 @@ public:
     double* dsol = _dsolid.d();
     double* q = _q.d();
     const kernels::HeterogeneousReaction* reac = _reactions.d();
-    const kernels::Stoichiometry* nasa = _nasa.d();
+    const kernels::ReactionEnthalpyPoly* dhPoly = _dh.d();
+    // R1/R2 and R4/R5 heats (none when reaction heat is off: the heat is not used then).
+    const kernels::ReactionEnthalpyPoly* dhChar = cp.reactionHeat ? dhPoly + cp.nReactions : nullptr;
+    const kernels::ReactionEnthalpyPoly* dhOc = cp.reactionHeat ? dhPoly + cp.nReactions + 2 : nullptr;
     const double* gasM = _gasM.d();
     const double* rhoG = gas ? _rhoG.d() : nullptr;
     const double* yg = gas ? _yg.d() : nullptr;
@@ -162,7 +176,11 @@ public:
       for (int k = 0; k < nS; ++k) solidRate[k] = 0.0;
       for (int k = 0; k < nG; ++k) gasRate[k] = 0.0;
       double heat = 0.0;
-      const bool active = !(2.0 * r[i] < frac * d0[i]);
+      // A particle holding none of the reactants of any enabled model does nothing (the data-defined
+      // reactions check their own solid reactants).
+      const bool hasReactant = cp.nReactions > 0 || (cp.charOn && cp.solidC >= 0 && sm[cp.solidC] > 0.0) ||
+                               (cp.ocOn && cp.solidFe2O3 >= 0 && sm[cp.solidFe2O3] > 0.0);
+      const bool active = hasReactant && !(2.0 * r[i] < frac * d0[i]);
       if (active) {
         const double tp = T[i];
         // Gas of the particle's PCM cell (no gas: gas-dependent rates are zero).
@@ -191,12 +209,12 @@ public:
           const HeterogeneousReaction& rx = reac[a];
           const double w = heterogeneousExtentRate(rx, tp, conc, sm, dt);
           addHeterogeneousSources(rx, w, solidRate, gasRate);
-          const double dH = nasa[a].n > 0 ? reactionEnthalpy(nasa[a], tp) : rx.dH;
-          heat -= dH * w;
+          if (w != 0.0) heat -= (dhPoly[a].n > 0 ? reactionEnthalpy(dhPoly[a], tp) : rx.dH) * w;
         }
         // R1 + R2 (char).
         if (cp.charOn && cp.solidC >= 0) {
-          const CharGasificationRates cr = charGasification(cp.charParams, tp, pBar, sm[cp.solidC], ref[2 * i]);
+          const CharGasificationRates cr =
+              charGasificationHoisted(cp.charParams, dhChar, tp, pBar, sm[cp.solidC], ref[2 * i]);
           solidRate[cp.solidC] += cr.mdotC;
           for (int g = 0; g < kGasSpeciesCount; ++g)
             if (cp.gasIndex[g] >= 0) gasRate[cp.gasIndex[g]] += cr.mdotGas[g];
@@ -206,8 +224,8 @@ public:
         if (cp.ocOn && cp.solidFe2O3 >= 0 && cp.solidFe3O4 >= 0 && mi > 0.0) {
           const double mf[3] = {sm[cp.solidFe2O3] / mi, sm[cp.solidFe3O4] / mi, 0.0};
           const int iCO = cp.gasIndex[idx(GasSpecies::CO)], iH2 = cp.gasIndex[idx(GasSpecies::H2)];
-          const OcReductionRates orr = ocReduction(cp.ocParams, tp, mi, mf, iCO >= 0 ? conc[iCO] : 0.0,
-                                                   iH2 >= 0 ? conc[iH2] : 0.0);
+          const OcReductionRates orr = ocReductionHoisted(cp.ocParams, dhOc, tp, mi, mf, iCO >= 0 ? conc[iCO] : 0.0,
+                                                          iH2 >= 0 ? conc[iH2] : 0.0);
           solidRate[cp.solidFe2O3] += orr.mdotSolid[idx(OcSolid::Fe2O3)];
           solidRate[cp.solidFe3O4] += orr.mdotSolid[idx(OcSolid::Fe3O4)];
           for (int g = 0; g < kGasSpeciesCount; ++g)

@@ -1,6 +1,10 @@
 // NASA-7 data, reaction enthalpies and equilibrium constants vs PHYSICS.md §3.5 / Appendix A
 // and the numbers printed by physics/reference/nasa.py (same Burcat/MFiX coefficients).
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -170,4 +174,65 @@ TEST(ReactionEnthalpy, ReactionsBalanceMassToRoundOff) {
     SCOPED_TRACE(static_cast<int>(r.s));
     EXPECT_NEAR(k::molarMass(r.s) * 1e3, r.gPerMol, 2.1e-3);
   }
+}
+
+// The combined ΔH_r polynomial (one NASA-7-form polynomial per piece, pieces split at every
+// species' interval break) equals the species sum Σ ν H_n(T) over 250–3000 K in 1 K steps and
+// just below/at/just above every break (both sides of every T_mid), for R1–R5 and a generic
+// reaction mixing species with different breaks (Fe2O3 960/1000 K, Fe3O4 850/1000 K, Al2O3
+// 1000/1200 K). The only difference is the summation order, so the error is round-off of a
+// cancelling sum: bounded by 1e-12 Σ|ν_n H_n(T)| everywhere, and 1e-12 |ΔH_r| wherever |ΔH_r| ≥
+// 1e-3 Σ|ν_n H_n| (everywhere except close to a zero of ΔH_r, e.g. R4 extrapolated far past its
+// data near 2600 K or R5 near 900 K, where no relative bound on ΔH_r itself can hold).
+TEST(ReactionEnthalpy, CombinedPolynomialEqualsSpeciesSum) {
+  std::vector<std::pair<const char*, k::Stoichiometry>> reactions;
+  const char* names[] = {"R1", "R2", "R3", "R4", "R5"};
+  for (int i = 0; i < 5; ++i) reactions.emplace_back(names[i], k::clgStoichiometry(static_cast<k::ClgReaction>(i)));
+  // Generic (not a real reaction; the identity holds for any ν): six species, four breaks.
+  reactions.emplace_back("generic", k::Stoichiometry{6,
+                                                     {Species::Fe3O4, Species::Al2O3, Species::H2, Species::Fe2O3,
+                                                      Species::N2, Species::C},
+                                                     {-1.0, 0.5, 2.0, 1.5, -0.25, -3.0}});
+  for (const auto& [name, st] : reactions) {
+    SCOPED_TRACE(name);
+    const k::ReactionEnthalpyPoly h = k::combineReactionEnthalpy(st);
+    ASSERT_GT(h.n, 0);
+    std::vector<double> temps;
+    for (double t = 250.0; t <= 3000.0; t += 1.0) temps.push_back(t);
+    // Every break of every species, from both sides.
+    int breaks = 0;
+    for (int s = 0; s < st.n; ++s) {
+      const k::Nasa7Data d = k::nasa7Data(st.species[s]);
+      for (int i = 0; i + 1 < d.n; ++i) {
+        const double b = d.iv[i].tMax;
+        ++breaks;
+        for (double t : {std::nextafter(b, 0.0), b, std::nextafter(b, 1e9), b - 1e-6, b + 1e-6}) temps.push_back(t);
+      }
+    }
+    EXPECT_GE(h.n, 2);
+    EXPECT_LE(h.n, breaks + 1);
+    double worst = 0.0;
+    std::size_t relChecked = 0;
+    for (double t : temps) {
+      const double ref = k::reactionEnthalpy(st, t);
+      const double got = k::reactionEnthalpy(h, t);
+      double scale = 0.0;
+      for (int s = 0; s < st.n; ++s) scale += std::fabs(st.nu[s] * k::nasa7EnthalpyMolar(st.species[s], t));
+      ASSERT_NEAR(got, ref, 1e-12 * scale) << "T = " << t;
+      if (std::fabs(ref) >= 1e-3 * scale) {
+        ++relChecked;
+        worst = std::max(worst, std::fabs(got - ref) / std::fabs(ref));
+        ASSERT_NEAR(got, ref, 1e-12 * std::fabs(ref)) << "T = " << t;
+      }
+    }
+    EXPECT_GT(relChecked, temps.size() * 3 / 4);  // the relative bound covers most of the range
+    RecordProperty(std::string("worst_rel_") + name, std::to_string(worst));
+  }
+  // The generic reaction's pieces split at 850, 960, 1000 and 1200 K.
+  const k::ReactionEnthalpyPoly g = k::combineReactionEnthalpy(reactions.back().second);
+  ASSERT_EQ(g.n, 5);
+  EXPECT_EQ(g.tUpper[0], 850.0);
+  EXPECT_EQ(g.tUpper[1], 960.0);
+  EXPECT_EQ(g.tUpper[2], 1000.0);
+  EXPECT_EQ(g.tUpper[3], 1200.0);
 }

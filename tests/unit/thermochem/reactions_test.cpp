@@ -220,3 +220,72 @@ TEST(OcReduction, ConservationAlongAReductionPath) {
   EXPECT_NEAR(m0 - m, reduced * 15.999e-3 / (3.0 * k::molarMass(k::Species::Fe2O3)),
               1e-10 * (m0 - m));
 }
+
+// ---- the engine's hoisted kernels equal the reference ones ------------------------------------
+
+// charGasificationHoisted / ocReductionHoisted (1/(RT) once, no exp for T-independent adsorption,
+// one exp instead of exp·pow, combined ΔH_r polynomials) give the reference kernels' rates and
+// heat to 1e-12 relative (round-off of the reordered arithmetic: exp of an argument |x| ≲ 30
+// carries ~|x|·1e-16), over 600–1600 K and several compositions, including absent gases. The
+// heat is a cancelling sum (ΔH_R5 changes sign near 900 K): its bound is 1e-12 Σ_j ṅ_j Σ_n |ν_n H_n|.
+namespace {
+double enthalpyScale(k::ClgReaction r, double t) {
+  const k::Stoichiometry st = k::clgStoichiometry(r);
+  double s = 0.0;
+  for (int n = 0; n < st.n; ++n) s += std::fabs(st.nu[n] * k::nasa7EnthalpyMolar(st.species[n], t));
+  return s;
+}
+} // namespace
+TEST(HoistedKernels, CharAndOcEqualTheReferenceKernels) {
+  const k::CharGasificationParams cp;
+  const k::OcReductionParams op;
+  const k::ReactionEnthalpyPoly charDh[2] = {k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R1)),
+                                              k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R2))};
+  const k::ReactionEnthalpyPoly ocDh[2] = {k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R4)),
+                                            k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R5))};
+  auto near = [](double got, double ref, const char* what, double t) {
+    EXPECT_NEAR(got, ref, 1e-12 * std::fabs(ref)) << what << " T = " << t;
+  };
+  const double pBars[3][5] = {{0.05, 0.2, 0.05, 0.5, 0.2}, {0.1, 0.0, 0.1, 0.3, 0.5}, {0.2, 0.3, 0.0, 0.0, 0.5}};
+  const double mC0 = 1540.0 * v::sphereVolume(0.48e-3);
+  const double m = 3734.0 * v::sphereVolume(0.48e-3);
+  const double x[3] = {0.3, 0.2, 0.5};
+  const double conc[3][2] = {{2.0, 3.0}, {0.0, 1.5}, {0.7, 0.0}};
+  int nonzero = 0;
+  for (double t = 600.0; t <= 1600.0; t += 37.0) {
+    for (const auto& pb : pBars) {
+      const auto ref = k::charGasification(cp, t, pb, 0.3 * mC0, mC0);
+      const auto got = k::charGasificationHoisted(cp, charDh, t, pb, 0.3 * mC0, mC0);
+      near(got.nR1, ref.nR1, "nR1", t);
+      near(got.nR2, ref.nR2, "nR2", t);
+      near(got.mdotC, ref.mdotC, "mdotC", t);
+      for (int g = 0; g < k::kGasSpeciesCount; ++g) near(got.mdotGas[g], ref.mdotGas[g], "mdotGas", t);
+      EXPECT_NEAR(got.heat, ref.heat,
+                  1e-12 * (enthalpyScale(k::ClgReaction::R1, t) * ref.nR1 + enthalpyScale(k::ClgReaction::R2, t) * ref.nR2))
+          << t;
+      EXPECT_EQ(k::charGasificationHoisted(cp, nullptr, t, pb, 0.3 * mC0, mC0).heat, 0.0);
+      nonzero += ref.nR1 > 0.0 && ref.nR2 > 0.0 ? 1 : 0;
+    }
+    for (const auto& c : conc) {
+      const auto ref = k::ocReduction(op, t, m, x, c[0], c[1]);
+      const auto got = k::ocReductionHoisted(op, ocDh, t, m, x, c[0], c[1]);
+      near(got.nR4, ref.nR4, "nR4", t);
+      near(got.nR5, ref.nR5, "nR5", t);
+      EXPECT_EQ(got.conversion, ref.conversion);
+      for (int s = 0; s < 3; ++s) near(got.mdotSolid[s], ref.mdotSolid[s], "mdotSolid", t);
+      for (int g = 0; g < k::kGasSpeciesCount; ++g) near(got.mdotGas[g], ref.mdotGas[g], "mdotGas", t);
+      EXPECT_NEAR(got.heat, ref.heat,
+                  1e-12 * (enthalpyScale(k::ClgReaction::R4, t) * ref.nR4 + enthalpyScale(k::ClgReaction::R5, t) * ref.nR5))
+          << t;
+    }
+  }
+  EXPECT_GT(nonzero, 0);
+  // No reactant: nothing (and no rates from absent gases).
+  const double none[5] = {0.0, 0.0, 0.0, 0.0, 1.0};
+  EXPECT_EQ(k::charGasificationHoisted(cp, charDh, 1200.0, none, mC0, mC0).mdotC, 0.0);
+  EXPECT_EQ(k::charGasificationHoisted(cp, charDh, 1200.0, pBars[0], 0.0, mC0).mdotC, 0.0);
+  const double inert[3] = {0.0, 0.6, 0.4};
+  const auto o = k::ocReductionHoisted(op, ocDh, 1200.0, m, inert, 2.0, 3.0);
+  EXPECT_EQ(o.nR4 + o.nR5, 0.0);
+  EXPECT_EQ(o.conversion, k::ocReduction(op, 1200.0, m, inert, 2.0, 3.0).conversion);
+}

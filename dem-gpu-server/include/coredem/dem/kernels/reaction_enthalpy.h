@@ -63,6 +63,68 @@ DEM_HD double reactionEnthalpy(ClgReaction r, double T) {
   return reactionEnthalpy(clgStoichiometry(r), T);
 }
 
+/// ΔH_r(T) of one reaction as one NASA-7-form polynomial per temperature piece: on a piece
+/// where every species uses one interval, Σ ν_n H_n(T) = R [T (c0 + T (c1 + T (c2 + T (c3 +
+/// T c4)))) + c5] with c_m = Σ ν_n a_m,n/(m+1) (m < 5) and c5 = Σ ν_n a_6,n. The pieces are split
+/// at every interval break of every species (the union of their T_mid values), so the form
+/// equals the species sum up to round-off at every T, including the extrapolated ends
+/// (reactionEnthalpy(Stoichiometry) is the reference; tests/unit/thermochem/nasa7_test.cpp).
+/// Built once per reaction on the host (combineReactionEnthalpy); one polynomial per call.
+inline constexpr int kMaxEnthalpyPieces = 8;
+
+struct ReactionEnthalpyPoly {
+  int n = 0;                                  ///< pieces (0: none; −1: too many breaks)
+  double tUpper[kMaxEnthalpyPieces] = {};     ///< upper end of piece k, K (k < n − 1)
+  double c[kMaxEnthalpyPieces][6] = {};       ///< coefficients of piece k (see above)
+};
+
+/// Combined coefficients of a reaction (pieces at every species interval break; n = −1 if
+/// there are more than kMaxEnthalpyPieces pieces). Same interval rule as nasa7IntervalIndex: at
+/// a break the upper piece is used.
+DEM_HD constexpr ReactionEnthalpyPoly combineReactionEnthalpy(const Stoichiometry& s) {
+  ReactionEnthalpyPoly out{};
+  double breaks[kMaxStoichTerms * 2 + 1] = {};
+  int nb = 0;
+  for (int k = 0; k < s.n; ++k) {
+    const Nasa7Data d = nasa7Data(s.species[k]);
+    for (int i = 0; i + 1 < d.n; ++i) {
+      const double b = d.iv[i].tMax;
+      bool seen = false;
+      for (int j = 0; j < nb; ++j) seen = seen || breaks[j] == b;
+      if (seen) continue;
+      if (nb >= kMaxEnthalpyPieces - 1) {
+        out.n = -1;
+        return out;
+      }
+      int j = nb++;
+      for (; j > 0 && breaks[j - 1] > b; --j) breaks[j] = breaks[j - 1];  // keep sorted
+      breaks[j] = b;
+    }
+  }
+  out.n = nb + 1;
+  for (int p = 0; p < out.n; ++p) {
+    out.tUpper[p] = p < nb ? breaks[p] : 0.0;
+    // Every species' interval on this piece: the one at the piece's lower end (piece 0: the
+    // first interval of every species, extrapolated below the data as nasa7EnthalpyMolar does).
+    const double tLow = p == 0 ? -1.0 : breaks[p - 1];
+    for (int k = 0; k < s.n; ++k) {
+      const Nasa7Data d = nasa7Data(s.species[k]);
+      const double* a = d.iv[nasa7IntervalIndex(d, tLow)].a;
+      for (int m = 0; m < 5; ++m) out.c[p][m] += s.nu[k] * (a[m] / (m + 1.0));
+      out.c[p][5] += s.nu[k] * a[5];
+    }
+  }
+  return out;
+}
+
+/// Heat of reaction ΔH_r(T) from the combined coefficients, J per mol of reaction (Eq. 29).
+DEM_HD double reactionEnthalpy(const ReactionEnthalpyPoly& h, double T) {
+  int p = 0;
+  while (p + 1 < h.n && T >= h.tUpper[p]) ++p;
+  const double* c = h.c[p];
+  return kGasConstant * (T * (c[0] + T * (c[1] + T * (c[2] + T * (c[3] + T * c[4])))) + c[5]);
+}
+
 /// Standard Gibbs energy of reaction ΔG°_r(T), J/mol.
 DEM_HD double reactionGibbs(const Stoichiometry& s, double T) {
   double dG = 0.0;

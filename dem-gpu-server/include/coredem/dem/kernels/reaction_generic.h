@@ -50,11 +50,13 @@ struct HeterogeneousReaction {
 DEM_HD double heterogeneousRate(const HeterogeneousReaction& r, double tP, const double* gasConc) {
   double w = r.A;
   if (r.law == RateLaw::Arrhenius) {
-    w *= std::pow(tP, r.beta) * std::exp(-r.E / (8.314462618 * tP));
+    // T^β exp(−E/(RT)) as one exp() (β = 0: no log).
+    const double arg = -r.E / (8.314462618 * tP);
+    w *= std::exp(r.beta == 0.0 ? arg : r.beta * std::log(tP) + arg);
   }
   if (r.orderTerm >= 0) {
     const double c = gasConc[r.index[r.orderTerm]];
-    w *= c > 0.0 ? std::pow(c, r.order) : 0.0;
+    w *= c > 0.0 ? (r.order == 1.0 ? c : std::pow(c, r.order)) : 0.0;
   }
   return w;
 }
