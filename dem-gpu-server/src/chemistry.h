@@ -29,13 +29,13 @@
 #include "engine.h"
 #include "particle_store.h"
 
-#include "coredem/common/check.h"
 #include "coredem/dem/chemistry_options.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
 #include "coredem/dem/kernels/species_particle.h"
 
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
 namespace coredem::dem {
@@ -82,8 +82,11 @@ public:
     for (kernels::ClgReaction r : {kernels::ClgReaction::R1, kernels::ClgReaction::R2, kernels::ClgReaction::R4,
                                    kernels::ClgReaction::R5})
       dh.push_back(kernels::combineReactionEnthalpy(kernels::clgStoichiometry(r)));
+    // All species' breaks together are 850, 960, 1000, 1200 K (5 pieces), so this cannot fire
+    // unless species data with more breaks are added (then raise kMaxEnthalpyPieces). No check.h
+    // here: this header is compiled by nvcc, which cannot take fmt.
     for (const kernels::ReactionEnthalpyPoly& h : dh)
-      COREDEM_ASSERT(h.n >= 0);  // all species' breaks together are 850, 960, 1000, 1200 K: 5 pieces
+      if (h.n < 0) throw std::logic_error("chemistry: a reaction has more than kMaxEnthalpyPieces enthalpy pieces");
     put(_dh, dh);
     put(_gasM, c.gasMolarMass);
     put(_cp, c.materialCp);
