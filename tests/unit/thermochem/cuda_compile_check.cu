@@ -43,6 +43,13 @@ __global__ void thermochemKernelsCompileCheck(const double* in, double* out, int
   acc += k::charGasification(k::CharGasificationParams{}, t, pBar, 1e-9, 2e-9).heat;
   const double x[3] = {0.6, 0.0, 0.4};
   acc += k::ocReduction(k::OcReductionParams{}, t, 1e-6, x, 1.0, 1.0).heat;
+  // The engine's hoisted kernels with combined ΔH_r polynomials (built on the device here only
+  // to compile combineReactionEnthalpy for it; the engine builds them on the host).
+  const k::ReactionEnthalpyPoly dh[2] = {k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R4)),
+                                         k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R5))};
+  acc += k::reactionEnthalpy(dh[0], t);
+  acc += k::charGasificationHoisted(k::CharGasificationParams{}, dh, t, pBar, 1e-9, 2e-9).heat;
+  acc += k::ocReductionHoisted(k::OcReductionParams{}, dh, t, 1e-6, x, 1.0, 1.0).heat;
   const double y[k::kGasSpeciesCount] = {0.2, 0.1, 0.01, 0.3, 0.39};
   acc += k::wgsCellSources(k::WgsParams{}, t, 0.9, 0.3, y, 1e-3).heatSource;
   double m = 1e-6;
