@@ -485,7 +485,7 @@ std::vector<Metric> checkRadiation(const CaseSpec& spec, const CaseConfig& c,
 }
 
 /// A(g) + 2B(s) → C(g) + D(s) at a constant rate on one particle (§8.5), schema of
-/// chem-schema (species, solid_species, reactions[0] with a constant rate).
+/// docs/case-schema.md (species, solid_species, reactions[0] with a constant rate).
 std::vector<Metric> checkReaction(const CaseSpec& spec, const CaseConfig& c,
                                   const std::vector<Snapshot>& snaps, Series& series) {
   const auto ps = particlesOf(c);
