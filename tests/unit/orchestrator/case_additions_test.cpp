@@ -9,7 +9,11 @@
 #include <coredem/dem/dem_system.h>
 #include <coredem/orchestrator/case_config.h>
 
+#include "case_text.h"
+
 using namespace coredem::orchestrator;
+using coredem::orchestrator::test::errorOf;
+using coredem::orchestrator::test::replace;
 namespace fs = std::filesystem;
 
 namespace {
@@ -31,21 +35,6 @@ particles:
     positions: [[0.005, 0.002, 0.005], [0.005, 0.0049, 0.005]]
 models: {motion: frozen}
 )";
-
-std::string errorOf(const std::string& text) {
-  try {
-    parseCase(text, "cases/x/case.yaml", fs::temp_directory_path());
-  } catch (const CaseError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-std::string replace(std::string s, const std::string& from, const std::string& to) {
-  const auto pos = s.find(from);
-  EXPECT_NE(pos, std::string::npos) << from;
-  return s.replace(pos, from.size(), to);
-}
 
 } // namespace
 

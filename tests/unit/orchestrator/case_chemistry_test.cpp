@@ -9,11 +9,15 @@
 #include <coredem/common/check.h>
 #include <coredem/dem/dem_system.h>
 #include <coredem/orchestrator/case_config.h>
+
+#include "case_text.h"
 #include <coredem/v1/configure.pb.h>
 
 #include "configure_map.h"
 
 using namespace coredem::orchestrator;
+using coredem::orchestrator::test::errorOf;
+using coredem::orchestrator::test::replace;
 namespace fs = std::filesystem;
 
 namespace {
@@ -54,21 +58,6 @@ chemistry:
   reaction_heat: off
 models: {heat: "off"}
 )";
-
-std::string errorOf(const std::string& text) {
-  try {
-    parseCase(text, "cases/x/case.yaml", fs::temp_directory_path());
-  } catch (const CaseError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-std::string replace(std::string s, const std::string& from, const std::string& to) {
-  const auto pos = s.find(from);
-  EXPECT_NE(pos, std::string::npos) << from;
-  return s.replace(pos, from.size(), to);
-}
 
 } // namespace
 

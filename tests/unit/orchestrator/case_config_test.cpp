@@ -7,7 +7,11 @@
 
 #include <coredem/orchestrator/case_config.h>
 
+#include "case_text.h"
+
 using namespace coredem::orchestrator;
+using coredem::orchestrator::test::errorOf;
+using coredem::orchestrator::test::replace;
 namespace fs = std::filesystem;
 
 namespace {
@@ -33,21 +37,6 @@ particles:
 checkpoint: {every_steps: 10, keep: 2}
 output: {every: 5}
 )";
-
-std::string errorOf(const std::string& text) {
-  try {
-    parseCase(text, "cases/x/case.yaml", fs::temp_directory_path());
-  } catch (const CaseError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-std::string replace(std::string s, const std::string& from, const std::string& to) {
-  const auto pos = s.find(from);
-  EXPECT_NE(pos, std::string::npos) << from;
-  return s.replace(pos, from.size(), to);
-}
 
 } // namespace
 
