@@ -12,10 +12,14 @@
 ///   3. species masses m_k += Δt ṁ_k (Eq. 31; inert species unchanged), m = Σ m_k, X_k = m_k/m,
 ///      radius from the mass at constant density (Eq. 32): the contact model uses it from the
 ///      next force evaluation on, the motion update of this sub-step uses the new mass
-///   4. per cell (segment heads of the PCM order): Σ ṁ_gas Δt, Σ Δm_solid, Σ Q_rxn Δt added to the
-///      window accumulators (row nCells: particles outside the grid, ledgers only)
+///   4. per cell (segment heads of the PCM order): Σ ṁ_gas Δt, Σ Δm_solid, Σ Q_rxn Δt, the sensible
+///      heat of the transferred gas Σ ṁ_gas,i c_p,g (T_p,i − T_g) Δt (gas enters at T_p, not T_g;
+///      c_p,g, T_g of the cell from the frozen gas; 0 outside the grid or without gas fields) and the
+///      particle-side Σ Δm_i c_p,i T_p,i (J) added to the window accumulators (row nCells:
+///      particles outside the grid, ledgers only)
 ///   5. after the heat module's temperature update: T += Δt Q_rxn/(m c_p) (when reaction heat is on)
-/// At the window end R_species = Σ ṁ Δt/(V_c t_window) and the WGS (R3) of every cell is added
+/// At the window end R_species = Σ ṁ Δt/(V_c t_window), Q_hom = Σ ṁ_gas c_p,g (T_p − T_g) Δt/(V_c
+/// t_window) and the WGS (R3) of every cell is added
 /// from the frozen gas (host, once per CFD step). A particle whose diameter fell below
 /// removalFraction·d_0 stops reacting and is reported (pendingRemoval) so that DemSystem removes
 /// it at the CFD-step boundary.
@@ -55,13 +59,15 @@ public:
   Dual<kernels::ReactionEnthalpyPoly> _dh;
   Dual<double> _gasM, _cp;
   Dual<double> _rhoG, _yg;       ///< gas fields (per cell)
-  bool _hasRho = false, _hasY = false;
+  Dual<double> _tgCell, _cpgCell;  ///< T_g, c_p,g per cell (sensible heat of the transferred gas)
+  bool _hasRho = false, _hasY = false, _hasTg = false, _hasCpG = false;
   std::vector<double> _tgHost, _rhoHost, _ygHost;
   Dev<double> _gdot;             ///< per particle: gas mass rates (kg/s), N*nGas
   Dev<double> _dsolid;           ///< per particle: solid mass change in this sub-step (kg), N*nSolid
   Dev<double> _q;                ///< per particle: Q_rxn (W)
-  Dual<double> _acc;             ///< (nCells+1)*W: Σ gas kg, Σ solid kg, Σ Q_rxn J over the window
-  int _width = 0;                ///< W = nGas + nSolid + 1
+  Dev<double> _sens;             ///< per particle: ṁ_gas c_p,g (T_p − T_g) (W), Δm c_p T_p (J); N*2
+  Dual<double> _acc;             ///< (nCells+1)*W: Σ gas kg, Σ solid kg, Σ Q_rxn J, Σ gas sensible J, Σ Δm c T J
+  int _width = 0;                ///< W = nGas + nSolid + 3
   double _dt = 0.0;
   bool _pending = false;         ///< a particle is below the removal diameter
   ChemistryTotals _totals;
@@ -90,7 +96,7 @@ public:
     put(_dh, dh);
     put(_gasM, c.gasMolarMass);
     put(_cp, c.materialCp);
-    _width = c.params.nGas + c.params.nSolid + 1;
+    _width = c.params.nGas + c.params.nSolid + 3;
     _acc.allocate((nCells + 1) * static_cast<std::size_t>(_width));
     for (std::size_t k = 0; k < _acc.size(); ++k) _acc.h()[k] = 0.0;
     _acc.markHostModified();
@@ -114,6 +120,8 @@ public:
     };
     _hasRho = put(_rhoG, g.rhoG);
     _hasY = put(_yg, g.Yg);
+    _hasTg = put(_tgCell, g.Tg);
+    _hasCpG = put(_cpgCell, g.cpG);
     _tgHost = g.Tg;
     _rhoHost = g.rhoG;
     _ygHost = g.Yg;
@@ -122,7 +130,8 @@ public:
   std::size_t bytes() const {
     auto& s = const_cast<ChemistryModule&>(*this);
     return s._reactions.bytes() + s._dh.bytes() + s._gasM.bytes() + s._cp.bytes() + s._rhoG.bytes() +
-           s._yg.bytes() + _gdot.bytes() + _dsolid.bytes() + _q.bytes() + s._acc.bytes();
+           s._yg.bytes() + s._tgCell.bytes() + s._cpgCell.bytes() + _gdot.bytes() + _dsolid.bytes() + _q.bytes() +
+           _sens.bytes() + s._acc.bytes();
   }
 
   void beginWindow(Exec& exec) {
@@ -146,8 +155,10 @@ public:
     _gdot.reserve(n * static_cast<std::size_t>(nG > 0 ? nG : 1));
     _dsolid.reserve(n * static_cast<std::size_t>(nS > 0 ? nS : 1));
     _q.reserve(n);
+    _sens.reserve(2 * n);
     const bool coupled = s.coupled;
     const bool gas = coupled && gasPresent && _hasRho && _hasY;
+    const bool sensGas = coupled && gasPresent && _hasTg && _hasCpG;
     const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
     const double* T = p.temperature.d();
     const double* rho = p.density.d();
@@ -159,6 +170,11 @@ public:
     double* gdot = _gdot.d();
     double* dsol = _dsolid.d();
     double* q = _q.d();
+    double* sens = _sens.d();
+    const std::int32_t* mat = p.material.d();
+    const double* cpm = _cp.d();
+    const double* tgC = sensGas ? _tgCell.d() : nullptr;
+    const double* cpgC = sensGas ? _cpgCell.d() : nullptr;
     const kernels::HeterogeneousReaction* reac = _reactions.d();
     const kernels::ReactionEnthalpyPoly* dhPoly = _dh.d();
     // R1/R2 and R4/R5 heats (none when reaction heat is off: the heat is not used then).
@@ -261,6 +277,7 @@ public:
         if (mk[k] < 0.0) mk[k] = 0.0;  // round-off only (the limiter keeps it ≥ 0)
         mNew += mk[k];
       }
+      double dmStored = 0.0;  // the change of the stored mass (what Σ m c_p T sees)
       if (mNew > 0.0) {  // unchanged particles keep their bits
         bool changed = false;
         for (int k = 0; k < nS; ++k) changed = changed || mk[k] != sm[k];
@@ -268,11 +285,22 @@ public:
           for (int k = 0; k < nS; ++k) X[i * nS + k] = mk[k] / mNew;
           m[i] = mNew;
           r[i] = 0.5 * shrinkingDiameter(mNew, rho[i]);
+          dmStored = mNew - mi;
         }
       }
       for (int k = 0; k < nS; ++k) dsol[i * nS + k] = mk[k] - sm[k];
-      for (int k = 0; k < nG; ++k) gdot[i * nG + k] = sc * gasRate[k];
+      double mGas = 0.0;  // net gas mass produced by the particle (kg/s)
+      for (int k = 0; k < nG; ++k) {
+        gdot[i * nG + k] = sc * gasRate[k];
+        mGas += gdot[i * nG + k];
+      }
       q[i] = cp.reactionHeat ? sc * heat : 0.0;
+      // Sensible enthalpy carried by the moved mass (PHYSICS §3.5): the gas gets ṁ_gas at T_p
+      // instead of T_g; the particle's Σ m c_p T changes by Δm c_p T_p without a heat flow.
+      const std::uint32_t pc = coupled ? pcell[i] : nCells;
+      sens[2 * i] = (sensGas && pc < nCells && mGas != 0.0)
+                        ? mGas * cpgC[pc] * (T[i] - tgC[pc]) : 0.0;
+      sens[2 * i + 1] = dmStored * cpm[mat[i]] * T[i];
       return 2.0 * r[i] < frac * d0[i] ? 1.0 : 0.0;
     }, 0.0);
     p.produced(kMass | kSpecies | kRadius);
@@ -295,6 +323,8 @@ public:
           for (int g = 0; g < nG; ++g) acc[row + g] += gdot[static_cast<std::size_t>(i) * nG + g] * dt;
           for (int a = 0; a < nS; ++a) acc[row + nG + a] += dsol[static_cast<std::size_t>(i) * nS + a];
           acc[row + nG + nS] += q[i] * dt;
+          acc[row + nG + nS + 1] += sens[2 * static_cast<std::size_t>(i)] * dt;
+          acc[row + nG + nS + 2] += sens[2 * static_cast<std::size_t>(i) + 1];
         }
       });
     } else {
@@ -303,6 +333,8 @@ public:
           for (int g = 0; g < nG; ++g) acc[g] += gdot[i * nG + g] * dt;
           for (int a = 0; a < nS; ++a) acc[nG + a] += dsol[i * nS + a];
           acc[nG + nS] += q[i] * dt;
+          acc[nG + nS + 1] += sens[2 * i] * dt;
+          acc[nG + nS + 2] += sens[2 * i + 1];
         }
       });
     }
@@ -334,7 +366,7 @@ public:
     const std::size_t nc = s.coupled ? s.nCells : 0;
     const double* acc = _acc.h();
     std::vector<double> gasSum(static_cast<std::size_t>(nG), 0.0), solidSum(static_cast<std::size_t>(nS), 0.0);
-    double heatSum = 0.0;
+    double heatSum = 0.0, gasSensSum = 0.0, massSensSum = 0.0;
     for (std::size_t c = 0; c <= nc; ++c) {
       const double* row = acc + c * W;
       for (int g = 0; g < nG; ++g) {
@@ -343,10 +375,16 @@ public:
       }
       for (int a = 0; a < nS; ++a) solidSum[a] += row[nG + a];
       heatSum += row[nG + nS];
+      gasSensSum += row[nG + nS + 1];
+      massSensSum += row[nG + nS + 2];
+      if (c < nc && window > 0.0 && row[nG + nS + 1] != 0.0)
+        out.qHom[c] += row[nG + nS + 1] / (s.cellVolume * window);
     }
     for (int g = 0; g < nG; ++g) _totals.gasProduced[g] += gasSum[g];
     for (int a = 0; a < nS; ++a) _totals.solidChange[a] += solidSum[a];
     _totals.reactionHeat += heatSum;
+    _totals.gasSensibleHeat += gasSensSum;
+    _totals.sensibleMassEnthalpy += massSensSum;
 
     // R3, homogeneous water–gas shift: once per CFD step per cell from the frozen gas.
     if (cp.wgsOn && nc > 0 && window > 0.0 && !_tgHost.empty() && !_rhoHost.empty() && !_ygHost.empty()) {

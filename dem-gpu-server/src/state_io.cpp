@@ -140,6 +140,8 @@ void writeStateFile(const std::string& path, const HostState& s, const StateMeta
     writeArray(g.id, "homogeneous_source_kg", c.homogeneousSource, {c.homogeneousSource.size()});
     writeAttr(g.id, "reaction_heat_J", c.reactionHeat);
     writeAttr(g.id, "homogeneous_heat_J", c.homogeneousHeat);
+    writeAttr(g.id, "gas_sensible_heat_J", c.gasSensibleHeat);
+    writeAttr(g.id, "sensible_mass_enthalpy_J", c.sensibleMassEnthalpy);
     writeAttr(g.id, "removed_count", static_cast<std::uint64_t>(c.removedCount));
   }
   {
@@ -244,6 +246,11 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
     vec("homogeneous_source_kg", c.homogeneousSource);
     c.reactionHeat = readAttr<double>(gc.id, "reaction_heat_J", path);
     c.homogeneousHeat = readAttr<double>(gc.id, "homogeneous_heat_J", path);
+    // Files written before the sensible-enthalpy ledgers: they start at 0.
+    c.gasSensibleHeat = H5Aexists(gc.id, "gas_sensible_heat_J") > 0
+                            ? readAttr<double>(gc.id, "gas_sensible_heat_J", path) : 0.0;
+    c.sensibleMassEnthalpy = H5Aexists(gc.id, "sensible_mass_enthalpy_J") > 0
+                                 ? readAttr<double>(gc.id, "sensible_mass_enthalpy_J", path) : 0.0;
     c.removedCount = readAttr<std::uint64_t>(gc.id, "removed_count", path);
   }
   Handle g{H5Gopen2(file.id, "contacts", H5P_DEFAULT), H5Gclose};

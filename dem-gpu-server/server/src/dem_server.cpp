@@ -626,6 +626,10 @@ struct DemServer::Impl {
       proto::addNamedValue(l.mutable_mass(), "dem.removed_mass_kg", c.removedMass());
       proto::addNamedValue(l.mutable_energy(), "dem.reaction_heat_J", c.reactionHeat);
       proto::addNamedValue(l.mutable_energy(), "dem.homogeneous_heat_J", c.homogeneousHeat);
+      // Sensible enthalpy of the transferred mass (PHYSICS §3.5): into the gas inside Q_hom, and the
+      // particles' Σ m c_p T change by mass leaving at T_p (closes the particle energy ledger).
+      proto::addNamedValue(l.mutable_energy(), "dem.gas_sensible_heat_J", c.gasSensibleHeat);
+      proto::addNamedValue(l.mutable_energy(), "dem.sensible_mass_enthalpy_J", c.sensibleMassEnthalpy);
     }
     return l;
   }

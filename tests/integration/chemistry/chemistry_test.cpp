@@ -249,6 +249,62 @@ std::vector<double> rk4(const std::function<double(double)>& f, double h, const 
 
 } // namespace
 
+/// One particle whose data-defined reaction 2 B(s) -> C(g) releases gas (M_C = 2 M_B: balanced),
+/// at T_p in a coupled cell of gas at T_g (c_p,g = 1200 J/(kg K) from Gas), heat transfer off.
+DemConfig releasingGasCase(double tp, double dH) {
+  DemConfig cfg = reactiveChemistryCase(dH);
+  cfg.particleSets[0].temperature = tp;
+  cfg.chemistry.reactions[0].terms = {{"B", -2}, {"C", 1}};
+  return cfg;
+}
+
+TEST(ChemistryStep, ReleasedGasCarriesItsSensibleEnthalpyAtTpIntoQHom) {
+  const double tp = 900.0, tg = 300.0, cpg = 1200.0, dt = 0.1, vc = 0.02 * 0.02 * 0.02;
+  DemSystem sys(releasingGasCase(tp, -2.0e5), BackendKind::Cpu, 1);
+  Gas(1, tg, 1.2, {0.5, 0.5}).apply(sys);
+  const double e0 = sys.thermalEnergy();
+  const double m0 = sys.particles().mass[0];
+  const CellSources& s = sys.advance(dt, 1);
+  // Net gas mass produced: ω M_C (kg/s); the gas gets it at T_p instead of T_g (no WGS here).
+  const double mGas = kOmega * kMC;
+  const double q = mGas * cpg * (tp - tg) / vc;
+  ASSERT_EQ(s.qHom.size(), 1u);
+  EXPECT_NEAR(s.qHom[0], q, 1e-12 * q);
+  EXPECT_NEAR(s.rSpecies[1], mGas / vc, 1e-12 * mGas / vc);
+  const ChemistryTotals t = sys.chemistryTotals();
+  EXPECT_NEAR(t.gasSensibleHeat, q * vc * dt, 1e-12 * q * vc * dt);
+  EXPECT_EQ(t.homogeneousHeat, 0.0);
+  // Particle ledger: Δ Σ m c_p T = Q_rxn + Σ Δm c_p T_p (heat transfer off), Δm < 0 here.
+  const ParticleData p = sys.particles();
+  const double dm = p.mass[0] - m0;
+  EXPECT_NEAR(dm, -mGas * dt, 1e-12 * mGas * dt);
+  EXPECT_NEAR(t.sensibleMassEnthalpy, dm * 1000.0 * tp, 1e-12 * std::fabs(dm * 1000.0 * tp));
+  const double de = sys.thermalEnergy() - e0;
+  const double closure = t.reactionHeat + t.sensibleMassEnthalpy;
+  // Round-off of the difference of two ~32 J sums: tolerance 1e-12 of |ΔE| (ΔE ≈ 6.8 J).
+  EXPECT_NEAR(de, closure, 1e-12 * std::fabs(de)) << "ΔE " << sci(de) << " ledger " << sci(closure);
+  EXPECT_GT(t.reactionHeat, 0.0);
+  EXPECT_LT(t.sensibleMassEnthalpy, 0.0);
+  // Without the new term the ledger is off by far more than round-off.
+  EXPECT_GT(std::fabs(de - t.reactionHeat), 1e3 * 1e-12 * std::fabs(de));
+}
+
+TEST(ChemistryStep, NoSensibleGasHeatWhenTpEqualsTgButTheParticleLedgerStillCloses) {
+  const double t0 = 700.0, dt = 0.1;
+  DemSystem sys(releasingGasCase(t0, 0.0), BackendKind::Cpu, 1);
+  Gas(1, t0, 1.2, {0.5, 0.5}).apply(sys);
+  const double e0 = sys.thermalEnergy();
+  const CellSources& s = sys.advance(dt, 1);
+  EXPECT_EQ(s.qHom[0], 0.0);
+  const ChemistryTotals t = sys.chemistryTotals();
+  EXPECT_EQ(t.gasSensibleHeat, 0.0);
+  EXPECT_EQ(t.reactionHeat, 0.0);
+  EXPECT_EQ(sys.particles().temperature[0], t0);  // athermal: mass leaves at T_p, T_p unchanged
+  const double de = sys.thermalEnergy() - e0;
+  EXPECT_LT(de, 0.0);
+  EXPECT_NEAR(de, t.sensibleMassEnthalpy, 1e-12 * std::fabs(de));
+}
+
 TEST(ChemistryStep, CharParticleFollowsTheKernelRatesAndTheConversionOde) {
   const double tp = 1400.0, p = 101325.0;
   const std::vector<double> x = {0.05, 0.15, 0.05, 0.5, 0.25};  // CO, CO2, H2, H2O, N2
@@ -523,6 +579,8 @@ void expectSame(const BedRun& a, const BedRun& b) {
   EXPECT_EQ(a.tot.solidChange, b.tot.solidChange);
   EXPECT_EQ(a.tot.reactionHeat, b.tot.reactionHeat);
   EXPECT_EQ(a.tot.homogeneousHeat, b.tot.homogeneousHeat);
+  EXPECT_EQ(a.tot.gasSensibleHeat, b.tot.gasSensibleHeat);
+  EXPECT_EQ(a.tot.sensibleMassEnthalpy, b.tot.sensibleMassEnthalpy);
 }
 
 } // namespace
@@ -546,6 +604,8 @@ TEST(ChemistryStep, OneAndTwoThreadsAreBitwiseIdenticalWithChemistryOn) {
   EXPECT_GT(a.tot.solidChange[3], 0.0);
   EXPECT_NE(a.tot.reactionHeat, 0.0);
   EXPECT_NE(a.tot.homogeneousHeat, 0.0);
+  EXPECT_NE(a.tot.gasSensibleHeat, 0.0);       // T_p (1200/1300 K) ≠ T_g (1250 K)
+  EXPECT_NE(a.tot.sensibleMassEnthalpy, 0.0);
   // Mass: Σ solid change + Σ gas released = 0 (balanced reactions; molar masses balance to round-off).
   double s = 0.0, scale = 0.0;
   for (double v : a.tot.solidChange) s += v, scale += std::fabs(v);

@@ -124,5 +124,20 @@ TEST(DemServerChemistry, SourcesCarryTheParticlesSpeciesRatesAndTheLedgerTheConv
   EXPECT_NEAR(named(l.mass(), "dem.particle_mass_kg"), m0 - kN * (2 * 0.015 - 0.025) * kOmega * dt, 1e-13 * m0);
   EXPECT_EQ(named(l.mass(), "dem.removed_mass_kg"), 0.0);
   EXPECT_EQ(named(l.energy(), "dem.reaction_heat_J"), 0.0);
+  // Sensible enthalpy of the moved mass (PHYSICS §3.5): the gas-side total is the transfer part of
+  // the Q_hom it was sent (no WGS here; 1e-12 rel), the particle side is Δm c_p T_p with
+  // c_p T_p = E/m (identical particles; heat and reaction heat off, so T_p stays put). Δm is the
+  // change of the stored masses (what Σ m c_p T sees): it matches the analytic Δm to the round-off
+  // of the particle masses, hence the same 1e-13 m0 as the mass check above (times c_p T_p).
+  const auto qh = src.values<double>(f::kHomogeneousHeat);
+  ASSERT_EQ(qh.size(), n);
+  double qSum = 0.0;
+  for (double v : qh) qSum += v * vc * dt;
+  const double gasSens = named(l.energy(), "dem.gas_sensible_heat_J");
+  EXPECT_NEAR(gasSens, qSum, 1e-12 * std::fabs(qSum));
+  const double cT = named(l.energy(), "dem.thermal_energy_J") / named(l.mass(), "dem.particle_mass_kg");
+  const double dm = -kN * (2 * 0.015 - 0.025) * kOmega * dt;
+  EXPECT_NEAR(named(l.energy(), "dem.sensible_mass_enthalpy_J"), dm * cT, 1e-13 * m0 * cT);
+  EXPECT_LT(named(l.energy(), "dem.sensible_mass_enthalpy_J"), 0.0);
   o.shutdown();
 }

@@ -74,6 +74,11 @@ struct ChemistryTotals {
   std::vector<double> removedSolid;  ///< kg per solid species in particles removed below the size threshold
   double reactionHeat = 0.0;         ///< J of Q_rxn into the particles (heterogeneous; 0 when reactionHeat off)
   double homogeneousHeat = 0.0;      ///< J of Q_hom (WGS) into the gas
+  /// J into the gas inside Q_hom: sensible heat of the gas the particles release, Σ ṁ_gas c_p,g (T_p − T_g) Δt
+  double gasSensibleHeat = 0.0;
+  /// J: Σ Δm_i c_p,i T_p,i, the change of the particles' Σ m c_p T by mass leaving (< 0) or joining
+  /// them at T_p; Δ Σ m c_p T = Q_gas + Q_rad + Q_wall + reactionHeat + this (+ removed particles)
+  double sensibleMassEnthalpy = 0.0;
   std::vector<double> homogeneousSource;  ///< kg per gas species produced by WGS (sums to ~0)
   std::uint64_t removedCount = 0;    ///< particles removed
   double removedMass() const {
