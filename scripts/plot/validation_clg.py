@@ -27,24 +27,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from plot_run import read_timeseries  # noqa: E402  (same folder)
 import yaml  # noqa: E402
 
 DRY = ["CO", "CO2", "H2"]
-
-
-def read_timeseries(path):
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    if len(rows) < 2:
-        raise SystemExit(f"{path}: no data rows")
-    header = rows[0]
-    cols = {h: [] for h in header}
-    for r in rows[1:]:
-        if len(r) != len(header):
-            continue
-        for h, v in zip(header, r):
-            cols[h].append(float(v) if v != "" else np.nan)
-    return {h: np.asarray(v) for h, v in cols.items()}
 
 
 def conversion_from_snapshots(run_dir, solid):

@@ -18,7 +18,6 @@ the run's case file (walls.box, x and z extents) and U, T_in, ρ_g, c_p,g from i
 Interpreter: COREDEM_PYTHON (/usr/bin/python3 with numpy, matplotlib, yaml-free parsing).
 """
 import argparse
-import csv
 import math
 import os
 import re
@@ -29,25 +28,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from plot_run import read_timeseries  # noqa: E402  (same folder)
 
 CP_P = 840.0  # J/kg/K, glass (PHYSICS §7), = the case files' materials[0].cp
 T0_C = 90.0
 SEED = {"75g": 3.0, "125g": 2.5}  # °C/s, PHYSICS §9.1 fits
-
-
-def read_timeseries(path):
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    if len(rows) < 2:
-        raise SystemExit(f"{path}: no data rows")
-    header = rows[0]
-    cols = {h: [] for h in header}
-    for r in rows[1:]:
-        if len(r) != len(header):
-            continue
-        for h, v in zip(header, r):
-            cols[h].append(float(v) if v != "" else np.nan)
-    return {h: np.asarray(v) for h, v in cols.items()}
 
 
 def case_numbers(run_dir):
