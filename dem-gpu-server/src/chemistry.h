@@ -31,6 +31,7 @@
 #include "backend/exec_common.h"
 #include "chemistry_setup.h"
 #include "engine.h"
+#include "gas_fields.h"
 #include "particle_store.h"
 
 #include "coredem/dem/chemistry_options.h"
@@ -58,10 +59,8 @@ public:
   /// dH), then R1, R2, R4, R5 at kClgHeat.
   Dual<kernels::ReactionEnthalpyPoly> _dh;
   Dual<double> _gasM, _cp;
-  Dual<double> _rhoG, _yg;       ///< gas fields (per cell)
-  Dual<double> _tgCell, _cpgCell;  ///< T_g, c_p,g per cell (sensible heat of the transferred gas)
+  const GasFields<Exec>* _gas = nullptr;  ///< the engine's gas fields of the CFD step (ρ_g, Y_g, T_g, c_p,g)
   bool _hasRho = false, _hasY = false, _hasTg = false, _hasCpG = false;
-  std::vector<double> _tgHost, _rhoHost, _ygHost;
   Dev<double> _gdot;             ///< per particle: gas mass rates (kg/s), N*nGas
   Dev<double> _dsolid;           ///< per particle: solid mass change in this sub-step (kg), N*nSolid
   Dev<double> _q;                ///< per particle: Q_rxn (W)
@@ -110,27 +109,19 @@ public:
   bool enabled() const { return _c.enabled; }
   bool pendingRemoval() const { return _pending; }
 
-  void setGas(const GasArrays& g) {
-    auto put = [](Dual<double>& arr, const std::vector<double>& v) {
-      arr.allocate(v.size());
-      for (std::size_t k = 0; k < v.size(); ++k) arr.h()[k] = v[k];
-      arr.markHostModified();
-      arr.toDevice();
-      return !v.empty();
-    };
-    _hasRho = put(_rhoG, g.rhoG);
-    _hasY = put(_yg, g.Yg);
-    _hasTg = put(_tgCell, g.Tg);
-    _hasCpG = put(_cpgCell, g.cpG);
-    _tgHost = g.Tg;
-    _rhoHost = g.rhoG;
-    _ygHost = g.Yg;
+  /// Uses the engine's gas fields from now on; `gas` outlives this module.
+  void setGas(const GasFields<Exec>& gas) {
+    _gas = &gas;
+    _hasRho = gas.has(gas.rhoG);
+    _hasY = gas.has(gas.Yg);
+    _hasTg = gas.has(gas.Tg);
+    _hasCpG = gas.has(gas.cpG);
   }
 
   std::size_t bytes() const {
     auto& s = const_cast<ChemistryModule&>(*this);
-    return s._reactions.bytes() + s._dh.bytes() + s._gasM.bytes() + s._cp.bytes() + s._rhoG.bytes() +
-           s._yg.bytes() + s._tgCell.bytes() + s._cpgCell.bytes() + _gdot.bytes() + _dsolid.bytes() + _q.bytes() +
+    return s._reactions.bytes() + s._dh.bytes() + s._gasM.bytes() + s._cp.bytes() +
+           _gdot.bytes() + _dsolid.bytes() + _q.bytes() +
            _sens.bytes() + s._acc.bytes();
   }
 
@@ -173,16 +164,16 @@ public:
     double* sens = _sens.d();
     const std::int32_t* mat = p.material.d();
     const double* cpm = _cp.d();
-    const double* tgC = sensGas ? _tgCell.d() : nullptr;
-    const double* cpgC = sensGas ? _cpgCell.d() : nullptr;
+    const double* tgC = sensGas ? _gas->Tg.d() : nullptr;
+    const double* cpgC = sensGas ? _gas->cpG.d() : nullptr;
     const kernels::HeterogeneousReaction* reac = _reactions.d();
     const kernels::ReactionEnthalpyPoly* dhPoly = _dh.d();
     // R1/R2 and R4/R5 heats (none when reaction heat is off: the heat is not used then).
     const kernels::ReactionEnthalpyPoly* dhChar = cp.reactionHeat ? dhPoly + cp.nReactions : nullptr;
     const kernels::ReactionEnthalpyPoly* dhOc = cp.reactionHeat ? dhPoly + cp.nReactions + 2 : nullptr;
     const double* gasM = _gasM.d();
-    const double* rhoG = gas ? _rhoG.d() : nullptr;
-    const double* yg = gas ? _yg.d() : nullptr;
+    const double* rhoG = gas ? _gas->rhoG.d() : nullptr;
+    const double* yg = gas ? _gas->Yg.d() : nullptr;
 
     const double below = exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
@@ -387,17 +378,20 @@ public:
     _totals.sensibleMassEnthalpy += massSensSum;
 
     // R3, homogeneous water–gas shift: once per CFD step per cell from the frozen gas.
-    if (cp.wgsOn && nc > 0 && window > 0.0 && !_tgHost.empty() && !_rhoHost.empty() && !_ygHost.empty()) {
+    if (cp.wgsOn && nc > 0 && window > 0.0 && _hasTg && _hasRho && _hasY) {
+      const double* tgH = _gas->Tg.h();
+      const double* rhoH = _gas->rhoG.h();
+      const double* ygH = _gas->Yg.h();
       std::vector<double> srcSum(static_cast<std::size_t>(nG), 0.0);
       double heat = 0.0;
       for (std::size_t c = 0; c < nc; ++c) {
         double y[kernels::kGasSpeciesCount];
         for (int g = 0; g < kernels::kGasSpeciesCount; ++g) {
           const int k = cp.gasIndex[g];
-          y[g] = k >= 0 ? _ygHost[c * nG + k] : 0.0;
+          y[g] = k >= 0 ? ygH[c * nG + k] : 0.0;
         }
         const kernels::WgsCellSources w =
-            kernels::wgsCellSources(cp.wgsParams, _tgHost[c], epsFrozen[c], _rhoHost[c], y, window);
+            kernels::wgsCellSources(cp.wgsParams, tgH[c], epsFrozen[c], rhoH[c], y, window);
         for (int g = 0; g < kernels::kGasSpeciesCount; ++g) {
           const int k = cp.gasIndex[g];
           if (k < 0) continue;

@@ -22,6 +22,7 @@
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
 #include "engine.h"
+#include "gas_fields.h"
 #include "heat.h"
 #include "chemistry.h"
 #include "particle_store.h"
@@ -62,8 +63,7 @@ public:
   ParticleStore<Exec> _p;
   Dual<PairProps> _pairs;
   Dual<kernels::PlaneWall> _walls;
-  Dual<double> _ug, _gradP, _rhoG, _muG;  // gas fields used by the DEM core (per cell)
-  GasArrays _gasHost;                      // all fields, host copy (thermochemistry will use them)
+  GasFields<Exec> _gas;  ///< per-cell gas fields of the CFD step, shared with _heat and _chem
   bool _hasGas = false;
   Dual<double> _epsFrozen;  // nCells: PCM ε_g at the window start (drag)
   Dual<double> _acc;        // nCells*5: Σ V_s, Σ K, Σ K v over the window
@@ -167,20 +167,10 @@ public:
   }
 
   void setGas(const GasArrays& g) override {
-    _gasHost = g;
-    auto put = [](Dual<double>& arr, const std::vector<double>& v) {
-      arr.allocate(v.size());
-      for (std::size_t k = 0; k < v.size(); ++k) arr.h()[k] = v[k];
-      arr.markHostModified();
-      arr.toDevice();
-    };
-    put(_ug, g.ug);
-    put(_gradP, g.gradP);
-    put(_rhoG, g.rhoG);
-    put(_muG, g.muG);
+    _gas.set(g);
     _hasGas = true;
-    _heat.setGas(g);
-    _chem.setGas(g);
+    _heat.setGas(_gas);
+    _chem.setGas(_gas);
   }
 
   void reserveScratch() {
@@ -197,7 +187,7 @@ public:
     return self._p.bytes() + _keys.bytes() + _perm.bytes() + _cellStart.bytes() +
            _cellEnd.bytes() + _pcell.bytes() + _kcoef.bytes() + _scratch.bytes() +
            _cStart.bytes() + _cEnd.bytes() + self._epsFrozen.bytes() + self._acc.bytes() +
-           _heat.bytes() + _chem.bytes();
+           _heat.bytes() + _chem.bytes() + _gas.bytes();
   }
 
   // ---------------------------------------------------------------- neighbour search
@@ -524,10 +514,10 @@ public:
     const bool gas = _hasGas;
     const kernels::GridParams grid = _s.grid;
     const std::uint32_t nCells = static_cast<std::uint32_t>(_s.nCells);
-    const double* ug = gas ? _ug.d() : nullptr;
-    const double* gp = gas ? _gradP.d() : nullptr;
-    const double* rho = gas ? _rhoG.d() : nullptr;
-    const double* mu = gas ? _muG.d() : nullptr;
+    const double* ug = gas ? _gas.ug.d() : nullptr;
+    const double* gp = gas ? _gas.gradP.d() : nullptr;
+    const double* rho = gas ? _gas.rhoG.d() : nullptr;
+    const double* mu = gas ? _gas.muG.d() : nullptr;
     const double* eps = _epsFrozen.d();
     double* kc = _kcoef.d();
     std::uint32_t* pc = _pcell.d();
@@ -754,8 +744,8 @@ public:
     if (_heat.enabled()) {
       const bool gas = _hasGas && _s.coupled;
       _heat.sources(_exec, _p, _s, gas, _pcell.d(), _perm.d(), _cStart.d(), _cEnd.d(),
-                    _s.coupled ? _epsFrozen.d() : nullptr, gas ? _ug.d() : nullptr,
-                    gas ? _rhoG.d() : nullptr, gas ? _muG.d() : nullptr, dt);
+                    _s.coupled ? _epsFrozen.d() : nullptr, gas ? _gas.ug.d() : nullptr,
+                    gas ? _gas.rhoG.d() : nullptr, gas ? _gas.muG.d() : nullptr, dt);
       Exec::synchronize();
       auto t2 = Clock::now();
       _t.heat += std::chrono::duration<double>(t2 - t1).count();

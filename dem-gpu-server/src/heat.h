@@ -25,6 +25,7 @@
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
 #include "engine.h"
+#include "gas_fields.h"
 #include "heat_setup.h"
 #include "particle_store.h"
 
@@ -55,7 +56,7 @@ public:
 
   HeatSetup _h;
   Dual<HeatMaterial> _mat;
-  Dual<double> _tg, _kappa, _cp;  ///< gas fields (per cell), present when the CFD sent them
+  const GasFields<Exec>* _gas = nullptr;  ///< the engine's gas fields of the CFD step
   bool _hasTg = false, _hasKappa = false, _hasCp = false;
   Dev<double> _q, _g, _qrad;      ///< per particle: Q_i (W), G_i (W/K), Q_rad,i (W)
   Dev<double> _cellT;             ///< per cell: Σ T_p (radiation environment)
@@ -94,22 +95,17 @@ public:
 
   bool enabled() const { return _h.enabled; }
 
-  void setGas(const GasArrays& g) {
-    auto put = [](Dual<double>& arr, const std::vector<double>& v) {
-      arr.allocate(v.size());
-      for (std::size_t k = 0; k < v.size(); ++k) arr.h()[k] = v[k];
-      arr.markHostModified();
-      arr.toDevice();
-      return !v.empty();
-    };
-    _hasTg = put(_tg, g.Tg);
-    _hasKappa = put(_kappa, g.kappaG);
-    _hasCp = put(_cp, g.cpG);
+  /// Uses the engine's gas fields (T_g, κ_g, c_p,g) from now on; `gas` outlives this module.
+  void setGas(const GasFields<Exec>& gas) {
+    _gas = &gas;
+    _hasTg = gas.has(gas.Tg);
+    _hasKappa = gas.has(gas.kappaG);
+    _hasCp = gas.has(gas.cpG);
   }
 
   std::size_t bytes() const {
     auto& s = const_cast<HeatModule&>(*this);
-    return s._mat.bytes() + s._tg.bytes() + s._kappa.bytes() + s._cp.bytes() + _q.bytes() +
+    return s._mat.bytes() + _q.bytes() +
            _g.bytes() + _qrad.bytes() + _cellT.bytes() + _lensI.bytes() + s._acc.bytes() +
            s._walls.bytes() + _qw.bytes() + s._wallAcc.bytes();
   }
@@ -164,9 +160,9 @@ public:
     const std::int32_t* list = p.nbList.d();
     const int M = p.M;
     const HeatMaterial* hm = _mat.d();
-    const double* tg = _hasTg ? _tg.d() : nullptr;
-    const double* kap = _hasKappa ? _kappa.d() : nullptr;
-    const double* cpg = _hasCp ? _cp.d() : nullptr;
+    const double* tg = _hasTg ? _gas->Tg.d() : nullptr;
+    const double* kap = _hasKappa ? _gas->kappaG.d() : nullptr;
+    const double* cpg = _hasCp ? _gas->cpG.d() : nullptr;
     double* q = _q.d();
     double* gOut = _g.d();
     double* qr = _qrad.d();
@@ -378,7 +374,7 @@ public:
     for (std::size_t c = 0; c < s.nCells; ++c) {
       out.heatH[c] = acc[3 * c] * w;
       out.heatHTp[c] = acc[3 * c + 1] * w;
-      if (_hasTg) conv += out.heatH[c] * _tg.h()[c] - out.heatHTp[c];
+      if (_hasTg) conv += out.heatH[c] * _gas->Tg.h()[c] - out.heatHTp[c];
       rad += acc[3 * c + 2] * w;
     }
     _totals.convection += conv * s.cellVolume * window;

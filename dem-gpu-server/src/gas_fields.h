@@ -1,0 +1,50 @@
+#pragma once
+/// @file
+/// The per-cell gas fields of the current CFD step as host/device mirrors, uploaded once per
+/// setGas and read (never written) by the engine core, the heat module and the chemistry module.
+/// An array the CFD did not send is empty (has() is false).
+
+#include "backend/arrays.h"
+#include "engine.h"
+
+#include <cstddef>
+#include <vector>
+
+namespace coredem::dem {
+
+template <class Exec>
+struct GasFields {
+  using Arr = backend::DualArray<double, Exec>;
+
+  Arr ug, gradP, Tg, rhoG, muG, kappaG, cpG, Yg;
+
+  static bool has(const Arr& a) { return a.size() > 0; }
+
+  /// Copies every field to the host mirror and the device (one transfer per field and step).
+  void set(const GasArrays& g) {
+    upload(ug, g.ug);
+    upload(gradP, g.gradP);
+    upload(Tg, g.Tg);
+    upload(rhoG, g.rhoG);
+    upload(muG, g.muG);
+    upload(kappaG, g.kappaG);
+    upload(cpG, g.cpG);
+    upload(Yg, g.Yg);
+  }
+
+  std::size_t bytes() const {
+    std::size_t b = 0;
+    for (const Arr* a : {&ug, &gradP, &Tg, &rhoG, &muG, &kappaG, &cpG, &Yg}) b += a->bytes();
+    return b;
+  }
+
+private:
+  static void upload(Arr& a, const std::vector<double>& v) {
+    a.allocate(v.size());
+    for (std::size_t k = 0; k < v.size(); ++k) a.h()[k] = v[k];
+    a.markHostModified();
+    a.toDevice();
+  }
+};
+
+} // namespace coredem::dem
