@@ -1,6 +1,7 @@
 // Chemistry through coredem-dem's session (real ZeroMQ tcp loopback, ephemeral port, real DEM core):
 // a v1.1 Configure with solid species and a reaction -> Sources.R_species and the StepDone ledger.
 #include "../client/mini_orchestrator.h"
+#include "../dem-server/server_thread.h"
 
 #include "coredem/server/dem_server.h"
 
@@ -13,27 +14,6 @@
 using namespace coredem::testing;
 
 namespace {
-
-class ServerThread {
-public:
-  ServerThread() {
-    coredem::server::ServerOptions o;
-    o.bind = "tcp://127.0.0.1:*";
-    o.backend = "cpu";
-    o.threads = 1;
-    _server = std::make_unique<coredem::server::DemServer>(o);
-    _thread = std::thread([this] { _server->run(); });
-  }
-  ~ServerThread() {
-    _server->stop();
-    _thread.join();
-  }
-  std::string endpoint() const { return _server->endpoint(); }
-
-private:
-  std::unique_ptr<coredem::server::DemServer> _server;
-  std::thread _thread;
-};
 
 constexpr int kN = 40;
 constexpr double kD = 1e-3, kBox = 6e-3, kOmega = 1e-7;  // ω: mol/s per particle
@@ -74,7 +54,7 @@ v1::Configure reactingCase() {
 } // namespace
 
 TEST(DemServerChemistry, SourcesCarryTheParticlesSpeciesRatesAndTheLedgerTheConvertedMass) {
-  ServerThread server;
+  ServerThread server(600.0, 60.0);  // the server defaults
   MiniOrchestrator o(server.endpoint(), reactingCase());
   ASSERT_EQ(o.particles(), static_cast<std::uint64_t>(kN));
   proto::Client cfd;

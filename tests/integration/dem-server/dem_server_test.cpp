@@ -2,6 +2,7 @@
 // Configure + GasFields -> Sources, one session at a time, invalid messages refused without
 // changing anything, checkpoint -> fresh server -> bitwise identical continuation.
 #include "../client/mini_orchestrator.h"
+#include "server_thread.h"
 
 #include "coredem/server/dem_server.h"
 
@@ -18,30 +19,6 @@ using namespace coredem::testing;
 namespace fs = std::filesystem;
 
 namespace {
-
-/// A DemServer running in its own thread (the real server loop).
-class ServerThread {
-public:
-  explicit ServerThread(double sessionTimeout = 600.0, double grantWait = 5.0) {
-    coredem::server::ServerOptions o;
-    o.bind = "tcp://127.0.0.1:*";
-    o.backend = "cpu";
-    o.threads = 1;
-    o.grantWaitSeconds = grantWait;
-    o.sessionTimeoutSeconds = sessionTimeout;
-    _server = std::make_unique<coredem::server::DemServer>(o);
-    _thread = std::thread([this] { _server->run(); });
-  }
-  ~ServerThread() {
-    _server->stop();
-    _thread.join();
-  }
-  std::string endpoint() const { return _server->endpoint(); }
-
-private:
-  std::unique_ptr<coredem::server::DemServer> _server;
-  std::thread _thread;
-};
 
 /// Uniform gas fields: upward flow so that drag acts, one species.
 struct Gas {
