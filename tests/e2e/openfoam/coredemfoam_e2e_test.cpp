@@ -41,6 +41,7 @@ const fs::path kBin = COREDEM_BIN_DIR;
 const fs::path kTemplate = COREDEM_FOAM_E2E_TEMPLATE;
 
 using coredem::e2e::readAll;
+using coredem::e2e::readTimeseries;
 
 using coredem::e2e::datasetsOf;
 using coredem::e2e::writeAll;
@@ -91,30 +92,6 @@ int runCoredem(std::vector<std::string> args, const fs::path& log,
                std::chrono::seconds timeout = 150s) {
   args.push_back("--no-plots");
   return coredem::e2e::waitExit(coredem::e2e::startProgram(kBin / "coredem", args, log), timeout);
-}
-
-/// timeseries.csv of a run: column name -> values (one per row).
-std::map<std::string, std::vector<double>> readTimeseries(const fs::path& runDir) {
-  std::ifstream in(runDir / "timeseries.csv");
-  std::map<std::string, std::vector<double>> out;
-  std::string line;
-  std::vector<std::string> names;
-  if (!std::getline(in, line)) {
-    ADD_FAILURE() << "no timeseries.csv in " << runDir;
-    return out;
-  }
-  std::stringstream h(line);
-  for (std::string n; std::getline(h, n, ',');) {
-    names.push_back(n);
-  }
-  while (std::getline(in, line)) {
-    std::stringstream r(line);
-    std::size_t i = 0;
-    for (std::string v; std::getline(r, v, ',') && i < names.size(); ++i) {
-      out[names[i]].push_back(v.empty() ? std::nan("") : std::strtod(v.c_str(), nullptr));
-    }
-  }
-  return out;
 }
 
 std::string logTail(const fs::path& runDir) {

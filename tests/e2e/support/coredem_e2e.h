@@ -4,10 +4,13 @@
 /// `coredem` as a child process with a deadline (a test never waits forever on it).
 
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -39,6 +42,28 @@ inline std::string readAll(const fs::path& p) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+/// timeseries.csv of a run: column name -> values (one per row; an empty cell is NaN).
+inline std::map<std::string, std::vector<double>> readTimeseries(const fs::path& runDir) {
+  std::ifstream in(runDir / "timeseries.csv");
+  std::map<std::string, std::vector<double>> out;
+  std::string line;
+  std::vector<std::string> names;
+  if (!std::getline(in, line)) {
+    ADD_FAILURE() << "no timeseries.csv in " << runDir;
+    return out;
+  }
+  std::stringstream h(line);
+  for (std::string n; std::getline(h, n, ',');) names.push_back(n);
+  while (std::getline(in, line)) {
+    std::stringstream r(line);
+    std::size_t i = 0;
+    for (std::string v; std::getline(r, v, ',') && i < names.size(); ++i) {
+      out[names[i]].push_back(v.empty() ? std::nan("") : std::strtod(v.c_str(), nullptr));
+    }
+  }
+  return out;
 }
 
 inline void writeAll(const fs::path& p, const std::string& text) {

@@ -28,6 +28,7 @@ const fs::path kPlots = COREDEM_PLOT_DIR;
 const std::string kPython = COREDEM_PYTHON;
 
 using coredem::e2e::readAll;
+using coredem::e2e::readTimeseries;
 using coredem::e2e::writeAll;
 
 /// Copy of `caseDir/file` (and its CFD folder `cfdFolder`) in `dir`, with `time.end` = `end`.
@@ -53,28 +54,6 @@ int runCoredem(const std::vector<std::string>& args, const fs::path& log,
 
 int runPython(const std::vector<std::string>& args, const fs::path& log) {
   return coredem::e2e::waitExit(coredem::e2e::startProgram(kPython, args, log), 120s);
-}
-
-/// timeseries.csv of a run: column name -> values.
-std::map<std::string, std::vector<double>> readTimeseries(const fs::path& runDir) {
-  std::ifstream in(runDir / "timeseries.csv");
-  std::map<std::string, std::vector<double>> out;
-  std::string line;
-  std::vector<std::string> names;
-  if (!std::getline(in, line)) {
-    ADD_FAILURE() << "no timeseries.csv in " << runDir;
-    return out;
-  }
-  std::stringstream h(line);
-  for (std::string n; std::getline(h, n, ',');) names.push_back(n);
-  while (std::getline(in, line)) {
-    std::stringstream r(line);
-    std::size_t i = 0;
-    for (std::string v; std::getline(r, v, ',') && i < names.size(); ++i) {
-      out[names[i]].push_back(v.empty() ? std::nan("") : std::strtod(v.c_str(), nullptr));
-    }
-  }
-  return out;
 }
 
 std::string tail(const fs::path& p) {
