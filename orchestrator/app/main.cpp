@@ -14,6 +14,7 @@
 #include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/outputs.h>
+#include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/processes.h>
 #include <coredem/orchestrator/session.h>
 #include <coredem/orchestrator/verify.h>
@@ -140,7 +141,7 @@ int main(int argc, char** argv) {
     CaseConfig config;
     if (*run) {
       config = loadCase(caseDir);    // throws CaseError: nothing written yet
-      checkParticipantInput(config); // the gas section, by the participant itself
+      checkParticipantInput(config); // programs, cfd.case, the participant's pre-flight check
       opts.runDir =
           prepareRunDir(config, out.empty() ? std::nullopt : std::optional<fs::path>(out));
       log->info("run folder {}", opts.runDir.string());

@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <coredem/orchestrator/case_config.h>
+#include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/sha256.h>
 
 namespace fs = std::filesystem;
@@ -828,18 +829,27 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   }
   if (top.has("cfd")) {
     const Section f = top.section("cfd", {"participant", "gas_key", "case", "timeout_s", "timers"});
-    c.cfd.participant =
-        f.choice("participant", std::string("coredem-gas"), {"coredem-gas", "coredemFoam"});
-    if (c.cfd.participant == "coredemFoam") {
-      c.cfd.foamCase = f.string("case", std::nullopt,
-                                "OpenFOAM case folder of coredemFoam, relative to the case folder");
+    // What a participant takes and allows comes from its row of the participant table.
+    c.cfd.participant = f.choice("participant", c.cfd.participant, participantNames());
+    const ParticipantDescriptor& p = participant(c.cfd.participant);
+    if (!p.caseFolder.empty()) {
+      c.cfd.caseFolder = f.string("case", std::nullopt,
+                                  fmt::format("{} of {}, relative to the case folder",
+                                              p.caseFolder, p.name));
     }
-    c.cfd.gasKey = f.string("gas_key", std::string("gas"), "key of the coredem-gas section");
+    c.cfd.gasKey = f.string("gas_key", std::string("gas"), "key of the prescribed-gas section");
     c.cfd.timeoutSeconds = f.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
     const std::string cfdTimers = f.choice("timers", std::string("off"), {"on", "off", "true", "false"});
     c.cfd.timers = cfdTimers == "on" || cfdTimers == "true";
-    if (c.cfd.timers && c.cfd.participant != "coredemFoam") {
-      f.fail(f.markOf("timers"), "cfd.timers", "stage timers exist in coredemFoam only; remove the key");
+    if (c.cfd.timers && !p.hasTimers()) {
+      std::vector<std::string> withTimers;
+      for (const auto& q : participantTable()) {
+        if (q.hasTimers()) {
+          withTimers.push_back(q.name);
+        }
+      }
+      f.fail(f.markOf("timers"), "cfd.timers",
+             fmt::format("stage timers exist in {} only; remove the key", join(withTimers)));
     }
   }
   c.hasGasSection = top.has("gas");

@@ -76,7 +76,7 @@ std::string allowedKeys(bool region) {
   return s;
 }
 
-/// Location of a node for messages: "file:line".
+/// Location of a node for messages: "file:line:col" (as the orchestrator's case schema).
 struct Ctx {
   std::string where;
   std::string at(const YAML::Node& n) const {
@@ -84,7 +84,7 @@ struct Ctx {
     if (m.line < 0) {
       return where;
     }
-    return fmt::format("{}:{}", where, m.line + 1);
+    return fmt::format("{}:{}:{}", where, m.line + 1, m.column + 1);
   }
 };
 
@@ -339,7 +339,8 @@ GasModel GasModel::fromFile(const std::string& file, const std::string& key) {
   } catch (const YAML::BadFile&) {
     COREDEM_CHECK(false, "cannot read the case file '{}': check the path (--case)", file);
   } catch (const YAML::Exception& e) {
-    COREDEM_CHECK(false, "{}:{}: YAML syntax error: {}", file, e.mark.line + 1, e.msg);
+    COREDEM_CHECK(false, "{}:{}:{}: YAML syntax error: {}", file, e.mark.line + 1, e.mark.column + 1,
+                  e.msg);
   }
   YAML::Node node = root;
   std::string done;

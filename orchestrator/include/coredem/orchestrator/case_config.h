@@ -86,11 +86,12 @@ struct DemConfig {
 };
 
 struct CfdConfig {
+  /// A row of the participant table (participants.h); the default is its first row.
   std::string participant = "coredem-gas";
-  std::string gasKey = "gas"; ///< key of the coredem-gas section
-  std::string foamCase;       ///< coredemFoam: OpenFOAM case folder, relative to the case folder
-  double timeoutSeconds = 60; ///< deadline for C's next StepDone
-  bool timers = false;        ///< cfd.timers: coredemFoam -timers (RUN/timers-cfd.json)
+  std::string gasKey = "gas";  ///< cfd.gas_key: key of the prescribed-gas section
+  std::string caseFolder;      ///< cfd.case: the participant's input folder, relative to the case folder
+  double timeoutSeconds = 60;  ///< deadline for C's next StepDone
+  bool timers = false;         ///< cfd.timers: the participant's stage timers (RUN/timers-cfd.json)
 };
 
 struct CheckpointConfig {

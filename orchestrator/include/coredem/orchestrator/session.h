@@ -48,10 +48,6 @@ enum ExitCode : int {
   kExitInterrupted = 130,
 };
 
-/// Checks the `gas:` section with `coredem-gas --check` (when the case uses coredem-gas).
-/// Throws CaseError with coredem-gas's message.
-void checkParticipantInput(const CaseConfig& config);
-
 /// Creates the run folder for a new run (`runs/<name>` or a timestamped sibling when that
 /// exists, or `out` which must not contain a run yet) and copies the case file into it.
 std::filesystem::path prepareRunDir(const CaseConfig& config,

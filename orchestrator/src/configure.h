@@ -1,0 +1,26 @@
+#pragma once
+// Building the Configure message of a run from the case (internal to the orchestrator).
+
+#include <filesystem>
+
+#include <coredem/orchestrator/case_config.h>
+#include <coredem/orchestrator/time_handler.h>
+#include <coredem/protocol/protocol.h>
+
+namespace coredem::orchestrator {
+
+/// Smallest collision time over the particle sets / 50 (PHYSICS Eq. 12, m_eff = m/2 for equal
+/// particles): t_col = sqrt(π² + ln² e_n) / sqrt(k_n / m_eff). Only used for the provisional
+/// plan in Configure; the DEM server's reply is authoritative.
+double estimateDtDemMax(const CaseConfig& c);
+
+/// The sub-cycling plan of a step: from the forced DEM step time.dt_dem when given (n_sub =
+/// dt/dt_dem; a step shortened to land on time.end gets n_sub = ceil), else from Δt_DEM,max.
+SubcyclePlan planFor(const CaseConfig& c, double dt, double dtDemMax);
+
+/// Configure of the case (grid, species, gas properties, materials, particle sets, walls,
+/// gravity, models, chemistry, output folder) with the given first Δt_CFD and plan.
+v1::Configure buildConfigure(const CaseConfig& c, const std::filesystem::path& runDir, double dtCfd,
+                             const SubcyclePlan& plan);
+
+} // namespace coredem::orchestrator

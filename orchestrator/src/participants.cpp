@@ -1,0 +1,214 @@
+// The participant table (participants.h): every CFD participant that `coredem run` can start,
+// one row each, and the generic code that launches, prepares and checks a row.
+#include <cstdlib>
+#include <stdexcept>
+
+#include <fnmatch.h>
+
+#include <coredem/gas/gas_model.h>
+#include <coredem/orchestrator/participants.h>
+#include <coredem/orchestrator/processes.h>
+
+namespace fs = std::filesystem;
+
+namespace coredem::orchestrator {
+namespace {
+
+std::vector<ParticipantDescriptor> makeTable() {
+  std::vector<ParticipantDescriptor> t;
+  {
+    // Prescribed gas from the case file (docs/client.md "coredem-gas"): verification cases,
+    // DEM-only runs, tests. Everything on its command line; its restart file is gas.h5.
+    ParticipantDescriptor p;
+    p.name = "coredem-gas";
+    p.summary = "prescribed gas fields from the case file's gas section";
+    p.args = {"--case",    "{run_case_file}", "--key",     "{gas_key}",
+              "--control", "{control_endpoint}", "--dem", "{dem_endpoint}",
+              "--session", "{session}",       "--timeout-s", "{timeout_s}"};
+    p.restartArgs = {"--restart", "{restart_file}"};
+    p.env = {{"COREDEM_DEM_SERVER_KEY", "{dem_server_key}"}};
+    p.restartFile = "*.h5";
+    p.preflight = &checkGasSection;
+    t.push_back(std::move(p));
+  }
+  {
+    // The OpenFOAM solver (docs/coredemFoam.md): runs in a copy of the OpenFOAM case inside the
+    // run folder and learns its peers from the environment (docs/client.md). Its restart file
+    // is coredemFoam.restart (the files of its time directory are listed as well).
+    ParticipantDescriptor p;
+    p.name = "coredemFoam";
+    p.summary = "OpenFOAM solver (volume-averaged PIMPLE with the DEM sources)";
+    p.args = {"-case", "{work_dir}"};
+    p.restartArgs = {"-restart", "{restart_file}"};
+    p.timersArgs = {"-timers"}; // writes RUN/timers-cfd.json
+    p.env = {{"COREDEM_CONTROL_ENDPOINT", "{control_endpoint}"},
+             {"COREDEM_DEM_ENDPOINT", "{dem_endpoint}"},
+             {"COREDEM_SESSION", "{session}"},
+             {"COREDEM_TIMEOUT_S", "{timeout_s}"},
+             {"COREDEM_DEM_SERVER_KEY", "{dem_server_key}"}}; // remote DEM behind CURVE
+    // OpenFOAM reads its etc tree while its libraries load: Debian's unless set.
+    p.envDefaults = {{"WM_PROJECT_DIR", "/usr/share/openfoam"}};
+    p.restartFile = "coredemFoam.restart";
+    p.caseFolder = "an OpenFOAM case folder";
+    p.caseFolderMarker = "system/controlDict";
+    p.caseFolderHint = "give the folder with system/, constant/ and 0/";
+    p.workDir = "openfoam";
+    t.push_back(std::move(p));
+  }
+  return t;
+}
+
+std::string joined(const std::vector<std::string>& items, const char* sep = ", ") {
+  std::string out;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    out += (i ? sep : "") + items[i];
+  }
+  return out;
+}
+
+} // namespace
+
+const std::vector<ParticipantDescriptor>& participantTable() {
+  static const std::vector<ParticipantDescriptor> table = makeTable();
+  return table;
+}
+
+std::vector<std::string> participantNames() {
+  std::vector<std::string> names;
+  for (const auto& p : participantTable()) {
+    names.push_back(p.name);
+  }
+  return names;
+}
+
+const ParticipantDescriptor& participant(const std::string& name) {
+  for (const auto& p : participantTable()) {
+    if (p.name == name) {
+      return p;
+    }
+  }
+  throw CaseError(fmt::format("unknown CFD participant '{}'; known participants: {}", name,
+                              joined(participantNames())));
+}
+
+std::string expandTemplate(const std::string& text,
+                           const std::map<std::string, std::string>& values) {
+  std::string out;
+  std::size_t pos = 0;
+  while (true) {
+    const std::size_t open = text.find('{', pos);
+    if (open == std::string::npos) {
+      out += text.substr(pos);
+      return out;
+    }
+    const std::size_t close = text.find('}', open);
+    if (close == std::string::npos) {
+      throw std::logic_error("participant template '" + text + "': unclosed '{'");
+    }
+    const std::string name = text.substr(open + 1, close - open - 1);
+    const auto it = values.find(name);
+    if (it == values.end()) {
+      throw std::logic_error("participant template '" + text + "': unknown placeholder {" + name +
+                             "}");
+    }
+    out += text.substr(pos, open - pos) + it->second;
+    pos = close + 1;
+  }
+}
+
+LaunchCommand launchCommand(const ParticipantDescriptor& p, const CaseConfig& config,
+                            const LaunchInputs& in) {
+  const std::map<std::string, std::string> values = {
+      {"run_case_file", (in.runDir / "case.yaml").string()},
+      {"gas_key", config.cfd.gasKey},
+      {"work_dir", p.workDir.empty() ? std::string() : (in.runDir / p.workDir).string()},
+      {"control_endpoint", in.controlEndpoint},
+      {"dem_endpoint", in.demEndpoint},
+      {"session", in.session},
+      {"timeout_s", fmt::format("{}", config.cfd.timeoutSeconds)},
+      {"dem_server_key", in.demServerKey},
+      {"restart_file", in.restartFile.string()}};
+  LaunchCommand cmd;
+  cmd.argv.push_back(in.program.string());
+  auto append = [&](const std::vector<std::string>& args) {
+    for (const auto& a : args) {
+      cmd.argv.push_back(expandTemplate(a, values));
+    }
+  };
+  append(p.args);
+  if (!in.restartFile.empty()) {
+    append(p.restartArgs);
+  }
+  if (in.timers || config.cfd.timers) {
+    append(p.timersArgs);
+  }
+  for (const auto& [key, text] : p.env) {
+    std::string v = expandTemplate(text, values);
+    if (!v.empty()) {
+      cmd.env[key] = std::move(v);
+    }
+  }
+  for (const auto& [key, value] : p.envDefaults) {
+    const char* own = std::getenv(key.c_str());
+    cmd.env[key] = own != nullptr ? own : value;
+  }
+  return cmd;
+}
+
+void prepareWorkDir(const ParticipantDescriptor& p, const CaseConfig& config,
+                    const fs::path& runDir) {
+  if (p.workDir.empty()) {
+    return;
+  }
+  const fs::path work = runDir / p.workDir;
+  if (!p.caseFolderMarker.empty() && fs::exists(work / p.caseFolderMarker)) {
+    return; // made by the first start; a resumed run keeps it
+  }
+  const fs::path src = config.caseDir / config.cfd.caseFolder;
+  COREDEM_CHECK(p.caseFolderMarker.empty() || fs::is_regular_file(src / p.caseFolderMarker),
+                "cfd.case: {} is not {} (no {})", src.string(), p.caseFolder,
+                p.caseFolderMarker);
+  fs::create_directories(work);
+  fs::copy(src, work, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+}
+
+bool isRestartFile(const ParticipantDescriptor& p, const fs::path& path) {
+  return !p.restartFile.empty() &&
+         ::fnmatch(p.restartFile.c_str(), path.filename().c_str(), 0) == 0;
+}
+
+void checkGasSection(const CaseConfig& config) {
+  try {
+    gas::GasModel::fromFile(config.caseFile.string(), config.cfd.gasKey);
+  } catch (const UserError& e) {
+    throw CaseError(e.what());
+  }
+}
+
+void checkParticipantInput(const CaseConfig& config) {
+  if (config.dem.endpoint.empty()) {
+    COREDEM_CHECK(!findProgram("coredem-dem").empty(),
+                  "coredem-dem not found next to coredem ({}) or on PATH; build it (cmake --build "
+                  "build --target coredem-dem) or name a running server in dem.endpoint",
+                  executableDir().string());
+  }
+  const ParticipantDescriptor& p = participant(config.cfd.participant);
+  COREDEM_CHECK(!findProgram(p.name).empty(),
+                "{} not found next to coredem ({}) or on PATH; build it (cmake --build "
+                "build --target {})",
+                p.name, executableDir().string(), p.name);
+  if (!p.caseFolder.empty() && !p.caseFolderMarker.empty()) {
+    const fs::path src = config.caseDir / config.cfd.caseFolder;
+    if (!fs::is_regular_file(src / p.caseFolderMarker)) {
+      throw CaseError(fmt::format("{}: cfd.case: {} is not {} (no {}); {}, relative to the "
+                                  "case folder",
+                                  config.caseFile.string(), src.string(), p.caseFolder,
+                                  p.caseFolderMarker, p.caseFolderHint));
+    }
+  }
+  if (p.preflight != nullptr) {
+    p.preflight(config);
+  }
+}
+
+} // namespace coredem::orchestrator

@@ -1,0 +1,142 @@
+// The records of a run: timeseries rows, checkpoint manifests, particle snapshots and their
+// index, and the wall-time overhead record.
+#include <fstream>
+#include <sstream>
+
+#include "session_impl.h"
+
+namespace fs = std::filesystem;
+namespace v1 = coredem::v1;
+
+namespace coredem::orchestrator {
+
+using protocol::Message;
+
+void collect(const v1::StepDone& done, std::vector<std::pair<std::string, double>>& row) {
+  for (const auto& d : done.diagnostics()) {
+    row.emplace_back(d.name(), d.value());
+  }
+  for (const auto* list :
+       {&done.ledger().mass(), &done.ledger().energy(), &done.ledger().species()}) {
+    for (const auto& v : *list) {
+      row.emplace_back(v.name(), v.value());
+    }
+  }
+}
+
+std::vector<SnapshotEntry> readSnapshotIndex(const fs::path& runDir) {
+  std::vector<SnapshotEntry> out;
+  std::ifstream in(runDir / "snapshots" / "index.csv");
+  std::string line;
+  std::getline(in, line); // header
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::string step, time, file;
+    if (std::getline(s, step, ',') && std::getline(s, time, ',') && std::getline(s, file)) {
+      out.push_back({std::stoll(step), doubleFromHex(time), file});
+    }
+  }
+  return out;
+}
+
+void writeSnapshotIndex(const fs::path& runDir, const std::vector<SnapshotEntry>& snaps) {
+  std::string text = "step,time_hex,file\n";
+  std::vector<std::pair<double, std::string>> xdmf;
+  for (const auto& s : snaps) {
+    text += fmt::format("{},{},{}\n", s.step, doubleToHex(s.time), s.file);
+    xdmf.emplace_back(s.time, s.file);
+  }
+  writeFileAtomic(runDir / "snapshots" / "index.csv", text);
+  writeParticleXdmf(runDir / "particles.xdmf", xdmf);
+}
+
+void OverheadTotals::report(spdlog::logger& log, const fs::path& runDir) const {
+  if (measured <= 0) {
+    return;
+  }
+  const double n = double(measured);
+  log.info("{} steps: step wall {:.3f} ms, DEM compute {:.3f} ms, coupling overhead (wall - "
+           "DEM) {:.3f} ms, orchestrator bookkeeping {:.1f} us per step; checkpoints {:.3f} s, "
+           "snapshots {:.3f} s in total",
+           measured, 1e3 * stepWall / n, 1e3 * demWall / n, 1e3 * (stepWall - demWall) / n,
+           1e6 * overhead / n, checkpoints, snapshots);
+  writeFileAtomic(
+      runDir / "logs" / "overhead.json",
+      fmt::format("{{\"steps\": {}, \"step_wall_s\": {:.9g}, \"dem_compute_s\": {:.9g}, "
+                  "\"coupling_overhead_s\": {:.9g}, \"orchestrator_bookkeeping_s\": {:.9g}, "
+                  "\"checkpoints_total_s\": {:.9g}, \"snapshots_total_s\": {:.9g}}}\n",
+                  measured, stepWall / n, demWall / n, (stepWall - demWall) / n, overhead / n,
+                  checkpoints, snapshots));
+}
+
+void Session::writeTimeseriesRow(std::int64_t step, double dt, const SubcyclePlan& plan,
+                                 double wallStep, const v1::StepDone& dd, const v1::StepDone& cd) {
+  std::vector<std::pair<std::string, double>> row = {{"step", double(step)},
+                                                     {"t", _time.time()},
+                                                     {"dt", dt},
+                                                     {"n_sub", double(plan.nSub)},
+                                                     {"dt_dem", plan.dtDem},
+                                                     {"courant", cd.cfl()},
+                                                     {"wall_step_s", wallStep},
+                                                     {"wall_dem_s", dd.wall_seconds()}};
+  collect(dd, row);
+  collect(cd, row);
+  // Heat balance: what the particles got from the gas (DEM) plus what the gas got from the
+  // particles (CFD) is zero when both sides agree.
+  const auto demHeat = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_from_gas_J");
+  const auto gasHeat = protocol::findNamedValue(cd.ledger().energy(), "gas.heat_from_particles_J");
+  if (demHeat && gasHeat) {
+    row.emplace_back("balance.heat_residual_J", *demHeat + *gasHeat);
+  }
+  _timeseries->write(row);
+}
+
+void Session::writeCheckpoint(std::int64_t step, const fs::path& ckDir, const v1::StepDone& dd,
+                              const v1::StepDone& cd) {
+  std::vector<std::pair<std::string, std::string>> files;
+  for (const auto& f : dd.checkpoint().files()) {
+    files.emplace_back(f, "dem");
+  }
+  for (const auto& f : cd.checkpoint().files()) {
+    files.emplace_back(f, "cfd");
+  }
+  if (dd.checkpoint().files().empty()) {
+    throw ParticipantFault(kDemName, fmt::format("wrote no checkpoint file for step {}", step));
+  }
+  Manifest m;
+  m.step = step;
+  m.time = _time.time();
+  m.timeCompensation = _time.compensation();
+  m.lastDt = _policy.lastDt();
+  m.lastCourant = _lastCourant;
+  m.softwareVersion = COREDEM_SOFTWARE_VERSION;
+  m.protocolVersion = protocol::kProtocolVersion.toString();
+  m.configHash = _c.configHash;
+  writeManifest(ckDir, m, files);
+  for (const auto& removed : pruneCheckpoints(_o.runDir, _c.checkpoint.keep)) {
+    _log->debug("removed old checkpoint {}", removed.string());
+  }
+  _log->debug("checkpoint {} written", ckDir.string());
+}
+
+void Session::takeSnapshot(std::int64_t step, double time) {
+  const fs::path tmp = _o.runDir / "snapshots" / ".incoming";
+  fs::remove_all(tmp);
+  fs::create_directories(tmp);
+  Message req = protocol::makeCheckpointRequest(step, fs::absolute(tmp).string(), "snapshot");
+  req.setSessionId(_session).setTime(time);
+  _dem->send(std::move(req));
+  Message done = receiveFromDem(std::chrono::milliseconds(int(_c.dem.timeoutSeconds * 1000)),
+                                "CheckpointDone of a snapshot");
+  if (done.type() != v1::MESSAGE_TYPE_CHECKPOINT_DONE ||
+      done.envelope().checkpoint_done().files().empty()) {
+    throw ParticipantFault(kDemName, "answered a snapshot request without a file");
+  }
+  const std::string rel = fmt::format("snapshots/particles_{:08d}.h5", step);
+  fs::rename(tmp / done.envelope().checkpoint_done().files(0), _o.runDir / rel);
+  fs::remove_all(tmp);
+  _snapshots.push_back({step, time, rel});
+  writeSnapshotIndex(_o.runDir, _snapshots);
+}
+
+} // namespace coredem::orchestrator

@@ -1,0 +1,121 @@
+// The step loop of a run (docs/orchestrator.md "A run, step by step", 5): Δt from the dt policy,
+// the sub-cycling plan, the checkpoint decision, the same StepGrant to both participants, their
+// StepDone, then the records of the step (records.cpp).
+#include "configure.h"
+#include "session_impl.h"
+
+#include <coredem/orchestrator/progress.h>
+
+namespace fs = std::filesystem;
+namespace v1 = coredem::v1;
+
+namespace coredem::orchestrator {
+
+using protocol::Message;
+
+void Session::stepLoop(std::int64_t startStep) {
+  _step = startStep;
+  const auto demTimeout = std::chrono::milliseconds(int(_c.dem.timeoutSeconds * 1000));
+  const auto cfdTimeout = std::chrono::milliseconds(int(_c.cfd.timeoutSeconds * 1000));
+  Progress progress(_time.time(), _c.endTime, _step, _o.tty);
+  auto lastCheckpointWall = SteadyClock::now();
+  auto afterPrevious = SteadyClock::now();
+
+  while (true) {
+    const bool stopHere = _o.stopAfterStep && _step >= *_o.stopAfterStep;
+    if (_time.reached(_c.endTime) || stopHere) {
+      break;
+    }
+    const auto t0 = SteadyClock::now();
+    const std::int64_t step = _step + 1;
+    const double tStart = _time.time();
+    const double dt = _policy.next(_lastCourant, _time.remaining(_c.endTime));
+    const SubcyclePlan plan = planFor(_c, dt, _dtDemMax);
+    TimeHandler probe = _time;
+    probe.advance(dt);
+    const bool last = probe.reached(_c.endTime) || (_o.stopAfterStep && step >= *_o.stopAfterStep);
+    const bool checkpoint =
+        checkpointDue(step, last, _c.checkpoint.everySteps, _c.checkpoint.everySeconds,
+                      std::chrono::duration<double>(SteadyClock::now() - lastCheckpointWall).count());
+    fs::path ckDir;
+    if (checkpoint) {
+      ckDir = fs::absolute(checkpointDir(_o.runDir, step));
+      fs::remove_all(ckDir); // a stale, incomplete one from an earlier attempt
+      fs::create_directories(ckDir);
+    }
+    auto makeGrant = [&] {
+      Message g = protocol::makeStepGrant(step, tStart, dt, std::uint32_t(plan.nSub), plan.dtDem);
+      g.setSessionId(_session);
+      if (checkpoint) {
+        g.envelope().mutable_step_grant()->mutable_checkpoint()->set_directory(ckDir.string());
+      }
+      return g;
+    };
+    _dem->send(makeGrant());
+    {
+      Message g = makeGrant();
+      g.setSequence(_pendingCfd->message.envelope().sequence());
+      _ctrl->reply(_pendingCfd->peer, std::move(g));
+      _pendingCfd.reset();
+    }
+    _overhead.overhead += std::chrono::duration<double>(SteadyClock::now() - afterPrevious).count();
+
+    Message demDone = receiveFromDem(demTimeout, fmt::format("StepDone of step {}", step));
+    if (demDone.type() != v1::MESSAGE_TYPE_STEP_DONE || demDone.envelope().step() != step) {
+      throw ParticipantFault(kDemName,
+                             fmt::format("answered the grant of step {} with {} of step {}", step,
+                                         protocol::messageTypeName(demDone.type()),
+                                         demDone.envelope().step()));
+    }
+    protocol::Request cfdDone;
+    while (true) {
+      cfdDone = receiveFromCfd(cfdTimeout, fmt::format("StepDone of step {}", step));
+      if (cfdDone.message.type() == v1::MESSAGE_TYPE_STEP_DONE &&
+          cfdDone.message.envelope().step() == step) {
+        break;
+      }
+      Message err =
+          protocol::makeError(v1::ERROR_CODE_OUT_OF_ORDER,
+                              fmt::format("expected StepDone of step {}, got {} of step {}", step,
+                                          protocol::messageTypeName(cfdDone.message.type()),
+                                          cfdDone.message.envelope().step()),
+                              cfdDone.message.envelope().sequence(), cfdDone.message.type());
+      _ctrl->reply(cfdDone.peer, std::move(err));
+    }
+    const auto tDone = SteadyClock::now();
+    _time.advance(dt);
+    _step = step;
+    const auto& dd = demDone.envelope().step_done();
+    const auto& cd = cfdDone.message.envelope().step_done();
+    _lastCourant = cd.cfl();
+
+    // The timeseries row of a step is written before its checkpoint manifest: a resume from
+    // that checkpoint must find the row (a crash between the two would otherwise lose it).
+    if (step % _c.output.timeseriesEvery == 0 || last) {
+      writeTimeseriesRow(step, dt, plan, std::chrono::duration<double>(tDone - t0).count(), dd, cd);
+    }
+    const auto tIo0 = SteadyClock::now();
+    if (checkpoint) {
+      writeCheckpoint(step, ckDir, dd, cd);
+      lastCheckpointWall = SteadyClock::now();
+    }
+    const auto tIo1 = SteadyClock::now();
+    if (_c.output.snapshotEvery > 0 && (step % _c.output.snapshotEvery == 0 || last)) {
+      takeSnapshot(step, _time.time());
+    }
+    const auto tIo2 = SteadyClock::now();
+    _overhead.checkpoints += std::chrono::duration<double>(tIo1 - tIo0).count();
+    _overhead.snapshots += std::chrono::duration<double>(tIo2 - tIo1).count();
+    _overhead.stepWall += std::chrono::duration<double>(tDone - t0).count();
+    _overhead.demWall += dd.wall_seconds();
+    ++_overhead.measured;
+    progress.update(_step, _time.time());
+    _pendingCfd = std::move(cfdDone);
+    afterPrevious = SteadyClock::now();
+    _overhead.overhead += std::chrono::duration<double>(afterPrevious - tDone).count() -
+                    std::chrono::duration<double>(tIo2 - tIo0).count();
+  }
+  progress.finish(_step, _time.time());
+}
+
+} // namespace coredem::orchestrator
