@@ -1,9 +1,9 @@
 // Configure of a run, built from the case (configure.h).
+#include "configure.h"
+
 #include <cmath>
 #include <limits>
 #include <numbers>
-
-#include "configure.h"
 
 namespace fs = std::filesystem;
 namespace v1 = coredem::v1;
@@ -136,7 +136,7 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
     kv->set_value(v);
   }
   cfg.set_output_directory(fs::absolute(runDir).string());
-  addChemistryToConfigure(c, cfg);  // v1.1: solid species, reactions, chemistry
+  addChemistryToConfigure(c, cfg); // v1.1: solid species, reactions, chemistry
   return cfg;
 }
 

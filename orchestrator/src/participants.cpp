@@ -22,9 +22,9 @@ std::vector<ParticipantDescriptor> makeTable() {
     ParticipantDescriptor p;
     p.name = "coredem-gas";
     p.summary = "prescribed gas fields from the case file's gas section";
-    p.args = {"--case",    "{run_case_file}", "--key",     "{gas_key}",
-              "--control", "{control_endpoint}", "--dem", "{dem_endpoint}",
-              "--session", "{session}",       "--timeout-s", "{timeout_s}"};
+    p.args = {"--case",    "{run_case_file}",    "--key",       "{gas_key}",
+              "--control", "{control_endpoint}", "--dem",       "{dem_endpoint}",
+              "--session", "{session}",          "--timeout-s", "{timeout_s}"};
     p.restartArgs = {"--restart", "{restart_file}"};
     p.env = {{"COREDEM_DEM_SERVER_KEY", "{dem_server_key}"}};
     p.restartFile = "*.h5";
@@ -166,8 +166,7 @@ void prepareWorkDir(const ParticipantDescriptor& p, const CaseConfig& config,
   }
   const fs::path src = config.caseDir / config.cfd.caseFolder;
   COREDEM_CHECK(p.caseFolderMarker.empty() || fs::is_regular_file(src / p.caseFolderMarker),
-                "cfd.case: {} is not {} (no {})", src.string(), p.caseFolder,
-                p.caseFolderMarker);
+                "cfd.case: {} is not {} (no {})", src.string(), p.caseFolder, p.caseFolderMarker);
   fs::create_directories(work);
   fs::copy(src, work, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
 }

@@ -36,7 +36,7 @@ namespace coredem::orchestrator {
 
 using SteadyClock = std::chrono::steady_clock;
 
-/// SIGINT/SIGTERM arrived: finish, checkpoint-free stop, exit 130.
+/// SIGINT/SIGTERM arrived: the participants are stopped; exit 130, the run can be resumed.
 class Interrupted : public UserError {
 public:
   Interrupted()
@@ -77,7 +77,8 @@ struct SnapshotEntry {
 
 /// RUN/snapshots/index.csv (exact hex times) and RUN/particles.xdmf.
 std::vector<SnapshotEntry> readSnapshotIndex(const std::filesystem::path& runDir);
-void writeSnapshotIndex(const std::filesystem::path& runDir, const std::vector<SnapshotEntry>& snaps);
+void writeSnapshotIndex(const std::filesystem::path& runDir,
+                        const std::vector<SnapshotEntry>& snaps);
 
 /// Ledger entries and diagnostics of a StepDone as (name, value) pairs, appended to `row`.
 void collect(const v1::StepDone& done, std::vector<std::pair<std::string, double>>& row);
@@ -118,10 +119,10 @@ private:
   // step_loop.cpp
   void stepLoop(std::int64_t startStep);
   // records.cpp
-  void writeTimeseriesRow(std::int64_t step, double dt, const SubcyclePlan& plan,
-                          double wallStep, const v1::StepDone& dem, const v1::StepDone& cfd);
-  void writeCheckpoint(std::int64_t step, const std::filesystem::path& dir,
-                       const v1::StepDone& dem, const v1::StepDone& cfd);
+  void writeTimeseriesRow(std::int64_t step, double dt, const SubcyclePlan& plan, double wallStep,
+                          const v1::StepDone& dem, const v1::StepDone& cfd);
+  void writeCheckpoint(std::int64_t step, const std::filesystem::path& dir, const v1::StepDone& dem,
+                       const v1::StepDone& cfd);
   void takeSnapshot(std::int64_t step, double time);
 
   const CaseConfig& _c;

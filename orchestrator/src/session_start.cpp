@@ -56,7 +56,8 @@ void Session::startDem() {
       argv.insert(argv.end(), {"--threads", std::to_string(_c.dem.threads)});
     }
     if (_c.dem.timers || _o.timers) {
-      argv.insert(argv.end(), {"--timers", "--timers-file", (_o.runDir / "timers-dem.json").string()});
+      argv.insert(argv.end(),
+                  {"--timers", "--timers-file", (_o.runDir / "timers-dem.json").string()});
     }
     // OpenMP threads that spin at barriers stall every parallel region when the DEM shares
     // its cores with the CFD participant (docs/performance.md, "DEM core"); passive waiting
@@ -65,9 +66,11 @@ void Session::startDem() {
     if (std::getenv("OMP_WAIT_POLICY") == nullptr) {
       demEnv["OMP_WAIT_POLICY"] = "PASSIVE";
     }
-    _demProc = std::make_unique<ChildProcess>(kDemName, argv, demEnv, _o.runDir / "logs" / "dem.log");
-    const auto deadline = SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
-                                             std::chrono::duration<double>(_c.dem.timeoutSeconds));
+    _demProc =
+        std::make_unique<ChildProcess>(kDemName, argv, demEnv, _o.runDir / "logs" / "dem.log");
+    const auto deadline =
+        SteadyClock::now() + std::chrono::duration_cast<SteadyClock::duration>(
+                                 std::chrono::duration<double>(_c.dem.timeoutSeconds));
     while (!fs::exists(epFile)) {
       checkAlive();
       if (SteadyClock::now() > deadline) {
@@ -170,15 +173,15 @@ protocol::Request Session::receiveFromCfd(std::chrono::milliseconds timeout,
       if (r->message.type() == v1::MESSAGE_TYPE_ERROR) {
         throw ParticipantFault(
             cfdName(), fmt::format("reported Error {}: {}",
-                                     protocol::errorCodeName(r->message.envelope().error().code()),
-                                     r->message.envelope().error().message()));
+                                   protocol::errorCodeName(r->message.envelope().error().code()),
+                                   r->message.envelope().error().message()));
       }
       return std::move(*r);
     }
     checkAlive();
     if (SteadyClock::now() > deadline) {
-      throw ParticipantFault(cfdName(), fmt::format("stopped answering: no {} within {} s",
-                                                      awaited, timeout.count() / 1000.0));
+      throw ParticipantFault(cfdName(), fmt::format("stopped answering: no {} within {} s", awaited,
+                                                    timeout.count() / 1000.0));
     }
   }
 }
@@ -284,7 +287,7 @@ void Session::handshakeCfd() {
       const auto& cd = env.configured();
       if (cd.cell_count() != _cells) {
         throw ParticipantFault(cfdName(), fmt::format("has {} coupling cells, the DEM server {}",
-                                                        cd.cell_count(), _cells));
+                                                      cd.cell_count(), _cells));
       }
       _pendingCfd = std::move(r); // answered with the first grant
       configured = true;

@@ -1,10 +1,10 @@
 // The step loop of a run (docs/orchestrator.md "A run, step by step", 5): Δt from the dt policy,
 // the sub-cycling plan, the checkpoint decision, the same StepGrant to both participants, their
 // StepDone, then the records of the step (records.cpp).
+#include <coredem/orchestrator/progress.h>
+
 #include "configure.h"
 #include "session_impl.h"
-
-#include <coredem/orchestrator/progress.h>
 
 namespace fs = std::filesystem;
 namespace v1 = coredem::v1;
@@ -34,9 +34,9 @@ void Session::stepLoop(std::int64_t startStep) {
     TimeHandler probe = _time;
     probe.advance(dt);
     const bool last = probe.reached(_c.endTime) || (_o.stopAfterStep && step >= *_o.stopAfterStep);
-    const bool checkpoint =
-        checkpointDue(step, last, _c.checkpoint.everySteps, _c.checkpoint.everySeconds,
-                      std::chrono::duration<double>(SteadyClock::now() - lastCheckpointWall).count());
+    const bool checkpoint = checkpointDue(
+        step, last, _c.checkpoint.everySteps, _c.checkpoint.everySeconds,
+        std::chrono::duration<double>(SteadyClock::now() - lastCheckpointWall).count());
     fs::path ckDir;
     if (checkpoint) {
       ckDir = fs::absolute(checkpointDir(_o.runDir, step));
@@ -113,7 +113,7 @@ void Session::stepLoop(std::int64_t startStep) {
     _pendingCfd = std::move(cfdDone);
     afterPrevious = SteadyClock::now();
     _overhead.overhead += std::chrono::duration<double>(afterPrevious - tDone).count() -
-                    std::chrono::duration<double>(tIo2 - tIo0).count();
+                          std::chrono::duration<double>(tIo2 - tIo0).count();
   }
   progress.finish(_step, _time.time());
 }

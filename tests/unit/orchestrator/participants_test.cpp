@@ -43,8 +43,8 @@ gas:
 struct TempDir {
   fs::path path;
   explicit TempDir(const std::string& name)
-      : path(fs::temp_directory_path() / ("coredem-participants-" + name + "-" +
-                                          std::to_string(::getpid()))) {
+      : path(fs::temp_directory_path() /
+             ("coredem-participants-" + name + "-" + std::to_string(::getpid()))) {
     fs::remove_all(path);
     fs::create_directories(path);
   }
@@ -91,7 +91,8 @@ TEST(Participants, UnknownParticipantNamesTheKnownOnes) {
     EXPECT_NE(msg.find("coredem-gas, coredemFoam"), std::string::npos) << msg;
   }
   // The case schema refuses it with file:line:col and the same list.
-  const std::string msg = errorOf(replace(kCase, "participant: coredem-gas", "participant: fluent"));
+  const std::string msg =
+      errorOf(replace(kCase, "participant: coredem-gas", "participant: fluent"));
   EXPECT_NE(msg.find("cases/x/case.yaml:11:20: cfd.participant: 'fluent' is not allowed; allowed: "
                      "coredem-gas, coredemFoam"),
             std::string::npos)
@@ -103,11 +104,10 @@ TEST(Participants, PrescribedGasCommandLineAndEnvironment) {
   const auto& p = participant("coredem-gas");
   LaunchInputs in = inputs("/runs/r1");
   LaunchCommand cmd = launchCommand(p, c, in);
-  EXPECT_EQ(cmd.argv, (std::vector<std::string>{"/opt/coredem/bin/participant", "--case",
-                                                "/runs/r1/case.yaml", "--key", "gas", "--control",
-                                                "tcp://127.0.0.1:5001", "--dem",
-                                                "tcp://127.0.0.1:5002", "--session", "s-123",
-                                                "--timeout-s", "30"}));
+  EXPECT_EQ(cmd.argv, (std::vector<std::string>{
+                          "/opt/coredem/bin/participant", "--case", "/runs/r1/case.yaml", "--key",
+                          "gas", "--control", "tcp://127.0.0.1:5001", "--dem",
+                          "tcp://127.0.0.1:5002", "--session", "s-123", "--timeout-s", "30"}));
   EXPECT_TRUE(cmd.env.empty()) << "no CURVE key: nothing in the environment";
 
   // Resumed, with CURVE and `coredem run --timers` (no stage timers: nothing added for them).
@@ -251,7 +251,8 @@ TEST(Participants, GasSectionValidatedInProcessWithFileLineColumn) {
   }
   // No gas section under cfd.gas_key.
   try {
-    checkGasSection(caseIn(d.path, replace(kCase, "timeout_s: 30}", "timeout_s: 30, gas_key: flow}")));
+    checkGasSection(
+        caseIn(d.path, replace(kCase, "timeout_s: 30}", "timeout_s: 30, gas_key: flow}")));
     FAIL() << "no error";
   } catch (const CaseError& e) {
     EXPECT_NE(std::string(e.what()).find("no key 'flow'"), std::string::npos) << e.what();

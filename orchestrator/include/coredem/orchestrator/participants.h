@@ -91,9 +91,9 @@ struct LaunchInputs {
   std::filesystem::path program; ///< the participant's executable (findProgram)
   std::filesystem::path runDir;  ///< absolute run folder
   std::string controlEndpoint, demEndpoint, session;
-  std::string demServerKey;             ///< Z85 CURVE public key, empty without CURVE
-  std::filesystem::path restartFile;    ///< empty: a fresh start
-  bool timers = false;                  ///< `coredem run --timers`
+  std::string demServerKey;          ///< Z85 CURVE public key, empty without CURVE
+  std::filesystem::path restartFile; ///< empty: a fresh start
+  bool timers = false;               ///< `coredem run --timers`
 };
 
 /// The command line and the extra environment of a participant start.
@@ -108,7 +108,8 @@ LaunchCommand launchCommand(const ParticipantDescriptor& p, const CaseConfig& co
 
 /// Replaces every `{name}` of `text` by `values.at(name)`; an unknown name is an internal error
 /// (std::logic_error).
-std::string expandTemplate(const std::string& text, const std::map<std::string, std::string>& values);
+std::string expandTemplate(const std::string& text,
+                           const std::map<std::string, std::string>& values);
 
 /// Copies `cfd.case` into RUN/<workDir> unless a copy is there already (no-op for a participant
 /// without a work folder). Throws UserError when `cfd.case` lacks the marker file.
