@@ -7,7 +7,7 @@
 
 #include <coredem/gas/gas_model.h>
 #include <coredem/orchestrator/participants.h>
-#include <coredem/orchestrator/processes.h>
+#include <coredem/common/process.h>
 
 namespace fs = std::filesystem;
 

@@ -23,7 +23,7 @@
 #include <coredem/orchestrator/checkpoint.h>
 #include <coredem/orchestrator/outputs.h>
 #include <coredem/orchestrator/participants.h>
-#include <coredem/orchestrator/processes.h>
+#include <coredem/common/process.h>
 #include <coredem/orchestrator/session.h>
 #include <coredem/orchestrator/time_handler.h>
 #include <coredem/protocol/protocol.h>
