@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <coredem/common/log.h>
+#include <coredem/common/version.h>
 #include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/outputs.h>
@@ -54,7 +55,7 @@ int main(int argc, char** argv) {
     return campaignMain(argc - 1, argv + 1);
   }
   CLI::App app{"coredem: orchestrates a coupled CFD-DEM run (DEM server + CFD participant)"};
-  app.set_version_flag("--version", std::string("coredem ") + COREDEM_SOFTWARE_VERSION);
+  app.set_version_flag("--version", std::string("coredem ") + coredem::kVersion);
   app.require_subcommand(1);
 
   std::string caseDir, out, runDir, file;

@@ -15,19 +15,18 @@
 
 #include <CLI/CLI.hpp>
 #include <fcntl.h>
-#include <spawn.h>
 #include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <coredem/common/check.h>
 #include <coredem/common/log.h>
+#include <coredem/common/process.h>
+#include <coredem/common/version.h>
 #include <coredem/orchestrator/campaign_db.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/checkpoint.h>
 #include <coredem/orchestrator/sha256.h>
-
-extern char** environ;
 
 namespace coredem::orchestrator {
 
@@ -302,27 +301,11 @@ private:
       out << "=== campaign attempt " << m.attempts + 1 << " " << utcNow() << ": coredem " << how
           << "\n";
     }
-    std::vector<char*> c;
-    for (auto& a : args) {
-      c.push_back(a.data());
-    }
-    c.push_back(nullptr);
-    posix_spawn_file_actions_t fa;
-    posix_spawn_file_actions_init(&fa);
-    posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-    posix_spawn_file_actions_adddup2(&fa, 1, 2);
-    posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-    posix_spawnattr_t attr;
-    posix_spawnattr_init(&attr);
-    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP); // own group: stopped as a whole
-    posix_spawnattr_setpgroup(&attr, 0);
-    pid_t pid = -1;
-    const int rc = posix_spawn(&pid, c[0], &fa, &attr, c.data(), environ);
-    posix_spawn_file_actions_destroy(&fa);
-    posix_spawnattr_destroy(&attr);
-    if (rc != 0) {
-      const std::string reason =
-          fmt::format("cannot start {}: {}", _coredem.string(), std::strerror(rc));
+    int pid = -1;
+    try {
+      pid = spawnProcess("campaign member " + m.id, args, log); // own process group
+    } catch (const UserError& e) {
+      const std::string reason = e.what();
       _db.transaction([&] {
         _db.markFailed(m.id, reason, _retries);
         _db.addEvent(m.id, "failed", reason);
@@ -387,14 +370,7 @@ private:
       _log->info("member {}: done", id);
       return;
     }
-    std::string reason;
-    if (status < 0) {
-      reason = "lost track of the process";
-    } else if (WIFEXITED(status)) {
-      reason = fmt::format("exited with code {}", WEXITSTATUS(status));
-    } else if (WIFSIGNALED(status)) {
-      reason = fmt::format("killed by signal {}", WTERMSIG(status));
-    }
+    std::string reason = status < 0 ? "lost track of the process" : describeWaitStatus(status);
     const std::string err = lastErrorLine(fs::path(m ? m->caseDir : "").parent_path() /
                                           "coredem.log");
     if (!err.empty()) {
@@ -484,7 +460,7 @@ void createCampaign(const Sweep& sw, const fs::path& dir) {
       db.setSetting("executor", sw.executor);
       db.setSetting("concurrency", std::to_string(sw.concurrency));
       db.setSetting("retries", std::to_string(sw.retries));
-      db.setSetting("software_version", COREDEM_SOFTWARE_VERSION);
+      db.setSetting("software_version", kVersion);
       db.setSetting("created", utcNow());
       std::string scalars;
       for (const auto& s : sw.scalars) {

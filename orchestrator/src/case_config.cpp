@@ -30,8 +30,6 @@ const std::vector<std::string> kClgKinetics = {
     "K_H2O", "dH_H2O", "K_H2", "dH_H2", "rho_m", "r_grain", "k0_CO", "E_CO",
     "n_CO",  "k0_H2", "E_H2", "n_H2", "kf0", "Ef_over_R"};
 
-bool onOff(const Section& s, const std::string& key, bool def) { return s.onOff(key, def); }
-
 const SpeciesConfig* findSpecies(const std::vector<SpeciesConfig>& list, const std::string& name) {
   for (const auto& sp : list) {
     if (sp.name == name) {
@@ -199,15 +197,15 @@ void parseChemistry(const Section& top, CaseConfig& c) {
                                           "wgs", "wgs_equilibrium"};
       allowed.insert(allowed.end(), kClgKinetics.begin(), kClgKinetics.end());
       const Section g = s.section("clg", allowed);
-      ch.charGasification = onOff(g, "char_gasification", false);
+      ch.charGasification = g.onOff("char_gasification", false);
       ch.charStoichiometry = g.choice("char_stoichiometry", std::string("carbon"), {"carbon", "seed"});
       if (ch.charStoichiometry == "seed") {
         g.fail(g.markOf("char_stoichiometry"), g.full("char_stoichiometry"),
                "seed is not implemented: the seed's pseudo-char lines of R1 and R2 are not mutually "
                "consistent (PHYSICS §6.1); use carbon");
       }
-      ch.ocReduction = onOff(g, "oc_reduction", false);
-      ch.wgs = onOff(g, "wgs", false);
+      ch.ocReduction = g.onOff("oc_reduction", false);
+      ch.wgs = g.onOff("wgs", false);
       ch.wgsEquilibrium =
           g.choice("wgs_equilibrium", std::string("yoon_denn"), {"yoon_denn", "seed", "thermodynamic"});
       for (const auto& k : kClgKinetics) {
@@ -250,7 +248,7 @@ void parseChemistry(const Section& top, CaseConfig& c) {
       }
     }
     if (s.has("reaction_heat")) {
-      ch.reactionHeat = onOff(s, "reaction_heat", true);
+      ch.reactionHeat = s.onOff("reaction_heat", true);
     }
   }
 }
@@ -572,8 +570,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     c.dem.backend = d.choice("backend", std::string("cpu"), {"cpu", "cuda", "auto"});
     c.dem.threads = int(d.integer("threads", 0, 0, 4096, "OpenMP threads, 0 = default"));
     c.dem.timeoutSeconds = d.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
-    const std::string timers = d.choice("timers", std::string("off"), {"on", "off", "true", "false"});
-    c.dem.timers = timers == "on" || timers == "true";
+    c.dem.timers = d.onOff("timers", false);
     if (d.has("server_key")) {
       const std::string rel =
           d.string("server_key", std::nullopt,
@@ -603,8 +600,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     }
     c.cfd.gasKey = f.string("gas_key", std::string("gas"), "key of the prescribed-gas section");
     c.cfd.timeoutSeconds = f.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
-    const std::string cfdTimers = f.choice("timers", std::string("off"), {"on", "off", "true", "false"});
-    c.cfd.timers = cfdTimers == "on" || cfdTimers == "true";
+    c.cfd.timers = f.onOff("timers", false);
     if (c.cfd.timers && !p.hasTimers()) {
       std::vector<std::string> withTimers;
       for (const auto& q : participantTable()) {

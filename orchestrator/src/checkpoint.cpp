@@ -12,6 +12,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <coredem/common/check.h>
+#include <coredem/common/json.h>
 #include <coredem/orchestrator/checkpoint.h>
 #include <coredem/orchestrator/sha256.h>
 
@@ -27,39 +28,6 @@ void fsyncPath(const fs::path& p, bool directory) {
   }
   ::fsync(fd);
   ::close(fd);
-}
-
-std::string jsonEscape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-    case '"':
-      out += "\\\"";
-      break;
-    case '\\':
-      out += "\\\\";
-      break;
-    case '\n':
-      out += "\\n";
-      break;
-    case '\t':
-      out += "\\t";
-      break;
-    default:
-      if (static_cast<unsigned char>(c) < 0x20) {
-        char buf[8];
-        std::snprintf(buf, sizeof buf, "\\u%04x", c);
-        out += buf;
-      } else {
-        out += c;
-      }
-    }
-  }
-  return out;
-}
-
-std::string quoted(const std::string& s) {
-  return "\"" + jsonEscape(s) + "\"";
 }
 
 std::string formatDouble(double v) {
@@ -154,28 +122,31 @@ void writeManifest(const fs::path& dir, Manifest manifest,
   if (manifest.created.empty()) {
     manifest.created = utcNow();
   }
-  std::ostringstream js;
-  js << "{\n";
-  js << "  \"format\": \"coredem-checkpoint-1\",\n";
-  js << "  \"step\": " << manifest.step << ",\n";
-  js << "  \"time\": " << formatDouble(manifest.time) << ",\n";
-  js << "  \"time_hex\": " << quoted(doubleToHex(manifest.time)) << ",\n";
-  js << "  \"time_compensation_hex\": " << quoted(doubleToHex(manifest.timeCompensation)) << ",\n";
-  js << "  \"last_dt_hex\": " << quoted(doubleToHex(manifest.lastDt)) << ",\n";
-  js << "  \"last_courant_hex\": " << quoted(doubleToHex(manifest.lastCourant)) << ",\n";
-  js << "  \"software_version\": " << quoted(manifest.softwareVersion) << ",\n";
-  js << "  \"protocol_version\": " << quoted(manifest.protocolVersion) << ",\n";
-  js << "  \"config_hash\": " << quoted(manifest.configHash) << ",\n";
-  js << "  \"created\": " << quoted(manifest.created) << ",\n";
-  js << "  \"files\": [";
-  for (std::size_t i = 0; i < manifest.files.size(); ++i) {
-    const auto& f = manifest.files[i];
-    js << (i ? ",\n" : "\n") << "    {\"path\": " << quoted(f.path)
-       << ", \"participant\": " << quoted(f.participant) << ", \"bytes\": " << f.bytes
-       << ", \"sha256\": " << quoted(f.sha256) << "}";
+  // One member a line, one file a line (docs/orchestrator.md "Checkpoints"); time also as a
+  // hex float, which resume reads, so that the orchestrator's state comes back bit for bit.
+  JsonWriter js;
+  js.beginObject()
+      .field("format", "coredem-checkpoint-1")
+      .field("step", manifest.step)
+      .key("time")
+      .raw(formatDouble(manifest.time))
+      .field("time_hex", doubleToHex(manifest.time))
+      .field("time_compensation_hex", doubleToHex(manifest.timeCompensation))
+      .field("last_dt_hex", doubleToHex(manifest.lastDt))
+      .field("last_courant_hex", doubleToHex(manifest.lastCourant))
+      .field("software_version", manifest.softwareVersion)
+      .field("protocol_version", manifest.protocolVersion)
+      .field("config_hash", manifest.configHash)
+      .field("created", manifest.created)
+      .key("files")
+      .beginArray();
+  for (const auto& f : manifest.files) {
+    js.raw(fmt::format("{{\"path\": \"{}\", \"participant\": \"{}\", \"bytes\": {}, "
+                       "\"sha256\": \"{}\"}}",
+                       jsonEscape(f.path), jsonEscape(f.participant), f.bytes,
+                       jsonEscape(f.sha256)));
   }
-  js << (manifest.files.empty() ? "]\n" : "\n  ]\n");
-  js << "}\n";
+  js.endArray().endObject();
   writeFileAtomic(dir / "manifest.json", js.str());
 }
 

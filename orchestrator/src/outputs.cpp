@@ -7,10 +7,10 @@
 #include <sstream>
 
 #include <fcntl.h>
-#include <hdf5.h>
 #include <unistd.h>
 
 #include <coredem/common/check.h>
+#include <coredem/common/hdf5.h>
 #include <coredem/orchestrator/checkpoint.h>
 #include <coredem/orchestrator/outputs.h>
 
@@ -144,22 +144,21 @@ std::string typeName(hid_t type) {
 }
 
 std::string attributeText(hid_t attr) {
-  const hid_t type = H5Aget_type(attr);
-  const hid_t space = H5Aget_space(attr);
+  const h5::Handle type(H5Aget_type(attr), H5Tclose);
+  const h5::Handle space(H5Aget_space(attr), H5Sclose);
   const hssize_t n = H5Sget_simple_extent_npoints(space);
   std::string out;
   const H5T_class_t cls = H5Tget_class(type);
   if (cls == H5T_STRING) {
     if (H5Tis_variable_str(type) > 0) {
       std::vector<char*> ptrs(std::size_t(std::max<hssize_t>(n, 1)), nullptr);
-      const hid_t mem = H5Tget_native_type(type, H5T_DIR_ASCEND);
+      const h5::Handle mem(H5Tget_native_type(type, H5T_DIR_ASCEND), H5Tclose);
       if (H5Aread(attr, mem, ptrs.data()) >= 0) {
         for (hssize_t i = 0; i < n; ++i) {
           out += (i ? ", " : "") + std::string(ptrs[std::size_t(i)] ? ptrs[std::size_t(i)] : "");
         }
         H5Dvlen_reclaim(mem, space, H5P_DEFAULT, ptrs.data());
       }
-      H5Tclose(mem);
     } else {
       const std::size_t size = H5Tget_size(type);
       std::vector<char> buf(size * std::size_t(std::max<hssize_t>(n, 1)) + 1, '\0');
@@ -177,8 +176,6 @@ std::string attributeText(hid_t attr) {
   } else {
     out = "(" + typeName(type) + ")";
   }
-  H5Sclose(space);
-  H5Tclose(type);
   return out;
 }
 
@@ -190,15 +187,15 @@ void scanAttributes(hid_t obj, const std::string& path, ScanState& st) {
   H5Oget_info2(obj, &info, H5O_INFO_NUM_ATTRS);
 #endif
   for (hsize_t i = 0; i < info.num_attrs; ++i) {
-    const hid_t attr =
-        H5Aopen_by_idx(obj, ".", H5_INDEX_NAME, H5_ITER_INC, i, H5P_DEFAULT, H5P_DEFAULT);
-    if (attr < 0) {
+    const h5::Handle attr(
+        H5Aopen_by_idx(obj, ".", H5_INDEX_NAME, H5_ITER_INC, i, H5P_DEFAULT, H5P_DEFAULT),
+        H5Aclose);
+    if (!attr.valid()) {
       continue;
     }
     char name[256] = {0};
     H5Aget_name(attr, sizeof name, name);
     st.attributes->push_back({path + "@" + name, attributeText(attr)});
-    H5Aclose(attr);
   }
 }
 
@@ -214,13 +211,12 @@ herr_t visit(hid_t group, const char* name, const H5L_info_t*, void* data) {
   }
   const std::string path = std::string("/") + name;
   if (info.type == H5O_TYPE_GROUP) {
-    const hid_t g = H5Gopen2(group, name, H5P_DEFAULT);
+    const h5::Handle g(H5Gopen2(group, name, H5P_DEFAULT), H5Gclose);
     scanAttributes(g, path, st);
-    H5Gclose(g);
   } else if (info.type == H5O_TYPE_DATASET) {
-    const hid_t ds = H5Dopen2(group, name, H5P_DEFAULT);
-    const hid_t space = H5Dget_space(ds);
-    const hid_t type = H5Dget_type(ds);
+    const h5::Handle ds(H5Dopen2(group, name, H5P_DEFAULT), H5Dclose);
+    const h5::Handle space(H5Dget_space(ds), H5Sclose);
+    const h5::Handle type(H5Dget_type(ds), H5Tclose);
     DatasetInfo d;
     d.path = path;
     const int rank = H5Sget_simple_extent_ndims(space);
@@ -245,9 +241,6 @@ herr_t visit(hid_t group, const char* name, const H5L_info_t*, void* data) {
     }
     st.datasets->push_back(d);
     scanAttributes(ds, path, st);
-    H5Tclose(type);
-    H5Sclose(space);
-    H5Dclose(ds);
   }
   return 0;
 }
@@ -258,12 +251,11 @@ void scanHdf5(const fs::path& file, std::vector<DatasetInfo>& datasets,
               std::vector<AttributeInfo>& attributes, bool statistics) {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   COREDEM_CHECK(H5Fis_hdf5(file.c_str()) > 0, "'{}' is not an HDF5 file", file.string());
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  COREDEM_CHECK(f >= 0, "cannot open HDF5 file '{}'", file.string());
+  const h5::Handle f(H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  COREDEM_CHECK(f.valid(), "cannot open HDF5 file '{}'", file.string());
   ScanState st{&datasets, &attributes, statistics};
   scanAttributes(f, "/", st);
   H5Lvisit(f, H5_INDEX_NAME, H5_ITER_INC, visit, &st);
-  H5Fclose(f);
 }
 
 void writeParticleXdmf(const fs::path& xdmfPath,

@@ -5,6 +5,8 @@
 
 #include "session_impl.h"
 
+#include <coredem/common/json.h>
+
 namespace fs = std::filesystem;
 namespace v1 = coredem::v1;
 
@@ -60,13 +62,17 @@ void OverheadTotals::report(spdlog::logger& log, const fs::path& runDir) const {
            "snapshots {:.3f} s in total",
            measured, 1e3 * stepWall / n, 1e3 * demWall / n, 1e3 * (stepWall - demWall) / n,
            1e6 * overhead / n, checkpoints, snapshots);
-  writeFileAtomic(
-      runDir / "logs" / "overhead.json",
-      fmt::format("{{\"steps\": {}, \"step_wall_s\": {:.9g}, \"dem_compute_s\": {:.9g}, "
-                  "\"coupling_overhead_s\": {:.9g}, \"orchestrator_bookkeeping_s\": {:.9g}, "
-                  "\"checkpoints_total_s\": {:.9g}, \"snapshots_total_s\": {:.9g}}}\n",
-                  measured, stepWall / n, demWall / n, (stepWall - demWall) / n, overhead / n,
-                  checkpoints, snapshots));
+  JsonWriter js;
+  js.beginObject()
+      .field("steps", measured)
+      .field("step_wall_s", stepWall / n)
+      .field("dem_compute_s", demWall / n)
+      .field("coupling_overhead_s", (stepWall - demWall) / n)
+      .field("orchestrator_bookkeeping_s", overhead / n)
+      .field("checkpoints_total_s", checkpoints)
+      .field("snapshots_total_s", snapshots)
+      .endObject();
+  writeFileAtomic(runDir / "logs" / "overhead.json", js.str());
 }
 
 void Session::writeTimeseriesRow(std::int64_t step, double dt, const SubcyclePlan& plan,
@@ -109,7 +115,7 @@ void Session::writeCheckpoint(std::int64_t step, const fs::path& ckDir, const v1
   m.timeCompensation = _time.compensation();
   m.lastDt = _policy.lastDt();
   m.lastCourant = _lastCourant;
-  m.softwareVersion = COREDEM_SOFTWARE_VERSION;
+  m.softwareVersion = kVersion;
   m.protocolVersion = protocol::kProtocolVersion.toString();
   m.configHash = _c.configHash;
   writeManifest(ckDir, m, files);

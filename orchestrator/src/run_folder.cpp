@@ -6,6 +6,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <coredem/common/json.h>
+#include <coredem/common/version.h>
+
 #include "session_impl.h"
 
 namespace fs = std::filesystem;
@@ -37,11 +40,14 @@ fs::path prepareRunDir(const CaseConfig& config, const std::optional<fs::path>& 
   }
   fs::create_directories(dir / "logs");
   writeFileAtomic(dir / "case.yaml", config.text);
-  writeFileAtomic(dir / "run.json",
-                  fmt::format("{{\"case_dir\": \"{}\", \"case_file\": \"{}\", \"created\": \"{}\", "
-                              "\"software_version\": \"{}\"}}\n",
-                              config.caseDir.string(), config.caseFile.filename().string(),
-                              utcNow(), COREDEM_SOFTWARE_VERSION));
+  JsonWriter run;
+  run.beginObject()
+      .field("case_dir", config.caseDir.string())
+      .field("case_file", config.caseFile.filename().string())
+      .field("created", utcNow())
+      .field("software_version", kVersion)
+      .endObject();
+  writeFileAtomic(dir / "run.json", run.str());
   return fs::absolute(dir);
 }
 

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include <coredem/common/log.h>
+#include <coredem/common/version.h>
 #include <coredem/orchestrator/checkpoint.h>
 #include <coredem/orchestrator/outputs.h>
 #include <coredem/orchestrator/participants.h>
@@ -27,10 +28,6 @@
 #include <coredem/orchestrator/session.h>
 #include <coredem/orchestrator/time_handler.h>
 #include <coredem/protocol/protocol.h>
-
-#ifndef COREDEM_SOFTWARE_VERSION
-#define COREDEM_SOFTWARE_VERSION "0.0.0"
-#endif
 
 namespace coredem::orchestrator {
 

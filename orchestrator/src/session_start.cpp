@@ -7,6 +7,8 @@
 #include "configure.h"
 #include "session_impl.h"
 
+#include <coredem/common/version.h>
+
 namespace fs = std::filesystem;
 namespace v1 = coredem::v1;
 using namespace std::chrono_literals;
@@ -85,7 +87,7 @@ void Session::startDem() {
     _log->info("started the DEM server (pid {}) at {}", _demProc->pid(), _demEndpoint);
   }
   _dem->connect(_demEndpoint);
-  Message hello = protocol::makeHello(v1::ROLE_ORCHESTRATOR, COREDEM_SOFTWARE_VERSION);
+  Message hello = protocol::makeHello(v1::ROLE_ORCHESTRATOR, kVersion);
   _dem->send(std::move(hello));
   Message welcome;
   try {
@@ -270,7 +272,7 @@ void Session::handshakeCfd() {
         _ctrl->reply(r.peer, std::move(rej));
         continue;
       }
-      Message w = protocol::makeWelcome(v1::ROLE_ORCHESTRATOR, COREDEM_SOFTWARE_VERSION,
+      Message w = protocol::makeWelcome(v1::ROLE_ORCHESTRATOR, kVersion,
                                         nego.agreed.major, nego.agreed.minor, _session);
       w.setSequence(seq).setSessionId(_session);
       _ctrl->reply(r.peer, std::move(w));

@@ -10,24 +10,20 @@ namespace coredem::orchestrator {
 bool timeEquals(double a, double b, double tol) { return coredem::timeEquals(a, b, tol); }
 
 TimeHandler::TimeHandler(double time, double compensation)
-    : _sum(time)
-    , _carry(compensation) {}
+    : _sum(time, compensation) {}
 
 void TimeHandler::advance(double dt) {
   COREDEM_ASSERT(dt > 0.0 && std::isfinite(dt));
-  // Kahan: _carry holds the low-order bits lost by the previous additions.
-  const double y = dt - _carry;
-  const double t = _sum + y;
-  _carry = (t - _sum) - y;
-  _sum = t;
+  _sum.add(dt);
 }
 
 double TimeHandler::remaining(double tEnd) const {
-  return reached(tEnd) ? 0.0 : (tEnd - _sum) + _carry;
+  return reached(tEnd) ? 0.0 : (tEnd - _sum.value()) + _sum.compensation();
 }
 
 bool TimeHandler::reached(double tEnd) const {
-  return _sum - _carry >= tEnd || timeEquals(_sum - _carry, tEnd);
+  const double t = _sum.value() - _sum.compensation();
+  return t >= tEnd || timeEquals(t, tEnd);
 }
 
 DtPolicy::DtPolicy(const DtPolicyConfig& config, double lastDt)

@@ -14,10 +14,10 @@
 #include <set>
 #include <sstream>
 
-#include <hdf5.h>
 #include <spdlog/spdlog.h>
 #include <yaml-cpp/yaml.h>
 
+#include <coredem/common/hdf5.h>
 #include <coredem/common/log.h>
 #include <coredem/dem/verification/analytic.h>
 #include <coredem/orchestrator/case_config.h>
@@ -269,41 +269,6 @@ struct Snapshot {
   std::size_t nSpecies = 0;
 };
 
-struct H5 {
-  hid_t id;
-  herr_t (*close)(hid_t);
-  ~H5() {
-    if (id >= 0) {
-      close(id);
-    }
-  }
-};
-
-template <typename T>
-std::vector<T> readArray(hid_t file, const char* name, hid_t type, const fs::path& path,
-                         std::vector<hsize_t>* dims = nullptr) {
-  COREDEM_CHECK(H5Lexists(file, name, H5P_DEFAULT) > 0, "{}: no dataset {}", path.string(), name);
-  H5 ds{H5Dopen2(file, name, H5P_DEFAULT), H5Dclose};
-  COREDEM_CHECK(ds.id >= 0, "{}: cannot open {}", path.string(), name);
-  H5 space{H5Dget_space(ds.id), H5Sclose};
-  const int rank = H5Sget_simple_extent_ndims(space.id);
-  std::vector<hsize_t> d(std::size_t(std::max(rank, 0)));
-  H5Sget_simple_extent_dims(space.id, d.data(), nullptr);
-  hsize_t n = 1;
-  for (auto v : d) {
-    n *= v;
-  }
-  std::vector<T> out(n);
-  if (n > 0) {
-    COREDEM_CHECK(H5Dread(ds.id, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) >= 0,
-                  "{}: cannot read {}", path.string(), name);
-  }
-  if (dims) {
-    *dims = d;
-  }
-  return out;
-}
-
 std::vector<Snapshot> readSnapshots(const fs::path& runDir) {
   const fs::path index = runDir / "snapshots" / "index.csv";
   std::ifstream in(index);
@@ -324,13 +289,13 @@ std::vector<Snapshot> readSnapshots(const fs::path& runDir) {
     Snapshot s;
     s.t = std::strtod(line.substr(c1 + 1, c2 - c1 - 1).c_str(), nullptr);
     const fs::path file = runDir / line.substr(c2 + 1);
-    H5 f{H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
-    COREDEM_CHECK(f.id >= 0, "{}: cannot open snapshot", file.string());
-    const auto gid = readArray<std::int64_t>(f.id, "/particles/global_id", H5T_NATIVE_INT64, file);
-    const auto t = readArray<double>(f.id, "/particles/temperature", H5T_NATIVE_DOUBLE, file);
-    const auto m = readArray<double>(f.id, "/particles/mass", H5T_NATIVE_DOUBLE, file);
-    std::vector<hsize_t> dims;
-    const auto y = readArray<double>(f.id, "/particles/species", H5T_NATIVE_DOUBLE, file, &dims);
+    const h5::Handle f = h5::openFile(file);
+    const std::string what = file.string();
+    const auto gid = h5::readDataset<std::int64_t>(f, "/particles/global_id", what);
+    const auto t = h5::readDataset<double>(f, "/particles/temperature", what);
+    const auto m = h5::readDataset<double>(f, "/particles/mass", what);
+    const auto y = h5::readDataset<double>(f, "/particles/species", what);
+    const std::vector<hsize_t> dims = h5::datasetShape(f, "/particles/species", what);
     const std::size_t n = gid.size();
     s.nSpecies = dims.size() == 2 ? std::size_t(dims[1]) : 0;
     s.temperature.assign(n, 0.0);

@@ -6,6 +6,8 @@
 
 #include <cstdint>
 
+#include <coredem/common/compensated_sum.h>
+
 namespace coredem::orchestrator {
 
 /// Tolerant comparison of two times in seconds: |a - b| <= tol * max(1, |a|, |b|).
@@ -20,17 +22,16 @@ public:
   /// Advances by dt > 0 [s].
   void advance(double dt);
   /// Current time [s].
-  double time() const { return _sum; }
+  double time() const { return _sum.value(); }
   /// The Kahan compensation term (store it in checkpoints for a bitwise-identical resume).
-  double compensation() const { return _carry; }
+  double compensation() const { return _sum.compensation(); }
   /// Time still to go until tEnd (0 if reached).
   double remaining(double tEnd) const;
   /// True when time() has reached tEnd within the tolerance of timeEquals.
   bool reached(double tEnd) const;
 
 private:
-  double _sum;
-  double _carry;
+  CompensatedSum _sum;
 };
 
 /// How Δt_CFD is chosen each step.
