@@ -20,6 +20,7 @@
 #include <unistd.h>
 
 #include <coredem/common/check.h>
+#include <coredem/common/json.h>
 #include <coredem/common/log.h>
 #include <coredem/common/process.h>
 #include <coredem/common/version.h>
@@ -147,19 +148,9 @@ std::string csvField(const std::string& v) {
   return q + "\"";
 }
 
+/// A JSON string literal with the common escaper (`status --json` is one line, written here).
 std::string jsonString(const std::string& v) {
-  std::string o = "\"";
-  for (char c : v) {
-    if (c == '"' || c == '\\') {
-      o += '\\';
-      o += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      o += fmt::format("\\u{:04x}", static_cast<int>(c));
-    } else {
-      o += c;
-    }
-  }
-  return o + "\"";
+  return "\"" + jsonEscape(v) + "\"";
 }
 
 std::vector<std::string> splitCsvLine(const std::string& line) {
