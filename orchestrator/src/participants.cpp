@@ -5,9 +5,9 @@
 
 #include <fnmatch.h>
 
+#include <coredem/common/process.h>
 #include <coredem/gas/gas_model.h>
 #include <coredem/orchestrator/participants.h>
-#include <coredem/common/process.h>
 
 namespace fs = std::filesystem;
 

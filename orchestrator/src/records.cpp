@@ -3,9 +3,9 @@
 #include <fstream>
 #include <sstream>
 
-#include "session_impl.h"
-
 #include <coredem/common/json.h>
+
+#include "session_impl.h"
 
 namespace fs = std::filesystem;
 namespace v1 = coredem::v1;
@@ -64,11 +64,12 @@ void OverheadTotals::report(spdlog::logger& log, const fs::path& runDir) const {
            1e6 * overhead / n, checkpoints, snapshots);
   JsonWriter js;
   js.beginObject().field("steps", measured);
-  for (const auto& [key, seconds] :
-       {std::pair{"step_wall_s", stepWall / n}, {"dem_compute_s", demWall / n},
-        {"coupling_overhead_s", (stepWall - demWall) / n},
-        {"orchestrator_bookkeeping_s", overhead / n}, {"checkpoints_total_s", checkpoints},
-        {"snapshots_total_s", snapshots}}) {
+  for (const auto& [key, seconds] : {std::pair{"step_wall_s", stepWall / n},
+                                     {"dem_compute_s", demWall / n},
+                                     {"coupling_overhead_s", (stepWall - demWall) / n},
+                                     {"orchestrator_bookkeeping_s", overhead / n},
+                                     {"checkpoints_total_s", checkpoints},
+                                     {"snapshots_total_s", snapshots}}) {
     js.key(key).raw(fmt::format("{:.9g}", seconds)); // wall times: 9 digits are plenty
   }
   js.endObject();

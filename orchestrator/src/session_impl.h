@@ -20,11 +20,11 @@
 #include <vector>
 
 #include <coredem/common/log.h>
+#include <coredem/common/process.h>
 #include <coredem/common/version.h>
 #include <coredem/orchestrator/checkpoint.h>
 #include <coredem/orchestrator/outputs.h>
 #include <coredem/orchestrator/participants.h>
-#include <coredem/common/process.h>
 #include <coredem/orchestrator/session.h>
 #include <coredem/orchestrator/time_handler.h>
 #include <coredem/protocol/protocol.h>

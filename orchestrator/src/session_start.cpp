@@ -4,10 +4,10 @@
 #include <fstream>
 #include <thread>
 
+#include <coredem/common/version.h>
+
 #include "configure.h"
 #include "session_impl.h"
-
-#include <coredem/common/version.h>
 
 namespace fs = std::filesystem;
 namespace v1 = coredem::v1;
@@ -272,8 +272,8 @@ void Session::handshakeCfd() {
         _ctrl->reply(r.peer, std::move(rej));
         continue;
       }
-      Message w = protocol::makeWelcome(v1::ROLE_ORCHESTRATOR, kVersion,
-                                        nego.agreed.major, nego.agreed.minor, _session);
+      Message w = protocol::makeWelcome(v1::ROLE_ORCHESTRATOR, kVersion, nego.agreed.major,
+                                        nego.agreed.minor, _session);
       w.setSequence(seq).setSessionId(_session);
       _ctrl->reply(r.peer, std::move(w));
       _cfdPeer = r.peer;

@@ -7,7 +7,9 @@
 
 namespace coredem::orchestrator {
 
-bool timeEquals(double a, double b, double tol) { return coredem::timeEquals(a, b, tol); }
+bool timeEquals(double a, double b, double tol) {
+  return coredem::timeEquals(a, b, tol);
+}
 
 TimeHandler::TimeHandler(double time, double compensation)
     : _sum(time, compensation) {}
