@@ -38,6 +38,7 @@
 #include "stageTimers.H"
 
 #include "coredem/client/participant.h"
+#include "coredem/common/version.h"
 
 #include <fstream>
 #include <string>
