@@ -68,3 +68,27 @@ TEST(Process, SpawnReturnsAPidAndFailsClearly) {
 }
 
 } // namespace
+
+// writeFileAtomic (files.h): the whole content or the old file, never a temporary left behind.
+#include <coredem/common/files.h>
+
+namespace {
+
+TEST(Files, WriteFileAtomicReplacesWholeAndLeavesNoTemporary) {
+  const fs::path dir = tempLog("atomic").parent_path() / "atomic-dir";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  coredem::writeFileAtomic(dir / "a.json", "old\n");
+  coredem::writeFileAtomic(dir / "a.json", std::string(100000, 'x'));
+  std::stringstream s;
+  s << std::ifstream(dir / "a.json").rdbuf();
+  EXPECT_EQ(s.str(), std::string(100000, 'x'));
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir)) {
+    ++files;
+  }
+  EXPECT_EQ(files, 1);
+  EXPECT_THROW(coredem::writeFileAtomic(dir / "missing" / "b.json", "x"), coredem::UserError);
+}
+
+} // namespace

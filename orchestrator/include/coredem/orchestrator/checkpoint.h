@@ -10,17 +10,17 @@
 #include <string>
 #include <vector>
 
+#include <coredem/common/files.h> // writeFileAtomic (used with the manifests)
+
 namespace coredem::orchestrator {
+
+using coredem::writeFileAtomic; // common/files.h: manifests and records are written with it
 
 /// Whether step `step` gets a coordinated checkpoint: every `everySteps` steps (0 = off), when
 /// `everySeconds` of wall time (0 = off) have passed since the last checkpoint, and always at
 /// the last step of a run (`lastStep`).
 bool checkpointDue(std::int64_t step, bool lastStep, std::int64_t everySteps, double everySeconds,
                    double wallSecondsSinceLast);
-
-/// Writes `content` to `path` atomically: a temp file in the same folder, fsync, rename,
-/// fsync of the folder. A crash leaves either the old file or the new one, never a half.
-void writeFileAtomic(const std::filesystem::path& path, const std::string& content);
 
 /// One file of a checkpoint, path relative to the checkpoint folder.
 struct ManifestFile {
