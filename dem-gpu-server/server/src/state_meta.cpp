@@ -41,7 +41,6 @@ void writeServerLedgers(const std::string& path, const ServerLedgers& l, std::in
   H5Handle group(H5Gcreate2(file.id, "/server", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose);
   COREDEM_CHECK(group.id >= 0, "cannot create /server in {}", path);
   writeScalarAttr(group.id, "step", H5T_NATIVE_INT64, &step);
-  writeScalarAttr(group.id, "heat_from_gas_J", H5T_NATIVE_DOUBLE, &l.heatFromGas);
   {
     H5Handle strType(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(strType.id, session.size() + 1);
@@ -65,11 +64,6 @@ ServerLedgers readServerLedgers(const std::string& path, int species) {
     return l;
   }
   H5Handle group(H5Gopen2(file.id, "/server", H5P_DEFAULT), H5Gclose);
-  {
-    H5Handle attr(H5Aopen(group.id, "heat_from_gas_J", H5P_DEFAULT), H5Aclose);
-    COREDEM_CHECK(attr.id >= 0 && H5Aread(attr.id, H5T_NATIVE_DOUBLE, &l.heatFromGas) >= 0,
-                  "{}: /server/heat_from_gas_J unreadable", path);
-  }
   H5Handle ds(H5Dopen2(group.id, "species_to_gas_kg", H5P_DEFAULT), H5Dclose);
   H5Handle space(H5Dget_space(ds.id), H5Sclose);
   const auto n = H5Sget_simple_extent_npoints(space.id);

@@ -1,10 +1,10 @@
 #pragma once
 /// @file
-/// Model switches of the particle heat transfer integrated in the DEM step (PHYSICS §3,
-/// docs/heat-coupling.md). Plain data; set from `Configure.options` (case.yaml `models:`)
-/// through setHeatOption().
+/// Model switches of the particle heat transfer integrated in the DEM step (docs/heat-coupling.md).
+/// Plain data; set from `Configure.options` (case.yaml `models:`) through the model registry
+/// (coredem/dem/models.h, applyModelOption).
 
-#include <string>
+#include "coredem/dem/kernels/convection.h"
 
 namespace coredem::dem {
 
@@ -13,7 +13,7 @@ namespace coredem::dem {
 struct HeatOptions {
   bool enabled = true;              ///< `heat: on|off` — off: temperatures stay constant, H = H_Tp = 0
   bool convection = true;           ///< particle–gas convection (Eqs. 19–21); needs T_g, κ_g, c_p,g
-  bool ranzMarshall = false;        ///< `convection: li-mason|ranz-marshall` (default Li–Mason)
+  kernels::NusseltModel nusselt = kernels::NusseltModel::LiMason;  ///< `convection: li-mason|ranz-marshall`
   bool reynoldsWithVoidage = true;  ///< `convection_reynolds: with-voidage|without-voidage`
   double voidageExponent = 3.5;     ///< `nusselt_exponent`: n of ε^n in Li–Mason (Eq. 21)
   bool contactConduction = true;    ///< `contact_conduction: on|off` (Eqs. 22–23)
@@ -25,14 +25,6 @@ struct HeatOptions {
   bool wallConduction = true;       ///< `wall_conduction: on|off`: contact conduction to fixed-temperature walls
   bool wallLensConduction = true;   ///< `wall_lens_conduction: on|off`: gas-lens conduction to them (needs κ_g)
 };
-
-/// Applies one `Configure.options` entry if it is a heat option. Returns false when `key` is not
-/// a heat option (the caller handles or ignores it); throws coredem::UserError when the key is a
-/// heat option but the value is not allowed (the message lists the allowed values).
-/// Keys: heat, convection, convection_reynolds, nusselt_exponent, contact_conduction,
-/// lens_conduction, flpc, s_min, lens_rel_tol, radiation, radiation_environment, wall_conduction,
-/// wall_lens_conduction.
-bool setHeatOption(HeatOptions& options, const std::string& key, const std::string& value);
 
 /// Heat the particles received since the system was built (or restarted from a state file
 /// written by it), J. Conduction between particles moves heat between particles only and is
