@@ -11,17 +11,16 @@
 /// summing cStart[c]..cEnd[c] in sorted order, which is the order of a loop over all cells, so
 /// the sums are bitwise the same.
 
-#include "backend/arrays.h"
-#include "backend/exec_common.h"
-#include "engine.h"
-#include "particle_store.h"
-
-#include "coredem/dem/kernels/pcm.h"
-#include "coredem/dem/kernels/pressure_gradient.h"  // sphereVolume
-#include "coredem/dem/kernels/vec3.h"
-
 #include <cstddef>
 #include <cstdint>
+
+#include "backend/arrays.h"
+#include "backend/exec_common.h"
+#include "coredem/dem/kernels/pcm.h"
+#include "coredem/dem/kernels/pressure_gradient.h" // sphereVolume
+#include "coredem/dem/kernels/vec3.h"
+#include "engine.h"
+#include "particle_store.h"
 
 namespace coredem::dem {
 
@@ -36,9 +35,11 @@ public:
   /// Sizes the per-cell arrays (nCells = 0: no coupling grid, nothing allocated).
   void setup(std::size_t nCells) {
     _nCells = nCells;
-    if (nCells == 0) return;
+    if (nCells == 0)
+      return;
     _epsFrozen.allocate(nCells);
-    for (std::size_t c = 0; c < nCells; ++c) _epsFrozen.h()[c] = 1.0;
+    for (std::size_t c = 0; c < nCells; ++c)
+      _epsFrozen.h()[c] = 1.0;
     _epsFrozen.markHostModified();
     _epsFrozen.toDevice();
     _cStart.reserve(nCells + 1);
@@ -88,14 +89,17 @@ public:
     const std::uint32_t* perm = _perm.d();
     exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t k) {
       const std::uint32_t c = pc[perm[k]];
-      if (k == 0 || pc[perm[k - 1]] != c) cs[c] = static_cast<std::uint32_t>(k);
-      if (k + 1 == n || pc[perm[k + 1]] != c) ce[c] = static_cast<std::uint32_t>(k + 1);
+      if (k == 0 || pc[perm[k - 1]] != c)
+        cs[c] = static_cast<std::uint32_t>(k);
+      if (k + 1 == n || pc[perm[k + 1]] != c)
+        ce[c] = static_cast<std::uint32_t>(k + 1);
     });
   }
 
   /// Window start: cells and sort from the current positions, then ε_g of every cell (PCM).
   /// Reads pos, radius; writes pcell, perm, cStart, cEnd, epsFrozen.
-  void freeze(Exec& exec, ParticleStore<Exec>& p, const kernels::GridParams& grid, double cellVolume) {
+  void freeze(Exec& exec, ParticleStore<Exec>& p, const kernels::GridParams& grid,
+              double cellVolume) {
     computeCells(exec, p, grid);
     sort(exec, p.n);
     const std::uint32_t* cs = _cStart.d();
@@ -107,13 +111,16 @@ public:
     const std::uint32_t* pc = _pcell.d();
     const std::uint32_t nc = static_cast<std::uint32_t>(_nCells);
     // Every cell (empty ones get ε_g of zero solid volume) ...
-    exec.parallelFor(_nCells, [=] DEM_LAMBDA(std::size_t c) { eps[c] = kernels::pcmGasFraction(0.0, vc); });
+    exec.parallelFor(_nCells,
+                     [=] DEM_LAMBDA(std::size_t c) { eps[c] = kernels::pcmGasFraction(0.0, vc); });
     // ... then the occupied cells, one segment head each (cs/ce are valid only there).
     exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t h) {
       const std::size_t c = pc[perm[h]];
-      if (c >= nc || (h > 0 && pc[perm[h - 1]] == c)) return;
+      if (c >= nc || (h > 0 && pc[perm[h - 1]] == c))
+        return;
       double vs = 0.0;
-      for (std::uint32_t k = cs[c]; k < ce[c]; ++k) vs += kernels::sphereVolume(r[perm[k]]);
+      for (std::uint32_t k = cs[c]; k < ce[c]; ++k)
+        vs += kernels::sphereVolume(r[perm[k]]);
       eps[c] = kernels::pcmGasFraction(vs, vc);
     });
     _epsFrozen.markDeviceModified();
@@ -126,7 +133,7 @@ public:
 private:
   std::size_t _nCells = 0;
   Dev<std::uint32_t> _pcell, _perm, _cStart, _cEnd;
-  Dual<double> _epsFrozen;  ///< nCells: PCM ε_g at the window start (drag, heat, WGS)
+  Dual<double> _epsFrozen; ///< nCells: PCM ε_g at the window start (drag, heat, WGS)
 };
 
 } // namespace coredem::dem

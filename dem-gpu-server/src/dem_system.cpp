@@ -446,6 +446,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
     // Heat transfer (heat.h): the lens needs the neighbour list to reach FLPC·R_max further.
     const HeatOptions& h = config.heat;
     HeatSetup& hs = es.heat;
+    hs.options = h;
     hs.enabled = h.enabled;
     hs.convection = h.convection;
     hs.contactConduction = h.contactConduction;

@@ -10,18 +10,17 @@
 ///   endWindow:  ε_g, K_sl and K_sl U_s averaged over the sub-steps (CellSources)
 /// Only coupled runs (a coupling grid) have this module enabled.
 
+#include <cstddef>
+#include <cstdint>
+
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
-#include "step_module.h"
-
 #include "coredem/dem/kernels/cell_sources.h"
 #include "coredem/dem/kernels/drag.h"
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
 #include "coredem/dem/kernels/vec3.h"
-
-#include <cstddef>
-#include <cstdint>
+#include "step_module.h"
 
 namespace coredem::dem {
 
@@ -39,7 +38,8 @@ public:
   void setup(const EngineSetup& s) {
     _enabled = s.coupled;
     _params = s.drag;
-    if (!_enabled) return;
+    if (!_enabled)
+      return;
     _acc.allocate(s.nCells * 5);
   }
 
@@ -49,7 +49,8 @@ public:
 
   /// Clears the window accumulators.
   void beginWindow(StepContext<Exec>& ctx) {
-    if (!_enabled) return;
+    if (!_enabled)
+      return;
     double* acc = _acc.d();
     ctx.exec.parallelFor(5 * ctx.setup.nCells, [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
     _acc.markDeviceModified();
@@ -58,7 +59,8 @@ public:
   /// Gas force and PCM cell per particle, then the cell sums of this sub-step.
   /// Reads pos, vel, radius (+ gas fields, ε_g); writes force (the gas force), pcell, the sort.
   void sources(StepContext<Exec>& ctx) {
-    if (!_enabled) return;
+    if (!_enabled)
+      return;
     _kcoef.reserve(ctx.particles.n);
     gasForces(ctx);
     ctx.cells.sort(ctx.exec, ctx.particles.n);
@@ -69,12 +71,14 @@ public:
 
   /// ε_g, K_sl, K_sl U_s averaged over the window into out (sized by the engine).
   void endWindow(WindowContext<Exec>& w) {
-    if (!_enabled) return;
+    if (!_enabled)
+      return;
     _acc.toHost();
     const double* acc = _acc.h();
     CellSources& out = w.out;
     for (std::size_t c = 0; c < w.setup.nCells; ++c) {
-      const kernels::CellAccumulator a{acc[5 * c], acc[5 * c + 1], {acc[5 * c + 2], acc[5 * c + 3], acc[5 * c + 4]}};
+      const kernels::CellAccumulator a{
+          acc[5 * c], acc[5 * c + 1], {acc[5 * c + 2], acc[5 * c + 3], acc[5 * c + 4]}};
       const kernels::CellAverages avg = kernels::averageSources(a, w.nSub, w.setup.cellVolume);
       out.epsG[c] = avg.epsG;
       out.kSl[c] = avg.kSl;
@@ -145,11 +149,13 @@ public:
     // One segment head per occupied cell; segments are disjoint, so no atomics.
     ctx.exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t h) {
       const std::size_t c = pc[perm[h]];
-      if (c >= nc || (h > 0 && pc[perm[h - 1]] == c)) return;
+      if (c >= nc || (h > 0 && pc[perm[h - 1]] == c))
+        return;
       kernels::CellAccumulator a{0.0, 0.0, {0.0, 0.0, 0.0}};
       for (std::uint32_t k = cs[c]; k < ce[c]; ++k) {
         const std::uint32_t i = perm[k];
-        kernels::accumulate(a, kernels::cellContribution(kernels::sphereVolume(r[i]), kc[i], kernels::load3(v, i)));
+        kernels::accumulate(
+            a, kernels::cellContribution(kernels::sphereVolume(r[i]), kc[i], kernels::load3(v, i)));
       }
       acc[5 * c] += a.solidVolume;
       acc[5 * c + 1] += a.kCoeff;
@@ -163,8 +169,8 @@ public:
 private:
   bool _enabled = false;
   kernels::DragParams _params{};
-  Dev<double> _kcoef;  ///< per particle: β V_p/(1−ε) (kg/s)
-  Dual<double> _acc;   ///< nCells*5: Σ_sub V_s, Σ_sub K, Σ_sub K v
+  Dev<double> _kcoef; ///< per particle: β V_p/(1−ε) (kg/s)
+  Dual<double> _acc;  ///< nCells*5: Σ_sub V_s, Σ_sub K, Σ_sub K v
 };
 
 } // namespace coredem::dem

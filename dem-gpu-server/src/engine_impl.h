@@ -413,13 +413,13 @@ public:
 
   /// Runs one module's sources (or update) and books its wall time in `stage`.
   template <class Module>
-  void run(Module& module, StepContext<Exec>& ctx, double& stage, Clock::time_point& t0, bool update = false) {
+  void run(Module& stepModule, StepContext<Exec>& ctx, double& stage, Clock::time_point& t0, bool update = false) {
     static_assert(StepModule<Module, Exec>);
-    if (!module.enabled()) return;
+    if (!stepModule.enabled()) return;
     if (update) {
-      module.update(ctx);
+      stepModule.update(ctx);
     } else {
-      module.sources(ctx);
+      stepModule.sources(ctx);
     }
     Exec::synchronize();
     const auto t1 = Clock::now();

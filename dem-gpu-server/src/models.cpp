@@ -1,14 +1,14 @@
 // Model registries and the `models:` key table (coredem/dem/models.h).
 #include "coredem/dem/models.h"
 
-#include "coredem/common/check.h"
-#include "coredem/dem/dem_system.h"
-
 #include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
 #include <optional>
+
+#include "coredem/common/check.h"
+#include "coredem/dem/dem_system.h"
 
 namespace coredem::dem {
 
@@ -16,11 +16,14 @@ namespace coredem::dem {
 namespace {
 
 constexpr ModelEntry<kernels::DragLaw> kDrag[] = {
-    {"gidaspow", kernels::DragLaw::Gidaspow, "Ergun for ε ≤ 0.8, Wen–Yu above (kernels/drag_gidaspow.h)"},
+    {"gidaspow", kernels::DragLaw::Gidaspow,
+     "Ergun for ε ≤ 0.8, Wen–Yu above (kernels/drag_gidaspow.h)"},
 };
 constexpr ModelEntry<kernels::NusseltModel> kNusselt[] = {
-    {"li-mason", kernels::NusseltModel::LiMason, "Li & Mason (2000), Nu = 2 + 0.6 εⁿ Re^½ Pr^⅓ (Re < 200) …"},
-    {"ranz-marshall", kernels::NusseltModel::RanzMarshall, "Ranz–Marshall, Nu = 2 + 0.6 Re^½ Pr^⅓ (MFiX)"},
+    {"li-mason", kernels::NusseltModel::LiMason,
+     "Li & Mason (2000), Nu = 2 + 0.6 εⁿ Re^½ Pr^⅓ (Re < 200) …"},
+    {"ranz-marshall", kernels::NusseltModel::RanzMarshall,
+     "Ranz–Marshall, Nu = 2 + 0.6 Re^½ Pr^⅓ (MFiX)"},
 };
 constexpr ModelEntry<ReynoldsDefinition> kReynolds[] = {
     {"with-voidage", ReynoldsDefinition::WithVoidage, "Re = ε ρ_g d |Δu|/μ_g, as the drag"},
@@ -28,7 +31,8 @@ constexpr ModelEntry<ReynoldsDefinition> kReynolds[] = {
 };
 constexpr ModelEntry<MotionModel> kMotion[] = {
     {"free", MotionModel::Free, "forces, torques and gravity move the particles"},
-    {"frozen", MotionModel::Frozen, "particles held in place, velocities zeroed (MFiX verification cases)"},
+    {"frozen", MotionModel::Frozen,
+     "particles held in place, velocities zeroed (MFiX verification cases)"},
 };
 constexpr ModelEntry<kernels::RateLaw> kRateLaw[] = {
     {"constant", kernels::RateLaw::Constant, "ω = A (mol/s)"},
@@ -44,8 +48,10 @@ constexpr ModelEntry<kernels::WgsEquilibrium> kWgs[] = {
 std::string normalise(std::string_view s) {
   std::string out(s);
   for (char& c : out) {
-    if (c == '_') c = '-';
-    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+    if (c == '_')
+      c = '-';
+    if (c >= 'A' && c <= 'Z')
+      c = static_cast<char>(c - 'A' + 'a');
   }
   return out;
 }
@@ -53,7 +59,8 @@ std::string normalise(std::string_view s) {
 std::string joinOr(std::span<const std::string_view> names) {
   std::string s;
   for (std::size_t k = 0; k < names.size(); ++k) {
-    if (k > 0) s += k + 1 == names.size() ? " or " : ", ";
+    if (k > 0)
+      s += k + 1 == names.size() ? " or " : ", ";
     s += names[k];
   }
   return s;
@@ -61,7 +68,8 @@ std::string joinOr(std::span<const std::string_view> names) {
 
 std::size_t editDistance(std::string_view a, std::string_view b) {
   std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t j = 0; j <= b.size(); ++j)
+    row[j] = j;
   for (std::size_t i = 1; i <= a.size(); ++i) {
     std::size_t diag = row[0];
     row[0] = i;
@@ -80,21 +88,24 @@ template <class E>
 const ModelEntry<E>* ModelFamily<E>::find(std::string_view model) const {
   const std::string want = normalise(model);
   for (const ModelEntry<E>& e : entries)
-    if (normalise(e.name) == want) return &e;
+    if (normalise(e.name) == want)
+      return &e;
   return nullptr;
 }
 
 template <class E>
 std::string_view ModelFamily<E>::nameOf(E value) const {
   for (const ModelEntry<E>& e : entries)
-    if (e.value == value) return e.name;
+    if (e.value == value)
+      return e.name;
   return "?";
 }
 
 template <class E>
 std::string ModelFamily<E>::allowed() const {
   std::vector<std::string_view> names;
-  for (const ModelEntry<E>& e : entries) names.push_back(e.name);
+  for (const ModelEntry<E>& e : entries)
+    names.push_back(e.name);
   return joinOr(names);
 }
 
@@ -151,7 +162,8 @@ std::string withSuggestion(std::string_view value, std::span<const std::string_v
                            const std::string& allowed) {
   const std::string guess = didYouMean(value, names);
   return fmt::format("'{}' is not allowed{}; allowed: {}", value,
-                     guess.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", guess), allowed);
+                     guess.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", guess),
+                     allowed);
 }
 
 /// The family entry named `value`, or the message saying what is allowed (`extra`: further
@@ -159,9 +171,11 @@ std::string withSuggestion(std::string_view value, std::span<const std::string_v
 template <class E>
 std::optional<E> choice(const ModelFamily<E>& f, std::string_view value, std::string& error,
                         std::span<const std::string_view> extra = {}) {
-  if (const ModelEntry<E>* e = f.find(value)) return e->value;
+  if (const ModelEntry<E>* e = f.find(value))
+    return e->value;
   std::vector<std::string_view> names;
-  for (const ModelEntry<E>& e : f.entries) names.push_back(e.name);
+  for (const ModelEntry<E>& e : f.entries)
+    names.push_back(e.name);
   names.insert(names.end(), extra.begin(), extra.end());
   error = withSuggestion(value, names, joinOr(names));
   return std::nullopt;
@@ -170,8 +184,10 @@ std::optional<E> choice(const ModelFamily<E>& f, std::string_view value, std::st
 /// on/true/yes/1 or off/false/no/0.
 std::optional<bool> onOff(std::string_view value, std::string& error) {
   const std::string v = normalise(value);
-  if (v == "on" || v == "true" || v == "yes" || v == "1") return true;
-  if (v == "off" || v == "false" || v == "no" || v == "0") return false;
+  if (v == "on" || v == "true" || v == "yes" || v == "1")
+    return true;
+  if (v == "off" || v == "false" || v == "no" || v == "0")
+    return false;
   static constexpr std::string_view kNames[] = {"on", "off"};
   error = withSuggestion(value, kNames, "on or off");
   return std::nullopt;
@@ -185,7 +201,8 @@ std::optional<double> number(std::string_view value, double lo, bool loOpen, dou
   const auto r = std::from_chars(value.data(), end, v);
   const bool ok = r.ec == std::errc() && r.ptr == end && std::isfinite(v) &&
                   (loOpen ? v > lo : v >= lo) && v <= hi;
-  if (ok) return v;
+  if (ok)
+    return v;
   error = fmt::format("'{}' is not allowed; expected {}", value, what);
   return std::nullopt;
 }
@@ -196,7 +213,8 @@ std::optional<int> integer(std::string_view value, int lo, int hi, std::string_v
   int v = 0;
   const char* end = value.data() + value.size();
   const auto r = std::from_chars(value.data(), end, v);
-  if (r.ec == std::errc() && r.ptr == end && v >= lo && v <= hi) return v;
+  if (r.ec == std::errc() && r.ptr == end && v >= lo && v <= hi)
+    return v;
   error = fmt::format("'{}' is not allowed; expected {}", value, what);
   return std::nullopt;
 }
@@ -208,7 +226,8 @@ constexpr std::string_view kOff[] = {"off"};
 template <bool HeatOptions::*Field>
 std::string heatSwitch(DemConfig& c, std::string_view v) {
   std::string e;
-  if (const auto b = onOff(v, e)) c.heat.*Field = *b;
+  if (const auto b = onOff(v, e))
+    c.heat.*Field = *b;
   return e;
 }
 
@@ -216,20 +235,23 @@ std::vector<ModelOption> makeOptions() {
   std::vector<ModelOption> o;
   const std::string onOffText = "on, off";
   // --- drag
-  o.push_back({"drag", "drag", dragModels().allowed(), "gidaspow", "drag law of the gas force on the particles",
-               [](DemConfig& c, std::string_view v) {
+  o.push_back({"drag", "drag", dragModels().allowed(), "gidaspow",
+               "drag law of the gas force on the particles", [](DemConfig& c, std::string_view v) {
                  std::string e;
-                 if (const auto law = choice(dragModels(), v, e)) c.drag = *law;
+                 if (const auto law = choice(dragModels(), v, e))
+                   c.drag = *law;
                  return e;
                }});
   auto epsMin = [](DemConfig& c, std::string_view v) {
     std::string e;
-    if (const auto x = number(v, 0.0, true, 1.0 - 1e-15, "a number in (0, 1) (ε_min, 0.35)", e)) c.epsMinDrag = *x;
+    if (const auto x = number(v, 0.0, true, 1.0 - 1e-15, "a number in (0, 1) (ε_min, 0.35)", e))
+      c.epsMinDrag = *x;
     return e;
   };
   o.push_back({"eps_min_drag", "drag", "number in (0, 1)", "0.35",
                "lower clip ε_min of ε_g in the drag and the Nusselt correlation", epsMin});
-  o.push_back({"dem.eps_min_drag", "drag", "number in (0, 1)", "0.35", "same as eps_min_drag", epsMin});
+  o.push_back(
+      {"dem.eps_min_drag", "drag", "number in (0, 1)", "0.35", "same as eps_min_drag", epsMin});
   // --- heat master switch
   o.push_back({"heat", "heat", onOffText, "on", "off: temperatures stay constant, H = H_Tp = 0",
                heatSwitch<&HeatOptions::enabled>});
@@ -257,77 +279,90 @@ std::vector<ModelOption> makeOptions() {
   o.push_back({"nusselt_exponent", "convection", "number in [0, 10]", "3.5", "n of εⁿ in Li–Mason",
                [](DemConfig& c, std::string_view v) {
                  std::string e;
-                 if (const auto x = number(v, 0.0, false, 10.0, "a number in [0, 10] (Li–Mason n, 3.5)", e))
+                 if (const auto x =
+                         number(v, 0.0, false, 10.0, "a number in [0, 10] (Li–Mason n, 3.5)", e))
                    c.heat.voidageExponent = *x;
                  return e;
                }});
   // --- conduction
   o.push_back({"contact_conduction", "conduction", onOffText, "on",
-               "particle–particle conduction through the contact area", heatSwitch<&HeatOptions::contactConduction>});
+               "particle–particle conduction through the contact area",
+               heatSwitch<&HeatOptions::contactConduction>});
   o.push_back({"lens_conduction", "conduction", onOffText, "on",
                "conduction through the gas lens between neighbours (coupled runs only)",
                heatSwitch<&HeatOptions::lensConduction>});
   o.push_back({"flpc", "conduction", "number in [0, 1]", "0.2", "lens radius (1 + FLPC) R_L",
                [](DemConfig& c, std::string_view v) {
                  std::string e;
-                 if (const auto x = number(v, 0.0, false, 1.0, "a number in [0, 1] (lens radius (1+FLPC) R_L, 0.2)", e))
+                 if (const auto x = number(v, 0.0, false, 1.0,
+                                           "a number in [0, 1] (lens radius (1+FLPC) R_L, 0.2)", e))
                    c.heat.lensFraction = *x;
                  return e;
                }});
-  o.push_back({"s_min", "conduction", "length in (0, 1e-3] m", "1e-6", "minimum conduction distance in the lens (m)",
-               [](DemConfig& c, std::string_view v) {
+  o.push_back({"s_min", "conduction", "length in (0, 1e-3] m", "1e-6",
+               "minimum conduction distance in the lens (m)", [](DemConfig& c, std::string_view v) {
                  std::string e;
-                 if (const auto x = number(v, 0.0, true, 1.0e-3, "a length in (0, 1e-3] m (1e-6)", e))
+                 if (const auto x =
+                         number(v, 0.0, true, 1.0e-3, "a length in (0, 1e-3] m (1e-6)", e))
                    c.heat.minSeparation = *x;
                  return e;
                }});
   o.push_back({"lens_rel_tol", "conduction", "number in [1e-14, 1e-3]", "1e-8",
-               "quadrature tolerance of the lens integral",
-               [](DemConfig& c, std::string_view v) {
+               "quadrature tolerance of the lens integral", [](DemConfig& c, std::string_view v) {
                  std::string e;
-                 if (const auto x = number(v, 1.0e-14, false, 1.0e-3, "a tolerance in [1e-14, 1e-3] (1e-8)", e))
+                 if (const auto x = number(v, 1.0e-14, false, 1.0e-3,
+                                           "a tolerance in [1e-14, 1e-3] (1e-8)", e))
                    c.heat.lensRelTol = *x;
                  return e;
                }});
   o.push_back({"wall_conduction", "conduction", onOffText, "on",
-               "contact conduction to fixed-temperature walls", heatSwitch<&HeatOptions::wallConduction>});
+               "contact conduction to fixed-temperature walls",
+               heatSwitch<&HeatOptions::wallConduction>});
   o.push_back({"wall_lens_conduction", "conduction", onOffText, "on",
                "gas-lens conduction to fixed-temperature walls (coupled runs only)",
                heatSwitch<&HeatOptions::wallLensConduction>});
   // --- radiation
   o.push_back({"radiation", "radiation", onOffText, "on",
-               "radiation of materials with emissivity > 0 (environment: ε_g T_g + (1 − ε_g) cell-mean T_p)",
+               "radiation of materials with emissivity > 0 (environment: ε_g T_g + (1 − ε_g) "
+               "cell-mean T_p)",
                heatSwitch<&HeatOptions::radiation>});
   // --- motion
-  o.push_back({"motion", "motion", motionModels().allowed(), "free",
-               "frozen: particles held in place (MFiX verification cases); set the step with time.dt_dem",
-               [](DemConfig& c, std::string_view v) {
-                 std::string e;
-                 if (const auto m = choice(motionModels(), v, e)) c.frozenMotion = *m == MotionModel::Frozen;
-                 return e;
-               }});
+  o.push_back(
+      {"motion", "motion", motionModels().allowed(), "free",
+       "frozen: particles held in place (MFiX verification cases); set the step with time.dt_dem",
+       [](DemConfig& c, std::string_view v) {
+         std::string e;
+         if (const auto m = choice(motionModels(), v, e))
+           c.frozenMotion = *m == MotionModel::Frozen;
+         return e;
+       }});
   // --- numerics of the DEM step
   auto dtFactor = [](DemConfig& c, std::string_view v) {
     std::string e;
-    if (const auto x = number(v, 1.0, false, kHuge, "a number >= 1 (Δt_DEM,max = t_col/dt_factor, 50)", e))
+    if (const auto x =
+            number(v, 1.0, false, kHuge, "a number >= 1 (Δt_DEM,max = t_col/dt_factor, 50)", e))
       c.dtFactor = *x;
     return e;
   };
-  o.push_back({"dem.dt_factor", "numerics", "number >= 1", "50", "Δt_DEM,max = t_col / dt_factor", dtFactor});
+  o.push_back({"dem.dt_factor", "numerics", "number >= 1", "50", "Δt_DEM,max = t_col / dt_factor",
+               dtFactor});
   o.push_back({"dt_factor", "numerics", "number >= 1", "50", "same as dem.dt_factor", dtFactor});
   o.push_back({"dem.skin_factor", "numerics", "number >= 0", "0.1",
                "Verlet skin = skin_factor · d_max (neighbour lists)",
                [](DemConfig& c, std::string_view v) {
                  std::string e;
-                 if (const auto x = number(v, 0.0, false, kHuge, "a number >= 0 (0.1)", e)) c.neighbour.skinFactor = *x;
+                 if (const auto x = number(v, 0.0, false, kHuge, "a number >= 0 (0.1)", e))
+                   c.neighbour.skinFactor = *x;
                  return e;
                }});
-  o.push_back({"dem.history_slots", "numerics", fmt::format("integer in [1, {}]", kMaxHistorySlots), "12",
-               "tangential-history slots per particle (simultaneous contacts)",
+  o.push_back({"dem.history_slots", "numerics", fmt::format("integer in [1, {}]", kMaxHistorySlots),
+               "12", "tangential-history slots per particle (simultaneous contacts)",
                [](DemConfig& c, std::string_view v) {
                  std::string e;
-                 const std::string what = fmt::format("an integer in [1, {}] (12)", kMaxHistorySlots);
-                 if (const auto x = integer(v, 1, kMaxHistorySlots, what, e)) c.neighbour.historySlots = *x;
+                 const std::string what =
+                     fmt::format("an integer in [1, {}] (12)", kMaxHistorySlots);
+                 if (const auto x = integer(v, 1, kMaxHistorySlots, what, e))
+                   c.neighbour.historySlots = *x;
                  return e;
                }});
   return o;
@@ -342,38 +377,45 @@ std::span<const ModelOption> modelOptions() {
 
 const ModelOption* findModelOption(std::string_view key) {
   for (const ModelOption& o : modelOptions())
-    if (o.key == key) return &o;
+    if (o.key == key)
+      return &o;
   return nullptr;
 }
 
 bool applyModelOption(DemConfig& config, std::string_view key, std::string_view value) {
   const ModelOption* o = findModelOption(key);
-  if (o == nullptr) return false;
+  if (o == nullptr)
+    return false;
   const std::string error = o->apply(config, value);
   COREDEM_CHECK(error.empty(), "model option {} = '{}': {}", key, value, error);
   return true;
 }
 
-std::vector<ModelIssue> validateModels(std::span<const std::pair<std::string, std::string>> models) {
+std::vector<ModelIssue>
+validateModels(std::span<const std::pair<std::string, std::string>> models) {
   std::vector<ModelIssue> issues;
   std::vector<std::string_view> keys;
-  for (const ModelOption& o : modelOptions()) keys.push_back(o.key);
+  for (const ModelOption& o : modelOptions())
+    keys.push_back(o.key);
   std::string allKeys;
-  for (std::string_view k : keys) allKeys += (allKeys.empty() ? "" : ", ") + std::string(k);
+  for (std::string_view k : keys)
+    allKeys += (allKeys.empty() ? "" : ", ") + std::string(k);
   DemConfig scratch;
   for (std::size_t i = 0; i < models.size(); ++i) {
     const auto& [key, value] = models[i];
     const ModelOption* o = findModelOption(key);
     if (o == nullptr) {
       const std::string guess = didYouMean(key, keys);
-      issues.push_back({i, key, true,
-                        fmt::format("unknown model key{}; allowed keys: {}",
-                                    guess.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", guess),
-                                    allKeys)});
+      issues.push_back(
+          {i, key, true,
+           fmt::format("unknown model key{}; allowed keys: {}",
+                       guess.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", guess),
+                       allKeys)});
       continue;
     }
     std::string error = o->apply(scratch, value);
-    if (!error.empty()) issues.push_back({i, key, false, std::move(error)});
+    if (!error.empty())
+      issues.push_back({i, key, false, std::move(error)});
   }
   return issues;
 }

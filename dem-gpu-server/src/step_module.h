@@ -13,13 +13,13 @@
 /// Adding a heat-transfer term with its ledger: its kernel, its call in HeatModule::sources and
 /// its entry in HeatTotals (docs/architecture-models.md).
 
+#include <concepts>
+#include <cstddef>
+
 #include "coupling_cells.h"
 #include "engine.h"
 #include "gas_fields.h"
 #include "particle_store.h"
-
-#include <concepts>
-#include <cstddef>
 
 namespace coredem::dem {
 
@@ -34,7 +34,7 @@ struct StepContext {
   /// PCM cell of every particle, the particles sorted by cell and ε_g frozen at the window
   /// start (coupling_cells.h); unused without a coupling grid.
   CouplingCells<Exec>& cells;
-  double dt;  ///< sub-step length Δt_DEM (s)
+  double dt; ///< sub-step length Δt_DEM (s)
 };
 
 /// What a module sees at the end of a window of nSub sub-steps (host side).
@@ -44,15 +44,16 @@ struct WindowContext {
   /// The gas fields of the CFD step (host mirrors valid); nullptr as in StepContext.
   const GasFields<Exec>* gas;
   CouplingCells<Exec>& cells;
-  int nSub;       ///< sub-steps in the window
-  double dtCfd;   ///< window length Δt_CFD (s), as the CFD books it
-  double dtSub;   ///< sub-step length Δt_DEM (s); dtSub·nSub = Δt_CFD to round-off
-  CellSources& out;  ///< sized by the engine (zeros); each module fills its own sources
+  int nSub;         ///< sub-steps in the window
+  double dtCfd;     ///< window length Δt_CFD (s), as the CFD books it
+  double dtSub;     ///< sub-step length Δt_DEM (s); dtSub·nSub = Δt_CFD to round-off
+  CellSources& out; ///< sized by the engine (zeros); each module fills its own sources
 };
 
 /// A DEM sub-step module: private data, one interface.
 template <class M, class Exec>
-concept StepModule = requires(M m, const M cm, StepContext<Exec>& step, WindowContext<Exec>& window) {
+concept StepModule = requires(M m, const M cm, StepContext<Exec>& step,
+                              WindowContext<Exec>& window) {
   { cm.enabled() } -> std::same_as<bool>;
   m.beginWindow(step);
   m.sources(step);

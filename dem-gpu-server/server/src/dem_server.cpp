@@ -605,9 +605,9 @@ struct DemServer::Impl {
     // Particle heat balance (docs/heat-coupling.md): Δ thermal energy = heat from gas + radiation
     // + walls, all from the DEM core's heat ledger (kept across restarts in the state file).
     const dem::HeatTotals heat = system->heatTotals();
-    proto::addNamedValue(l.mutable_energy(), "dem.heat_from_gas_J", heat.convection);
-    proto::addNamedValue(l.mutable_energy(), "dem.heat_radiation_J", heat.radiation);
-    proto::addNamedValue(l.mutable_energy(), "dem.heat_wall_J", heat.wall);
+    for (const dem::HeatLedgerEntry& e : dem::kHeatLedger) {
+      proto::addNamedValue(l.mutable_energy(), e.name, heat.*e.value);
+    }
     proto::addNamedValue(l.mutable_energy(), "dem.thermal_energy_J", system->thermalEnergy());
     for (std::size_t k = 0; k < speciesNames.size(); ++k) {
       proto::addNamedValue(l.mutable_species(), "dem.species_to_gas." + speciesNames[k] + "_kg",

@@ -1,6 +1,15 @@
 // Model registries (coredem/dem/models.h): every row parses its own default, every family name
 // maps to its enum and back, the kernels dispatch on each enum, and bad keys/values are reported
 // with the allowed ones.
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
 #include "coredem/common/check.h"
 #include "coredem/dem/dem_system.h"
 #include "coredem/dem/kernels/convection.h"
@@ -8,15 +17,6 @@
 #include "coredem/dem/kernels/reaction_generic.h"
 #include "coredem/dem/kernels/wgs.h"
 #include "coredem/dem/models.h"
-
-#include <gtest/gtest.h>
-
-#include <fstream>
-#include <set>
-#include <sstream>
-#include <string>
-#include <utility>
-#include <vector>
 
 using namespace coredem::dem;
 namespace k = coredem::dem::kernels;
@@ -82,19 +82,21 @@ TEST(ModelRegistry, EveryRowParsesItsDefault) {
     EXPECT_EQ(c.neighbour.historySlots, reference.neighbour.historySlots) << o.key;
     const HeatOptions& h = c.heat;
     const HeatOptions& r = reference.heat;
-    EXPECT_TRUE(h.enabled == r.enabled && h.convection == r.convection && h.nusselt == r.nusselt &&
-                h.reynoldsWithVoidage == r.reynoldsWithVoidage && h.voidageExponent == r.voidageExponent &&
-                h.contactConduction == r.contactConduction && h.lensConduction == r.lensConduction &&
-                h.lensFraction == r.lensFraction && h.minSeparation == r.minSeparation &&
-                h.lensRelTol == r.lensRelTol && h.radiation == r.radiation &&
-                h.wallConduction == r.wallConduction && h.wallLensConduction == r.wallLensConduction)
+    EXPECT_TRUE(
+        h.enabled == r.enabled && h.convection == r.convection && h.nusselt == r.nusselt &&
+        h.reynoldsWithVoidage == r.reynoldsWithVoidage && h.voidageExponent == r.voidageExponent &&
+        h.contactConduction == r.contactConduction && h.lensConduction == r.lensConduction &&
+        h.lensFraction == r.lensFraction && h.minSeparation == r.minSeparation &&
+        h.lensRelTol == r.lensRelTol && h.radiation == r.radiation &&
+        h.wallConduction == r.wallConduction && h.wallLensConduction == r.wallLensConduction)
         << o.key << ": the default '" << o.defaultValue << "' is not the built-in default";
   }
   // The keys that cases use today.
-  for (const char* key : {"drag", "heat", "convection", "convection_reynolds", "nusselt_exponent",
-                          "contact_conduction", "lens_conduction", "flpc", "s_min", "lens_rel_tol",
-                          "radiation", "wall_conduction", "wall_lens_conduction", "motion",
-                          "dem.dt_factor", "dem.eps_min_drag", "dem.skin_factor", "dem.history_slots"})
+  for (const char* key :
+       {"drag", "heat", "convection", "convection_reynolds", "nusselt_exponent",
+        "contact_conduction", "lens_conduction", "flpc", "s_min", "lens_rel_tol", "radiation",
+        "wall_conduction", "wall_lens_conduction", "motion", "dem.dt_factor", "dem.eps_min_drag",
+        "dem.skin_factor", "dem.history_slots"})
     EXPECT_TRUE(keys.count(key)) << key;
 }
 
@@ -115,26 +117,30 @@ TEST(ModelRegistry, ApplySetsTheConfig) {
   EXPECT_EQ(c.dtFactor, 40.0);
   EXPECT_TRUE(applyModelOption(c, "heat", "off"));
   EXPECT_FALSE(c.heat.enabled);
-  EXPECT_FALSE(applyModelOption(c, "no_such_key", "1"));  // the server warns and ignores it
+  EXPECT_FALSE(applyModelOption(c, "no_such_key", "1")); // the server warns and ignores it
   EXPECT_THROW(applyModelOption(c, "dem.history_slots", "33"), coredem::UserError);
   EXPECT_THROW(applyModelOption(c, "drag", "wen-yu"), coredem::UserError);
 }
 
 // `coredem check` input: a misspelled key and a bad value, each named with the allowed ones.
 TEST(ModelRegistry, ValidateNamesKeyValueAndAllowed) {
-  const std::vector<std::pair<std::string, std::string>> models = {
-      {"motion", "frozen"}, {"convecton", "li-mason"}, {"convection", "li-masn"}, {"flpc", "2"},
-      {"drag", "gidaspow"}};
+  const std::vector<std::pair<std::string, std::string>> models = {{"motion", "frozen"},
+                                                                   {"convecton", "li-mason"},
+                                                                   {"convection", "li-masn"},
+                                                                   {"flpc", "2"},
+                                                                   {"drag", "gidaspow"}};
   const std::vector<ModelIssue> issues = validateModels(models);
   ASSERT_EQ(issues.size(), 3u);
   EXPECT_EQ(issues[0].index, 1u);
   EXPECT_EQ(issues[0].key, "convecton");
   EXPECT_TRUE(issues[0].unknownKey);
-  EXPECT_NE(issues[0].message.find("did you mean 'convection'?"), std::string::npos) << issues[0].message;
+  EXPECT_NE(issues[0].message.find("did you mean 'convection'?"), std::string::npos)
+      << issues[0].message;
   EXPECT_NE(issues[0].message.find("allowed keys: drag, "), std::string::npos) << issues[0].message;
   EXPECT_EQ(issues[1].index, 2u);
   EXPECT_FALSE(issues[1].unknownKey);
-  EXPECT_NE(issues[1].message.find("'li-masn' is not allowed (did you mean 'li-mason'?)"), std::string::npos)
+  EXPECT_NE(issues[1].message.find("'li-masn' is not allowed (did you mean 'li-mason'?)"),
+            std::string::npos)
       << issues[1].message;
   EXPECT_NE(issues[1].message.find("allowed: li-mason, ranz-marshall or off"), std::string::npos)
       << issues[1].message;
@@ -167,7 +173,7 @@ TEST(ModelDispatch, NusseltModel) {
     p.model = e.value;
     nu[static_cast<int>(e.value)] = k::convection(p, g, 1e-3, 1.0, 300.0).conductance;
   }
-  EXPECT_NE(nu[0], nu[1]);  // Li–Mason has εⁿ, Ranz–Marshall not
+  EXPECT_NE(nu[0], nu[1]); // Li–Mason has εⁿ, Ranz–Marshall not
 }
 
 TEST(ModelDispatch, WgsEquilibrium) {
@@ -202,5 +208,6 @@ TEST(ModelRegistry, CaseSchemaDocumentsEveryKey) {
   std::stringstream text;
   text << in.rdbuf();
   for (const ModelOption& o : modelOptions())
-    EXPECT_NE(text.str().find("| `" + o.key + "` |"), std::string::npos) << o.key << " is not in docs/case-schema.md";
+    EXPECT_NE(text.str().find("| `" + o.key + "` |"), std::string::npos)
+        << o.key << " is not in docs/case-schema.md";
 }

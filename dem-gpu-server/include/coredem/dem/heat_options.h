@@ -35,4 +35,17 @@ struct HeatTotals {
   double wall = 0.0;        ///< from fixed-temperature walls (kernels/wall_conduction.h)
 };
 
+/// One entry of the heat ledger as the DEM server reports it (StepDone ledger, energy, J).
+struct HeatLedgerEntry {
+  const char* name;             ///< ledger name, e.g. "dem.heat_from_gas_J"
+  double HeatTotals::*value;    ///< the total it reports
+};
+
+/// The heat ledger in report order: a new HeatTotals field is reported by adding its row here.
+inline constexpr HeatLedgerEntry kHeatLedger[] = {
+    {"dem.heat_from_gas_J", &HeatTotals::convection},
+    {"dem.heat_radiation_J", &HeatTotals::radiation},
+    {"dem.heat_wall_J", &HeatTotals::wall},
+};
+
 } // namespace coredem::dem

@@ -16,11 +16,6 @@
 /// Adding a drag law: its kernel header, an enumerator + case in kernels/drag.h, one row in
 /// dragModels() (models.cpp), its test (docs/architecture-models.md).
 
-#include "coredem/dem/kernels/convection.h"
-#include "coredem/dem/kernels/drag.h"
-#include "coredem/dem/kernels/reaction_generic.h"
-#include "coredem/dem/kernels/wgs.h"
-
 #include <cstddef>
 #include <span>
 #include <string>
@@ -28,35 +23,40 @@
 #include <utility>
 #include <vector>
 
+#include "coredem/dem/kernels/convection.h"
+#include "coredem/dem/kernels/drag.h"
+#include "coredem/dem/kernels/reaction_generic.h"
+#include "coredem/dem/kernels/wgs.h"
+
 namespace coredem::dem {
 
 struct DemConfig;
 
 /// `models: {motion: ...}`.
 enum class MotionModel : int {
-  Free = 0,   ///< forces move the particles (default)
-  Frozen = 1  ///< held in place, velocities zeroed every sub-step (DemConfig::frozenMotion)
+  Free = 0,  ///< forces move the particles (default)
+  Frozen = 1 ///< held in place, velocities zeroed every sub-step (DemConfig::frozenMotion)
 };
 
 /// `models: {convection_reynolds: ...}`: the Reynolds number of the Nusselt correlation.
 enum class ReynoldsDefinition : int {
-  WithVoidage = 0,    ///< Re = ε ρ_g d |Δu|/μ_g, as the drag (default)
-  WithoutVoidage = 1  ///< Re = ρ_g d |Δu|/μ_g (Kratos form)
+  WithVoidage = 0,   ///< Re = ε ρ_g d |Δu|/μ_g, as the drag (default)
+  WithoutVoidage = 1 ///< Re = ρ_g d |Δu|/μ_g (Kratos form)
 };
 
 /// One model of a family.
 template <class E>
 struct ModelEntry {
-  std::string_view name;  ///< as written in case.yaml; '_' and '-' are interchangeable on input
-  E value;                ///< what the kernels dispatch on
-  std::string_view doc;   ///< one line
+  std::string_view name; ///< as written in case.yaml; '_' and '-' are interchangeable on input
+  E value;               ///< what the kernels dispatch on
+  std::string_view doc;  ///< one line
 };
 
 /// The registry of one model family: its models in enum order.
 template <class E>
 struct ModelFamily {
-  std::string_view name;                   ///< family name, e.g. "drag"
-  std::span<const ModelEntry<E>> entries;  ///< every model of the family
+  std::string_view name;                  ///< family name, e.g. "drag"
+  std::span<const ModelEntry<E>> entries; ///< every model of the family
 
   /// The entry called `model` ('_' and '-' alike), or nullptr.
   const ModelEntry<E>* find(std::string_view model) const;
@@ -81,11 +81,11 @@ const ModelFamily<kernels::WgsEquilibrium>& wgsEquilibriumModels();
 
 /// One key of `models:`.
 struct ModelOption {
-  std::string key;           ///< e.g. "convection"
-  std::string family;        ///< drag, heat, convection, conduction, radiation, motion, numerics
-  std::string values;        ///< allowed values as users read them, from the family registry
-  std::string defaultValue;  ///< as written in case.yaml
-  std::string doc;           ///< one line
+  std::string key;          ///< e.g. "convection"
+  std::string family;       ///< drag, heat, convection, conduction, radiation, motion, numerics
+  std::string values;       ///< allowed values as users read them, from the family registry
+  std::string defaultValue; ///< as written in case.yaml
+  std::string doc;          ///< one line
   /// Checks `value` and stores it in `config`. Returns "" when it is allowed, else what is wrong
   /// with it and the allowed values (and a "did you mean" when a close value exists).
   std::string (*apply)(DemConfig& config, std::string_view value) = nullptr;
@@ -103,10 +103,10 @@ bool applyModelOption(DemConfig& config, std::string_view key, std::string_view 
 
 /// A bad entry of a `models:` mapping.
 struct ModelIssue {
-  std::size_t index = 0;    ///< position in the mapping given to validateModels
-  std::string key;          ///< the key as written
-  bool unknownKey = false;  ///< true: the key is wrong; false: the value is
-  std::string message;      ///< what is wrong and what is allowed (without the key itself)
+  std::size_t index = 0;   ///< position in the mapping given to validateModels
+  std::string key;         ///< the key as written
+  bool unknownKey = false; ///< true: the key is wrong; false: the value is
+  std::string message;     ///< what is wrong and what is allowed (without the key itself)
 };
 
 /// Validates a whole `models:` mapping (key, value pairs in file order) with the registry the

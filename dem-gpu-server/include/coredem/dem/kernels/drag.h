@@ -12,13 +12,13 @@ namespace coredem::dem::kernels {
 
 /// Drag laws (enum values are stable: the configuration hash uses them).
 enum class DragLaw : int {
-  Gidaspow = 0  ///< Ergun (ε ≤ 0.8) / Wen–Yu (drag_gidaspow.h)
+  Gidaspow = 0 ///< Ergun (ε ≤ 0.8) / Wen–Yu (drag_gidaspow.h)
 };
 
 /// Parameters of every drag law (plain data, passed by value into the kernels).
 struct DragParams {
   DragLaw law = DragLaw::Gidaspow;
-  GidaspowParams gidaspow{};  ///< ε_min clip and the Ergun/Wen–Yu switch
+  GidaspowParams gidaspow{}; ///< ε_min clip and the Ergun/Wen–Yu switch
 };
 
 /// Per-particle drag coefficient β V_p/(1−ε) (kg/s) of the chosen law, for the gas fraction
