@@ -44,15 +44,11 @@ constexpr ModelEntry<kernels::WgsEquilibrium> kWgs[] = {
     {"thermodynamic", kernels::WgsEquilibrium::Thermodynamic, "K_eq from the NASA-7 data"},
 };
 
-/// Lower case, '_' as '-'.
+/// '_' as '-' (model names accept either).
 std::string normalise(std::string_view s) {
   std::string out(s);
-  for (char& c : out) {
-    if (c == '_')
-      c = '-';
-    if (c >= 'A' && c <= 'Z')
-      c = static_cast<char>(c - 'A' + 'a');
-  }
+  for (char& c : out)
+    if (c == '_') c = '-';
   return out;
 }
 
@@ -181,13 +177,10 @@ std::optional<E> choice(const ModelFamily<E>& f, std::string_view value, std::st
   return std::nullopt;
 }
 
-/// on/true/yes/1 or off/false/no/0.
+/// on/true/yes/1 or off/false/no/0 (the spellings of every switch).
 std::optional<bool> onOff(std::string_view value, std::string& error) {
-  const std::string v = normalise(value);
-  if (v == "on" || v == "true" || v == "yes" || v == "1")
-    return true;
-  if (v == "off" || v == "false" || v == "no" || v == "0")
-    return false;
+  if (value == "on" || value == "true" || value == "yes" || value == "1") return true;
+  if (value == "off" || value == "false" || value == "no" || value == "0") return false;
   static constexpr std::string_view kNames[] = {"on", "off"};
   error = withSuggestion(value, kNames, "on or off");
   return std::nullopt;
