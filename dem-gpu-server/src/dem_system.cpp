@@ -8,6 +8,7 @@
 
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
+#include "coredem/common/version.h"
 #include "coredem/dem/kernels/collision_time.h"
 #include "coredem/dem/kernels/damping.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
@@ -20,9 +21,6 @@
 #include <limits>
 #include <unordered_map>
 
-#ifndef COREDEM_VERSION
-#define COREDEM_VERSION "0.0.0"
-#endif
 
 namespace coredem::dem {
 
@@ -571,7 +569,7 @@ void DemSystem::writeState(const std::string& path) const {
   meta.step = m.step;
   meta.backend = m.engine->name();
   meta.configHash = m.hash;
-  meta.softwareVersion = std::string(COREDEM_VERSION);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
+  meta.softwareVersion = std::string(kVersion);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
   meta.protocolVersion = std::string("1");
   const HeatTotals heat = m.engine->heatTotals();
   meta.heatConvection = heat.convection;

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "coredem/common/check.h"
+#include "coredem/common/switch.h"
 #include "coredem/dem/dem_system.h"
 
 namespace coredem::dem {
@@ -177,10 +178,9 @@ std::optional<E> choice(const ModelFamily<E>& f, std::string_view value, std::st
   return std::nullopt;
 }
 
-/// on/true/yes/1 or off/false/no/0 (the spellings of every switch).
+/// on/true/yes/1 or off/false/no/0 (coredem::parseSwitch, the one spelling of a switch).
 std::optional<bool> onOff(std::string_view value, std::string& error) {
-  if (value == "on" || value == "true" || value == "yes" || value == "1") return true;
-  if (value == "off" || value == "false" || value == "no" || value == "0") return false;
+  if (const auto b = parseSwitch(value)) return b;
   static constexpr std::string_view kNames[] = {"on", "off"};
   error = withSuggestion(value, kNames, "on or off");
   return std::nullopt;
