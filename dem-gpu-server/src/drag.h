@@ -61,10 +61,8 @@ public:
   void sources(StepContext<Exec>& ctx) {
     if (!_enabled)
       return;
-    _kcoef.reserve(ctx.particles.n);
     gasForces(ctx);
-    ctx.cells.sort(ctx.exec, ctx.particles.n);
-    deposit(ctx);
+    sortAndDeposit(ctx);
   }
 
   void update(StepContext<Exec>&) {}
@@ -89,12 +87,14 @@ public:
   }
 
   // The passes below are public because nvcc refuses extended (device) lambdas in private
-  // member functions; they are called by sources() only.
+  // member functions. The engine calls the first two itself to time them apart (stages drag and
+  // coupling); together they are sources().
 
-  /// PCM cell, drag and −V_p ∇p per particle. The sums are in the order of the former fused
+  /// First pass: PCM cell, drag and −V_p ∇p per particle. The sums are in the order of the former fused
   /// kernel (bitwise the same forces).
   void gasForces(StepContext<Exec>& ctx) {
     ParticleStore<Exec>& p = ctx.particles;
+    _kcoef.reserve(p.n);
     const double* x = p.pos.d();
     const double* v = p.vel.d();
     const double* r = p.radius.d();
@@ -132,6 +132,12 @@ public:
       pc[i] = cell < 0 ? nCells : static_cast<std::uint32_t>(cell);
     });
     p.produced(kForce);
+  }
+
+  /// Second pass: the particles sorted by cell, then their sums added to the window accumulators.
+  void sortAndDeposit(StepContext<Exec>& ctx) {
+    ctx.cells.sort(ctx.exec, ctx.particles.n);
+    deposit(ctx);
   }
 
   /// Reads pos, vel, radius, _kcoef and the sort; adds this sub-step's PCM sums into _acc.

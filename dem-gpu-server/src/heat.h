@@ -307,7 +307,7 @@ public:
       _wallAcc.markDeviceModified();
     }
 
-    // 4. Cell sources (gather per cell in the PCM order of deposit()).
+    // 4. Cell sources (gather per cell in the PCM order the drag module sorted).
     if (s.coupled) {
       double* acc = _acc.d();
       const double invVc = 1.0 / s.cellVolume;

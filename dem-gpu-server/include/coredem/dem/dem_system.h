@@ -191,9 +191,9 @@ struct ParticleData {
 struct StageTimes {
   double neighbour = 0;  ///< cell keys, sort, reorder, neighbour lists
   double contact = 0;    ///< particle–particle and wall contact forces
-  double drag = 0;       ///< gas forces (PCM cell, drag, −V_p∇p) and their K_sl deposition (coupled runs only)
+  double drag = 0;       ///< gas forces: PCM cell, drag law, −V_p∇p (coupled runs only)
   double integrate = 0;  ///< motion update and temperature updates
-  double coupling = 0;   ///< PCM cells and ε_g at the window start
+  double coupling = 0;   ///< PCM ε_g and cell-source deposition
   double heat = 0;       ///< heat sources (conduction, convection, radiation) and their deposition
   double chemistry = 0;  ///< reaction rates, mass/diameter update, species deposition, WGS, removal
   std::uint64_t rebuilds = 0;
