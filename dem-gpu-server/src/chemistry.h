@@ -21,8 +21,8 @@
 /// At the window end R_species = Σ ṁ Δt/(V_c t_window), Q_hom = Σ ṁ_gas c_p,g (T_p − T_g) Δt/(V_c
 /// t_window) and the WGS (R3) of every cell is added
 /// from the frozen gas (host, once per CFD step). A particle whose diameter fell below
-/// removalFraction·d_0 stops reacting and is reported (pendingRemoval) so that DemSystem removes
-/// it at the CFD-step boundary.
+/// removalFraction·d_0 stops reacting and is reported (takeRemovalRequest) so that DemSystem
+/// removes it at the CFD-step boundary.
 ///
 /// Every loop writes only its own index (gather per cell over sorted segments, no atomics), so
 /// results are bitwise independent of the thread count.
@@ -30,9 +30,7 @@
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
 #include "chemistry_setup.h"
-#include "engine.h"
-#include "gas_fields.h"
-#include "particle_store.h"
+#include "step_module.h"
 
 #include "coredem/dem/chemistry_options.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
@@ -45,6 +43,8 @@
 
 namespace coredem::dem {
 
+/// Chemistry of the particles and cells: a StepModule (step_module.h) with the ledger
+/// ChemistryTotals.
 template <class Exec>
 class ChemistryModule {
 public:
@@ -52,24 +52,6 @@ public:
   using Dual = backend::DualArray<T, Exec>;
   template <class T>
   using Dev = backend::DeviceArray<T, Exec>;
-
-  ChemistrySetup _c;
-  Dual<kernels::HeterogeneousReaction> _reactions;
-  /// ΔH_r polynomials (combineReactionEnthalpy): one per data-defined reaction (n = 0: constant
-  /// dH), then R1, R2, R4, R5 at kClgHeat.
-  Dual<kernels::ReactionEnthalpyPoly> _dh;
-  Dual<double> _gasM, _cp;
-  const GasFields<Exec>* _gas = nullptr;  ///< the engine's gas fields of the CFD step (ρ_g, Y_g, T_g, c_p,g)
-  bool _hasRho = false, _hasY = false, _hasTg = false, _hasCpG = false;
-  Dev<double> _gdot;             ///< per particle: gas mass rates (kg/s), N*nGas
-  Dev<double> _dsolid;           ///< per particle: solid mass change in this sub-step (kg), N*nSolid
-  Dev<double> _q;                ///< per particle: Q_rxn (W)
-  Dev<double> _sens;             ///< per particle: ṁ_gas c_p,g (T_p − T_g) (W), Δm c_p T_p (J); N*2
-  Dual<double> _acc;             ///< (nCells+1)*W: Σ gas kg, Σ solid kg, Σ Q_rxn J, Σ gas sensible J, Σ Δm c T J
-  int _width = 0;                ///< W = nGas + nSolid + 3
-  double _dt = 0.0;
-  bool _pending = false;         ///< a particle is below the removal diameter
-  ChemistryTotals _totals;
 
   void setup(const ChemistrySetup& c, std::size_t nCells) {
     _c = c;
@@ -107,40 +89,51 @@ public:
   }
 
   bool enabled() const { return _c.enabled; }
-  bool pendingRemoval() const { return _pending; }
 
-  /// Uses the engine's gas fields from now on; `gas` outlives this module.
-  void setGas(const GasFields<Exec>& gas) {
-    _gas = &gas;
-    _hasRho = gas.has(gas.rhoG);
-    _hasY = gas.has(gas.Yg);
-    _hasTg = gas.has(gas.Tg);
-    _hasCpG = gas.has(gas.cpG);
+  /// True when a particle fell below the removal diameter since the last call (clears it).
+  bool takeRemovalRequest() {
+    const bool p = _pending;
+    _pending = false;
+    return p;
   }
 
   std::size_t bytes() const {
-    auto& s = const_cast<ChemistryModule&>(*this);
-    return s._reactions.bytes() + s._dh.bytes() + s._gasM.bytes() + s._cp.bytes() +
-           _gdot.bytes() + _dsolid.bytes() + _q.bytes() +
-           _sens.bytes() + s._acc.bytes();
+    return _reactions.bytes() + _dh.bytes() + _gasM.bytes() + _cp.bytes() + _gdot.bytes() + _dsolid.bytes() +
+           _q.bytes() + _sens.bytes() + _acc.bytes();
   }
 
-  void beginWindow(Exec& exec) {
+  /// Chemistry ledgers since construction (or the restored ones).
+  const ChemistryTotals& totals() const { return _totals; }
+  /// Continues the ledgers of a state file, or books removed particles (DemSystem).
+  void restoreTotals(const ChemistryTotals& t) { _totals = t; }
+
+  void beginWindow(StepContext<Exec>& ctx) {
     if (!_c.enabled) return;
     double* acc = _acc.d();
-    exec.parallelFor(_acc.size(), [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
+    ctx.exec.parallelFor(_acc.size(), [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
     _acc.markDeviceModified();
   }
 
-  /// Steps 1–4 of the file comment. When coupled, the particles must be sorted by PCM cell
-  /// (perm, cStart, cEnd, pcell) as deposit() leaves them. Reads temperature, material, radius,
+  /// Steps 1–4 of the file comment. When coupled, the particles are sorted by PCM cell
+  /// (ctx.cells) as the drag module leaves them. Reads temperature, material, radius,
   /// mass, density, species, d0, chemRef; writes mass, species, radius, _gdot, _dsolid, _q, _acc.
-  void react(Exec& exec, ParticleStore<Exec>& p, const EngineSetup& s, bool gasPresent,
-             const std::uint32_t* pcell, const std::uint32_t* perm, const std::uint32_t* cStart,
-             const std::uint32_t* cEnd, double dt) {
+  void sources(StepContext<Exec>& ctx) {
     if (!_c.enabled) return;
+    Exec& exec = ctx.exec;
+    ParticleStore<Exec>& p = ctx.particles;
+    const EngineSetup& s = ctx.setup;
+    const double dt = ctx.dt;
+    const std::uint32_t* pcell = ctx.cells.pcell();
+    const std::uint32_t* perm = ctx.cells.perm();
+    const std::uint32_t* cStart = ctx.cells.cStart();
+    const std::uint32_t* cEnd = ctx.cells.cEnd();
+    const GasFields<Exec>* gasFields = ctx.gas;  // nullptr: no gas fields or no coupling grid
+    const bool gasPresent = gasFields != nullptr;
+    const bool hasRho = gasPresent && gasFields->has(gasFields->rhoG);
+    const bool hasY = gasPresent && gasFields->has(gasFields->Yg);
+    const bool hasTg = gasPresent && gasFields->has(gasFields->Tg);
+    const bool hasCpG = gasPresent && gasFields->has(gasFields->cpG);
     const std::size_t n = p.n;
-    _dt = dt;
     const ChemParams cp = _c.params;
     const int nG = cp.nGas, nS = cp.nSolid, W = _width;
     _gdot.reserve(n * static_cast<std::size_t>(nG > 0 ? nG : 1));
@@ -148,8 +141,8 @@ public:
     _q.reserve(n);
     _sens.reserve(2 * n);
     const bool coupled = s.coupled;
-    const bool gas = coupled && gasPresent && _hasRho && _hasY;
-    const bool sensGas = coupled && gasPresent && _hasTg && _hasCpG;
+    const bool gas = coupled && gasPresent && hasRho && hasY;
+    const bool sensGas = coupled && gasPresent && hasTg && hasCpG;
     const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
     const double* T = p.temperature.d();
     const double* rho = p.density.d();
@@ -164,16 +157,16 @@ public:
     double* sens = _sens.d();
     const std::int32_t* mat = p.material.d();
     const double* cpm = _cp.d();
-    const double* tgC = sensGas ? _gas->Tg.d() : nullptr;
-    const double* cpgC = sensGas ? _gas->cpG.d() : nullptr;
+    const double* tgC = sensGas ? gasFields->Tg.d() : nullptr;
+    const double* cpgC = sensGas ? gasFields->cpG.d() : nullptr;
     const kernels::HeterogeneousReaction* reac = _reactions.d();
     const kernels::ReactionEnthalpyPoly* dhPoly = _dh.d();
     // R1/R2 and R4/R5 heats (none when reaction heat is off: the heat is not used then).
     const kernels::ReactionEnthalpyPoly* dhChar = cp.reactionHeat ? dhPoly + cp.nReactions : nullptr;
     const kernels::ReactionEnthalpyPoly* dhOc = cp.reactionHeat ? dhPoly + cp.nReactions + 2 : nullptr;
     const double* gasM = _gasM.d();
-    const double* rhoG = gas ? _gas->rhoG.d() : nullptr;
-    const double* yg = gas ? _gas->Yg.d() : nullptr;
+    const double* rhoG = gas ? gasFields->rhoG.d() : nullptr;
+    const double* yg = gas ? gasFields->Yg.d() : nullptr;
 
     const double below = exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
@@ -332,9 +325,13 @@ public:
     _acc.markDeviceModified();
   }
 
-  /// T_i += Δt Q_rxn,i/(m_i c_p,i) (Eq. 18 with Q_rxn only; the heat module adds the rest).
-  void updateTemperature(Exec& exec, ParticleStore<Exec>& p, double dt) {
+  /// After the motion update and the heat module's update: T_i += Δt Q_rxn,i/(m_i c_p,i)
+  /// (Eq. 18 with Q_rxn only; the heat module adds the rest).
+  void update(StepContext<Exec>& ctx) {
     if (!_c.enabled || !_c.params.reactionHeat) return;
+    Exec& exec = ctx.exec;
+    ParticleStore<Exec>& p = ctx.particles;
+    const double dt = ctx.dt;
     const double* q = _q.d();
     const double* m = p.mass.d();
     const std::int32_t* mat = p.material.d();
@@ -347,13 +344,16 @@ public:
   }
 
   /// Window end (host): R_species from the particle sources, WGS per cell, ledgers.
-  /// out.rSpecies / out.qHom are sized (zeros) by the engine. epsFrozen: host ε_g per cell.
-  void endWindow(int nSub, const EngineSetup& s, const double* epsFrozen, CellSources& out) {
+  /// out.rSpecies / out.qHom are sized (zeros) by the engine.
+  void endWindow(WindowContext<Exec>& w) {
     if (!_c.enabled) return;
+    const EngineSetup& s = w.setup;
+    CellSources& out = w.out;
+    const int nSub = w.nSub;
     _acc.toHost();
     const ChemParams& cp = _c.params;
     const int nG = cp.nGas, nS = cp.nSolid, W = _width;
-    const double window = _dt * nSub;
+    const double window = w.dtSub * nSub;
     const std::size_t nc = s.coupled ? s.nCells : 0;
     const double* acc = _acc.h();
     std::vector<double> gasSum(static_cast<std::size_t>(nG), 0.0), solidSum(static_cast<std::size_t>(nS), 0.0);
@@ -378,10 +378,13 @@ public:
     _totals.sensibleMassEnthalpy += massSensSum;
 
     // R3, homogeneous water–gas shift: once per CFD step per cell from the frozen gas.
-    if (cp.wgsOn && nc > 0 && window > 0.0 && _hasTg && _hasRho && _hasY) {
-      const double* tgH = _gas->Tg.h();
-      const double* rhoH = _gas->rhoG.h();
-      const double* ygH = _gas->Yg.h();
+    const GasFields<Exec>* gf = w.gas;
+    if (cp.wgsOn && nc > 0 && window > 0.0 && gf != nullptr && gf->has(gf->Tg) && gf->has(gf->rhoG) &&
+        gf->has(gf->Yg)) {
+      const double* tgH = gf->Tg.h();
+      const double* rhoH = gf->rhoG.h();
+      const double* ygH = gf->Yg.h();
+      const double* epsFrozen = w.cells.epsFrozenHost();
       std::vector<double> srcSum(static_cast<std::size_t>(nG), 0.0);
       double heat = 0.0;
       for (std::size_t c = 0; c < nc; ++c) {
@@ -405,6 +408,22 @@ public:
       _totals.homogeneousHeat += heat * s.cellVolume * window;
     }
   }
+
+private:
+  ChemistrySetup _c;
+  Dual<kernels::HeterogeneousReaction> _reactions;
+  /// ΔH_r polynomials (combineReactionEnthalpy): one per data-defined reaction (n = 0: constant
+  /// dH), then R1, R2, R4, R5 at kClgHeat.
+  Dual<kernels::ReactionEnthalpyPoly> _dh;
+  Dual<double> _gasM, _cp;
+  Dev<double> _gdot;             ///< per particle: gas mass rates (kg/s), N*nGas
+  Dev<double> _dsolid;           ///< per particle: solid mass change in this sub-step (kg), N*nSolid
+  Dev<double> _q;                ///< per particle: Q_rxn (W)
+  Dev<double> _sens;             ///< per particle: ṁ_gas c_p,g (T_p − T_g) (W), Δm c_p T_p (J); N*2
+  Dual<double> _acc;             ///< (nCells+1)*W: Σ gas kg, Σ solid kg, Σ Q_rxn J, Σ gas sensible J, Σ Δm c T J
+  int _width = 0;                ///< W = nGas + nSolid + 3
+  bool _pending = false;         ///< a particle is below the removal diameter
+  ChemistryTotals _totals;
 };
 
 } // namespace coredem::dem

@@ -8,6 +8,7 @@
 
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
+#include "coredem/common/version.h"
 #include "coredem/dem/kernels/collision_time.h"
 #include "coredem/dem/kernels/damping.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
@@ -20,9 +21,6 @@
 #include <limits>
 #include <unordered_map>
 
-#ifndef COREDEM_VERSION
-#define COREDEM_VERSION "0.0.0"
-#endif
 
 namespace coredem::dem {
 
@@ -264,10 +262,14 @@ std::string hashConfig(const DemConfig& c) {
   t += "|opts:";
   num(c.neighbour.skinFactor), num(c.neighbour.historySlots), num(c.epsMinDrag), num(c.dtFactor);
   if (c.frozenMotion) t += "|frozen";  // absent otherwise: earlier hashes unchanged
+  if (c.drag != kernels::DragLaw::Gidaspow) {  // absent for the default law: earlier hashes unchanged
+    t += "|drag:";
+    num(static_cast<int>(c.drag));
+  }
   if (c.heat.enabled) {  // heat off keeps the hash of configurations without heat transfer
     const HeatOptions& h = c.heat;
     t += "|heat:";
-    for (double v : {double(h.convection), double(h.ranzMarshall), double(h.reynoldsWithVoidage),
+    for (double v : {double(h.convection), double(static_cast<int>(h.nusselt)), double(h.reynoldsWithVoidage),
                      h.voidageExponent, double(h.contactConduction), double(h.lensConduction),
                      h.lensFraction, h.minSeparation, h.lensRelTol, double(h.radiation)})
       num(v);
@@ -430,7 +432,8 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
     es.cellVolume = g.spacing[0] * g.spacing[1] * g.spacing[2];
   }
   es.nGasSpecies = static_cast<int>(config.gasSpecies.size());
-  es.epsMin = config.epsMinDrag;
+  es.drag.law = config.drag;
+  es.drag.gidaspow.epsMin = config.epsMinDrag;
   es.maxRadius = rmax;
   es.skin = config.neighbour.skinFactor * 2.0 * rmax;
   es.historySlots = config.neighbour.historySlots;
@@ -441,6 +444,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
     // Heat transfer (heat.h): the lens needs the neighbour list to reach FLPC·R_max further.
     const HeatOptions& h = config.heat;
     HeatSetup& hs = es.heat;
+    hs.options = h;
     hs.enabled = h.enabled;
     hs.convection = h.convection;
     hs.contactConduction = h.contactConduction;
@@ -451,7 +455,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
       anyEmissive = anyEmissive || mat.emissivity > 0;
     }
     hs.radiation = h.radiation && anyEmissive;
-    hs.convectionParams.model = h.ranzMarshall ? kernels::NusseltModel::RanzMarshall : kernels::NusseltModel::LiMason;
+    hs.convectionParams.model = h.nusselt;
     hs.convectionParams.voidageExponent = h.voidageExponent;
     hs.convectionParams.reynoldsWithVoidage = h.reynoldsWithVoidage;
     hs.convectionParams.epsMin = config.epsMinDrag;
@@ -537,14 +541,15 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
     m.time.add(dt);
     ++m.step;
   }
-  m.engine->endWindow(nSub, m.sources);
-  if (m.engine->takePendingRemoval()) {
+  m.engine->endWindow(dtCfd, nSub, m.sources);
+  if (m.engine->takeRemovalRequest()) {
     // Particles below removalFraction·d_p0: removed at the CFD-step boundary (host compaction).
     const auto t0 = std::chrono::steady_clock::now();
     HostState st = m.engine->state();
-    ChemistryTotals& totals = m.engine->chemistryTotals();
+    ChemistryTotals totals = m.engine->chemistryTotals();
     const double before = totals.removedMass();
     const std::size_t removed = removeSmallParticles(m.config.chemistry.removalFraction, st, totals);
+    m.engine->restoreChemistryTotals(totals);  // the removed mass joins the chemistry ledger
     if (removed > 0) {
       m.engine->setState(st);
       m.nParticles = st.n;
@@ -564,11 +569,12 @@ void DemSystem::writeState(const std::string& path) const {
   meta.step = m.step;
   meta.backend = m.engine->name();
   meta.configHash = m.hash;
-  meta.softwareVersion = std::string(COREDEM_VERSION);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
+  meta.softwareVersion = std::string(kVersion);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
   meta.protocolVersion = std::string("1");
-  meta.heatConvection = m.engine->heatTotals().convection;
-  meta.heatRadiation = m.engine->heatTotals().radiation;
-  meta.heatWall = m.engine->heatTotals().wall;
+  const HeatTotals heat = m.engine->heatTotals();
+  meta.heatConvection = heat.convection;
+  meta.heatRadiation = heat.radiation;
+  meta.heatWall = heat.wall;
   meta.hasChemistry = m.config.chemistry.active();
   meta.chemistry = m.engine->chemistryTotals();
   writeStateFile(path, m.engine->state(), meta);
@@ -606,8 +612,8 @@ void DemSystem::readState(const std::string& path) {
     m.engine = m.makeEngine();
   }
   m.engine->setState(st);
-  m.engine->heatTotals() = HeatTotals{meta.heatConvection, meta.heatRadiation, meta.heatWall};
-  if (meta.hasChemistry) m.engine->chemistryTotals() = meta.chemistry;
+  m.engine->restoreHeatTotals(HeatTotals{meta.heatConvection, meta.heatRadiation, meta.heatWall});
+  if (meta.hasChemistry) m.engine->restoreChemistryTotals(meta.chemistry);
   m.nParticles = st.n;
   m.dtMax = dtDemMaxFor(m.config, minMass);
   m.time.restore(meta.time, meta.timeCompensation);

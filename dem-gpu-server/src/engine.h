@@ -6,6 +6,7 @@
 #include "coredem/dem/dem_system.h"
 #include "heat_setup.h"
 #include "chemistry_setup.h"
+#include "coredem/dem/kernels/drag.h"
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_contact.h"
@@ -33,7 +34,7 @@ struct EngineSetup {
   double cellVolume = 0;
   std::size_t nCells = 0;
   int nGasSpecies = 0;
-  double epsMin = 0.35;
+  kernels::DragParams drag{};            ///< drag law and its parameters (kernels/drag.h)
   double skin = 0;                       ///< m
   double maxRadius = 0;                  ///< m
   int historySlots = 12;
@@ -83,20 +84,24 @@ public:
   virtual void beginWindow() = 0;
   /// One DEM sub-step of length dt (rebuild if needed, forces, sources, motion).
   virtual void subStep(double dt) = 0;
-  /// Sub-step-averaged sources after nSub sub-steps.
-  virtual void endWindow(int nSub, CellSources& out) = 0;
+  /// Sub-step-averaged sources after nSub sub-steps of dtCfd/nSub each.
+  virtual void endWindow(double dtCfd, int nSub, CellSources& out) = 0;
   virtual std::size_t pairContacts() = 0;
   virtual std::size_t wallContacts() = 0;
   virtual std::array<double, 3> wallForce() = 0;
   virtual std::size_t memoryBytes() const = 0;
   virtual StageTimes& times() = 0;
   virtual const char* name() const = 0;
-  /// Heat received by the particles since construction (heat.h); settable for restarts.
-  virtual HeatTotals& heatTotals() = 0;
-  /// Chemistry ledgers since construction (chemistry.h); settable for restarts.
-  virtual ChemistryTotals& chemistryTotals() = 0;
+  /// Heat received by the particles since construction (heat.h).
+  virtual HeatTotals heatTotals() const = 0;
+  /// Continues the heat ledger of a state file.
+  virtual void restoreHeatTotals(const HeatTotals& totals) = 0;
+  /// Chemistry ledgers since construction (chemistry.h).
+  virtual ChemistryTotals chemistryTotals() const = 0;
+  /// Continues the chemistry ledgers of a state file, or books removed particles.
+  virtual void restoreChemistryTotals(const ChemistryTotals& totals) = 0;
   /// True when a particle fell below the removal diameter since the last call (clears the flag).
-  virtual bool takePendingRemoval() = 0;
+  virtual bool takeRemovalRequest() = 0;
 };
 
 std::unique_ptr<Engine> makeCpuEngine(const EngineSetup& setup);

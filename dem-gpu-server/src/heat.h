@@ -24,10 +24,8 @@
 
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
-#include "engine.h"
-#include "gas_fields.h"
 #include "heat_setup.h"
-#include "particle_store.h"
+#include "step_module.h"
 
 #include "coredem/dem/kernels/conduction_contact.h"
 #include "coredem/dem/kernels/conduction_gas_lens.h"
@@ -46,6 +44,7 @@ namespace coredem::dem {
 /// Partial-sum slots of the wall heat (fixed count, so the sum order does not depend on threads).
 constexpr std::size_t kWallSlots = 64;
 
+/// Heat transfer of the particles: a StepModule (step_module.h) with the ledger HeatTotals.
 template <class Exec>
 class HeatModule {
 public:
@@ -53,20 +52,6 @@ public:
   using Dual = backend::DualArray<T, Exec>;
   template <class T>
   using Dev = backend::DeviceArray<T, Exec>;
-
-  HeatSetup _h;
-  Dual<HeatMaterial> _mat;
-  const GasFields<Exec>* _gas = nullptr;  ///< the engine's gas fields of the CFD step
-  bool _hasTg = false, _hasKappa = false, _hasCp = false;
-  Dev<double> _q, _g, _qrad;      ///< per particle: Q_i (W), G_i (W/K), Q_rad,i (W)
-  Dev<double> _cellT;             ///< per cell: Σ T_p (radiation environment)
-  Dev<double> _lensI;             ///< per neighbour slot: lens integral I (m), owner = smaller gid
-  Dual<double> _acc;              ///< per cell: Σ_sub H, Σ_sub H_Tp, Σ_sub Q_rad/V_c
-  Dual<ThermalWall> _walls;       ///< fixed-temperature walls
-  Dev<double> _qw;                ///< per particle: Q_wall,i (W)
-  Dual<double> _wallAcc;          ///< kWallSlots partial sums of Σ_sub Σ_i Q_wall,i Δt (J)
-  double _dt = 0.0;               ///< sub-step length of the current window
-  HeatTotals _totals;
 
   void setup(const HeatSetup& h, std::size_t nCells) {
     _h = h;
@@ -95,47 +80,55 @@ public:
 
   bool enabled() const { return _h.enabled; }
 
-  /// Uses the engine's gas fields (T_g, κ_g, c_p,g) from now on; `gas` outlives this module.
-  void setGas(const GasFields<Exec>& gas) {
-    _gas = &gas;
-    _hasTg = gas.has(gas.Tg);
-    _hasKappa = gas.has(gas.kappaG);
-    _hasCp = gas.has(gas.cpG);
-  }
-
   std::size_t bytes() const {
-    auto& s = const_cast<HeatModule&>(*this);
-    return s._mat.bytes() + _q.bytes() +
-           _g.bytes() + _qrad.bytes() + _cellT.bytes() + _lensI.bytes() + s._acc.bytes() +
-           s._walls.bytes() + _qw.bytes() + s._wallAcc.bytes();
+    return _mat.bytes() + _q.bytes() + _g.bytes() + _qrad.bytes() + _cellT.bytes() + _lensI.bytes() +
+           _acc.bytes() + _walls.bytes() + _qw.bytes() + _wallAcc.bytes();
   }
 
-  void beginWindow(Exec& exec, std::size_t nCells) {
+  /// Heat the particles received since construction (or the restored totals).
+  const HeatTotals& totals() const { return _totals; }
+  /// Continues the ledger of a state file.
+  void restoreTotals(const HeatTotals& t) { _totals = t; }
+
+  void beginWindow(StepContext<Exec>& ctx) {
+    const std::size_t nCells = ctx.setup.coupled ? ctx.setup.nCells : 0;
     if (!_h.enabled || nCells == 0) return;
     double* acc = _acc.d();
-    exec.parallelFor(3 * nCells, [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
+    ctx.exec.parallelFor(3 * nCells, [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
     _acc.markDeviceModified();
   }
 
-  /// Heat sources of one sub-step. `gasPresent`: the gas fields were set. When coupled, the
-  /// particles must be sorted by PCM cell (perm, cStart, cEnd, pcell) as deposit() leaves them.
+  /// Heat sources of one sub-step. When coupled, the particles are sorted by PCM cell
+  /// (ctx.cells) as the drag module leaves them.
   /// Reads pos, vel, radius, temperature, material, gid, nbCount, nbList; writes _q, _g, _qrad, _acc.
-  void sources(Exec& exec, ParticleStore<Exec>& p, const EngineSetup& s, bool gasPresent,
-               const std::uint32_t* pcell, const std::uint32_t* perm, const std::uint32_t* cStart,
-               const std::uint32_t* cEnd, const double* epsFrozen, const double* ug,
-               const double* rhoG, const double* muG, double dt) {
+  void sources(StepContext<Exec>& ctx) {
     if (!_h.enabled) return;
+    Exec& exec = ctx.exec;
+    ParticleStore<Exec>& p = ctx.particles;
+    const EngineSetup& s = ctx.setup;
+    const double dt = ctx.dt;
     const std::size_t n = p.n;
-    _dt = dt;
     _q.reserve(n);
     _g.reserve(n);
     _qrad.reserve(n);
-    const bool coupled = s.coupled && gasPresent;
-    const bool conv = coupled && _h.convection && _hasTg && _hasKappa && _hasCp;
-    const bool rad = coupled && _h.radiation && _hasTg;
-    const bool lens = coupled && _h.lensConduction && _hasKappa;
+    const GasFields<Exec>* gasFields = ctx.gas;  // nullptr: no gas fields or no coupling grid
+    const bool coupled = gasFields != nullptr;
+    const bool hasTg = coupled && gasFields->has(gasFields->Tg);
+    const bool hasKappa = coupled && gasFields->has(gasFields->kappaG);
+    const bool hasCp = coupled && gasFields->has(gasFields->cpG);
+    const bool conv = coupled && _h.convection && hasTg && hasKappa && hasCp;
+    const bool rad = coupled && _h.radiation && hasTg;
+    const bool lens = coupled && _h.lensConduction && hasKappa;
     const bool contact = _h.contactConduction;
     const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
+    const std::uint32_t* pcell = ctx.cells.pcell();
+    const std::uint32_t* perm = ctx.cells.perm();
+    const std::uint32_t* cStart = ctx.cells.cStart();
+    const std::uint32_t* cEnd = ctx.cells.cEnd();
+    const double* epsFrozen = s.coupled ? ctx.cells.epsFrozen() : nullptr;
+    const double* ug = coupled ? gasFields->ug.d() : nullptr;
+    const double* rhoG = coupled ? gasFields->rhoG.d() : nullptr;
+    const double* muG = coupled ? gasFields->muG.d() : nullptr;
 
     // 1. Σ T_p per cell (radiation environment, variant (a)).
     double* cellT = _cellT.d();
@@ -160,9 +153,9 @@ public:
     const std::int32_t* list = p.nbList.d();
     const int M = p.M;
     const HeatMaterial* hm = _mat.d();
-    const double* tg = _hasTg ? _gas->Tg.d() : nullptr;
-    const double* kap = _hasKappa ? _gas->kappaG.d() : nullptr;
-    const double* cpg = _hasCp ? _gas->cpG.d() : nullptr;
+    const double* tg = hasTg ? gasFields->Tg.d() : nullptr;
+    const double* kap = hasKappa ? gasFields->kappaG.d() : nullptr;
+    const double* cpg = hasCp ? gasFields->cpG.d() : nullptr;
     double* q = _q.d();
     double* gOut = _g.d();
     double* qr = _qrad.d();
@@ -174,7 +167,7 @@ public:
     const int nWalls = static_cast<int>(_h.walls.size());
     const ThermalWall* tw = nWalls > 0 ? _walls.d() : nullptr;
     const kernels::WallConductionParams wp = _h.wallParams;
-    const bool wallLens = wp.lens && coupled && _hasKappa;
+    const bool wallLens = wp.lens && coupled && hasKappa;
     // A wall is reached within R (contact) or (1 + FLPC) R (lens).
     const double wallReach = wallLens ? 1.0 + wp.lensFraction : 1.0;
     if (nWalls > 0) _qw.reserve(n);
@@ -314,7 +307,7 @@ public:
       _wallAcc.markDeviceModified();
     }
 
-    // 4. Cell sources (gather per cell in the PCM order of deposit()).
+    // 4. Cell sources (gather per cell in the PCM order the drag module sorted).
     if (s.coupled) {
       double* acc = _acc.d();
       const double invVc = 1.0 / s.cellVolume;
@@ -337,9 +330,13 @@ public:
     }
   }
 
-  /// T_i += Δt Q_i/(m_i c_p,i) (Eq. 18, explicit Euler). Reads _q, mass, material; writes temperature.
-  void updateTemperature(Exec& exec, ParticleStore<Exec>& p, double dt) {
+  /// After the motion update: T_i += Δt Q_i/(m_i c_p,i) (Eq. 18, explicit Euler).
+  /// Reads _q, mass, material; writes temperature.
+  void update(StepContext<Exec>& ctx) {
     if (!_h.enabled) return;
+    Exec& exec = ctx.exec;
+    ParticleStore<Exec>& p = ctx.particles;
+    const double dt = ctx.dt;
     const double* q = _q.d();
     const double* m = p.mass.d();
     const std::int32_t* mat = p.material.d();
@@ -352,8 +349,13 @@ public:
   }
 
   /// Averages the heat sources over nSub sub-steps into out.heatH / out.heatHTp (already sized)
-  /// and adds the window's energies to the totals (host).
-  void endWindow(int nSub, const EngineSetup& s, CellSources& out) {
+  /// and adds the window's energies to the totals (host). The heat from the gas is booked over
+  /// Δt_CFD, Σ_c (H T_g − H_Tp) V_c Δt_CFD, exactly as the CFD side books its loss, so that the
+  /// two ledgers cancel to round-off (balance.heat_residual_J).
+  void endWindow(WindowContext<Exec>& w) {
+    const EngineSetup& s = w.setup;
+    CellSources& out = w.out;
+    const int nSub = w.nSub;
     if (_h.enabled && !_h.walls.empty()) {
       _wallAcc.toHost();
       double wall = 0.0;
@@ -368,18 +370,31 @@ public:
     if (!_h.enabled || !s.coupled) return;
     _acc.toHost();
     const double* acc = _acc.h();
-    const double w = 1.0 / static_cast<double>(nSub);
-    const double window = _dt * nSub;
+    const double avg = 1.0 / static_cast<double>(nSub);
+    const double window = w.dtSub * nSub;
+    const double* tg = (w.gas != nullptr && w.gas->has(w.gas->Tg)) ? w.gas->Tg.h() : nullptr;
     double conv = 0.0, rad = 0.0;
     for (std::size_t c = 0; c < s.nCells; ++c) {
-      out.heatH[c] = acc[3 * c] * w;
-      out.heatHTp[c] = acc[3 * c + 1] * w;
-      if (_hasTg) conv += out.heatH[c] * _gas->Tg.h()[c] - out.heatHTp[c];
-      rad += acc[3 * c + 2] * w;
+      out.heatH[c] = acc[3 * c] * avg;
+      out.heatHTp[c] = acc[3 * c + 1] * avg;
+      if (tg != nullptr) conv += out.heatH[c] * tg[c] - out.heatHTp[c];
+      rad += acc[3 * c + 2] * avg;
     }
-    _totals.convection += conv * s.cellVolume * window;
+    _totals.convection += conv * s.cellVolume * w.dtCfd;
     _totals.radiation += rad * s.cellVolume * window;
   }
+
+private:
+  HeatSetup _h;
+  Dual<HeatMaterial> _mat;
+  Dev<double> _q, _g, _qrad;      ///< per particle: Q_i (W), G_i (W/K), Q_rad,i (W)
+  Dev<double> _cellT;             ///< per cell: Σ T_p (radiation environment)
+  Dev<double> _lensI;             ///< per neighbour slot: lens integral I (m), owner = smaller gid
+  Dual<double> _acc;              ///< per cell: Σ_sub H, Σ_sub H_Tp, Σ_sub Q_rad/V_c
+  Dual<ThermalWall> _walls;       ///< fixed-temperature walls
+  Dev<double> _qw;                ///< per particle: Q_wall,i (W)
+  Dual<double> _wallAcc;          ///< kWallSlots partial sums of Σ_sub Σ_i Q_wall,i Δt (J)
+  HeatTotals _totals;
 };
 
 } // namespace coredem::dem

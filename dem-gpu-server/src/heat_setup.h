@@ -2,6 +2,7 @@
 /// @file
 /// What the engine's heat module needs besides the particles (plain data, filled by DemSystem).
 
+#include "coredem/dem/heat_options.h"
 #include "coredem/dem/kernels/conduction_gas_lens.h"
 #include "coredem/dem/kernels/convection.h"
 #include "coredem/dem/kernels/wall_conduction.h"
@@ -26,6 +27,9 @@ struct ThermalWall {
 };
 
 struct HeatSetup {
+  /// The `models:` heat switches as configured. A new term reads its switch here; the flags
+  /// below are the switches combined with what the run has (coupling grid, emissive materials).
+  HeatOptions options;
   bool enabled = false;            ///< master switch; false: the heat module does nothing
   bool convection = false;         ///< Eqs. 19–21 (needs coupling and T_g, κ_g, c_p,g)
   bool contactConduction = false;  ///< Eqs. 22–23

@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <coredem/common/yaml_section.h>
+#include <coredem/dem/models.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/sha256.h>
@@ -550,11 +551,22 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
       top.fail(top.markOf("models"), "models",
                "expected a mapping name -> model, e.g. {drag: gidaspow}");
     }
+    std::vector<YAML::Mark> keyMarks, valueMarks;
     for (const auto& kv : m) {
       if (!kv.second.IsScalar()) {
         top.fail(kv.second.Mark(), "models." + kv.first.Scalar(), "expected a model name");
       }
       c.models.emplace_back(kv.first.Scalar(), kv.second.Scalar());
+      keyMarks.push_back(kv.first.Mark());
+      valueMarks.push_back(kv.second.Mark());
+    }
+    // The DEM server's model registry (coredem/dem/models.h): every key and value it would refuse
+    // or ignore fails here, before anything starts.
+    const std::vector<dem::ModelIssue> issues = dem::validateModels(c.models);
+    if (!issues.empty()) {
+      const dem::ModelIssue& bad = issues.front();
+      top.fail(bad.unknownKey ? keyMarks[bad.index] : valueMarks[bad.index], "models." + bad.key,
+               bad.message);
     }
   }
 

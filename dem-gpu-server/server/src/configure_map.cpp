@@ -2,9 +2,9 @@
 #include "configure_map.h"
 
 #include "coredem/common/check.h"
+#include "coredem/dem/models.h"
 
 #include <algorithm>
-#include <charconv>
 #include <map>
 
 namespace coredem::server {
@@ -12,15 +12,6 @@ namespace coredem::server {
 namespace {
 
 std::array<double, 3> vec(const v1::Vec3& v) { return {v.x(), v.y(), v.z()}; }
-
-double parseDouble(const std::string& key, const std::string& value) {
-  double v = 0.0;
-  const auto* end = value.data() + value.size();
-  const auto r = std::from_chars(value.data(), end, v);
-  COREDEM_CHECK(r.ec == std::errc() && r.ptr == end,
-                "Configure option '{}' = '{}' is not a number", key, value);
-  return v;
-}
 
 void addChemistry(const v1::Configure& c, dem::DemConfig& cfg) {
   dem::ChemistryOptions& o = cfg.chemistry;
@@ -217,27 +208,9 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   // Chemistry (v1.1): reactions, CLG models, removal, reaction heat (docs/thermochemistry.md).
   addChemistry(c, cfg);
 
-  // Model options by name.
+  // Model options by name (`models:` in case.yaml), through the model registry (models.h).
   for (const auto& kv : c.options()) {
-    if (kv.key() == "dem.dt_factor" || kv.key() == "dt_factor") {
-      cfg.dtFactor = parseDouble(kv.key(), kv.value());
-    } else if (kv.key() == "dem.eps_min_drag" || kv.key() == "eps_min_drag") {
-      cfg.epsMinDrag = parseDouble(kv.key(), kv.value());
-    } else if (kv.key() == "dem.skin_factor") {
-      cfg.neighbour.skinFactor = parseDouble(kv.key(), kv.value());
-    } else if (kv.key() == "dem.history_slots") {
-      cfg.neighbour.historySlots = static_cast<int>(parseDouble(kv.key(), kv.value()));
-    } else if (dem::setHeatOption(cfg.heat, kv.key(), kv.value())) {
-      // heat-transfer switch (docs/heat-coupling.md)
-    } else if (kv.key() == "motion") {
-      COREDEM_CHECK(kv.value() == "free" || kv.value() == "frozen",
-                    "Configure option motion = '{}': use free (default) or frozen (particles held "
-                    "in place, as in MFiX's verification cases)", kv.value());
-      cfg.frozenMotion = kv.value() == "frozen";
-    } else if (kv.key() == "drag") {
-      COREDEM_CHECK(kv.value() == "gidaspow", "Configure option drag = '{}': this server "
-                    "implements 'gidaspow' only", kv.value());
-    } else if (warnings != nullptr) {
+    if (!dem::applyModelOption(cfg, kv.key(), kv.value()) && warnings != nullptr) {
       warnings->push_back(kv.key());
     }
   }

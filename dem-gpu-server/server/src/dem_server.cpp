@@ -502,13 +502,9 @@ struct DemServer::Impl {
     xt.advance += std::chrono::duration<double>(tAdvanced - tGas).count();
     xt.particleSubSteps += static_cast<std::uint64_t>(system->particleCount()) * grant->nSub;
 
-    // Ledgers: what the particles took from / gave to the gas during this step.
+    // Ledgers: the species the particles gave to the gas during this step (the heat from the gas
+    // is the DEM core's HeatTotals::convection, booked there once).
     const auto n = static_cast<std::size_t>(cells);
-    double heat = 0.0;
-    for (std::size_t c = 0; c < n; ++c) {
-      heat += s->heatH[c] * view.Tg[c] - s->heatHTp[c];
-    }
-    ledgers.heatFromGas += heat * cellVolume * dt;
     for (std::size_t k = 0; k < species; ++k) {
       double sum = 0.0;
       for (std::size_t c = 0; c < n; ++c) {
@@ -606,10 +602,12 @@ struct DemServer::Impl {
     }
     proto::addNamedValue(l.mutable_mass(), "dem.particle_mass_kg", mass);
     proto::addNamedValue(l.mutable_energy(), "dem.kinetic_energy_J", kinetic);
-    proto::addNamedValue(l.mutable_energy(), "dem.heat_from_gas_J", ledgers.heatFromGas);
-    // Particle heat balance (docs/heat-coupling.md): Δ thermal energy = heat from gas + radiation.
-    proto::addNamedValue(l.mutable_energy(), "dem.heat_radiation_J", system->heatTotals().radiation);
-    proto::addNamedValue(l.mutable_energy(), "dem.heat_wall_J", system->heatTotals().wall);
+    // Particle heat balance (docs/heat-coupling.md): Δ thermal energy = heat from gas + radiation
+    // + walls, all from the DEM core's heat ledger (kept across restarts in the state file).
+    const dem::HeatTotals heat = system->heatTotals();
+    for (const dem::HeatLedgerEntry& e : dem::kHeatLedger) {
+      proto::addNamedValue(l.mutable_energy(), e.name, heat.*e.value);
+    }
     proto::addNamedValue(l.mutable_energy(), "dem.thermal_energy_J", system->thermalEnergy());
     for (std::size_t k = 0; k < speciesNames.size(); ++k) {
       proto::addNamedValue(l.mutable_species(), "dem.species_to_gas." + speciesNames[k] + "_kg",

@@ -7,13 +7,15 @@
 
 namespace coredem::server {
 
+/// The heat from the gas, ∫ Σ V_c (H T_g − H_Tp) dt, is the DEM core's HeatTotals::convection
+/// (/meta heat_convection_J); files of earlier versions also hold /server heat_from_gas_J, which
+/// is not read.
 struct ServerLedgers {
-  double heatFromGas = 0.0;          ///< J, ∫ Σ V_c (H T_g − H_Tp) dt
   std::vector<double> speciesToGas;  ///< kg per gas species, ∫ Σ V_c R_k dt
 };
 
-/// Adds /server (attributes step, session, heat_from_gas_J; dataset species_to_gas_kg) to an
-/// existing HDF5 file. Throws UserError on failure.
+/// Adds /server (attributes step, session; dataset species_to_gas_kg) to an existing HDF5 file.
+/// Throws UserError on failure.
 void writeServerLedgers(const std::string& path, const ServerLedgers& l, std::int64_t step,
                         const std::string& session);
 /// Reads /server if present (else zero ledgers of `species` entries).

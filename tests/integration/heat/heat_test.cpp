@@ -3,6 +3,7 @@
 #include "coredem/common/check.h"
 #include "coredem/dem/dem_system.h"
 #include "coredem/dem/kernels/drag_gidaspow.h"
+#include "coredem/dem/models.h"
 #include "coredem/dem/verification/analytic.h"
 
 #include <gtest/gtest.h>
@@ -124,8 +125,8 @@ TEST(HeatStep, GasLensPairFollowsTheAnalyticSolution) {
   cfg.grid.origin = {-0.01, -0.01, -0.01};
   cfg.grid.spacing = {0.02, 0.02, 0.02};
   cfg.grid.counts = {1, 1, 1};
-  ASSERT_TRUE(setHeatOption(cfg.heat, "convection", "off"));
-  ASSERT_TRUE(setHeatOption(cfg.heat, "lens_rel_tol", "1e-10"));
+  ASSERT_TRUE(applyModelOption(cfg, "convection", "off"));
+  ASSERT_TRUE(applyModelOption(cfg, "lens_rel_tol", "1e-10"));
   DemSystem sys(cfg, BackendKind::Cpu, 1);
   Gas(1, 300.0, 1.2, 1.8e-5, va::kMusserLensGasConductivity, 1000.0).apply(sys);
   const va::ExchangeCoefficients k = va::gasLensCoefficients(c);
@@ -225,8 +226,8 @@ TEST(HeatStep, CellHeatSourcesEqualTheParticlesConvectiveGain) {
   cfg.addBox({0, 0, 0}, {0.01, 0.01, 0.01});
   cfg.grid.spacing = {0.005, 0.005, 0.0025};
   cfg.grid.counts = {2, 2, 4};
-  ASSERT_TRUE(setHeatOption(cfg.heat, "contact_conduction", "off"));
-  ASSERT_TRUE(setHeatOption(cfg.heat, "lens_conduction", "off"));
+  ASSERT_TRUE(applyModelOption(cfg, "contact_conduction", "off"));
+  ASSERT_TRUE(applyModelOption(cfg, "lens_conduction", "off"));
   DemSystem sys(cfg, BackendKind::Cpu, 2);
   Gas gas(sys.cellCount(), 600.0, 0.588, 3e-5, 0.046, 1051.0);
   for (std::size_t c = 0; c < sys.cellCount(); ++c) {
@@ -268,7 +269,7 @@ TEST(HeatStep, RadiationOfTwoParticlesFollowsTheRk4Reference) {
   cfg.grid.origin = {0.0175, 0.0295, -0.0018};
   cfg.grid.spacing = {0.015, 0.010, 0.0036};
   cfg.grid.counts = {1, 1, 1};
-  ASSERT_TRUE(setHeatOption(cfg.heat, "convection", "off"));
+  ASSERT_TRUE(applyModelOption(cfg, "convection", "off"));
   DemSystem sys(cfg, BackendKind::Cpu, 1);
   Gas(1, rc.tG, 1.2, 1.8e-5, 0.05, 1000.0).apply(sys);
   std::vector<double> times;
@@ -403,7 +404,7 @@ TEST(HeatStep, RestartFromHdf5IsBitwiseWithHeatOn) {
 
 TEST(HeatStep, HeatOffKeepsTemperaturesAndSendsNoHeat) {
   DemConfig cfg = heatedBed();
-  ASSERT_TRUE(setHeatOption(cfg.heat, "heat", "off"));
+  ASSERT_TRUE(applyModelOption(cfg, "heat", "off"));
   DemSystem sys(cfg, BackendKind::Cpu, 1);
   Gas(sys.cellCount(), 600.0, 0.588, 3e-5, 0.046, 1051.0).apply(sys);
   const CellSources& s = sys.advance(1e-3, static_cast<int>(std::ceil(1e-3 / sys.dtDemMax())));
@@ -412,22 +413,27 @@ TEST(HeatStep, HeatOffKeepsTemperaturesAndSendsNoHeat) {
 }
 
 TEST(HeatOptions, ParseAndRejectWithAClearMessage) {
-  HeatOptions o;
-  EXPECT_TRUE(setHeatOption(o, "convection", "ranz-marshall"));
-  EXPECT_TRUE(o.ranzMarshall);
-  EXPECT_TRUE(setHeatOption(o, "s_min", "4e-10"));
-  EXPECT_EQ(o.minSeparation, 4e-10);
-  EXPECT_TRUE(setHeatOption(o, "flpc", "0.25"));
-  EXPECT_FALSE(setHeatOption(o, "drag", "gidaspow"));
+  // The heat keys of `models:` go through the model registry (coredem/dem/models.h).
+  DemConfig o;
+  EXPECT_TRUE(applyModelOption(o, "convection", "ranz-marshall"));
+  EXPECT_EQ(o.heat.nusselt, kernels::NusseltModel::RanzMarshall);
+  EXPECT_TRUE(applyModelOption(o, "s_min", "4e-10"));
+  EXPECT_EQ(o.heat.minSeparation, 4e-10);
+  EXPECT_TRUE(applyModelOption(o, "flpc", "0.25"));
+  // drag is a model key of its own family, not a heat option.
+  ASSERT_NE(findModelOption("drag"), nullptr);
+  EXPECT_EQ(findModelOption("drag")->family, "drag");
   try {
-    setHeatOption(o, "convection", "nusselt-magic");
+    applyModelOption(o, "convection", "nusselt-magic");
     FAIL() << "no error";
   } catch (const coredem::UserError& e) {
     EXPECT_NE(std::string(e.what()).find("ranz-marshall"), std::string::npos) << e.what();
   }
-  EXPECT_THROW(setHeatOption(o, "s_min", "-1"), coredem::UserError);
-  EXPECT_THROW(setHeatOption(o, "heat", "maybe"), coredem::UserError);
-  EXPECT_THROW(setHeatOption(o, "radiation_environment", "neighbour-mean"), coredem::UserError);
+  EXPECT_THROW(applyModelOption(o, "s_min", "-1"), coredem::UserError);
+  EXPECT_THROW(applyModelOption(o, "heat", "maybe"), coredem::UserError);
+  // The neighbour-mean radiation environment is not offered: its key is refused by validation.
+  const std::vector<std::pair<std::string, std::string>> bad = {{"radiation_environment", "neighbour-mean"}};
+  EXPECT_EQ(validateModels(bad).size(), 1u);
 }
 
 // The 1-vs-2-thread and restart cases run two OpenMP threads on a machine shared with other

@@ -3,6 +3,7 @@
 // temperature at the rate the kernel predicts, the wall heat is booked in HeatTotals::wall, and
 // adiabatic walls transfer nothing. Real DemSystem runs on the cpu backend.
 #include "coredem/dem/dem_system.h"
+#include "coredem/dem/models.h"
 #include "coredem/dem/kernels/wall_conduction.h"
 
 #include <gtest/gtest.h>
@@ -105,8 +106,8 @@ TEST(WallHeat, AdiabaticWallsTransferNothing) {
   for (int variant = 0; variant < 2; ++variant) {
     DemConfig cfg = bead(variant == 0 ? 0.0 : kTw);
     if (variant == 1) {
-      ASSERT_TRUE(setHeatOption(cfg.heat, "wall_conduction", "off"));
-      ASSERT_TRUE(setHeatOption(cfg.heat, "wall_lens_conduction", "off"));
+      ASSERT_TRUE(applyModelOption(cfg, "wall_conduction", "off"));
+      ASSERT_TRUE(applyModelOption(cfg, "wall_lens_conduction", "off"));
     }
     DemSystem sys(cfg, BackendKind::Cpu, 1);
     sys.advance(0.1, 1000);
@@ -123,8 +124,8 @@ TEST(WallHeat, CoupledWallLensAddsToContact) {
   cfg.grid.origin = {0, 0, 0};
   cfg.grid.spacing = {1e-2, 1e-2, 1e-2};
   cfg.grid.counts = {1, 1, 1};
-  ASSERT_TRUE(setHeatOption(cfg.heat, "convection", "off"));
-  ASSERT_TRUE(setHeatOption(cfg.heat, "lens_conduction", "off"));
+  ASSERT_TRUE(applyModelOption(cfg, "convection", "off"));
+  ASSERT_TRUE(applyModelOption(cfg, "lens_conduction", "off"));
   DemSystem sys(cfg, BackendKind::Cpu, 1);
   const double kg = 0.0257;
   std::vector<double> u(3, 0.0), gp(3, 0.0), tg(1, kT0), rho(1, 1.204), mu(1, 1.81e-5),

@@ -130,3 +130,37 @@ TEST(CaseConfig, AdaptiveBounds) {
   const std::string e = errorOf(replace(good, "dt_min: 1.0e-5", "dt_min: 1.0e-2"));
   EXPECT_NE(e.find("need dt_min <= dt_max"), std::string::npos) << e;
 }
+
+// `models:` is checked with the DEM server's model registry (coredem/dem/models.h): a misspelled
+// key or a bad value fails `coredem check` with file:line:col, the key and the allowed ones.
+TEST(CaseConfig, ModelsMisspelledKeyNamesLineAndAllowedKeys) {
+  const std::string text = std::string(kGood) + "models:\n  motion: frozen\n  convecton: li-mason\n";
+  const std::string e = errorOf(text);
+  EXPECT_NE(e.find("cases/x/case.yaml:23:3: models.convecton: unknown model key (did you mean "
+                   "'convection'?); allowed keys: drag, "),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("lens_conduction"), std::string::npos) << e;
+}
+
+TEST(CaseConfig, ModelsBadValueNamesLineAndAllowedValues) {
+  const std::string text = std::string(kGood) + "models: {convection: li-masn}\n";
+  const std::string e = errorOf(text);
+  EXPECT_NE(e.find("cases/x/case.yaml:21:22: models.convection: 'li-masn' is not allowed (did "
+                   "you mean 'li-mason'?); allowed: li-mason, ranz-marshall or off"),
+            std::string::npos)
+      << e;
+  const std::string d = errorOf(std::string(kGood) + "models:\n  drag: wen-yu\n");
+  EXPECT_NE(d.find("case.yaml:22:9: models.drag: 'wen-yu' is not allowed; allowed: gidaspow"),
+            std::string::npos)
+      << d;
+  const std::string n = errorOf(std::string(kGood) + "models:\n  flpc: 2\n");
+  EXPECT_NE(n.find("models.flpc: '2' is not allowed; expected a number in [0, 1]"), std::string::npos) << n;
+}
+
+TEST(CaseConfig, ModelsValidPass) {
+  const std::string text = std::string(kGood) +
+                           "models: {motion: frozen, convection: \"off\", radiation: \"off\", "
+                           "lens_conduction: \"off\", s_min: 1e-06, dem.history_slots: 16}\n";
+  EXPECT_EQ(errorOf(text), "");
+}

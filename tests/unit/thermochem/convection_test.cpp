@@ -139,12 +139,3 @@ TEST(Convection, CellSourceSplitReproducesParticleSum) {
   // Tolerance: the split form subtracts two sums of ~20 terms of size ~G·T/V; 1e-12 of those.
   EXPECT_NEAR(k::cellConvectionHeat(cell, g.T), sumQ / vCell, 1e-12 * cell.H * g.T);
 }
-
-// Case-file names of the model enums: one per enumerator, in enum order (the server maps
-// `models:` strings through these tables).
-TEST(ModelNames, TablesMatchEnums) {
-  EXPECT_STREQ(k::kNusseltModelNames[static_cast<int>(k::NusseltModel::LiMason)], "li_mason");
-  EXPECT_STREQ(k::kNusseltModelNames[static_cast<int>(k::NusseltModel::RanzMarshall)],
-               "ranz_marshall");
-  EXPECT_EQ(std::size(k::kNusseltModelNames), 2u);
-}

@@ -92,13 +92,3 @@ TEST(Radiation, Rk4RejectsBadInput) {
   const std::vector<double> one = {1.0};
   EXPECT_THROW(v::radiationReferenceRK4(v::mfixRadiationCase(), one, 0.0), coredem::UserError);
 }
-
-TEST(ModelNames, RadiationEnvironmentNames) {
-  EXPECT_STREQ(k::kRadiationEnvironmentNames[static_cast<int>(
-                   k::RadiationEnvironment::CellMeanIncludingSelf)],
-               "cell_mean");
-  EXPECT_STREQ(k::kRadiationEnvironmentNames[static_cast<int>(
-                   k::RadiationEnvironment::NeighbourMeanExcludingSelf)],
-               "neighbour_mean");
-  EXPECT_EQ(std::size(k::kRadiationEnvironmentNames), 2u);
-}

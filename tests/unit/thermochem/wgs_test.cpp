@@ -114,11 +114,3 @@ TEST(Wgs, SourcesHeatAndLimiter) {
   off.enabled = false;
   EXPECT_EQ(k::wgsCellSources(off, t, 0.8, 0.3, y).omega, 0.0);
 }
-
-TEST(ModelNames, WgsEquilibriumNames) {
-  EXPECT_STREQ(k::kWgsEquilibriumNames[static_cast<int>(k::WgsEquilibrium::YoonDenn)], "yoon_denn");
-  EXPECT_STREQ(k::kWgsEquilibriumNames[static_cast<int>(k::WgsEquilibrium::Seed)], "seed");
-  EXPECT_STREQ(k::kWgsEquilibriumNames[static_cast<int>(k::WgsEquilibrium::Thermodynamic)],
-               "thermodynamic");
-  EXPECT_EQ(std::size(k::kWgsEquilibriumNames), 3u);
-}

@@ -16,6 +16,7 @@
 
 #include "coredem/dem/chemistry_options.h"
 #include "coredem/dem/heat_options.h"
+#include "coredem/dem/kernels/drag.h"
 
 #include <array>
 #include <cstddef>
@@ -105,15 +106,19 @@ struct Species {
   double molarMass = 0.0;
 };
 
+/// Largest NeighbourOptions::historySlots (local arrays in the contact kernel).
+inline constexpr int kMaxHistorySlots = 32;
+
 /// Tuning of neighbour search and contact storage (defaults from bench measurements,
 /// docs/performance.md "## DEM core").
 struct NeighbourOptions {
   double skinFactor = 0.1;       ///< Verlet skin = skinFactor · d_max; lists rebuilt when a particle moved > skin/2
-  int historySlots = 12;         ///< tangential-history slots per particle (contacts incl. walls)
+  int historySlots = 12;         ///< tangential-history slots per particle (contacts incl. walls), 1..kMaxHistorySlots
   int initialNeighbourSlots = 16;///< neighbour-list width per particle (grows automatically)
 };
 
-/// Everything needed to build a DemSystem. Plain data; validated by the constructor.
+/// Everything needed to build a DemSystem. Plain data; validated by the constructor. The
+/// `models:` keys of a case (Configure.options) are applied by applyModelOption (models.h).
 struct DemConfig {
   std::vector<Material> materials{Material{}};
   std::vector<ParticleSet> particleSets;
@@ -123,6 +128,7 @@ struct DemConfig {
   std::vector<Species> solidSpecies;   ///< per-particle composition entries
   std::vector<Species> gasSpecies;     ///< Y_g and R_species entries
   NeighbourOptions neighbour;
+  kernels::DragLaw drag = kernels::DragLaw::Gidaspow;  ///< `models: {drag: ...}` (kernels/drag.h)
   double epsMinDrag = 0.35;            ///< ε_min clip in drag (PHYSICS §1.1 [C])
   double dtFactor = 50.0;              ///< Δt_DEM,max = t_col,min / dtFactor (PHYSICS Eq. 12)
   HeatOptions heat;                    ///< particle heat transfer (docs/heat-coupling.md)
@@ -185,8 +191,8 @@ struct ParticleData {
 struct StageTimes {
   double neighbour = 0;  ///< cell keys, sort, reorder, neighbour lists
   double contact = 0;    ///< particle–particle and wall contact forces
-  double drag = 0;       ///< gas forces: PCM cell, Gidaspow drag, −V_p∇p (coupled runs only)
-  double integrate = 0;  ///< motion update
+  double drag = 0;       ///< gas forces: PCM cell, drag law, −V_p∇p (coupled runs only)
+  double integrate = 0;  ///< motion update and temperature updates
   double coupling = 0;   ///< PCM ε_g and cell-source deposition
   double heat = 0;       ///< heat sources (conduction, convection, radiation) and their deposition
   double chemistry = 0;  ///< reaction rates, mass/diameter update, species deposition, WGS, removal

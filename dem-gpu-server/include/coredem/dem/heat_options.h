@@ -1,10 +1,10 @@
 #pragma once
 /// @file
-/// Model switches of the particle heat transfer integrated in the DEM step (PHYSICS §3,
-/// docs/heat-coupling.md). Plain data; set from `Configure.options` (case.yaml `models:`)
-/// through setHeatOption().
+/// Model switches of the particle heat transfer integrated in the DEM step (docs/heat-coupling.md).
+/// Plain data; set from `Configure.options` (case.yaml `models:`) through the model registry
+/// (coredem/dem/models.h, applyModelOption).
 
-#include <string>
+#include "coredem/dem/kernels/convection.h"
 
 namespace coredem::dem {
 
@@ -13,7 +13,7 @@ namespace coredem::dem {
 struct HeatOptions {
   bool enabled = true;              ///< `heat: on|off` — off: temperatures stay constant, H = H_Tp = 0
   bool convection = true;           ///< particle–gas convection (Eqs. 19–21); needs T_g, κ_g, c_p,g
-  bool ranzMarshall = false;        ///< `convection: li-mason|ranz-marshall` (default Li–Mason)
+  kernels::NusseltModel nusselt = kernels::NusseltModel::LiMason;  ///< `convection: li-mason|ranz-marshall`
   bool reynoldsWithVoidage = true;  ///< `convection_reynolds: with-voidage|without-voidage`
   double voidageExponent = 3.5;     ///< `nusselt_exponent`: n of ε^n in Li–Mason (Eq. 21)
   bool contactConduction = true;    ///< `contact_conduction: on|off` (Eqs. 22–23)
@@ -26,14 +26,6 @@ struct HeatOptions {
   bool wallLensConduction = true;   ///< `wall_lens_conduction: on|off`: gas-lens conduction to them (needs κ_g)
 };
 
-/// Applies one `Configure.options` entry if it is a heat option. Returns false when `key` is not
-/// a heat option (the caller handles or ignores it); throws coredem::UserError when the key is a
-/// heat option but the value is not allowed (the message lists the allowed values).
-/// Keys: heat, convection, convection_reynolds, nusselt_exponent, contact_conduction,
-/// lens_conduction, flpc, s_min, lens_rel_tol, radiation, radiation_environment, wall_conduction,
-/// wall_lens_conduction.
-bool setHeatOption(HeatOptions& options, const std::string& key, const std::string& value);
-
 /// Heat the particles received since the system was built (or restarted from a state file
 /// written by it), J. Conduction between particles moves heat between particles only and is
 /// not listed; conduction from fixed-temperature walls is (`wall`).
@@ -41,6 +33,19 @@ struct HeatTotals {
   double convection = 0.0;  ///< from the gas (Σ_c (H T_g − H_Tp) V_c Δt), the gas loses the same
   double radiation = 0.0;   ///< from the radiative environment (Eq. 27)
   double wall = 0.0;        ///< from fixed-temperature walls (kernels/wall_conduction.h)
+};
+
+/// One entry of the heat ledger as the DEM server reports it (StepDone ledger, energy, J).
+struct HeatLedgerEntry {
+  const char* name;             ///< ledger name, e.g. "dem.heat_from_gas_J"
+  double HeatTotals::*value;    ///< the total it reports
+};
+
+/// The heat ledger in report order: a new HeatTotals field is reported by adding its row here.
+inline constexpr HeatLedgerEntry kHeatLedger[] = {
+    {"dem.heat_from_gas_J", &HeatTotals::convection},
+    {"dem.heat_radiation_J", &HeatTotals::radiation},
+    {"dem.heat_wall_J", &HeatTotals::wall},
 };
 
 } // namespace coredem::dem

@@ -26,9 +26,8 @@
 
 namespace coredem::dem::kernels {
 
+/// Nusselt correlations; case-file names in the registry (coredem/dem/models.h, nusseltModels()).
 enum class NusseltModel : int { LiMason = 0, RanzMarshall = 1 };
-/// Case-file names of NusseltModel (index = enum value), e.g. `models: {nusselt: li_mason}`.
-inline constexpr const char* kNusseltModelNames[] = {"li_mason", "ranz_marshall"};
 
 struct ConvectionParams {
   NusseltModel model = NusseltModel::LiMason;

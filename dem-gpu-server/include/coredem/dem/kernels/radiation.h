@@ -6,11 +6,12 @@
 ///   (27) Q_rad,i = e_p,i σ A_p,i (T_env,i⁴ − T_p,i⁴),   A_p,i = π d_p,i²       W, into i
 ///   (28) T_env,i = ε_g,Ω T_g,Ω + (1 − ε_g,Ω) T̄_p,Ω
 ///
-/// Two definitions of T̄_p,Ω (switch, PHYSICS §3.4 [C]):
-///  (a) CellMeanIncludingSelf (default, MFiX `des_thermo_rad.f`): arithmetic mean of all
-///      particles whose centroid is in the CFD cell of i, including i.
-///  (b) NeighbourMeanExcludingSelf (Zhou/Kratos, literal seed Eq. 28): mean over the
-///      neighbours j ≠ i within neighbourRadiusFactor·d_p,i of i; T_env = T_g if none.
+/// Two definitions of T̄_p,Ω (PHYSICS §3.4):
+///  (a) CellMeanIncludingSelf (MFiX `des_thermo_rad.f`): arithmetic mean of all particles whose
+///      centroid is in the CFD cell of i, including i. The DEM step uses this one (heat.h).
+///  (b) NeighbourMeanExcludingSelf (Zhou/Kratos, literal seed Eq. 28): mean over the neighbours
+///      j ≠ i within 1.5 d_p,i of i; T_env = T_g if none. Used by the verification solutions
+///      (verification/analytic.h) only; the DEM step does not offer it.
 /// The caller accumulates the sum and the count of the chosen set; the kernels below turn
 /// them into T_env and Q_rad.
 
@@ -26,13 +27,6 @@ inline constexpr double kStefanBoltzmann = 5.670374419e-8;
 enum class RadiationEnvironment : int {
   CellMeanIncludingSelf = 0,     ///< (a) MFiX
   NeighbourMeanExcludingSelf = 1 ///< (b) Zhou / Kratos
-};
-/// Case-file names of RadiationEnvironment (index = enum value).
-inline constexpr const char* kRadiationEnvironmentNames[] = {"cell_mean", "neighbour_mean"};
-
-struct RadiationParams {
-  RadiationEnvironment environment = RadiationEnvironment::CellMeanIncludingSelf;
-  double neighbourRadiusFactor = 1.5; ///< (b): search radius / d_p,i [K] Zhou 2009
 };
 
 /// T_env (Eq. 28), K. sumTp/count: sum and number of the particle temperatures of the set

@@ -25,10 +25,8 @@ namespace coredem::dem::kernels {
 inline constexpr int kMaxReactionTerms = 6;
 
 enum class ReactionPhase : int { Gas = 0, Solid = 1 };
+/// Rate laws; case-file names in the registry (coredem/dem/models.h, rateLawModels()).
 enum class RateLaw : int { Constant = 0, Arrhenius = 1 };
-/// Case-file names of ReactionPhase and RateLaw (index = enum value).
-inline constexpr const char* kReactionPhaseNames[] = {"gas", "solid"};
-inline constexpr const char* kRateLawNames[] = {"constant", "arrhenius"};
 
 struct HeterogeneousReaction {
   int n = 0;                                   ///< number of terms

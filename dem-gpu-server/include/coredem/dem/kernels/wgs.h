@@ -20,9 +20,8 @@
 
 namespace coredem::dem::kernels {
 
+/// K_eq choices; case-file names in the registry (coredem/dem/models.h, wgsEquilibriumModels()).
 enum class WgsEquilibrium : int { YoonDenn = 0, Seed = 1, Thermodynamic = 2 };
-/// Case-file names of WgsEquilibrium (index = enum value).
-inline constexpr const char* kWgsEquilibriumNames[] = {"yoon_denn", "seed", "thermodynamic"};
 
 struct WgsParams {
   double kf0 = 2.78e-3;    ///< m³/(mol s)

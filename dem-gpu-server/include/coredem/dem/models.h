@@ -1,0 +1,122 @@
+#pragma once
+/// @file
+/// Model registries of the DEM server: one table per model family, and the table of the keys of
+/// case.yaml `models:` (= `Configure.options`) that select and parametrise them.
+///
+/// A family registry lists {name, enum value, one-line doc}; the kernels dispatch on the enum
+/// (e.g. kernels/drag.h on kernels::DragLaw). A `models:` key row holds the key, the family it
+/// belongs to, the allowed values and the default as users read them, a one-line doc and the
+/// parser that checks a value and stores it in a DemConfig. The DEM server applies `models:`
+/// with applyModelOption(); `coredem check` / `coredem run` validate the whole mapping with
+/// validateModels() before anything starts: the same rows, the same parsers, the same messages.
+///
+/// This library (target coredem::dem_models) needs neither CUDA nor the protocol nor the engine:
+/// only the plain-data headers dem_system.h and the kernels' enums.
+///
+/// Adding a drag law: its kernel header, an enumerator + case in kernels/drag.h, one row in
+/// dragModels() (models.cpp), its test (docs/architecture-models.md).
+
+#include <cstddef>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "coredem/dem/kernels/convection.h"
+#include "coredem/dem/kernels/drag.h"
+#include "coredem/dem/kernels/reaction_generic.h"
+#include "coredem/dem/kernels/wgs.h"
+
+namespace coredem::dem {
+
+struct DemConfig;
+
+/// `models: {motion: ...}`.
+enum class MotionModel : int {
+  Free = 0,  ///< forces move the particles (default)
+  Frozen = 1 ///< held in place, velocities zeroed every sub-step (DemConfig::frozenMotion)
+};
+
+/// `models: {convection_reynolds: ...}`: the Reynolds number of the Nusselt correlation.
+enum class ReynoldsDefinition : int {
+  WithVoidage = 0,   ///< Re = ε ρ_g d |Δu|/μ_g, as the drag (default)
+  WithoutVoidage = 1 ///< Re = ρ_g d |Δu|/μ_g (Kratos form)
+};
+
+/// One model of a family.
+template <class E>
+struct ModelEntry {
+  std::string_view name; ///< as written in case.yaml; '_' and '-' are interchangeable on input
+  E value;               ///< what the kernels dispatch on
+  std::string_view doc;  ///< one line
+};
+
+/// The registry of one model family: its models in enum order.
+template <class E>
+struct ModelFamily {
+  std::string_view name;                  ///< family name, e.g. "drag"
+  std::span<const ModelEntry<E>> entries; ///< every model of the family
+
+  /// The entry called `model` ('_' and '-' alike), or nullptr.
+  const ModelEntry<E>* find(std::string_view model) const;
+  /// The name of `value` ("?" if it has no entry).
+  std::string_view nameOf(E value) const;
+  /// The names, for messages: "a, b or c".
+  std::string allowed() const;
+};
+
+/// Drag laws (kernels/drag.h).
+const ModelFamily<kernels::DragLaw>& dragModels();
+/// Nusselt correlations of the particle–gas convection (kernels/convection.h).
+const ModelFamily<kernels::NusseltModel>& nusseltModels();
+/// Reynolds number definitions of the Nusselt correlations.
+const ModelFamily<ReynoldsDefinition>& reynoldsModels();
+/// Particle motion.
+const ModelFamily<MotionModel>& motionModels();
+/// Heterogeneous kinetics: rate laws of data-defined reactions (kernels/reaction_generic.h).
+const ModelFamily<kernels::RateLaw>& rateLawModels();
+/// Water–gas-shift equilibrium constants (kernels/wgs.h; case.yaml chemistry.clg.wgs_equilibrium).
+const ModelFamily<kernels::WgsEquilibrium>& wgsEquilibriumModels();
+
+/// One key of `models:`.
+struct ModelOption {
+  std::string key;          ///< e.g. "convection"
+  std::string family;       ///< drag, heat, convection, conduction, radiation, motion, numerics
+  std::string values;       ///< allowed values as users read them, from the family registry
+  std::string defaultValue; ///< as written in case.yaml
+  std::string doc;          ///< one line
+  /// Checks `value` and stores it in `config`. Returns "" when it is allowed, else what is wrong
+  /// with it and the allowed values (and a "did you mean" when a close value exists).
+  std::string (*apply)(DemConfig& config, std::string_view value) = nullptr;
+};
+
+/// Every `models:` key, in documentation order.
+std::span<const ModelOption> modelOptions();
+/// The row of `key`, or nullptr.
+const ModelOption* findModelOption(std::string_view key);
+
+/// Applies one `models:` entry to `config`. Returns false when `key` is not a model key (the
+/// server warns and ignores it); throws coredem::UserError naming the key, the value and the
+/// allowed values when the value is not allowed.
+bool applyModelOption(DemConfig& config, std::string_view key, std::string_view value);
+
+/// A bad entry of a `models:` mapping.
+struct ModelIssue {
+  std::size_t index = 0;   ///< position in the mapping given to validateModels
+  std::string key;         ///< the key as written
+  bool unknownKey = false; ///< true: the key is wrong; false: the value is
+  std::string message;     ///< what is wrong and what is allowed (without the key itself)
+};
+
+/// Validates a whole `models:` mapping (key, value pairs in file order) with the registry the
+/// DEM server uses. Returns one issue per bad entry (none: the mapping is valid): an unknown key
+/// lists the allowed keys, a bad value the allowed values, each with a "did you mean" when a
+/// close one exists.
+std::vector<ModelIssue> validateModels(std::span<const std::pair<std::string, std::string>> models);
+
+/// The closest of `candidates` to `word` when it is a plausible typo of it (edit distance at most
+/// max(1, |word|/3), '_' and '-' alike), else "".
+std::string didYouMean(std::string_view word, std::span<const std::string_view> candidates);
+
+} // namespace coredem::dem

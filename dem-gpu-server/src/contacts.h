@@ -1,0 +1,228 @@
+#pragma once
+/// @file
+/// Particle–particle and particle–wall contact forces in the DEM sub-step (PHYSICS §2.1, LSD with
+/// tangential history), written once for every backend like engine_impl.h. Every particle
+/// gathers its own contacts over its full neighbour list (no atomics), keeps its tangential
+/// history in K slots (partner gid, −(w+2) for wall w) and adds the contact forces to the gas
+/// force the drag module wrote (coupled runs).
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "backend/arrays.h"
+#include "backend/exec_common.h"
+#include "coredem/dem/kernels/damping.h"
+#include "coredem/dem/kernels/lsd_contact.h"
+#include "coredem/dem/kernels/vec3.h"
+#include "coredem/dem/kernels/wall_contact.h"
+#include "step_module.h"
+
+namespace coredem::dem {
+
+/// The contact module has no ledger (counts and wall forces are read from the particles).
+struct ContactTotals {};
+
+template <class Exec>
+class ContactModule {
+public:
+  template <class T>
+  using Dual = backend::DualArray<T, Exec>;
+
+  void setup(const EngineSetup& s) {
+    _pairs.allocate(s.pairs.size());
+    for (std::size_t k = 0; k < s.pairs.size(); ++k)
+      _pairs.h()[k] = s.pairs[k];
+    _pairs.markHostModified();
+    _pairs.toDevice();
+    _walls.allocate(s.walls.size());
+    for (std::size_t k = 0; k < s.walls.size(); ++k)
+      _walls.h()[k] = s.walls[k];
+    _walls.markHostModified();
+    _walls.toDevice();
+  }
+
+  bool enabled() const { return true; }
+  std::size_t bytes() const { return _pairs.bytes() + _walls.bytes(); }
+  ContactTotals totals() const { return {}; }
+
+  /// History slots in use in some row (slots at or beyond it are empty everywhere); the
+  /// neighbour rebuild moves only these.
+  int usedSlots() const { return _maxUsedSlots; }
+  /// After new particles: every slot may be in use.
+  void resetUsedSlots(int slots) { _maxUsedSlots = slots; }
+
+  void beginWindow(StepContext<Exec>&) {}
+  void update(StepContext<Exec>&) {}
+  void endWindow(WindowContext<Exec>&) {}
+
+  /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, nbCount, nbList
+  /// (+ the gas force of the drag module in coupled runs); writes force, torque, fwall, histKey,
+  /// histDisp, contacts, wallContacts.
+  void sources(StepContext<Exec>& ctx) {
+    ParticleStore<Exec>& p = ctx.particles;
+    const double dt = ctx.dt;
+    const std::size_t n = p.n;
+    const double* x = p.pos.d();
+    const double* v = p.vel.d();
+    const double* w = p.omega.d();
+    const double* r = p.radius.d();
+    const double* m = p.mass.d();
+    const std::int32_t* mat = p.material.d();
+    const std::int64_t* gid = p.gid.d();
+    std::int64_t* hk = p.histKey.d();
+    double* hd = p.histDisp.d();
+    const std::int32_t* cnt = p.nbCount.d();
+    const std::int32_t* list = p.nbList.d();
+    double* f = p.force.d();
+    double* tq = p.torque.d();
+    double* fw = p.fwall.d();
+    std::int32_t* nc = p.contacts.d();
+    std::int32_t* nwc = p.wallContacts.d();
+    const PairProps* pairs = _pairs.d();
+    const kernels::PlaneWall* walls = _walls.d();
+    const int nWalls = static_cast<int>(ctx.setup.walls.size());
+    const int nMat = ctx.setup.nMaterials;
+    const int K = p.K;
+    const int M = p.M;
+    const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
+
+    // reduceMax runs the kernel body once per index (side effects on index i only) and
+    // returns the largest number of contacts of a particle, in the same pass.
+    const double maxSlots = ctx.exec.reduceMax(
+        n,
+        [=] DEM_LAMBDA(std::size_t i) {
+          using namespace kernels;
+          const long long ii = static_cast<long long>(i);
+          const Vec3 xi = load3(x, ii);
+          const Vec3 vi = load3(v, ii);
+          const Vec3 wi = load3(w, ii);
+          const double ri = r[i];
+          const double mi = m[i];
+          const int ai = mat[i];
+          // Slots in use are compacted at the front: the last sub-step used nc + nwc of them.
+          const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
+          std::int64_t oldKey[kMaxHistorySlots];
+          Vec3 oldD[kMaxHistorySlots];
+          for (int s = 0; s < used; ++s) {
+            oldKey[s] = hk[i * K + s];
+            oldD[s] = load3(hd, ii * K + s);
+          }
+          int slot = 0;
+          auto history = [&](std::int64_t key) {
+            for (int s = 0; s < used; ++s)
+              if (oldKey[s] == key)
+                return oldD[s];
+            return Vec3{0.0, 0.0, 0.0};
+          };
+          auto remember = [&](std::int64_t key, Vec3 d) {
+            if (slot < K) {
+              hk[i * K + slot] = key;
+              store3(hd, ii * K + slot, d);
+            }
+            ++slot;
+          };
+          Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
+          Vec3 T{0.0, 0.0, 0.0};
+          // Particle–particle LSD (Eqs. 7–13), gathered over the full neighbour list.
+          int pairCount = 0;
+          const int nb = cnt[i];
+          for (int a = 0; a < nb; ++a) {
+            const std::int32_t j = list[i * M + a];
+            const Vec3 d = load3(x, j) - xi;
+            const double l2 = dot(d, d);
+            const double rj = r[j];
+            const double rsum = ri + rj;
+            if (l2 >= rsum * rsum)
+              continue;
+            const double l = ::sqrt(l2);
+            const Vec3 nrm = (1.0 / l) * d;
+            const double deltaN = rsum - l;
+            const PairProps pp = pairs[ai * nMat + mat[j]];
+            const double meff = effectiveMass(mi, m[j]);
+            const double etan = pp.dampFactor * ::sqrt(pp.kn * meff);
+            const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+            const double lij = leverArm(l, ri, rj);
+            const double lji = leverArm(l, rj, ri);
+            const Vec3 vij = relativeVelocity(vi, load3(v, j), wi, load3(w, j), lij, lji, nrm);
+            const std::int64_t key = gid[j];
+            const LsdResult res = lsdContact(lp, nrm, deltaN, vij, lij, history(key), dt);
+            F += res.force;
+            T += res.torque;
+            remember(key, res.deltaT);
+            ++pairCount;
+          }
+          // Walls (m_eff = m_i, the particle's material).
+          Vec3 FW{0.0, 0.0, 0.0};
+          int wallCount = 0;
+          for (int k = 0; k < nWalls; ++k) {
+            const double deltaN = wallOverlap(walls[k], xi, ri);
+            if (deltaN <= 0.0)
+              continue;
+            const PairProps pp = pairs[ai * nMat + ai];
+            const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
+            const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+            const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
+            const LsdResult res = wallContact(lp, walls[k], deltaN, vi, wi, ri, history(key), dt);
+            FW += res.force;
+            T += res.torque;
+            remember(key, res.deltaT);
+            ++wallCount;
+          }
+          F += FW;
+          for (int s = slot; s < used; ++s)
+            hk[i * K + s] = -1;
+          store3(f, ii, F);
+          store3(tq, ii, T);
+          store3(fw, ii, FW);
+          nc[i] = pairCount;
+          nwc[i] = wallCount;
+          return static_cast<double>(pairCount + wallCount);
+        },
+        0.0);
+    p.produced(kForce | kTorque | kFwall | kHistKey | kHistDisp | kContacts | kWallContacts);
+    _maxUsedSlots = maxSlots < K ? static_cast<int>(maxSlots) : K;
+    if (maxSlots > K) {
+      backend::raiseUserError("a particle has " + std::to_string(static_cast<int>(maxSlots)) +
+                              " simultaneous contacts but only " + std::to_string(K) +
+                              " tangential-history slots; raise NeighbourOptions::historySlots "
+                              "(at most " +
+                              std::to_string(kMaxHistorySlots) + ")");
+    }
+  }
+
+  /// Particle–particle contact pairs of the last sub-step.
+  std::size_t pairContacts(ParticleStore<Exec>& p) const {
+    p.toHost(kContacts);
+    std::size_t s = 0;
+    for (std::size_t i = 0; i < p.n; ++i)
+      s += static_cast<std::size_t>(p.contacts.h()[i]);
+    return s / 2;
+  }
+  /// Particle–wall contacts of the last sub-step.
+  std::size_t wallContacts(ParticleStore<Exec>& p) const {
+    p.toHost(kWallContacts);
+    std::size_t s = 0;
+    for (std::size_t i = 0; i < p.n; ++i)
+      s += static_cast<std::size_t>(p.wallContacts.h()[i]);
+    return s;
+  }
+  /// Σ force of the walls on the particles in the last sub-step (N).
+  std::array<double, 3> wallForce(ParticleStore<Exec>& p) const {
+    p.toHost(kFwall);
+    std::array<double, 3> s{0, 0, 0};
+    for (std::size_t i = 0; i < p.n; ++i)
+      for (int c = 0; c < 3; ++c)
+        s[c] += p.fwall.h()[3 * i + c];
+    return s;
+  }
+
+private:
+  Dual<PairProps> _pairs;
+  Dual<kernels::PlaneWall> _walls;
+  int _maxUsedSlots =
+      kMaxHistorySlots; ///< max contacts of a particle in the last sub-step (≥ slots in use)
+};
+
+} // namespace coredem::dem

@@ -1,0 +1,416 @@
+// Model registries and the `models:` key table (coredem/dem/models.h).
+#include "coredem/dem/models.h"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <optional>
+
+#include "coredem/common/check.h"
+#include "coredem/common/switch.h"
+#include "coredem/dem/dem_system.h"
+
+namespace coredem::dem {
+
+// ------------------------------------------------------------------ family registries
+namespace {
+
+constexpr ModelEntry<kernels::DragLaw> kDrag[] = {
+    {"gidaspow", kernels::DragLaw::Gidaspow,
+     "Ergun for ε ≤ 0.8, Wen–Yu above (kernels/drag_gidaspow.h)"},
+};
+constexpr ModelEntry<kernels::NusseltModel> kNusselt[] = {
+    {"li-mason", kernels::NusseltModel::LiMason,
+     "Li & Mason (2000), Nu = 2 + 0.6 εⁿ Re^½ Pr^⅓ (Re < 200) …"},
+    {"ranz-marshall", kernels::NusseltModel::RanzMarshall,
+     "Ranz–Marshall, Nu = 2 + 0.6 Re^½ Pr^⅓ (MFiX)"},
+};
+constexpr ModelEntry<ReynoldsDefinition> kReynolds[] = {
+    {"with-voidage", ReynoldsDefinition::WithVoidage, "Re = ε ρ_g d |Δu|/μ_g, as the drag"},
+    {"without-voidage", ReynoldsDefinition::WithoutVoidage, "Re = ρ_g d |Δu|/μ_g"},
+};
+constexpr ModelEntry<MotionModel> kMotion[] = {
+    {"free", MotionModel::Free, "forces, torques and gravity move the particles"},
+    {"frozen", MotionModel::Frozen,
+     "particles held in place, velocities zeroed (MFiX verification cases)"},
+};
+constexpr ModelEntry<kernels::RateLaw> kRateLaw[] = {
+    {"constant", kernels::RateLaw::Constant, "ω = A (mol/s)"},
+    {"arrhenius", kernels::RateLaw::Arrhenius, "ω = A T^β exp(−E/(R T)) (× C_g^order)"},
+};
+constexpr ModelEntry<kernels::WgsEquilibrium> kWgs[] = {
+    {"yoon_denn", kernels::WgsEquilibrium::YoonDenn, "K_eq of Yoon & Denn (seed default)"},
+    {"seed", kernels::WgsEquilibrium::Seed, "K_eq = exp(−4.33 + 4577.8/T) (seed)"},
+    {"thermodynamic", kernels::WgsEquilibrium::Thermodynamic, "K_eq from the NASA-7 data"},
+};
+
+/// '_' as '-' (model names accept either).
+std::string normalise(std::string_view s) {
+  std::string out(s);
+  for (char& c : out)
+    if (c == '_') c = '-';
+  return out;
+}
+
+std::string joinOr(std::span<const std::string_view> names) {
+  std::string s;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    if (k > 0)
+      s += k + 1 == names.size() ? " or " : ", ";
+    s += names[k];
+  }
+  return s;
+}
+
+std::size_t editDistance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j)
+    row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+} // namespace
+
+template <class E>
+const ModelEntry<E>* ModelFamily<E>::find(std::string_view model) const {
+  const std::string want = normalise(model);
+  for (const ModelEntry<E>& e : entries)
+    if (normalise(e.name) == want)
+      return &e;
+  return nullptr;
+}
+
+template <class E>
+std::string_view ModelFamily<E>::nameOf(E value) const {
+  for (const ModelEntry<E>& e : entries)
+    if (e.value == value)
+      return e.name;
+  return "?";
+}
+
+template <class E>
+std::string ModelFamily<E>::allowed() const {
+  std::vector<std::string_view> names;
+  for (const ModelEntry<E>& e : entries)
+    names.push_back(e.name);
+  return joinOr(names);
+}
+
+template struct ModelFamily<kernels::DragLaw>;
+template struct ModelFamily<kernels::NusseltModel>;
+template struct ModelFamily<ReynoldsDefinition>;
+template struct ModelFamily<MotionModel>;
+template struct ModelFamily<kernels::RateLaw>;
+template struct ModelFamily<kernels::WgsEquilibrium>;
+
+const ModelFamily<kernels::DragLaw>& dragModels() {
+  static const ModelFamily<kernels::DragLaw> f{"drag", kDrag};
+  return f;
+}
+const ModelFamily<kernels::NusseltModel>& nusseltModels() {
+  static const ModelFamily<kernels::NusseltModel> f{"convection", kNusselt};
+  return f;
+}
+const ModelFamily<ReynoldsDefinition>& reynoldsModels() {
+  static const ModelFamily<ReynoldsDefinition> f{"convection_reynolds", kReynolds};
+  return f;
+}
+const ModelFamily<MotionModel>& motionModels() {
+  static const ModelFamily<MotionModel> f{"motion", kMotion};
+  return f;
+}
+const ModelFamily<kernels::RateLaw>& rateLawModels() {
+  static const ModelFamily<kernels::RateLaw> f{"rate law", kRateLaw};
+  return f;
+}
+const ModelFamily<kernels::WgsEquilibrium>& wgsEquilibriumModels() {
+  static const ModelFamily<kernels::WgsEquilibrium> f{"wgs_equilibrium", kWgs};
+  return f;
+}
+
+std::string didYouMean(std::string_view word, std::span<const std::string_view> candidates) {
+  const std::string w = normalise(word);
+  std::size_t best = std::max<std::size_t>(1, w.size() / 3) + 1;
+  std::string_view pick;
+  for (std::string_view c : candidates) {
+    const std::size_t d = editDistance(w, normalise(c));
+    if (d < best) {
+      best = d;
+      pick = c;
+    }
+  }
+  return std::string(pick);
+}
+
+// ------------------------------------------------------------------ value parsers
+namespace {
+
+std::string withSuggestion(std::string_view value, std::span<const std::string_view> names,
+                           const std::string& allowed) {
+  const std::string guess = didYouMean(value, names);
+  return fmt::format("'{}' is not allowed{}; allowed: {}", value,
+                     guess.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", guess),
+                     allowed);
+}
+
+/// The family entry named `value`, or the message saying what is allowed (`extra`: further
+/// accepted words such as "off", listed after the family's names).
+template <class E>
+std::optional<E> choice(const ModelFamily<E>& f, std::string_view value, std::string& error,
+                        std::span<const std::string_view> extra = {}) {
+  if (const ModelEntry<E>* e = f.find(value))
+    return e->value;
+  std::vector<std::string_view> names;
+  for (const ModelEntry<E>& e : f.entries)
+    names.push_back(e.name);
+  names.insert(names.end(), extra.begin(), extra.end());
+  error = withSuggestion(value, names, joinOr(names));
+  return std::nullopt;
+}
+
+/// on/true/yes/1 or off/false/no/0 (coredem::parseSwitch, the one spelling of a switch).
+std::optional<bool> onOff(std::string_view value, std::string& error) {
+  if (const auto b = parseSwitch(value)) return b;
+  static constexpr std::string_view kNames[] = {"on", "off"};
+  error = withSuggestion(value, kNames, "on or off");
+  return std::nullopt;
+}
+
+/// A finite number in the range `lo`..`hi` (`loOpen`: lo excluded), described by `what`.
+std::optional<double> number(std::string_view value, double lo, bool loOpen, double hi,
+                             std::string_view what, std::string& error) {
+  double v = 0.0;
+  const char* end = value.data() + value.size();
+  const auto r = std::from_chars(value.data(), end, v);
+  const bool ok = r.ec == std::errc() && r.ptr == end && std::isfinite(v) &&
+                  (loOpen ? v > lo : v >= lo) && v <= hi;
+  if (ok)
+    return v;
+  error = fmt::format("'{}' is not allowed; expected {}", value, what);
+  return std::nullopt;
+}
+
+/// An integer in [lo, hi].
+std::optional<int> integer(std::string_view value, int lo, int hi, std::string_view what,
+                           std::string& error) {
+  int v = 0;
+  const char* end = value.data() + value.size();
+  const auto r = std::from_chars(value.data(), end, v);
+  if (r.ec == std::errc() && r.ptr == end && v >= lo && v <= hi)
+    return v;
+  error = fmt::format("'{}' is not allowed; expected {}", value, what);
+  return std::nullopt;
+}
+
+constexpr double kHuge = 1.0e300;
+constexpr std::string_view kOff[] = {"off"};
+
+/// A row whose value is on/off, stored in the bool that `field` selects.
+template <bool HeatOptions::*Field>
+std::string heatSwitch(DemConfig& c, std::string_view v) {
+  std::string e;
+  if (const auto b = onOff(v, e))
+    c.heat.*Field = *b;
+  return e;
+}
+
+std::vector<ModelOption> makeOptions() {
+  std::vector<ModelOption> o;
+  const std::string onOffText = "on, off";
+  // --- drag
+  o.push_back({"drag", "drag", dragModels().allowed(), "gidaspow",
+               "drag law of the gas force on the particles", [](DemConfig& c, std::string_view v) {
+                 std::string e;
+                 if (const auto law = choice(dragModels(), v, e))
+                   c.drag = *law;
+                 return e;
+               }});
+  auto epsMin = [](DemConfig& c, std::string_view v) {
+    std::string e;
+    if (const auto x = number(v, 0.0, true, 1.0 - 1e-15, "a number in (0, 1) (ε_min, 0.35)", e))
+      c.epsMinDrag = *x;
+    return e;
+  };
+  o.push_back({"eps_min_drag", "drag", "number in (0, 1)", "0.35",
+               "lower clip ε_min of ε_g in the drag and the Nusselt correlation", epsMin});
+  o.push_back(
+      {"dem.eps_min_drag", "drag", "number in (0, 1)", "0.35", "same as eps_min_drag", epsMin});
+  // --- heat master switch
+  o.push_back({"heat", "heat", onOffText, "on", "off: temperatures stay constant, H = H_Tp = 0",
+               heatSwitch<&HeatOptions::enabled>});
+  // --- convection
+  o.push_back({"convection", "convection", nusseltModels().allowed() + " or off", "li-mason",
+               "Nusselt correlation of the particle–gas convection (off: no convection)",
+               [](DemConfig& c, std::string_view v) {
+                 std::string e;
+                 if (normalise(v) == "off") {
+                   c.heat.convection = false;
+                 } else if (const auto m = choice(nusseltModels(), v, e, kOff)) {
+                   c.heat.convection = true;
+                   c.heat.nusselt = *m;
+                 }
+                 return e;
+               }});
+  o.push_back({"convection_reynolds", "convection", reynoldsModels().allowed(), "with-voidage",
+               "Reynolds number of the Nusselt correlation (with ε as the drag, or without)",
+               [](DemConfig& c, std::string_view v) {
+                 std::string e;
+                 if (const auto m = choice(reynoldsModels(), v, e))
+                   c.heat.reynoldsWithVoidage = *m == ReynoldsDefinition::WithVoidage;
+                 return e;
+               }});
+  o.push_back({"nusselt_exponent", "convection", "number in [0, 10]", "3.5", "n of εⁿ in Li–Mason",
+               [](DemConfig& c, std::string_view v) {
+                 std::string e;
+                 if (const auto x =
+                         number(v, 0.0, false, 10.0, "a number in [0, 10] (Li–Mason n, 3.5)", e))
+                   c.heat.voidageExponent = *x;
+                 return e;
+               }});
+  // --- conduction
+  o.push_back({"contact_conduction", "conduction", onOffText, "on",
+               "particle–particle conduction through the contact area",
+               heatSwitch<&HeatOptions::contactConduction>});
+  o.push_back({"lens_conduction", "conduction", onOffText, "on",
+               "conduction through the gas lens between neighbours (coupled runs only)",
+               heatSwitch<&HeatOptions::lensConduction>});
+  o.push_back({"flpc", "conduction", "number in [0, 1]", "0.2", "lens radius (1 + FLPC) R_L",
+               [](DemConfig& c, std::string_view v) {
+                 std::string e;
+                 if (const auto x = number(v, 0.0, false, 1.0,
+                                           "a number in [0, 1] (lens radius (1+FLPC) R_L, 0.2)", e))
+                   c.heat.lensFraction = *x;
+                 return e;
+               }});
+  o.push_back({"s_min", "conduction", "length in (0, 1e-3] m", "1e-6",
+               "minimum conduction distance in the lens (m)", [](DemConfig& c, std::string_view v) {
+                 std::string e;
+                 if (const auto x =
+                         number(v, 0.0, true, 1.0e-3, "a length in (0, 1e-3] m (1e-6)", e))
+                   c.heat.minSeparation = *x;
+                 return e;
+               }});
+  o.push_back({"lens_rel_tol", "conduction", "number in [1e-14, 1e-3]", "1e-8",
+               "quadrature tolerance of the lens integral", [](DemConfig& c, std::string_view v) {
+                 std::string e;
+                 if (const auto x = number(v, 1.0e-14, false, 1.0e-3,
+                                           "a tolerance in [1e-14, 1e-3] (1e-8)", e))
+                   c.heat.lensRelTol = *x;
+                 return e;
+               }});
+  o.push_back({"wall_conduction", "conduction", onOffText, "on",
+               "contact conduction to fixed-temperature walls",
+               heatSwitch<&HeatOptions::wallConduction>});
+  o.push_back({"wall_lens_conduction", "conduction", onOffText, "on",
+               "gas-lens conduction to fixed-temperature walls (coupled runs only)",
+               heatSwitch<&HeatOptions::wallLensConduction>});
+  // --- radiation
+  o.push_back({"radiation", "radiation", onOffText, "on",
+               "radiation of materials with emissivity > 0 (environment: ε_g T_g + (1 − ε_g) "
+               "cell-mean T_p)",
+               heatSwitch<&HeatOptions::radiation>});
+  // --- motion
+  o.push_back(
+      {"motion", "motion", motionModels().allowed(), "free",
+       "frozen: particles held in place (MFiX verification cases); set the step with time.dt_dem",
+       [](DemConfig& c, std::string_view v) {
+         std::string e;
+         if (const auto m = choice(motionModels(), v, e))
+           c.frozenMotion = *m == MotionModel::Frozen;
+         return e;
+       }});
+  // --- numerics of the DEM step
+  auto dtFactor = [](DemConfig& c, std::string_view v) {
+    std::string e;
+    if (const auto x =
+            number(v, 1.0, false, kHuge, "a number >= 1 (Δt_DEM,max = t_col/dt_factor, 50)", e))
+      c.dtFactor = *x;
+    return e;
+  };
+  o.push_back({"dem.dt_factor", "numerics", "number >= 1", "50", "Δt_DEM,max = t_col / dt_factor",
+               dtFactor});
+  o.push_back({"dt_factor", "numerics", "number >= 1", "50", "same as dem.dt_factor", dtFactor});
+  o.push_back({"dem.skin_factor", "numerics", "number >= 0", "0.1",
+               "Verlet skin = skin_factor · d_max (neighbour lists)",
+               [](DemConfig& c, std::string_view v) {
+                 std::string e;
+                 if (const auto x = number(v, 0.0, false, kHuge, "a number >= 0 (0.1)", e))
+                   c.neighbour.skinFactor = *x;
+                 return e;
+               }});
+  o.push_back({"dem.history_slots", "numerics", fmt::format("integer in [1, {}]", kMaxHistorySlots),
+               "12", "tangential-history slots per particle (simultaneous contacts)",
+               [](DemConfig& c, std::string_view v) {
+                 std::string e;
+                 const std::string what =
+                     fmt::format("an integer in [1, {}] (12)", kMaxHistorySlots);
+                 if (const auto x = integer(v, 1, kMaxHistorySlots, what, e))
+                   c.neighbour.historySlots = *x;
+                 return e;
+               }});
+  return o;
+}
+
+} // namespace
+
+std::span<const ModelOption> modelOptions() {
+  static const std::vector<ModelOption> table = makeOptions();
+  return table;
+}
+
+const ModelOption* findModelOption(std::string_view key) {
+  for (const ModelOption& o : modelOptions())
+    if (o.key == key)
+      return &o;
+  return nullptr;
+}
+
+bool applyModelOption(DemConfig& config, std::string_view key, std::string_view value) {
+  const ModelOption* o = findModelOption(key);
+  if (o == nullptr)
+    return false;
+  const std::string error = o->apply(config, value);
+  COREDEM_CHECK(error.empty(), "model option {} = '{}': {}", key, value, error);
+  return true;
+}
+
+std::vector<ModelIssue>
+validateModels(std::span<const std::pair<std::string, std::string>> models) {
+  std::vector<ModelIssue> issues;
+  std::vector<std::string_view> keys;
+  for (const ModelOption& o : modelOptions())
+    keys.push_back(o.key);
+  std::string allKeys;
+  for (std::string_view k : keys)
+    allKeys += (allKeys.empty() ? "" : ", ") + std::string(k);
+  DemConfig scratch;
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    const auto& [key, value] = models[i];
+    const ModelOption* o = findModelOption(key);
+    if (o == nullptr) {
+      const std::string guess = didYouMean(key, keys);
+      issues.push_back(
+          {i, key, true,
+           fmt::format("unknown model key{}; allowed keys: {}",
+                       guess.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", guess),
+                       allKeys)});
+      continue;
+    }
+    std::string error = o->apply(scratch, value);
+    if (!error.empty())
+      issues.push_back({i, key, false, std::move(error)});
+  }
+  return issues;
+}
+
+} // namespace coredem::dem
