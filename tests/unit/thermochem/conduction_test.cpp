@@ -366,7 +366,7 @@ TEST(GasLens, ClippedLimitAndReach) {
 // The closed form gasLensIntegral() against 40-digit values (mpmath quadrature of Eq. 24 at the
 // same binary inputs, R_lens = (1.0 + 0.2)·R_L rounded as in the kernel): equal and unequal
 // radii, R_S/R_L from 0.1 to 1, R from 1e-4 to 1e-2 m, overlaps to 5 % of R_S, gaps up to
-// the lens reach, s_min from 1e-10 to 1e-5 m. Observed ≤ 1e-15; asserted at the stated bound
+// the lens reach, s_min from 1e-10 to 1e-5 m. Observed ≤ 1.3e-15; asserted at the stated bound
 // kGasLensClosedFormRelError = 1e-13.
 TEST(GasLens, ClosedFormMatchesFortyDigitValues) {
   struct Row {
@@ -414,7 +414,8 @@ TEST(GasLens, ClosedFormMatchesFortyDigitValues) {
 // Dense sweep over the DEM range against the adaptive reference (gasLensIntegralReference at
 // relTol 1e-12): R_L = 1e-4, 1e-3, 1e-2 m; R_S/R_L = 0.1 … 1 (15 ratios, including the
 // hemisphere switch near 0.19); s_min = 1e-10 … 1e-5 m; surface gaps from −5 % of R_S
-// (log-spaced down to 1e-9 of it, both signs) to 1e-6 below the lens reach. Asserted 1e-12
+// (log-spaced down to 1e-9 of it, both signs) to 1e-6 below the lens reach (and two beyond it,
+// where both give 0; the closed form's limits follow gasLensGeometry()). Asserted 1e-12
 // relative (5e-14 observed; the reference runs at relTol 1e-12), and 5e-9 at the last point
 // before the reach: the reference is the limit there (its u = ln(g0 + c0 r²) substitution
 // cancels in e^u − g0 when c0 r² ≪ g0; 1.3e-9 observed), while the closed form stays within
@@ -438,6 +439,8 @@ TEST(GasLens, ClosedFormMatchesAdaptiveReferenceOverDemRange) {
         }
         for (int m = 1; m <= 20; ++m)
           gaps.push_back(reachGap * (m / 20.0) * (1.0 - 1e-6));
+        gaps.push_back(reachGap * (1.0 + 1e-9)); // beyond the reach: no lens
+        gaps.push_back(reachGap * 1.5);
         for (double gap : gaps) {
           const bool atReach = gap > reachGap * (1.0 - 2e-6);
           const double l = big + small + gap;
@@ -451,6 +454,7 @@ TEST(GasLens, ClosedFormMatchesAdaptiveReferenceOverDemRange) {
           ASSERT_TRUE(ref.converged);
           EXPECT_TRUE(closed.converged);
           EXPECT_EQ(closed.value, k::gasLensIntegral(p, small, big, l).value);
+          EXPECT_EQ(closed.value > 0.0, k::gasLensGeometry(p, big, small, l).active);
           if (ref.value == 0.0) {
             EXPECT_EQ(closed.value, 0.0);
             continue;

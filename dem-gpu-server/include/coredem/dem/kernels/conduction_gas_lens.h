@@ -19,7 +19,7 @@
 ///  * gasLensIntegral() evaluates I in closed form (substitution t = √(R_L² − r²) + √(R_S² − r²)
 ///    turns the integrand into a rational function of t; derivation at the function). Its
 ///    rounding error is below kGasLensClosedFormRelError = 1e-13 relative over the DEM range;
-///    it costs ~6 square roots and 2 log1p per pair, no iteration.
+///    it costs one square root, one or two logarithms and a few divisions per pair.
 ///  * gasLensIntegralReference() is the former per-pair adaptive quadrature, kept as the
 ///    independent reference for the tests: the gap without cancellation as
 ///      gap(r) = g0 + (r − R_in)(r + R_in) [1/(a + a0) + 1/(b + b0)],
@@ -176,10 +176,19 @@ DEM_HD GasLensIntegral gasLensIntegralReference(const GasLensParams& p, double r
 
 /// Relative bound on the rounding error of the closed form gasLensIntegral() over the DEM
 /// range (R_S/R_L in [0.1, 1], overlaps up to 5 % of R_S, s_min 1e-10..1e-5 m for R of
-/// 1e-4..1e-2 m). Observed: ≤ 1.3e-15 against 40-digit quadrature (24 points in the unit
-/// tests, ~1,500 random points offline), ≤ 6e-14 against gasLensIntegralReference at relTol
-/// 1e-12 over a 10,800-point sweep (tests/unit/thermochem/conduction_test.cpp).
+/// 1e-4..1e-2 m). Each term of the closed form is formed to a few ulp and the terms cancel by
+/// at most a factor ~10 there (t − D²/t³ ≥ 0.3 t for R_S/R_L ≥ 0.1), so ~1e-14; stated with
+/// margin. Observed: ≤ 1.7e-15 against 40-digit quadrature (24 points in the unit tests,
+/// 1,500 random points offline), ≤ 6e-14 against gasLensIntegralReference at relTol 1e-12
+/// over a 10,800-point sweep (tests/unit/thermochem/conduction_test.cpp). Below the range the
+/// cancellation grows like R_L/R_S (a sphere against a wall-like partner of 10⁴ R: ~1e-12).
 inline constexpr double kGasLensClosedFormRelError = 1.0e-13;
+
+/// ln(1 + x) for x ≥ 0: log1p near 0, the (cheaper) log of 1 + x above 1, where rounding 1 + x
+/// costs at most 1 ulp of a result ≥ ln 2.
+DEM_HD double gasLensLog1p(double x) {
+  return x > 1.0 ? std::log(1.0 + x) : std::log1p(x);
+}
 
 /// The lens integral I of Eq. 24 (m) in closed form. Depends only on the sorted radii and l.
 ///
@@ -200,7 +209,9 @@ inline constexpr double kGasLensClosedFormRelError = 1.0e-13;
 /// Δ = t_in − t* = s_min − g_in, using t_in² − D = 2 b_in t_in. Every difference is formed
 /// without cancellation: g_out − g_in = (R_out² − R_in²)[1/(a_in + a_out) + 1/(b_in + b_out)],
 /// 1 − q = (l² − D)/l² with l² − D = (l − R_L)(l + R_L) + R_S², the logarithms as log1p.
-/// No iteration, no quadrature: ~6 square roots, 2 log1p and a dozen divisions.
+/// The limits follow gasLensGeometry()'s rules, as R² and chord distances from factored
+/// triangle formulas (below). No iteration, no quadrature: one square root, one logarithm
+/// (equal radii) or two, a few divisions.
 ///
 /// `error` is kGasLensClosedFormRelError·I (a bound on the rounding error, not an estimate);
 /// `converged` is false if that exceeds p.relTol·I, or for invalid parameters.
@@ -209,44 +220,69 @@ DEM_HD GasLensIntegral gasLensIntegral(const GasLensParams& p, double ri, double
   if (!(p.minSeparation > 0.0) || !(p.lensFraction >= 0.0)) {
     return {0.0, 0.0, false}; // invalid parameters (the case parser rejects them)
   }
-  const GasLensGeometry geo = gasLensGeometry(p, ri, rj, l);
-  if (!geo.active) {
-    return {0.0, 0.0, true};
-  }
   const double big = ri > rj ? ri : rj;
   const double small = ri > rj ? rj : ri;
   const double sMin = p.minSeparation;
-  const double rIn = geo.rIn;
-  const double rOut = geo.rOut;
   auto result = [&](double value) {
     const double err = kGasLensClosedFormRelError * value;
     return GasLensIntegral{value, err, err <= p.relTol * value};
   };
+  // Limits as gasLensGeometry() (same rules), but as R² and the chord distances a = √(R_L² − R²),
+  // b = √(R_S² − R²) from the factored triangle formulas, which need no square root:
+  //   R_L − a_c = h (l + R_S − R_L)/(2l),  R_S − b_c = h (l + R_L − R_S)/(2l)   (h = R_L + R_S − l)
+  // for the circle where two spheres cross; R_c² = (R_L − a_c)(R_L + a_c).
+  const double rLens = (1.0 + p.lensFraction) * big;
+  const double lMinusBig = l - big;
+  if (!(l < rLens + small)) {
+    return {0.0, 0.0, true}; // the lens does not reach the smaller sphere
+  }
+  const double half = 0.5 / l;                     // 1/(2l)
+  const double dd = (big - small) * (big + small); // D = R_L² − R_S²
+  // Outer end R_out (Eq. 26, or R_S once l² ≤ R_lens² − R_S²).
+  double rOut2 = small * small;
+  double bOut = 0.0;
+  if (l * l > (rLens - small) * (rLens + small)) {
+    const double lensDrop = (small - (l - rLens)) * ((l - rLens) + small) * half; // R_lens − x
+    const double x = rLens - lensDrop; // plane of the lens/small-sphere circle from the big centre
+    rOut2 = lensDrop * (rLens + x);
+    bOut = l - x;
+  }
+  const double aOut = std::sqrt(dd + bOut * bOut); // a² − b² = D
   // Inner end R_in: a, b, t = a + b and the gap g = l − t there.
   double aIn = big;
   double bIn = small;
   double tIn = big + small;
-  double gIn = l - big - small;
-  if (geo.contact) {
-    aIn = std::sqrt((big - rIn) * (big + rIn));
-    bIn = std::sqrt((small - rIn) * (small + rIn));
-    if (l * l >= (big - small) * (big + small)) {
-      tIn = l; // intersection plane between the centres: the surfaces meet at R_in
+  double gIn = lMinusBig - small;
+  double rIn2 = 0.0;
+  if (l < big + small) {
+    if (!(lMinusBig + small > 0.0)) {
+      return {0.0, 0.0, true}; // one sphere inside the other: R_in = R_S ≥ R_out
+    }
+    const double overlap = small - lMinusBig;
+    const double aDrop = overlap * (lMinusBig + small) * half; // R_L − a_in
+    const double bDrop = overlap * ((l - small) + big) * half; // R_S − b_in (b signed)
+    aIn = big - aDrop;
+    rIn2 = aDrop * (big + aIn);
+    const double bSigned = small - bDrop;
+    if (bSigned >= 0.0) {
+      bIn = bSigned; // intersection plane between the centres: the surfaces meet at R_in
+      tIn = l;
       gIn = 0.0;
     } else {
+      bIn = -bSigned;
       tIn = aIn + bIn;
       gIn = l - aIn - bIn;
     }
   }
-  // Outer end R_out.
-  const double aOut = std::sqrt(std::fmax((big - rOut) * (big + rOut), 0.0));
-  const double bOut = std::sqrt(std::fmax((small - rOut) * (small + rOut), 0.0));
-  const double rise = (rOut - rIn) * (rOut + rIn) * (1.0 / (aIn + aOut) + 1.0 / (bIn + bOut));
-  const double gOut = gIn + rise;
-  if (gOut <= sMin) {
-    return result(pi * (rOut - rIn) * (rOut + rIn) / sMin); // all clipped
+  if (!(rOut2 > rIn2)) {
+    return {0.0, 0.0, true};
   }
-  // Clipped part on [R_in, r*] where gap < s_min, closed form.
+  // g_out − g_in without cancellation.
+  const double rise = (rOut2 - rIn2) * (1.0 / (aIn + aOut) + 1.0 / (bIn + bOut));
+  if (gIn + rise <= sMin) {
+    return result(pi * (rOut2 - rIn2) / sMin); // all clipped
+  }
+  // Clipped part on [R_in, r*] where gap < s_min: π (r*² − R_in²)/s_min.
   double clipped = 0.0;
   double t1 = tIn;
   double g1 = gIn;
@@ -254,21 +290,26 @@ DEM_HD GasLensIntegral gasLensIntegral(const GasLensParams& p, double ri, double
   if (gIn < sMin) {
     const double tStar = l - sMin;
     const double dT = sMin - gIn;
-    const double aStar = 0.5 * (tStar + ((big - small) * (big + small)) / tStar);
-    clipped = pi * (dT * (2.0 * bIn - dT) / (2.0 * tStar)) * (aIn + aStar) / sMin;
+    const double aStar = 0.5 * (tStar + dd / tStar);
+    clipped = pi * dT * (2.0 * bIn - dT) * (aIn + aStar) / (2.0 * tStar * sMin);
     t1 = tStar;
     g1 = sMin;
     delta = rise - dT;
   }
   // Open part on [r*, R_out] (or [R_in, R_out]).
-  const double t2 = tIn - rise;
-  const double l2 = l * l;
-  const double q = ((big - small) * (big + small)) / l2;
-  const double oneMinusQ = ((l - big) * (l + big) + small * small) / l2;
-  const double q2 = q * q;
-  const double open = l * (oneMinusQ * (1.0 + q)) * std::log1p(delta / g1) - delta -
-                      q2 * (l2 * l * (t1 + t2) * delta / (2.0 * (t1 * t1) * (t2 * t2)) +
-                            l2 * delta / (t1 * t2) + l * std::log1p(delta / t2));
+  double open = 0.0;
+  if (dd == 0.0) {
+    open = l * gasLensLog1p(delta / g1) - delta; // equal radii
+  } else {
+    const double t2 = tIn - rise;
+    const double invL2 = 4.0 * half * half; // 1/l²
+    const double q = dd * invL2;
+    const double oneMinusQ = (lMinusBig * (l + big) + small * small) * invL2;
+    const double inv12 = 1.0 / (t1 * t2);
+    open = l * (oneMinusQ * (1.0 + q)) * gasLensLog1p(delta / g1) - delta -
+           (q * q) * (l * l * delta * inv12 * (0.5 * l * (t1 + t2) * inv12 + 1.0) +
+                      l * gasLensLog1p(delta / t2));
+  }
   return result(clipped + 0.5 * pi * open);
 }
 
