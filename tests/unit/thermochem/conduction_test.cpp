@@ -1,8 +1,11 @@
 // Contact conduction (PHYSICS §3.2) and gas-lens conduction (§3.3) vs the MFiX reference
 // constants (§8.1, §8.2), reference/refvalues.py, closed forms and an independent fine
 // long-double quadrature.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -261,7 +264,8 @@ TEST(GasLens, SeedVariantsMatchReferenceScript) {
 
 // Accuracy target 1e-8 relative (PHYSICS §3.3): compare against the closed form for equal
 // spheres and the independent long-double quadrature for unequal spheres, in and out of
-// contact, with s_min from 4e-10 to 1e-6 m. Observed agreement is ~1e-13; assert 1e-10.
+// contact, with s_min from 4e-10 to 1e-6 m. Observed agreement is ~1e-13; assert 1e-10 for
+// the closed form gasLensIntegral() and the adaptive gasLensIntegralReference() alike.
 TEST(GasLens, QuadratureAccurateToBetterThan1e8) {
   for (double sMin : {4e-10, 1e-8, 1e-6}) {
     for (double gap : {-4e-5, -1e-6, -1e-9, 1e-9, 1e-7, 1e-5, 2e-4}) {
@@ -280,6 +284,11 @@ TEST(GasLens, QuadratureAccurateToBetterThan1e8) {
       const long double fine = fineLensIntegral(1.5e-3L, 1.8e-3L, lu, 0.2L, sMin);
       EXPECT_TRUE(un.converged);
       EXPECT_NEAR(un.value, static_cast<double>(fine), 1e-10 * un.value);
+      // The adaptive reference the closed form is swept against meets the same bound.
+      EXPECT_NEAR(k::gasLensIntegralReference(p, rad, rad, le).value, static_cast<double>(exactEq),
+                  1e-10 * eq.value);
+      EXPECT_NEAR(k::gasLensIntegralReference(p, 1.5e-3, 1.8e-3, lu).value,
+                  static_cast<double>(fine), 1e-10 * un.value);
     }
   }
 }
@@ -303,6 +312,8 @@ TEST(GasLens, QuadratureAccurateForSmallSizeRatios) {
         EXPECT_TRUE(in.converged);
         EXPECT_GT(in.value, 0.0);
         EXPECT_NEAR(in.value, static_cast<double>(fine), 1e-10 * in.value);
+        EXPECT_NEAR(k::gasLensIntegralReference(p, big, small, l).value, static_cast<double>(fine),
+                    1e-10 * in.value);
       }
     }
   }
@@ -348,6 +359,118 @@ TEST(GasLens, ClippedLimitAndReach) {
   // Lens around the larger sphere: swapping the argument order changes nothing.
   EXPECT_EQ(k::gasLensIntegral(d, 1.8e-3, 1.5e-3, 3.4e-3).value,
             k::gasLensIntegral(d, 1.5e-3, 1.8e-3, 3.4e-3).value);
+}
+
+// ---- closed form vs reference quadrature and 40-digit values ------------------------------
+
+// The closed form gasLensIntegral() against 40-digit values (mpmath quadrature of Eq. 24 at the
+// same binary inputs, R_lens = (1.0 + 0.2)·R_L rounded as in the kernel): equal and unequal
+// radii, R_S/R_L from 0.1 to 1, R from 1e-4 to 1e-2 m, overlaps to 5 % of R_S, gaps up to
+// the lens reach, s_min from 1e-10 to 1e-5 m. Observed ≤ 1.3e-15; asserted at the stated bound
+// kGasLensClosedFormRelError = 1e-13.
+TEST(GasLens, ClosedFormMatchesFortyDigitValues) {
+  struct Row {
+    double big, small, l, sMin, integral;
+  };
+  const Row rows[] = {
+      {0.001, 0.001, 0.0019500000000000001, 1e-10, 0.047518891972462871403},
+      {0.001, 0.001, 0.001999999, 1e-06, 0.019741374890600020929},
+      {0.001, 0.001, 0.0020003, 1e-06, 0.018801428534031667521},
+      {0.001, 0.001, 0.0021, 1e-08, 0.0022678800834538365616},
+      {0.01, 0.001, 0.01095, 1e-05, 0.025598211516973631407},
+      {0.01, 0.001, 0.010999, 1e-10, 0.092659146825969673176},
+      {0.01, 0.001, 0.011002, 1e-09, 0.030532445300712640575},
+      {0.01, 0.001, 0.012499999999999999, 1e-06, 0.0013156704734675914612},
+      {0.0001, 1e-05, 0.0001095, 1e-10, 0.0006338924880155654771},
+      {0.0001, 1.5e-05, 0.000134, 1e-07, 4.1817067721005624817e-6},
+      {0.0001, 5e-05, 0.00014800000000000002, 1e-05, 0.00032345422940312102773},
+      {0.0001, 9.9e-05, 0.000203, 1e-05, 0.0004115085637851585934},
+      {0.002, 0.0012, 0.0031699999999999996, 4e-10, 0.068483554289332297223},
+      {0.005, 0.004, 0.009800000000000001, 1e-07, 0.0032995952118128523533},
+      {0.0018, 0.0015, 0.00331, 1e-06, 0.018286763312759479337},
+      {0.001, 0.0002, 0.00119, 1e-08, 0.010178671753415074056},
+      {0.001, 0.001, 0.002199998, 1e-06, 3.427205954291401435e-8},
+      {0.001, 0.0003, 0.0014998, 1e-09, 1.5083619274701594251e-6},
+      {0.001, 0.0001, 0.0012900000000000001, 1e-10, 0.000028472659311632316984},
+      {0.001, 0.00015, 0.001148, 1e-06, 0.0041959583722470403931},
+      // 1e-6 below the lens reach, where the adaptive reference loses digits:
+      {0.0001, 1.8e-05, 0.00013799998000000002, 1e-06, 9.8345515517039017713e-11},
+      {0.0001, 5e-05, 0.00016999998, 1e-06, 2.2175956202988373946e-10},
+      {0.01, 0.01, 0.021999998, 1e-06, 3.427193383744377616e-8},
+      {0.001, 0.0001, 0.0012999998, 1e-06, 5.7998612655456781066e-10},
+  };
+  for (const Row& r : rows) {
+    SCOPED_TRACE(::testing::Message()
+                 << "R_L " << r.big << " R_S " << r.small << " l " << r.l << " s_min " << r.sMin);
+    k::GasLensParams p;
+    p.minSeparation = r.sMin;
+    const auto in = k::gasLensIntegral(p, r.big, r.small, r.l);
+    EXPECT_TRUE(in.converged);
+    EXPECT_NEAR(in.value, r.integral, k::kGasLensClosedFormRelError * r.integral);
+    EXPECT_LE(in.error, k::kGasLensClosedFormRelError * in.value);
+  }
+}
+
+// Dense sweep over the DEM range against the adaptive reference (gasLensIntegralReference at
+// relTol 1e-12): R_L = 1e-4, 1e-3, 1e-2 m; R_S/R_L = 0.1 … 1 (15 ratios, including the
+// hemisphere switch near 0.19); s_min = 1e-10 … 1e-5 m; surface gaps from −5 % of R_S
+// (log-spaced down to 1e-9 of it, both signs) to 1e-6 below the lens reach (and two beyond it,
+// where both give 0; the closed form's limits follow gasLensGeometry()). Asserted 1e-12
+// relative (5e-14 observed; the reference runs at relTol 1e-12), and 5e-9 at the last point
+// before the reach: the reference is the limit there (its u = ln(g0 + c0 r²) substitution
+// cancels in e^u − g0 when c0 r² ≪ g0; 1.3e-9 observed), while the closed form stays within
+// 1e-15 of 40-digit values at those points (test above). Also: both orders of the radii give
+// bitwise the same value.
+TEST(GasLens, ClosedFormMatchesAdaptiveReferenceOverDemRange) {
+  const double ratios[] = {0.1, 0.15, 0.18, 0.19, 0.2, 0.25, 0.3, 0.4,
+                           0.5, 0.6,  0.7,  0.8,  0.9, 0.99, 1.0};
+  double worst = 0.0;
+  double worstAtReach = 0.0;
+  int count = 0;
+  for (double big : {1e-4, 1e-3, 1e-2}) {
+    for (double ratio : ratios) {
+      for (double sMin : {1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5}) {
+        const double small = ratio * big;
+        const double reachGap = 0.2 * big; // l = R_lens + R_S
+        std::vector<double> gaps;
+        for (int e = 0; e <= 9; ++e) {
+          gaps.push_back(-0.05 * small * std::pow(10.0, -e));
+          gaps.push_back(0.05 * small * std::pow(10.0, -e));
+        }
+        for (int m = 1; m <= 20; ++m)
+          gaps.push_back(reachGap * (m / 20.0) * (1.0 - 1e-6));
+        gaps.push_back(reachGap * (1.0 + 1e-9)); // beyond the reach: no lens
+        gaps.push_back(reachGap * 1.5);
+        for (double gap : gaps) {
+          const bool atReach = gap > reachGap * (1.0 - 2e-6);
+          const double l = big + small + gap;
+          k::GasLensParams p;
+          p.minSeparation = sMin;
+          p.relTol = 1e-12;
+          const auto closed = k::gasLensIntegral(p, big, small, l);
+          const auto ref = k::gasLensIntegralReference(p, big, small, l);
+          SCOPED_TRACE(::testing::Message()
+                       << "R_L " << big << " R_S " << small << " gap " << gap << " s_min " << sMin);
+          ASSERT_TRUE(ref.converged);
+          EXPECT_TRUE(closed.converged);
+          EXPECT_EQ(closed.value, k::gasLensIntegral(p, small, big, l).value);
+          EXPECT_EQ(closed.value > 0.0, k::gasLensGeometry(p, big, small, l).active);
+          if (ref.value == 0.0) {
+            EXPECT_EQ(closed.value, 0.0);
+            continue;
+          }
+          const double rel = std::fabs(closed.value - ref.value) / ref.value;
+          EXPECT_LE(rel, atReach ? 5e-9 : 1e-12);
+          (atReach ? worstAtReach : worst) = std::max(atReach ? worstAtReach : worst, rel);
+          ++count;
+        }
+      }
+    }
+  }
+  EXPECT_GT(count, 10000);
+  std::printf("gas lens: %d pairs, closed form vs adaptive reference: worst %.2e relative "
+              "(%.2e at the reach)\n",
+              count, worst, worstAtReach);
 }
 
 // s_min dominates touching particles (§3.3): 1e-6 → 4e-10 m roughly doubles I (0.0351 → 0.0752).
