@@ -301,7 +301,8 @@ std::vector<ModelOption> makeOptions() {
                  return e;
                }});
   o.push_back({"lens_rel_tol", "conduction", "number in [1e-14, 1e-3]", "1e-8",
-               "quadrature tolerance of the lens integral", [](DemConfig& c, std::string_view v) {
+               "accepted for compatibility (the lens integral is in closed form)",
+               [](DemConfig& c, std::string_view v) {
                  std::string e;
                  if (const auto x = number(v, 1.0e-14, false, 1.0e-3,
                                            "a tolerance in [1e-14, 1e-3] (1e-8)", e))
