@@ -404,6 +404,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   st.nbList.assign(n * st.neighbourSlots, 0);
   st.listValid = 0;
   initChemistryReferences(config, st);  // d_p0, initial C / Fe2O3-equivalent masses
+  fillDefaults(st);  // schema fields not set above take their defaults
   m.nParticles = n;
 
   const std::size_t nm = config.materials.size();
@@ -556,7 +557,7 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
   return m.sources;
 }
 
-void DemSystem::writeState(const std::string& path) const {
+void DemSystem::writeState(const std::string& path, const std::string& protocolVersion) const {
   Impl& m = *_impl;
   StateMeta meta;
   meta.time = m.time.time();
@@ -565,7 +566,7 @@ void DemSystem::writeState(const std::string& path) const {
   meta.backend = m.engine->name();
   meta.configHash = m.hash;
   meta.softwareVersion = std::string(COREDEM_VERSION);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
-  meta.protocolVersion = std::string("1");
+  meta.protocolVersion = protocolVersion.empty() ? std::string("none") : protocolVersion;
   meta.heatConvection = m.engine->heatTotals().convection;
   meta.heatRadiation = m.engine->heatTotals().radiation;
   meta.heatWall = m.engine->heatTotals().wall;

@@ -3,9 +3,11 @@
 #include "state_io.h"
 
 #include "coredem/common/check.h"
+#include "coredem/dem/particle_schema.h"
 
 #include <hdf5.h>
 
+#include <string>
 #include <vector>
 
 namespace coredem::dem {
@@ -109,27 +111,16 @@ void writeStateFile(const std::string& path, const HostState& s, const StateMeta
   Handle file{H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose};
   COREDEM_CHECK(file.id >= 0, "cannot create state file '{}': check that the directory exists "
                               "and is writable", path);
-  const hsize_t n = s.n, K = static_cast<hsize_t>(s.historySlots),
-                M = static_cast<hsize_t>(s.neighbourSlots), ns = static_cast<hsize_t>(s.nSpecies);
+  checkShapes(s, "writeStateFile");  // every field holds n · width values: nothing is skipped
   {
-    Handle g{H5Gcreate2(file.id, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
-    writeArray(g.id, "position", s.pos, {n, 3});
-    writeArray(g.id, "velocity", s.vel, {n, 3});
-    writeArray(g.id, "angular_velocity", s.omega, {n, 3});
-    writeArray(g.id, "force", s.force, {n, 3});
-    writeArray(g.id, "torque", s.torque, {n, 3});
-    writeArray(g.id, "wall_force", s.fwall, {n, 3});
-    writeArray(g.id, "position_at_rebuild", s.xref, {n, 3});
-    writeArray(g.id, "radius", s.radius, {n});
-    writeArray(g.id, "mass", s.mass, {n});
-    writeArray(g.id, "density", s.density, {n});
-    writeArray(g.id, "temperature", s.temperature, {n});
-    writeArray(g.id, "species", s.species, {n, ns});
-    writeArray(g.id, "material", s.material, {n});
-    writeArray(g.id, "global_id", s.gid, {n});
-    // Chemistry references (initial diameter; initial C and Fe2O3-equivalent masses).
-    if (s.d0.size() == n) writeArray(g.id, "initial_diameter", s.d0, {n});
-    if (s.chemRef.size() == 2 * n) writeArray(g.id, "chemistry_reference", s.chemRef, {n, 2});
+    Handle gp{H5Gcreate2(file.id, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
+    Handle gc{H5Gcreate2(file.id, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
+    schema::forEachField(s, [&](const schema::FieldInfo& f, const auto& v) {
+      if (!f.has(schema::kCheckpointed)) return;
+      const std::vector<std::uint64_t> dims = schema::datasetDims(f, s.n, s.extents());
+      writeArray(f.group == schema::Group::Particles ? gp.id : gc.id, std::string(f.name).c_str(), v,
+                 std::vector<hsize_t>(dims.begin(), dims.end()));
+    });
   }
   if (meta.hasChemistry) {
     const ChemistryTotals& c = meta.chemistry;
@@ -144,16 +135,8 @@ void writeStateFile(const std::string& path, const HostState& s, const StateMeta
     writeAttr(g.id, "sensible_mass_enthalpy_J", c.sensibleMassEnthalpy);
     writeAttr(g.id, "removed_count", static_cast<std::uint64_t>(c.removedCount));
   }
-  {
-    Handle g{H5Gcreate2(file.id, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
-    writeArray(g.id, "history_key", s.histKey, {n, K});
-    writeArray(g.id, "history_displacement", s.histDisp, {n, K, 3});
-    writeArray(g.id, "contact_count", s.contacts, {n});
-    writeArray(g.id, "wall_contact_count", s.wallContacts, {n});
-    writeArray(g.id, "neighbour_count", s.nbCount, {n});
-    writeArray(g.id, "neighbour_list", s.nbList, {n, M});
-  }
   Handle g{H5Gcreate2(file.id, "meta", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
+  writeAttr(g.id, "format_version", static_cast<std::int32_t>(schema::kFormatVersion));
   writeAttr(g.id, "time", meta.time);
   writeAttr(g.id, "time_compensation", meta.timeCompensation);
   writeAttr(g.id, "step", meta.step);
@@ -182,6 +165,15 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
                     H5Lexists(file.id, "contacts", H5P_DEFAULT) > 0,
                 "'{}' is not a CoReDEM DEM state file (needs /meta, /particles, /contacts)", path);
   Handle gm{H5Gopen2(file.id, "meta", H5P_DEFAULT), H5Gclose};
+  // Files written before the attribute existed are version 1.
+  meta.formatVersion =
+      H5Aexists(gm.id, "format_version") > 0 ? readAttr<std::int32_t>(gm.id, "format_version", path) : 1;
+  COREDEM_CHECK(meta.formatVersion <= schema::kFormatVersion,
+                "state file '{}' has format version {}, newer than this build reads ({}); it was written "
+                "by CoReDEM {}: read it with that version or a newer one",
+                path, meta.formatVersion, schema::kFormatVersion,
+                H5Aexists(gm.id, "software_version") > 0 ? readStringAttr(gm.id, "software_version", path)
+                                                          : std::string("(unknown)"));
   meta.time = readAttr<double>(gm.id, "time", path);
   meta.timeCompensation = readAttr<double>(gm.id, "time_compensation", path);
   meta.step = readAttr<std::uint64_t>(gm.id, "step", path);
@@ -198,37 +190,21 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
   meta.heatConvection = H5Aexists(gm.id, "heat_convection_J") > 0 ? readAttr<double>(gm.id, "heat_convection_J", path) : 0.0;
   meta.heatRadiation = H5Aexists(gm.id, "heat_radiation_J") > 0 ? readAttr<double>(gm.id, "heat_radiation_J", path) : 0.0;
   meta.heatWall = H5Aexists(gm.id, "heat_wall_J") > 0 ? readAttr<double>(gm.id, "heat_wall_J", path) : 0.0;
-  const hsize_t n = s.n, K = static_cast<hsize_t>(s.historySlots),
-                M = static_cast<hsize_t>(s.neighbourSlots), ns = static_cast<hsize_t>(s.nSpecies);
   {
-    Handle g{H5Gopen2(file.id, "particles", H5P_DEFAULT), H5Gclose};
-    readArray(g.id, "position", s.pos, 3 * n, path);
-    readArray(g.id, "velocity", s.vel, 3 * n, path);
-    readArray(g.id, "angular_velocity", s.omega, 3 * n, path);
-    readArray(g.id, "force", s.force, 3 * n, path);
-    readArray(g.id, "torque", s.torque, 3 * n, path);
-    readArray(g.id, "wall_force", s.fwall, 3 * n, path);
-    readArray(g.id, "position_at_rebuild", s.xref, 3 * n, path);
-    readArray(g.id, "radius", s.radius, n, path);
-    readArray(g.id, "mass", s.mass, n, path);
-    readArray(g.id, "density", s.density, n, path);
-    readArray(g.id, "temperature", s.temperature, n, path);
-    readArray(g.id, "species", s.species, n * ns, path);
-    readArray(g.id, "material", s.material, n, path);
-    readArray(g.id, "global_id", s.gid, n, path);
-    // Chemistry references: absent in files written before chemistry was integrated.
-    if (H5Lexists(g.id, "initial_diameter", H5P_DEFAULT) > 0) {
-      readArray(g.id, "initial_diameter", s.d0, n, path);
-    } else {
-      s.d0.resize(n);
-      for (std::size_t i = 0; i < n; ++i) s.d0[i] = 2.0 * s.radius[i];
-    }
-    if (H5Lexists(g.id, "chemistry_reference", H5P_DEFAULT) > 0) {
-      readArray(g.id, "chemistry_reference", s.chemRef, 2 * n, path);
-    } else {
-      s.chemRef.assign(2 * n, 0.0);
-    }
+    Handle gp{H5Gopen2(file.id, "particles", H5P_DEFAULT), H5Gclose};
+    Handle gc{H5Gopen2(file.id, "contacts", H5P_DEFAULT), H5Gclose};
+    schema::forEachField(s, [&](const schema::FieldInfo& f, auto& v) {
+      v.clear();
+      if (!f.has(schema::kCheckpointed)) return;  // filled from its default below
+      const hid_t g = f.group == schema::Group::Particles ? gp.id : gc.id;
+      const std::string name(f.name);
+      // A field newer than the file takes its default (below); from its version on it is required.
+      if (meta.formatVersion < f.since && H5Lexists(g, name.c_str(), H5P_DEFAULT) <= 0) return;
+      readArray(g, name.c_str(), v, s.expectedSize(f), path);
+    });
   }
+  fillDefaults(s);   // fields the file predates (schema defaults)
+  checkShapes(s, "readStateFile");
   meta.hasChemistry = H5Lexists(file.id, "chemistry", H5P_DEFAULT) > 0;
   if (meta.hasChemistry) {
     Handle gc{H5Gopen2(file.id, "chemistry", H5P_DEFAULT), H5Gclose};
@@ -253,13 +229,6 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
                                  ? readAttr<double>(gc.id, "sensible_mass_enthalpy_J", path) : 0.0;
     c.removedCount = readAttr<std::uint64_t>(gc.id, "removed_count", path);
   }
-  Handle g{H5Gopen2(file.id, "contacts", H5P_DEFAULT), H5Gclose};
-  readArray(g.id, "history_key", s.histKey, n * K, path);
-  readArray(g.id, "history_displacement", s.histDisp, 3 * n * K, path);
-  readArray(g.id, "contact_count", s.contacts, n, path);
-  readArray(g.id, "wall_contact_count", s.wallContacts, n, path);
-  readArray(g.id, "neighbour_count", s.nbCount, n, path);
-  readArray(g.id, "neighbour_list", s.nbList, n * M, path);
 }
 
 } // namespace coredem::dem
