@@ -392,19 +392,12 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   const std::size_t n = st.gid.size();
   COREDEM_CHECK(n < (1ull << 31), "{} particles: at most 2^31-1 are supported", n);
   st.n = n;
-  st.force.assign(3 * n, 0.0);
-  st.torque.assign(3 * n, 0.0);
-  st.fwall.assign(3 * n, 0.0);
   st.xref = st.pos;
-  st.contacts.assign(n, 0);
-  st.wallContacts.assign(n, 0);
-  st.histKey.assign(n * st.historySlots, -1);
-  st.histDisp.assign(3 * n * st.historySlots, 0.0);
-  st.nbCount.assign(n, 0);
-  st.nbList.assign(n * st.neighbourSlots, 0);
   st.listValid = 0;
   initChemistryReferences(config, st);  // d_p0, initial C / Fe2O3-equivalent masses
-  fillDefaults(st);  // schema fields not set above take their defaults
+  // Every other field (forces, contact counts, history, neighbour lists, ...) starts from its
+  // particle-schema default (zero; empty history slots −1).
+  fillDefaults(st);
   m.nParticles = n;
 
   const std::size_t nm = config.materials.size();

@@ -6,20 +6,21 @@
 /// fields they read and write with FieldMask bits; the engine syncs exactly those (`require`)
 /// and marks the written ones (`produced`).
 
-#include "backend/arrays.h"
-#include "coredem/dem/particle_schema.h"
-
 #include <cstddef>
 #include <cstdint>
+
+#include "backend/arrays.h"
+#include "coredem/dem/particle_schema.h"
 
 namespace coredem::dem {
 
 /// One bit per schema row, in table order: kPos, kVel, ..., kChemRef.
 enum FieldMask : std::uint32_t {
-#define COREDEM_FIELD_MASK_(member, Mask, ...) k##Mask = 1u << static_cast<int>(schema::Field::Mask),
+#define COREDEM_FIELD_MASK_(member, Mask, ...)                                                     \
+  k##Mask = 1u << static_cast<int>(schema::Field::Mask),
   COREDEM_PARTICLE_FIELDS(COREDEM_FIELD_MASK_)
 #undef COREDEM_FIELD_MASK_
-  kAllFields = schema::kFieldCount == 32 ? 0xffffffffu : (1u << schema::kFieldCount) - 1u
+      kAllFields = schema::kFieldCount == 32 ? 0xffffffffu : (1u << schema::kFieldCount) - 1u
 };
 
 template <class Exec>
@@ -29,15 +30,17 @@ struct ParticleStore {
 
   std::size_t n = 0;
   int nSpecies = 0;
-  int K = 0;  ///< history slots per particle
-  int M = 0;  ///< neighbour-list width per particle
+  int K = 0; ///< history slots per particle
+  int M = 0; ///< neighbour-list width per particle
 
   /// One mirror per schema row (`pos`, `vel`, ..., `chemRef`); widths and units in the schema.
 #define COREDEM_STORE_MEMBER_(member, Mask, T, ...) Arr<T> member;
   COREDEM_PARTICLE_FIELDS(COREDEM_STORE_MEMBER_)
 #undef COREDEM_STORE_MEMBER_
 
-  schema::Extents extents() const { return {nSpecies, K, M}; }
+  schema::Extents extents() const {
+    return {nSpecies, K, M};
+  }
   /// Values per particle of a field (its row's width for this store's extents).
   int width(const schema::FieldInfo& f) const {
     return static_cast<int>(schema::valuesPerParticle(f, extents()));
@@ -47,13 +50,18 @@ struct ParticleStore {
   template <class F>
   void forEach(std::uint32_t mask, F&& f) {
     schema::forEachField(*this, [&](const schema::FieldInfo& info, auto& a) {
-      if (mask & (1u << schema::indexOf(info))) f(a);
+      if (mask & (1u << schema::indexOf(info)))
+        f(a);
     });
   }
   /// Makes the device copies of `mask` current (before a kernel reads them).
-  void require(std::uint32_t mask) { forEach(mask, [](auto& a) { a.toDevice(); }); }
+  void require(std::uint32_t mask) {
+    forEach(mask, [](auto& a) { a.toDevice(); });
+  }
   /// Marks the device copies of `mask` as newer (after a kernel wrote them).
-  void produced(std::uint32_t mask) { forEach(mask, [](auto& a) { a.markDeviceModified(); }); }
+  void produced(std::uint32_t mask) {
+    forEach(mask, [](auto& a) { a.markDeviceModified(); });
+  }
   /// Host mirror → device for `mask`, after host-side writes.
   void toDevice(std::uint32_t mask) {
     forEach(mask, [](auto& a) {
@@ -62,7 +70,9 @@ struct ParticleStore {
     });
   }
   /// Device → host mirror for `mask`.
-  void toHost(std::uint32_t mask) { forEach(mask, [](auto& a) { a.toHost(); }); }
+  void toHost(std::uint32_t mask) {
+    forEach(mask, [](auto& a) { a.toHost(); });
+  }
 
   /// Sizes every field for `count` particles (contents undefined).
   void allocate(std::size_t count, int nSpeciesPerParticle, int slots, int width) {

@@ -1,17 +1,6 @@
 // The particle schema (coredem/dem/particle_schema.h): every row is allocated, re-sorted,
 // compacted and round-trips through the HDF5 state file exactly; older files read with the
 // table's defaults, newer ones are refused, and a size mismatch fails loudly.
-#include "backend/cpu/cpu_exec.h"
-#include "engine.h"
-#include "particle_store.h"
-#include "state_io.h"
-
-#include "coredem/common/check.h"
-#include "coredem/dem/particle_schema.h"
-
-#include <gtest/gtest.h>
-#include <hdf5.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -19,7 +8,16 @@
 #include <set>
 #include <string>
 
+#include <gtest/gtest.h>
+#include <hdf5.h>
 #include <unistd.h>
+
+#include "backend/cpu/cpu_exec.h"
+#include "coredem/common/check.h"
+#include "coredem/dem/particle_schema.h"
+#include "engine.h"
+#include "particle_store.h"
+#include "state_io.h"
 
 namespace fs = std::filesystem;
 using namespace coredem::dem;
@@ -28,8 +26,8 @@ namespace sc = coredem::dem::schema;
 namespace {
 
 constexpr int kTestSpecies = 2;
-constexpr int kTestSlots = 3;       // K
-constexpr int kTestNeighbours = 4;  // M
+constexpr int kTestSlots = 3;      // K
+constexpr int kTestNeighbours = 4; // M
 
 /// A value that identifies (field, particle gid, component) and is exact in every field type.
 double tag(int field, std::int64_t gid, std::size_t k) {
@@ -56,7 +54,7 @@ HostState taggedState(std::size_t n) {
     const auto g = static_cast<std::int64_t>(n - 1 - i);
     s.gid[i] = g;
     for (int d = 0; d < 3; ++d) {
-      s.pos[3 * i + d] = d == 0 ? 0.01 * static_cast<double>(g) : 0.0;  // 1 cm apart, r < 1 mm
+      s.pos[3 * i + d] = d == 0 ? 0.01 * static_cast<double>(g) : 0.0; // 1 cm apart, r < 1 mm
       s.xref[3 * i + d] = s.pos[3 * i + d];
       s.vel[3 * i + d] = s.omega[3 * i + d] = 0.0;
     }
@@ -72,10 +70,12 @@ HostState taggedState(std::size_t n) {
 template <class A, class B>
 void expectFieldsEqual(const A& a, const B& b, unsigned flag, const std::string& what) {
   sc::forEachField(a, b, [&](const sc::FieldInfo& f, const auto& va, const auto& vb) {
-    if (flag != 0 && !f.has(flag)) return;
+    if (flag != 0 && !f.has(flag))
+      return;
     ASSERT_EQ(va.size(), vb.size()) << what << ": " << f.name;
     for (std::size_t k = 0; k < va.size(); ++k) {
-      ASSERT_EQ(va[k], vb[k]) << what << ": field " << f.name << " value " << k;  // bitwise for doubles
+      ASSERT_EQ(va[k], vb[k]) << what << ": field " << f.name << " value "
+                              << k; // bitwise for doubles
     }
   });
 }
@@ -106,7 +106,9 @@ void editFile(const fs::path& path, F&& f) {
   H5Fclose(file);
 }
 
-std::string dataset(const sc::FieldInfo& f) { return "/" + std::string(sc::groupName(f.group)) + "/" + std::string(f.name); }
+std::string dataset(const sc::FieldInfo& f) {
+  return "/" + std::string(sc::groupName(f.group)) + "/" + std::string(f.name);
+}
 
 } // namespace
 
@@ -132,7 +134,8 @@ TEST(ParticleSchema, TableIsConsistent) {
   ASSERT_FALSE(snap.empty());
   EXPECT_EQ(snap.front().name, sc::kGeometryField);
   auto has = [&](std::string_view n) {
-    return std::any_of(snap.begin(), snap.end(), [&](const sc::FieldInfo& f) { return f.name == n; });
+    return std::any_of(snap.begin(), snap.end(),
+                       [&](const sc::FieldInfo& f) { return f.name == n; });
   };
   EXPECT_TRUE(has("temperature"));
   EXPECT_TRUE(has("velocity"));
@@ -144,14 +147,22 @@ TEST(ParticleSchema, EveryRowIsAllocatedWithItsWidth) {
   ParticleStore<backend::CpuExec> p;
   p.allocate(5, kTestSpecies, kTestSlots, kTestNeighbours);
   sc::forEachField(p, [&](const sc::FieldInfo& f, auto& a) {
-    EXPECT_EQ(a.size(), 5u * sc::valuesPerParticle(f, {kTestSpecies, kTestSlots, kTestNeighbours})) << f.name;
+    EXPECT_EQ(a.size(), 5u * sc::valuesPerParticle(f, {kTestSpecies, kTestSlots, kTestNeighbours}))
+        << f.name;
   });
-  EXPECT_EQ(sc::valuesPerParticle(sc::fieldInfo(sc::Field::HistDisp), {kTestSpecies, kTestSlots, kTestNeighbours}), 3u * kTestSlots);
-  EXPECT_EQ(sc::valuesPerParticle(sc::fieldInfo(sc::Field::Species), {kTestSpecies, kTestSlots, kTestNeighbours}), 2u);
-  EXPECT_EQ(sc::datasetDims(sc::fieldInfo(sc::Field::HistDisp), 5, {kTestSpecies, kTestSlots, kTestNeighbours}),
+  EXPECT_EQ(sc::valuesPerParticle(sc::fieldInfo(sc::Field::HistDisp),
+                                  {kTestSpecies, kTestSlots, kTestNeighbours}),
+            3u * kTestSlots);
+  EXPECT_EQ(sc::valuesPerParticle(sc::fieldInfo(sc::Field::Species),
+                                  {kTestSpecies, kTestSlots, kTestNeighbours}),
+            2u);
+  EXPECT_EQ(sc::datasetDims(sc::fieldInfo(sc::Field::HistDisp), 5,
+                            {kTestSpecies, kTestSlots, kTestNeighbours}),
             (std::vector<std::uint64_t>{5, kTestSlots, 3}));
-  EXPECT_EQ(sc::datasetDims(sc::fieldInfo(sc::Field::Radius), 5, {}), (std::vector<std::uint64_t>{5}));
-  EXPECT_EQ(sc::datasetDims(sc::fieldInfo(sc::Field::ChemRef), 5, {}), (std::vector<std::uint64_t>{5, 2}));
+  EXPECT_EQ(sc::datasetDims(sc::fieldInfo(sc::Field::Radius), 5, {}),
+            (std::vector<std::uint64_t>{5}));
+  EXPECT_EQ(sc::datasetDims(sc::fieldInfo(sc::Field::ChemRef), 5, {}),
+            (std::vector<std::uint64_t>{5, 2}));
 }
 
 TEST(ParticleSchema, EveryResortedRowFollowsItsParticle) {
@@ -166,20 +177,23 @@ TEST(ParticleSchema, EveryResortedRowFollowsItsParticle) {
   setup.threads = 1;
   auto engine = makeCpuEngine(setup);
   engine->setState(before);
-  engine->subStep(1e-6);  // rebuild: re-sorts by cell (ascending x, the reverse of the input)
+  engine->subStep(1e-6); // rebuild: re-sorts by cell (ascending x, the reverse of the input)
   const HostState after = engine->state();
   ASSERT_EQ(after.n, n);
   EXPECT_NE(after.gid, before.gid) << "the rebuild did not re-sort: the test proves nothing";
   std::map<std::int64_t, std::size_t> rowOf;
-  for (std::size_t i = 0; i < n; ++i) rowOf[before.gid[i]] = i;
+  for (std::size_t i = 0; i < n; ++i)
+    rowOf[before.gid[i]] = i;
   sc::forEachField(after, before, [&](const sc::FieldInfo& f, const auto& va, const auto& vb) {
-    if (!f.has(sc::kResorted)) return;
+    if (!f.has(sc::kResorted))
+      return;
     const std::size_t w = sc::valuesPerParticle(f, after.extents());
     ASSERT_EQ(va.size(), n * w) << f.name;
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t j = rowOf.at(after.gid[i]);
       for (std::size_t k = 0; k < w; ++k) {
-        ASSERT_EQ(va[i * w + k], vb[j * w + k]) << f.name << " of gid " << after.gid[i] << " value " << k;
+        ASSERT_EQ(va[i * w + k], vb[j * w + k])
+            << f.name << " of gid " << after.gid[i] << " value " << k;
       }
     }
   });
@@ -196,10 +210,12 @@ TEST(ParticleSchema, EveryCompactedRowKeepsItsParticle) {
   EXPECT_EQ(s.listValid, 0);
   checkShapes(s, "test");
   sc::forEachField(s, before, [&](const sc::FieldInfo& f, const auto& va, const auto& vb) {
-    if (!f.has(sc::kCompacted)) return;  // reset to its default; sized by checkShapes above
+    if (!f.has(sc::kCompacted))
+      return; // reset to its default; sized by checkShapes above
     const std::size_t w = sc::valuesPerParticle(f, s.extents());
     for (std::size_t a = 0; a < keep.size(); ++a)
-      for (std::size_t k = 0; k < w; ++k) ASSERT_EQ(va[a * w + k], vb[keep[a] * w + k]) << f.name;
+      for (std::size_t k = 0; k < w; ++k)
+        ASSERT_EQ(va[a * w + k], vb[keep[a] * w + k]) << f.name;
   });
 }
 
@@ -218,7 +234,8 @@ TEST(ParticleSchema, EveryRowRoundTripsThroughTheStateFileExactly) {
   // Each checkpointed field is its own dataset with the schema's shape.
   editFile(file, [&](hid_t f) {
     for (const sc::FieldInfo& info : sc::kFields) {
-      if (!info.has(sc::kCheckpointed)) continue;
+      if (!info.has(sc::kCheckpointed))
+        continue;
       const hid_t ds = H5Dopen2(f, dataset(info).c_str(), H5P_DEFAULT);
       ASSERT_GE(ds, 0) << dataset(info);
       const hid_t space = H5Dget_space(ds);
@@ -255,8 +272,8 @@ TEST(ParticleSchema, OlderFileReadsWithTheTableDefaults) {
   EXPECT_EQ(m.formatVersion, 1);
   checkShapes(r, "test");
   for (std::size_t i = 0; i < r.n; ++i) {
-    EXPECT_EQ(r.d0[i], 2.0 * s.radius[i]);  // Default::Diameter
-    EXPECT_EQ(r.chemRef[2 * i], 0.0);        // Default::Zero
+    EXPECT_EQ(r.d0[i], 2.0 * s.radius[i]); // Default::Diameter
+    EXPECT_EQ(r.chemRef[2 * i], 0.0);      // Default::Zero
     EXPECT_EQ(r.chemRef[2 * i + 1], 0.0);
   }
   // The fields the old file has are read as they are.
@@ -272,7 +289,9 @@ TEST(ParticleSchema, CurrentFileMissingAFieldIsRefused) {
   const HostState s = taggedState(3);
   const fs::path file = tempFile("missing.h5");
   writeStateFile(file.string(), s, someMeta());
-  editFile(file, [&](hid_t f) { ASSERT_GE(H5Ldelete(f, "/particles/initial_diameter", H5P_DEFAULT), 0); });
+  editFile(file, [&](hid_t f) {
+    ASSERT_GE(H5Ldelete(f, "/particles/initial_diameter", H5P_DEFAULT), 0);
+  });
   HostState r;
   StateMeta m;
   try {
@@ -291,8 +310,8 @@ TEST(ParticleSchema, NewerFormatIsRefusedWithAClearError) {
   editFile(file, [&](hid_t f) {
     ASSERT_GE(H5Adelete_by_name(f, "meta", "format_version", H5P_DEFAULT), 0);
     const hid_t space = H5Screate(H5S_SCALAR);
-    const hid_t a = H5Acreate_by_name(f, "meta", "format_version", H5T_NATIVE_INT32, space, H5P_DEFAULT,
-                                      H5P_DEFAULT, H5P_DEFAULT);
+    const hid_t a = H5Acreate_by_name(f, "meta", "format_version", H5T_NATIVE_INT32, space,
+                                      H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     ASSERT_GE(a, 0);
     const std::int32_t v = sc::kFormatVersion + 1;
     ASSERT_GE(H5Awrite(a, H5T_NATIVE_INT32, &v), 0);
@@ -306,7 +325,8 @@ TEST(ParticleSchema, NewerFormatIsRefusedWithAClearError) {
     FAIL() << "a newer file was accepted";
   } catch (const coredem::UserError& e) {
     const std::string w = e.what();
-    EXPECT_NE(w.find("format version " + std::to_string(sc::kFormatVersion + 1)), std::string::npos) << w;
+    EXPECT_NE(w.find("format version " + std::to_string(sc::kFormatVersion + 1)), std::string::npos)
+        << w;
     EXPECT_NE(w.find("newer"), std::string::npos) << w;
   }
   fs::remove_all(file.parent_path());
@@ -355,7 +375,9 @@ TEST(ParticleSchema, SizeMismatchFailsLoudly) {
     readStateFile(file.string(), r, m);
     FAIL() << "a short dataset was accepted";
   } catch (const coredem::UserError& e) {
-    EXPECT_NE(std::string(e.what()).find("'temperature' has 3 values, expected 4"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("'temperature' has 3 values, expected 4"),
+              std::string::npos)
+        << e.what();
   }
   fs::remove_all(file.parent_path());
 }
@@ -369,8 +391,9 @@ TEST(ParticleSchema, DefaultsFillFieldsAConstructorLeavesEmpty) {
   checkShapes(s, "test");
   EXPECT_EQ(s.force, std::vector<double>(9, 0.0));
   EXPECT_EQ(s.histKey, std::vector<std::int64_t>(3 * kTestSlots, -1));
-  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(s.d0[i], 2.0 * s.radius[i]);
-  s.radius.clear();  // Required: no default
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_EQ(s.d0[i], 2.0 * s.radius[i]);
+  s.radius.clear(); // Required: no default
   fillDefaults(s);
   EXPECT_THROW(checkShapes(s, "test"), coredem::InternalError);
 }

@@ -80,10 +80,10 @@ enum class Per { Particle, Species, History, Neighbour };
 enum class Default { Required, Zero, MinusOne, Diameter };
 
 enum Flag : unsigned {
-  kResorted = 1u << 0,      ///< moved with its particle when particles are re-sorted
-  kCompacted = 1u << 1,     ///< kept with its particle when particles are removed (else reset)
-  kCheckpointed = 1u << 2,  ///< written to and read from the HDF5 state file
-  kSnapshot = 1u << 3,      ///< a node attribute of the snapshot XDMF (position: the geometry)
+  kResorted = 1u << 0,     ///< moved with its particle when particles are re-sorted
+  kCompacted = 1u << 1,    ///< kept with its particle when particles are removed (else reset)
+  kCheckpointed = 1u << 2, ///< written to and read from the HDF5 state file
+  kSnapshot = 1u << 3,     ///< a node attribute of the snapshot XDMF (position: the geometry)
 };
 
 /// One row of the table.
@@ -106,11 +106,17 @@ struct FieldInfo {
 template <class T>
 constexpr Type typeOf();
 template <>
-constexpr Type typeOf<double>() { return Type::Float64; }
+constexpr Type typeOf<double>() {
+  return Type::Float64;
+}
 template <>
-constexpr Type typeOf<std::int32_t>() { return Type::Int32; }
+constexpr Type typeOf<std::int32_t>() {
+  return Type::Int32;
+}
 template <>
-constexpr Type typeOf<std::int64_t>() { return Type::Int64; }
+constexpr Type typeOf<std::int64_t>() {
+  return Type::Int64;
+}
 
 /// Field identifiers in table order (bit k of FieldMask is field k).
 enum class Field : int {
@@ -121,49 +127,63 @@ enum class Field : int {
 
 /// The table as data.
 inline constexpr FieldInfo kFields[] = {
+// clang-format off
 #define COREDEM_SCHEMA_ROW_(member, Mask, T, name, group, comps, per, unit, flags, since, def, doc) \
   FieldInfo{#member, name, typeOf<T>(), Group::group, comps, Per::per, unit, flags, since, Default::def, doc},
+    // clang-format on
     COREDEM_PARTICLE_FIELDS(COREDEM_SCHEMA_ROW_)
 #undef COREDEM_SCHEMA_ROW_
 };
 
 inline constexpr int kFieldCount = static_cast<int>(sizeof(kFields) / sizeof(kFields[0]));
 
-constexpr const FieldInfo& fieldInfo(Field f) { return kFields[static_cast<int>(f)]; }
+constexpr const FieldInfo& fieldInfo(Field f) {
+  return kFields[static_cast<int>(f)];
+}
 /// Row index of a FieldInfo of kFields (its FieldMask bit).
-constexpr int indexOf(const FieldInfo& f) { return static_cast<int>(&f - kFields); }
+constexpr int indexOf(const FieldInfo& f) {
+  return static_cast<int>(&f - kFields);
+}
 
 /// Per-run extents the widths depend on.
 struct Extents {
-  int nSpecies = 0;        ///< solid species per particle
-  int historySlots = 0;    ///< K, tangential-history slots per particle
-  int neighbourSlots = 0;  ///< M, neighbour-list width per particle
+  int nSpecies = 0;       ///< solid species per particle
+  int historySlots = 0;   ///< K, tangential-history slots per particle
+  int neighbourSlots = 0; ///< M, neighbour-list width per particle
 };
 
 /// Values per particle of a field.
 constexpr std::size_t valuesPerParticle(const FieldInfo& f, const Extents& e) {
   const auto c = static_cast<std::size_t>(f.components);
   switch (f.per) {
-  case Per::Species: return c * static_cast<std::size_t>(e.nSpecies);
-  case Per::History: return c * static_cast<std::size_t>(e.historySlots);
-  case Per::Neighbour: return c * static_cast<std::size_t>(e.neighbourSlots);
-  case Per::Particle: break;
+  case Per::Species:
+    return c * static_cast<std::size_t>(e.nSpecies);
+  case Per::History:
+    return c * static_cast<std::size_t>(e.historySlots);
+  case Per::Neighbour:
+    return c * static_cast<std::size_t>(e.neighbourSlots);
+  case Per::Particle:
+    break;
   }
   return c;
 }
 
 /// HDF5 dataset shape of a field for n particles: [n], [n, comps], [n, slots] or [n, slots, comps].
-inline std::vector<std::uint64_t> datasetDims(const FieldInfo& f, std::uint64_t n, const Extents& e) {
+inline std::vector<std::uint64_t> datasetDims(const FieldInfo& f, std::uint64_t n,
+                                              const Extents& e) {
   std::vector<std::uint64_t> dims{n};
   if (f.per != Per::Particle) {
     dims.push_back(valuesPerParticle(f, e) / static_cast<std::size_t>(f.components));
   }
-  if (f.components > 1) dims.push_back(static_cast<std::uint64_t>(f.components));
+  if (f.components > 1)
+    dims.push_back(static_cast<std::uint64_t>(f.components));
   return dims;
 }
 
 /// HDF5 group of a field ("particles" or "contacts").
-constexpr const char* groupName(Group g) { return g == Group::Particles ? "particles" : "contacts"; }
+constexpr const char* groupName(Group g) {
+  return g == Group::Particles ? "particles" : "contacts";
+}
 
 /// The snapshot field that is the XDMF geometry (every other snapshot field is an attribute).
 inline constexpr std::string_view kGeometryField = "position";
@@ -174,7 +194,8 @@ inline constexpr std::string_view kGeometryField = "position";
 inline std::vector<FieldInfo> snapshotFields() {
   std::vector<FieldInfo> out;
   for (const FieldInfo& f : kFields) {
-    if (f.has(kSnapshot)) out.push_back(f);
+    if (f.has(kSnapshot))
+      out.push_back(f);
   }
   return out;
 }
@@ -184,18 +205,23 @@ namespace detail {
 constexpr bool uniqueNames() {
   for (int a = 0; a < kFieldCount; ++a)
     for (int b = a + 1; b < kFieldCount; ++b)
-      if (kFields[a].name == kFields[b].name || kFields[a].member == kFields[b].member) return false;
+      if (kFields[a].name == kFields[b].name || kFields[a].member == kFields[b].member)
+        return false;
   return true;
 }
 constexpr bool rowsValid() {
   for (const FieldInfo& f : kFields) {
-    if (f.components < 1 || f.since < 1 || f.since > kFormatVersion) return false;
+    if (f.components < 1 || f.since < 1 || f.since > kFormatVersion)
+      return false;
     // A field introduced after version 1 needs a default for older files.
-    if (f.since > 1 && f.def == Default::Required) return false;
+    if (f.since > 1 && f.def == Default::Required)
+      return false;
     // A field that is not compacted is reset after a removal: it needs a default.
-    if (!f.has(kCompacted) && f.def == Default::Required) return false;
+    if (!f.has(kCompacted) && f.def == Default::Required)
+      return false;
     // Neighbour indices are in internal order: re-sorting them would make them wrong.
-    if (f.per == Per::Neighbour && f.has(kResorted)) return false;
+    if (f.per == Per::Neighbour && f.has(kResorted))
+      return false;
     // Snapshot attributes are node attributes of /particles: scalars or 3-vectors.
     if (f.has(kSnapshot) && (f.group != Group::Particles || f.per != Per::Particle ||
                              (f.components != 1 && f.components != 3) || !f.has(kCheckpointed)))
@@ -206,16 +232,18 @@ constexpr bool rowsValid() {
 } // namespace detail
 static_assert(kFieldCount <= 32, "FieldMask is 32 bits wide");
 static_assert(detail::uniqueNames(), "particle schema: duplicate member or dataset name");
-static_assert(detail::rowsValid(), "particle schema: inconsistent row (see the rules in detail::rowsValid)");
-static_assert(kFields[0].name == kGeometryField && kFields[0].has(kSnapshot), "position is the first field");
+static_assert(detail::rowsValid(),
+              "particle schema: inconsistent row (see the rules in detail::rowsValid)");
+static_assert(kFields[0].name == kGeometryField && kFields[0].has(kSnapshot),
+              "position is the first field");
 
 } // namespace coredem::dem::schema
 
 /// Calls `f(info, a.member, b.member)` for every row (a, b: ParticleStore or HostState).
-#define COREDEM_SCHEMA_ZIP_(member, Mask, ...)                                                    \
+#define COREDEM_SCHEMA_ZIP_(member, Mask, ...)                                                     \
   f(::coredem::dem::schema::fieldInfo(::coredem::dem::schema::Field::Mask), a.member, b.member);
 /// Calls `f(info, a.member)` for every row.
-#define COREDEM_SCHEMA_VISIT_(member, Mask, ...)                                                  \
+#define COREDEM_SCHEMA_VISIT_(member, Mask, ...)                                                   \
   f(::coredem::dem::schema::fieldInfo(::coredem::dem::schema::Field::Mask), a.member);
 
 namespace coredem::dem::schema {
