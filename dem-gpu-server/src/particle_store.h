@@ -20,8 +20,10 @@ enum FieldMask : std::uint32_t {
   k##Mask = 1u << static_cast<int>(schema::Field::Mask),
   COREDEM_PARTICLE_FIELDS(COREDEM_FIELD_MASK_)
 #undef COREDEM_FIELD_MASK_
-      kAllFields = schema::kFieldCount == 32 ? 0xffffffffu : (1u << schema::kFieldCount) - 1u
 };
+/// Every field of the schema.
+inline constexpr std::uint32_t kAllFields =
+    schema::kFieldCount == 32 ? 0xffffffffu : (1u << schema::kFieldCount) - 1u;
 
 template <class Exec>
 struct ParticleStore {
