@@ -65,6 +65,24 @@ void readArray(hid_t group, const char* name, std::vector<T>& v, hsize_t expecte
   }
 }
 
+/// "[a, b, c]"
+std::string shapeText(const std::vector<hsize_t>& dims) {
+  std::string t = "[";
+  for (std::size_t k = 0; k < dims.size(); ++k) t += (k > 0 ? ", " : "") + std::to_string(dims[k]);
+  return t + "]";
+}
+
+/// Checks that dataset `name` of `group` has the shape `dims` (after its value count matched).
+void checkShape(hid_t group, const char* name, const std::vector<hsize_t>& dims, const std::string& path) {
+  Handle ds{H5Dopen2(group, name, H5P_DEFAULT), H5Dclose};
+  Handle space{H5Dget_space(ds.id), H5Sclose};
+  const int rank = H5Sget_simple_extent_ndims(space.id);
+  std::vector<hsize_t> got(static_cast<std::size_t>(rank < 0 ? 0 : rank));
+  H5Sget_simple_extent_dims(space.id, got.data(), nullptr);
+  COREDEM_CHECK(got == dims, "state file '{}': dataset '{}' has shape {}, expected {}", path, name,
+                shapeText(got), shapeText(dims));
+}
+
 template <class T>
 void writeAttr(hid_t obj, const char* name, T value) {
   Handle space{H5Screate(H5S_SCALAR), H5Sclose};
@@ -201,6 +219,8 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
       // A field newer than the file takes its default (below); from its version on it is required.
       if (meta.formatVersion < f.since && H5Lexists(g, name.c_str(), H5P_DEFAULT) <= 0) return;
       readArray(g, name.c_str(), v, s.expectedSize(f), path);
+      const std::vector<std::uint64_t> dims = schema::datasetDims(f, s.n, s.extents());
+      checkShape(g, name.c_str(), std::vector<hsize_t>(dims.begin(), dims.end()), path);
     });
   }
   fillDefaults(s);   // fields the file predates (schema defaults)

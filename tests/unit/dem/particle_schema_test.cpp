@@ -379,6 +379,27 @@ TEST(ParticleSchema, SizeMismatchFailsLoudly) {
               std::string::npos)
         << e.what();
   }
+  // The right number of values in the wrong shape ([3N] for [N, 3]) is refused too.
+  const fs::path flat = tempFile("flat.h5");
+  writeStateFile(flat.string(), taggedState(4), someMeta());
+  editFile(flat, [&](hid_t f) {
+    ASSERT_GE(H5Ldelete(f, "/particles/velocity", H5P_DEFAULT), 0);
+    const hsize_t twelve = 12;
+    const hid_t space = H5Screate_simple(1, &twelve, nullptr);
+    const hid_t ds = H5Dcreate2(f, "/particles/velocity", H5T_NATIVE_DOUBLE, space, H5P_DEFAULT,
+                                H5P_DEFAULT, H5P_DEFAULT);
+    const std::vector<double> zeros(12, 0.0);
+    H5Dwrite(ds, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, zeros.data());
+    H5Dclose(ds);
+    H5Sclose(space);
+  });
+  try {
+    readStateFile(flat.string(), r, m);
+    FAIL() << "a flattened dataset was accepted";
+  } catch (const coredem::UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("'velocity' has shape [12], expected [4, 3]"), std::string::npos)
+        << e.what();
+  }
   fs::remove_all(file.parent_path());
 }
 
