@@ -397,7 +397,8 @@ TEST(ParticleSchema, SizeMismatchFailsLoudly) {
     readStateFile(flat.string(), r, m);
     FAIL() << "a flattened dataset was accepted";
   } catch (const coredem::UserError& e) {
-    EXPECT_NE(std::string(e.what()).find("'velocity' has shape [12], expected [4, 3]"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("'velocity' has shape [12], expected [4, 3]"),
+              std::string::npos)
         << e.what();
   }
   fs::remove_all(file.parent_path());
