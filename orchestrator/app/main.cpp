@@ -14,7 +14,7 @@
 #include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/outputs.h>
-#include <coredem/orchestrator/processes.h>
+#include <coredem/common/process.h>
 #include <coredem/orchestrator/session.h>
 #include <coredem/orchestrator/verify.h>
 
@@ -34,7 +34,7 @@ void makePlots(const fs::path& runDir) {
               script.string());
     return;
   }
-  ChildProcess plot("plot script", {python.string(), script.string(), runDir.string()}, {},
+  coredem::ChildProcess plot("plot script", {python.string(), script.string(), runDir.string()}, {},
                     runDir / "logs" / "plot.log");
   if (!plot.waitFor(std::chrono::seconds(120))) {
     plot.stop();

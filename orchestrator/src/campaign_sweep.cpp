@@ -69,11 +69,7 @@ struct SweepReader {
   std::string file;
   [[noreturn]] void fail(const YAML::Node& at, const std::string& key,
                          const std::string& what) const {
-    const YAML::Mark mk = at.Mark();
-    if (mk.line >= 0) {
-      throw CaseError(fmt::format("{}:{}:{}: {}: {}", file, mk.line + 1, mk.column + 1, key, what));
-    }
-    throw CaseError(fmt::format("{}: {}: {}", file, key, what));
+    yaml::fail(file, at.Mark(), key, what);
   }
   int integer(const YAML::Node& n, const std::string& key, int min, const std::string& what) const {
     try {

@@ -6,6 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <coredem/common/yaml_section.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/sha256.h>
 
@@ -14,225 +15,9 @@ namespace fs = std::filesystem;
 namespace coredem::orchestrator {
 namespace {
 
-std::string join(const std::vector<std::string>& items) {
-  std::string out;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    out += (i ? ", " : "") + items[i];
-  }
-  return out;
-}
-
-std::string describe(const YAML::Node& n) {
-  switch (n.Type()) {
-  case YAML::NodeType::Null:
-    return "nothing (null)";
-  case YAML::NodeType::Sequence:
-    return "a list";
-  case YAML::NodeType::Map:
-    return "a mapping";
-  case YAML::NodeType::Scalar:
-    return "'" + n.Scalar() + "'";
-  default:
-    return "an undefined value";
-  }
-}
-
-/// A mapping of the case file with the keys it allows. Every accessor checks type and range
-/// and throws CaseError with "file:line:col: key: problem; allowed".
-class Section {
-public:
-  Section(YAML::Node node, std::string file, std::string path, std::vector<std::string> allowed,
-          const YAML::Mark& parentMark)
-      : _node(std::move(node))
-      , _file(std::move(file))
-      , _path(std::move(path))
-      , _allowed(std::move(allowed)) {
-    const YAML::Mark mark = _node.IsDefined() && !_node.IsNull() ? _node.Mark() : parentMark;
-    if (!_node.IsMap()) {
-      fail(mark, _path.empty() ? "the case file" : _path,
-           fmt::format("expected a mapping with keys {}, got {}", join(_allowed), describe(_node)));
-    }
-    for (const auto& kv : _node) {
-      const std::string key = kv.first.Scalar();
-      if (std::find(_allowed.begin(), _allowed.end(), key) == _allowed.end()) {
-        fail(kv.first.Mark(), full(key),
-             fmt::format("unknown key; allowed keys {}: {}",
-                         _path.empty() ? "at the top level" : "in '" + _path + "'",
-                         join(_allowed)));
-      }
-    }
-  }
-
-  [[noreturn]] void fail(const YAML::Mark& mark, const std::string& key,
-                         const std::string& what) const {
-    if (mark.line >= 0) {
-      throw CaseError(
-          fmt::format("{}:{}:{}: {}: {}", _file, mark.line + 1, mark.column + 1, key, what));
-    }
-    throw CaseError(fmt::format("{}: {}: {}", _file, key, what));
-  }
-
-  std::string full(const std::string& key) const { return _path.empty() ? key : _path + "." + key; }
-  bool has(const std::string& key) const { return bool(_node[key]); }
-  YAML::Node raw(const std::string& key) const { return _node[key]; }
-  YAML::Mark mark() const { return _node.Mark(); }
-  YAML::Mark markOf(const std::string& key) const {
-    for (const auto& kv : _node) {
-      if (kv.first.Scalar() == key) {
-        return kv.second.IsNull() ? kv.first.Mark() : kv.second.Mark();
-      }
-    }
-    return _node.Mark();
-  }
-  const std::string& file() const { return _file; }
-
-  void require(const std::string& key, const std::string& what) const {
-    if (!has(key)) {
-      fail(_node.Mark(), _path.empty() ? "the case file" : _path,
-           fmt::format("missing required key '{}' ({})", key, what));
-    }
-  }
-
-  double number(const std::string& key, std::optional<double> def, double lo, double hi,
-                const std::string& what, bool loOpen = false) const {
-    if (!has(key)) {
-      if (!def) {
-        require(key, what);
-      }
-      return *def;
-    }
-    return numberOf(_node[key], full(key), lo, hi, what, loOpen);
-  }
-
-  double numberOf(const YAML::Node& n, const std::string& key, double lo, double hi,
-                  const std::string& what, bool loOpen = false) const {
-    double v = 0.0;
-    bool ok = n.IsScalar();
-    if (ok) {
-      try {
-        v = n.as<double>();
-      } catch (const YAML::Exception&) {
-        ok = false;
-      }
-    }
-    if (!ok || !std::isfinite(v)) {
-      fail(n.Mark(), key, fmt::format("expected a number ({}), got {}", what, describe(n)));
-    }
-    if (v < lo || v > hi || (loOpen && v == lo)) {
-      fail(n.Mark(), key,
-           fmt::format("{} is out of range; allowed: {} ({})", v, rangeText(lo, hi, loOpen), what));
-    }
-    return v;
-  }
-
-  std::int64_t integer(const std::string& key, std::optional<std::int64_t> def, std::int64_t lo,
-                       std::int64_t hi, const std::string& what) const {
-    if (!has(key)) {
-      if (!def) {
-        require(key, what);
-      }
-      return *def;
-    }
-    const YAML::Node n = _node[key];
-    std::int64_t v = 0;
-    bool ok = n.IsScalar();
-    if (ok) {
-      try {
-        v = n.as<std::int64_t>();
-      } catch (const YAML::Exception&) {
-        ok = false;
-      }
-    }
-    if (!ok) {
-      fail(n.Mark(), full(key), fmt::format("expected an integer ({}), got {}", what, describe(n)));
-    }
-    if (v < lo || v > hi) {
-      fail(n.Mark(), full(key),
-           fmt::format("{} is out of range; allowed: {} to {} ({})", v, lo, hi, what));
-    }
-    return v;
-  }
-
-  std::string string(const std::string& key, std::optional<std::string> def,
-                     const std::string& what) const {
-    if (!has(key)) {
-      if (!def) {
-        require(key, what);
-      }
-      return *def;
-    }
-    const YAML::Node n = _node[key];
-    if (!n.IsScalar()) {
-      fail(n.Mark(), full(key), fmt::format("expected a string ({}), got {}", what, describe(n)));
-    }
-    return n.Scalar();
-  }
-
-  std::string choice(const std::string& key, std::optional<std::string> def,
-                     const std::vector<std::string>& options) const {
-    const std::string v = string(key, def, "one of " + join(options));
-    if (std::find(options.begin(), options.end(), v) == options.end()) {
-      fail(markOf(key), full(key),
-           fmt::format("'{}' is not allowed; allowed: {}", v, join(options)));
-    }
-    return v;
-  }
-
-  Vec3 vec3(const std::string& key, std::optional<Vec3> def, const std::string& what,
-            double lo = -std::numeric_limits<double>::max(),
-            double hi = std::numeric_limits<double>::max(), bool loOpen = false) const {
-    if (!has(key)) {
-      if (!def) {
-        require(key, what);
-      }
-      return *def;
-    }
-    const YAML::Node n = _node[key];
-    if (!n.IsSequence() || n.size() != 3) {
-      fail(n.Mark(), full(key),
-           fmt::format("expected a list of 3 numbers [x, y, z] ({}), got {}", what, describe(n)));
-    }
-    Vec3 v{};
-    for (std::size_t i = 0; i < 3; ++i) {
-      v[i] = numberOf(n[i], fmt::format("{}[{}]", full(key), i), lo, hi, what, loOpen);
-    }
-    return v;
-  }
-
-  Section section(const std::string& key, std::vector<std::string> allowed) const {
-    return Section(_node[key], _file, full(key), std::move(allowed), markOf(key));
-  }
-
-  std::vector<Section> list(const std::string& key, std::vector<std::string> allowed,
-                            const std::string& what) const {
-    const YAML::Node n = _node[key];
-    if (!n.IsSequence()) {
-      fail(markOf(key), full(key), fmt::format("expected a list ({}), got {}", what, describe(n)));
-    }
-    std::vector<Section> out;
-    for (std::size_t i = 0; i < n.size(); ++i) {
-      out.emplace_back(n[i], _file, fmt::format("{}[{}]", full(key), i), allowed, n.Mark());
-    }
-    return out;
-  }
-
-private:
-  static std::string rangeText(double lo, double hi, bool loOpen) {
-    const double big = std::numeric_limits<double>::max();
-    if (hi == big && lo == -big) {
-      return "any finite number";
-    }
-    if (hi == big) {
-      return fmt::format("{} {}", loOpen ? ">" : ">=", lo);
-    }
-    return fmt::format("{} {} and <= {}", loOpen ? ">" : ">=", lo, hi);
-  }
-
-  YAML::Node _node;
-  std::string _file;
-  std::string _path;
-  std::vector<std::string> _allowed;
-};
+using yaml::describe;
+using yaml::join;
+using yaml::Section;
 
 constexpr double kBig = std::numeric_limits<double>::max();
 
@@ -244,22 +29,7 @@ const std::vector<std::string> kClgKinetics = {
     "K_H2O", "dH_H2O", "K_H2", "dH_H2", "rho_m", "r_grain", "k0_CO", "E_CO",
     "n_CO",  "k0_H2", "E_H2", "n_H2", "kf0", "Ef_over_R"};
 
-bool onOff(const Section& s, const std::string& key, bool def) {
-  if (!s.has(key)) {
-    return def;
-  }
-  const YAML::Node n = s.raw(key);
-  if (n.IsScalar()) {
-    const std::string v = n.Scalar();
-    if (v == "on" || v == "true" || v == "yes") {
-      return true;
-    }
-    if (v == "off" || v == "false" || v == "no") {
-      return false;
-    }
-  }
-  s.fail(s.markOf(key), s.full(key), fmt::format("expected on or off, got {}", describe(n)));
-}
+bool onOff(const Section& s, const std::string& key, bool def) { return s.onOff(key, def); }
 
 const SpeciesConfig* findSpecies(const std::vector<SpeciesConfig>& list, const std::string& name) {
   for (const auto& sp : list) {
@@ -497,13 +267,7 @@ int materialIndex(const CaseConfig& config, const std::string& name) {
 
 CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::path& caseDir) {
   const std::string fileName = file.string();
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}", fileName, e.mark.line + 1,
-                                e.mark.column + 1, e.msg));
-  }
+  const YAML::Node root = yaml::parse(text, fileName);
   CaseConfig c;
   c.caseDir = caseDir;
   c.caseFile = fs::absolute(file);

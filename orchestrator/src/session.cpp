@@ -15,7 +15,7 @@
 #include <coredem/common/log.h>
 #include <coredem/orchestrator/checkpoint.h>
 #include <coredem/orchestrator/outputs.h>
-#include <coredem/orchestrator/processes.h>
+#include <coredem/common/process.h>
 #include <coredem/orchestrator/progress.h>
 #include <coredem/orchestrator/session.h>
 #include <coredem/orchestrator/sha256.h>

@@ -21,7 +21,7 @@
 #include <coredem/common/log.h>
 #include <coredem/dem/verification/analytic.h>
 #include <coredem/orchestrator/case_config.h>
-#include <coredem/orchestrator/processes.h>
+#include <coredem/common/process.h>
 #include <coredem/orchestrator/session.h>
 
 namespace fs = std::filesystem;

@@ -215,27 +215,13 @@ Message& Message::setTime(double time) {
   return *this;
 }
 
-#define COREDEM_SET_BODY(Type, field, TYPE)                                                   \
-  Message& Message::setBody(const v1::Type& body) {                                           \
+#define COREDEM_SET_BODY(Body, field, TYPE)                                                   \
+  Message& Message::setBody(const v1::Body& body) {                                           \
     *_impl->envelope.mutable_##field() = body;                                                \
-    _impl->envelope.set_type(v1::MESSAGE_TYPE_##TYPE);                                        \
+    _impl->envelope.set_type(MessageTraits<v1::Body>::type);                                  \
     return *this;                                                                             \
   }
-COREDEM_SET_BODY(Hello, hello, HELLO)
-COREDEM_SET_BODY(Welcome, welcome, WELCOME)
-COREDEM_SET_BODY(Reject, reject, REJECT)
-COREDEM_SET_BODY(Configure, configure, CONFIGURE)
-COREDEM_SET_BODY(Configured, configured, CONFIGURED)
-COREDEM_SET_BODY(GasFields, gas_fields, GAS_FIELDS)
-COREDEM_SET_BODY(Sources, sources, SOURCES)
-COREDEM_SET_BODY(StepGrant, step_grant, STEP_GRANT)
-COREDEM_SET_BODY(StepDone, step_done, STEP_DONE)
-COREDEM_SET_BODY(CheckpointRequest, checkpoint_request, CHECKPOINT_REQUEST)
-COREDEM_SET_BODY(CheckpointDone, checkpoint_done, CHECKPOINT_DONE)
-COREDEM_SET_BODY(Heartbeat, heartbeat, HEARTBEAT)
-COREDEM_SET_BODY(Error, error, ERROR)
-COREDEM_SET_BODY(Shutdown, shutdown, SHUTDOWN)
-COREDEM_SET_BODY(Ack, ack, ACK)
+COREDEM_PROTOCOL_MESSAGES(COREDEM_SET_BODY)
 #undef COREDEM_SET_BODY
 
 namespace {

@@ -24,42 +24,10 @@ std::string shapeString(const std::vector<std::uint64_t>& shape) {
   return s + "]";
 }
 
-/// The body case that belongs to a message type.
+/// The body case that belongs to a message type (message_types.h).
 v1::Envelope::BodyCase bodyCaseOf(v1::MessageType type) {
-  switch (type) {
-  case v1::MESSAGE_TYPE_HELLO:
-    return v1::Envelope::kHello;
-  case v1::MESSAGE_TYPE_WELCOME:
-    return v1::Envelope::kWelcome;
-  case v1::MESSAGE_TYPE_REJECT:
-    return v1::Envelope::kReject;
-  case v1::MESSAGE_TYPE_CONFIGURE:
-    return v1::Envelope::kConfigure;
-  case v1::MESSAGE_TYPE_CONFIGURED:
-    return v1::Envelope::kConfigured;
-  case v1::MESSAGE_TYPE_GAS_FIELDS:
-    return v1::Envelope::kGasFields;
-  case v1::MESSAGE_TYPE_SOURCES:
-    return v1::Envelope::kSources;
-  case v1::MESSAGE_TYPE_STEP_GRANT:
-    return v1::Envelope::kStepGrant;
-  case v1::MESSAGE_TYPE_STEP_DONE:
-    return v1::Envelope::kStepDone;
-  case v1::MESSAGE_TYPE_CHECKPOINT_REQUEST:
-    return v1::Envelope::kCheckpointRequest;
-  case v1::MESSAGE_TYPE_CHECKPOINT_DONE:
-    return v1::Envelope::kCheckpointDone;
-  case v1::MESSAGE_TYPE_HEARTBEAT:
-    return v1::Envelope::kHeartbeat;
-  case v1::MESSAGE_TYPE_ERROR:
-    return v1::Envelope::kError;
-  case v1::MESSAGE_TYPE_SHUTDOWN:
-    return v1::Envelope::kShutdown;
-  case v1::MESSAGE_TYPE_ACK:
-    return v1::Envelope::kAck;
-  default:
-    return v1::Envelope::BODY_NOT_SET;
-  }
+  const MessageTypeInfo* row = findMessageType(type);
+  return row != nullptr ? row->bodyCase : v1::Envelope::BODY_NOT_SET;
 }
 
 template <class T>

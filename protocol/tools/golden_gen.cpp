@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <utility>
+#include <algorithm>
 #include <filesystem>
 
 using namespace coredem::protocol;
@@ -294,6 +295,16 @@ int main(int argc, char** argv) {
     Message m = makeAck("shutting down");
     stamp(m, 7);
     all.emplace_back("ack", std::move(m));
+  }
+  // Every row of the message table (message_types.h) has its golden message.
+  for (const auto& row : kMessageTypes) {
+    const bool found = std::any_of(all.begin(), all.end(),
+                                   [&](const auto& e) { return e.second.type() == row.type; });
+    if (!found) {
+      std::fprintf(stderr, "coredem-golden-gen: no golden message for '%s': add one above\n",
+                   std::string(row.field).c_str());
+      return 1;
+    }
   }
   for (const auto& [name, message] : all) {
     auto path = dir / (name + ".cdmf");

@@ -3,6 +3,7 @@
 
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
+#include "coredem/common/version.h"
 #include "coredem/protocol/protocol.h"
 
 #include <algorithm>
@@ -20,7 +21,7 @@ namespace proto = coredem::protocol;
 
 namespace {
 
-constexpr const char* kLibraryVersion = "coredem-client 0.1.0";
+const std::string kLibraryVersion = std::string("coredem-client ") + coredem::kVersion;
 constexpr double kDefaultTimeoutS = 60.0;
 /// |dt - granted dt| <= kDtTolerance * granted dt (the DEM sub-cycles exactly the granted dt).
 constexpr double kDtTolerance = 1e-12;

@@ -6,7 +6,9 @@
 
 #include "coredem/client/participant.h"
 #include "coredem/common/check.h"
+#include "coredem/common/compensated_sum.h"
 #include "coredem/common/log.h"
+#include "coredem/common/version.h"
 #include "coredem/gas/gas_model.h"
 
 #include <CLI/CLI.hpp>
@@ -30,25 +32,16 @@ public:
     _index[name] = _names.size();
     _names.push_back(name);
     _kinds.push_back(kind);
-    _sum.push_back(0.0);
-    _comp.push_back(0.0);
+    _sum.emplace_back();
   }
-  void add(const std::string& name, double v) {
-    const auto i = _index.at(name);
-    const double y = v - _comp[i];
-    const double t = _sum[i] + y;
-    _comp[i] = (t - _sum[i]) - y;
-    _sum[i] = t;
-  }
+  void add(const std::string& name, double v) { _sum[_index.at(name)].add(v); }
   void set(const std::string& name, double v) {
-    const auto i = _index.at(name);
-    _sum[i] = v;
-    _comp[i] = 0.0;
+    _sum[_index.at(name)] = coredem::CompensatedSum(v);
   }
   client::Ledgers report() const {
     client::Ledgers l;
     for (std::size_t i = 0; i < _names.size(); ++i) {
-      const std::pair<std::string, double> e{_names[i], _sum[i]};
+      const std::pair<std::string, double> e{_names[i], _sum[i].value()};
       switch (_kinds[i]) {
       case Kind::Mass: l.mass.push_back(e); break;
       case Kind::Energy: l.energy.push_back(e); break;
@@ -60,16 +53,19 @@ public:
   }
   void save(gas::GasState& s) const {
     s.names = _names;
-    s.values = _sum;
-    s.compensation = _comp;
+    s.values.clear();
+    s.compensation.clear();
+    for (const auto& sum : _sum) {
+      s.values.push_back(sum.value());
+      s.compensation.push_back(sum.compensation());
+    }
   }
   void restore(const gas::GasState& s) {
     for (std::size_t i = 0; i < s.names.size(); ++i) {
       const auto it = _index.find(s.names[i]);
       COREDEM_CHECK(it != _index.end(), "restart file has ledger '{}', which this case does not "
                     "produce (another case or species list?)", s.names[i]);
-      _sum[it->second] = s.values[i];
-      _comp[it->second] = s.compensation[i];
+      _sum[it->second] = coredem::CompensatedSum(s.values[i], s.compensation[i]);
     }
   }
 
@@ -77,7 +73,7 @@ private:
   std::map<std::string, std::size_t> _index;
   std::vector<std::string> _names;
   std::vector<Kind> _kinds;
-  std::vector<double> _sum, _comp;
+  std::vector<coredem::CompensatedSum> _sum;
 };
 
 int runParticipant(const std::string& caseFile, const std::string& key, client::Options opts,
@@ -221,7 +217,7 @@ int main(int argc, char** argv) {
   std::string caseFile, key = "gas", restart;
   client::Options opts;
   opts.name = "coredem-gas";
-  opts.softwareVersion = "coredem-gas 0.1.0";
+  opts.softwareVersion = std::string("coredem-gas ") + coredem::kVersion;
   bool check = false;
   app.add_option("--case", caseFile, "case YAML file")->required();
   app.add_option("--key", key, "dot-separated key of the gas description in the case file")

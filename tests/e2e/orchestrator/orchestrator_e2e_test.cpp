@@ -17,7 +17,6 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -384,19 +383,8 @@ TEST_F(CoredemE2E, CurveRemoteServer) {
                                    "1",
                                    "--endpoint-file",
                                    (dir / "endpoint").string()};
-  std::vector<char*> c;
-  for (auto& a : argv) {
-    c.push_back(a.data());
-  }
-  c.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, (dir / "server.log").c_str(),
-                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  pid_t server = -1;
-  ASSERT_EQ(posix_spawn(&server, c[0], &fa, nullptr, c.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&fa);
+  const pid_t server = startProgram(argv.front(), {argv.begin() + 1, argv.end()}, dir / "server.log");
+  ASSERT_GT(server, 0);
   const auto end = std::chrono::steady_clock::now() + 20s;
   while (!fs::exists(dir / "endpoint") && std::chrono::steady_clock::now() < end) {
     std::this_thread::sleep_for(10ms);

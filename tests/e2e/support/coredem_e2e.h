@@ -3,6 +3,8 @@
 /// Helpers shared by the end-to-end tests: temporary folders, whole-file I/O, and running
 /// `coredem` as a child process with a deadline (a test never waits forever on it).
 
+#include <coredem/common/process.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -16,13 +18,10 @@
 #include <thread>
 #include <vector>
 
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-extern char** environ;
 
 namespace coredem::e2e {
 
@@ -77,23 +76,15 @@ inline pid_t startProgram(const fs::path& program, const std::vector<std::string
                           const fs::path& log) {
   std::vector<std::string> argv = {program.string()};
   argv.insert(argv.end(), args.begin(), args.end());
-  std::vector<char*> c;
-  for (auto& a : argv) {
-    c.push_back(a.data());
-  }
-  c.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, c[0], &fa, nullptr, c.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) {
-    ADD_FAILURE() << "cannot start " << argv[0];
+  coredem::SpawnOptions options;
+  options.ownProcessGroup = false;
+  options.stdinFromDevNull = false;
+  try {
+    return coredem::spawnProcess(program.filename().string(), argv, log, options);
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << e.what();
     return -1;
   }
-  return pid;
 }
 
 /// Waits for `pid` until `timeout`; past it the process gets SIGTERM, then SIGKILL two seconds

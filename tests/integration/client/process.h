@@ -1,6 +1,8 @@
 #pragma once
 // Child processes for the participant tests: start a program with extra environment
 // variables, wait for it with a deadline, kill only our own child (by pid) if it overruns.
+#include <coredem/common/process.h>
+
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -19,31 +21,11 @@ namespace coredem::testing {
 class Child {
 public:
   Child(const std::vector<std::string>& argv, const std::map<std::string, std::string>& env = {}) {
-    // Everything is prepared before fork(): the child of a multithreaded parent only execs.
-    std::vector<std::string> envStrings;
-    for (char** e = environ; *e != nullptr; ++e) {
-      const std::string entry(*e);
-      const auto eq = entry.find('=');
-      if (env.count(entry.substr(0, eq)) == 0) {
-        envStrings.push_back(entry);
-      }
-    }
-    for (const auto& [k, v] : env) {
-      envStrings.push_back(k + "=" + v);
-    }
-    std::vector<char*> envp, args;
-    for (auto& e : envStrings) envp.push_back(e.data());
-    envp.push_back(nullptr);
-    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    _pid = ::fork();
-    if (_pid < 0) {
-      throw std::runtime_error("fork failed");
-    }
-    if (_pid == 0) {
-      ::execve(args[0], args.data(), envp.data());
-      std::_Exit(127);
-    }
+    coredem::SpawnOptions options;
+    options.env = env;
+    options.ownProcessGroup = false;
+    options.stdinFromDevNull = false;
+    _pid = coredem::spawnProcess("test peer", argv, {}, options); // output stays on the test's
   }
   ~Child() {
     if (_pid > 0 && !_done) {

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <coredem/common/check.h>
+#include <coredem/common/yaml_section.h>
 #include <coredem/orchestrator/time_handler.h>
 
 namespace coredem::v1 {
@@ -22,10 +23,7 @@ class Configure;
 namespace coredem::orchestrator {
 
 /// A case file that does not follow the schema (or a file it names that is missing).
-class CaseError : public UserError {
-public:
-  using UserError::UserError;
-};
+using CaseError = ConfigError;
 
 using Vec3 = std::array<double, 3>;
 

@@ -25,6 +25,7 @@
 /// Received arrays are always at least 8-byte aligned (misaligned frames are copied once).
 /// A Message is move-only; it is not thread-safe.
 
+#include <coredem/protocol/message_types.h>
 #include <coredem/protocol/status.h>
 #include <coredem/v1/envelope.pb.h>
 
@@ -109,22 +110,11 @@ public:
   Message& setStep(std::int64_t step);
   Message& setTime(double time);
 
-  /// Set the body and the matching Envelope.type in one call.
-  Message& setBody(const v1::Hello& body);
-  Message& setBody(const v1::Welcome& body);
-  Message& setBody(const v1::Reject& body);
-  Message& setBody(const v1::Configure& body);
-  Message& setBody(const v1::Configured& body);
-  Message& setBody(const v1::GasFields& body);
-  Message& setBody(const v1::Sources& body);
-  Message& setBody(const v1::StepGrant& body);
-  Message& setBody(const v1::StepDone& body);
-  Message& setBody(const v1::CheckpointRequest& body);
-  Message& setBody(const v1::CheckpointDone& body);
-  Message& setBody(const v1::Heartbeat& body);
-  Message& setBody(const v1::Error& body);
-  Message& setBody(const v1::Shutdown& body);
-  Message& setBody(const v1::Ack& body);
+  /// Set the body and the matching Envelope.type in one call (one overload per row of
+  /// COREDEM_PROTOCOL_MESSAGES, message_types.h).
+#define COREDEM_PROTOCOL_SET_BODY_DECL(Body, field, TYPE) Message& setBody(const v1::Body& body);
+  COREDEM_PROTOCOL_MESSAGES(COREDEM_PROTOCOL_SET_BODY_DECL)
+#undef COREDEM_PROTOCOL_SET_BODY_DECL
 
   // ---- arrays (sending) ----------------------------------------------------------------
   /// Adds an array, copying `data` into the message. shape must satisfy

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Child processes of a run (the DEM server and the CFD participant): spawn with output
-/// redirected to a log file, liveness checks that name the exit reason, and a clean stop
+/// Child processes (the orchestrator's participants, campaign members, test peers): spawn with
+/// output redirected to a log file, liveness checks that name the exit reason, and a clean stop
 /// (SIGTERM, grace period, SIGKILL).
 
 #include <chrono>
@@ -12,7 +12,24 @@
 #include <string>
 #include <vector>
 
-namespace coredem::orchestrator {
+namespace coredem {
+
+/// How spawnProcess() starts a program.
+struct SpawnOptions {
+  std::map<std::string, std::string> env; ///< set (or override) these environment variables
+  bool ownProcessGroup = true; ///< own process group: a terminal Ctrl-C reaches only the parent
+  bool stdinFromDevNull = true; ///< stdin from /dev/null (else inherited)
+};
+
+/// Starts `argv[0]` (a path) with stdout and stderr appended to `logFile` (inherited when
+/// `logFile` is empty). Returns the pid.
+/// Throws UserError naming `what` and the program if it cannot be started.
+int spawnProcess(const std::string& what, const std::vector<std::string>& argv,
+                 const std::filesystem::path& logFile, const SpawnOptions& options = {});
+
+/// "exited with code 1", "killed by signal 9 (SIGKILL)" for a waitpid() status.
+std::string describeWaitStatus(int status);
+
 
 class ChildProcess {
 public:
@@ -54,4 +71,4 @@ std::filesystem::path executableDir();
 /// Finds a program: next to the coredem executable, else on PATH. Empty if not found.
 std::filesystem::path findProgram(const std::string& name);
 
-} // namespace coredem::orchestrator
+} // namespace coredem

@@ -12,32 +12,31 @@
 
 #include <coredem/common/check.h>
 #include <coredem/common/log.h>
-#include <coredem/orchestrator/processes.h>
+#include <coredem/common/process.h>
 
 extern char** environ;
 
 namespace fs = std::filesystem;
 
-namespace coredem::orchestrator {
+namespace coredem {
 
-ChildProcess::ChildProcess(std::string name, std::vector<std::string> argv,
-                           const std::map<std::string, std::string>& env, const fs::path& logFile)
-    : _name(std::move(name))
-    , _log(logFile) {
-  COREDEM_CHECK(!argv.empty(), "no program given for {}", _name);
+int spawnProcess(const std::string& what, const std::vector<std::string>& argv,
+                 const fs::path& logFile, const SpawnOptions& options) {
+  COREDEM_CHECK(!argv.empty(), "no program given for {}", what);
   std::vector<std::string> envStrings;
   for (char** e = environ; *e; ++e) {
     const std::string kv = *e;
     const std::string key = kv.substr(0, kv.find('='));
-    if (!env.count(key)) {
+    if (!options.env.count(key)) {
       envStrings.push_back(kv);
     }
   }
-  for (const auto& [k, v] : env) {
+  for (const auto& [k, v] : options.env) {
     envStrings.push_back(k + "=" + v);
   }
+  std::vector<std::string> args = argv;
   std::vector<char*> cargv, cenv;
-  for (auto& a : argv) {
+  for (auto& a : args) {
     cargv.push_back(a.data());
   }
   cargv.push_back(nullptr);
@@ -48,22 +47,49 @@ ChildProcess::ChildProcess(std::string name, std::vector<std::string> argv,
 
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, logFile.c_str(), O_WRONLY | O_CREAT | O_APPEND,
-                                   0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  if (!logFile.empty()) {
+    posix_spawn_file_actions_addopen(&actions, 1, logFile.c_str(), O_WRONLY | O_CREAT | O_APPEND,
+                                     0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  }
+  if (options.stdinFromDevNull) {
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
+  }
   posix_spawnattr_t attr;
   posix_spawnattr_init(&attr);
-  // Own process group: a Ctrl-C on the terminal reaches coredem, which stops the children.
-  posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
-  posix_spawnattr_setpgroup(&attr, 0);
+  if (options.ownProcessGroup) {
+    // Own process group: a Ctrl-C on the terminal reaches the parent, which stops the children.
+    posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attr, 0);
+  }
   pid_t pid = -1;
   const int rc = posix_spawn(&pid, cargv[0], &actions, &attr, cargv.data(), cenv.data());
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attr);
-  COREDEM_CHECK(rc == 0, "cannot start the {} ('{}'): {}", _name, argv[0], std::strerror(rc));
-  _pid = pid;
-  logger("orchestrator.process")->debug("started {} (pid {}): log {}", _name, _pid, _log.string());
+  COREDEM_CHECK(rc == 0, "cannot start the {} ('{}'): {}", what, argv[0], std::strerror(rc));
+  return pid;
+}
+
+std::string describeWaitStatus(int status) {
+  if (WIFEXITED(status)) {
+    return fmt::format("exited with code {}", WEXITSTATUS(status));
+  }
+  if (WIFSIGNALED(status)) {
+    const int sig = WTERMSIG(status);
+    const char* sname = sigabbrev_np(sig);
+    return fmt::format("killed by signal {} (SIG{})", sig, sname ? sname : "?");
+  }
+  return "ended";
+}
+
+ChildProcess::ChildProcess(std::string name, std::vector<std::string> argv,
+                           const std::map<std::string, std::string>& env, const fs::path& logFile)
+    : _name(std::move(name))
+    , _log(logFile) {
+  SpawnOptions options;
+  options.env = env;
+  _pid = spawnProcess(_name, argv, logFile, options);
+  logger("process")->debug("started {} (pid {}): log {}", _name, _pid, _log.string());
 }
 
 ChildProcess::~ChildProcess() {
@@ -85,15 +111,9 @@ std::optional<std::string> ChildProcess::exitReason() {
   _ended = true;
   if (r < 0) {
     _reason = "vanished (waitpid failed)";
-  } else if (WIFEXITED(status)) {
-    _exitCode = WEXITSTATUS(status);
-    _reason = fmt::format("exited with code {}", _exitCode);
-  } else if (WIFSIGNALED(status)) {
-    const int sig = WTERMSIG(status);
-    const char* sname = sigabbrev_np(sig);
-    _reason = fmt::format("killed by signal {} (SIG{})", sig, sname ? sname : "?");
   } else {
-    _reason = "ended";
+    _exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    _reason = describeWaitStatus(status);
   }
   return _reason;
 }
@@ -167,4 +187,4 @@ fs::path findProgram(const std::string& name) {
   return {};
 }
 
-} // namespace coredem::orchestrator
+} // namespace coredem
