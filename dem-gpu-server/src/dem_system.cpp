@@ -8,6 +8,7 @@
 
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
+#include "coredem/common/version.h"
 #include "coredem/dem/kernels/collision_time.h"
 #include "coredem/dem/kernels/damping.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
@@ -19,10 +20,6 @@
 #include <cstdio>
 #include <limits>
 #include <unordered_map>
-
-#ifndef COREDEM_VERSION
-#define COREDEM_VERSION "0.0.0"
-#endif
 
 namespace coredem::dem {
 
@@ -558,7 +555,7 @@ void DemSystem::writeState(const std::string& path, const std::string& protocolV
   meta.step = m.step;
   meta.backend = m.engine->name();
   meta.configHash = m.hash;
-  meta.softwareVersion = std::string(COREDEM_VERSION);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
+  meta.softwareVersion = std::string(coredem::kVersion);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
   meta.protocolVersion = protocolVersion.empty() ? std::string("none") : protocolVersion;
   meta.heatConvection = m.engine->heatTotals().convection;
   meta.heatRadiation = m.engine->heatTotals().radiation;
