@@ -16,6 +16,8 @@ packages=(
   python3 python3-matplotlib python3-h5py python3-zmq python3-protobuf python3-yaml
   # used by scripts/openfoam-headers.sh to fetch Debian's OpenFOAM sources
   dpkg-dev bzip2 ca-certificates
+  # the committed .clang-format is enforced by scripts/check-format.sh (CI)
+  clang-format
 )
 if [[ "${1:-}" == "--with-peers" ]]; then
   packages+=(liggghts openmpi-bin)

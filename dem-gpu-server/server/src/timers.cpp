@@ -2,6 +2,7 @@
 #include "timers.h"
 
 #include "coredem/common/check.h"
+#include "coredem/common/json.h"
 
 #include <fmt/format.h>
 
@@ -85,25 +86,32 @@ std::string timersReport(const ExchangeTimes& x, const dem::StageTimes& st, doub
 
 std::string timersJson(const ExchangeTimes& x, const dem::StageTimes& st, double sessionSeconds,
                        const std::string& session, const std::string& backend, int threads) {
-  std::string s = fmt::format(
-      "{{\"program\":\"coredem-dem\",\"session\":\"{}\",\"backend\":\"{}\",\"threads\":{},"
-      "\"steps\":{},\"particle_sub_steps\":{},\"rebuilds\":{},\"session_s\":{:.6f},\"advance_s\":{:.6f},"
-      "\"dem_s\":{{",
-      session, backend, threads, x.steps, x.particleSubSteps, st.rebuilds, sessionSeconds, x.advance);
-  const auto dem = demRows(x, st);
-  for (std::size_t k = 0; k < dem.size(); ++k) {
-    s += fmt::format("{}\"{}\":{:.6f}", k ? "," : "", dem[k].name, dem[k].seconds);
+  JsonWriter w(0);
+  w.beginObject()
+      .field("program", "coredem-dem")
+      .field("session", session)
+      .field("backend", backend)
+      .field("threads", threads)
+      .field("steps", static_cast<std::int64_t>(x.steps))
+      .field("particle_sub_steps", static_cast<std::uint64_t>(x.particleSubSteps))
+      .field("rebuilds", static_cast<std::uint64_t>(st.rebuilds))
+      .field("session_s", sessionSeconds)
+      .field("advance_s", x.advance);
+  w.key("dem_s").beginObject();
+  for (const Row& r : demRows(x, st)) {
+    w.field(r.name, r.seconds);
   }
-  s += "},\"exchange_s\":{";
-  const auto ex = exchangeRows(x);
+  w.endObject();
+  w.key("exchange_s").beginObject();
   double exSum = 0.0;
-  for (std::size_t k = 0; k < ex.size(); ++k) {
-    s += fmt::format("{}\"{}\":{:.6f}", k ? "," : "", ex[k].name, ex[k].seconds);
-    exSum += ex[k].seconds;
+  for (const Row& r : exchangeRows(x)) {
+    w.field(r.name, r.seconds);
+    exSum += r.seconds;
   }
-  s += fmt::format("}},\"exchange_total_s\":{:.6f},\"server_other_s\":{:.6f}}}\n", exSum,
-                   sessionSeconds - x.advance - exSum);
-  return s;
+  w.endObject();
+  w.field("exchange_total_s", exSum).field("server_other_s", sessionSeconds - x.advance - exSum);
+  w.endObject();
+  return w.str();
 }
 
 void writeTextFile(const std::string& path, const std::string& text) {

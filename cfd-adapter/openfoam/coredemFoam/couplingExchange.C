@@ -1,0 +1,125 @@
+#include "couplingExchange.H"
+
+#include <cstdlib>
+#include <string>
+
+namespace Foam
+{
+
+CouplingExchange::CouplingExchange
+(
+    ::coredem::client::Participant& coupling,
+    const CoredemGrid& grid,
+    label nCells,
+    StageTimers& timers
+)
+:
+    coupling_(coupling),
+    grid_(grid),
+    nCells_(nCells),
+    timers_(timers),
+    direct_(false)
+{
+    // Mesh cell order = grid order (one blockMesh block): the fields are sent from and the
+    // sources received into the solver's own arrays, with no gather/scatter copies.
+    // COREDEM_FOAM_EXCHANGE=copy forces the gather/scatter path (to measure the difference).
+    const char* mode = std::getenv("COREDEM_FOAM_EXCHANGE");
+    direct_ = grid_.identity() && !(mode != nullptr && std::string(mode) == "copy");
+    Info<< "Exchange: "
+        << (direct_ ? "in place (mesh cells in grid order)" : "gather/scatter copies")
+        << nl << endl;
+}
+
+
+void CouplingExchange::exchange(label step, scalar dt)
+{
+    using ::coredem::client::ConstView;
+
+    // Pack: the gas at the start of the step, in grid order.
+    std::vector<::coredem::client::NamedField> fields;
+    fields.reserve(outputs_.size());
+    for (std::size_t i = 0; i < outputs_.size(); ++i)
+    {
+        CouplingOutput& out = *outputs_[i];
+        out.update();
+        ConstView v = out.cellValues();
+        if (!direct_ && !out.uniform())
+        {
+            grid_.gather(v.data, out.nComponents(), gathered_[i]);
+            v = gathered_[i];
+        }
+        fields.push_back({out.name(), v});
+    }
+    timers_.toc(StageTimers::Pack);
+
+    // Sources received straight into the fields (in place) or viewed in the received frames
+    // and scattered below.
+    const std::size_t nc = std::size_t(nCells_);
+    std::vector<::coredem::client::NamedBuffer> into;
+    if (direct_)
+    {
+        for (const std::unique_ptr<CouplingInput>& in : inputs_)
+        {
+            double* storage = in->cellStorage();
+            if (storage != nullptr && in->nComponents() > 0)
+            {
+                into.push_back({in->name(), storage, nc*in->nComponents()});
+            }
+        }
+    }
+    const ::coredem::client::Sources* src = nullptr;
+    try
+    {
+        src = &coupling_.exchange(coupling_.step(), dt, fields, into);
+    }
+    catch (const ::coredem::client::ClientError& e)
+    {
+        FatalErrorInFunction << "coupling, step " << step << ": " << e.what()
+            << exit(FatalError);
+    }
+    {
+        const ::coredem::client::ExchangeTimes xt = coupling_.lastExchangeTimes();
+        timers_.add(StageTimers::Serialise, xt.serialise);
+        timers_.add(StageTimers::Send, xt.send);
+        timers_.add(StageTimers::Wait, xt.wait);
+        timers_.add(StageTimers::Receive, xt.receive);
+    }
+    timers_.tic();
+
+    // Unpack: sources -> cell values (a no-op for arrays received in place) -> inputs.
+    for (const std::unique_ptr<CouplingInput>& in : inputs_)
+    {
+        const label nComp = in->nComponents();
+        if (nComp == 0)
+        {
+            in->read(nullptr);
+            continue;
+        }
+        const ConstView v = src->field(in->name());
+        if (v.size != std::size_t(grid_.gridCells())*nComp)
+        {
+            FatalErrorInFunction
+                << "DEM source " << in->name().c_str() << " has " << label(v.size)
+                << " values, expected " << grid_.gridCells()*nComp << exit(FatalError);
+        }
+        double* storage = in->cellStorage();
+        if (storage != nullptr)
+        {
+            if (v.data != storage) grid_.scatter(v.data, nComp, storage);
+            in->read(storage);
+        }
+        else if (direct_)
+        {
+            in->read(v.data);
+        }
+        else
+        {
+            scattered_.assign(nc*nComp, 0.0);
+            grid_.scatter(v.data, nComp, scattered_.data());
+            in->read(scattered_.data());
+        }
+    }
+    timers_.toc(StageTimers::Unpack);
+}
+
+} // namespace Foam
