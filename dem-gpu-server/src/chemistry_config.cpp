@@ -224,7 +224,6 @@ namespace coredem::dem {
 std::size_t removeSmallParticles(double removalFraction, HostState& st, ChemistryTotals& totals) {
   const std::size_t n = st.n;
   const int ns = st.nSpecies;
-  const std::size_t K = static_cast<std::size_t>(st.historySlots);
   std::vector<std::size_t> keep;
   keep.reserve(n);
   if (totals.removedSolid.size() < static_cast<std::size_t>(ns)) totals.removedSolid.resize(static_cast<std::size_t>(ns), 0.0);
@@ -237,26 +236,7 @@ std::size_t removeSmallParticles(double removalFraction, HostState& st, Chemistr
   }
   const std::size_t removed = n - keep.size();
   if (removed == 0) return 0;
-  auto compact = [&](auto& v, std::size_t width) {
-    if (v.size() != n * width) return;
-    for (std::size_t a = 0; a < keep.size(); ++a)
-      for (std::size_t w = 0; w < width; ++w) v[a * width + w] = v[keep[a] * width + w];
-    v.resize(keep.size() * width);
-  };
-  for (auto* v : {&st.pos, &st.vel, &st.omega, &st.force, &st.torque, &st.fwall, &st.xref}) compact(*v, 3);
-  for (auto* v : {&st.radius, &st.mass, &st.density, &st.temperature, &st.d0}) compact(*v, 1);
-  compact(st.chemRef, 2);
-  compact(st.species, static_cast<std::size_t>(ns));
-  compact(st.material, 1);
-  compact(st.contacts, 1);
-  compact(st.wallContacts, 1);
-  compact(st.gid, 1);
-  compact(st.histKey, K);
-  compact(st.histDisp, 3 * K);
-  compact(st.nbCount, 1);
-  compact(st.nbList, static_cast<std::size_t>(st.neighbourSlots));
-  st.n = keep.size();
-  st.listValid = 0;  // indices changed: rebuilt before the next force evaluation
+  compactParticles(st, keep);  // every schema field; neighbour lists invalidated
   totals.removedCount += removed;
   return removed;
 }

@@ -394,18 +394,12 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   const std::size_t n = st.gid.size();
   COREDEM_CHECK(n < (1ull << 31), "{} particles: at most 2^31-1 are supported", n);
   st.n = n;
-  st.force.assign(3 * n, 0.0);
-  st.torque.assign(3 * n, 0.0);
-  st.fwall.assign(3 * n, 0.0);
   st.xref = st.pos;
-  st.contacts.assign(n, 0);
-  st.wallContacts.assign(n, 0);
-  st.histKey.assign(n * st.historySlots, -1);
-  st.histDisp.assign(3 * n * st.historySlots, 0.0);
-  st.nbCount.assign(n, 0);
-  st.nbList.assign(n * st.neighbourSlots, 0);
   st.listValid = 0;
   initChemistryReferences(config, st);  // d_p0, initial C / Fe2O3-equivalent masses
+  // Every other field (forces, contact counts, history, neighbour lists, ...) starts from its
+  // particle-schema default (zero; empty history slots −1).
+  fillDefaults(st);
   m.nParticles = n;
 
   const std::size_t nm = config.materials.size();
@@ -561,7 +555,7 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
   return m.sources;
 }
 
-void DemSystem::writeState(const std::string& path) const {
+void DemSystem::writeState(const std::string& path, const std::string& protocolVersion) const {
   Impl& m = *_impl;
   StateMeta meta;
   meta.time = m.time.time();
@@ -569,8 +563,8 @@ void DemSystem::writeState(const std::string& path) const {
   meta.step = m.step;
   meta.backend = m.engine->name();
   meta.configHash = m.hash;
-  meta.softwareVersion = std::string(kVersion);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
-  meta.protocolVersion = std::string("1");
+  meta.softwareVersion = std::string(coredem::kVersion);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
+  meta.protocolVersion = protocolVersion.empty() ? std::string("none") : protocolVersion;
   const HeatTotals heat = m.engine->heatTotals();
   meta.heatConvection = heat.convection;
   meta.heatRadiation = heat.radiation;

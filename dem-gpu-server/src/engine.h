@@ -7,6 +7,7 @@
 #include "heat_setup.h"
 #include "chemistry_setup.h"
 #include "coredem/dem/kernels/drag.h"
+#include "coredem/dem/particle_schema.h"
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_contact.h"
@@ -47,25 +48,37 @@ struct EngineSetup {
 };
 
 /// Host copy of the full engine state (particles in internal order, contact history,
-/// neighbour lists, rebuild reference). What writeState/readState store.
+/// neighbour lists, rebuild reference). What writeState/readState store. One vector per
+/// particle-schema row (`pos`, `vel`, ..., `chemRef`), each n · width values.
 struct HostState {
   std::size_t n = 0;
   int nSpecies = 0;
   int historySlots = 0;
   int neighbourSlots = 0;
-  std::vector<double> pos, vel, omega, force, torque, fwall, xref;  // N*3
-  std::vector<double> radius, mass, density, temperature;          // N
-  std::vector<double> species;                                     // N*nSpecies
-  std::vector<std::int32_t> material, contacts, wallContacts;      // N (contacts: pair, last sub-step)
-  std::vector<std::int64_t> gid;                                   // N
-  std::vector<std::int64_t> histKey;                               // N*K (−1 empty, ≥0 partner gid, −(w+2) wall w)
-  std::vector<double> histDisp;                                    // N*K*3
-  std::vector<std::int32_t> nbCount;                               // N
-  std::vector<std::int32_t> nbList;                                // N*M
-  std::int32_t listValid = 0;                                      // 1: nbList usable as is
-  std::vector<double> d0;                                          // N: initial diameter (chemistry)
-  std::vector<double> chemRef;                                     // N*2: initial C mass, initial Fe2O3-eq. mass
+  std::int32_t listValid = 0;  ///< 1: nbList usable as is
+#define COREDEM_HOST_MEMBER_(member, Mask, T, ...) std::vector<T> member;
+  COREDEM_PARTICLE_FIELDS(COREDEM_HOST_MEMBER_)
+#undef COREDEM_HOST_MEMBER_
+
+  schema::Extents extents() const { return {nSpecies, historySlots, neighbourSlots}; }
+  /// Values a field must hold: n · width.
+  std::size_t expectedSize(const schema::FieldInfo& f) const {
+    return n * schema::valuesPerParticle(f, extents());
+  }
 };
+
+/// Throws InternalError naming the field when a field of `s` does not hold n · width values
+/// (`where` names the caller).
+void checkShapes(const HostState& s, const char* where);
+
+/// Sizes every empty field that has a default in the schema (Zero, MinusOne, Diameter = 2 R)
+/// to n · width and fills it; fields already holding values are left alone.
+void fillDefaults(HostState& s);
+
+/// Keeps the particles `keep` (ascending indices), in that order: compacted fields move with
+/// their particles, the others are reset to their defaults; invalidates the neighbour lists.
+/// @pre checkShapes(s) holds.
+void compactParticles(HostState& s, const std::vector<std::size_t>& keep);
 
 /// Host copies of the gas fields (per cell).
 struct GasArrays {

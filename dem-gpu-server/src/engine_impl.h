@@ -81,21 +81,14 @@ public:
 
   // ---------------------------------------------------------------- state transfer
   void setState(const HostState& s) override {
+    checkShapes(s, "Engine::setState");  // every schema field holds n · width values
     _p.allocate(s.n, s.nSpecies, s.historySlots, s.neighbourSlots);
-    auto put = [](auto& arr, const auto& vec) {
-      for (std::size_t k = 0; k < vec.size() && k < arr.size(); ++k) arr.h()[k] = vec[k];
-    };
-    put(_p.pos, s.pos); put(_p.vel, s.vel); put(_p.omega, s.omega); put(_p.force, s.force);
-    put(_p.torque, s.torque); put(_p.fwall, s.fwall); put(_p.xref, s.xref);
-    put(_p.radius, s.radius); put(_p.mass, s.mass); put(_p.density, s.density);
-    put(_p.temperature, s.temperature); put(_p.species, s.species); put(_p.material, s.material);
-    put(_p.contacts, s.contacts); put(_p.gid, s.gid); put(_p.histKey, s.histKey);
-    put(_p.histDisp, s.histDisp); put(_p.nbCount, s.nbCount); put(_p.nbList, s.nbList);
-    put(_p.wallContacts, s.wallContacts);
-    put(_p.d0, s.d0); put(_p.chemRef, s.chemRef);  // chemistry references
+    schema::forEachField(_p, s, [](const schema::FieldInfo&, auto& arr, const auto& vec) {
+      for (std::size_t k = 0; k < vec.size(); ++k) arr.h()[k] = vec[k];
+    });
     _p.toDevice(kAllFields);
     _contacts.resetUsedSlots(_p.K);
-    _listValid = s.listValid != 0 && s.nbList.size() == s.n * static_cast<std::size_t>(s.neighbourSlots);
+    _listValid = s.listValid != 0;
     reserveScratch();
   }
 
@@ -106,15 +99,10 @@ public:
     s.nSpecies = _p.nSpecies;
     s.historySlots = _p.K;
     s.neighbourSlots = _p.M;
-    auto get = [](const auto& arr, auto& vec) { vec.assign(arr.h(), arr.h() + arr.size()); };
-    get(_p.pos, s.pos); get(_p.vel, s.vel); get(_p.omega, s.omega); get(_p.force, s.force);
-    get(_p.torque, s.torque); get(_p.fwall, s.fwall); get(_p.xref, s.xref);
-    get(_p.radius, s.radius); get(_p.mass, s.mass); get(_p.density, s.density);
-    get(_p.temperature, s.temperature); get(_p.species, s.species); get(_p.material, s.material);
-    get(_p.contacts, s.contacts); get(_p.wallContacts, s.wallContacts); get(_p.gid, s.gid); get(_p.histKey, s.histKey);
-    get(_p.histDisp, s.histDisp); get(_p.nbCount, s.nbCount); get(_p.nbList, s.nbList);
+    schema::forEachField(s, _p, [](const schema::FieldInfo&, auto& vec, const auto& arr) {
+      vec.assign(arr.h(), arr.h() + arr.size());
+    });
     s.listValid = _listValid ? 1 : 0;
-    get(_p.d0, s.d0); get(_p.chemRef, s.chemRef);  // chemistry references
     return s;
   }
 
@@ -247,16 +235,16 @@ public:
     NbGrid g = neighbourGrid();
     computeKeys(g);
     _exec.sortByKey(_keys.d(), n, g.cells, _perm.d());
-    // force, torque, fwall are recomputed right after the rebuild and xref is reset: not moved.
+    // Every kResorted schema field follows its particle. (force, torque, fwall are recomputed
+    // right after the rebuild, xref is reset and the neighbour lists rebuilt: not moved.)
     // History slots at or beyond the largest count in use are empty in every row: not moved.
-    reorder(_p.pos, 3); reorder(_p.vel, 3); reorder(_p.omega, 3);
-    reorder(_p.radius, 1); reorder(_p.mass, 1); reorder(_p.density, 1);
-    reorder(_p.temperature, 1); reorder(_p.material, 1); reorder(_p.contacts, 1);
-    reorder(_p.wallContacts, 1); reorder(_p.gid, 1);
-    if (_p.nSpecies > 0) reorder(_p.species, _p.nSpecies);
-    reorder(_p.d0, 1); reorder(_p.chemRef, 2);  // chemistry references
-    reorder(_p.histKey, _p.K, _contacts.usedSlots());
-    reorder(_p.histDisp, 3 * _p.K, 3 * _contacts.usedSlots());
+    const int usedSlots = _contacts.usedSlots();
+    schema::forEachField(_p, [&](const schema::FieldInfo& f, auto& arr) {
+      if (!f.has(schema::kResorted)) return;
+      const int width = _p.width(f);
+      if (width == 0) return;
+      reorder(arr, width, f.per == schema::Per::History ? f.components * usedSlots : width);
+    });
     computeKeys(g);  // keys of the sorted order (ascending)
 
     _cellStart.reserve(g.cells);

@@ -1,25 +1,29 @@
 #pragma once
 /// @file
 /// ParticleStore: the particle state as structure of arrays (DESIGN §4, STYLE §6), each array
-/// a host/device mirror. Kernels name the fields they read and write with FieldMask bits;
-/// the engine syncs exactly those (`require`) and marks the written ones (`produced`).
-
-#include "backend/arrays.h"
+/// a host/device mirror. The arrays, their widths and the FieldMask bits are generated from
+/// the particle schema (coredem/dem/particle_schema.h): one row a field. Kernels name the
+/// fields they read and write with FieldMask bits; the engine syncs exactly those (`require`)
+/// and marks the written ones (`produced`).
 
 #include <cstddef>
 #include <cstdint>
 
+#include "backend/arrays.h"
+#include "coredem/dem/particle_schema.h"
+
 namespace coredem::dem {
 
+/// One bit per schema row, in table order: kPos, kVel, ..., kChemRef.
 enum FieldMask : std::uint32_t {
-  kPos = 1u << 0, kVel = 1u << 1, kOmega = 1u << 2, kForce = 1u << 3, kTorque = 1u << 4,
-  kFwall = 1u << 5, kXref = 1u << 6, kRadius = 1u << 7, kMass = 1u << 8, kDensity = 1u << 9,
-  kTemperature = 1u << 10, kSpecies = 1u << 11, kMaterial = 1u << 12, kContacts = 1u << 13,
-  kWallContacts = 1u << 14, kGid = 1u << 15, kHistKey = 1u << 16, kHistDisp = 1u << 17,
-  kNbCount = 1u << 18, kNbList = 1u << 19,
-  kD0 = 1u << 20, kChemRef = 1u << 21,  // chemistry references (chemistry.h)
-  kAllFields = (1u << 22) - 1
+#define COREDEM_FIELD_MASK_(member, Mask, ...)                                                     \
+  k##Mask = 1u << static_cast<int>(schema::Field::Mask),
+  COREDEM_PARTICLE_FIELDS(COREDEM_FIELD_MASK_)
+#undef COREDEM_FIELD_MASK_
 };
+/// Every field of the schema.
+inline constexpr std::uint32_t kAllFields =
+    schema::kFieldCount == 32 ? 0xffffffffu : (1u << schema::kFieldCount) - 1u;
 
 template <class Exec>
 struct ParticleStore {
@@ -28,55 +32,38 @@ struct ParticleStore {
 
   std::size_t n = 0;
   int nSpecies = 0;
-  int K = 0;  ///< history slots per particle
-  int M = 0;  ///< neighbour-list width per particle
+  int K = 0; ///< history slots per particle
+  int M = 0; ///< neighbour-list width per particle
 
-  Arr<double> pos, vel, omega;   ///< N*3: m, m/s, rad/s
-  Arr<double> force, torque;     ///< N*3: N, N m (last sub-step; force without gravity)
-  Arr<double> fwall;             ///< N*3: wall part of force (N)
-  Arr<double> xref;              ///< N*3: positions at the last neighbour-list build (m)
-  Arr<double> radius, mass, density, temperature;  ///< N: m, kg, kg/m³, K
-  Arr<double> species;           ///< N*nSpecies mass fractions
-  Arr<std::int32_t> material;    ///< N
-  Arr<std::int32_t> contacts, wallContacts;  ///< N: contacts found in the last sub-step
-  Arr<std::int64_t> gid;         ///< N: global id (stable through re-sorting)
-  Arr<std::int64_t> histKey;     ///< N*K: partner gid, −(w+2) for wall w, −1 empty
-  Arr<double> histDisp;          ///< N*K*3: accumulated tangential displacement δ_t (m)
-  Arr<std::int32_t> nbCount;     ///< N
-  Arr<std::int32_t> nbList;      ///< N*M: neighbour indices (internal order)
-  Arr<double> d0;                ///< N: initial diameter d_p0 (m), removal reference
-  Arr<double> chemRef;           ///< N*2: initial char (C) mass, initial Fe2O3-equivalent mass (kg)
+  /// One mirror per schema row (`pos`, `vel`, ..., `chemRef`); widths and units in the schema.
+#define COREDEM_STORE_MEMBER_(member, Mask, T, ...) Arr<T> member;
+  COREDEM_PARTICLE_FIELDS(COREDEM_STORE_MEMBER_)
+#undef COREDEM_STORE_MEMBER_
+
+  schema::Extents extents() const {
+    return {nSpecies, K, M};
+  }
+  /// Values per particle of a field (its row's width for this store's extents).
+  int width(const schema::FieldInfo& f) const {
+    return static_cast<int>(schema::valuesPerParticle(f, extents()));
+  }
 
   /// Calls f(array) for every array selected by mask.
   template <class F>
   void forEach(std::uint32_t mask, F&& f) {
-    if (mask & kPos) f(pos);
-    if (mask & kVel) f(vel);
-    if (mask & kOmega) f(omega);
-    if (mask & kForce) f(force);
-    if (mask & kTorque) f(torque);
-    if (mask & kFwall) f(fwall);
-    if (mask & kXref) f(xref);
-    if (mask & kRadius) f(radius);
-    if (mask & kMass) f(mass);
-    if (mask & kDensity) f(density);
-    if (mask & kTemperature) f(temperature);
-    if (mask & kSpecies) f(species);
-    if (mask & kMaterial) f(material);
-    if (mask & kContacts) f(contacts);
-    if (mask & kWallContacts) f(wallContacts);
-    if (mask & kGid) f(gid);
-    if (mask & kHistKey) f(histKey);
-    if (mask & kHistDisp) f(histDisp);
-    if (mask & kNbCount) f(nbCount);
-    if (mask & kNbList) f(nbList);
-    if (mask & kD0) f(d0);
-    if (mask & kChemRef) f(chemRef);
+    schema::forEachField(*this, [&](const schema::FieldInfo& info, auto& a) {
+      if (mask & (1u << schema::indexOf(info)))
+        f(a);
+    });
   }
   /// Makes the device copies of `mask` current (before a kernel reads them).
-  void require(std::uint32_t mask) { forEach(mask, [](auto& a) { a.toDevice(); }); }
+  void require(std::uint32_t mask) {
+    forEach(mask, [](auto& a) { a.toDevice(); });
+  }
   /// Marks the device copies of `mask` as newer (after a kernel wrote them).
-  void produced(std::uint32_t mask) { forEach(mask, [](auto& a) { a.markDeviceModified(); }); }
+  void produced(std::uint32_t mask) {
+    forEach(mask, [](auto& a) { a.markDeviceModified(); });
+  }
   /// Host mirror → device for `mask`, after host-side writes.
   void toDevice(std::uint32_t mask) {
     forEach(mask, [](auto& a) {
@@ -85,23 +72,19 @@ struct ParticleStore {
     });
   }
   /// Device → host mirror for `mask`.
-  void toHost(std::uint32_t mask) { forEach(mask, [](auto& a) { a.toHost(); }); }
+  void toHost(std::uint32_t mask) {
+    forEach(mask, [](auto& a) { a.toHost(); });
+  }
 
+  /// Sizes every field for `count` particles (contents undefined).
   void allocate(std::size_t count, int nSpeciesPerParticle, int slots, int width) {
     n = count;
     nSpecies = nSpeciesPerParticle;
     K = slots;
     M = width;
-    for (auto* a : {&pos, &vel, &omega, &force, &torque, &fwall, &xref}) a->allocate(3 * n);
-    for (auto* a : {&radius, &mass, &density, &temperature}) a->allocate(n);
-    species.allocate(n * static_cast<std::size_t>(nSpecies));
-    for (auto* a : {&material, &contacts, &wallContacts, &nbCount}) a->allocate(n);
-    gid.allocate(n);
-    histKey.allocate(n * static_cast<std::size_t>(K));
-    histDisp.allocate(3 * n * static_cast<std::size_t>(K));
-    nbList.allocate(n * static_cast<std::size_t>(M));
-    d0.allocate(n);
-    chemRef.allocate(2 * n);
+    schema::forEachField(*this, [&](const schema::FieldInfo& info, auto& a) {
+      a.allocate(n * schema::valuesPerParticle(info, extents()));
+    });
   }
 
   std::size_t bytes() {

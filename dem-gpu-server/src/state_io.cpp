@@ -1,265 +1,162 @@
-// HDF5 state I/O with the HDF5 C API. Arrays are stored with their natural shapes
-// ([N], [N,3], [N,K], [N,K,3]); /meta carries the scalars as attributes.
+// HDF5 state I/O on the common HDF5 layer (coredem/common/hdf5.h). The per-particle datasets
+// are the checkpointed rows of the particle schema, stored with their natural shapes ([N],
+// [N,3], [N,K], [N,K,3]); /meta carries the scalars as attributes, /chemistry the ledgers.
 #include "state_io.h"
 
-#include "coredem/common/check.h"
-
-#include <hdf5.h>
-
+#include <string>
+#include <type_traits>
 #include <vector>
+
+#include "coredem/common/check.h"
+#include "coredem/common/hdf5.h"
+#include "coredem/dem/particle_schema.h"
 
 namespace coredem::dem {
 namespace {
 
-template <class T>
-hid_t h5type();
-template <>
-hid_t h5type<double>() { return H5T_NATIVE_DOUBLE; }
-template <>
-hid_t h5type<std::int32_t>() { return H5T_NATIVE_INT32; }
-template <>
-hid_t h5type<std::int64_t>() { return H5T_NATIVE_INT64; }
-template <>
-hid_t h5type<std::uint64_t>() { return H5T_NATIVE_UINT64; }
-
-/// Closes an HDF5 handle on scope exit.
-struct Handle {
-  hid_t id;
-  herr_t (*close)(hid_t);
-  ~Handle() {
-    if (id >= 0) close(id);
-  }
-};
-
-template <class T>
-void writeArray(hid_t group, const char* name, const std::vector<T>& v, std::vector<hsize_t> dims) {
-  hsize_t total = 1;
-  for (hsize_t d : dims) total *= d;
-  COREDEM_ASSERT(total == v.size());
-  Handle space{H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose};
-  Handle ds{H5Dcreate2(group, name, h5type<T>(), space.id, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose};
-  COREDEM_CHECK(ds.id >= 0, "cannot create HDF5 dataset '{}'", name);
-  if (total > 0) {
-    COREDEM_CHECK(H5Dwrite(ds.id, h5type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) >= 0,
-                  "cannot write HDF5 dataset '{}'", name);
-  }
+std::vector<hsize_t> dimsOf(const schema::FieldInfo& f, const HostState& s) {
+  const std::vector<std::uint64_t> d = schema::datasetDims(f, s.n, s.extents());
+  return {d.begin(), d.end()};
 }
 
+/// "[a, b, c]"
+std::string shapeText(const std::vector<hsize_t>& dims) {
+  std::string t = "[";
+  for (std::size_t k = 0; k < dims.size(); ++k)
+    t += (k > 0 ? ", " : "") + std::to_string(dims[k]);
+  return t + "]";
+}
+
+/// An attribute of /meta or /chemistry that older files lack: `fallback` then.
 template <class T>
-void readArray(hid_t group, const char* name, std::vector<T>& v, hsize_t expected,
-               const std::string& path) {
-  COREDEM_CHECK(H5Lexists(group, name, H5P_DEFAULT) > 0,
-                "state file '{}' has no dataset '{}': it was not written by DemSystem::writeState "
-                "(or is truncated)", path, name);
-  Handle ds{H5Dopen2(group, name, H5P_DEFAULT), H5Dclose};
-  Handle space{H5Dget_space(ds.id), H5Sclose};
-  const hssize_t total = H5Sget_simple_extent_npoints(space.id);
-  COREDEM_CHECK(total >= 0 && static_cast<hsize_t>(total) == expected,
-                "state file '{}': dataset '{}' has {} values, expected {}", path, name, total, expected);
-  v.resize(static_cast<std::size_t>(expected));
-  if (expected > 0) {
-    COREDEM_CHECK(H5Dread(ds.id, h5type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) >= 0,
-                  "state file '{}': cannot read dataset '{}'", path, name);
-  }
-}
-
-template <class T>
-void writeAttr(hid_t obj, const char* name, T value) {
-  Handle space{H5Screate(H5S_SCALAR), H5Sclose};
-  Handle a{H5Acreate2(obj, name, h5type<T>(), space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
-  H5Awrite(a.id, h5type<T>(), &value);
-}
-
-void writeAttr(hid_t obj, const char* name, const std::string& value) {
-  Handle type{H5Tcopy(H5T_C_S1), H5Tclose};
-  H5Tset_size(type.id, value.empty() ? 1 : value.size());
-  H5Tset_strpad(type.id, H5T_STR_NULLTERM);
-  Handle space{H5Screate(H5S_SCALAR), H5Sclose};
-  Handle a{H5Acreate2(obj, name, type.id, space.id, H5P_DEFAULT, H5P_DEFAULT), H5Aclose};
-  std::string buf = value.empty() ? std::string(1, '\0') : value;
-  H5Awrite(a.id, type.id, buf.data());
-}
-
-template <class T>
-T readAttr(hid_t obj, const char* name, const std::string& path) {
-  COREDEM_CHECK(H5Aexists(obj, name) > 0, "state file '{}': /meta has no attribute '{}'", path, name);
-  Handle a{H5Aopen(obj, name, H5P_DEFAULT), H5Aclose};
-  T value{};
-  H5Aread(a.id, h5type<T>(), &value);
-  return value;
-}
-
-std::string readStringAttr(hid_t obj, const char* name, const std::string& path) {
-  COREDEM_CHECK(H5Aexists(obj, name) > 0, "state file '{}': /meta has no attribute '{}'", path, name);
-  Handle a{H5Aopen(obj, name, H5P_DEFAULT), H5Aclose};
-  Handle type{H5Aget_type(a.id), H5Tclose};
-  const std::size_t size = H5Tget_size(type.id);
-  std::string buf(size, '\0');
-  Handle mem{H5Tcopy(H5T_C_S1), H5Tclose};
-  H5Tset_size(mem.id, size);
-  H5Aread(a.id, mem.id, buf.data());
-  buf.resize(buf.find('\0') == std::string::npos ? size : buf.find('\0'));
-  return buf;
+T optionalAttribute(hid_t loc, const std::string& name, T fallback, const std::string& what) {
+  return h5::hasAttribute(loc, name) ? h5::readAttribute<T>(loc, name, what) : fallback;
 }
 
 } // namespace
 
 void writeStateFile(const std::string& path, const HostState& s, const StateMeta& meta) {
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  Handle file{H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose};
-  COREDEM_CHECK(file.id >= 0, "cannot create state file '{}': check that the directory exists "
-                              "and is writable", path);
-  const hsize_t n = s.n, K = static_cast<hsize_t>(s.historySlots),
-                M = static_cast<hsize_t>(s.neighbourSlots), ns = static_cast<hsize_t>(s.nSpecies);
+  checkShapes(s, "writeStateFile"); // every field holds n · width values: nothing is skipped
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); // errors are reported by the checks, not on stderr
+  h5::Handle file = h5::createFile(path);
   {
-    Handle g{H5Gcreate2(file.id, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
-    writeArray(g.id, "position", s.pos, {n, 3});
-    writeArray(g.id, "velocity", s.vel, {n, 3});
-    writeArray(g.id, "angular_velocity", s.omega, {n, 3});
-    writeArray(g.id, "force", s.force, {n, 3});
-    writeArray(g.id, "torque", s.torque, {n, 3});
-    writeArray(g.id, "wall_force", s.fwall, {n, 3});
-    writeArray(g.id, "position_at_rebuild", s.xref, {n, 3});
-    writeArray(g.id, "radius", s.radius, {n});
-    writeArray(g.id, "mass", s.mass, {n});
-    writeArray(g.id, "density", s.density, {n});
-    writeArray(g.id, "temperature", s.temperature, {n});
-    writeArray(g.id, "species", s.species, {n, ns});
-    writeArray(g.id, "material", s.material, {n});
-    writeArray(g.id, "global_id", s.gid, {n});
-    // Chemistry references (initial diameter; initial C and Fe2O3-equivalent masses).
-    if (s.d0.size() == n) writeArray(g.id, "initial_diameter", s.d0, {n});
-    if (s.chemRef.size() == 2 * n) writeArray(g.id, "chemistry_reference", s.chemRef, {n, 2});
+    h5::Handle gp = h5::createGroup(file, "particles");
+    h5::Handle gc = h5::createGroup(file, "contacts");
+    schema::forEachField(s, [&](const schema::FieldInfo& f, const auto& v) {
+      if (!f.has(schema::kCheckpointed))
+        return;
+      h5::writeDataset(f.group == schema::Group::Particles ? gp : gc, std::string(f.name), v,
+                       dimsOf(f, s));
+    });
   }
   if (meta.hasChemistry) {
     const ChemistryTotals& c = meta.chemistry;
-    Handle g{H5Gcreate2(file.id, "chemistry", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
-    writeArray(g.id, "gas_produced_kg", c.gasProduced, {c.gasProduced.size()});
-    writeArray(g.id, "solid_change_kg", c.solidChange, {c.solidChange.size()});
-    writeArray(g.id, "removed_solid_kg", c.removedSolid, {c.removedSolid.size()});
-    writeArray(g.id, "homogeneous_source_kg", c.homogeneousSource, {c.homogeneousSource.size()});
-    writeAttr(g.id, "reaction_heat_J", c.reactionHeat);
-    writeAttr(g.id, "homogeneous_heat_J", c.homogeneousHeat);
-    writeAttr(g.id, "gas_sensible_heat_J", c.gasSensibleHeat);
-    writeAttr(g.id, "sensible_mass_enthalpy_J", c.sensibleMassEnthalpy);
-    writeAttr(g.id, "removed_count", static_cast<std::uint64_t>(c.removedCount));
+    h5::Handle g = h5::createGroup(file, "chemistry");
+    h5::writeDataset(g, "gas_produced_kg", c.gasProduced);
+    h5::writeDataset(g, "solid_change_kg", c.solidChange);
+    h5::writeDataset(g, "removed_solid_kg", c.removedSolid);
+    h5::writeDataset(g, "homogeneous_source_kg", c.homogeneousSource);
+    h5::writeAttribute(g, "reaction_heat_J", c.reactionHeat);
+    h5::writeAttribute(g, "homogeneous_heat_J", c.homogeneousHeat);
+    h5::writeAttribute(g, "gas_sensible_heat_J", c.gasSensibleHeat);
+    h5::writeAttribute(g, "sensible_mass_enthalpy_J", c.sensibleMassEnthalpy);
+    h5::writeAttribute(g, "removed_count", static_cast<std::uint64_t>(c.removedCount));
   }
-  {
-    Handle g{H5Gcreate2(file.id, "contacts", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
-    writeArray(g.id, "history_key", s.histKey, {n, K});
-    writeArray(g.id, "history_displacement", s.histDisp, {n, K, 3});
-    writeArray(g.id, "contact_count", s.contacts, {n});
-    writeArray(g.id, "wall_contact_count", s.wallContacts, {n});
-    writeArray(g.id, "neighbour_count", s.nbCount, {n});
-    writeArray(g.id, "neighbour_list", s.nbList, {n, M});
-  }
-  Handle g{H5Gcreate2(file.id, "meta", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose};
-  writeAttr(g.id, "time", meta.time);
-  writeAttr(g.id, "time_compensation", meta.timeCompensation);
-  writeAttr(g.id, "step", meta.step);
-  writeAttr(g.id, "backend", meta.backend);
-  writeAttr(g.id, "config_hash", meta.configHash);
-  writeAttr(g.id, "software_version", meta.softwareVersion);
-  writeAttr(g.id, "protocol_version", meta.protocolVersion);
-  writeAttr(g.id, "particle_count", static_cast<std::uint64_t>(s.n));
-  writeAttr(g.id, "n_species", static_cast<std::int32_t>(s.nSpecies));
-  writeAttr(g.id, "history_slots", static_cast<std::int32_t>(s.historySlots));
-  writeAttr(g.id, "neighbour_slots", static_cast<std::int32_t>(s.neighbourSlots));
-  writeAttr(g.id, "neighbour_list_valid", static_cast<std::int32_t>(s.listValid));
-  writeAttr(g.id, "heat_convection_J", meta.heatConvection);
-  writeAttr(g.id, "heat_radiation_J", meta.heatRadiation);
-  writeAttr(g.id, "heat_wall_J", meta.heatWall);
-  COREDEM_CHECK(H5Fflush(file.id, H5F_SCOPE_GLOBAL) >= 0, "cannot flush state file '{}'", path);
+  h5::Handle g = h5::createGroup(file, "meta");
+  h5::writeAttribute(g, "format_version", static_cast<std::int32_t>(schema::kFormatVersion));
+  h5::writeAttribute(g, "time", meta.time);
+  h5::writeAttribute(g, "time_compensation", meta.timeCompensation);
+  h5::writeAttribute(g, "step", meta.step);
+  h5::writeAttribute(g, "backend", meta.backend);
+  h5::writeAttribute(g, "config_hash", meta.configHash);
+  h5::writeAttribute(g, "software_version", meta.softwareVersion);
+  h5::writeAttribute(g, "protocol_version", meta.protocolVersion);
+  h5::writeAttribute(g, "particle_count", static_cast<std::uint64_t>(s.n));
+  h5::writeAttribute(g, "n_species", static_cast<std::int32_t>(s.nSpecies));
+  h5::writeAttribute(g, "history_slots", static_cast<std::int32_t>(s.historySlots));
+  h5::writeAttribute(g, "neighbour_slots", static_cast<std::int32_t>(s.neighbourSlots));
+  h5::writeAttribute(g, "neighbour_list_valid", static_cast<std::int32_t>(s.listValid));
+  h5::writeAttribute(g, "heat_convection_J", meta.heatConvection);
+  h5::writeAttribute(g, "heat_radiation_J", meta.heatRadiation);
+  h5::writeAttribute(g, "heat_wall_J", meta.heatWall);
+  COREDEM_CHECK(H5Fflush(file, H5F_SCOPE_GLOBAL) >= 0, "cannot flush state file '{}'", path);
 }
 
 void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  COREDEM_CHECK(H5Fis_hdf5(path.c_str()) > 0,
-                "state file '{}' does not exist or is not an HDF5 file", path);
-  Handle file{H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose};
-  COREDEM_CHECK(file.id >= 0, "cannot open state file '{}'", path);
-  COREDEM_CHECK(H5Lexists(file.id, "meta", H5P_DEFAULT) > 0 && H5Lexists(file.id, "particles", H5P_DEFAULT) > 0 &&
-                    H5Lexists(file.id, "contacts", H5P_DEFAULT) > 0,
+  const std::string what = "state file '" + path + "'";
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); // errors are reported by the checks, not on stderr
+  h5::Handle file = h5::openFile(path);
+  COREDEM_CHECK(h5::exists(file, "meta") && h5::exists(file, "particles") &&
+                    h5::exists(file, "contacts"),
                 "'{}' is not a CoReDEM DEM state file (needs /meta, /particles, /contacts)", path);
-  Handle gm{H5Gopen2(file.id, "meta", H5P_DEFAULT), H5Gclose};
-  meta.time = readAttr<double>(gm.id, "time", path);
-  meta.timeCompensation = readAttr<double>(gm.id, "time_compensation", path);
-  meta.step = readAttr<std::uint64_t>(gm.id, "step", path);
-  meta.backend = readStringAttr(gm.id, "backend", path);
-  meta.configHash = readStringAttr(gm.id, "config_hash", path);
-  meta.softwareVersion = readStringAttr(gm.id, "software_version", path);
-  meta.protocolVersion = readStringAttr(gm.id, "protocol_version", path);
-  s.n = readAttr<std::uint64_t>(gm.id, "particle_count", path);
-  s.nSpecies = readAttr<std::int32_t>(gm.id, "n_species", path);
-  s.historySlots = readAttr<std::int32_t>(gm.id, "history_slots", path);
-  s.neighbourSlots = readAttr<std::int32_t>(gm.id, "neighbour_slots", path);
-  s.listValid = readAttr<std::int32_t>(gm.id, "neighbour_list_valid", path);
+  h5::Handle gm = h5::openGroup(file, "meta", what);
+  // Files written before the attribute existed are version 1.
+  meta.formatVersion = optionalAttribute<std::int32_t>(gm, "format_version", 1, what);
+  COREDEM_CHECK(meta.formatVersion <= schema::kFormatVersion,
+                "{} has format version {}, newer than this build reads ({}); it was written by "
+                "CoReDEM {}: read it with that version or a newer one",
+                what, meta.formatVersion, schema::kFormatVersion,
+                h5::hasAttribute(gm, "software_version")
+                    ? h5::readStringAttribute(gm, "software_version", what)
+                    : std::string("(unknown)"));
+  meta.time = h5::readAttribute<double>(gm, "time", what);
+  meta.timeCompensation = h5::readAttribute<double>(gm, "time_compensation", what);
+  meta.step = h5::readAttribute<std::uint64_t>(gm, "step", what);
+  meta.backend = h5::readStringAttribute(gm, "backend", what);
+  meta.configHash = h5::readStringAttribute(gm, "config_hash", what);
+  meta.softwareVersion = h5::readStringAttribute(gm, "software_version", what);
+  meta.protocolVersion = h5::readStringAttribute(gm, "protocol_version", what);
+  s.n = h5::readAttribute<std::uint64_t>(gm, "particle_count", what);
+  s.nSpecies = h5::readAttribute<std::int32_t>(gm, "n_species", what);
+  s.historySlots = h5::readAttribute<std::int32_t>(gm, "history_slots", what);
+  s.neighbourSlots = h5::readAttribute<std::int32_t>(gm, "neighbour_slots", what);
+  s.listValid = h5::readAttribute<std::int32_t>(gm, "neighbour_list_valid", what);
   // Heat totals: absent in files written before heat transfer was integrated.
-  meta.heatConvection = H5Aexists(gm.id, "heat_convection_J") > 0 ? readAttr<double>(gm.id, "heat_convection_J", path) : 0.0;
-  meta.heatRadiation = H5Aexists(gm.id, "heat_radiation_J") > 0 ? readAttr<double>(gm.id, "heat_radiation_J", path) : 0.0;
-  meta.heatWall = H5Aexists(gm.id, "heat_wall_J") > 0 ? readAttr<double>(gm.id, "heat_wall_J", path) : 0.0;
-  const hsize_t n = s.n, K = static_cast<hsize_t>(s.historySlots),
-                M = static_cast<hsize_t>(s.neighbourSlots), ns = static_cast<hsize_t>(s.nSpecies);
+  meta.heatConvection = optionalAttribute(gm, "heat_convection_J", 0.0, what);
+  meta.heatRadiation = optionalAttribute(gm, "heat_radiation_J", 0.0, what);
+  meta.heatWall = optionalAttribute(gm, "heat_wall_J", 0.0, what);
   {
-    Handle g{H5Gopen2(file.id, "particles", H5P_DEFAULT), H5Gclose};
-    readArray(g.id, "position", s.pos, 3 * n, path);
-    readArray(g.id, "velocity", s.vel, 3 * n, path);
-    readArray(g.id, "angular_velocity", s.omega, 3 * n, path);
-    readArray(g.id, "force", s.force, 3 * n, path);
-    readArray(g.id, "torque", s.torque, 3 * n, path);
-    readArray(g.id, "wall_force", s.fwall, 3 * n, path);
-    readArray(g.id, "position_at_rebuild", s.xref, 3 * n, path);
-    readArray(g.id, "radius", s.radius, n, path);
-    readArray(g.id, "mass", s.mass, n, path);
-    readArray(g.id, "density", s.density, n, path);
-    readArray(g.id, "temperature", s.temperature, n, path);
-    readArray(g.id, "species", s.species, n * ns, path);
-    readArray(g.id, "material", s.material, n, path);
-    readArray(g.id, "global_id", s.gid, n, path);
-    // Chemistry references: absent in files written before chemistry was integrated.
-    if (H5Lexists(g.id, "initial_diameter", H5P_DEFAULT) > 0) {
-      readArray(g.id, "initial_diameter", s.d0, n, path);
-    } else {
-      s.d0.resize(n);
-      for (std::size_t i = 0; i < n; ++i) s.d0[i] = 2.0 * s.radius[i];
-    }
-    if (H5Lexists(g.id, "chemistry_reference", H5P_DEFAULT) > 0) {
-      readArray(g.id, "chemistry_reference", s.chemRef, 2 * n, path);
-    } else {
-      s.chemRef.assign(2 * n, 0.0);
-    }
+    h5::Handle gp = h5::openGroup(file, "particles", what);
+    h5::Handle gc = h5::openGroup(file, "contacts", what);
+    schema::forEachField(s, [&](const schema::FieldInfo& f, auto& v) {
+      using T = typename std::decay_t<decltype(v)>::value_type;
+      v.clear();
+      if (!f.has(schema::kCheckpointed))
+        return; // filled from its default below
+      const hid_t g = f.group == schema::Group::Particles ? gp.id() : gc.id();
+      const std::string name(f.name);
+      const bool present = h5::exists(g, name);
+      // A field newer than the file takes its default (below); from its version on it is required.
+      if (!present && meta.formatVersion < f.since)
+        return;
+      COREDEM_CHECK(present,
+                    "{} has no dataset '/{}/{}' (format version {}): it was not written by "
+                    "DemSystem::writeState (or is truncated)",
+                    what, schema::groupName(f.group), name, meta.formatVersion);
+      v = h5::readDataset<T>(g, name, what, static_cast<std::int64_t>(s.expectedSize(f)));
+      const std::vector<hsize_t> want = dimsOf(f, s);
+      const std::vector<hsize_t> got = h5::datasetShape(g, name, what);
+      COREDEM_CHECK(got == want, "{}: dataset '{}' has shape {}, expected {}", what, name,
+                    shapeText(got), shapeText(want));
+    });
   }
-  meta.hasChemistry = H5Lexists(file.id, "chemistry", H5P_DEFAULT) > 0;
+  fillDefaults(s); // fields the file predates (schema defaults)
+  checkShapes(s, "readStateFile");
+  meta.hasChemistry = h5::exists(file, "chemistry");
   if (meta.hasChemistry) {
-    Handle gc{H5Gopen2(file.id, "chemistry", H5P_DEFAULT), H5Gclose};
-    auto vec = [&](const char* name, std::vector<double>& v) {
-      Handle ds{H5Dopen2(gc.id, name, H5P_DEFAULT), H5Dclose};
-      COREDEM_CHECK(ds.id >= 0, "state file '{}': /chemistry has no dataset '{}'", path, name);
-      Handle space{H5Dget_space(ds.id), H5Sclose};
-      const hssize_t count = H5Sget_simple_extent_npoints(space.id);
-      readArray(gc.id, name, v, static_cast<hsize_t>(count < 0 ? 0 : count), path);
-    };
+    h5::Handle gc = h5::openGroup(file, "chemistry", what);
     ChemistryTotals& c = meta.chemistry;
-    vec("gas_produced_kg", c.gasProduced);
-    vec("solid_change_kg", c.solidChange);
-    vec("removed_solid_kg", c.removedSolid);
-    vec("homogeneous_source_kg", c.homogeneousSource);
-    c.reactionHeat = readAttr<double>(gc.id, "reaction_heat_J", path);
-    c.homogeneousHeat = readAttr<double>(gc.id, "homogeneous_heat_J", path);
+    c.gasProduced = h5::readDataset<double>(gc, "gas_produced_kg", what);
+    c.solidChange = h5::readDataset<double>(gc, "solid_change_kg", what);
+    c.removedSolid = h5::readDataset<double>(gc, "removed_solid_kg", what);
+    c.homogeneousSource = h5::readDataset<double>(gc, "homogeneous_source_kg", what);
+    c.reactionHeat = h5::readAttribute<double>(gc, "reaction_heat_J", what);
+    c.homogeneousHeat = h5::readAttribute<double>(gc, "homogeneous_heat_J", what);
     // Files written before the sensible-enthalpy ledgers: they start at 0.
-    c.gasSensibleHeat = H5Aexists(gc.id, "gas_sensible_heat_J") > 0
-                            ? readAttr<double>(gc.id, "gas_sensible_heat_J", path) : 0.0;
-    c.sensibleMassEnthalpy = H5Aexists(gc.id, "sensible_mass_enthalpy_J") > 0
-                                 ? readAttr<double>(gc.id, "sensible_mass_enthalpy_J", path) : 0.0;
-    c.removedCount = readAttr<std::uint64_t>(gc.id, "removed_count", path);
+    c.gasSensibleHeat = optionalAttribute(gc, "gas_sensible_heat_J", 0.0, what);
+    c.sensibleMassEnthalpy = optionalAttribute(gc, "sensible_mass_enthalpy_J", 0.0, what);
+    c.removedCount = h5::readAttribute<std::uint64_t>(gc, "removed_count", what);
   }
-  Handle g{H5Gopen2(file.id, "contacts", H5P_DEFAULT), H5Gclose};
-  readArray(g.id, "history_key", s.histKey, n * K, path);
-  readArray(g.id, "history_displacement", s.histDisp, 3 * n * K, path);
-  readArray(g.id, "contact_count", s.contacts, n, path);
-  readArray(g.id, "wall_contact_count", s.wallContacts, n, path);
-  readArray(g.id, "neighbour_count", s.nbCount, n, path);
-  readArray(g.id, "neighbour_list", s.nbList, n * M, path);
 }
 
 } // namespace coredem::dem

@@ -11,6 +11,7 @@
 
 #include <coredem/common/check.h>
 #include <coredem/common/hdf5.h>
+#include <coredem/dem/particle_schema.h>
 #include <coredem/orchestrator/checkpoint.h>
 #include <coredem/orchestrator/outputs.h>
 
@@ -288,9 +289,20 @@ void writeParticleXdmf(const fs::path& xdmfPath,
                      "Format=\"HDF\">{}:/particles/position</DataItem>\n",
                      n, rel);
     x << "    </Geometry>\n";
-    for (const auto& d : ds) {
-      if (d.path.rfind("/particles/", 0) != 0 || d.path == "/particles/position" || !d.numeric ||
-          d.dims.empty() || d.dims[0] != n) {
+    // The node attributes are the DEM particle schema's snapshot fields present in the file.
+    for (const dem::schema::FieldInfo& f : dem::schema::snapshotFields()) {
+      if (f.name == dem::schema::kGeometryField) {
+        continue;
+      }
+      const std::string name(f.name);
+      const auto it = std::find_if(ds.begin(), ds.end(), [&](const DatasetInfo& d) {
+        return d.path == "/particles/" + name;
+      });
+      if (it == ds.end()) {
+        continue;
+      }
+      const DatasetInfo& d = *it;
+      if (!d.numeric || d.dims.empty() || d.dims[0] != n) {
         continue;
       }
       const bool vec = d.dims.size() == 2 && d.dims[1] == 3;
@@ -298,7 +310,6 @@ void writeParticleXdmf(const fs::path& xdmfPath,
       if (!vec && !scalar) {
         continue;
       }
-      const std::string name = d.path.substr(std::strlen("/particles/"));
       const bool isFloat = d.type.rfind("float", 0) == 0;
       const std::string numberType =
           isFloat ? "Float" : (d.type.rfind("u", 0) == 0 ? "UInt" : "Int");

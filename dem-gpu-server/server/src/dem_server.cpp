@@ -654,7 +654,7 @@ struct DemServer::Impl {
     const fs::path final = fs::path(dir) / "dem.h5";
     const fs::path tmp = fs::path(dir) / ".dem.h5.tmp";
     fs::remove(tmp);
-    system->writeState(tmp.string());
+    system->writeState(tmp.string(), proto::kProtocolVersion.toString());
     ServerLedgers l = ledgers;
     writeServerLedgers(tmp.string(), l, step, session);
     syncFile(tmp);

@@ -229,7 +229,9 @@ public:
   const CellSources& advance(double dtCfd, int nSub);
 
   /// Writes the full state (particles, contact history, neighbour lists, time) to HDF5.
-  void writeState(const std::string& path) const;
+  /// `protocolVersion` is the coupling protocol of the server that writes it ("1.1"), recorded
+  /// in /meta; a system used without a server leaves it empty and the file says "none".
+  void writeState(const std::string& path, const std::string& protocolVersion = {}) const;
   /// Replaces the state by the one in `path`; continuing is bitwise identical to not
   /// having stopped (cpu backend; gas fields must be set again). A system configured without
   /// particle sets takes all particles from the file; Δt_DEM,max is recomputed from them.

@@ -52,8 +52,9 @@ void scanHdf5(const std::filesystem::path& file, std::vector<DatasetInfo>& datas
 
 /// Writes `xdmfPath` (atomically) describing the particle snapshots `snapshots` (paths
 /// relative to the XDMF's folder, with their times) as a temporal collection of
-/// poly-vertex grids: geometry from /particles/position (N×3), and every other /particles
-/// dataset with N rows as a node attribute (Scalar for [N], Vector for [N,3]).
+/// poly-vertex grids: geometry from /particles/position (N×3), and each snapshot field of the
+/// DEM particle schema (coredem/dem/particle_schema.h, snapshotFields()) that the file holds
+/// with N rows as a node attribute (Scalar for [N], Vector for [N,3]).
 void writeParticleXdmf(const std::filesystem::path& xdmfPath,
                        const std::vector<std::pair<double, std::string>>& snapshots);
 
