@@ -11,7 +11,7 @@
 ///                           with restoreTotals); each ledger is computed in one module only.
 ///
 /// Adding a heat-transfer term with its ledger: its kernel, its call in HeatModule::sources and
-/// its entry in HeatTotals (docs/architecture-models.md).
+/// its entry in HeatTotals (docs/architecture.md).
 
 #include <concepts>
 #include <cstddef>

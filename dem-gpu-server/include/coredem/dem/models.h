@@ -14,7 +14,7 @@
 /// only the plain-data headers dem_system.h and the kernels' enums.
 ///
 /// Adding a drag law: its kernel header, an enumerator + case in kernels/drag.h, one row in
-/// dragModels() (models.cpp), its test (docs/architecture-models.md).
+/// dragModels() (models.cpp), its test (docs/architecture.md).
 
 #include <cstddef>
 #include <span>

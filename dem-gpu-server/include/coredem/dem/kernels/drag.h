@@ -3,7 +3,7 @@
 /// Drag-law dispatch (PHYSICS §2.2): the engine calls particleDragCoefficient() with the law
 /// chosen by `models: {drag: ...}` (registry: coredem/dem/models.h). Adding a drag law: its
 /// kernel header (one function returning β V_p/(1−ε) in kg/s), an enumerator and a case here,
-/// one registry row in models.cpp, its test (docs/architecture-models.md).
+/// one registry row in models.cpp, its test (docs/architecture.md).
 
 #include "coredem/dem/kernels/common.h"
 #include "coredem/dem/kernels/drag_gidaspow.h"
