@@ -27,5 +27,7 @@ struct Registrar {
 } // namespace coredem::bench
 
 /// Registers `int fn(int argc, char** argv)` as `coredem-bench NAME`; argv[0] is NAME.
-#define COREDEM_BENCH_COMMAND(name, summary, fn)                                             \
-  static ::coredem::bench::Registrar coredemBenchRegistrar_##fn{name, summary, fn}
+#define COREDEM_BENCH_COMMAND(name, summary, fn)                                                   \
+  static ::coredem::bench::Registrar coredemBenchRegistrar_##fn {                                  \
+    name, summary, fn                                                                              \
+  }

@@ -1,8 +1,8 @@
 // coredem-bench: benchmarks of CoReDEM's parts. Figures are printed, never asserted.
-#include "commands.h"
-
 #include <cstdio>
 #include <cstring>
+
+#include "commands.h"
 
 namespace coredem::bench {
 std::map<std::string, CommandInfo>& commands() {
@@ -14,7 +14,8 @@ std::map<std::string, CommandInfo>& commands() {
 int main(int argc, char** argv) {
   auto& table = coredem::bench::commands();
   auto usage = [&](FILE* out) {
-    std::fprintf(out, "usage: coredem-bench <command> [options]   (<command> --help for its options)\n\ncommands:\n");
+    std::fprintf(out, "usage: coredem-bench <command> [options]   (<command> --help for its "
+                      "options)\n\ncommands:\n");
     for (const auto& [name, info] : table) {
       std::fprintf(out, "  %-12s %s\n", name.c_str(), info.summary.c_str());
     }

@@ -1,23 +1,24 @@
 // coredem-bench dem: throughput of the DEM core on the decks of bench/decks.md.
-//   coredem-bench dem --case packed --particles 100000 --steps 500 --backend cpu --threads 2 [--json]
+//   coredem-bench dem --case packed --particles 100000 --steps 500 --backend cpu --threads 2
+//   [--json]
 // Prints particle_steps_per_s, contacts per particle, bytes per particle and the time per
 // stage. Figures are measured, never asserted.
-#include "commands.h"
 #include "dem.h"
 
-#include "coredem/common/check.h"
-#include "coredem/dem/dem_system.h"
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
-#include <chrono>
-#include <ctime>
-#include <cmath>
-#include <cstdio>
-#include <algorithm>
-#include <array>
-#include <string>
-#include <vector>
+#include "commands.h"
+#include "coredem/common/check.h"
+#include "coredem/dem/dem_system.h"
 
 namespace {
 
@@ -27,25 +28,32 @@ using coredem::bench::BenchGas;
 using coredem::bench::deck;
 
 int runDem(int argc, char** argv) {
-  CLI::App app{"DEM core throughput on the packed / agitated decks (bench/decks.md)", "coredem-bench dem"};
+  CLI::App app{"DEM core throughput on the packed / agitated decks (bench/decks.md)",
+               "coredem-bench dem"};
   std::string deckName = "packed", backend = "cpu";
   std::size_t n = 10000;
   int steps = 500, threads = 2, warmup = 20;
   double skin = -1;
   bool json = false, coupled = false, heat = false;
   int nSub = 50;
-  app.add_option("--case", deckName, "deck: packed | agitated")->check(CLI::IsMember({"packed", "agitated"}));
+  app.add_option("--case", deckName, "deck: packed | agitated")
+      ->check(CLI::IsMember({"packed", "agitated"}));
   app.add_option("--particles", n, "number of particles")->check(CLI::Range(1.0, 2.0e9));
   app.add_option("--steps", steps, "measured DEM steps")->check(CLI::PositiveNumber);
   app.add_option("--warmup", warmup, "unmeasured steps first")->check(CLI::NonNegativeNumber);
-  app.add_option("--backend", backend, "cpu | cuda | auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
-  app.add_option("--threads", threads, "OpenMP threads (cpu backend)")->check(CLI::NonNegativeNumber);
+  app.add_option("--backend", backend, "cpu | cuda | auto")
+      ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
+  app.add_option("--threads", threads, "OpenMP threads (cpu backend)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--skin", skin, "Verlet skin as a fraction of d_max (default: the library's)");
   app.add_flag("--json", json, "print one JSON object");
-  app.add_flag("--coupled", coupled, "add a PCM coupling grid (cells of 4 d_p) with air rising at 0.5 m/s");
-  app.add_flag("--heat", heat, "switch the heat module on (the decks are mechanics only; with --coupled: "
+  app.add_flag("--coupled", coupled,
+               "add a PCM coupling grid (cells of 4 d_p) with air rising at 0.5 m/s");
+  app.add_flag("--heat", heat,
+               "switch the heat module on (the decks are mechanics only; with --coupled: "
                "conduction, convection with the gas, lens; radiation needs an emissivity)");
-  app.add_option("--nsub", nSub, "with --coupled: DEM sub-steps per CFD step")->check(CLI::PositiveNumber);
+  app.add_option("--nsub", nSub, "with --coupled: DEM sub-steps per CFD step")
+      ->check(CLI::PositiveNumber);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -53,12 +61,16 @@ int runDem(int argc, char** argv) {
   }
   try {
     DemConfig cfg = deck(deckName, n);
-    if (skin >= 0) cfg.neighbour.skinFactor = skin;
-    if (heat) cfg.heat.enabled = true;  // default options: contact conduction; the rest needs gas
-    if (coupled) addCouplingGrid(cfg, 4e-3);
+    if (skin >= 0)
+      cfg.neighbour.skinFactor = skin;
+    if (heat)
+      cfg.heat.enabled = true; // default options: contact conduction; the rest needs gas
+    if (coupled)
+      addCouplingGrid(cfg, 4e-3);
     const auto t0 = std::chrono::steady_clock::now();
     DemSystem sys(cfg, parseBackend(backend), threads);
-    const double setup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double setup =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double dt = sys.dtDemMax();
     if (coupled) {
       const BenchGas gas(sys.cellCount(), 0.5, 293.15);
@@ -72,49 +84,65 @@ int runDem(int argc, char** argv) {
         sys.advance(k * dt, k);
       }
     };
-    if (warmup > 0) runSteps(warmup);
+    if (warmup > 0)
+      runSteps(warmup);
     sys.resetStageTimes();
     const auto t1 = std::chrono::steady_clock::now();
     const std::clock_t c1 = std::clock();
     runSteps(steps);
-    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     // Process CPU time (all threads): cpu / (wall·threads) < 1 shows a shared/loaded machine.
     const double cpu = static_cast<double>(std::clock() - c1) / CLOCKS_PER_SEC;
     const int usedThreads = threads > 0 ? threads : 1;
     const StageTimes st = sys.stageTimes();
-    const double pairsPer = 2.0 * static_cast<double>(sys.pairContactCount()) / static_cast<double>(n);
-    const double wallPer = static_cast<double>(sys.contactCount() - sys.pairContactCount()) / static_cast<double>(n);
+    const double pairsPer =
+        2.0 * static_cast<double>(sys.pairContactCount()) / static_cast<double>(n);
+    const double wallPer =
+        static_cast<double>(sys.contactCount() - sys.pairContactCount()) / static_cast<double>(n);
     const double bytesPer = static_cast<double>(sys.memoryBytes()) / static_cast<double>(n);
     const double rate = static_cast<double>(n) * steps / wall;
     if (json) {
-      std::printf("{\"command\":\"dem\",\"case\":\"%s\",\"backend\":\"%s\",\"threads\":%d,\"particles\":%zu,"
-                  "\"steps\":%d,\"dt_dem\":%.6e,\"skin_factor\":%.4g,\"wall_s\":%.6f,\"setup_s\":%.6f,"
-                  "\"particle_steps_per_s\":%.6e,\"contacts_per_particle\":%.4f,"
-                  "\"wall_contacts_per_particle\":%.4f,\"bytes_per_particle\":%.1f,"
-                  "\"heat\":%s,\"stage_s\":{\"neighbour\":%.6f,\"contact\":%.6f,\"integrate\":%.6f,\"coupling\":%.6f,"
-                  "\"heat\":%.6f,\"drag\":%.6f},"
-                  "\"rebuilds\":%llu,\"cpu_s\":%.6f,\"cpu_utilisation\":%.3f,"
-                  "\"particle_steps_per_cpu_s\":%.6e}\n",
-                  deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt, cfg.neighbour.skinFactor,
-                  wall, setup, rate, pairsPer, wallPer, bytesPer, heat ? "true" : "false", st.neighbour,
-                  st.contact, st.integrate, st.coupling, st.heat, st.drag, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads),
-                  static_cast<double>(n) * steps / cpu);
+      std::printf(
+          "{\"command\":\"dem\",\"case\":\"%s\",\"backend\":\"%s\",\"threads\":%d,\"particles\":%"
+          "zu,"
+          "\"steps\":%d,\"dt_dem\":%.6e,\"skin_factor\":%.4g,\"wall_s\":%.6f,\"setup_s\":%.6f,"
+          "\"particle_steps_per_s\":%.6e,\"contacts_per_particle\":%.4f,"
+          "\"wall_contacts_per_particle\":%.4f,\"bytes_per_particle\":%.1f,"
+          "\"heat\":%s,\"stage_s\":{\"neighbour\":%.6f,\"contact\":%.6f,\"integrate\":%.6f,"
+          "\"coupling\":%.6f,"
+          "\"heat\":%.6f,\"drag\":%.6f},"
+          "\"rebuilds\":%llu,\"cpu_s\":%.6f,\"cpu_utilisation\":%.3f,"
+          "\"particle_steps_per_cpu_s\":%.6e}\n",
+          deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt,
+          cfg.neighbour.skinFactor, wall, setup, rate, pairsPer, wallPer, bytesPer,
+          heat ? "true" : "false", st.neighbour, st.contact, st.integrate, st.coupling, st.heat,
+          st.drag, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads),
+          static_cast<double>(n) * steps / cpu);
     } else {
-      std::printf("case %s, backend %s, threads %d, N = %zu, %d steps of dt_DEM = %.4e s (skin %.3g d)\n",
-                  deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt, cfg.neighbour.skinFactor);
+      std::printf(
+          "case %s, backend %s, threads %d, N = %zu, %d steps of dt_DEM = %.4e s (skin %.3g d)\n",
+          deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt,
+          cfg.neighbour.skinFactor);
       std::printf("particle_steps_per_s     %.4e\n", rate);
       std::printf("contacts_per_particle    %.3f  (+ %.3f wall contacts)\n", pairsPer, wallPer);
       std::printf("bytes_per_particle       %.0f\n", bytesPer);
       std::printf("wall time                %.3f s  (set-up %.3f s)\n", wall, setup);
-      std::printf("cpu time                 %.3f s  (utilisation %.0f %% of %d threads; %.4e particle steps per cpu s)\n",
-                  cpu, 100.0 * cpu / (wall * usedThreads), usedThreads, static_cast<double>(n) * steps / cpu);
+      std::printf("cpu time                 %.3f s  (utilisation %.0f %% of %d threads; %.4e "
+                  "particle steps per cpu s)\n",
+                  cpu, 100.0 * cpu / (wall * usedThreads), usedThreads,
+                  static_cast<double>(n) * steps / cpu);
       std::printf("stage neighbour search   %.3f s  (%llu rebuilds)\n", st.neighbour,
                   static_cast<unsigned long long>(st.rebuilds));
       std::printf("stage contact forces     %.3f s\n", st.contact);
       std::printf("stage integration        %.3f s\n", st.integrate);
-      if (coupled) std::printf("stage drag (gas forces)  %.3f s\n", st.drag);
-      if (heat) std::printf("stage heat               %.3f s\n", st.heat);
-      if (coupled) std::printf("stage coupling (PCM)     %.3f s  (%zu cells, %d sub-steps per CFD step)\n", st.coupling, sys.cellCount(), nSub);
+      if (coupled)
+        std::printf("stage drag (gas forces)  %.3f s\n", st.drag);
+      if (heat)
+        std::printf("stage heat               %.3f s\n", st.heat);
+      if (coupled)
+        std::printf("stage coupling (PCM)     %.3f s  (%zu cells, %d sub-steps per CFD step)\n",
+                    st.coupling, sys.cellCount(), nSub);
     }
     return 0;
   } catch (const coredem::UserError& e) {

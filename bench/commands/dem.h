@@ -3,13 +3,13 @@
 /// The DEM benchmark decks of bench/decks.md, shared by `coredem-bench dem` and
 /// `coredem-bench thermochem` (and mirrored by bench/peers/liggghts/make_deck.py).
 
-#include "coredem/dem/dem_system.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
 #include <vector>
+
+#include "coredem/dem/dem_system.h"
 
 namespace coredem::bench {
 
@@ -52,7 +52,8 @@ inline coredem::dem::DemConfig deck(const std::string& name, std::size_t n) {
 /// A PCM coupling grid over the deck's box with cells of about `cell` metres (PHYSICS §1.1:
 /// Δx ≈ 3–5 d_p). addBox order of the walls: x lo/hi, y lo/hi, z lo/hi.
 inline void addCouplingGrid(coredem::dem::DemConfig& cfg, double cell) {
-  const std::array<double, 3> hi{cfg.walls[1].point[0], cfg.walls[3].point[1], cfg.walls[5].point[2]};
+  const std::array<double, 3> hi{cfg.walls[1].point[0], cfg.walls[3].point[1],
+                                 cfg.walls[5].point[2]};
   for (int d = 0; d < 3; ++d) {
     cfg.grid.counts[d] = std::max(1, static_cast<int>(hi[d] / cell));
     cfg.grid.spacing[d] = hi[d] / cfg.grid.counts[d];

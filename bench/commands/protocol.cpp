@@ -13,15 +13,6 @@
 //                   and NaN/Inf scan: the receiver-side check every message gets)
 // Both sides use the library's zero-copy paths (addArrayShared on send, frame views on
 // receive), so the figure is the cost of the transport itself (no validation).
-#include "commands.h"
-
-#include <coredem/protocol/message.h>
-#include <coredem/protocol/transport.h>
-#include <coredem/protocol/validate.h>
-
-#include <CLI/CLI.hpp>
-#include <zmq.hpp>
-
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -32,10 +23,18 @@
 #include <thread>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zmq.hpp>
+
+#include <coredem/protocol/message.h>
+#include <coredem/protocol/transport.h>
+#include <coredem/protocol/validate.h>
+
+#include "commands.h"
 
 namespace {
 
@@ -163,8 +162,8 @@ Result measureTransport(const std::string& name, const std::string& bindEndpoint
       Message m(v1::MESSAGE_TYPE_ACK);
       m.envelope().mutable_ack();
       for (std::size_t f = 0; f < arrays.size(); ++f) {
-        m.addArrayShared<double>(arrayName(f), arrays[f],
-                                 std::span<const double>(*arrays[f]), {cells});
+        m.addArrayShared<double>(arrayName(f), arrays[f], std::span<const double>(*arrays[f]),
+                                 {cells});
       }
       auto t0 = Clock::now();
       Message reply = client.request(std::move(m), std::chrono::seconds(60));
@@ -191,8 +190,7 @@ Result measureTransport(const std::string& name, const std::string& bindEndpoint
   } else {
     ::waitpid(child, nullptr, 0);
   }
-  return Result{name, median(times), *std::min_element(times.begin(), times.end()),
-                times.size()};
+  return Result{name, median(times), *std::min_element(times.begin(), times.end()), times.size()};
 }
 
 /// The same round trip with bare cppzmq (DEALER -> ROUTER echo in a child process): no
@@ -321,8 +319,7 @@ double measureValidate(const std::vector<std::shared_ptr<std::vector<double>>>& 
   Message m(v1::MESSAGE_TYPE_ACK);
   m.envelope().mutable_ack();
   for (std::size_t f = 0; f < arrays.size(); ++f) {
-    m.addArrayShared<double>(arrayName(f), arrays[f],
-                             std::span<const double>(*arrays[f]), {cells});
+    m.addArrayShared<double>(arrayName(f), arrays[f], std::span<const double>(*arrays[f]), {cells});
   }
   std::vector<double> times;
   auto start = Clock::now();
@@ -382,17 +379,16 @@ int runProtocolBench(int argc, char** argv) {
   try {
     for (const auto& t : transports) {
       if (t == "tcp") {
-        results.push_back(measureTransport("tcp", "tcp://127.0.0.1:*", arrays, cells, seconds,
-                                           sameProcess));
+        results.push_back(
+            measureTransport("tcp", "tcp://127.0.0.1:*", arrays, cells, seconds, sameProcess));
       } else if (t == "ipc") {
-        results.push_back(measureTransport("ipc", "ipc://" + ipcPath, arrays, cells, seconds,
-                                           sameProcess));
+        results.push_back(
+            measureTransport("ipc", "ipc://" + ipcPath, arrays, cells, seconds, sameProcess));
         std::filesystem::remove(ipcPath);
       } else if (t == "tcp-raw") {
         results.push_back(measureRawZmq(arrays, cells, seconds));
       } else {
-        std::fprintf(stderr,
-                     "coredem-bench protocol: unknown transport '%s' (tcp, ipc, tcp-raw)\n",
+        std::fprintf(stderr, "coredem-bench protocol: unknown transport '%s' (tcp, ipc, tcp-raw)\n",
                      t.c_str());
         return 2;
       }
@@ -433,8 +429,7 @@ int runProtocolBench(int argc, char** argv) {
               static_cast<unsigned long long>(cells), nFields, static_cast<double>(bytes) / 1e6,
               sameProcess ? "a thread of this process" : "a child process");
   std::printf("memcpy of the same bytes: %.3f ms = %.2f GB/s\n", memcpySeconds * 1e3, memcpyGbps);
-  std::printf("validate() of such a message (structure + NaN/Inf scan): %.2f GB/s\n",
-              validateGbps);
+  std::printf("validate() of such a message (structure + NaN/Inf scan): %.2f GB/s\n", validateGbps);
   std::printf("%-9s %14s %10s %14s %12s\n", "transport", "round trip ms", "GB/s", "memcpy ratio",
               "iterations");
   for (const auto& r : results) {

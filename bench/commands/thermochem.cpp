@@ -13,15 +13,7 @@
 // species update and deposition together) is timed per model as well (chemistry_stage_* rows,
 // one variant each: CLG R1/R2, CLG R4/R5, a generic Arrhenius reaction). Figures are measured,
 // never asserted.
-#include "commands.h"
-#include "dem.h"
 #include "thermochem.h"
-
-#include "coredem/common/check.h"
-#include "coredem/dem/dem_system.h"
-
-#include <CLI/CLI.hpp>
-#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -29,6 +21,14 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include <CLI/CLI.hpp>
+#include <omp.h>
+
+#include "commands.h"
+#include "coredem/common/check.h"
+#include "coredem/dem/dem_system.h"
+#include "dem.h"
 
 namespace {
 
@@ -40,7 +40,8 @@ using Clock = std::chrono::steady_clock;
 struct Variant {
   const char* name;
   bool heat, convection, contact, lens, radiation;
-  int chemistry = 0;  ///< 0 none, 1 CLG R1/R2, 2 CLG R4/R5, 3 generic reaction (the engine's chemistry stage)
+  int chemistry =
+      0; ///< 0 none, 1 CLG R1/R2, 2 CLG R4/R5, 3 generic reaction (the engine's chemistry stage)
 };
 
 constexpr Variant kVariants[] = {
@@ -93,13 +94,20 @@ DemConfig makeConfig(const Options& o, const Variant& v) {
   h.radiation = v.radiation;
   // Species for the chemistry variants: a CLG bed (PHYSICS §6) of char + oxygen carrier.
   if (v.chemistry > 0) {
-    cfg.gasSpecies = {{"CO", 28.0101e-3}, {"CO2", 44.0095e-3}, {"H2", 2.01588e-3}, {"H2O", 18.01528e-3}, {"N2", 28.0134e-3}};
-    cfg.solidSpecies = {{"C", 12.0107e-3}, {"Fe2O3", 159.6882e-3}, {"Fe3O4", 231.5326e-3}, {"Al2O3", 101.9613e-3}};
+    cfg.gasSpecies = {{"CO", 28.0101e-3},
+                      {"CO2", 44.0095e-3},
+                      {"H2", 2.01588e-3},
+                      {"H2O", 18.01528e-3},
+                      {"N2", 28.0134e-3}};
+    cfg.solidSpecies = {
+        {"C", 12.0107e-3}, {"Fe2O3", 159.6882e-3}, {"Fe3O4", 231.5326e-3}, {"Al2O3", 101.9613e-3}};
     cfg.particleSets[0].composition = {0.3, 0.4, 0.2, 0.1};
     ChemistryOptions& ch = cfg.chemistry;
-    if (v.chemistry == 1) ch.clg.charGasification = true;
-    if (v.chemistry == 2) ch.clg.ocReduction = true;
-    if (v.chemistry == 3) {  // C + CO2 -> 2 CO, Arrhenius, first order in CO2 (as genericReaction())
+    if (v.chemistry == 1)
+      ch.clg.charGasification = true;
+    if (v.chemistry == 2)
+      ch.clg.ocReduction = true;
+    if (v.chemistry == 3) { // C + CO2 -> 2 CO, Arrhenius, first order in CO2 (as genericReaction())
       ReactionConfig r;
       r.name = "boudouard";
       r.terms = {{"C", -1.0}, {"CO2", -1.0}, {"CO", 2.0}};
@@ -123,18 +131,21 @@ Measured runVariant(const Options& o, const Variant& v, ParticleData* keep, Coup
   const coredem::bench::BenchGas gas(sys.cellCount(), o.uGas, o.tGas);
   GasFieldsView view = gas.view();
   std::vector<double> yg;
-  if (!cfg.gasSpecies.empty()) {  // the gasifier-like mixture of chemistryInput(), as mass fractions
+  if (!cfg.gasSpecies.empty()) { // the gasifier-like mixture of chemistryInput(), as mass fractions
     const double x[5] = {0.2, 0.2, 0.1, 0.2, 0.3};
     double mix = 0.0;
-    for (int k = 0; k < 5; ++k) mix += x[k] * cfg.gasSpecies[k].molarMass;
+    for (int k = 0; k < 5; ++k)
+      mix += x[k] * cfg.gasSpecies[k].molarMass;
     yg.resize(sys.cellCount() * 5);
     for (std::size_t c = 0; c < sys.cellCount(); ++c)
-      for (int k = 0; k < 5; ++k) yg[5 * c + k] = x[k] * cfg.gasSpecies[k].molarMass / mix;
+      for (int k = 0; k < 5; ++k)
+        yg[5 * c + k] = x[k] * cfg.gasSpecies[k].molarMass / mix;
     view.Yg = yg;
   }
   sys.setGasFields(view);
   const double dt = sys.dtDemMax();
-  if (o.warmup > 0) sys.advance(o.warmup * dt, o.warmup);
+  if (o.warmup > 0)
+    sys.advance(o.warmup * dt, o.warmup);
   std::vector<double> nb, ct, ht, in, cp, wl, chm;
   std::uint64_t rebuilds = 0;
   for (int r = 0; r < o.repeat; ++r) {
@@ -151,9 +162,12 @@ Measured runVariant(const Options& o, const Variant& v, ParticleData* keep, Coup
     chm.push_back(st.chemistry / o.steps);
     rebuilds += st.rebuilds;
   }
-  if (keep) *keep = sys.particles();
-  if (grid) *grid = cfg.grid;
-  return Measured{median(nb), median(ct), median(ht), median(in), median(cp), median(wl), median(chm), rebuilds};
+  if (keep)
+    *keep = sys.particles();
+  if (grid)
+    *grid = cfg.grid;
+  return Measured{median(nb), median(ct), median(ht),  median(in),
+                  median(cp), median(wl), median(chm), rebuilds};
 }
 
 /// The cells' gas: a gasifier-like mixture at T_g and 1 bar (mole fractions CO 0.2, CO2 0.2,
@@ -179,7 +193,7 @@ tc::ChemInput chemistryInput(const ParticleData& p, const CouplingGrid& g, doubl
     in.cell[i] = idx3[0] + g.counts[0] * (idx3[1] + g.counts[1] * idx3[2]);
   }
   const std::size_t nc = g.cellCount();
-  const double x[tc::kGas] = {0.2, 0.2, 0.1, 0.2, 0.3};  // GasSpecies order: CO, CO2, H2, H2O, N2
+  const double x[tc::kGas] = {0.2, 0.2, 0.1, 0.2, 0.3}; // GasSpecies order: CO, CO2, H2, H2O, N2
   const double pTot = 1.0e5;
   in.pBar.resize(nc * tc::kGas);
   in.conc.resize(nc * tc::kGas);
@@ -197,9 +211,21 @@ tc::ChemTimes runChemistryCpu(const tc::ChemInput& in, int reps, int threads) {
   const std::size_t n = in.n;
   std::vector<double> m = in.mass, y = in.Y, mdot(n * tc::kSolids), mg(n * tc::kGas), q(n), d(n);
   std::vector<std::int32_t> removed(n);
-  const tc::ChemArrays a{n, in.T.data(), in.mass.data(), in.cell.data(), in.pBar.data(), in.conc.data(),
-                         m.data(), y.data(), mdot.data(), mg.data(), q.data(), d.data(), removed.data(),
-                         in.dt, in.density};
+  const tc::ChemArrays a{n,
+                         in.T.data(),
+                         in.mass.data(),
+                         in.cell.data(),
+                         in.pBar.data(),
+                         in.conc.data(),
+                         m.data(),
+                         y.data(),
+                         mdot.data(),
+                         mg.data(),
+                         q.data(),
+                         d.data(),
+                         removed.data(),
+                         in.dt,
+                         in.density};
   const auto gen = tc::genericReaction();
   const int nt = threads > 0 ? threads : omp_get_max_threads();
   tc::ChemTimes t;
@@ -209,7 +235,8 @@ tc::ChemTimes runChemistryCpu(const tc::ChemInput& in, int reps, int threads) {
       const auto t0 = Clock::now();
       const std::int64_t count = static_cast<std::int64_t>(n);
 #pragma omp parallel for schedule(dynamic, 512) num_threads(nt)
-      for (std::int64_t i = 0; i < count; ++i) tc::chemBody(s, a, gen, static_cast<std::size_t>(i));
+      for (std::int64_t i = 0; i < count; ++i)
+        tc::chemBody(s, a, gen, static_cast<std::size_t>(i));
       t.seconds[s] += std::chrono::duration<double>(Clock::now() - t0).count();
     }
   }
@@ -217,19 +244,22 @@ tc::ChemTimes runChemistryCpu(const tc::ChemInput& in, int reps, int threads) {
 }
 
 int runThermochem(int argc, char** argv) {
-  CLI::App app{"Thermochemistry sub-models: ns per particle and DEM sub-step (seed Table 2 / Fig. 19)",
-               "coredem-bench thermochem"};
+  CLI::App app{
+      "Thermochemistry sub-models: ns per particle and DEM sub-step (seed Table 2 / Fig. 19)",
+      "coredem-bench thermochem"};
   Options o;
   bool json = false;
   app.add_option("--particles", o.n, "number of particles")->check(CLI::Range(1.0, 2.0e9));
   app.add_option("--threads", o.threads, "OpenMP threads (cpu backend; 0 = OpenMP default)")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--backend", o.backend, "cpu | cuda | auto")->check(CLI::IsMember({"cpu", "cuda", "auto"}));
+  app.add_option("--backend", o.backend, "cpu | cuda | auto")
+      ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
   app.add_option("--case", o.deckName, "deck of bench/decks.md: packed | agitated")
       ->check(CLI::IsMember({"packed", "agitated"}));
   app.add_option("--steps", o.steps, "measured sub-steps per repeat")->check(CLI::PositiveNumber);
   app.add_option("--warmup", o.warmup, "unmeasured sub-steps first")->check(CLI::NonNegativeNumber);
-  app.add_option("--repeat", o.repeat, "measured runs per variant (medians reported)")->check(CLI::PositiveNumber);
+  app.add_option("--repeat", o.repeat, "measured runs per variant (medians reported)")
+      ->check(CLI::PositiveNumber);
   app.add_flag("--json", json, "print one JSON object");
   try {
     app.parse(argc, argv);
@@ -238,7 +268,8 @@ int runThermochem(int argc, char** argv) {
   }
   try {
     const BackendKind kind = parseBackend(o.backend);
-    const bool cuda = kind == BackendKind::Cuda || (kind == BackendKind::Auto && cudaDeviceCount() > 0);
+    const bool cuda =
+        kind == BackendKind::Cuda || (kind == BackendKind::Auto && cudaDeviceCount() > 0);
     Measured m[kVariantCount];
     ParticleData particles;
     CouplingGrid grid;
@@ -246,8 +277,9 @@ int runThermochem(int argc, char** argv) {
     for (int v = 0; v < kVariantCount; ++v) {
       const bool last = v == kAllHeat;
       m[v] = runVariant(o, kVariants[v], last ? &particles : nullptr, last ? &grid : nullptr);
-      if (!json) std::fprintf(stderr, "  variant %-20s done (%.1f s so far)\n", kVariants[v].name,
-                              std::chrono::duration<double>(Clock::now() - t0).count());
+      if (!json)
+        std::fprintf(stderr, "  variant %-20s done (%.1f s so far)\n", kVariants[v].name,
+                     std::chrono::duration<double>(Clock::now() - t0).count());
     }
     const double dt = DemSystem(makeConfig(o, kVariants[0]), BackendKind::Cpu, 1).dtDemMax();
     const tc::ChemInput chemIn = chemistryInput(particles, grid, o.tGas, dt);
@@ -273,7 +305,8 @@ int runThermochem(int argc, char** argv) {
     rows.push_back({"temperature_update", "engine", (base.integrate - mech.integrate) * per});
     rows.push_back({"heat_stage_base", "engine", base.heat * per});
     rows.push_back({"all_heat_stage", "engine", m[kAllHeat].heat * per});
-    // The engine's chemistry stage (rates, mass/diameter/species update, deposition), one model a run.
+    // The engine's chemistry stage (rates, mass/diameter/species update, deposition), one model a
+    // run.
     rows.push_back({"chemistry_stage_clg_r1_r2", "engine", m[7].chemistry * per});
     rows.push_back({"chemistry_stage_clg_r4_r5", "engine", m[8].chemistry * per});
     rows.push_back({"chemistry_stage_generic", "engine", m[9].chemistry * per});
@@ -291,7 +324,8 @@ int runThermochem(int argc, char** argv) {
     const std::string backendUsed = cuda ? "cuda" : "cpu";
     if (json) {
       std::printf("{\"command\":\"thermochem\",\"case\":\"%s\",\"backend\":\"%s\",\"threads\":%d,"
-                  "\"particles\":%zu,\"steps\":%d,\"repeat\":%d,\"dt_dem\":%.6e,\"unit\":\"ns per particle per sub-step\","
+                  "\"particles\":%zu,\"steps\":%d,\"repeat\":%d,\"dt_dem\":%.6e,\"unit\":\"ns per "
+                  "particle per sub-step\","
                   "\"sub_models\":{",
                   o.deckName.c_str(), backendUsed.c_str(), o.threads, o.n, o.steps, o.repeat, dt);
       for (std::size_t k = 0; k < rows.size(); ++k)
@@ -317,10 +351,12 @@ int runThermochem(int argc, char** argv) {
       for (const Row& r : rows)
         std::printf("%-30s %14.2f   %s\n", r.name.c_str(), r.ns,
                     r.source != "engine" ? "kernel loop over the engine's particles"
-                    : r.name.rfind("chemistry_stage", 0) == 0 ? "in the DEM step (its chemistry stage)"
-                                                               : "in the DEM step (difference of stage times)");
+                    : r.name.rfind("chemistry_stage", 0) == 0
+                        ? "in the DEM step (its chemistry stage)"
+                        : "in the DEM step (difference of stage times)");
       std::printf("\ncontext (same deck, heat off unless named):\n");
-      for (const Row& r : ctx) std::printf("%-30s %14.2f\n", r.name.c_str(), r.ns);
+      for (const Row& r : ctx)
+        std::printf("%-30s %14.2f\n", r.name.c_str(), r.ns);
     }
     return 0;
   } catch (const coredem::UserError& e) {
@@ -335,10 +371,13 @@ int runThermochem(int argc, char** argv) {
 } // namespace
 
 #if !defined(COREDEM_BENCH_CUDA)
-coredem::bench::thermochem::ChemTimes coredem::bench::thermochem::runChemistryCuda(const ChemInput&, int) {
-  throw std::runtime_error("this coredem-bench was built without the CUDA backend; configure with "
-                           "-DCOREDEM_CUDA=ON (scripts/gpu-check.sh) to time the cuda chemistry loops");
+coredem::bench::thermochem::ChemTimes coredem::bench::thermochem::runChemistryCuda(const ChemInput&,
+                                                                                   int) {
+  throw std::runtime_error(
+      "this coredem-bench was built without the CUDA backend; configure with "
+      "-DCOREDEM_CUDA=ON (scripts/gpu-check.sh) to time the cuda chemistry loops");
 }
 #endif
 
-COREDEM_BENCH_COMMAND("thermochem", "thermochemistry sub-models: ns per particle per sub-step", runThermochem);
+COREDEM_BENCH_COMMAND("thermochem", "thermochemistry sub-models: ns per particle per sub-step",
+                      runThermochem);

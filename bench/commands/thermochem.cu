@@ -1,12 +1,12 @@
 // The CUDA side of `coredem-bench thermochem`: the chemistry stages of thermochem.h as one
 // kernel launch each (one thread per particle), timed with CUDA events. Built only with
 // COREDEM_CUDA_ENABLED (bench/commands/thermochem.cmake).
-#include "thermochem.h"
+#include <stdexcept>
+#include <string>
 
 #include <cuda_runtime.h>
 
-#include <stdexcept>
-#include <string>
+#include "thermochem.h"
 
 namespace coredem::bench::thermochem {
 
@@ -22,7 +22,8 @@ template <class T>
 T* upload(const std::vector<T>& v) {
   T* d = nullptr;
   check(cudaMalloc(&d, v.size() * sizeof(T) + 1), "cudaMalloc");
-  if (!v.empty()) check(cudaMemcpy(d, v.data(), v.size() * sizeof(T), cudaMemcpyHostToDevice), "cudaMemcpy");
+  if (!v.empty())
+    check(cudaMemcpy(d, v.data(), v.size() * sizeof(T), cudaMemcpyHostToDevice), "cudaMemcpy");
   return d;
 }
 
@@ -33,9 +34,11 @@ T* scratch(std::size_t n) {
   return d;
 }
 
-__global__ void chemKernel(int stage, ChemArrays a, coredem::dem::kernels::HeterogeneousReaction gen) {
+__global__ void chemKernel(int stage, ChemArrays a,
+                           coredem::dem::kernels::HeterogeneousReaction gen) {
   const std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i < a.n) chemBody(stage, a, gen, i);
+  if (i < a.n)
+    chemBody(stage, a, gen, i);
 }
 
 } // namespace
@@ -43,7 +46,8 @@ __global__ void chemKernel(int stage, ChemArrays a, coredem::dem::kernels::Heter
 ChemTimes runChemistryCuda(const ChemInput& in, int reps) {
   int devices = 0;
   if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0) {
-    throw std::runtime_error("no CUDA device is visible (cudaGetDeviceCount); run with --backend cpu");
+    throw std::runtime_error(
+        "no CUDA device is visible (cudaGetDeviceCount); run with --backend cpu");
   }
   const std::size_t n = in.n;
   double* T = upload(in.T);
@@ -58,7 +62,8 @@ ChemTimes runChemistryCuda(const ChemInput& in, int reps) {
   double* q = scratch<double>(n);
   double* d = scratch<double>(n);
   std::int32_t* removed = scratch<std::int32_t>(n);
-  const ChemArrays a{n, T, mass0, cell, pBar, conc, m, y, mdot, mg, q, d, removed, in.dt, in.density};
+  const ChemArrays a{n,    T,  mass0, cell, pBar,    conc,  m,         y,
+                     mdot, mg, q,     d,    removed, in.dt, in.density};
   const auto gen = genericReaction();
   cudaEvent_t start, stop;
   check(cudaEventCreate(&start), "cudaEventCreate");
@@ -70,7 +75,8 @@ ChemTimes runChemistryCuda(const ChemInput& in, int reps) {
   for (int r = 0; r < reps; ++r) {
     for (int s = 0; s < kChemStageCount; ++s) {
       check(cudaEventRecord(start), "cudaEventRecord");
-      if (grid > 0) chemKernel<<<grid, block>>>(s, a, gen);
+      if (grid > 0)
+        chemKernel<<<grid, block>>>(s, a, gen);
       check(cudaGetLastError(), "chemKernel launch");
       check(cudaEventRecord(stop), "cudaEventRecord");
       check(cudaEventSynchronize(stop), "cudaEventSynchronize");

@@ -6,16 +6,16 @@
 /// per index, the cell's gas state read by the particle's PCM cell). Written once for the cpu
 /// loop (thermochem.cpp, OpenMP) and the CUDA kernels (thermochem.cu).
 
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
 #include "coredem/dem/kernels/clg_char_gasification.h"
 #include "coredem/dem/kernels/clg_oc_reduction.h"
 #include "coredem/dem/kernels/nasa7.h"
 #include "coredem/dem/kernels/reaction_generic.h"
 #include "coredem/dem/kernels/species_particle.h"
-
-#include <cstddef>
-#include <cstdint>
-#include <string>
-#include <vector>
 
 #if defined(__CUDACC__)
 #define COREDEM_BENCH_HD __host__ __device__
@@ -39,11 +39,11 @@ inline constexpr const char* kChemStageNames[kChemStageCount] = {
 /// gas composition.
 struct ChemInput {
   std::size_t n = 0;
-  std::vector<double> T, mass, Y;       ///< N, N, N*kSolids
-  std::vector<std::int32_t> cell;       ///< N, PCM cell of each particle
-  std::vector<double> pBar, conc;       ///< nCells*kGas: partial pressures (bar), concentrations (mol/m³)
-  double dt = 1e-6;                     ///< sub-step (s)
-  double density = 2500.0;              ///< particle density for the shrinking diameter (kg/m³)
+  std::vector<double> T, mass, Y; ///< N, N, N*kSolids
+  std::vector<std::int32_t> cell; ///< N, PCM cell of each particle
+  std::vector<double> pBar, conc; ///< nCells*kGas: partial pressures (bar), concentrations (mol/m³)
+  double dt = 1e-6;               ///< sub-step (s)
+  double density = 2500.0;        ///< particle density for the shrinking diameter (kg/m³)
 };
 
 /// Device (or host) pointers of one run.
@@ -54,13 +54,13 @@ struct ChemArrays {
   const std::int32_t* cell;
   const double* pBar;
   const double* conc;
-  double* m;        ///< N (updated by kMassSpecies)
-  double* Y;        ///< N*kSolids (updated by kMassSpecies)
-  double* mdot;     ///< N*kSolids, kg/s
-  double* mdotGas;  ///< N*kGas, kg/s
-  double* q;        ///< N, W
-  double* d;        ///< N, m
-  std::int32_t* removed;  ///< N
+  double* m;             ///< N (updated by kMassSpecies)
+  double* Y;             ///< N*kSolids (updated by kMassSpecies)
+  double* mdot;          ///< N*kSolids, kg/s
+  double* mdotGas;       ///< N*kGas, kg/s
+  double* q;             ///< N, W
+  double* d;             ///< N, m
+  std::int32_t* removed; ///< N
   double dt;
   double density;
 };
@@ -70,9 +70,18 @@ inline coredem::dem::kernels::HeterogeneousReaction genericReaction() {
   using namespace coredem::dem::kernels;
   HeterogeneousReaction r;
   r.n = 3;
-  r.phase[0] = ReactionPhase::Solid; r.index[0] = 0; r.nu[0] = -1.0; r.molarMass[0] = 12.011e-3;
-  r.phase[1] = ReactionPhase::Gas;   r.index[1] = 1; r.nu[1] = -1.0; r.molarMass[1] = 44.0095e-3;
-  r.phase[2] = ReactionPhase::Gas;   r.index[2] = 0; r.nu[2] = 2.0;  r.molarMass[2] = 28.0101e-3;
+  r.phase[0] = ReactionPhase::Solid;
+  r.index[0] = 0;
+  r.nu[0] = -1.0;
+  r.molarMass[0] = 12.011e-3;
+  r.phase[1] = ReactionPhase::Gas;
+  r.index[1] = 1;
+  r.nu[1] = -1.0;
+  r.molarMass[1] = 44.0095e-3;
+  r.phase[2] = ReactionPhase::Gas;
+  r.index[2] = 0;
+  r.nu[2] = 2.0;
+  r.molarMass[2] = 28.0101e-3;
   r.law = RateLaw::Arrhenius;
   r.A = 1.0e3;
   r.beta = 0.0;
@@ -101,34 +110,40 @@ COREDEM_BENCH_HD inline void chemBody(int stage, const ChemArrays& a,
     md[0] = s * r.mdotC;
     md[1] = 0.0;
     md[2] = 0.0;
-    for (int k = 0; k < kGas; ++k) mg[k] = s * r.mdotGas[k];
+    for (int k = 0; k < kGas; ++k)
+      mg[k] = s * r.mdotGas[k];
     a.q[i] = s * r.heat;
     break;
   }
   case kOcR4R5: {
     const OcReductionParams p;
     const double* cc = a.conc + kGas * c;
-    const OcReductionRates r = ocReduction(p, a.T[i], a.m[i], y, cc[idx(GasSpecies::CO)],
-                                           cc[idx(GasSpecies::H2)]);
+    const OcReductionRates r =
+        ocReduction(p, a.T[i], a.m[i], y, cc[idx(GasSpecies::CO)], cc[idx(GasSpecies::H2)]);
     const double s = ocStepLimiter(r, a.m[i], y, a.dt);
-    for (int k = 0; k < kSolids; ++k) md[k] = s * r.mdotSolid[k];
-    for (int k = 0; k < kGas; ++k) mg[k] = s * r.mdotGas[k];
+    for (int k = 0; k < kSolids; ++k)
+      md[k] = s * r.mdotSolid[k];
+    for (int k = 0; k < kGas; ++k)
+      mg[k] = s * r.mdotGas[k];
     a.q[i] = s * r.heat;
     break;
   }
   case kGeneric: {
     double solidMass[kSolids];
-    for (int k = 0; k < kSolids; ++k) solidMass[k] = a.m[i] * y[k];
+    for (int k = 0; k < kSolids; ++k)
+      solidMass[k] = a.m[i] * y[k];
     const double w = heterogeneousExtentRate(gen, a.T[i], a.conc + kGas * c, solidMass, a.dt);
     double sr[kSolids] = {0.0, 0.0, 0.0};
     double gr[kGas] = {0.0, 0.0, 0.0, 0.0, 0.0};
     addHeterogeneousSources(gen, w, sr, gr);
-    for (int k = 0; k < kSolids; ++k) md[k] = sr[k];
-    for (int k = 0; k < kGas; ++k) mg[k] = gr[k];
+    for (int k = 0; k < kSolids; ++k)
+      md[k] = sr[k];
+    for (int k = 0; k < kGas; ++k)
+      mg[k] = gr[k];
     a.q[i] = heterogeneousHeat(gen, w);
     break;
   }
-  default: {  // kMassSpecies: Eq. 31 explicit Euler, shrinking diameter (Eq. 32), removal test
+  default: { // kMassSpecies: Eq. 31 explicit Euler, shrinking diameter (Eq. 32), removal test
     double m = a.m[i];
     updateParticleSpecies(m, y, md, kSolids, a.dt);
     a.m[i] = m;

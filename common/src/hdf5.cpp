@@ -7,8 +7,10 @@ namespace coredem::h5 {
 
 Handle createFile(const std::filesystem::path& path) {
   Handle f(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
-  COREDEM_CHECK(f.valid(), "cannot create HDF5 file '{}': check that its folder exists and is "
-                           "writable", path.string());
+  COREDEM_CHECK(f.valid(),
+                "cannot create HDF5 file '{}': check that its folder exists and is "
+                "writable",
+                path.string());
   return f;
 }
 
@@ -20,8 +22,10 @@ Handle openFile(const std::filesystem::path& path, bool writable) {
                H5Fclose);
   }
   H5E_END_TRY;
-  COREDEM_CHECK(f.valid(), "cannot open '{}' as HDF5: the file is not HDF5, is truncated or is "
-                           "open for writing elsewhere", path.string());
+  COREDEM_CHECK(f.valid(),
+                "cannot open '{}' as HDF5: the file is not HDF5, is truncated or is "
+                "open for writing elsewhere",
+                path.string());
   return f;
 }
 
@@ -40,7 +44,9 @@ Handle openGroup(hid_t loc, const std::string& name, const std::string& what) {
 
 bool exists(hid_t loc, const std::string& name) {
   htri_t r = -1;
-  H5E_BEGIN_TRY { r = H5Lexists(loc, name.c_str(), H5P_DEFAULT); }
+  H5E_BEGIN_TRY {
+    r = H5Lexists(loc, name.c_str(), H5P_DEFAULT);
+  }
   H5E_END_TRY;
   return r > 0;
 }
@@ -63,8 +69,7 @@ std::string readStringAttribute(hid_t loc, const std::string& name, const std::s
   COREDEM_CHECK(hasAttribute(loc, name), "{}: no attribute '{}'", what, name);
   Handle a(H5Aopen(loc, name.c_str(), H5P_DEFAULT), H5Aclose);
   Handle type(H5Aget_type(a), H5Tclose);
-  COREDEM_CHECK(H5Tget_class(type) == H5T_STRING, "{}: attribute '{}' is not a string", what,
-                name);
+  COREDEM_CHECK(H5Tget_class(type) == H5T_STRING, "{}: attribute '{}' is not a string", what, name);
   if (H5Tis_variable_str(type) > 0) {
     Handle mem(H5Tcopy(H5T_C_S1), H5Tclose);
     H5Tset_size(mem, H5T_VARIABLE);

@@ -1,9 +1,9 @@
-#include <coredem/common/log.h>
+#include <cstdlib>
+#include <mutex>
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 
-#include <cstdlib>
-#include <mutex>
+#include <coredem/common/log.h>
 
 namespace coredem {
 

@@ -80,8 +80,7 @@ Section::Section(YAML::Node node, std::string file, std::string path,
     if (std::find(_allowed.begin(), _allowed.end(), key) == _allowed.end()) {
       fail(kv.first.Mark(), full(key),
            fmt::format("unknown key; allowed keys {}: {}",
-                       _path.empty() ? "at the top level" : "in '" + _path + "'",
-                       join(_allowed)));
+                       _path.empty() ? "at the top level" : "in '" + _path + "'", join(_allowed)));
     }
   }
 }
@@ -156,7 +155,8 @@ std::int64_t Section::integer(const std::string& key, std::optional<std::int64_t
     fail(n.Mark(), full(key), fmt::format("expected an integer ({}), got {}", what, describe(n)));
   }
   if (v < lo || v > hi) {
-    fail(n.Mark(), full(key), fmt::format("{} is out of range; allowed: {} to {} ({})", v, lo, hi, what));
+    fail(n.Mark(), full(key),
+         fmt::format("{} is out of range; allowed: {} to {} ({})", v, lo, hi, what));
   }
   return v;
 }

@@ -14,10 +14,11 @@
 ///      next force evaluation on, the motion update of this sub-step uses the new mass
 ///   4. per cell (segment heads of the PCM order): Σ ṁ_gas Δt, Σ Δm_solid, Σ Q_rxn Δt, the sensible
 ///      heat of the transferred gas Σ ṁ_gas,i c_p,g (T_p,i − T_g) Δt (gas enters at T_p, not T_g;
-///      c_p,g, T_g of the cell from the frozen gas; 0 outside the grid or without gas fields) and the
-///      particle-side Σ Δm_i c_p,i T_p,i (J) added to the window accumulators (row nCells:
+///      c_p,g, T_g of the cell from the frozen gas; 0 outside the grid or without gas fields) and
+///      the particle-side Σ Δm_i c_p,i T_p,i (J) added to the window accumulators (row nCells:
 ///      particles outside the grid, ledgers only)
-///   5. after the heat module's temperature update: T += Δt Q_rxn/(m c_p) (when reaction heat is on)
+///   5. after the heat module's temperature update: T += Δt Q_rxn/(m c_p) (when reaction heat is
+///   on)
 /// At the window end R_species = Σ ṁ Δt/(V_c t_window), Q_hom = Σ ṁ_gas c_p,g (T_p − T_g) Δt/(V_c
 /// t_window) and the WGS (R3) of every cell is added
 /// from the frozen gas (host, once per CFD step). A particle whose diameter fell below
@@ -27,19 +28,18 @@
 /// Every loop writes only its own index (gather per cell over sorted segments, no atomics), so
 /// results are bitwise independent of the thread count.
 
-#include "backend/arrays.h"
-#include "backend/exec_common.h"
-#include "chemistry_setup.h"
-#include "step_module.h"
-
-#include "coredem/dem/chemistry_options.h"
-#include "coredem/dem/kernels/pressure_gradient.h"
-#include "coredem/dem/kernels/species_particle.h"
-
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <vector>
+
+#include "backend/arrays.h"
+#include "backend/exec_common.h"
+#include "chemistry_setup.h"
+#include "coredem/dem/chemistry_options.h"
+#include "coredem/dem/kernels/pressure_gradient.h"
+#include "coredem/dem/kernels/species_particle.h"
+#include "step_module.h"
 
 namespace coredem::dem {
 
@@ -58,28 +58,33 @@ public:
     _c.params.nReactions = static_cast<int>(c.reactions.size());
     auto put = [](auto& arr, const auto& v) {
       arr.allocate(v.size());
-      for (std::size_t k = 0; k < v.size(); ++k) arr.h()[k] = v[k];
+      for (std::size_t k = 0; k < v.size(); ++k)
+        arr.h()[k] = v[k];
       arr.markHostModified();
       arr.toDevice();
     };
     put(_reactions, c.reactions);
     std::vector<kernels::ReactionEnthalpyPoly> dh;
     for (const kernels::Stoichiometry& st : c.reactionNasa7)
-      dh.push_back(st.n > 0 ? kernels::combineReactionEnthalpy(st) : kernels::ReactionEnthalpyPoly{});
-    for (kernels::ClgReaction r : {kernels::ClgReaction::R1, kernels::ClgReaction::R2, kernels::ClgReaction::R4,
-                                   kernels::ClgReaction::R5})
+      dh.push_back(st.n > 0 ? kernels::combineReactionEnthalpy(st)
+                            : kernels::ReactionEnthalpyPoly{});
+    for (kernels::ClgReaction r : {kernels::ClgReaction::R1, kernels::ClgReaction::R2,
+                                   kernels::ClgReaction::R4, kernels::ClgReaction::R5})
       dh.push_back(kernels::combineReactionEnthalpy(kernels::clgStoichiometry(r)));
     // All species' breaks together are 850, 960, 1000, 1200 K (5 pieces), so this cannot fire
     // unless species data with more breaks are added (then raise kMaxEnthalpyPieces). No check.h
     // here: this header is compiled by nvcc, which cannot take fmt.
     for (const kernels::ReactionEnthalpyPoly& h : dh)
-      if (h.n < 0) throw std::logic_error("chemistry: a reaction has more than kMaxEnthalpyPieces enthalpy pieces");
+      if (h.n < 0)
+        throw std::logic_error(
+            "chemistry: a reaction has more than kMaxEnthalpyPieces enthalpy pieces");
     put(_dh, dh);
     put(_gasM, c.gasMolarMass);
     put(_cp, c.materialCp);
     _width = c.params.nGas + c.params.nSolid + 3;
     _acc.allocate((nCells + 1) * static_cast<std::size_t>(_width));
-    for (std::size_t k = 0; k < _acc.size(); ++k) _acc.h()[k] = 0.0;
+    for (std::size_t k = 0; k < _acc.size(); ++k)
+      _acc.h()[k] = 0.0;
     _acc.markHostModified();
     _acc.toDevice();
     _totals.gasProduced.assign(static_cast<std::size_t>(c.params.nGas), 0.0);
@@ -98,8 +103,8 @@ public:
   }
 
   std::size_t bytes() const {
-    return _reactions.bytes() + _dh.bytes() + _gasM.bytes() + _cp.bytes() + _gdot.bytes() + _dsolid.bytes() +
-           _q.bytes() + _sens.bytes() + _acc.bytes();
+    return _reactions.bytes() + _dh.bytes() + _gasM.bytes() + _cp.bytes() + _gdot.bytes() +
+           _dsolid.bytes() + _q.bytes() + _sens.bytes() + _acc.bytes();
   }
 
   /// Chemistry ledgers since construction (or the restored ones).
@@ -108,7 +113,8 @@ public:
   void restoreTotals(const ChemistryTotals& t) { _totals = t; }
 
   void beginWindow(StepContext<Exec>& ctx) {
-    if (!_c.enabled) return;
+    if (!_c.enabled)
+      return;
     double* acc = _acc.d();
     ctx.exec.parallelFor(_acc.size(), [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
     _acc.markDeviceModified();
@@ -118,7 +124,8 @@ public:
   /// (ctx.cells) as the drag module leaves them. Reads temperature, material, radius,
   /// mass, density, species, d0, chemRef; writes mass, species, radius, _gdot, _dsolid, _q, _acc.
   void sources(StepContext<Exec>& ctx) {
-    if (!_c.enabled) return;
+    if (!_c.enabled)
+      return;
     Exec& exec = ctx.exec;
     ParticleStore<Exec>& p = ctx.particles;
     const EngineSetup& s = ctx.setup;
@@ -127,7 +134,7 @@ public:
     const std::uint32_t* perm = ctx.cells.perm();
     const std::uint32_t* cStart = ctx.cells.cStart();
     const std::uint32_t* cEnd = ctx.cells.cEnd();
-    const GasFields<Exec>* gasFields = ctx.gas;  // nullptr: no gas fields or no coupling grid
+    const GasFields<Exec>* gasFields = ctx.gas; // nullptr: no gas fields or no coupling grid
     const bool gasPresent = gasFields != nullptr;
     const bool hasRho = gasPresent && gasFields->has(gasFields->rhoG);
     const bool hasY = gasPresent && gasFields->has(gasFields->Yg);
@@ -162,133 +169,159 @@ public:
     const kernels::HeterogeneousReaction* reac = _reactions.d();
     const kernels::ReactionEnthalpyPoly* dhPoly = _dh.d();
     // R1/R2 and R4/R5 heats (none when reaction heat is off: the heat is not used then).
-    const kernels::ReactionEnthalpyPoly* dhChar = cp.reactionHeat ? dhPoly + cp.nReactions : nullptr;
-    const kernels::ReactionEnthalpyPoly* dhOc = cp.reactionHeat ? dhPoly + cp.nReactions + 2 : nullptr;
+    const kernels::ReactionEnthalpyPoly* dhChar =
+        cp.reactionHeat ? dhPoly + cp.nReactions : nullptr;
+    const kernels::ReactionEnthalpyPoly* dhOc =
+        cp.reactionHeat ? dhPoly + cp.nReactions + 2 : nullptr;
     const double* gasM = _gasM.d();
     const double* rhoG = gas ? gasFields->rhoG.d() : nullptr;
     const double* yg = gas ? gasFields->Yg.d() : nullptr;
 
-    const double below = exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) {
-      using namespace kernels;
-      const double mi = m[i];
-      const double frac = cp.removalFraction;
-      double sm[kChemMaxSolids];
-      for (int k = 0; k < nS; ++k) sm[k] = X[i * nS + k] * mi;
-      double solidRate[kChemMaxSolids];
-      double gasRate[kChemMaxGas];
-      for (int k = 0; k < nS; ++k) solidRate[k] = 0.0;
-      for (int k = 0; k < nG; ++k) gasRate[k] = 0.0;
-      double heat = 0.0;
-      // A particle holding none of the reactants of any enabled model does nothing (the data-defined
-      // reactions check their own solid reactants).
-      const bool hasReactant = cp.nReactions > 0 || (cp.charOn && cp.solidC >= 0 && sm[cp.solidC] > 0.0) ||
-                               (cp.ocOn && cp.solidFe2O3 >= 0 && sm[cp.solidFe2O3] > 0.0);
-      const bool active = hasReactant && !(2.0 * r[i] < frac * d0[i]);
-      if (active) {
-        const double tp = T[i];
-        // Gas of the particle's PCM cell (no gas: gas-dependent rates are zero).
-        double conc[kChemMaxGas];
-        double pBar[kGasSpeciesCount];
-        for (int k = 0; k < nG; ++k) conc[k] = 0.0;
-        for (int k = 0; k < kGasSpeciesCount; ++k) pBar[k] = 0.0;
-        const std::uint32_t cell = coupled ? pcell[i] : nCells;
-        if (gas && cell < nCells) {
-          const double rg = rhoG[cell];
-          double moles = 0.0;
-          for (int k = 0; k < nG; ++k) {
-            conc[k] = molarConcentration(rg, yg[static_cast<std::size_t>(cell) * nG + k], gasM[k]);
-            moles += conc[k];
-          }
-          // P_j = x_j p (bar), x_j = C_j / Σ C.
-          if (moles > 0.0) {
-            for (int g = 0; g < kGasSpeciesCount; ++g) {
-              const int k = cp.gasIndex[g];
-              if (k >= 0) pBar[g] = conc[k] / moles * cp.pressure * 1.0e-5;
+    const double below = exec.reduceMax(
+        n,
+        [=] DEM_LAMBDA(std::size_t i) {
+          using namespace kernels;
+          const double mi = m[i];
+          const double frac = cp.removalFraction;
+          double sm[kChemMaxSolids];
+          for (int k = 0; k < nS; ++k)
+            sm[k] = X[i * nS + k] * mi;
+          double solidRate[kChemMaxSolids];
+          double gasRate[kChemMaxGas];
+          for (int k = 0; k < nS; ++k)
+            solidRate[k] = 0.0;
+          for (int k = 0; k < nG; ++k)
+            gasRate[k] = 0.0;
+          double heat = 0.0;
+          // A particle holding none of the reactants of any enabled model does nothing (the
+          // data-defined reactions check their own solid reactants).
+          const bool hasReactant = cp.nReactions > 0 ||
+                                   (cp.charOn && cp.solidC >= 0 && sm[cp.solidC] > 0.0) ||
+                                   (cp.ocOn && cp.solidFe2O3 >= 0 && sm[cp.solidFe2O3] > 0.0);
+          const bool active = hasReactant && !(2.0 * r[i] < frac * d0[i]);
+          if (active) {
+            const double tp = T[i];
+            // Gas of the particle's PCM cell (no gas: gas-dependent rates are zero).
+            double conc[kChemMaxGas];
+            double pBar[kGasSpeciesCount];
+            for (int k = 0; k < nG; ++k)
+              conc[k] = 0.0;
+            for (int k = 0; k < kGasSpeciesCount; ++k)
+              pBar[k] = 0.0;
+            const std::uint32_t cell = coupled ? pcell[i] : nCells;
+            if (gas && cell < nCells) {
+              const double rg = rhoG[cell];
+              double moles = 0.0;
+              for (int k = 0; k < nG; ++k) {
+                conc[k] =
+                    molarConcentration(rg, yg[static_cast<std::size_t>(cell) * nG + k], gasM[k]);
+                moles += conc[k];
+              }
+              // P_j = x_j p (bar), x_j = C_j / Σ C.
+              if (moles > 0.0) {
+                for (int g = 0; g < kGasSpeciesCount; ++g) {
+                  const int k = cp.gasIndex[g];
+                  if (k >= 0)
+                    pBar[g] = conc[k] / moles * cp.pressure * 1.0e-5;
+                }
+              }
+            }
+            // Data-defined reactions.
+            for (int a = 0; a < cp.nReactions; ++a) {
+              const HeterogeneousReaction& rx = reac[a];
+              const double w = heterogeneousExtentRate(rx, tp, conc, sm, dt);
+              addHeterogeneousSources(rx, w, solidRate, gasRate);
+              if (w != 0.0)
+                heat -= (dhPoly[a].n > 0 ? reactionEnthalpy(dhPoly[a], tp) : rx.dH) * w;
+            }
+            // R1 + R2 (char).
+            if (cp.charOn && cp.solidC >= 0) {
+              const CharGasificationRates cr = charGasificationHoisted(
+                  cp.charParams, dhChar, tp, pBar, sm[cp.solidC], ref[2 * i]);
+              solidRate[cp.solidC] += cr.mdotC;
+              for (int g = 0; g < kGasSpeciesCount; ++g)
+                if (cp.gasIndex[g] >= 0)
+                  gasRate[cp.gasIndex[g]] += cr.mdotGas[g];
+              heat += cr.heat;
+            }
+            // R4 + R5 (oxygen carrier).
+            if (cp.ocOn && cp.solidFe2O3 >= 0 && cp.solidFe3O4 >= 0 && mi > 0.0) {
+              const double mf[3] = {sm[cp.solidFe2O3] / mi, sm[cp.solidFe3O4] / mi, 0.0};
+              const int iCO = cp.gasIndex[idx(GasSpecies::CO)],
+                        iH2 = cp.gasIndex[idx(GasSpecies::H2)];
+              const OcReductionRates orr =
+                  ocReductionHoisted(cp.ocParams, dhOc, tp, mi, mf, iCO >= 0 ? conc[iCO] : 0.0,
+                                     iH2 >= 0 ? conc[iH2] : 0.0);
+              solidRate[cp.solidFe2O3] += orr.mdotSolid[idx(OcSolid::Fe2O3)];
+              solidRate[cp.solidFe3O4] += orr.mdotSolid[idx(OcSolid::Fe3O4)];
+              for (int g = 0; g < kGasSpeciesCount; ++g)
+                if (cp.gasIndex[g] >= 0)
+                  gasRate[cp.gasIndex[g]] += orr.mdotGas[g];
+              heat += orr.heat;
             }
           }
-        }
-        // Data-defined reactions.
-        for (int a = 0; a < cp.nReactions; ++a) {
-          const HeterogeneousReaction& rx = reac[a];
-          const double w = heterogeneousExtentRate(rx, tp, conc, sm, dt);
-          addHeterogeneousSources(rx, w, solidRate, gasRate);
-          if (w != 0.0) heat -= (dhPoly[a].n > 0 ? reactionEnthalpy(dhPoly[a], tp) : rx.dH) * w;
-        }
-        // R1 + R2 (char).
-        if (cp.charOn && cp.solidC >= 0) {
-          const CharGasificationRates cr =
-              charGasificationHoisted(cp.charParams, dhChar, tp, pBar, sm[cp.solidC], ref[2 * i]);
-          solidRate[cp.solidC] += cr.mdotC;
-          for (int g = 0; g < kGasSpeciesCount; ++g)
-            if (cp.gasIndex[g] >= 0) gasRate[cp.gasIndex[g]] += cr.mdotGas[g];
-          heat += cr.heat;
-        }
-        // R4 + R5 (oxygen carrier).
-        if (cp.ocOn && cp.solidFe2O3 >= 0 && cp.solidFe3O4 >= 0 && mi > 0.0) {
-          const double mf[3] = {sm[cp.solidFe2O3] / mi, sm[cp.solidFe3O4] / mi, 0.0};
-          const int iCO = cp.gasIndex[idx(GasSpecies::CO)], iH2 = cp.gasIndex[idx(GasSpecies::H2)];
-          const OcReductionRates orr = ocReductionHoisted(cp.ocParams, dhOc, tp, mi, mf, iCO >= 0 ? conc[iCO] : 0.0,
-                                                          iH2 >= 0 ? conc[iH2] : 0.0);
-          solidRate[cp.solidFe2O3] += orr.mdotSolid[idx(OcSolid::Fe2O3)];
-          solidRate[cp.solidFe3O4] += orr.mdotSolid[idx(OcSolid::Fe3O4)];
-          for (int g = 0; g < kGasSpeciesCount; ++g)
-            if (cp.gasIndex[g] >= 0) gasRate[cp.gasIndex[g]] += orr.mdotGas[g];
-          heat += orr.heat;
-        }
-      }
-      // One limiter for the particle: no species below zero, no shrinking below half the
-      // removal diameter within the step.
-      double sc = 1.0;
-      double mdot = 0.0;
-      for (int k = 0; k < nS; ++k) {
-        mdot += solidRate[k];
-        const double loss = -solidRate[k] * dt;
-        if (loss > sm[k]) sc = sm[k] > 0.0 ? (sm[k] / loss < sc ? sm[k] / loss : sc) : 0.0;
-      }
-      if (mdot < 0.0) {
-        const double dFloor = 0.5 * frac * d0[i];
-        const double mFloor = rho[i] * sphereVolume(0.5 * dFloor);
-        const double allowed = mi - mFloor;
-        const double loss = -mdot * dt * sc;
-        if (!(allowed > 0.0)) sc = 0.0;
-        else if (loss > allowed) sc *= allowed / loss;
-      }
-      // Eq. 31: species masses, total mass, fractions; Eq. 32: radius.
-      double mNew = 0.0;
-      double mk[kChemMaxSolids];
-      for (int k = 0; k < nS; ++k) {
-        mk[k] = sm[k] + dt * (sc * solidRate[k]);
-        if (mk[k] < 0.0) mk[k] = 0.0;  // round-off only (the limiter keeps it ≥ 0)
-        mNew += mk[k];
-      }
-      double dmStored = 0.0;  // the change of the stored mass (what Σ m c_p T sees)
-      if (mNew > 0.0) {  // unchanged particles keep their bits
-        bool changed = false;
-        for (int k = 0; k < nS; ++k) changed = changed || mk[k] != sm[k];
-        if (changed) {
-          for (int k = 0; k < nS; ++k) X[i * nS + k] = mk[k] / mNew;
-          m[i] = mNew;
-          r[i] = 0.5 * shrinkingDiameter(mNew, rho[i]);
-          dmStored = mNew - mi;
-        }
-      }
-      for (int k = 0; k < nS; ++k) dsol[i * nS + k] = mk[k] - sm[k];
-      double mGas = 0.0;  // net gas mass produced by the particle (kg/s)
-      for (int k = 0; k < nG; ++k) {
-        gdot[i * nG + k] = sc * gasRate[k];
-        mGas += gdot[i * nG + k];
-      }
-      q[i] = cp.reactionHeat ? sc * heat : 0.0;
-      // Sensible enthalpy carried by the moved mass (PHYSICS §3.5): the gas gets ṁ_gas at T_p
-      // instead of T_g; the particle's Σ m c_p T changes by Δm c_p T_p without a heat flow.
-      const std::uint32_t pc = coupled ? pcell[i] : nCells;
-      sens[2 * i] = (sensGas && pc < nCells && mGas != 0.0)
-                        ? mGas * cpgC[pc] * (T[i] - tgC[pc]) : 0.0;
-      sens[2 * i + 1] = dmStored * cpm[mat[i]] * T[i];
-      return 2.0 * r[i] < frac * d0[i] ? 1.0 : 0.0;
-    }, 0.0);
+          // One limiter for the particle: no species below zero, no shrinking below half the
+          // removal diameter within the step.
+          double sc = 1.0;
+          double mdot = 0.0;
+          for (int k = 0; k < nS; ++k) {
+            mdot += solidRate[k];
+            const double loss = -solidRate[k] * dt;
+            if (loss > sm[k])
+              sc = sm[k] > 0.0 ? (sm[k] / loss < sc ? sm[k] / loss : sc) : 0.0;
+          }
+          if (mdot < 0.0) {
+            const double dFloor = 0.5 * frac * d0[i];
+            const double mFloor = rho[i] * sphereVolume(0.5 * dFloor);
+            const double allowed = mi - mFloor;
+            const double loss = -mdot * dt * sc;
+            if (!(allowed > 0.0))
+              sc = 0.0;
+            else if (loss > allowed)
+              sc *= allowed / loss;
+          }
+          // Eq. 31: species masses, total mass, fractions; Eq. 32: radius.
+          double mNew = 0.0;
+          double mk[kChemMaxSolids];
+          for (int k = 0; k < nS; ++k) {
+            mk[k] = sm[k] + dt * (sc * solidRate[k]);
+            if (mk[k] < 0.0)
+              mk[k] = 0.0; // round-off only (the limiter keeps it ≥ 0)
+            mNew += mk[k];
+          }
+          double dmStored = 0.0; // the change of the stored mass (what Σ m c_p T sees)
+          if (mNew > 0.0) {      // unchanged particles keep their bits
+            bool changed = false;
+            for (int k = 0; k < nS; ++k)
+              changed = changed || mk[k] != sm[k];
+            if (changed) {
+              for (int k = 0; k < nS; ++k)
+                X[i * nS + k] = mk[k] / mNew;
+              m[i] = mNew;
+              r[i] = 0.5 * shrinkingDiameter(mNew, rho[i]);
+              dmStored = mNew - mi;
+            }
+          }
+          for (int k = 0; k < nS; ++k)
+            dsol[i * nS + k] = mk[k] - sm[k];
+          double mGas = 0.0; // net gas mass produced by the particle (kg/s)
+          for (int k = 0; k < nG; ++k) {
+            gdot[i * nG + k] = sc * gasRate[k];
+            mGas += gdot[i * nG + k];
+          }
+          q[i] = cp.reactionHeat ? sc * heat : 0.0;
+          // Sensible enthalpy carried by the moved mass (PHYSICS §3.5): the gas gets ṁ_gas at T_p
+          // instead of T_g; the particle's Σ m c_p T changes by Δm c_p T_p without a heat flow.
+          const std::uint32_t pc = coupled ? pcell[i] : nCells;
+          sens[2 * i] =
+              (sensGas && pc < nCells && mGas != 0.0) ? mGas * cpgC[pc] * (T[i] - tgC[pc]) : 0.0;
+          sens[2 * i + 1] = dmStored * cpm[mat[i]] * T[i];
+          return 2.0 * r[i] < frac * d0[i] ? 1.0 : 0.0;
+        },
+        0.0);
     p.produced(kMass | kSpecies | kRadius);
-    if (below > 0.0) _pending = true;
+    if (below > 0.0)
+      _pending = true;
 
     // Window accumulators per cell (+ one row for particles outside the grid).
     double* acc = _acc.d();
@@ -297,15 +330,18 @@ public:
       const std::uint32_t* ce = cEnd;
       exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
         const std::uint32_t c = pcell[perm[h]];
-        if (h > 0 && pcell[perm[h - 1]] == c) return;
+        if (h > 0 && pcell[perm[h - 1]] == c)
+          return;
         // Particles outside the grid share key nCells; their segment starts at the first of them.
         std::uint32_t b = c < nCells ? cs[c] : static_cast<std::uint32_t>(h);
         std::uint32_t e = c < nCells ? ce[c] : static_cast<std::uint32_t>(n);
         const std::size_t row = static_cast<std::size_t>(c < nCells ? c : nCells) * W;
         for (std::uint32_t k = b; k < e; ++k) {
           const std::uint32_t i = perm[k];
-          for (int g = 0; g < nG; ++g) acc[row + g] += gdot[static_cast<std::size_t>(i) * nG + g] * dt;
-          for (int a = 0; a < nS; ++a) acc[row + nG + a] += dsol[static_cast<std::size_t>(i) * nS + a];
+          for (int g = 0; g < nG; ++g)
+            acc[row + g] += gdot[static_cast<std::size_t>(i) * nG + g] * dt;
+          for (int a = 0; a < nS; ++a)
+            acc[row + nG + a] += dsol[static_cast<std::size_t>(i) * nS + a];
           acc[row + nG + nS] += q[i] * dt;
           acc[row + nG + nS + 1] += sens[2 * static_cast<std::size_t>(i)] * dt;
           acc[row + nG + nS + 2] += sens[2 * static_cast<std::size_t>(i) + 1];
@@ -314,8 +350,10 @@ public:
     } else {
       exec.parallelFor(1, [=] DEM_LAMBDA(std::size_t) {
         for (std::size_t i = 0; i < n; ++i) {
-          for (int g = 0; g < nG; ++g) acc[g] += gdot[i * nG + g] * dt;
-          for (int a = 0; a < nS; ++a) acc[nG + a] += dsol[i * nS + a];
+          for (int g = 0; g < nG; ++g)
+            acc[g] += gdot[i * nG + g] * dt;
+          for (int a = 0; a < nS; ++a)
+            acc[nG + a] += dsol[i * nS + a];
           acc[nG + nS] += q[i] * dt;
           acc[nG + nS + 1] += sens[2 * i] * dt;
           acc[nG + nS + 2] += sens[2 * i + 1];
@@ -328,7 +366,8 @@ public:
   /// After the motion update and the heat module's update: T_i += Δt Q_rxn,i/(m_i c_p,i)
   /// (Eq. 18 with Q_rxn only; the heat module adds the rest).
   void update(StepContext<Exec>& ctx) {
-    if (!_c.enabled || !_c.params.reactionHeat) return;
+    if (!_c.enabled || !_c.params.reactionHeat)
+      return;
     Exec& exec = ctx.exec;
     ParticleStore<Exec>& p = ctx.particles;
     const double dt = ctx.dt;
@@ -338,7 +377,8 @@ public:
     const double* cpm = _cp.d();
     double* T = p.temperature.d();
     exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
-      if (q[i] != 0.0) T[i] = T[i] + dt * (q[i] / (m[i] * cpm[mat[i]]));
+      if (q[i] != 0.0)
+        T[i] = T[i] + dt * (q[i] / (m[i] * cpm[mat[i]]));
     });
     p.produced(kTemperature);
   }
@@ -346,7 +386,8 @@ public:
   /// Window end (host): R_species from the particle sources, WGS per cell, ledgers.
   /// out.rSpecies / out.qHom are sized (zeros) by the engine.
   void endWindow(WindowContext<Exec>& w) {
-    if (!_c.enabled) return;
+    if (!_c.enabled)
+      return;
     const EngineSetup& s = w.setup;
     CellSources& out = w.out;
     const int nSub = w.nSub;
@@ -356,31 +397,36 @@ public:
     const double window = w.dtSub * nSub;
     const std::size_t nc = s.coupled ? s.nCells : 0;
     const double* acc = _acc.h();
-    std::vector<double> gasSum(static_cast<std::size_t>(nG), 0.0), solidSum(static_cast<std::size_t>(nS), 0.0);
+    std::vector<double> gasSum(static_cast<std::size_t>(nG), 0.0),
+        solidSum(static_cast<std::size_t>(nS), 0.0);
     double heatSum = 0.0, gasSensSum = 0.0, massSensSum = 0.0;
     for (std::size_t c = 0; c <= nc; ++c) {
       const double* row = acc + c * W;
       for (int g = 0; g < nG; ++g) {
         gasSum[g] += row[g];
-        if (c < nc && window > 0.0) out.rSpecies[c * nG + g] += row[g] / (s.cellVolume * window);
+        if (c < nc && window > 0.0)
+          out.rSpecies[c * nG + g] += row[g] / (s.cellVolume * window);
       }
-      for (int a = 0; a < nS; ++a) solidSum[a] += row[nG + a];
+      for (int a = 0; a < nS; ++a)
+        solidSum[a] += row[nG + a];
       heatSum += row[nG + nS];
       gasSensSum += row[nG + nS + 1];
       massSensSum += row[nG + nS + 2];
       if (c < nc && window > 0.0 && row[nG + nS + 1] != 0.0)
         out.qHom[c] += row[nG + nS + 1] / (s.cellVolume * window);
     }
-    for (int g = 0; g < nG; ++g) _totals.gasProduced[g] += gasSum[g];
-    for (int a = 0; a < nS; ++a) _totals.solidChange[a] += solidSum[a];
+    for (int g = 0; g < nG; ++g)
+      _totals.gasProduced[g] += gasSum[g];
+    for (int a = 0; a < nS; ++a)
+      _totals.solidChange[a] += solidSum[a];
     _totals.reactionHeat += heatSum;
     _totals.gasSensibleHeat += gasSensSum;
     _totals.sensibleMassEnthalpy += massSensSum;
 
     // R3, homogeneous water–gas shift: once per CFD step per cell from the frozen gas.
     const GasFields<Exec>* gf = w.gas;
-    if (cp.wgsOn && nc > 0 && window > 0.0 && gf != nullptr && gf->has(gf->Tg) && gf->has(gf->rhoG) &&
-        gf->has(gf->Yg)) {
+    if (cp.wgsOn && nc > 0 && window > 0.0 && gf != nullptr && gf->has(gf->Tg) &&
+        gf->has(gf->rhoG) && gf->has(gf->Yg)) {
       const double* tgH = gf->Tg.h();
       const double* rhoH = gf->rhoG.h();
       const double* ygH = gf->Yg.h();
@@ -397,14 +443,16 @@ public:
             kernels::wgsCellSources(cp.wgsParams, tgH[c], epsFrozen[c], rhoH[c], y, window);
         for (int g = 0; g < kernels::kGasSpeciesCount; ++g) {
           const int k = cp.gasIndex[g];
-          if (k < 0) continue;
+          if (k < 0)
+            continue;
           out.rSpecies[c * nG + k] += w.massSource[g];
           srcSum[k] += w.massSource[g];
         }
         out.qHom[c] += w.heatSource;
         heat += w.heatSource;
       }
-      for (int g = 0; g < nG; ++g) _totals.homogeneousSource[g] += srcSum[g] * s.cellVolume * window;
+      for (int g = 0; g < nG; ++g)
+        _totals.homogeneousSource[g] += srcSum[g] * s.cellVolume * window;
       _totals.homogeneousHeat += heat * s.cellVolume * window;
     }
   }
@@ -416,13 +464,14 @@ private:
   /// dH), then R1, R2, R4, R5 at kClgHeat.
   Dual<kernels::ReactionEnthalpyPoly> _dh;
   Dual<double> _gasM, _cp;
-  Dev<double> _gdot;             ///< per particle: gas mass rates (kg/s), N*nGas
-  Dev<double> _dsolid;           ///< per particle: solid mass change in this sub-step (kg), N*nSolid
-  Dev<double> _q;                ///< per particle: Q_rxn (W)
-  Dev<double> _sens;             ///< per particle: ṁ_gas c_p,g (T_p − T_g) (W), Δm c_p T_p (J); N*2
-  Dual<double> _acc;             ///< (nCells+1)*W: Σ gas kg, Σ solid kg, Σ Q_rxn J, Σ gas sensible J, Σ Δm c T J
-  int _width = 0;                ///< W = nGas + nSolid + 3
-  bool _pending = false;         ///< a particle is below the removal diameter
+  Dev<double> _gdot;   ///< per particle: gas mass rates (kg/s), N*nGas
+  Dev<double> _dsolid; ///< per particle: solid mass change in this sub-step (kg), N*nSolid
+  Dev<double> _q;      ///< per particle: Q_rxn (W)
+  Dev<double> _sens;   ///< per particle: ṁ_gas c_p,g (T_p − T_g) (W), Δm c_p T_p (J); N*2
+  Dual<double>
+      _acc; ///< (nCells+1)*W: Σ gas kg, Σ solid kg, Σ Q_rxn J, Σ gas sensible J, Σ Δm c T J
+  int _width = 0;        ///< W = nGas + nSolid + 3
+  bool _pending = false; ///< a particle is below the removal diameter
   ChemistryTotals _totals;
 };
 

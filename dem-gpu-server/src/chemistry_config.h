@@ -3,9 +3,9 @@
 /// Host side of the chemistry (DemSystem): ChemistryOptions → ChemistrySetup, hash text,
 /// per-particle references and the removal of particles below the size threshold.
 
-#include "engine.h"
-
 #include <string>
+
+#include "engine.h"
 
 namespace coredem::dem {
 
@@ -16,7 +16,8 @@ ChemistrySetup makeChemistrySetup(const DemConfig& config);
 /// Canonical text of the chemistry options for the config hash ("" when chemistry is off).
 std::string chemistryHashText(const DemConfig& config);
 
-/// Fills st.d0 (2 R) and st.chemRef (initial C mass, initial Fe2O3-equivalent mass) of every particle.
+/// Fills st.d0 (2 R) and st.chemRef (initial C mass, initial Fe2O3-equivalent mass) of every
+/// particle.
 void initChemistryReferences(const DemConfig& config, HostState& st);
 
 /// Removes the particles with 2R < removalFraction · d0: compacts every per-particle array

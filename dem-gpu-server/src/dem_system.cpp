@@ -2,18 +2,6 @@
 // Everything that runs per particle per step is in the backend engine (engine_impl.h).
 #include "coredem/dem/dem_system.h"
 
-#include "chemistry_config.h"
-#include "engine.h"
-#include "state_io.h"
-
-#include "coredem/common/check.h"
-#include "coredem/common/log.h"
-#include "coredem/common/version.h"
-#include "coredem/dem/kernels/collision_time.h"
-#include "coredem/dem/kernels/damping.h"
-#include "coredem/dem/kernels/pressure_gradient.h"
-#include "coredem/dem/time_handler.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,21 +9,37 @@
 #include <limits>
 #include <unordered_map>
 
+#include "chemistry_config.h"
+#include "coredem/common/check.h"
+#include "coredem/common/log.h"
+#include "coredem/common/version.h"
+#include "coredem/dem/kernels/collision_time.h"
+#include "coredem/dem/kernels/damping.h"
+#include "coredem/dem/kernels/pressure_gradient.h"
+#include "coredem/dem/time_handler.h"
+#include "engine.h"
+#include "state_io.h"
 
 namespace coredem::dem {
 
 BackendKind parseBackend(const std::string& name) {
-  if (name == "cpu") return BackendKind::Cpu;
-  if (name == "cuda") return BackendKind::Cuda;
-  if (name == "auto") return BackendKind::Auto;
+  if (name == "cpu")
+    return BackendKind::Cpu;
+  if (name == "cuda")
+    return BackendKind::Cuda;
+  if (name == "auto")
+    return BackendKind::Auto;
   throw UserError("unknown DEM backend '" + name + "'; use cpu, cuda or auto");
 }
 
 std::string backendName(BackendKind kind) {
   switch (kind) {
-  case BackendKind::Cpu: return "cpu";
-  case BackendKind::Cuda: return "cuda";
-  case BackendKind::Auto: return "auto";
+  case BackendKind::Cpu:
+    return "cpu";
+  case BackendKind::Cuda:
+    return "cuda";
+  case BackendKind::Auto:
+    return "auto";
   }
   return "?";
 }
@@ -81,31 +85,40 @@ struct Rng {
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
     return z ^ (z >> 31);
   }
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  // [0, 1)
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; } // [0, 1)
 };
 
 void validate(const DemConfig& c) {
   COREDEM_CHECK(!c.materials.empty(), "DemConfig.materials is empty; define at least one material");
   for (std::size_t m = 0; m < c.materials.size(); ++m) {
     const Material& mat = c.materials[m];
-    COREDEM_CHECK(mat.kn > 0 && std::isfinite(mat.kn), "material '{}': kn = {} must be > 0", mat.name, mat.kn);
-    COREDEM_CHECK(mat.en > 0 && mat.en <= 1, "material '{}': en = {} must be in (0, 1]", mat.name, mat.en);
+    COREDEM_CHECK(mat.kn > 0 && std::isfinite(mat.kn), "material '{}': kn = {} must be > 0",
+                  mat.name, mat.kn);
+    COREDEM_CHECK(mat.en > 0 && mat.en <= 1, "material '{}': en = {} must be in (0, 1]", mat.name,
+                  mat.en);
     COREDEM_CHECK(mat.mu >= 0, "material '{}': mu = {} must be >= 0", mat.name, mat.mu);
-    COREDEM_CHECK(mat.ktFactor > 0, "material '{}': ktFactor = {} must be > 0", mat.name, mat.ktFactor);
-    COREDEM_CHECK(mat.etatFactor >= 0, "material '{}': etatFactor = {} must be >= 0", mat.name, mat.etatFactor);
-    COREDEM_CHECK(mat.cp > 0 && std::isfinite(mat.cp), "material '{}': cp = {} J/kg/K must be > 0", mat.name, mat.cp);
+    COREDEM_CHECK(mat.ktFactor > 0, "material '{}': ktFactor = {} must be > 0", mat.name,
+                  mat.ktFactor);
+    COREDEM_CHECK(mat.etatFactor >= 0, "material '{}': etatFactor = {} must be >= 0", mat.name,
+                  mat.etatFactor);
+    COREDEM_CHECK(mat.cp > 0 && std::isfinite(mat.cp), "material '{}': cp = {} J/kg/K must be > 0",
+                  mat.name, mat.cp);
     COREDEM_CHECK(mat.conductivity >= 0 && std::isfinite(mat.conductivity),
-                  "material '{}': conductivity = {} W/m/K must be >= 0", mat.name, mat.conductivity);
-    COREDEM_CHECK(mat.emissivity >= 0 && mat.emissivity <= 1, "material '{}': emissivity = {} must be in [0, 1]",
-                  mat.name, mat.emissivity);
+                  "material '{}': conductivity = {} W/m/K must be >= 0", mat.name,
+                  mat.conductivity);
+    COREDEM_CHECK(mat.emissivity >= 0 && mat.emissivity <= 1,
+                  "material '{}': emissivity = {} must be in [0, 1]", mat.name, mat.emissivity);
   }
   for (const ParticleSet& s : c.particleSets) {
     COREDEM_CHECK(s.material >= 0 && s.material < static_cast<int>(c.materials.size()),
                   "particle set '{}': material index {} is not in 0..{}", s.name, s.material,
                   c.materials.size() - 1);
-    COREDEM_CHECK(s.diameter > 0 && std::isfinite(s.diameter), "particle set '{}': diameter {} must be > 0", s.name, s.diameter);
-    COREDEM_CHECK(s.density > 0 && std::isfinite(s.density), "particle set '{}': density {} must be > 0", s.name, s.density);
-    COREDEM_CHECK(s.temperature > 0, "particle set '{}': temperature {} K must be > 0", s.name, s.temperature);
+    COREDEM_CHECK(s.diameter > 0 && std::isfinite(s.diameter),
+                  "particle set '{}': diameter {} must be > 0", s.name, s.diameter);
+    COREDEM_CHECK(s.density > 0 && std::isfinite(s.density),
+                  "particle set '{}': density {} must be > 0", s.name, s.density);
+    COREDEM_CHECK(s.temperature > 0, "particle set '{}': temperature {} K must be > 0", s.name,
+                  s.temperature);
     COREDEM_CHECK(s.composition.empty() || s.composition.size() == c.solidSpecies.size(),
                   "particle set '{}': composition has {} entries but {} solid species are defined",
                   s.name, s.composition.size(), c.solidSpecies.size());
@@ -115,42 +128,55 @@ void validate(const DemConfig& c) {
         COREDEM_CHECK(y >= 0, "particle set '{}': negative mass fraction in composition", s.name);
         sum += y;
       }
-      COREDEM_CHECK(std::fabs(sum - 1.0) < 1e-9, "particle set '{}': composition sums to {}, not 1", s.name, sum);
+      COREDEM_CHECK(std::fabs(sum - 1.0) < 1e-9, "particle set '{}': composition sums to {}, not 1",
+                    s.name, sum);
     }
     if (s.packing == Packing::Explicit) {
       COREDEM_CHECK(s.positions.size() % 3 == 0 && !s.positions.empty(),
                     "particle set '{}': Explicit packing needs positions as x,y,z triples", s.name);
       const std::size_t n = s.positions.size() / 3;
-      for (double v : s.positions) COREDEM_CHECK(std::isfinite(v), "particle set '{}': a position is not finite", s.name);
-      for (double v : s.velocities) COREDEM_CHECK(std::isfinite(v), "particle set '{}': a velocity is not finite", s.name);
+      for (double v : s.positions)
+        COREDEM_CHECK(std::isfinite(v), "particle set '{}': a position is not finite", s.name);
+      for (double v : s.velocities)
+        COREDEM_CHECK(std::isfinite(v), "particle set '{}': a velocity is not finite", s.name);
       COREDEM_CHECK(s.velocities.empty() || s.velocities.size() == 3 * n,
-                    "particle set '{}': velocities must have 3 values per particle ({}), got {}", s.name, 3 * n, s.velocities.size());
+                    "particle set '{}': velocities must have 3 values per particle ({}), got {}",
+                    s.name, 3 * n, s.velocities.size());
       COREDEM_CHECK(s.angularVelocities.empty() || s.angularVelocities.size() == 3 * n,
                     "particle set '{}': angularVelocities must have 3 values per particle", s.name);
     } else {
       for (int d = 0; d < 3; ++d) {
-        COREDEM_CHECK(s.regionMax[d] > s.regionMin[d], "particle set '{}': region max[{}] = {} must exceed min = {}",
-                      s.name, d, s.regionMax[d], s.regionMin[d]);
+        COREDEM_CHECK(s.regionMax[d] > s.regionMin[d],
+                      "particle set '{}': region max[{}] = {} must exceed min = {}", s.name, d,
+                      s.regionMax[d], s.regionMin[d]);
       }
     }
   }
   for (const Wall& w : c.walls) {
     const double l = std::hypot(w.normal[0], w.normal[1], w.normal[2]);
-    COREDEM_CHECK(l > 0 && std::isfinite(l), "a wall has a zero or non-finite normal; give a nonzero normal");
+    COREDEM_CHECK(l > 0 && std::isfinite(l),
+                  "a wall has a zero or non-finite normal; give a nonzero normal");
   }
   const CouplingGrid& g = c.grid;
   const bool any = g.counts[0] != 0 || g.counts[1] != 0 || g.counts[2] != 0;
   if (any) {
     for (int d = 0; d < 3; ++d) {
-      COREDEM_CHECK(g.counts[d] > 0, "coupling grid: counts[{}] = {} must be > 0 (or all counts 0 for no coupling)", d, g.counts[d]);
-      COREDEM_CHECK(g.spacing[d] > 0, "coupling grid: spacing[{}] = {} must be > 0", d, g.spacing[d]);
+      COREDEM_CHECK(g.counts[d] > 0,
+                    "coupling grid: counts[{}] = {} must be > 0 (or all counts 0 for no coupling)",
+                    d, g.counts[d]);
+      COREDEM_CHECK(g.spacing[d] > 0, "coupling grid: spacing[{}] = {} must be > 0", d,
+                    g.spacing[d]);
     }
-    COREDEM_CHECK(g.cellCount() < (1ull << 31), "coupling grid has {} cells; at most 2^31-1 are supported", g.cellCount());
+    COREDEM_CHECK(g.cellCount() < (1ull << 31),
+                  "coupling grid has {} cells; at most 2^31-1 are supported", g.cellCount());
   }
-  COREDEM_CHECK(c.neighbour.skinFactor >= 0, "neighbour.skinFactor {} must be >= 0", c.neighbour.skinFactor);
-  COREDEM_CHECK(c.neighbour.initialNeighbourSlots >= 1, "neighbour.initialNeighbourSlots must be >= 1");
+  COREDEM_CHECK(c.neighbour.skinFactor >= 0, "neighbour.skinFactor {} must be >= 0",
+                c.neighbour.skinFactor);
+  COREDEM_CHECK(c.neighbour.initialNeighbourSlots >= 1,
+                "neighbour.initialNeighbourSlots must be >= 1");
   COREDEM_CHECK(c.dtFactor >= 1, "dtFactor {} must be >= 1 (PHYSICS: 50)", c.dtFactor);
-  COREDEM_CHECK(c.epsMinDrag > 0 && c.epsMinDrag < 1, "epsMinDrag {} must be in (0, 1)", c.epsMinDrag);
+  COREDEM_CHECK(c.epsMinDrag > 0 && c.epsMinDrag < 1, "epsMinDrag {} must be in (0, 1)",
+                c.epsMinDrag);
   COREDEM_CHECK(c.heat.minSeparation > 0, "heat: s_min = {} m must be > 0", c.heat.minSeparation);
   COREDEM_CHECK(c.heat.lensFraction >= 0, "heat: flpc = {} must be >= 0", c.heat.lensFraction);
   COREDEM_CHECK(c.heat.lensRelTol > 0, "heat: lens_rel_tol = {} must be > 0", c.heat.lensRelTol);
@@ -163,16 +189,20 @@ void validate(const DemConfig& c) {
 /// Positions of one set (x,y,z triples).
 std::vector<double> placeParticles(const ParticleSet& s) {
   std::vector<double> p;
-  if (s.packing == Packing::Explicit) return s.positions;
+  if (s.packing == Packing::Explicit)
+    return s.positions;
   const double r = 0.5 * s.diameter;
   if (s.packing == Packing::Lattice) {
     const double sp = s.spacing > 0 ? s.spacing : s.diameter;
     long long n[3];
-    for (int d = 0; d < 3; ++d) n[d] = static_cast<long long>(std::floor((s.regionMax[d] - s.regionMin[d]) / sp + 1e-9));
+    for (int d = 0; d < 3; ++d)
+      n[d] = static_cast<long long>(std::floor((s.regionMax[d] - s.regionMin[d]) / sp + 1e-9));
     const long long sites = n[0] * n[1] * n[2];
-    COREDEM_CHECK(sites >= static_cast<long long>(s.count),
-                  "particle set '{}': the region holds {} lattice sites at spacing {} m but count = {}; "
-                  "enlarge the region or reduce the count", s.name, sites, sp, s.count);
+    COREDEM_CHECK(
+        sites >= static_cast<long long>(s.count),
+        "particle set '{}': the region holds {} lattice sites at spacing {} m but count = {}; "
+        "enlarge the region or reduce the count",
+        s.name, sites, sp, s.count);
     p.reserve(3 * s.count);
     for (std::size_t k = 0; k < s.count; ++k) {
       const long long i = static_cast<long long>(k) % n[0];
@@ -189,31 +219,39 @@ std::vector<double> placeParticles(const ParticleSet& s) {
   for (int d = 0; d < 3; ++d) {
     lo[d] = s.regionMin[d] + r;
     hi[d] = s.regionMax[d] - r;
-    COREDEM_CHECK(hi[d] > lo[d], "particle set '{}': the region is thinner than one diameter along axis {}", s.name, d);
+    COREDEM_CHECK(hi[d] > lo[d],
+                  "particle set '{}': the region is thinner than one diameter along axis {}",
+                  s.name, d);
   }
   Rng rng{s.seed};
   std::unordered_map<std::uint64_t, std::vector<std::size_t>> grid;
-  auto cellOf = [&](double x, int d) { return static_cast<std::int64_t>(std::floor((x - lo[d]) / s.diameter)); };
+  auto cellOf = [&](double x, int d) {
+    return static_cast<std::int64_t>(std::floor((x - lo[d]) / s.diameter));
+  };
   auto key = [](std::int64_t a, std::int64_t b, std::int64_t c) {
-    return (static_cast<std::uint64_t>(a) * 73856093ull) ^ (static_cast<std::uint64_t>(b) * 19349663ull) ^
+    return (static_cast<std::uint64_t>(a) * 73856093ull) ^
+           (static_cast<std::uint64_t>(b) * 19349663ull) ^
            (static_cast<std::uint64_t>(c) * 83492791ull);
   };
   const std::size_t maxAttempts = 2000 * s.count + 10000;
   std::size_t attempts = 0;
   while (p.size() < 3 * s.count) {
-    COREDEM_CHECK(++attempts < maxAttempts,
-                  "particle set '{}': could not place {} non-overlapping particles of diameter {} m in the "
-                  "region (placed {}); enlarge the region, reduce the count or use Lattice packing",
-                  s.name, s.count, s.diameter, p.size() / 3);
+    COREDEM_CHECK(
+        ++attempts < maxAttempts,
+        "particle set '{}': could not place {} non-overlapping particles of diameter {} m in the "
+        "region (placed {}); enlarge the region, reduce the count or use Lattice packing",
+        s.name, s.count, s.diameter, p.size() / 3);
     double x[3];
-    for (int d = 0; d < 3; ++d) x[d] = lo[d] + (hi[d] - lo[d]) * rng.uniform();
+    for (int d = 0; d < 3; ++d)
+      x[d] = lo[d] + (hi[d] - lo[d]) * rng.uniform();
     const std::int64_t c[3] = {cellOf(x[0], 0), cellOf(x[1], 1), cellOf(x[2], 2)};
     bool ok = true;
     for (int a = -1; a <= 1 && ok; ++a)
       for (int b = -1; b <= 1 && ok; ++b)
         for (int e = -1; e <= 1 && ok; ++e) {
           auto it = grid.find(key(c[0] + a, c[1] + b, c[2] + e));
-          if (it == grid.end()) continue;
+          if (it == grid.end())
+            continue;
           for (std::size_t q : it->second) {
             const double dx = p[3 * q] - x[0], dy = p[3 * q + 1] - x[1], dz = p[3 * q + 2] - x[2];
             if (dx * dx + dy * dy + dz * dz < s.diameter * s.diameter) {
@@ -222,7 +260,8 @@ std::vector<double> placeParticles(const ParticleSet& s) {
             }
           }
         }
-    if (!ok) continue;
+    if (!ok)
+      continue;
     grid[key(c[0], c[1], c[2])].push_back(p.size() / 3);
     p.insert(p.end(), x, x + 3);
   }
@@ -245,42 +284,52 @@ std::string hashConfig(const DemConfig& c) {
   };
   for (const Material& m : c.materials) {
     t += m.name + ":";
-    for (double v : {m.kn, m.en, m.mu, m.ktFactor, m.etatFactor}) num(v);
-    if (c.heat.enabled) num(m.cp), num(m.conductivity), num(m.emissivity);
+    for (double v : {m.kn, m.en, m.mu, m.ktFactor, m.etatFactor})
+      num(v);
+    if (c.heat.enabled)
+      num(m.cp), num(m.conductivity), num(m.emissivity);
   }
   t += "|walls:";
   for (const Wall& w : c.walls)
-    for (int d = 0; d < 3; ++d) num(w.point[d]), num(w.normal[d]);
+    for (int d = 0; d < 3; ++d)
+      num(w.point[d]), num(w.normal[d]);
   t += "|g:";
-  for (double v : c.gravity) num(v);
+  for (double v : c.gravity)
+    num(v);
   t += "|grid:";
-  for (int d = 0; d < 3; ++d) num(c.grid.origin[d]), num(c.grid.spacing[d]), num(c.grid.counts[d]);
+  for (int d = 0; d < 3; ++d)
+    num(c.grid.origin[d]), num(c.grid.spacing[d]), num(c.grid.counts[d]);
   t += "|species:";
-  for (const Species& s : c.solidSpecies) t += s.name + ":", num(s.molarMass);
+  for (const Species& s : c.solidSpecies)
+    t += s.name + ":", num(s.molarMass);
   t += "|gas:";
-  for (const Species& s : c.gasSpecies) t += s.name + ":", num(s.molarMass);
+  for (const Species& s : c.gasSpecies)
+    t += s.name + ":", num(s.molarMass);
   t += "|opts:";
   num(c.neighbour.skinFactor), num(c.neighbour.historySlots), num(c.epsMinDrag), num(c.dtFactor);
-  if (c.frozenMotion) t += "|frozen";  // absent otherwise: earlier hashes unchanged
-  if (c.drag != kernels::DragLaw::Gidaspow) {  // absent for the default law: earlier hashes unchanged
+  if (c.frozenMotion)
+    t += "|frozen"; // absent otherwise: earlier hashes unchanged
+  if (c.drag !=
+      kernels::DragLaw::Gidaspow) { // absent for the default law: earlier hashes unchanged
     t += "|drag:";
     num(static_cast<int>(c.drag));
   }
-  if (c.heat.enabled) {  // heat off keeps the hash of configurations without heat transfer
+  if (c.heat.enabled) { // heat off keeps the hash of configurations without heat transfer
     const HeatOptions& h = c.heat;
     t += "|heat:";
-    for (double v : {double(h.convection), double(static_cast<int>(h.nusselt)), double(h.reynoldsWithVoidage),
-                     h.voidageExponent, double(h.contactConduction), double(h.lensConduction),
-                     h.lensFraction, h.minSeparation, h.lensRelTol, double(h.radiation)})
+    for (double v :
+         {double(h.convection), double(static_cast<int>(h.nusselt)), double(h.reynoldsWithVoidage),
+          h.voidageExponent, double(h.contactConduction), double(h.lensConduction), h.lensFraction,
+          h.minSeparation, h.lensRelTol, double(h.radiation)})
       num(v);
-    if (c.wallTemperature > 0.0) {  // absent for adiabatic walls: earlier hashes unchanged
+    if (c.wallTemperature > 0.0) { // absent for adiabatic walls: earlier hashes unchanged
       t += "|wallT:";
       for (double v : {c.wallTemperature, double(c.wallMaterial), double(h.wallConduction),
                        double(h.wallLensConduction)})
         num(v);
     }
   }
-  t += chemistryHashText(c);  // empty without chemistry
+  t += chemistryHashText(c); // empty without chemistry
   std::uint64_t h = 0xcbf29ce484222325ull;
   for (unsigned char ch : t) {
     h ^= ch;
@@ -303,26 +352,33 @@ double dtDemMaxFor(const DemConfig& config, const std::vector<double>& minMass) 
   const std::size_t nm = config.materials.size();
   double tcol = std::numeric_limits<double>::infinity();
   for (std::size_t a = 0; a < nm; ++a) {
-    if (!std::isfinite(minMass[a])) continue;
+    if (!std::isfinite(minMass[a]))
+      continue;
     for (std::size_t b = 0; b < nm; ++b) {
-      if (!std::isfinite(minMass[b])) continue;
+      if (!std::isfinite(minMass[b]))
+        continue;
       const PairProps pp = pairProps(config.materials[a], config.materials[b]);
       const double meff = kernels::effectiveMass(minMass[a], minMass[b]);
-      tcol = std::min(tcol, kernels::collisionTime(pp.kn, meff, pp.dampFactor * std::sqrt(pp.kn * meff)));
+      tcol = std::min(tcol,
+                      kernels::collisionTime(pp.kn, meff, pp.dampFactor * std::sqrt(pp.kn * meff)));
     }
     if (!config.walls.empty()) {
       const PairProps pp = pairProps(config.materials[a], config.materials[a]);
-      tcol = std::min(tcol, kernels::collisionTime(pp.kn, minMass[a], pp.dampFactor * std::sqrt(pp.kn * minMass[a])));
+      tcol = std::min(tcol, kernels::collisionTime(pp.kn, minMass[a],
+                                                   pp.dampFactor * std::sqrt(pp.kn * minMass[a])));
     }
   }
-  if (config.frozenMotion) return std::numeric_limits<double>::max();  // held: no collision limit
+  if (config.frozenMotion)
+    return std::numeric_limits<double>::max(); // held: no collision limit
   return std::isfinite(tcol) ? tcol / config.dtFactor : std::numeric_limits<double>::infinity();
 }
 
 /// Mass of particle i for Δt_DEM,max after a restart. With chemistry, the mass at the initial
-/// diameter: shrinking particles keep the step of the run that wrote the file (docs/thermochemistry.md).
+/// diameter: shrinking particles keep the step of the run that wrote the file
+/// (docs/thermochemistry.md).
 double restartMass(const DemConfig& c, const HostState& st, std::size_t i) {
-  if (!c.chemistry.active() || st.d0.size() != st.n) return st.mass[i];
+  if (!c.chemistry.active() || st.d0.size() != st.n)
+    return st.mass[i];
   return st.density[i] * kernels::sphereVolume(0.5 * st.d0[i]);
 }
 
@@ -341,7 +397,8 @@ struct DemSystem::Impl {
   BackendKind kind = BackendKind::Cpu;
   std::unique_ptr<Engine> makeEngine() const {
 #if defined(COREDEM_CUDA_ENABLED)
-    if (kind == BackendKind::Cuda) return makeCudaEngine(setup);
+    if (kind == BackendKind::Cuda)
+      return makeCudaEngine(setup);
 #endif
     return makeCpuEngine(setup);
   }
@@ -377,8 +434,10 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
       for (int d = 0; d < 3; ++d) {
         st.pos.push_back(p[3 * k + d]);
         double v = s.velocity[d];
-        if (!s.velocities.empty()) v = s.velocities[3 * k + d];
-        if (s.velocityJitter > 0) v += s.velocityJitter * (2.0 * rng.uniform() - 1.0);
+        if (!s.velocities.empty())
+          v = s.velocities[3 * k + d];
+        if (s.velocityJitter > 0)
+          v += s.velocityJitter * (2.0 * rng.uniform() - 1.0);
         st.vel.push_back(v);
         st.omega.push_back(s.angularVelocities.empty() ? 0.0 : s.angularVelocities[3 * k + d]);
       }
@@ -386,7 +445,8 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
       st.mass.push_back(mass);
       st.density.push_back(s.density);
       st.temperature.push_back(s.temperature);
-      for (int q = 0; q < ns; ++q) st.species.push_back(s.composition.empty() ? (q == 0 ? 1.0 : 0.0) : s.composition[q]);
+      for (int q = 0; q < ns; ++q)
+        st.species.push_back(s.composition.empty() ? (q == 0 ? 1.0 : 0.0) : s.composition[q]);
       st.material.push_back(s.material);
       st.gid.push_back(nextId++);
     }
@@ -396,7 +456,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   st.n = n;
   st.xref = st.pos;
   st.listValid = 0;
-  initChemistryReferences(config, st);  // d_p0, initial C / Fe2O3-equivalent masses
+  initChemistryReferences(config, st); // d_p0, initial C / Fe2O3-equivalent masses
   // Every other field (forces, contact counts, history, neighbour lists, ...) starts from its
   // particle-schema default (zero; empty history slots −1).
   fillDefaults(st);
@@ -409,7 +469,8 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   EngineSetup& es = m.setup;
   es.nMaterials = static_cast<int>(nm);
   for (std::size_t a = 0; a < nm; ++a)
-    for (std::size_t b = 0; b < nm; ++b) es.pairs.push_back(pairProps(config.materials[a], config.materials[b]));
+    for (std::size_t b = 0; b < nm; ++b)
+      es.pairs.push_back(pairProps(config.materials[a], config.materials[b]));
   for (const Wall& w : config.walls) {
     const double l = std::hypot(w.normal[0], w.normal[1], w.normal[2]);
     es.walls.push_back(kernels::PlaneWall{{w.point[0], w.point[1], w.point[2]},
@@ -422,7 +483,9 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
     const CouplingGrid& g = config.grid;
     es.grid = kernels::GridParams{{g.origin[0], g.origin[1], g.origin[2]},
                                   {1.0 / g.spacing[0], 1.0 / g.spacing[1], 1.0 / g.spacing[2]},
-                                  g.counts[0], g.counts[1], g.counts[2]};
+                                  g.counts[0],
+                                  g.counts[1],
+                                  g.counts[2]};
     es.cellVolume = g.spacing[0] * g.spacing[1] * g.spacing[2];
   }
   es.nGasSpecies = static_cast<int>(config.gasSpecies.size());
@@ -463,21 +526,25 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
     COREDEM_CHECK(config.wallMaterial >= 0 && config.wallMaterial < static_cast<int>(nm),
                   "wall material index {} is not one of the {} materials", config.wallMaterial, nm);
     if (h.enabled && config.wallTemperature > 0.0 && (h.wallConduction || h.wallLensConduction)) {
-      const double kw = config.materials[static_cast<std::size_t>(config.wallMaterial)].conductivity;
-      for (const kernels::PlaneWall& w : es.walls) hs.walls.push_back(ThermalWall{w, config.wallTemperature, kw});
-      hs.wallParams = kernels::WallConductionParams{h.wallConduction, h.wallLensConduction && es.coupled,
-                                                    h.lensFraction, h.minSeparation};
+      const double kw =
+          config.materials[static_cast<std::size_t>(config.wallMaterial)].conductivity;
+      for (const kernels::PlaneWall& w : es.walls)
+        hs.walls.push_back(ThermalWall{w, config.wallTemperature, kw});
+      hs.wallParams = kernels::WallConductionParams{
+          h.wallConduction, h.wallLensConduction && es.coupled, h.lensFraction, h.minSeparation};
     }
     es.reach = (h.enabled && hs.lensConduction) ? h.lensFraction * rmax : 0.0;
   }
 
-  es.chem = makeChemistrySetup(config);  // chemistry (chemistry.h); validates the options
+  es.chem = makeChemistrySetup(config); // chemistry (chemistry.h); validates the options
 
   BackendKind kind = backend;
-  if (kind == BackendKind::Auto) kind = cudaDeviceCount() > 0 ? BackendKind::Cuda : BackendKind::Cpu;
+  if (kind == BackendKind::Auto)
+    kind = cudaDeviceCount() > 0 ? BackendKind::Cuda : BackendKind::Cpu;
   if (kind == BackendKind::Cuda) {
-    COREDEM_CHECK(cudaBackendBuilt(), "backend 'cuda' requested but this build has no CUDA backend; "
-                                      "rebuild with -DCOREDEM_CUDA=ON or use --backend cpu");
+    COREDEM_CHECK(cudaBackendBuilt(),
+                  "backend 'cuda' requested but this build has no CUDA backend; "
+                  "rebuild with -DCOREDEM_CUDA=ON or use --backend cpu");
     COREDEM_CHECK(cudaDeviceCount() > 0, "backend 'cuda' requested but no CUDA device is visible; "
                                          "use --backend cpu (or auto)");
   }
@@ -490,16 +557,20 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
 
 DemSystem::~DemSystem() = default;
 
-double DemSystem::dtDemMax() const { return _impl->dtMax; }
+double DemSystem::dtDemMax() const {
+  return _impl->dtMax;
+}
 
 void DemSystem::setGasFields(const GasFieldsView& gas) {
   Impl& m = *_impl;
-  COREDEM_CHECK(m.setup.coupled, "setGasFields: no coupling grid is configured (DemConfig.grid counts are 0)");
+  COREDEM_CHECK(m.setup.coupled,
+                "setGasFields: no coupling grid is configured (DemConfig.grid counts are 0)");
   const std::size_t nc = m.setup.nCells;
   const std::size_t ns = m.config.gasSpecies.size();
   auto check = [&](std::span<const double> s, std::size_t want, const char* name, bool optional,
                    bool positive) -> std::vector<double> {
-    if (s.empty() && optional) return {};
+    if (s.empty() && optional)
+      return {};
     COREDEM_CHECK(s.size() == want, "setGasFields: {} has {} values, expected {} ({} cells)", name,
                   s.size(), want, nc);
     for (std::size_t k = 0; k < s.size(); ++k) {
@@ -522,13 +593,15 @@ void DemSystem::setGasFields(const GasFieldsView& gas) {
 
 const CellSources& DemSystem::advance(double dtCfd, int nSub) {
   Impl& m = *_impl;
-  COREDEM_CHECK(dtCfd > 0 && std::isfinite(dtCfd), "advance: dtCfd = {} must be > 0 and finite", dtCfd);
+  COREDEM_CHECK(dtCfd > 0 && std::isfinite(dtCfd), "advance: dtCfd = {} must be > 0 and finite",
+                dtCfd);
   COREDEM_CHECK(nSub >= 1, "advance: nSub = {} must be >= 1", nSub);
   const double dt = dtCfd / nSub;
-  COREDEM_CHECK(dt <= m.dtMax * (1.0 + 1e-12),
-                "advance: dtCfd/nSub = {:.6g} s exceeds the stable DEM step {:.6g} s (t_col/{}); use "
-                "nSub >= {} (TimeHandler::subStepsFor)", dt, m.dtMax, m.config.dtFactor,
-                TimeHandler::subStepsFor(dtCfd, m.dtMax));
+  COREDEM_CHECK(
+      dt <= m.dtMax * (1.0 + 1e-12),
+      "advance: dtCfd/nSub = {:.6g} s exceeds the stable DEM step {:.6g} s (t_col/{}); use "
+      "nSub >= {} (TimeHandler::subStepsFor)",
+      dt, m.dtMax, m.config.dtFactor, TimeHandler::subStepsFor(dtCfd, m.dtMax));
   m.engine->beginWindow();
   for (int s = 0; s < nSub; ++s) {
     m.engine->subStep(dt);
@@ -542,15 +615,19 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
     HostState st = m.engine->state();
     ChemistryTotals totals = m.engine->chemistryTotals();
     const double before = totals.removedMass();
-    const std::size_t removed = removeSmallParticles(m.config.chemistry.removalFraction, st, totals);
-    m.engine->restoreChemistryTotals(totals);  // the removed mass joins the chemistry ledger
+    const std::size_t removed =
+        removeSmallParticles(m.config.chemistry.removalFraction, st, totals);
+    m.engine->restoreChemistryTotals(totals); // the removed mass joins the chemistry ledger
     if (removed > 0) {
       m.engine->setState(st);
       m.nParticles = st.n;
-      m.log->info("t = {:.6g} s: removed {} particle(s) below {} of their initial diameter ({:.6g} kg); {} left",
-                  m.time.time(), removed, m.config.chemistry.removalFraction, totals.removedMass() - before, st.n);
+      m.log->info("t = {:.6g} s: removed {} particle(s) below {} of their initial diameter ({:.6g} "
+                  "kg); {} left",
+                  m.time.time(), removed, m.config.chemistry.removalFraction,
+                  totals.removedMass() - before, st.n);
     }
-    m.engine->times().chemistry += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    m.engine->times().chemistry +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   return m.sources;
 }
@@ -563,7 +640,8 @@ void DemSystem::writeState(const std::string& path, const std::string& protocolV
   meta.step = m.step;
   meta.backend = m.engine->name();
   meta.configHash = m.hash;
-  meta.softwareVersion = std::string(coredem::kVersion);  // (not operator=(const char*): GCC 12 -Wrestrict false positive)
+  meta.softwareVersion = std::string(
+      coredem::kVersion); // (not operator=(const char*): GCC 12 -Wrestrict false positive)
   meta.protocolVersion = protocolVersion.empty() ? std::string("none") : protocolVersion;
   const HeatTotals heat = m.engine->heatTotals();
   meta.heatConvection = heat.convection;
@@ -579,11 +657,14 @@ void DemSystem::readState(const std::string& path) {
   HostState st;
   StateMeta meta;
   readStateFile(path, st, meta);
-  COREDEM_CHECK(meta.configHash == m.hash,
-                "state file '{}' was written with config hash {} but this system's is {}: restart with "
-                "the same materials, walls, gravity, grid, species and options", path, meta.configHash, m.hash);
+  COREDEM_CHECK(
+      meta.configHash == m.hash,
+      "state file '{}' was written with config hash {} but this system's is {}: restart with "
+      "the same materials, walls, gravity, grid, species and options",
+      path, meta.configHash, m.hash);
   COREDEM_CHECK(st.nSpecies == static_cast<int>(m.config.solidSpecies.size()),
-                "state file '{}' has {} solid species, the config {}", path, st.nSpecies, m.config.solidSpecies.size());
+                "state file '{}' has {} solid species, the config {}", path, st.nSpecies,
+                m.config.solidSpecies.size());
   COREDEM_CHECK(st.historySlots >= 1, "state file '{}': bad history_slots", path);
   double rmax = 0;
   std::vector<double> minMass(m.config.materials.size(), std::numeric_limits<double>::infinity());
@@ -591,36 +672,53 @@ void DemSystem::readState(const std::string& path) {
     rmax = std::max(rmax, st.radius[i]);
     if (st.material[i] >= 0 && st.material[i] < static_cast<int>(minMass.size()))
       minMass[st.material[i]] = std::min(minMass[st.material[i]], restartMass(m.config, st, i));
-    COREDEM_CHECK(st.material[i] >= 0 && st.material[i] < static_cast<int>(m.config.materials.size()),
-                  "state file '{}': particle {} has material {} not in the config", path, i, st.material[i]);
+    COREDEM_CHECK(
+        st.material[i] >= 0 && st.material[i] < static_cast<int>(m.config.materials.size()),
+        "state file '{}': particle {} has material {} not in the config", path, i, st.material[i]);
   }
   COREDEM_CHECK(rmax <= m.setup.maxRadius * (1 + 1e-12) || m.nParticles == 0,
-                "state file '{}' holds particles larger (r = {}) than the configured sets (r = {})", path, rmax,
-                m.setup.maxRadius);
+                "state file '{}' holds particles larger (r = {}) than the configured sets (r = {})",
+                path, rmax, m.setup.maxRadius);
   if (m.nParticles == 0 && rmax > 0) {
     // Built without particle sets: take the neighbour cell size from the file.
     m.setup.maxRadius = rmax;
     m.setup.skin = m.config.neighbour.skinFactor * 2.0 * rmax;
-    if (m.config.heat.enabled && m.setup.heat.lensConduction) m.setup.reach = m.config.heat.lensFraction * rmax;
+    if (m.config.heat.enabled && m.setup.heat.lensConduction)
+      m.setup.reach = m.config.heat.lensFraction * rmax;
     m.engine.reset();
     m.engine = m.makeEngine();
   }
   m.engine->setState(st);
   m.engine->restoreHeatTotals(HeatTotals{meta.heatConvection, meta.heatRadiation, meta.heatWall});
-  if (meta.hasChemistry) m.engine->restoreChemistryTotals(meta.chemistry);
+  if (meta.hasChemistry)
+    m.engine->restoreChemistryTotals(meta.chemistry);
   m.nParticles = st.n;
   m.dtMax = dtDemMaxFor(m.config, minMass);
   m.time.restore(meta.time, meta.timeCompensation);
   m.step = meta.step;
 }
 
-double DemSystem::time() const { return _impl->time.time(); }
-std::uint64_t DemSystem::step() const { return _impl->step; }
-std::size_t DemSystem::particleCount() const { return _impl->nParticles; }
-std::size_t DemSystem::cellCount() const { return _impl->setup.nCells; }
-std::string DemSystem::backendName() const { return _impl->engine->name(); }
-std::string DemSystem::configHash() const { return _impl->hash; }
-const DemConfig& DemSystem::config() const { return _impl->config; }
+double DemSystem::time() const {
+  return _impl->time.time();
+}
+std::uint64_t DemSystem::step() const {
+  return _impl->step;
+}
+std::size_t DemSystem::particleCount() const {
+  return _impl->nParticles;
+}
+std::size_t DemSystem::cellCount() const {
+  return _impl->setup.nCells;
+}
+std::string DemSystem::backendName() const {
+  return _impl->engine->name();
+}
+std::string DemSystem::configHash() const {
+  return _impl->hash;
+}
+const DemConfig& DemSystem::config() const {
+  return _impl->config;
+}
 
 ParticleData DemSystem::particles() const {
   ParticleData p;
@@ -628,22 +726,29 @@ ParticleData DemSystem::particles() const {
   return p;
 }
 
-void DemSystem::setVelocities(std::span<const double> velocityByGid, std::span<const double> omegaByGid) {
+void DemSystem::setVelocities(std::span<const double> velocityByGid,
+                              std::span<const double> omegaByGid) {
   Impl& m = *_impl;
   HostState s = m.engine->state();
   COREDEM_CHECK(velocityByGid.empty() || velocityByGid.size() == 3 * s.n,
                 "setVelocities: {} velocity values, expected {}", velocityByGid.size(), 3 * s.n);
   COREDEM_CHECK(omegaByGid.empty() || omegaByGid.size() == 3 * s.n,
-                "setVelocities: {} angular velocity values, expected {}", omegaByGid.size(), 3 * s.n);
-  for (double v : velocityByGid) COREDEM_CHECK(std::isfinite(v), "setVelocities: a velocity is not finite");
-  for (double v : omegaByGid) COREDEM_CHECK(std::isfinite(v), "setVelocities: an angular velocity is not finite");
+                "setVelocities: {} angular velocity values, expected {}", omegaByGid.size(),
+                3 * s.n);
+  for (double v : velocityByGid)
+    COREDEM_CHECK(std::isfinite(v), "setVelocities: a velocity is not finite");
+  for (double v : omegaByGid)
+    COREDEM_CHECK(std::isfinite(v), "setVelocities: an angular velocity is not finite");
   for (std::size_t i = 0; i < s.n; ++i) {
     const std::size_t g = static_cast<std::size_t>(s.gid[i]);
-    COREDEM_CHECK(s.gid[i] >= 0 && g < s.n, "setVelocities: global ids are not 0..N-1 (state read from a file "
-                                            "with other ids); set velocities through ParticleSet instead");
+    COREDEM_CHECK(s.gid[i] >= 0 && g < s.n,
+                  "setVelocities: global ids are not 0..N-1 (state read from a file "
+                  "with other ids); set velocities through ParticleSet instead");
     for (int d = 0; d < 3; ++d) {
-      if (!velocityByGid.empty()) s.vel[3 * i + d] = velocityByGid[3 * g + d];
-      if (!omegaByGid.empty()) s.omega[3 * i + d] = omegaByGid[3 * g + d];
+      if (!velocityByGid.empty())
+        s.vel[3 * i + d] = velocityByGid[3 * g + d];
+      if (!omegaByGid.empty())
+        s.omega[3 * i + d] = omegaByGid[3 * g + d];
     }
   }
   m.engine->setState(s);
@@ -652,19 +757,34 @@ void DemSystem::setVelocities(std::span<const double> velocityByGid, std::span<c
 std::size_t DemSystem::contactCount() const {
   return _impl->engine->pairContacts() + _impl->engine->wallContacts();
 }
-std::size_t DemSystem::pairContactCount() const { return _impl->engine->pairContacts(); }
-std::array<double, 3> DemSystem::wallForce() const { return _impl->engine->wallForce(); }
-std::size_t DemSystem::memoryBytes() const { return _impl->engine->memoryBytes(); }
-StageTimes DemSystem::stageTimes() const { return _impl->engine->times(); }
-void DemSystem::resetStageTimes() { _impl->engine->times() = StageTimes{}; }
-HeatTotals DemSystem::heatTotals() const { return _impl->engine->heatTotals(); }
-ChemistryTotals DemSystem::chemistryTotals() const { return _impl->engine->chemistryTotals(); }
+std::size_t DemSystem::pairContactCount() const {
+  return _impl->engine->pairContacts();
+}
+std::array<double, 3> DemSystem::wallForce() const {
+  return _impl->engine->wallForce();
+}
+std::size_t DemSystem::memoryBytes() const {
+  return _impl->engine->memoryBytes();
+}
+StageTimes DemSystem::stageTimes() const {
+  return _impl->engine->times();
+}
+void DemSystem::resetStageTimes() {
+  _impl->engine->times() = StageTimes{};
+}
+HeatTotals DemSystem::heatTotals() const {
+  return _impl->engine->heatTotals();
+}
+ChemistryTotals DemSystem::chemistryTotals() const {
+  return _impl->engine->chemistryTotals();
+}
 
 double DemSystem::thermalEnergy() const {
   const ParticleData p = particles();
   double e = 0.0;
   for (std::size_t i = 0; i < p.count; ++i)
-    e += p.mass[i] * _impl->config.materials[static_cast<std::size_t>(p.material[i])].cp * p.temperature[i];
+    e += p.mass[i] * _impl->config.materials[static_cast<std::size_t>(p.material[i])].cp *
+         p.temperature[i];
   return e;
 }
 

@@ -90,8 +90,8 @@ public:
   // member functions. The engine calls the first two itself to time them apart (stages drag and
   // coupling); together they are sources().
 
-  /// First pass: PCM cell, drag and −V_p ∇p per particle. The sums are in the order of the former fused
-  /// kernel (bitwise the same forces).
+  /// First pass: PCM cell, drag and −V_p ∇p per particle. The sums are in the order of the former
+  /// fused kernel (bitwise the same forces).
   void gasForces(StepContext<Exec>& ctx) {
     ParticleStore<Exec>& p = ctx.particles;
     _kcoef.reserve(p.n);

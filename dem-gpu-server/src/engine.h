@@ -3,19 +3,19 @@
 /// The backend-neutral interface between DemSystem (host: config, time, I/O) and the
 /// templated engine that runs the kernels (engine_impl.h, instantiated once per backend).
 
-#include "coredem/dem/dem_system.h"
-#include "heat_setup.h"
-#include "chemistry_setup.h"
-#include "coredem/dem/kernels/drag.h"
-#include "coredem/dem/particle_schema.h"
-#include "coredem/dem/kernels/pcm.h"
-#include "coredem/dem/kernels/vec3.h"
-#include "coredem/dem/kernels/wall_contact.h"
-
 #include <array>
 #include <cstdint>
 #include <memory>
 #include <vector>
+
+#include "chemistry_setup.h"
+#include "coredem/dem/dem_system.h"
+#include "coredem/dem/kernels/drag.h"
+#include "coredem/dem/kernels/pcm.h"
+#include "coredem/dem/kernels/vec3.h"
+#include "coredem/dem/kernels/wall_contact.h"
+#include "coredem/dem/particle_schema.h"
+#include "heat_setup.h"
 
 namespace coredem::dem {
 
@@ -27,24 +27,24 @@ struct PairProps {
 /// Everything the engine needs besides the particles. Plain data.
 struct EngineSetup {
   int nMaterials = 1;
-  std::vector<PairProps> pairs;          ///< nMaterials², [a*nMaterials + b]; walls use [a*n + a]
+  std::vector<PairProps> pairs; ///< nMaterials², [a*nMaterials + b]; walls use [a*n + a]
   std::vector<kernels::PlaneWall> walls;
   kernels::Vec3 gravity{0, 0, 0};
   bool coupled = false;
-  kernels::GridParams grid{};            ///< valid when coupled
+  kernels::GridParams grid{}; ///< valid when coupled
   double cellVolume = 0;
   std::size_t nCells = 0;
   int nGasSpecies = 0;
-  kernels::DragParams drag{};            ///< drag law and its parameters (kernels/drag.h)
-  double skin = 0;                       ///< m
-  double maxRadius = 0;                  ///< m
+  kernels::DragParams drag{}; ///< drag law and its parameters (kernels/drag.h)
+  double skin = 0;            ///< m
+  double maxRadius = 0;       ///< m
   int historySlots = 12;
   int neighbourSlots = 16;
   int threads = 0;
-  HeatSetup heat;                        ///< particle heat transfer (heat.h)
-  double reach = 0;                      ///< m, neighbour-list reach beyond R_i+R_j+skin (gas lens)
-  bool frozen = false;                   ///< DemConfig::frozenMotion: positions fixed, velocities zeroed
-  ChemistrySetup chem;                   ///< chemistry in the sub-step (chemistry.h)
+  HeatSetup heat;      ///< particle heat transfer (heat.h)
+  double reach = 0;    ///< m, neighbour-list reach beyond R_i+R_j+skin (gas lens)
+  bool frozen = false; ///< DemConfig::frozenMotion: positions fixed, velocities zeroed
+  ChemistrySetup chem; ///< chemistry in the sub-step (chemistry.h)
 };
 
 /// Host copy of the full engine state (particles in internal order, contact history,
@@ -55,12 +55,14 @@ struct HostState {
   int nSpecies = 0;
   int historySlots = 0;
   int neighbourSlots = 0;
-  std::int32_t listValid = 0;  ///< 1: nbList usable as is
+  std::int32_t listValid = 0; ///< 1: nbList usable as is
 #define COREDEM_HOST_MEMBER_(member, Mask, T, ...) std::vector<T> member;
   COREDEM_PARTICLE_FIELDS(COREDEM_HOST_MEMBER_)
 #undef COREDEM_HOST_MEMBER_
 
-  schema::Extents extents() const { return {nSpecies, historySlots, neighbourSlots}; }
+  schema::Extents extents() const {
+    return {nSpecies, historySlots, neighbourSlots};
+  }
   /// Values a field must hold: n · width.
   std::size_t expectedSize(const schema::FieldInfo& f) const {
     return n * schema::valuesPerParticle(f, extents());

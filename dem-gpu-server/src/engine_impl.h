@@ -22,10 +22,18 @@
 /// and for the velocity-dependent LSD law velocity Verlet (LIGGGHTS) gave the same rebound
 /// ratios in a binary-collision check (docs/performance.md "Integrator").
 
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
 #include "chemistry.h"
 #include "contacts.h"
+#include "coredem/dem/kernels/body_force.h"
+#include "coredem/dem/kernels/pcm.h"
+#include "coredem/dem/kernels/vec3.h"
 #include "coupling_cells.h"
 #include "drag.h"
 #include "engine.h"
@@ -33,15 +41,6 @@
 #include "heat.h"
 #include "particle_store.h"
 #include "step_module.h"
-
-#include "coredem/dem/kernels/body_force.h"
-#include "coredem/dem/kernels/pcm.h"
-#include "coredem/dem/kernels/vec3.h"
-
-#include <chrono>
-#include <cmath>
-#include <cstdint>
-#include <string>
 
 namespace coredem::dem {
 
@@ -58,11 +57,13 @@ public:
   using Dual = backend::DualArray<T, Exec>;
   using Clock = std::chrono::steady_clock;
 
-  explicit EngineImpl(const EngineSetup& s) : _s(s) {
+  explicit EngineImpl(const EngineSetup& s)
+      : _s(s) {
     _exec.threads = s.threads;
     if (_s.historySlots > kMaxHistorySlots || _s.historySlots < 1) {
-      backend::raiseUserError("NeighbourOptions::historySlots = " + std::to_string(_s.historySlots) +
-                              " is out of range; use 1.." + std::to_string(kMaxHistorySlots));
+      backend::raiseUserError(
+          "NeighbourOptions::historySlots = " + std::to_string(_s.historySlots) +
+          " is out of range; use 1.." + std::to_string(kMaxHistorySlots));
     }
     _cells.setup(_s.coupled ? _s.nCells : 0);
     _drag.setup(_s);
@@ -81,10 +82,11 @@ public:
 
   // ---------------------------------------------------------------- state transfer
   void setState(const HostState& s) override {
-    checkShapes(s, "Engine::setState");  // every schema field holds n · width values
+    checkShapes(s, "Engine::setState"); // every schema field holds n · width values
     _p.allocate(s.n, s.nSpecies, s.historySlots, s.neighbourSlots);
     schema::forEachField(_p, s, [](const schema::FieldInfo&, auto& arr, const auto& vec) {
-      for (std::size_t k = 0; k < vec.size(); ++k) arr.h()[k] = vec[k];
+      for (std::size_t k = 0; k < vec.size(); ++k)
+        arr.h()[k] = vec[k];
     });
     _p.toDevice(kAllFields);
     _contacts.resetUsedSlots(_p.K);
@@ -113,10 +115,17 @@ public:
     out.count = _p.n;
     out.nSpecies = _p.nSpecies;
     auto get = [](const auto& arr, auto& vec) { vec.assign(arr.h(), arr.h() + arr.size()); };
-    get(_p.pos, out.position); get(_p.vel, out.velocity); get(_p.omega, out.angularVelocity);
-    get(_p.force, out.force); get(_p.radius, out.radius); get(_p.mass, out.mass);
-    get(_p.density, out.density); get(_p.temperature, out.temperature);
-    get(_p.species, out.species); get(_p.material, out.material); get(_p.gid, out.globalId);
+    get(_p.pos, out.position);
+    get(_p.vel, out.velocity);
+    get(_p.omega, out.angularVelocity);
+    get(_p.force, out.force);
+    get(_p.radius, out.radius);
+    get(_p.mass, out.mass);
+    get(_p.density, out.density);
+    get(_p.temperature, out.temperature);
+    get(_p.species, out.species);
+    get(_p.material, out.material);
+    get(_p.gid, out.globalId);
     get(_p.d0, out.initialDiameter);
   }
 
@@ -146,7 +155,8 @@ public:
   template <class T>
   void reorder(Dual<T>& arr, int width, int columns = -1) {
     const std::size_t n = _p.n;
-    if (columns < 0 || columns > width) columns = width;
+    if (columns < 0 || columns > width)
+      columns = width;
     T* a = arr.d();
     T* tmp = reinterpret_cast<T*>(_scratch.d());
     const std::uint32_t* perm = _perm.d();
@@ -154,10 +164,12 @@ public:
       const int w = columns - c0 < kReorderBlock ? columns - c0 : kReorderBlock;
       _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
         const T* src = a + static_cast<std::size_t>(perm[i]) * width + c0;
-        for (int q = 0; q < w; ++q) tmp[i * w + q] = src[q];
+        for (int q = 0; q < w; ++q)
+          tmp[i * w + q] = src[q];
       });
       _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
-        for (int q = 0; q < w; ++q) a[i * width + c0 + q] = tmp[i * w + q];
+        for (int q = 0; q < w; ++q)
+          a[i * width + c0 + q] = tmp[i * w + q];
       });
     }
   }
@@ -177,14 +189,20 @@ public:
     double hi[3];
     for (int c = 0; c < 3; ++c) {
       // NaN → +inf, so a non-finite position is reported below instead of being skipped by max.
-      hi[c] = _exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) {
-        const double v = x[3 * i + c];
-        return v == v ? v : HUGE_VAL;
-      }, -HUGE_VAL);
-      g.lo[c] = -_exec.reduceMax(n, [=] DEM_LAMBDA(std::size_t i) {
-        const double v = x[3 * i + c];
-        return v == v ? -v : HUGE_VAL;
-      }, -HUGE_VAL);
+      hi[c] = _exec.reduceMax(
+          n,
+          [=] DEM_LAMBDA(std::size_t i) {
+            const double v = x[3 * i + c];
+            return v == v ? v : HUGE_VAL;
+          },
+          -HUGE_VAL);
+      g.lo[c] = -_exec.reduceMax(
+          n,
+          [=] DEM_LAMBDA(std::size_t i) {
+            const double v = x[3 * i + c];
+            return v == v ? -v : HUGE_VAL;
+          },
+          -HUGE_VAL);
       if (!std::isfinite(hi[c]) || !std::isfinite(g.lo[c])) {
         backend::raiseUserError("a particle position is not finite (NaN/inf): the DEM step is "
                                 "unstable; reduce the time step (dtCfd/nSub) or check the forces");
@@ -200,14 +218,16 @@ public:
         total *= dims[c];
       }
       if (!std::isfinite(total)) {
-        backend::raiseUserError("the particles spread over a non-representable region (a particle "
-                                "flew off): the DEM step is unstable; check the forces and time step");
+        backend::raiseUserError(
+            "the particles spread over a non-representable region (a particle "
+            "flew off): the DEM step is unstable; check the forces and time step");
       }
       if (total <= limit) {
-        for (int c = 0; c < 3; ++c) g.dims[c] = static_cast<int>(dims[c]);
+        for (int c = 0; c < 3; ++c)
+          g.dims[c] = static_cast<int>(dims[c]);
         break;
       }
-      cs *= 1.25 * std::cbrt(total / limit);  // sparse domain: coarser cells, still correct
+      cs *= 1.25 * std::cbrt(total / limit); // sparse domain: coarser cells, still correct
     }
     g.inv = 1.0 / cs;
     g.cells = static_cast<std::uint32_t>(g.dims[0]) * g.dims[1] * g.dims[2];
@@ -240,22 +260,29 @@ public:
     // History slots at or beyond the largest count in use are empty in every row: not moved.
     const int usedSlots = _contacts.usedSlots();
     schema::forEachField(_p, [&](const schema::FieldInfo& f, auto& arr) {
-      if (!f.has(schema::kResorted)) return;
+      if (!f.has(schema::kResorted))
+        return;
       const int width = _p.width(f);
-      if (width == 0) return;
+      if (width == 0)
+        return;
       reorder(arr, width, f.per == schema::Per::History ? f.components * usedSlots : width);
     });
-    computeKeys(g);  // keys of the sorted order (ascending)
+    computeKeys(g); // keys of the sorted order (ascending)
 
     _cellStart.reserve(g.cells);
     _cellEnd.reserve(g.cells);
     std::uint32_t* cs = _cellStart.d();
     std::uint32_t* ce = _cellEnd.d();
     const std::uint32_t* keys = _keys.d();
-    _exec.parallelFor(g.cells, [=] DEM_LAMBDA(std::size_t c) { cs[c] = kEmptyCell; ce[c] = 0; });
+    _exec.parallelFor(g.cells, [=] DEM_LAMBDA(std::size_t c) {
+      cs[c] = kEmptyCell;
+      ce[c] = 0;
+    });
     _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
-      if (i == 0 || keys[i] != keys[i - 1]) cs[keys[i]] = static_cast<std::uint32_t>(i);
-      if (i + 1 == n || keys[i] != keys[i + 1]) ce[keys[i]] = static_cast<std::uint32_t>(i + 1);
+      if (i == 0 || keys[i] != keys[i - 1])
+        cs[keys[i]] = static_cast<std::uint32_t>(i);
+      if (i + 1 == n || keys[i] != keys[i + 1])
+        ce[keys[i]] = static_cast<std::uint32_t>(i + 1);
     });
 
     for (;;) {
@@ -272,26 +299,34 @@ public:
         const std::uint32_t key = keys[i];
         const int cx = static_cast<int>(key % gg.dims[0]);
         const int cy = static_cast<int>((key / gg.dims[0]) % gg.dims[1]);
-        const int cz = static_cast<int>(key / (static_cast<std::uint32_t>(gg.dims[0]) * gg.dims[1]));
+        const int cz =
+            static_cast<int>(key / (static_cast<std::uint32_t>(gg.dims[0]) * gg.dims[1]));
         int count = 0;
         for (int dz = -1; dz <= 1; ++dz) {
           const int z = cz + dz;
-          if (z < 0 || z >= gg.dims[2]) continue;
+          if (z < 0 || z >= gg.dims[2])
+            continue;
           for (int dy = -1; dy <= 1; ++dy) {
             const int y = cy + dy;
-            if (y < 0 || y >= gg.dims[1]) continue;
+            if (y < 0 || y >= gg.dims[1])
+              continue;
             for (int dx = -1; dx <= 1; ++dx) {
               const int xx = cx + dx;
-              if (xx < 0 || xx >= gg.dims[0]) continue;
-              const std::uint32_t c = static_cast<std::uint32_t>(xx + gg.dims[0] * (y + gg.dims[1] * z));
+              if (xx < 0 || xx >= gg.dims[0])
+                continue;
+              const std::uint32_t c =
+                  static_cast<std::uint32_t>(xx + gg.dims[0] * (y + gg.dims[1] * z));
               const std::uint32_t b = cs[c];
-              if (b == kEmptyCell) continue;
+              if (b == kEmptyCell)
+                continue;
               for (std::uint32_t j = b; j < ce[c]; ++j) {
-                if (j == i) continue;
+                if (j == i)
+                  continue;
                 const kernels::Vec3 d = kernels::load3(x, j) - xi;
                 const double cut = ri + r[j] + skin;
                 if (kernels::dot(d, d) < cut * cut) {
-                  if (count < width) list[i * width + count] = static_cast<std::int32_t>(j);
+                  if (count < width)
+                    list[i * width + count] = static_cast<std::int32_t>(j);
                   ++count;
                 }
               }
@@ -302,8 +337,9 @@ public:
       });
       const double maxCount = _exec.reduceMax(
           n, [=] DEM_LAMBDA(std::size_t i) { return static_cast<double>(cnt[i]); }, 0.0);
-      if (maxCount <= width) break;
-      _p.M = static_cast<int>(maxCount) + 4;  // grow and redo
+      if (maxCount <= width)
+        break;
+      _p.M = static_cast<int>(maxCount) + 4; // grow and redo
       _p.nbList.allocate(n * static_cast<std::size_t>(_p.M));
     }
     double* xr = _p.xref.d();
@@ -324,8 +360,9 @@ public:
   /// Freezes ε_g (PCM at the current positions) and clears every module's window accumulators.
   void beginWindow() override {
     StepContext<Exec> ctx = stepContext(0.0);
-    _chem.beginWindow(ctx);  // chemistry window accumulators (also uncoupled: ledgers)
-    if (!_s.coupled) return;
+    _chem.beginWindow(ctx); // chemistry window accumulators (also uncoupled: ledgers)
+    if (!_s.coupled)
+      return;
     const auto t0 = Clock::now();
     _p.require(kPos | kRadius);
     _cells.freeze(_exec, _p, _s.grid, _s.cellVolume);
@@ -339,8 +376,8 @@ public:
     WindowContext<Exec> w{_s, gasOrNull(), _cells, nSub, dtCfd, dtCfd / nSub, out};
     if (!_s.coupled) {
       out = CellSources{};
-      _chem.endWindow(w);  // ledgers only
-      _heat.endWindow(w);  // wall heat totals only
+      _chem.endWindow(w); // ledgers only
+      _heat.endWindow(w); // wall heat totals only
       return;
     }
     const std::size_t nc = _s.nCells;
@@ -353,7 +390,7 @@ public:
     out.qHom.assign(nc, 0.0);
     _drag.endWindow(w);
     _heat.endWindow(w);
-    if (_chem.enabled()) {  // R_species, WGS, chemistry ledgers (chemistry.h)
+    if (_chem.enabled()) { // R_species, WGS, chemistry ledgers (chemistry.h)
       const auto tc = Clock::now();
       _chem.endWindow(w);
       _t.chemistry += std::chrono::duration<double>(Clock::now() - tc).count();
@@ -372,7 +409,7 @@ public:
     double* w = _p.omega.d();
     const double* xr = _p.xref.d();
     const kernels::Vec3 g = _s.gravity;
-    if (_s.frozen) {  // held in place (MFiX verification cases): no motion, zero velocities
+    if (_s.frozen) { // held in place (MFiX verification cases): no motion, zero velocities
       _exec.parallelFor(_p.n, [=] DEM_LAMBDA(std::size_t i) {
         const long long ii = static_cast<long long>(i);
         store3(v, ii, kernels::Vec3{0.0, 0.0, 0.0});
@@ -381,29 +418,35 @@ public:
       _p.produced(kVel | kOmega);
       return 0.0;
     }
-    const double maxDisp2 = _exec.reduceMax(_p.n, [=] DEM_LAMBDA(std::size_t i) {
-      using namespace kernels;
-      const long long ii = static_cast<long long>(i);
-      const double invM = 1.0 / m[i];
-      const Vec3 vn = load3(v, ii) + (dt * invM) * (load3(f, ii) + gravityForce(m[i], g));  // Eq. 6
-      const double invI = 1.0 / (0.4 * m[i] * r[i] * r[i]);  // I = 2/5 m R² (Eq. 7)
-      store3(w, ii, load3(w, ii) + (dt * invI) * load3(tq, ii));
-      store3(v, ii, vn);
-      const Vec3 xn = load3(x, ii) + dt * vn;
-      store3(x, ii, xn);
-      const Vec3 d = xn - load3(xr, ii);
-      const double d2 = dot(d, d);
-      return d2 == d2 ? d2 : HUGE_VAL;  // NaN forces a rebuild, which reports it
-    }, 0.0);
+    const double maxDisp2 = _exec.reduceMax(
+        _p.n,
+        [=] DEM_LAMBDA(std::size_t i) {
+          using namespace kernels;
+          const long long ii = static_cast<long long>(i);
+          const double invM = 1.0 / m[i];
+          const Vec3 vn =
+              load3(v, ii) + (dt * invM) * (load3(f, ii) + gravityForce(m[i], g)); // Eq. 6
+          const double invI = 1.0 / (0.4 * m[i] * r[i] * r[i]); // I = 2/5 m R² (Eq. 7)
+          store3(w, ii, load3(w, ii) + (dt * invI) * load3(tq, ii));
+          store3(v, ii, vn);
+          const Vec3 xn = load3(x, ii) + dt * vn;
+          store3(x, ii, xn);
+          const Vec3 d = xn - load3(xr, ii);
+          const double d2 = dot(d, d);
+          return d2 == d2 ? d2 : HUGE_VAL; // NaN forces a rebuild, which reports it
+        },
+        0.0);
     _p.produced(kPos | kVel | kOmega);
     return maxDisp2;
   }
 
   /// Runs one module's sources (or update) and books its wall time in `stage`.
   template <class Module>
-  void run(Module& stepModule, StepContext<Exec>& ctx, double& stage, Clock::time_point& t0, bool update = false) {
+  void run(Module& stepModule, StepContext<Exec>& ctx, double& stage, Clock::time_point& t0,
+           bool update = false) {
     static_assert(StepModule<Module, Exec>);
-    if (!stepModule.enabled()) return;
+    if (!stepModule.enabled())
+      return;
     if (update) {
       stepModule.update(ctx);
     } else {
@@ -416,7 +459,8 @@ public:
   }
 
   void subStep(double dt) override {
-    if (_p.n == 0) return;
+    if (_p.n == 0)
+      return;
     auto t0 = Clock::now();
     if (!_listValid) {
       rebuild();
@@ -428,23 +472,24 @@ public:
     _p.require(kAllFields);
     StepContext<Exec> ctx = stepContext(dt);
     if (_drag.enabled()) {  // drag.sources() in its two passes, timed apart (stages drag, coupling)
-      _drag.gasForces(ctx);  // gas force and PCM cell per particle
+      _drag.gasForces(ctx); // gas force and PCM cell per particle
       Exec::synchronize();
       auto t1 = Clock::now();
       _t.drag += std::chrono::duration<double>(t1 - t0).count();
-      _drag.sortAndDeposit(ctx);  // particles sorted by cell, K_sl sums
+      _drag.sortAndDeposit(ctx); // particles sorted by cell, K_sl sums
       Exec::synchronize();
       t0 = Clock::now();
       _t.coupling += std::chrono::duration<double>(t0 - t1).count();
     }
-    run(_contacts, ctx, _t.contact, t0);   // + contact forces
-    run(_heat, ctx, _t.heat, t0);          // heat sources on the same configuration
-    run(_chem, ctx, _t.chemistry, t0);     // rates -> mass/diameter, before the motion
+    run(_contacts, ctx, _t.contact, t0); // + contact forces
+    run(_heat, ctx, _t.heat, t0);        // heat sources on the same configuration
+    run(_chem, ctx, _t.chemistry, t0);   // rates -> mass/diameter, before the motion
     const double half = 0.5 * _s.skin;
-    if (integrate(dt) > half * half) _listValid = false;
+    if (integrate(dt) > half * half)
+      _listValid = false;
     double integrateTime = 0.0;
-    run(_heat, ctx, integrateTime, t0, true);  // T += Δt Q/(m c_p)
-    run(_chem, ctx, integrateTime, t0, true);  // + Δt Q_rxn/(m c_p)
+    run(_heat, ctx, integrateTime, t0, true); // T += Δt Q/(m c_p)
+    run(_chem, ctx, integrateTime, t0, true); // + Δt Q_rxn/(m c_p)
     Exec::synchronize();
     _t.integrate += integrateTime + std::chrono::duration<double>(Clock::now() - t0).count();
   }
@@ -457,17 +502,17 @@ private:
   EngineSetup _s;
   Exec _exec;
   ParticleStore<Exec> _p;
-  GasFields<Exec> _gas;  ///< per-cell gas fields of the CFD step, read by the modules
+  GasFields<Exec> _gas; ///< per-cell gas fields of the CFD step, read by the modules
   bool _hasGas = false;
-  CouplingCells<Exec> _cells;  ///< PCM cell binning and frozen ε_g, read by the modules
-  Dev<std::uint32_t> _keys, _perm, _cellStart, _cellEnd;  ///< neighbour search
+  CouplingCells<Exec> _cells; ///< PCM cell binning and frozen ε_g, read by the modules
+  Dev<std::uint32_t> _keys, _perm, _cellStart, _cellEnd; ///< neighbour search
   Dev<unsigned char> _scratch;
   bool _listValid = false;
   StageTimes _t;
-  DragModule<Exec> _drag;          ///< gas forces and K_sl (drag.h)
-  ContactModule<Exec> _contacts;   ///< contact forces (contacts.h)
-  HeatModule<Exec> _heat;          ///< particle heat transfer (heat.h)
-  ChemistryModule<Exec> _chem;     ///< chemistry (chemistry.h)
+  DragModule<Exec> _drag;        ///< gas forces and K_sl (drag.h)
+  ContactModule<Exec> _contacts; ///< contact forces (contacts.h)
+  HeatModule<Exec> _heat;        ///< particle heat transfer (heat.h)
+  ChemistryModule<Exec> _chem;   ///< chemistry (chemistry.h)
 };
 
 } // namespace coredem::dem

@@ -4,11 +4,11 @@
 /// setGas and read (never written) by the engine core, the heat module and the chemistry module.
 /// An array the CFD did not send is empty (has() is false).
 
-#include "backend/arrays.h"
-#include "engine.h"
-
 #include <cstddef>
 #include <vector>
+
+#include "backend/arrays.h"
+#include "engine.h"
 
 namespace coredem::dem {
 
@@ -34,14 +34,16 @@ struct GasFields {
 
   std::size_t bytes() const {
     std::size_t b = 0;
-    for (const Arr* a : {&ug, &gradP, &Tg, &rhoG, &muG, &kappaG, &cpG, &Yg}) b += a->bytes();
+    for (const Arr* a : {&ug, &gradP, &Tg, &rhoG, &muG, &kappaG, &cpG, &Yg})
+      b += a->bytes();
     return b;
   }
 
 private:
   static void upload(Arr& a, const std::vector<double>& v) {
     a.allocate(v.size());
-    for (std::size_t k = 0; k < v.size(); ++k) a.h()[k] = v[k];
+    for (std::size_t k = 0; k < v.size(); ++k)
+      a.h()[k] = v[k];
     a.markHostModified();
     a.toDevice();
   }

@@ -22,22 +22,21 @@
 /// conductance G_ab and temperature difference T_b − T_a and add ±G_ab (T_b − T_a):
 /// Q_ab = −Q_ba exactly on every backend, whatever the evaluation order or FMA contraction.
 
+#include <cstdint>
+#include <vector>
+
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
-#include "heat_setup.h"
-#include "step_module.h"
-
 #include "coredem/dem/kernels/conduction_contact.h"
 #include "coredem/dem/kernels/conduction_gas_lens.h"
 #include "coredem/dem/kernels/convection.h"
 #include "coredem/dem/kernels/particle_energy.h"
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/radiation.h"
-#include "coredem/dem/kernels/wall_conduction.h"
 #include "coredem/dem/kernels/vec3.h"
-
-#include <cstdint>
-#include <vector>
+#include "coredem/dem/kernels/wall_conduction.h"
+#include "heat_setup.h"
+#include "step_module.h"
 
 namespace coredem::dem {
 
@@ -56,22 +55,26 @@ public:
   void setup(const HeatSetup& h, std::size_t nCells) {
     _h = h;
     _mat.allocate(h.materials.size());
-    for (std::size_t k = 0; k < h.materials.size(); ++k) _mat.h()[k] = h.materials[k];
+    for (std::size_t k = 0; k < h.materials.size(); ++k)
+      _mat.h()[k] = h.materials[k];
     _mat.markHostModified();
     _mat.toDevice();
     if (!h.walls.empty()) {
       _walls.allocate(h.walls.size());
-      for (std::size_t k = 0; k < h.walls.size(); ++k) _walls.h()[k] = h.walls[k];
+      for (std::size_t k = 0; k < h.walls.size(); ++k)
+        _walls.h()[k] = h.walls[k];
       _walls.markHostModified();
       _walls.toDevice();
       _wallAcc.allocate(kWallSlots);
-      for (std::size_t k = 0; k < kWallSlots; ++k) _wallAcc.h()[k] = 0.0;
+      for (std::size_t k = 0; k < kWallSlots; ++k)
+        _wallAcc.h()[k] = 0.0;
       _wallAcc.markHostModified();
       _wallAcc.toDevice();
     }
     if (nCells > 0) {
       _acc.allocate(3 * nCells);
-      for (std::size_t k = 0; k < 3 * nCells; ++k) _acc.h()[k] = 0.0;
+      for (std::size_t k = 0; k < 3 * nCells; ++k)
+        _acc.h()[k] = 0.0;
       _acc.markHostModified();
       _acc.toDevice();
       _cellT.reserve(nCells);
@@ -81,8 +84,8 @@ public:
   bool enabled() const { return _h.enabled; }
 
   std::size_t bytes() const {
-    return _mat.bytes() + _q.bytes() + _g.bytes() + _qrad.bytes() + _cellT.bytes() + _lensI.bytes() +
-           _acc.bytes() + _walls.bytes() + _qw.bytes() + _wallAcc.bytes();
+    return _mat.bytes() + _q.bytes() + _g.bytes() + _qrad.bytes() + _cellT.bytes() +
+           _lensI.bytes() + _acc.bytes() + _walls.bytes() + _qw.bytes() + _wallAcc.bytes();
   }
 
   /// Heat the particles received since construction (or the restored totals).
@@ -92,7 +95,8 @@ public:
 
   void beginWindow(StepContext<Exec>& ctx) {
     const std::size_t nCells = ctx.setup.coupled ? ctx.setup.nCells : 0;
-    if (!_h.enabled || nCells == 0) return;
+    if (!_h.enabled || nCells == 0)
+      return;
     double* acc = _acc.d();
     ctx.exec.parallelFor(3 * nCells, [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
     _acc.markDeviceModified();
@@ -100,9 +104,11 @@ public:
 
   /// Heat sources of one sub-step. When coupled, the particles are sorted by PCM cell
   /// (ctx.cells) as the drag module leaves them.
-  /// Reads pos, vel, radius, temperature, material, gid, nbCount, nbList; writes _q, _g, _qrad, _acc.
+  /// Reads pos, vel, radius, temperature, material, gid, nbCount, nbList; writes _q, _g, _qrad,
+  /// _acc.
   void sources(StepContext<Exec>& ctx) {
-    if (!_h.enabled) return;
+    if (!_h.enabled)
+      return;
     Exec& exec = ctx.exec;
     ParticleStore<Exec>& p = ctx.particles;
     const EngineSetup& s = ctx.setup;
@@ -111,7 +117,7 @@ public:
     _q.reserve(n);
     _g.reserve(n);
     _qrad.reserve(n);
-    const GasFields<Exec>* gasFields = ctx.gas;  // nullptr: no gas fields or no coupling grid
+    const GasFields<Exec>* gasFields = ctx.gas; // nullptr: no gas fields or no coupling grid
     const bool coupled = gasFields != nullptr;
     const bool hasTg = coupled && gasFields->has(gasFields->Tg);
     const bool hasKappa = coupled && gasFields->has(gasFields->kappaG);
@@ -137,9 +143,11 @@ public:
       // Occupied cells only (one segment head each); cellT is read only at a particle's cell.
       exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
         const std::size_t c = pcell[perm[h]];
-        if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c)) return;
+        if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c))
+          return;
         double sum = 0.0;
-        for (std::uint32_t k = cStart[c]; k < cEnd[c]; ++k) sum += T[perm[k]];
+        for (std::uint32_t k = cStart[c]; k < cEnd[c]; ++k)
+          sum += T[perm[k]];
         cellT[c] = sum;
       });
     }
@@ -170,7 +178,8 @@ public:
     const bool wallLens = wp.lens && coupled && hasKappa;
     // A wall is reached within R (contact) or (1 + FLPC) R (lens).
     const double wallReach = wallLens ? 1.0 + wp.lensFraction : 1.0;
-    if (nWalls > 0) _qw.reserve(n);
+    if (nWalls > 0)
+      _qw.reserve(n);
     double* qwOut = nWalls > 0 ? _qw.d() : nullptr;
 
     // 2. Lens integrals, once per pair: the particle with the smaller global id evaluates the
@@ -192,7 +201,8 @@ public:
             const double big = r[i] > r[j] ? r[i] : r[j];
             const double small = r[i] > r[j] ? r[j] : r[i];
             const double reach = lensFactor * big + small;
-            if (l2 < reach * reach) value = gasLensIntegral(lp, r[i], r[j], ::sqrt(l2)).value;
+            if (l2 < reach * reach)
+              value = gasLensIntegral(lp, r[i], r[j], ::sqrt(l2)).value;
           }
           li[i * M + a] = value;
         }
@@ -223,9 +233,10 @@ public:
           const double big = rlo > rhi ? rlo : rhi;
           const double small = rlo > rhi ? rhi : rlo;
           const double reach = lens ? lensFactor * big + small : rlo + rhi;
-          if (!(l2 < reach * reach)) continue;
+          if (!(l2 < reach * reach))
+            continue;
           const double l = ::sqrt(l2);
-          const double dT = T[hi] - T[lo];  // heat into lo = G (T_hi − T_lo)
+          const double dT = T[hi] - T[lo]; // heat into lo = G (T_hi − T_lo)
           if (contact && l < rlo + rhi) {
             const double klo = hm[mat[lo]].k, khi = hm[mat[hi]].k;
             if (klo + khi > 0.0) {
@@ -238,14 +249,17 @@ public:
             // the other's; both outside: no lens) [C].
             const std::uint32_t clo = pcell[lo], chi = pcell[hi];
             double kg = 0.0;
-            if (clo < nCells && chi < nCells) kg = 0.5 * (kap[clo] + kap[chi]);
-            else if (clo < nCells) kg = kap[clo];
-            else if (chi < nCells) kg = kap[chi];
+            if (clo < nCells && chi < nCells)
+              kg = 0.5 * (kap[clo] + kap[chi]);
+            else if (clo < nCells)
+              kg = kap[clo];
+            else if (chi < nCells)
+              kg = kap[chi];
             if (kg > 0.0) {
               double lensIntegral = 0.0;
               if (iFirst) {
                 lensIntegral = li[i * M + a];
-              } else {  // the partner's slot that holds i (the lists are symmetric)
+              } else { // the partner's slot that holds i (the lists are symmetric)
                 const int nbj = cnt[j];
                 for (int b = 0; b < nbj; ++b) {
                   if (list[static_cast<std::size_t>(j) * M + b] == static_cast<std::int32_t>(i)) {
@@ -284,7 +298,8 @@ public:
         const double kgw = (wallLens && celli < nCells) ? kap[celli] : 0.0;
         for (int k = 0; k < nWalls; ++k) {
           const double h = dot(xi - tw[k].plane.point, tw[k].plane.normal);
-          if (!(h < wallReach * r[i])) continue;
+          if (!(h < wallReach * r[i]))
+            continue;
           qw += wallConductionHeat(wp, mi.k, tw[k].k, kgw, r[i], h, tw[k].temperature, ti);
         }
         qwOut[i] = qw;
@@ -301,7 +316,8 @@ public:
       exec.parallelFor(kWallSlots, [=] DEM_LAMBDA(std::size_t sl) {
         const std::size_t lo = n * sl / kWallSlots, hi = n * (sl + 1) / kWallSlots;
         double sum = 0.0;
-        for (std::size_t i = lo; i < hi; ++i) sum += qwIn[i];
+        for (std::size_t i = lo; i < hi; ++i)
+          sum += qwIn[i];
         wa[sl] += sum * dt;
       });
       _wallAcc.markDeviceModified();
@@ -314,7 +330,8 @@ public:
       // Occupied cells only: one segment head each, same order as a loop over all cells.
       exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
         const std::size_t c = pcell[perm[h]];
-        if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c)) return;
+        if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c))
+          return;
         kernels::ConvectionCellSource cellSrc;
         double rs = 0.0;
         for (std::uint32_t k = cs[c]; k < ce[c]; ++k) {
@@ -333,7 +350,8 @@ public:
   /// After the motion update: T_i += Δt Q_i/(m_i c_p,i) (Eq. 18, explicit Euler).
   /// Reads _q, mass, material; writes temperature.
   void update(StepContext<Exec>& ctx) {
-    if (!_h.enabled) return;
+    if (!_h.enabled)
+      return;
     Exec& exec = ctx.exec;
     ParticleStore<Exec>& p = ctx.particles;
     const double dt = ctx.dt;
@@ -342,9 +360,8 @@ public:
     const std::int32_t* mat = p.material.d();
     const HeatMaterial* hm = _mat.d();
     double* T = p.temperature.d();
-    exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
-      T[i] = T[i] + dt * (q[i] / (m[i] * hm[mat[i]].cp));
-    });
+    exec.parallelFor(
+        p.n, [=] DEM_LAMBDA(std::size_t i) { T[i] = T[i] + dt * (q[i] / (m[i] * hm[mat[i]].cp)); });
     p.produced(kTemperature);
   }
 
@@ -367,7 +384,8 @@ public:
       _wallAcc.toDevice();
       _totals.wall += wall;
     }
-    if (!_h.enabled || !s.coupled) return;
+    if (!_h.enabled || !s.coupled)
+      return;
     _acc.toHost();
     const double* acc = _acc.h();
     const double avg = 1.0 / static_cast<double>(nSub);
@@ -377,7 +395,8 @@ public:
     for (std::size_t c = 0; c < s.nCells; ++c) {
       out.heatH[c] = acc[3 * c] * avg;
       out.heatHTp[c] = acc[3 * c + 1] * avg;
-      if (tg != nullptr) conv += out.heatH[c] * tg[c] - out.heatHTp[c];
+      if (tg != nullptr)
+        conv += out.heatH[c] * tg[c] - out.heatHTp[c];
       rad += acc[3 * c + 2] * avg;
     }
     _totals.convection += conv * s.cellVolume * w.dtCfd;
@@ -387,13 +406,13 @@ public:
 private:
   HeatSetup _h;
   Dual<HeatMaterial> _mat;
-  Dev<double> _q, _g, _qrad;      ///< per particle: Q_i (W), G_i (W/K), Q_rad,i (W)
-  Dev<double> _cellT;             ///< per cell: Σ T_p (radiation environment)
-  Dev<double> _lensI;             ///< per neighbour slot: lens integral I (m), owner = smaller gid
-  Dual<double> _acc;              ///< per cell: Σ_sub H, Σ_sub H_Tp, Σ_sub Q_rad/V_c
-  Dual<ThermalWall> _walls;       ///< fixed-temperature walls
-  Dev<double> _qw;                ///< per particle: Q_wall,i (W)
-  Dual<double> _wallAcc;          ///< kWallSlots partial sums of Σ_sub Σ_i Q_wall,i Δt (J)
+  Dev<double> _q, _g, _qrad; ///< per particle: Q_i (W), G_i (W/K), Q_rad,i (W)
+  Dev<double> _cellT;        ///< per cell: Σ T_p (radiation environment)
+  Dev<double> _lensI;        ///< per neighbour slot: lens integral I (m), owner = smaller gid
+  Dual<double> _acc;         ///< per cell: Σ_sub H, Σ_sub H_Tp, Σ_sub Q_rad/V_c
+  Dual<ThermalWall> _walls;  ///< fixed-temperature walls
+  Dev<double> _qw;           ///< per particle: Q_wall,i (W)
+  Dual<double> _wallAcc;     ///< kWallSlots partial sums of Σ_sub Σ_i Q_wall,i Δt (J)
   HeatTotals _totals;
 };
 

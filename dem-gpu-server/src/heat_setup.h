@@ -2,39 +2,39 @@
 /// @file
 /// What the engine's heat module needs besides the particles (plain data, filled by DemSystem).
 
+#include <vector>
+
 #include "coredem/dem/heat_options.h"
 #include "coredem/dem/kernels/conduction_gas_lens.h"
 #include "coredem/dem/kernels/convection.h"
 #include "coredem/dem/kernels/wall_conduction.h"
 #include "coredem/dem/kernels/wall_contact.h"
 
-#include <vector>
-
 namespace coredem::dem {
 
 /// Thermal properties of one material (index = material index).
 struct HeatMaterial {
-  double cp;          ///< J/(kg K), > 0
-  double k;           ///< W/(m K), ≥ 0
-  double emissivity;  ///< −
+  double cp;         ///< J/(kg K), > 0
+  double k;          ///< W/(m K), ≥ 0
+  double emissivity; ///< −
 };
 
 /// A wall held at a fixed temperature (kernels/wall_conduction.h); adiabatic walls are not listed.
 struct ThermalWall {
-  kernels::PlaneWall plane;  ///< unit inward normal
-  double temperature;        ///< K, > 0
-  double k;                  ///< wall material conductivity, W/(m K)
+  kernels::PlaneWall plane; ///< unit inward normal
+  double temperature;       ///< K, > 0
+  double k;                 ///< wall material conductivity, W/(m K)
 };
 
 struct HeatSetup {
   /// The `models:` heat switches as configured. A new term reads its switch here; the flags
   /// below are the switches combined with what the run has (coupling grid, emissive materials).
   HeatOptions options;
-  bool enabled = false;            ///< master switch; false: the heat module does nothing
-  bool convection = false;         ///< Eqs. 19–21 (needs coupling and T_g, κ_g, c_p,g)
-  bool contactConduction = false;  ///< Eqs. 22–23
-  bool lensConduction = false;     ///< Eqs. 24–26 (needs coupling and κ_g)
-  bool radiation = false;          ///< Eqs. 27–28 (a) (needs coupling and T_g)
+  bool enabled = false;           ///< master switch; false: the heat module does nothing
+  bool convection = false;        ///< Eqs. 19–21 (needs coupling and T_g, κ_g, c_p,g)
+  bool contactConduction = false; ///< Eqs. 22–23
+  bool lensConduction = false;    ///< Eqs. 24–26 (needs coupling and κ_g)
+  bool radiation = false;         ///< Eqs. 27–28 (a) (needs coupling and T_g)
   kernels::ConvectionParams convectionParams{};
   kernels::GasLensParams lensParams{};
   std::vector<HeatMaterial> materials;

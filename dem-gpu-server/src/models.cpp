@@ -49,7 +49,8 @@ constexpr ModelEntry<kernels::WgsEquilibrium> kWgs[] = {
 std::string normalise(std::string_view s) {
   std::string out(s);
   for (char& c : out)
-    if (c == '_') c = '-';
+    if (c == '_')
+      c = '-';
   return out;
 }
 
@@ -180,7 +181,8 @@ std::optional<E> choice(const ModelFamily<E>& f, std::string_view value, std::st
 
 /// on/true/yes/1 or off/false/no/0 (coredem::parseSwitch, the one spelling of a switch).
 std::optional<bool> onOff(std::string_view value, std::string& error) {
-  if (const auto b = parseSwitch(value)) return b;
+  if (const auto b = parseSwitch(value))
+    return b;
   static constexpr std::string_view kNames[] = {"on", "off"};
   error = withSuggestion(value, kNames, "on or off");
   return std::nullopt;

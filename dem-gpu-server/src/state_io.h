@@ -4,27 +4,28 @@
 /// particle schema (coredem/dem/particle_schema.h), /meta attributes (with format_version),
 /// /chemistry ledgers.
 
-#include "engine.h"
-
 #include <cstdint>
 #include <string>
+
+#include "engine.h"
 
 namespace coredem::dem {
 
 struct StateMeta {
-  int formatVersion = schema::kFormatVersion;  ///< read: the file's (1 when absent); written: always the current
+  int formatVersion =
+      schema::kFormatVersion; ///< read: the file's (1 when absent); written: always the current
   double time = 0;
-  double timeCompensation = 0;  ///< Kahan compensation term, for bitwise restarts
+  double timeCompensation = 0; ///< Kahan compensation term, for bitwise restarts
   std::uint64_t step = 0;
   std::string backend;
   std::string configHash;
   std::string softwareVersion;
-  std::string protocolVersion;  ///< coupling protocol of the writing server ("none" without one)
-  double heatWall = 0;        ///< HeatTotals::wall (J); optional in the file
-  double heatConvection = 0;  ///< HeatTotals (J); optional in the file (0 when absent)
+  std::string protocolVersion; ///< coupling protocol of the writing server ("none" without one)
+  double heatWall = 0;         ///< HeatTotals::wall (J); optional in the file
+  double heatConvection = 0;   ///< HeatTotals (J); optional in the file (0 when absent)
   double heatRadiation = 0;
-  bool hasChemistry = false;   ///< write/read the chemistry ledgers (/chemistry)
-  ChemistryTotals chemistry;   ///< ledgers; read only when the file has /chemistry
+  bool hasChemistry = false; ///< write/read the chemistry ledgers (/chemistry)
+  ChemistryTotals chemistry; ///< ledgers; read only when the file has /chemistry
 };
 
 /// Writes every checkpointed schema field and `meta`. Throws InternalError when a field of `s`

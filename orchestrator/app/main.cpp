@@ -11,11 +11,11 @@
 #include <unistd.h>
 
 #include <coredem/common/log.h>
+#include <coredem/common/process.h>
 #include <coredem/common/version.h>
 #include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/outputs.h>
-#include <coredem/common/process.h>
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/session.h>
 #include <coredem/orchestrator/verify.h>
@@ -37,7 +37,7 @@ void makePlots(const fs::path& runDir) {
     return;
   }
   coredem::ChildProcess plot("plot script", {python.string(), script.string(), runDir.string()}, {},
-                    runDir / "logs" / "plot.log");
+                             runDir / "logs" / "plot.log");
   if (!plot.waitFor(std::chrono::seconds(120))) {
     plot.stop();
   }

@@ -1,8 +1,6 @@
 // `coredem campaign run|resume|status|collect` (campaign.h, docs/campaigns.md): the local
 // executor runs every member as a child `coredem run` / `coredem resume` process, at most
 // `concurrency` at once, and records every transition in DIR/campaign.db.
-#include <coredem/orchestrator/campaign.h>
-
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -24,6 +22,7 @@
 #include <coredem/common/log.h>
 #include <coredem/common/process.h>
 #include <coredem/common/version.h>
+#include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/campaign_db.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/checkpoint.h>
@@ -39,7 +38,9 @@ using namespace std::chrono_literals;
 constexpr int kOk = 0, kFault = 1, kBadInput = 2, kInterrupted = 130;
 
 std::atomic<int> gSignal{0};
-extern "C" void onCampaignSignal(int sig) { gSignal = sig; }
+extern "C" void onCampaignSignal(int sig) {
+  gSignal = sig;
+}
 
 std::string readFile(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -171,7 +172,10 @@ std::vector<std::string> splitCsvLine(const std::string& line) {
 
 class Runner {
 public:
-  Runner(fs::path dir, CampaignDb& db) : _dir(std::move(dir)), _db(db), _log(logger("campaign")) {
+  Runner(fs::path dir, CampaignDb& db)
+      : _dir(std::move(dir))
+      , _db(db)
+      , _log(logger("campaign")) {
     _concurrency = std::stoi(_db.setting("concurrency", "1"));
     _retries = std::stoi(_db.setting("retries", "0"));
     _coredem = selfDir() / "coredem";
@@ -362,8 +366,8 @@ private:
       return;
     }
     std::string reason = status < 0 ? "lost track of the process" : describeWaitStatus(status);
-    const std::string err = lastErrorLine(fs::path(m ? m->caseDir : "").parent_path() /
-                                          "coredem.log");
+    const std::string err =
+        lastErrorLine(fs::path(m ? m->caseDir : "").parent_path() / "coredem.log");
     if (!err.empty()) {
       reason += ": " + err;
     }
@@ -570,9 +574,8 @@ int status(const fs::path& dir, bool json) {
               "checkpoint", "values", "exit reason");
   for (const auto& m : members) {
     ++counts[m.status];
-    std::printf("%-6s %-8s %8d %8d %-10s %-40s %s\n", m.id.c_str(), m.status.c_str(),
-                m.attempts, m.failures, m.lastCheckpoint.c_str(), valuesText(m).c_str(),
-                m.exitReason.c_str());
+    std::printf("%-6s %-8s %8d %8d %-10s %-40s %s\n", m.id.c_str(), m.status.c_str(), m.attempts,
+                m.failures, m.lastCheckpoint.c_str(), valuesText(m).c_str(), m.exitReason.c_str());
   }
   std::printf("%zu members: %d done, %d running, %d pending, %d failed\n", members.size(),
               counts["done"], counts["running"], counts["pending"], counts["failed"]);
@@ -664,8 +667,8 @@ int collect(const fs::path& dir, bool noPlot) {
   const fs::path python = COREDEM_PYTHON;
   const fs::path script = COREDEM_CAMPAIGN_PLOT_SCRIPT;
   if (python.empty() || !fs::exists(python) || !fs::exists(script)) {
-    logger("campaign")->warn("no plot: python ('{}') or {} not found", python.string(),
-                             script.string());
+    logger("campaign")
+        ->warn("no plot: python ('{}') or {} not found", python.string(), script.string());
     return kOk;
   }
   fs::create_directories(dir / "plots");
@@ -680,9 +683,8 @@ int collect(const fs::path& dir, bool noPlot) {
   }
   const std::string cmd = fmt::format(
       "'{}' '{}' '{}' --x '{}' --y '{}'{} --title '{}' --out '{}' > '{}' 2>&1", python.string(),
-      script.string(), (dir / "summary.csv").string(), db.setting("plot_x"),
-      db.setting("plot_y"), groups, db.setting("name"), png.string(),
-      (dir / "plots" / "plot.log").string());
+      script.string(), (dir / "summary.csv").string(), db.setting("plot_x"), db.setting("plot_y"),
+      groups, db.setting("name"), png.string(), (dir / "plots" / "plot.log").string());
   const int rc = std::system(cmd.c_str());
   if (rc != 0) {
     logger("campaign")->warn("plot script failed (see {})", (dir / "plots" / "plot.log").string());

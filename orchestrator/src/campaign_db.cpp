@@ -1,11 +1,10 @@
 // SQLite state of a campaign (campaign_db.h).
-#include <coredem/orchestrator/campaign_db.h>
-
 #include <map>
 
 #include <sqlite3.h>
 
 #include <coredem/common/check.h>
+#include <coredem/orchestrator/campaign_db.h>
 #include <coredem/orchestrator/checkpoint.h> // utcNow
 
 namespace coredem::orchestrator {
@@ -15,7 +14,8 @@ namespace {
 /// A prepared statement; text columns come back as "" for NULL.
 class Stmt {
 public:
-  Stmt(sqlite3* db, const char* sql) : _db(db) {
+  Stmt(sqlite3* db, const char* sql)
+      : _db(db) {
     COREDEM_CHECK(sqlite3_prepare_v2(db, sql, -1, &_s, nullptr) == SQLITE_OK,
                   "campaign database: cannot prepare '{}': {}", sql, sqlite3_errmsg(db));
   }
@@ -37,8 +37,9 @@ public:
     if (rc == SQLITE_ROW) {
       return true;
     }
-    COREDEM_CHECK(rc == SQLITE_DONE, "campaign database: {} (is the disk full or the file "
-                                     "locked by another process?)",
+    COREDEM_CHECK(rc == SQLITE_DONE,
+                  "campaign database: {} (is the disk full or the file "
+                  "locked by another process?)",
                   sqlite3_errmsg(_db));
     return false;
   }
@@ -208,8 +209,12 @@ int CampaignDb::doneEvents(const std::string& id) const {
   return static_cast<int>(s.integer(0));
 }
 
-void CampaignDb::begin() { _impl->exec("BEGIN IMMEDIATE"); }
-void CampaignDb::commit() { _impl->exec("COMMIT"); }
+void CampaignDb::begin() {
+  _impl->exec("BEGIN IMMEDIATE");
+}
+void CampaignDb::commit() {
+  _impl->exec("COMMIT");
+}
 void CampaignDb::rollback() {
   sqlite3_exec(_impl->db, "ROLLBACK", nullptr, nullptr, nullptr);
 }
@@ -226,8 +231,7 @@ void CampaignDb::setPid(const std::string& id, std::int64_t pid) {
 }
 
 bool CampaignDb::markDone(const std::string& id, const std::string& lastCheckpoint,
-                          const std::string& softwareVersion,
-                          const std::string& protocolVersion) {
+                          const std::string& softwareVersion, const std::string& protocolVersion) {
   return _impl->update(
       "UPDATE members SET status = 'done', done_count = done_count + 1, pid = 0, "
       "finished = ?2, last_checkpoint = ?3, software_version = ?4, protocol_version = ?5, "

@@ -1,6 +1,4 @@
 // Sweep files: parsing, validation, member expansion and case-key substitution (campaign.h).
-#include <coredem/orchestrator/campaign.h>
-
 #include <fstream>
 #include <regex>
 #include <set>
@@ -8,6 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/case_config.h>
 
 namespace coredem::orchestrator {
@@ -81,15 +80,16 @@ struct SweepReader {
       }
       return static_cast<int>(v);
     } catch (const std::exception&) {
-      fail(n, key, fmt::format("expected an integer >= {} ({}), got '{}'", min, what,
-                               n.IsScalar() ? n.as<std::string>() : flowYaml(n)));
+      fail(n, key,
+           fmt::format("expected an integer >= {} ({}), got '{}'", min, what,
+                       n.IsScalar() ? n.as<std::string>() : flowYaml(n)));
     }
   }
 };
 
-const std::set<std::string> kTopKeys = {"name",    "description", "base_case", "executor",
-                                        "concurrency", "retries", "grid",      "members",
-                                        "collect"};
+const std::set<std::string> kTopKeys = {"name",     "description", "base_case",
+                                        "executor", "concurrency", "retries",
+                                        "grid",     "members",     "collect"};
 const std::set<std::string> kReduces = {"final", "max", "min", "mean"};
 
 } // namespace
@@ -104,9 +104,9 @@ std::string setCaseKey(const std::string& caseText, const std::string& path,
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const bool last = i + 1 == steps.size();
     const PathStep& s = steps[i];
-    const std::string here =
-        walked.empty() ? s.key : (s.index >= 0 ? walked + fmt::format("[{}]", s.index)
-                                               : walked + "." + s.key);
+    const std::string here = walked.empty() ? s.key
+                                            : (s.index >= 0 ? walked + fmt::format("[{}]", s.index)
+                                                            : walked + "." + s.key);
     if (s.index >= 0) {
       if (!cur.IsSequence()) {
         throw CaseError(fmt::format("'{}': '{}' is not a list in the base case", path, walked));
@@ -178,8 +178,9 @@ Sweep loadSweep(const fs::path& sweepFile) {
   }
   // base case
   if (!root["base_case"] || !root["base_case"].IsScalar()) {
-    r.fail(root, "base_case", "required: the case folder (or case.yaml) to vary, relative to "
-                              "the sweep file");
+    r.fail(root, "base_case",
+           "required: the case folder (or case.yaml) to vary, relative to "
+           "the sweep file");
   }
   fs::path base = root["base_case"].as<std::string>();
   if (base.is_relative()) {
@@ -190,8 +191,7 @@ Sweep loadSweep(const fs::path& sweepFile) {
   }
   base = fs::weakly_canonical(base);
   if (!fs::is_regular_file(base / "case.yaml")) {
-    r.fail(root["base_case"], "base_case",
-           fmt::format("no case.yaml in '{}'", base.string()));
+    r.fail(root["base_case"], "base_case", fmt::format("no case.yaml in '{}'", base.string()));
   }
   sw.baseCase = base;
   sw.name = root["name"] ? root["name"].as<std::string>() : sw.file.stem().string();
@@ -368,11 +368,11 @@ Sweep loadSweep(const fs::path& sweepFile) {
       try {
         text = setCaseKey(text, path, value);
       } catch (const CaseError& e) {
-        throw CaseError(fmt::format("{}: member {} ({} = {}): {}", r.file, mem.id, path, value,
-                                    e.what()));
+        throw CaseError(
+            fmt::format("{}: member {} ({} = {}): {}", r.file, mem.id, path, value, e.what()));
       } catch (const YAML::Exception& e) {
-        throw CaseError(fmt::format("{}: member {} ({} = {}): {}", r.file, mem.id, path, value,
-                                    e.what()));
+        throw CaseError(
+            fmt::format("{}: member {} ({} = {}): {}", r.file, mem.id, path, value, e.what()));
       }
     }
     std::string header = fmt::format("# campaign {}, member {} of the base case {}:\n", sw.name,
@@ -389,8 +389,8 @@ Sweep loadSweep(const fs::path& sweepFile) {
       for (const auto& [path, value] : mem.values) {
         vals += (vals.empty() ? "" : ", ") + path + " = " + value;
       }
-      throw CaseError(fmt::format("{}: member {} ({}) gives an invalid case: {}", r.file,
-                                  mem.id, vals, e.what()));
+      throw CaseError(fmt::format("{}: member {} ({}) gives an invalid case: {}", r.file, mem.id,
+                                  vals, e.what()));
     }
     sw.resolvedCases.push_back(std::move(text));
   }

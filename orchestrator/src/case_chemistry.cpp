@@ -42,9 +42,10 @@ void addChemistryToConfigure(const CaseConfig& c, v1::Configure& cfg) {
                                                                : v1::CHAR_STOICHIOMETRY_CARBON);
     clg->set_oc_reduction(ch.ocReduction);
     clg->set_wgs(ch.wgs);
-    clg->set_wgs_equilibrium(ch.wgsEquilibrium == "seed"            ? v1::WGS_EQUILIBRIUM_SEED
-                             : ch.wgsEquilibrium == "thermodynamic" ? v1::WGS_EQUILIBRIUM_THERMODYNAMIC
-                                                                    : v1::WGS_EQUILIBRIUM_YOON_DENN);
+    clg->set_wgs_equilibrium(ch.wgsEquilibrium == "seed" ? v1::WGS_EQUILIBRIUM_SEED
+                             : ch.wgsEquilibrium == "thermodynamic"
+                                 ? v1::WGS_EQUILIBRIUM_THERMODYNAMIC
+                                 : v1::WGS_EQUILIBRIUM_YOON_DENN);
     for (const auto& [name, value] : ch.kinetics) {
       protocol::addNamedValue(clg->mutable_kinetics(), name, value);
     }

@@ -27,9 +27,9 @@ constexpr double kBig = std::numeric_limits<double>::max();
 /// Kinetic overrides of chemistry.clg (same names as coredem::dem::clgKineticNames(), which the
 /// DEM server checks again).
 const std::vector<std::string> kClgKinetics = {
-    "A_CO2", "E_CO2", "K_CO2", "dH_CO2", "K_CO",  "dH_CO", "A_H2O", "E_H2O",
-    "K_H2O", "dH_H2O", "K_H2", "dH_H2", "rho_m", "r_grain", "k0_CO", "E_CO",
-    "n_CO",  "k0_H2", "E_H2", "n_H2", "kf0", "Ef_over_R"};
+    "A_CO2", "E_CO2",  "K_CO2", "dH_CO2", "K_CO",  "dH_CO",    "A_H2O", "E_H2O",
+    "K_H2O", "dH_H2O", "K_H2",  "dH_H2",  "rho_m", "r_grain",  "k0_CO", "E_CO",
+    "n_CO",  "k0_H2",  "E_H2",  "n_H2",   "kf0",   "Ef_over_R"};
 
 const SpeciesConfig* findSpecies(const std::vector<SpeciesConfig>& list, const std::string& name) {
   for (const auto& sp : list) {
@@ -93,7 +93,8 @@ void parseChemistry(const Section& top, CaseConfig& c) {
       ReactionConfig rc;
       rc.name = r.string("name", std::nullopt, "reaction name");
       if (!names.insert(rc.name).second) {
-        r.fail(r.markOf("name"), r.full("name"), fmt::format("reaction '{}' is defined twice", rc.name));
+        r.fail(r.markOf("name"), r.full("name"),
+               fmt::format("reaction '{}' is defined twice", rc.name));
       }
       r.require("terms", "list of {species, nu}, nu < 0 for reactants");
       double imbalance = 0.0, scale = 0.0;
@@ -171,8 +172,8 @@ void parseChemistry(const Section& top, CaseConfig& c) {
         const YAML::Node h = r.raw("heat_of_reaction");
         if (h.IsScalar() && h.Scalar() == "nasa7") {
           rc.heatFromNasa7 = true;
-          static const std::set<std::string> nasa = {"CO",    "CO2",   "H2",   "H2O",  "N2",
-                                                     "C",     "Fe2O3", "Fe3O4", "Al2O3"};
+          static const std::set<std::string> nasa = {"CO", "CO2",   "H2",    "H2O",  "N2",
+                                                     "C",  "Fe2O3", "Fe3O4", "Al2O3"};
           for (const auto& t : rc.terms) {
             if (nasa.count(t.species) == 0) {
               r.fail(r.markOf("heat_of_reaction"), r.full("heat_of_reaction"),
@@ -199,16 +200,18 @@ void parseChemistry(const Section& top, CaseConfig& c) {
       allowed.insert(allowed.end(), kClgKinetics.begin(), kClgKinetics.end());
       const Section g = s.section("clg", allowed);
       ch.charGasification = g.onOff("char_gasification", false);
-      ch.charStoichiometry = g.choice("char_stoichiometry", std::string("carbon"), {"carbon", "seed"});
+      ch.charStoichiometry =
+          g.choice("char_stoichiometry", std::string("carbon"), {"carbon", "seed"});
       if (ch.charStoichiometry == "seed") {
-        g.fail(g.markOf("char_stoichiometry"), g.full("char_stoichiometry"),
-               "seed is not implemented: the seed's pseudo-char lines of R1 and R2 are not mutually "
-               "consistent (PHYSICS §6.1); use carbon");
+        g.fail(
+            g.markOf("char_stoichiometry"), g.full("char_stoichiometry"),
+            "seed is not implemented: the seed's pseudo-char lines of R1 and R2 are not mutually "
+            "consistent (PHYSICS §6.1); use carbon");
       }
       ch.ocReduction = g.onOff("oc_reduction", false);
       ch.wgs = g.onOff("wgs", false);
-      ch.wgsEquilibrium =
-          g.choice("wgs_equilibrium", std::string("yoon_denn"), {"yoon_denn", "seed", "thermodynamic"});
+      ch.wgsEquilibrium = g.choice("wgs_equilibrium", std::string("yoon_denn"),
+                                   {"yoon_denn", "seed", "thermodynamic"});
       for (const auto& k : kClgKinetics) {
         if (g.has(k)) {
           ch.kinetics.emplace_back(k, g.number(k, std::nullopt, -kBig, kBig, "kinetic parameter"));
@@ -275,9 +278,10 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   c.configHash = sha256Hex(text);
 
   const Section top(root, fileName, "",
-                    {"name", "description", "time", "grid", "gravity", "species", "gas_properties",
-                     "materials", "particles", "initial_state", "walls", "models", "dem", "cfd",
-                     "gas", "checkpoint", "output", "solid_species", "reactions", "chemistry"},
+                    {"name",       "description",    "time",          "grid",      "gravity",
+                     "species",    "gas_properties", "materials",     "particles", "initial_state",
+                     "walls",      "models",         "dem",           "cfd",       "gas",
+                     "checkpoint", "output",         "solid_species", "reactions", "chemistry"},
                     YAML::Mark());
   c.name = top.string("name", std::nullopt, "the case name, used for the run folder");
   if (c.name.empty() || c.name.find('/') != std::string::npos) {
@@ -447,11 +451,11 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
           ps.positions.push_back(x);
         }
       }
-      ps.count = ps.positions.empty()
-                     ? std::uint64_t(p.integer("count", std::nullopt, 1, 100000000,
-                                               "number of particles"))
-                     : std::uint64_t(p.integer("count", std::int64_t(ps.positions.size()), 1,
-                                               100000000, "number of particles"));
+      ps.count =
+          ps.positions.empty()
+              ? std::uint64_t(p.integer("count", std::nullopt, 1, 100000000, "number of particles"))
+              : std::uint64_t(p.integer("count", std::int64_t(ps.positions.size()), 1, 100000000,
+                                        "number of particles"));
       if (!ps.positions.empty() && ps.count != ps.positions.size()) {
         p.fail(p.markOf("count"), p.full("count"),
                fmt::format("{} particles but {} positions; with 'positions' leave 'count' out "
@@ -529,7 +533,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     // Thermal condition (docs/heat-coupling.md "Walls"): adiabatic (default) or every wall held
     // at `temperature` with particle–wall conduction. Configure carries it as temperature (0 =
     // adiabatic).
-    const std::string thermal = w.choice("thermal", std::string("adiabatic"), {"adiabatic", "fixed_temperature"});
+    const std::string thermal =
+        w.choice("thermal", std::string("adiabatic"), {"adiabatic", "fixed_temperature"});
     if (thermal == "fixed_temperature") {
       c.walls.temperature = w.number("temperature", std::nullopt, 0.0, kBig,
                                      "K, > 0 (the temperature the walls are held at)", true);
@@ -537,7 +542,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
       if (w.has("temperature")) {
         w.fail(w.markOf("temperature"), "walls.temperature",
                "walls are adiabatic (walls.thermal: adiabatic, the default), so a wall temperature "
-               "has no effect; add 'thermal: fixed_temperature' to hold the walls at it, or remove it");
+               "has no effect; add 'thermal: fixed_temperature' to hold the walls at it, or remove "
+               "it");
       }
       c.walls.temperature = 0.0;
     }
@@ -606,9 +612,9 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     c.cfd.participant = f.choice("participant", c.cfd.participant, participantNames());
     const ParticipantDescriptor& p = participant(c.cfd.participant);
     if (!p.caseFolder.empty()) {
-      c.cfd.caseFolder = f.string("case", std::nullopt,
-                                  fmt::format("{} of {}, relative to the case folder",
-                                              p.caseFolder, p.name));
+      c.cfd.caseFolder =
+          f.string("case", std::nullopt,
+                   fmt::format("{} of {}, relative to the case folder", p.caseFolder, p.name));
     }
     c.cfd.gasKey = f.string("gas_key", std::string("gas"), "key of the prescribed-gas section");
     c.cfd.timeoutSeconds = f.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);

@@ -1,7 +1,5 @@
 // `coredem verify` (docs/verification.md): the PHYSICS §8 verification cases through the real
 // processes, compared with the analytic solutions of dem/verification/analytic.h.
-#include <coredem/orchestrator/verify.h>
-
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -19,11 +17,12 @@
 
 #include <coredem/common/hdf5.h>
 #include <coredem/common/log.h>
+#include <coredem/common/process.h>
 #include <coredem/dem/verification/analytic.h>
 #include <coredem/orchestrator/case_config.h>
-#include <coredem/common/process.h>
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/session.h>
+#include <coredem/orchestrator/verify.h>
 
 namespace fs = std::filesystem;
 namespace va = coredem::dem::verification;
@@ -43,10 +42,10 @@ struct CaseSpec {
   std::string name;
   fs::path dir;
   std::string family;
-  std::string reference;           ///< PHYSICS section and reference values (free text)
-  double tolerance = 0.0;          ///< primary metric (relative unless the metric says)
-  double secondTolerance = 0.0;    ///< energy drift (conduction) or mass fractions (reaction)
-  std::string skip;                ///< non-empty: not run, reported as skipped (the reason)
+  std::string reference;        ///< PHYSICS section and reference values (free text)
+  double tolerance = 0.0;       ///< primary metric (relative unless the metric says)
+  double secondTolerance = 0.0; ///< energy drift (conduction) or mass fractions (reaction)
+  std::string skip;             ///< non-empty: not run, reported as skipped (the reason)
 };
 
 /// One comparison of summary.json.
@@ -74,8 +73,8 @@ CaseSpec loadSpec(const fs::path& dir) {
     bad(file, "expected a mapping with keys family, reference, tolerance[, energy_tolerance, "
               "fraction_tolerance, skip]");
   }
-  const std::set<std::string> allowed = {"family", "reference", "tolerance", "energy_tolerance",
-                                         "fraction_tolerance", "skip"};
+  const std::set<std::string> allowed = {"family",           "reference",          "tolerance",
+                                         "energy_tolerance", "fraction_tolerance", "skip"};
   for (const auto& kv : n) {
     if (!allowed.count(kv.first.Scalar())) {
       bad(file, fmt::format("unknown key '{}'; allowed: family, reference, tolerance, "
@@ -348,11 +347,11 @@ std::vector<Metric> checkTwoParticle(const CaseSpec& spec, const CaseConfig& c,
                                      const std::vector<Snapshot>& snaps, Series& series) {
   const auto ps = particlesOf(c);
   if (ps.size() != 2) {
-    bad(c.caseFile, fmt::format("family {} needs exactly 2 particles, got {}", spec.family,
-                                ps.size()));
+    bad(c.caseFile,
+        fmt::format("family {} needs exactly 2 particles, got {}", spec.family, ps.size()));
   }
-  const double l = std::hypot(ps[1].x[0] - ps[0].x[0], ps[1].x[1] - ps[0].x[1],
-                              ps[1].x[2] - ps[0].x[2]);
+  const double l =
+      std::hypot(ps[1].x[0] - ps[0].x[0], ps[1].x[1] - ps[0].x[1], ps[1].x[2] - ps[0].x[2]);
   va::ExchangeCoefficients k{};
   if (spec.family == "contact-conduction") {
     k = va::contactConductionCoefficients(ps[0].d, ps[0].material, ps[1].d, ps[1].material, l);
@@ -361,8 +360,8 @@ std::vector<Metric> checkTwoParticle(const CaseSpec& spec, const CaseConfig& c,
     p.lensFraction = modelNumber(c, "flpc", 0.2);
     p.minSeparation = modelNumber(c, "s_min", 1e-6);
     p.relTol = 1e-11; // the reference integral, tighter than the simulation's lens_rel_tol
-    k = va::gasLensCoefficients(ps[0].d, ps[0].material, ps[1].d, ps[1].material, l,
-                                gasOf(c).kappa, p);
+    k = va::gasLensCoefficients(ps[0].d, ps[0].material, ps[1].d, ps[1].material, l, gasOf(c).kappa,
+                                p);
   }
   series.columns = {"t", "sim:T1", "ref:T1", "sim:T2", "ref:T2", "error"};
   double maxErr = 0.0;
@@ -419,8 +418,8 @@ std::vector<Metric> checkConvection(const CaseSpec& spec, const CaseConfig& c,
     maxErr = std::max(maxErr, err);
     series.rows.push_back({s.t, s.temperature[0], ref, err});
   }
-  return {{spec.name, "max relative error of T_p", maxErr, spec.tolerance,
-           maxErr <= spec.tolerance}};
+  return {
+      {spec.name, "max relative error of T_p", maxErr, spec.tolerance, maxErr <= spec.tolerance}};
 }
 
 /// Two particles in one cell radiating to T_env = ε_g T_g + (1 − ε_g) T̄_p (§8.4), RK4 reference.
@@ -430,8 +429,8 @@ std::vector<Metric> checkRadiation(const CaseSpec& spec, const CaseConfig& c,
   if (ps.size() != 2 || cellOf(c, ps[0].x) != cellOf(c, ps[1].x)) {
     bad(c.caseFile, "family radiation needs exactly 2 particles in one coupling cell");
   }
-  va::RadiationCase rc{ps[0].d, ps[0].material, ps[1].d,  ps[1].material,
-                       cellVoidage(c, ps, 0), gasOf(c).T, ps[0].t0, ps[1].t0};
+  va::RadiationCase rc{ps[0].d,    ps[0].material, ps[1].d, ps[1].material, cellVoidage(c, ps, 0),
+                       gasOf(c).T, ps[0].t0,       ps[1].t0};
   std::vector<double> times;
   for (const auto& s : snaps) {
     times.push_back(s.t);
@@ -522,7 +521,7 @@ std::vector<Metric> checkReaction(const CaseSpec& spec, const CaseConfig& c,
   };
   const std::size_t cB = column(nameB), cD = column(nameD);
   const std::size_t cI = nameI.empty() ? cB : column(nameI);
-  series.columns = {"t",      "sim:m",   "ref:m",   "sim:X_B", "ref:X_B",       "sim:X_D",
+  series.columns = {"t",       "sim:m",   "ref:m",   "sim:X_B", "ref:X_B",       "sim:X_D",
                     "ref:X_D", "sim:X_I", "ref:X_I", "error",   "fraction_error"};
   double maxErr = 0.0;
   double maxFrac = 0.0;
@@ -539,8 +538,7 @@ std::vector<Metric> checkReaction(const CaseSpec& spec, const CaseConfig& c,
                                   nameI.empty() ? 0.0 : std::abs(xI - ref.xI)});
     maxErr = std::max(maxErr, err);
     maxFrac = std::max(maxFrac, frac);
-    series.rows.push_back(
-        {s.t, s.mass[0], ref.m, xB, ref.xB, xD, ref.xD, xI, ref.xI, err, frac});
+    series.rows.push_back({s.t, s.mass[0], ref.m, xB, ref.xB, xD, ref.xD, xI, ref.xI, err, frac});
   }
   return {{spec.name, "max relative error of the particle mass", maxErr, spec.tolerance,
            maxErr <= spec.tolerance},
@@ -649,8 +647,8 @@ int runVerify(const VerifyOptions& options) {
   if (!options.only.empty()) {
     std::vector<CaseSpec> chosen;
     for (const auto& n : options.only) {
-      const auto it = std::find_if(cases.begin(), cases.end(),
-                                   [&](const CaseSpec& s) { return s.name == n; });
+      const auto it =
+          std::find_if(cases.begin(), cases.end(), [&](const CaseSpec& s) { return s.name == n; });
       if (it == cases.end()) {
         std::string names;
         for (const auto& s : cases) {
@@ -707,8 +705,8 @@ int runVerify(const VerifyOptions& options) {
         return kExitInterrupted;
       }
       if (rc != kExitOk) {
-        throw UserError(fmt::format("the run failed with exit code {} (see {}/logs)", rc,
-                                    runDir.string()));
+        throw UserError(
+            fmt::format("the run failed with exit code {} (see {}/logs)", rc, runDir.string()));
       }
       const auto snaps = readSnapshots(runDir);
       Series series;
@@ -745,8 +743,8 @@ int runVerify(const VerifyOptions& options) {
 
   std::printf("\n%-34s %-44s %11s %9s  %s\n", "case", "metric", "value", "tolerance", "result");
   for (const auto& m : metrics) {
-    std::printf("%-34s %-44s %11.3e %9.2e  %s\n", m.name.c_str(),
-                m.metric.substr(0, 44).c_str(), m.value, m.tolerance, m.pass ? "pass" : "FAIL");
+    std::printf("%-34s %-44s %11.3e %9.2e  %s\n", m.name.c_str(), m.metric.substr(0, 44).c_str(),
+                m.value, m.tolerance, m.pass ? "pass" : "FAIL");
   }
   for (const auto& s : skipped) {
     std::printf("%-34s %-44s %11s %9s  %s\n", s.c_str(), "-", "-", "-", "skipped");

@@ -1,7 +1,7 @@
+#include <array>
+
 #include <coredem/common/check.h>
 #include <coredem/protocol/fields.h>
-
-#include <array>
 
 namespace coredem::protocol::fields {
 
@@ -28,8 +28,12 @@ constexpr std::array<FieldSpec, 7> kSourceFields{{
 }};
 } // namespace
 
-std::span<const FieldSpec> gasFields() { return kGasFields; }
-std::span<const FieldSpec> sourceFields() { return kSourceFields; }
+std::span<const FieldSpec> gasFields() {
+  return kGasFields;
+}
+std::span<const FieldSpec> sourceFields() {
+  return kSourceFields;
+}
 
 const FieldSpec* findField(std::string_view name) {
   for (const auto& f : kGasFields) {
@@ -58,8 +62,7 @@ std::uint64_t componentsOf(v1::Extent extent, std::uint64_t species) {
   }
 }
 
-std::vector<std::uint64_t> shapeOf(v1::Extent extent, std::uint64_t cells,
-                                   std::uint64_t species) {
+std::vector<std::uint64_t> shapeOf(v1::Extent extent, std::uint64_t cells, std::uint64_t species) {
   if (extent == v1::EXTENT_SCALAR) {
     return {cells};
   }
@@ -70,8 +73,7 @@ std::vector<std::uint64_t> shapeOf(std::string_view name, std::uint64_t cells,
                                    std::uint64_t species) {
   const FieldSpec* spec = findField(name);
   COREDEM_CHECK(spec != nullptr,
-                "'{}' is not a coupling field; see coredem/protocol/fields.h for the names",
-                name);
+                "'{}' is not a coupling field; see coredem/protocol/fields.h for the names", name);
   return shapeOf(spec->extent, cells, species);
 }
 

@@ -1,10 +1,10 @@
+#include <random>
+#include <thread>
+
 #include <coredem/common/log.h>
 #include <coredem/protocol/fields.h>
 #include <coredem/protocol/loopback.h>
 #include <coredem/protocol/validate.h>
-
-#include <random>
-#include <thread>
 
 namespace coredem::protocol {
 
@@ -13,7 +13,9 @@ constexpr const char* kSoftware = "coredem-loopback 1.0";
 }
 
 struct LoopbackService::Impl {
-  Impl(TransportOptions options, Version v) : server(std::move(options)), version(v) {}
+  Impl(TransportOptions options, Version v)
+      : server(std::move(options))
+      , version(v) {}
 
   Server server;
   Version version;
@@ -86,7 +88,8 @@ struct LoopbackService::Impl {
       s = Status::error(v1::ERROR_CODE_NOT_CONFIGURED,
                         messageTypeName(m.type()) + " before Configure; send Configure first");
     }
-    if (m.envelope().sequence() > lastSequence && (s.ok() || s.code != v1::ERROR_CODE_UNKNOWN_SESSION)) {
+    if (m.envelope().sequence() > lastSequence &&
+        (s.ok() || s.code != v1::ERROR_CODE_UNKNOWN_SESSION)) {
       lastSequence = m.envelope().sequence(); // numbers only increase, even for refused ones
     }
     if (!s.ok()) {
@@ -117,8 +120,8 @@ struct LoopbackService::Impl {
       break;
     case v1::MESSAGE_TYPE_STEP_GRANT: {
       v1::StepDone done;
-      reply = makeStepDone(m.envelope().step(), m.envelope().time() + m.envelope().step_grant().dt_cfd(),
-                           done);
+      reply = makeStepDone(m.envelope().step(),
+                           m.envelope().time() + m.envelope().step_grant().dt_cfd(), done);
       break;
     }
     case v1::MESSAGE_TYPE_CHECKPOINT_REQUEST:
@@ -135,8 +138,8 @@ struct LoopbackService::Impl {
     default:
       sendError(req.peer,
                 Status::error(v1::ERROR_CODE_UNEXPECTED_MESSAGE,
-                              "the loopback server does not accept " +
-                                  messageTypeName(m.type()) + " messages"),
+                              "the loopback server does not accept " + messageTypeName(m.type()) +
+                                  " messages"),
                 m);
       return;
     }
@@ -194,8 +197,8 @@ struct LoopbackService::Impl {
     for (const auto& f : fields::sourceFields()) {
       auto shape = fields::shapeOf(f.extent, cells, species);
       std::size_t n = cells * fields::componentsOf(f.extent, species);
-      auto values = std::make_shared<std::vector<double>>(
-          n, f.name == fields::kVoidFraction ? 1.0 : 0.0);
+      auto values =
+          std::make_shared<std::vector<double>>(n, f.name == fields::kVoidFraction ? 1.0 : 0.0);
       out.addArrayShared<double>(f.name, values, std::span<const double>(*values),
                                  std::move(shape));
     }
@@ -257,7 +260,11 @@ std::uint64_t LoopbackService::serve(const std::atomic<bool>* stop,
   return _impl->handled - before;
 }
 
-std::uint64_t LoopbackService::requestsHandled() const { return _impl->handled; }
-std::uint64_t LoopbackService::errorsSent() const { return _impl->errors; }
+std::uint64_t LoopbackService::requestsHandled() const {
+  return _impl->handled;
+}
+std::uint64_t LoopbackService::errorsSent() const {
+  return _impl->errors;
+}
 
 } // namespace coredem::protocol

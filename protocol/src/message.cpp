@@ -1,14 +1,14 @@
-#include "message_impl.h"
-
-#include <coredem/common/check.h>
-#include <coredem/protocol/version.h>
+#include <chrono>
+#include <cstring>
+#include <limits>
 
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
 
-#include <chrono>
-#include <cstring>
-#include <limits>
+#include <coredem/common/check.h>
+#include <coredem/protocol/version.h>
+
+#include "message_impl.h"
 
 namespace coredem::protocol {
 
@@ -54,9 +54,9 @@ std::string dtypeName(v1::DType dtype) {
 
 void ArrayView::checkDtype(v1::DType wanted) const {
   if (descriptor->dtype() != wanted) {
-    throw ProtocolError(v1::ERROR_CODE_DTYPE,
-                        "array '" + descriptor->name() + "' has dtype " +
-                            dtypeName(descriptor->dtype()) + ", read as " + dtypeName(wanted));
+    throw ProtocolError(v1::ERROR_CODE_DTYPE, "array '" + descriptor->name() + "' has dtype " +
+                                                  dtypeName(descriptor->dtype()) + ", read as " +
+                                                  dtypeName(wanted));
   }
 }
 
@@ -152,8 +152,8 @@ Status decodeInto(Message& out, const std::byte* envelopeData, std::size_t envel
     }
     if (b.size != d.byte_length()) {
       return Status::error(v1::ERROR_CODE_BYTE_LENGTH,
-                           "array '" + d.name() + "' (frame " + std::to_string(i + 1) +
-                               ") has " + std::to_string(b.size) +
+                           "array '" + d.name() + "' (frame " + std::to_string(i + 1) + ") has " +
+                               std::to_string(b.size) +
                                " bytes but its descriptor declares byte_length " +
                                std::to_string(d.byte_length()) +
                                "; the frame was truncated or the descriptor is wrong");
@@ -161,14 +161,14 @@ Status decodeInto(Message& out, const std::byte* envelopeData, std::size_t envel
     std::uint64_t elements = 0;
     if (!shapeElements(d.shape(), &elements) || elements > d.byte_length() / elem ||
         elements * elem != d.byte_length()) {
-      return Status::error(v1::ERROR_CODE_BYTE_LENGTH,
-                           "array '" + d.name() + "': shape " + shapeString(d.shape()) +
-                               " of " + dtypeName(d.dtype()) + " needs " +
-                               (elements > d.byte_length() ? std::string("more than ")
-                                                           : std::string()) +
-                               std::to_string(elements * elem) +
-                               " bytes but byte_length is " + std::to_string(d.byte_length()) +
-                               "; byte_length must be prod(shape) * sizeof(dtype)");
+      return Status::error(
+          v1::ERROR_CODE_BYTE_LENGTH,
+          "array '" + d.name() + "': shape " + shapeString(d.shape()) + " of " +
+              dtypeName(d.dtype()) + " needs " +
+              (elements > d.byte_length() ? std::string("more than ") : std::string()) +
+              std::to_string(elements * elem) + " bytes but byte_length is " +
+              std::to_string(d.byte_length()) +
+              "; byte_length must be prod(shape) * sizeof(dtype)");
     }
   }
   impl.arrays.reserve(arrays.size());
@@ -184,9 +184,14 @@ Status decodeInto(Message& out, const std::byte* envelopeData, std::size_t envel
 
 // ---- Message ---------------------------------------------------------------------------
 
-Message::Message() : _impl(std::make_unique<Impl>()) {}
-Message::Message(v1::MessageType type) : Message() { _impl->envelope.set_type(type); }
-Message::Message(const v1::Envelope& envelope) : Message() {
+Message::Message()
+    : _impl(std::make_unique<Impl>()) {}
+Message::Message(v1::MessageType type)
+    : Message() {
+  _impl->envelope.set_type(type);
+}
+Message::Message(const v1::Envelope& envelope)
+    : Message() {
   _impl->envelope = envelope;
   _impl->envelope.clear_arrays();
 }
@@ -194,9 +199,15 @@ Message::~Message() = default;
 Message::Message(Message&&) noexcept = default;
 Message& Message::operator=(Message&&) noexcept = default;
 
-v1::MessageType Message::type() const { return _impl->envelope.type(); }
-const v1::Envelope& Message::envelope() const { return _impl->envelope; }
-v1::Envelope& Message::envelope() { return _impl->envelope; }
+v1::MessageType Message::type() const {
+  return _impl->envelope.type();
+}
+const v1::Envelope& Message::envelope() const {
+  return _impl->envelope;
+}
+v1::Envelope& Message::envelope() {
+  return _impl->envelope;
+}
 
 Message& Message::setSessionId(std::string id) {
   _impl->envelope.set_session_id(std::move(id));
@@ -215,11 +226,11 @@ Message& Message::setTime(double time) {
   return *this;
 }
 
-#define COREDEM_SET_BODY(Body, field, TYPE)                                                   \
-  Message& Message::setBody(const v1::Body& body) {                                           \
-    *_impl->envelope.mutable_##field() = body;                                                \
-    _impl->envelope.set_type(MessageTraits<v1::Body>::type);                                  \
-    return *this;                                                                             \
+#define COREDEM_SET_BODY(Body, field, TYPE)                                                        \
+  Message& Message::setBody(const v1::Body& body) {                                                \
+    *_impl->envelope.mutable_##field() = body;                                                     \
+    _impl->envelope.set_type(MessageTraits<v1::Body>::type);                                       \
+    return *this;                                                                                  \
   }
 COREDEM_PROTOCOL_MESSAGES(COREDEM_SET_BODY)
 #undef COREDEM_SET_BODY
@@ -238,8 +249,8 @@ v1::ArrayDescriptor* addDescriptor(v1::Envelope& env, std::string_view name, v1:
     elements *= d;
   }
   COREDEM_CHECK(elements * elem == bytes,
-                "array '{}': shape has {} elements ({} bytes of {}) but {} bytes were given",
-                name, elements, elements * elem, dtypeName(dtype), bytes);
+                "array '{}': shape has {} elements ({} bytes of {}) but {} bytes were given", name,
+                elements, elements * elem, dtypeName(dtype), bytes);
   auto* d = env.add_arrays();
   d->set_name(std::string(name));
   d->set_dtype(dtype);
@@ -268,7 +279,9 @@ Message& Message::addArraySharedBytes(std::string_view name, v1::DType dtype,
   return *this;
 }
 
-std::size_t Message::arrayCount() const { return _impl->arrays.size(); }
+std::size_t Message::arrayCount() const {
+  return _impl->arrays.size();
+}
 
 ArrayView Message::array(std::size_t i) const {
   COREDEM_ASSERT(i < _impl->arrays.size());
@@ -288,9 +301,9 @@ std::optional<ArrayView> Message::findArray(std::string_view name) const {
 ArrayView Message::array(std::string_view name) const {
   auto view = findArray(name);
   if (!view) {
-    throw ProtocolError(v1::ERROR_CODE_MISSING_FIELD,
-                        std::string(messageTypeName(type())) + " message has no array '" +
-                            std::string(name) + "'");
+    throw ProtocolError(v1::ERROR_CODE_MISSING_FIELD, std::string(messageTypeName(type())) +
+                                                          " message has no array '" +
+                                                          std::string(name) + "'");
   }
   return *view;
 }
@@ -349,11 +362,10 @@ Message Message::decode(Frames frames, Status* status) {
 
 // ---- builders --------------------------------------------------------------------------
 
-Message makeHello(v1::Role role, std::string softwareVersion,
-                  std::vector<std::string> capabilities,
+Message makeHello(v1::Role role, std::string softwareVersion, std::vector<std::string> capabilities,
                   std::vector<v1::FieldManifestEntry> manifest) {
-  Message m = makeHello(role, std::move(softwareVersion), kProtocolVersion.major,
-                        kProtocolVersion.minor);
+  Message m =
+      makeHello(role, std::move(softwareVersion), kProtocolVersion.major, kProtocolVersion.minor);
   auto* h = m.envelope().mutable_hello();
   for (auto& c : capabilities) {
     h->add_capabilities(std::move(c));
@@ -485,9 +497,8 @@ Message makeCheckpointDone(std::int64_t step, std::string directory,
 
 Message makeHeartbeat(std::string state) {
   v1::Heartbeat h;
-  h.set_unix_time(std::chrono::duration<double>(
-                      std::chrono::system_clock::now().time_since_epoch())
-                      .count());
+  h.set_unix_time(
+      std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count());
   h.set_state(std::move(state));
   Message m;
   m.setBody(h);
@@ -533,18 +544,17 @@ void expectType(const Message& reply, v1::MessageType expected) {
   }
   const auto& env = reply.envelope();
   if (reply.type() == v1::MESSAGE_TYPE_ERROR) {
-    throw PeerError(env.error().code(), "peer answered Error " +
-                                            errorCodeName(env.error().code()) + ": " +
-                                            env.error().message());
+    throw PeerError(env.error().code(), "peer answered Error " + errorCodeName(env.error().code()) +
+                                            ": " + env.error().message());
   }
   if (reply.type() == v1::MESSAGE_TYPE_REJECT) {
     throw PeerError(env.reject().code(), "peer rejected the handshake (" +
                                              errorCodeName(env.reject().code()) +
                                              "): " + env.reject().reason());
   }
-  throw ProtocolError(v1::ERROR_CODE_UNEXPECTED_MESSAGE,
-                      "expected a " + messageTypeName(expected) + " reply but got " +
-                          messageTypeName(reply.type()));
+  throw ProtocolError(v1::ERROR_CODE_UNEXPECTED_MESSAGE, "expected a " + messageTypeName(expected) +
+                                                             " reply but got " +
+                                                             messageTypeName(reply.type()));
 }
 
 void addNamedValue(google::protobuf::RepeatedPtrField<v1::NamedValue>* list, std::string name,

@@ -2,11 +2,11 @@
 // Internal representation of coredem::protocol::Message, shared by message.cpp and
 // transport.cpp. Not installed, not part of the API.
 
-#include <coredem/protocol/message.h>
-
 #include <cstddef>
 #include <memory>
 #include <vector>
+
+#include <coredem/protocol/message.h>
 
 namespace coredem::protocol {
 

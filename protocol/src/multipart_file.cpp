@@ -1,11 +1,11 @@
-#include <coredem/common/check.h>
-#include <coredem/protocol/multipart_file.h>
-
 #include <array>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+
+#include <coredem/common/check.h>
+#include <coredem/protocol/multipart_file.h>
 
 namespace coredem::protocol {
 

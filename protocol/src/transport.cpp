@@ -1,14 +1,14 @@
 // ZeroMQ transport. The only translation unit that includes zmq.hpp: ZeroMQ stays private.
-#include "message_impl.h"
+#include <cstring>
+#include <mutex>
+#include <regex>
+
+#include <zmq.hpp>
 
 #include <coredem/common/log.h>
 #include <coredem/protocol/transport.h>
 
-#include <zmq.hpp>
-
-#include <cstring>
-#include <mutex>
-#include <regex>
+#include "message_impl.h"
 
 namespace coredem::protocol {
 
@@ -22,8 +22,7 @@ std::shared_ptr<spdlog::logger> transportLog() {
 }
 
 [[noreturn]] void rethrowZmq(const zmq::error_t& e, const std::string& what) {
-  throw TransportError(what + ": ZeroMQ error " + std::to_string(e.num()) + " (" + e.what() +
-                       ")");
+  throw TransportError(what + ": ZeroMQ error " + std::to_string(e.num()) + " (" + e.what() + ")");
 }
 
 void setCommonOptions(zmq::socket_t& socket, const TransportOptions& o) {
@@ -44,8 +43,8 @@ void setKey(zmq::socket_t& socket, int option, const std::string& key, const cha
   }
   if (zmq_setsockopt(socket.handle(), option, key.c_str(), 41) != 0) {
     throw ProtocolError(v1::ERROR_CODE_SECURITY,
-                        std::string("setting the CURVE ") + which + " failed: " +
-                            zmq_strerror(zmq_errno()) +
+                        std::string("setting the CURVE ") + which +
+                            " failed: " + zmq_strerror(zmq_errno()) +
                             (zmq_has("curve") ? "" : " (libzmq was built without CURVE)"));
   }
 }
@@ -197,8 +196,8 @@ Status decodeFrames(std::vector<zmq::message_t>& frames, std::size_t first, Mess
 
 std::string describe(const Message& m) {
   const auto& env = m.envelope();
-  return messageTypeName(env.type()) + " (sequence " + std::to_string(env.sequence()) +
-         ", step " + std::to_string(env.step()) + ")";
+  return messageTypeName(env.type()) + " (sequence " + std::to_string(env.sequence()) + ", step " +
+         std::to_string(env.step()) + ")";
 }
 
 /// One ZeroMQ context (one I/O thread) per process, shared by every Server and Client and
@@ -305,7 +304,9 @@ std::string Server::bind(const std::string& endpoint) {
   return _impl->endpoint;
 }
 
-std::string Server::endpoint() const { return _impl->endpoint; }
+std::string Server::endpoint() const {
+  return _impl->endpoint;
+}
 
 std::optional<Request> Server::receive(std::chrono::milliseconds timeout,
                                        const ReceiveOptions& options) {
@@ -321,8 +322,7 @@ std::optional<Request> Server::receive(std::chrono::milliseconds timeout,
   request.peer = frames[0].to_string();
   request.status = decodeFrames(frames, 1, request.message, options);
   if (!request.status.ok()) {
-    _impl->log->debug("undecodable message on {}: {}", _impl->endpoint,
-                     request.status.toString());
+    _impl->log->debug("undecodable message on {}: {}", _impl->endpoint, request.status.toString());
   }
   return request;
 }
@@ -385,9 +385,13 @@ void Client::connect(const std::string& endpoint) {
   _impl->endpoint = endpoint;
 }
 
-std::string Client::endpoint() const { return _impl->endpoint; }
+std::string Client::endpoint() const {
+  return _impl->endpoint;
+}
 
-std::uint64_t Client::nextSequence() const { return _impl->nextSequence; }
+std::uint64_t Client::nextSequence() const {
+  return _impl->nextSequence;
+}
 
 std::uint64_t Client::send(Message message) {
   auto& env = message.envelope();
@@ -448,13 +452,12 @@ Message Client::request(Message message, std::chrono::milliseconds timeout,
                              "); is the server running, reachable and not stalled?");
     }
     const auto& env = reply->envelope();
-    if (env.sequence() == seq ||
-        (env.sequence() == 0 && reply->type() == v1::MESSAGE_TYPE_ERROR)) {
+    if (env.sequence() == seq || (env.sequence() == 0 && reply->type() == v1::MESSAGE_TYPE_ERROR)) {
       applyBufferProvider(*reply, options);
       return std::move(*reply);
     }
-    _impl->log->debug("discarding stale reply {} from {} (awaiting sequence {})",
-                      describe(*reply), _impl->endpoint, seq);
+    _impl->log->debug("discarding stale reply {} from {} (awaiting sequence {})", describe(*reply),
+                      _impl->endpoint, seq);
   }
 }
 

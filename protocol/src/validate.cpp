@@ -1,13 +1,13 @@
-#include "message_impl.h"
-
-#include <coredem/protocol/fields.h>
-#include <coredem/protocol/validate.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <set>
 #include <sstream>
+
+#include <coredem/protocol/fields.h>
+#include <coredem/protocol/validate.h>
+
+#include "message_impl.h"
 
 namespace coredem::protocol {
 
@@ -71,7 +71,8 @@ Status checkArrays(const Message& message, std::span<const fields::FieldSpec> re
       return Status::error(v1::ERROR_CODE_MISSING_FIELD,
                            messageTypeName(message.type()) + " message lacks the required array '" +
                                std::string(spec.name) + "' (" + std::string(spec.description) +
-                               ", " + std::string(spec.unit) + "); send every field listed in "
+                               ", " + std::string(spec.unit) +
+                               "); send every field listed in "
                                "coredem/protocol/fields.h");
     }
     if (v->dtype() != v1::DTYPE_FLOAT64) {
@@ -112,15 +113,15 @@ Status structure(const Message& message) {
   if (static_cast<std::size_t>(env.arrays_size()) != impl.arrays.size()) {
     return Status::error(v1::ERROR_CODE_FRAME_COUNT,
                          "the envelope describes " + std::to_string(env.arrays_size()) +
-                             " arrays but the message has " +
-                             std::to_string(impl.arrays.size()) + " array frames");
+                             " arrays but the message has " + std::to_string(impl.arrays.size()) +
+                             " array frames");
   }
   for (int i = 0; i < env.arrays_size(); ++i) {
     const auto& d = env.arrays(i);
     std::size_t elem = dtypeSize(d.dtype());
     if (elem == 0) {
-      return Status::error(v1::ERROR_CODE_DTYPE, "array '" + d.name() + "' has unknown dtype " +
-                                                     dtypeName(d.dtype()));
+      return Status::error(v1::ERROR_CODE_DTYPE,
+                           "array '" + d.name() + "' has unknown dtype " + dtypeName(d.dtype()));
     }
     std::uint64_t elements = 0;
     if (impl.arrays[static_cast<std::size_t>(i)].size != d.byte_length() ||
@@ -206,9 +207,8 @@ Status validate(const Message& message, const Expectation& e) {
                            messageTypeName(type) +
                                " received before Configure; send Hello and Configure first");
     }
-    std::uint64_t bodyCells = type == v1::MESSAGE_TYPE_GAS_FIELDS
-                                  ? env.gas_fields().cell_count()
-                                  : env.sources().cell_count();
+    std::uint64_t bodyCells = type == v1::MESSAGE_TYPE_GAS_FIELDS ? env.gas_fields().cell_count()
+                                                                  : env.sources().cell_count();
     std::uint64_t bodySpecies = type == v1::MESSAGE_TYPE_GAS_FIELDS
                                     ? env.gas_fields().species_count()
                                     : env.sources().species_count();
@@ -216,9 +216,8 @@ Status validate(const Message& message, const Expectation& e) {
       return Status::error(v1::ERROR_CODE_SHAPE,
                            messageTypeName(type) + " declares " + std::to_string(bodyCells) +
                                " cells and " + std::to_string(bodySpecies) +
-                               " species but the configured mesh has " +
-                               std::to_string(*e.cells) + " cells and " +
-                               std::to_string(*e.species) +
+                               " species but the configured mesh has " + std::to_string(*e.cells) +
+                               " cells and " + std::to_string(*e.species) +
                                " species; send fields on the configured coupling mesh");
     }
     auto required =
@@ -229,7 +228,9 @@ Status validate(const Message& message, const Expectation& e) {
 }
 
 namespace {
-bool positive(const v1::Vec3& v) { return v.x() > 0 && v.y() > 0 && v.z() > 0; }
+bool positive(const v1::Vec3& v) {
+  return v.x() > 0 && v.y() > 0 && v.z() > 0;
+}
 bool finite3(const v1::Vec3& v) {
   return std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z());
 }
@@ -263,12 +264,13 @@ Status validateConfigure(const v1::Configure& c) {
   // references and the models' needs when it builds the system).
   for (const auto& s : c.solid_species()) {
     if (s.name().empty() || !names.insert(s.name()).second) {
-      return bad("solid_species name '" + s.name() + "' is empty or repeated (also among the gas "
+      return bad("solid_species name '" + s.name() +
+                 "' is empty or repeated (also among the gas "
                  "species); names must be unique");
     }
     if (!(s.molar_mass() > 0) || !std::isfinite(s.molar_mass())) {
-      return bad("solid_species '" + s.name() + "' has molar_mass " + std::to_string(s.molar_mass()) +
-                 " kg/mol; it must be > 0");
+      return bad("solid_species '" + s.name() + "' has molar_mass " +
+                 std::to_string(s.molar_mass()) + " kg/mol; it must be > 0");
     }
   }
   for (const auto& r : c.reactions()) {
@@ -278,16 +280,19 @@ Status validateConfigure(const v1::Configure& c) {
     }
     for (const auto& t : r.terms()) {
       if (!(t.nu() != 0.0) || !std::isfinite(t.nu())) {
-        return bad("reaction '" + r.name() + "': term '" + t.species() + "' needs a finite nonzero nu");
+        return bad("reaction '" + r.name() + "': term '" + t.species() +
+                   "' needs a finite nonzero nu");
       }
     }
     if (r.rate().law() != v1::RATE_LAW_CONSTANT && r.rate().law() != v1::RATE_LAW_ARRHENIUS) {
-      return bad("reaction '" + r.name() + "': rate.law must be RATE_LAW_CONSTANT or RATE_LAW_ARRHENIUS");
+      return bad("reaction '" + r.name() +
+                 "': rate.law must be RATE_LAW_CONSTANT or RATE_LAW_ARRHENIUS");
     }
     if (!(r.rate().a() >= 0.0) || !std::isfinite(r.rate().a()) || !std::isfinite(r.rate().beta()) ||
         !(r.rate().activation_energy() >= 0.0) || !std::isfinite(r.rate().activation_energy()) ||
         !std::isfinite(r.rate().order())) {
-      return bad("reaction '" + r.name() + "': rate needs finite a >= 0, beta, activation_energy >= 0, order");
+      return bad("reaction '" + r.name() +
+                 "': rate needs finite a >= 0, beta, activation_energy >= 0, order");
     }
     if (r.heat_case() == v1::Reaction::kHeatOfReaction && !std::isfinite(r.heat_of_reaction())) {
       return bad("reaction '" + r.name() + "': heat_of_reaction is not finite");
@@ -305,8 +310,9 @@ Status validateConfigure(const v1::Configure& c) {
   if (std::abs(sc.dt_dem() * sc.n_sub() - sc.dt_cfd()) > 1e-12 * sc.dt_cfd()) {
     std::ostringstream os;
     os.precision(17);
-    os << "sub_cycling: dt_dem * n_sub = " << sc.dt_dem() * sc.n_sub() << " s differs from dt_cfd = "
-       << sc.dt_cfd() << " s (relative tolerance 1e-12); set dt_dem = dt_cfd / n_sub";
+    os << "sub_cycling: dt_dem * n_sub = " << sc.dt_dem() * sc.n_sub()
+       << " s differs from dt_cfd = " << sc.dt_cfd()
+       << " s (relative tolerance 1e-12); set dt_dem = dt_cfd / n_sub";
     return bad(os.str());
   }
   std::set<std::uint32_t> materialIds;

@@ -1,6 +1,6 @@
-#include <coredem/protocol/version.h>
-
 #include <algorithm>
+
+#include <coredem/protocol/version.h>
 
 namespace coredem::protocol {
 
@@ -17,7 +17,8 @@ Negotiation negotiate(Version ours, Version theirs) {
         "protocol version mismatch: this server speaks coredem protocol " + ours.toString() +
             ", the client speaks " + theirs.toString() +
             "; major versions must be equal. Use a client and server built from the same "
-            "major release (" + std::to_string(ours.major) + ".x).");
+            "major release (" +
+            std::to_string(ours.major) + ".x).");
     return result;
   }
   result.accepted = true;

@@ -5,15 +5,15 @@
 // and the chemistry switches). The files are committed and never regenerated for a
 // released version: tests/unit/protocol/golden_test.cpp decodes them with the current code
 // forever and checks every value written below. Container format: multipart_file.h.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <utility>
+
 #include <coredem/protocol/fields.h>
 #include <coredem/protocol/message.h>
 #include <coredem/protocol/multipart_file.h>
-
-#include <cstdio>
-#include <cstdlib>
-#include <utility>
-#include <algorithm>
-#include <filesystem>
 
 using namespace coredem::protocol;
 namespace v1 = coredem::v1;
@@ -25,7 +25,9 @@ constexpr std::uint32_t kSpecies = 2; // O2, N2
 
 /// Array values of the golden GasFields/Sources: field f (index in fields.h order), flat
 /// index i -> 0.25 * (f + 1) + 0.125 * i (exact in binary).
-double goldenValue(std::size_t f, std::size_t i) { return 0.25 * double(f + 1) + 0.125 * double(i); }
+double goldenValue(std::size_t f, std::size_t i) {
+  return 0.25 * double(f + 1) + 0.125 * double(i);
+}
 
 void stamp(Message& m, std::uint64_t seq) {
   m.setSessionId("golden-session").setSequence(seq).setStep(3).setTime(0.25);
@@ -136,7 +138,8 @@ void addV11(v1::Configure& c) {
   opt->set_key("motion");
   opt->set_value("frozen");
   // Chemistry.
-  for (auto [name, molar] : {std::pair{"Fe2O3", 0.159688}, {"Fe3O4", 0.231533}, {"Al2O3", 0.101961}}) {
+  for (auto [name, molar] :
+       {std::pair{"Fe2O3", 0.159688}, {"Fe3O4", 0.231533}, {"Al2O3", 0.101961}}) {
     auto* s = c.add_solid_species();
     s->set_name(name);
     s->set_molar_mass(molar);
@@ -182,7 +185,8 @@ void addFieldArrays(Message& m, std::span<const fields::FieldSpec> specs) {
 
 int main(int argc, char** argv) {
   if (argc != 2 && argc != 3) {
-    std::fprintf(stderr, "usage: coredem-golden-gen OUTPUT_DIR [MINOR]   (e.g. protocol/golden/v1.1 1)\n");
+    std::fprintf(stderr,
+                 "usage: coredem-golden-gen OUTPUT_DIR [MINOR]   (e.g. protocol/golden/v1.1 1)\n");
     return 2;
   }
   const int minor = argc == 3 ? std::atoi(argv[2]) : 0;
@@ -206,7 +210,8 @@ int main(int argc, char** argv) {
     all.emplace_back("hello", std::move(m));
   }
   {
-    Message m = makeWelcome(v1::ROLE_DEM, "coredem-dem 0.1.0", 1, std::uint32_t(minor), "golden-session");
+    Message m =
+        makeWelcome(v1::ROLE_DEM, "coredem-dem 0.1.0", 1, std::uint32_t(minor), "golden-session");
     m.envelope().mutable_welcome()->add_capabilities("cpu");
     stamp(m, 1);
     all.emplace_back("welcome", std::move(m));

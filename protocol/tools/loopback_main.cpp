@@ -6,19 +6,19 @@
 // `serve` prints the bound endpoint (and writes it to --endpoint-file) and serves until a
 // Shutdown arrives. `exchange` does Hello, Configure, K x GasFields->Sources, checks the
 // loopback's checksums and prints what was sent, how many bytes and how long it took.
-#include <coredem/common/log.h>
-#include <coredem/protocol/fields.h>
-#include <coredem/protocol/loopback.h>
-#include <coredem/protocol/validate.h>
-
-#include <CLI/CLI.hpp>
-
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <numeric>
+
+#include <CLI/CLI.hpp>
+
+#include <coredem/common/log.h>
+#include <coredem/protocol/fields.h>
+#include <coredem/protocol/loopback.h>
+#include <coredem/protocol/validate.h>
 
 using namespace coredem::protocol;
 using namespace coredem;
@@ -27,13 +27,17 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 std::atomic<bool> gStop{false};
-void onSignal(int) { gStop = true; }
+void onSignal(int) {
+  gStop = true;
+}
 
-int serve(const std::string& endpoint, const std::string& endpointFile, double idleLimit, int minor) {
+int serve(const std::string& endpoint, const std::string& endpointFile, double idleLimit,
+          int minor) {
   TransportOptions options;
   options.sender = "coredem-loopback";
-  LoopbackService service(options, minor < 0 ? kProtocolVersion
-                                             : Version{kProtocolVersion.major, std::uint32_t(minor)});
+  LoopbackService service(options, minor < 0
+                                       ? kProtocolVersion
+                                       : Version{kProtocolVersion.major, std::uint32_t(minor)});
   std::string bound = service.bind(endpoint);
   if (!endpointFile.empty()) {
     // Write to a temporary name and rename, so a reader never sees a partial endpoint.
@@ -97,8 +101,7 @@ int exchange(const std::string& endpoint, std::vector<std::uint64_t> grid, std::
   cfg.mutable_sub_cycling()->set_dt_cfd(1e-4);
   cfg.mutable_sub_cycling()->set_n_sub(50);
   cfg.mutable_sub_cycling()->set_dt_dem(1e-4 / 50);
-  Message configured =
-      client.request(std::move(makeConfigure(cfg).setSessionId(session)), timeout);
+  Message configured = client.request(std::move(makeConfigure(cfg).setSessionId(session)), timeout);
   expectType(configured, v1::MESSAGE_TYPE_CONFIGURED);
   std::printf("configure: %llu x %llu x %llu = %llu cells, %u species\n",
               static_cast<unsigned long long>(grid[0]), static_cast<unsigned long long>(grid[1]),
@@ -178,8 +181,8 @@ int exchange(const std::string& endpoint, std::vector<std::uint64_t> grid, std::
                 failures ? "MISMATCH" : "match");
   }
   if (shutdown) {
-    Message ack = client.request(std::move(makeShutdown("exchange finished").setSessionId(session)),
-                                 timeout);
+    Message ack =
+        client.request(std::move(makeShutdown("exchange finished").setSessionId(session)), timeout);
     expectType(ack, v1::MESSAGE_TYPE_ACK);
     std::printf("shutdown acknowledged\n");
   }
@@ -198,7 +201,8 @@ int main(int argc, char** argv) {
   auto* serveCmd = app.add_subcommand("serve", "run the loopback server until Shutdown");
   serveCmd->add_option("--endpoint", endpoint, "endpoint to bind (loopback or ipc)");
   serveCmd->add_option("--endpoint-file", endpointFile, "write the bound endpoint here");
-  serveCmd->add_option("--idle-limit", idleLimit, "stop after this many seconds without requests (0 = never)");
+  serveCmd->add_option("--idle-limit", idleLimit,
+                       "stop after this many seconds without requests (0 = never)");
   int minor = -1;
   serveCmd->add_option("--protocol-minor", minor, "speak protocol 1.MINOR (default: this build's)");
 

@@ -1,11 +1,11 @@
 // The C API (coredem_client.h) over coredem::client::Participant.
-#include "coredem/client/coredem_client.h"
-#include "coredem/client/participant.h"
-
 #include <exception>
 #include <new>
 #include <string>
 #include <vector>
+
+#include "coredem/client/coredem_client.h"
+#include "coredem/client/participant.h"
 
 using coredem::client::ClientError;
 using coredem::client::ErrorCode;
@@ -22,18 +22,25 @@ namespace {
 
 coredem_status toStatus(ErrorCode c) {
   switch (c) {
-  case ErrorCode::Argument: return COREDEM_ERROR_ARGUMENT;
-  case ErrorCode::State: return COREDEM_ERROR_STATE;
-  case ErrorCode::Protocol: return COREDEM_ERROR_PROTOCOL;
-  case ErrorCode::Timeout: return COREDEM_ERROR_TIMEOUT;
-  case ErrorCode::Peer: return COREDEM_ERROR_PEER;
-  case ErrorCode::Internal: return COREDEM_ERROR_INTERNAL;
+  case ErrorCode::Argument:
+    return COREDEM_ERROR_ARGUMENT;
+  case ErrorCode::State:
+    return COREDEM_ERROR_STATE;
+  case ErrorCode::Protocol:
+    return COREDEM_ERROR_PROTOCOL;
+  case ErrorCode::Timeout:
+    return COREDEM_ERROR_TIMEOUT;
+  case ErrorCode::Peer:
+    return COREDEM_ERROR_PEER;
+  case ErrorCode::Internal:
+    return COREDEM_ERROR_INTERNAL;
   }
   return COREDEM_ERROR_INTERNAL;
 }
 
 /// Runs f on a valid handle; records the error message.
-template <class F> coredem_status call(coredem_client* c, const char* name, F&& f) {
+template <class F>
+coredem_status call(coredem_client* c, const char* name, F&& f) {
   if (c == nullptr) {
     return COREDEM_ERROR_ARGUMENT;
   }
@@ -155,15 +162,17 @@ coredem_status coredem_client_species_name(const coredem_client* cc, int32_t k, 
   });
 }
 
-coredem_status coredem_client_exchange(coredem_client* c, int64_t step, double dt,
-                                       int32_t n_fields, const char* const* names,
-                                       const double* const* values, const size_t* sizes) {
+coredem_status coredem_client_exchange(coredem_client* c, int64_t step, double dt, int32_t n_fields,
+                                       const char* const* names, const double* const* values,
+                                       const size_t* sizes) {
   return call(c, "coredem_client_exchange", [&] {
-    argCheck(n_fields >= 0 && (n_fields == 0 || (names != nullptr && values != nullptr && sizes != nullptr)),
+    argCheck(n_fields >= 0 &&
+                 (n_fields == 0 || (names != nullptr && values != nullptr && sizes != nullptr)),
              "coredem_client_exchange: names, values and sizes must hold n_fields entries");
     std::vector<coredem::client::NamedField> fields;
     for (int32_t i = 0; i < n_fields; ++i) {
-      argCheck(names[i] != nullptr, "coredem_client_exchange: names[" + std::to_string(i) + "] is NULL");
+      argCheck(names[i] != nullptr,
+               "coredem_client_exchange: names[" + std::to_string(i) + "] is NULL");
       fields.push_back({names[i], coredem::client::ConstView(values[i], sizes[i])});
     }
     participant(c).exchange(step, dt, fields);
@@ -183,22 +192,24 @@ coredem_status coredem_client_source(const coredem_client* cc, const char* name,
 }
 
 coredem_status coredem_client_advance(coredem_client* c, double courant, int32_t n_ledgers,
-                                      const char* const* ledger_names,
-                                      const double* ledger_values, int32_t n_files,
-                                      const char* const* checkpoint_files) {
+                                      const char* const* ledger_names, const double* ledger_values,
+                                      int32_t n_files, const char* const* checkpoint_files) {
   return call(c, "coredem_client_advance", [&] {
-    argCheck(n_ledgers >= 0 && (n_ledgers == 0 || (ledger_names != nullptr && ledger_values != nullptr)),
+    argCheck(n_ledgers >= 0 &&
+                 (n_ledgers == 0 || (ledger_names != nullptr && ledger_values != nullptr)),
              "coredem_client_advance: ledger_names and ledger_values must hold n_ledgers entries");
     argCheck(n_files >= 0 && (n_files == 0 || checkpoint_files != nullptr),
              "coredem_client_advance: checkpoint_files must hold n_files entries");
     coredem::client::Ledgers l;
     for (int32_t i = 0; i < n_ledgers; ++i) {
-      argCheck(ledger_names[i] != nullptr, "coredem_client_advance: ledger_names[" + std::to_string(i) + "] is NULL");
+      argCheck(ledger_names[i] != nullptr,
+               "coredem_client_advance: ledger_names[" + std::to_string(i) + "] is NULL");
       l.energy.emplace_back(ledger_names[i], ledger_values[i]);
     }
     std::vector<std::string> files;
     for (int32_t i = 0; i < n_files; ++i) {
-      argCheck(checkpoint_files[i] != nullptr, "coredem_client_advance: checkpoint_files[" + std::to_string(i) + "] is NULL");
+      argCheck(checkpoint_files[i] != nullptr,
+               "coredem_client_advance: checkpoint_files[" + std::to_string(i) + "] is NULL");
       files.emplace_back(checkpoint_files[i]);
     }
     participant(c).advance(courant, l, files);
@@ -209,7 +220,9 @@ coredem_status coredem_client_finalize(coredem_client* c) {
   return call(c, "coredem_client_finalize", [&] { participant(c).finalize(); });
 }
 
-void coredem_client_destroy(coredem_client* c) { delete c; }
+void coredem_client_destroy(coredem_client* c) {
+  delete c;
+}
 
 const char* coredem_client_last_error(const coredem_client* c) {
   return c == nullptr ? "NULL handle" : c->lastError.c_str();
@@ -217,13 +230,20 @@ const char* coredem_client_last_error(const coredem_client* c) {
 
 const char* coredem_status_name(coredem_status s) {
   switch (s) {
-  case COREDEM_OK: return "OK";
-  case COREDEM_ERROR_ARGUMENT: return "ERROR_ARGUMENT";
-  case COREDEM_ERROR_STATE: return "ERROR_STATE";
-  case COREDEM_ERROR_PROTOCOL: return "ERROR_PROTOCOL";
-  case COREDEM_ERROR_TIMEOUT: return "ERROR_TIMEOUT";
-  case COREDEM_ERROR_PEER: return "ERROR_PEER";
-  case COREDEM_ERROR_INTERNAL: return "ERROR_INTERNAL";
+  case COREDEM_OK:
+    return "OK";
+  case COREDEM_ERROR_ARGUMENT:
+    return "ERROR_ARGUMENT";
+  case COREDEM_ERROR_STATE:
+    return "ERROR_STATE";
+  case COREDEM_ERROR_PROTOCOL:
+    return "ERROR_PROTOCOL";
+  case COREDEM_ERROR_TIMEOUT:
+    return "ERROR_TIMEOUT";
+  case COREDEM_ERROR_PEER:
+    return "ERROR_PEER";
+  case COREDEM_ERROR_INTERNAL:
+    return "ERROR_INTERNAL";
   }
   return "UNKNOWN";
 }

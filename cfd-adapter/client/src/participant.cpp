@@ -1,11 +1,6 @@
 // The coupling client (docs/client.md): C's side of docs/session.md over the protocol library.
 #include "coredem/client/participant.h"
 
-#include "coredem/common/check.h"
-#include "coredem/common/log.h"
-#include "coredem/common/version.h"
-#include "coredem/protocol/protocol.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,6 +8,11 @@
 #include <cstring>
 #include <optional>
 #include <set>
+
+#include "coredem/common/check.h"
+#include "coredem/common/log.h"
+#include "coredem/common/version.h"
+#include "coredem/protocol/protocol.h"
 
 namespace coredem::client {
 
@@ -38,11 +38,16 @@ std::string fromEnv(const std::string& given, const char* var) {
 
 const char* stateName(State s) {
   switch (s) {
-  case State::Created: return "Created";
-  case State::Granted: return "Granted";
-  case State::Exchanged: return "Exchanged";
-  case State::Finished: return "Finished";
-  case State::Finalized: return "Finalized";
+  case State::Created:
+    return "Created";
+  case State::Granted:
+    return "Granted";
+  case State::Exchanged:
+    return "Exchanged";
+  case State::Finished:
+    return "Finished";
+  case State::Finalized:
+    return "Finalized";
   }
   return "?";
 }
@@ -54,8 +59,10 @@ ConstView Sources::field(const std::string& name) const {
   const auto it = arrays.find(name);
   if (it == arrays.end()) {
     std::string sent;
-    for (const auto& n : names()) sent += (sent.empty() ? "" : ", ") + n;
-    throw ClientError(ErrorCode::Argument, "Sources: no array '" + name + "' (D sent: " + sent + ")");
+    for (const auto& n : names())
+      sent += (sent.empty() ? "" : ", ") + n;
+    throw ClientError(ErrorCode::Argument,
+                      "Sources: no array '" + name + "' (D sent: " + sent + ")");
   }
   return ConstView(it->second.data(), it->second.size());
 }
@@ -66,8 +73,10 @@ bool Sources::has(const std::string& name) const {
 
 std::vector<std::string> Sources::names() const {
   std::set<std::string> n;
-  for (const auto& kv : views) n.insert(kv.first);
-  for (const auto& kv : arrays) n.insert(kv.first);
+  for (const auto& kv : views)
+    n.insert(kv.first);
+  for (const auto& kv : arrays)
+    n.insert(kv.first);
   return {n.begin(), n.end()};
 }
 
@@ -99,13 +108,14 @@ struct Participant::Impl {
         return;
       }
     }
-    throw StateError(fmt::format("Participant::{}() called in state {}: {}", call,
-                                 stateName(state), hint));
+    throw StateError(
+        fmt::format("Participant::{}() called in state {}: {}", call, stateName(state), hint));
   }
 
   proto::TransportOptions transport(bool forDem) const {
     proto::TransportOptions t;
-    t.sender = opt.name + " (" + (opt.softwareVersion.empty() ? kLibraryVersion : opt.softwareVersion) + ")";
+    t.sender = opt.name + " (" +
+               (opt.softwareVersion.empty() ? kLibraryVersion : opt.softwareVersion) + ")";
     if (forDem) {
       const auto key = fromEnv(opt.demServerPublicKey, "COREDEM_DEM_SERVER_KEY");
       if (!key.empty()) {
@@ -132,13 +142,14 @@ struct Participant::Impl {
     e.types = {v1::MESSAGE_TYPE_STEP_GRANT};
     e.step = expectedStep;
     if (const auto s = proto::validate(reply, e); !s.ok()) {
-      throw proto::ProtocolError(s.code, "orchestrator " + controlEp + " sent a bad StepGrant: " +
-                                             s.message);
+      throw proto::ProtocolError(s.code, "orchestrator " + controlEp +
+                                             " sent a bad StepGrant: " + s.message);
     }
     const auto& g = reply.envelope().step_grant();
     COREDEM_CHECK(g.dt_cfd() > 0.0 && g.n_sub() >= 1,
                   "orchestrator {} granted step {} with dt_cfd = {} s and n_sub = {}: both must "
-                  "be positive", controlEp, expectedStep, g.dt_cfd(), g.n_sub());
+                  "be positive",
+                  controlEp, expectedStep, g.dt_cfd(), g.n_sub());
     step = reply.envelope().step();
     time = reply.envelope().time();
     dt = g.dt_cfd();
@@ -149,8 +160,8 @@ struct Participant::Impl {
   }
 
   proto::Message handshake(proto::Client& client, const std::string& peer) {
-    auto hello = proto::makeHello(v1::ROLE_CFD,
-                                  opt.softwareVersion.empty() ? kLibraryVersion : opt.softwareVersion);
+    auto hello = proto::makeHello(v1::ROLE_CFD, opt.softwareVersion.empty() ? kLibraryVersion
+                                                                            : opt.softwareVersion);
     hello.setSessionId(session);
     auto reply = client.request(std::move(hello), timeout);
     proto::expectType(reply, v1::MESSAGE_TYPE_WELCOME);
@@ -167,12 +178,13 @@ struct Participant::Impl {
     controlEp = fromEnv(opt.controlEndpoint, "COREDEM_CONTROL_ENDPOINT");
     demEp = fromEnv(opt.demEndpoint, "COREDEM_DEM_ENDPOINT");
     session = fromEnv(opt.sessionId, "COREDEM_SESSION");
-    COREDEM_CHECK(!controlEp.empty(), "no orchestrator control endpoint: set COREDEM_CONTROL_ENDPOINT "
+    COREDEM_CHECK(!controlEp.empty(),
+                  "no orchestrator control endpoint: set COREDEM_CONTROL_ENDPOINT "
                   "(or Options::controlEndpoint / --control), e.g. tcp://127.0.0.1:40123");
     COREDEM_CHECK(!demEp.empty(), "no DEM server endpoint: set COREDEM_DEM_ENDPOINT (or "
-                  "Options::demEndpoint / --dem), e.g. tcp://127.0.0.1:40125");
+                                  "Options::demEndpoint / --dem), e.g. tcp://127.0.0.1:40125");
     COREDEM_CHECK(!session.empty(), "no session id: set COREDEM_SESSION (or Options::sessionId / "
-                  "--session) to the id the orchestrator passes");
+                                    "--session) to the id the orchestrator passes");
     double t = opt.timeoutSeconds;
     if (t <= 0.0) {
       const auto env = fromEnv("", "COREDEM_TIMEOUT_S");
@@ -200,15 +212,21 @@ struct Participant::Impl {
     const auto& c = cfg.envelope().configure();
     COREDEM_CHECK(c.coupling_mesh().has_cartesian(),
                   "orchestrator {} sent a Configure without a Cartesian coupling grid; this "
-                  "client supports coupling_mesh.cartesian only", controlEp);
+                  "client supports coupling_mesh.cartesian only",
+                  controlEp);
     const auto& g = c.coupling_mesh().cartesian();
-    grid.origin[0] = g.origin().x(); grid.origin[1] = g.origin().y(); grid.origin[2] = g.origin().z();
-    grid.spacing[0] = g.spacing().x(); grid.spacing[1] = g.spacing().y(); grid.spacing[2] = g.spacing().z();
+    grid.origin[0] = g.origin().x();
+    grid.origin[1] = g.origin().y();
+    grid.origin[2] = g.origin().z();
+    grid.spacing[0] = g.spacing().x();
+    grid.spacing[1] = g.spacing().y();
+    grid.spacing[2] = g.spacing().z();
     grid.counts[0] = static_cast<std::int64_t>(g.counts().x());
     grid.counts[1] = static_cast<std::int64_t>(g.counts().y());
     grid.counts[2] = static_cast<std::int64_t>(g.counts().z());
-    COREDEM_CHECK(grid.cellCount() > 0, "orchestrator {} sent an empty coupling grid ({} x {} x {})",
-                  controlEp, grid.counts[0], grid.counts[1], grid.counts[2]);
+    COREDEM_CHECK(grid.cellCount() > 0,
+                  "orchestrator {} sent an empty coupling grid ({} x {} x {})", controlEp,
+                  grid.counts[0], grid.counts[1], grid.counts[2]);
     grid.species.clear();
     grid.molarMasses.clear();
     for (const auto& s : c.species()) {
@@ -231,7 +249,8 @@ struct Participant::Impl {
     takeGrantOrShutdown(control->request(std::move(ready), timeout), startStep + 1);
     if (state == State::Granted) {
       log->info("{}: coupled on a {} x {} x {} grid with {} species; first grant: step {}, dt {} s",
-                opt.name, grid.counts[0], grid.counts[1], grid.counts[2], grid.species.size(), step, dt);
+                opt.name, grid.counts[0], grid.counts[1], grid.counts[2], grid.species.size(), step,
+                dt);
     }
   }
 
@@ -239,35 +258,46 @@ struct Participant::Impl {
                           const std::vector<NamedBuffer>& into) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
-    COREDEM_CHECK(s == step, "exchange(step = {}): the granted step is {}; send the fields of the "
-                  "granted step", s, step);
+    COREDEM_CHECK(s == step,
+                  "exchange(step = {}): the granted step is {}; send the fields of the "
+                  "granted step",
+                  s, step);
     COREDEM_CHECK(std::abs(d - dt) <= kDtTolerance * dt,
                   "exchange(dt = {:.17g} s): the granted dt of step {} is {:.17g} s; the DEM "
-                  "sub-cycles exactly the granted dt, so advance by dt()", d, step, dt);
+                  "sub-cycles exactly the granted dt, so advance by dt()",
+                  d, step, dt);
     const auto cells = static_cast<std::uint64_t>(grid.cellCount());
     const auto ns = static_cast<std::uint64_t>(grid.species.size());
     std::map<std::string, ConstView> given;
     for (const auto& f : fields) {
       COREDEM_CHECK(proto::fields::findField(f.name) != nullptr &&
-                        std::any_of(proto::fields::gasFields().begin(), proto::fields::gasFields().end(),
+                        std::any_of(proto::fields::gasFields().begin(),
+                                    proto::fields::gasFields().end(),
                                     [&](const auto& spec) { return spec.name == f.name; }),
                     "exchange: '{}' is not a GasFields array; the names are u_g, grad_p, T_g, "
-                    "rho_g, mu_g, kappa_g, cp_g, Y_g", f.name);
-      COREDEM_CHECK(given.emplace(f.name, f.values).second, "exchange: field '{}' given twice", f.name);
+                    "rho_g, mu_g, kappa_g, cp_g, Y_g",
+                    f.name);
+      COREDEM_CHECK(given.emplace(f.name, f.values).second, "exchange: field '{}' given twice",
+                    f.name);
     }
     std::map<std::string, const NamedBuffer*> dest;
     for (const auto& b : into) {
-      const auto spec = std::find_if(proto::fields::sourceFields().begin(), proto::fields::sourceFields().end(),
-                                     [&](const auto& sp) { return sp.name == b.name; });
+      const auto spec =
+          std::find_if(proto::fields::sourceFields().begin(), proto::fields::sourceFields().end(),
+                       [&](const auto& sp) { return sp.name == b.name; });
       COREDEM_CHECK(spec != proto::fields::sourceFields().end(),
                     "exchange: '{}' is not a Sources array; the names are eps_g, K_sl, K_sl_Us, H, "
-                    "H_Tp, R_species, Q_hom", b.name);
+                    "H_Tp, R_species, Q_hom",
+                    b.name);
       const std::uint64_t n = cells * proto::fields::componentsOf(spec->extent, ns);
-      COREDEM_CHECK(b.size == n, "exchange: the buffer for '{}' holds {} values; the coupling grid "
-                    "has {} cells, so it needs {} ({} per cell)", b.name, b.size, cells, n,
-                    proto::fields::componentsOf(spec->extent, ns));
-      COREDEM_CHECK(n == 0 || b.data != nullptr, "exchange: buffer for '{}' points to null", b.name);
-      COREDEM_CHECK(dest.emplace(b.name, &b).second, "exchange: buffer for '{}' given twice", b.name);
+      COREDEM_CHECK(b.size == n,
+                    "exchange: the buffer for '{}' holds {} values; the coupling grid "
+                    "has {} cells, so it needs {} ({} per cell)",
+                    b.name, b.size, cells, n, proto::fields::componentsOf(spec->extent, ns));
+      COREDEM_CHECK(n == 0 || b.data != nullptr, "exchange: buffer for '{}' points to null",
+                    b.name);
+      COREDEM_CHECK(dest.emplace(b.name, &b).second, "exchange: buffer for '{}' given twice",
+                    b.name);
     }
     auto msg = proto::makeGasFields(step, time, dt, cells, static_cast<std::uint32_t>(ns));
     msg.setSessionId(session);
@@ -280,8 +310,8 @@ struct Participant::Impl {
       const std::uint64_t n = cells * proto::fields::componentsOf(spec.extent, ns);
       COREDEM_CHECK(it->second.size == n,
                     "exchange: '{}' has {} values; the coupling grid has {} cells, so it needs {} "
-                    "({} per cell)", name, it->second.size, cells, n,
-                    proto::fields::componentsOf(spec.extent, ns));
+                    "({} per cell)",
+                    name, it->second.size, cells, n, proto::fields::componentsOf(spec.extent, ns));
       COREDEM_CHECK(n == 0 || it->second.data != nullptr, "exchange: '{}' points to null", name);
       // One copy into the message: zero-copy would leave ZeroMQ pointing into the caller's
       // arrays after a timed-out request, when the caller may already have freed them.
@@ -296,7 +326,8 @@ struct Participant::Impl {
     // into the caller's buffers. Replies to earlier, timed-out requests are skipped.
     std::optional<proto::Message> reply;
     for (;;) {
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
       if (left.count() > 0) {
         reply = dem->receive(left);
       }
@@ -304,10 +335,12 @@ struct Participant::Impl {
         throw proto::TimeoutError(demEp, what,
                                   fmt::format("no reply from DEM server {} within {} ms while "
                                               "awaiting the {}; is it running, reachable and not "
-                                              "stalled?", demEp, timeout.count(), what));
+                                              "stalled?",
+                                              demEp, timeout.count(), what));
       }
       const auto& env = reply->envelope();
-      if (env.sequence() == seq || (env.sequence() == 0 && reply->type() == v1::MESSAGE_TYPE_ERROR)) {
+      if (env.sequence() == seq ||
+          (env.sequence() == 0 && reply->type() == v1::MESSAGE_TYPE_ERROR)) {
         break;
       }
       log->debug("{}: discarding a stale reply (sequence {}) while awaiting {}", opt.name,
@@ -336,10 +369,10 @@ struct Participant::Impl {
       const auto v = kept->values<double>(name);
       if (const auto b = dest.find(name); b != dest.end()) {
         if (b->second->size != v.size()) {
-          throw proto::ProtocolError(v1::ERROR_CODE_SHAPE,
-                                     fmt::format("DEM server {} sent {} values of '{}' for step {}; "
-                                                 "the buffer given for it holds {}", demEp, v.size(),
-                                                 name, step, b->second->size));
+          throw proto::ProtocolError(
+              v1::ERROR_CODE_SHAPE, fmt::format("DEM server {} sent {} values of '{}' for step {}; "
+                                                "the buffer given for it holds {}",
+                                                demEp, v.size(), name, step, b->second->size));
         }
         copies.emplace_back(b->second, v);
       } else {
@@ -368,7 +401,8 @@ struct Participant::Impl {
                   "advance: the Courant number must be finite and >= 0 (got {})", courant);
     COREDEM_CHECK(files.empty() || !checkpointDir.empty(),
                   "advance: checkpoint files given for step {}, but its grant asked for no "
-                  "checkpoint", step);
+                  "checkpoint",
+                  step);
     v1::StepDone body;
     body.set_cfl(courant);
     auto fill = [](auto* list, const std::vector<std::pair<std::string, double>>& values) {
@@ -396,7 +430,8 @@ struct Participant::Impl {
       return;
     }
     if (state == State::Granted || state == State::Exchanged) {
-      log->warn("{}: finalize() during step {} before the orchestrator ended the run", opt.name, step);
+      log->warn("{}: finalize() during step {} before the orchestrator ended the run", opt.name,
+                step);
     }
     dem.reset();
     control.reset();
@@ -408,7 +443,8 @@ struct Participant::Impl {
 namespace {
 
 /// Runs f, turning every exception into ClientError with the matching code.
-template <class F> decltype(auto) guarded(const char* call, F&& f) {
+template <class F>
+decltype(auto) guarded(const char* call, F&& f) {
   try {
     return f();
   } catch (const ClientError&) {
@@ -430,7 +466,8 @@ template <class F> decltype(auto) guarded(const char* call, F&& f) {
 
 } // namespace
 
-Participant::Participant(Options options) : _impl(std::make_unique<Impl>()) {
+Participant::Participant(Options options)
+    : _impl(std::make_unique<Impl>()) {
   _impl->opt = std::move(options);
 }
 Participant::~Participant() {
@@ -449,16 +486,18 @@ void Participant::initialize() {
   guarded("initialize", [&] { _impl->initialize(); });
 }
 
-State Participant::state() const { return _impl->state; }
+State Participant::state() const {
+  return _impl->state;
+}
 bool Participant::isRunning() const {
   return _impl->state == State::Granted || _impl->state == State::Exchanged;
 }
 
-#define COREDEM_GRANT_GETTER(type, name, member)                                             \
-  type Participant::name() const {                                                           \
-    _impl->require({State::Granted, State::Exchanged}, #name,                                 \
-                   "the grant is known between initialize()/advance() and the end of the run"); \
-    return _impl->member;                                                                    \
+#define COREDEM_GRANT_GETTER(type, name, member)                                                   \
+  type Participant::name() const {                                                                 \
+    _impl->require({State::Granted, State::Exchanged}, #name,                                      \
+                   "the grant is known between initialize()/advance() and the end of the run");    \
+    return _impl->member;                                                                          \
   }
 COREDEM_GRANT_GETTER(std::int64_t, step, step)
 COREDEM_GRANT_GETTER(double, time, time)
@@ -468,7 +507,9 @@ COREDEM_GRANT_GETTER(double, dtDem, dtDem)
 COREDEM_GRANT_GETTER(std::string, checkpointDir, checkpointDir)
 #undef COREDEM_GRANT_GETTER
 
-bool Participant::requiresCheckpoint() const { return !checkpointDir().empty(); }
+bool Participant::requiresCheckpoint() const {
+  return !checkpointDir().empty();
+}
 
 std::string Participant::shutdownReason() const {
   _impl->require({State::Finished, State::Finalized}, "shutdownReason", "the run has not ended");
@@ -495,7 +536,8 @@ const Sources& Participant::exchange(std::int64_t step, double dt,
                                      const std::vector<NamedField>& fields) {
   _impl->require({State::Granted}, "exchange",
                  "exchange() once per grant, after initialize() or advance() granted a step");
-  return guarded("exchange", [&]() -> const Sources& { return _impl->exchange(step, dt, fields, {}); });
+  return guarded("exchange",
+                 [&]() -> const Sources& { return _impl->exchange(step, dt, fields, {}); });
 }
 
 const Sources& Participant::exchange(std::int64_t step, double dt,
@@ -503,10 +545,13 @@ const Sources& Participant::exchange(std::int64_t step, double dt,
                                      const std::vector<NamedBuffer>& into) {
   _impl->require({State::Granted}, "exchange",
                  "exchange() once per grant, after initialize() or advance() granted a step");
-  return guarded("exchange", [&]() -> const Sources& { return _impl->exchange(step, dt, fields, into); });
+  return guarded("exchange",
+                 [&]() -> const Sources& { return _impl->exchange(step, dt, fields, into); });
 }
 
-ExchangeTimes Participant::lastExchangeTimes() const { return _impl->times; }
+ExchangeTimes Participant::lastExchangeTimes() const {
+  return _impl->times;
+}
 
 const Sources& Participant::sources() const {
   _impl->require({State::Exchanged}, "sources", "sources exist between exchange() and advance()");
@@ -519,6 +564,8 @@ void Participant::advance(double courant, const Ledgers& ledgers,
   guarded("advance", [&] { _impl->advance(courant, ledgers, checkpointFiles); });
 }
 
-void Participant::finalize() { _impl->finalize(); }
+void Participant::finalize() {
+  _impl->finalize();
+}
 
 } // namespace coredem::client

@@ -1,16 +1,16 @@
 // The prescribed gas of coredem-gas (docs/client.md, "coredem-gas input").
 #include "coredem/gas/gas_model.h"
 
-#include "coredem/common/check.h"
-
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <optional>
 #include <set>
 #include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include "coredem/common/check.h"
 
 namespace coredem::gas {
 
@@ -25,11 +25,13 @@ std::array<double, 3> CartesianGrid::cellCentre(std::int64_t c) const {
 
 template <int D>
 TimeSeries<D>::TimeSeries(std::vector<double> times, std::vector<Value> values)
-    : _times(std::move(times)), _values(std::move(values)) {
+    : _times(std::move(times))
+    , _values(std::move(values)) {
   COREDEM_ASSERT(!_times.empty() && _times.size() == _values.size());
 }
 
-template <int D> typename TimeSeries<D>::Value TimeSeries<D>::at(double t) const {
+template <int D>
+typename TimeSeries<D>::Value TimeSeries<D>::at(double t) const {
   if (_times.size() == 1 || t <= _times.front()) {
     return _values.front();
   }
@@ -53,12 +55,14 @@ template class TimeSeries<3>;
 namespace {
 
 enum Field { kUg = 0, kGradP, kTg, kRhoG, kMuG, kKappaG, kCpG, kYg, kFieldCount };
-constexpr const char* kFieldNames[kFieldCount] = {"u_g",   "grad_p",  "T_g",  "rho_g",
-                                                  "mu_g",  "kappa_g", "cp_g", "Y_g"};
-constexpr const char* kUnits[kFieldCount] = {"m/s", "Pa/m", "K", "kg/m^3", "Pa s", "W/m/K",
-                                             "J/kg/K", "-"};
+constexpr const char* kFieldNames[kFieldCount] = {"u_g",  "grad_p",  "T_g",  "rho_g",
+                                                  "mu_g", "kappa_g", "cp_g", "Y_g"};
+constexpr const char* kUnits[kFieldCount] = {"m/s",  "Pa/m",  "K",      "kg/m^3",
+                                             "Pa s", "W/m/K", "J/kg/K", "-"};
 
-bool isVectorField(int f) { return f == kUg || f == kGradP; }
+bool isVectorField(int f) {
+  return f == kUg || f == kGradP;
+}
 
 /// Tolerance on the sum of mass fractions (docs/client.md).
 constexpr double kCompositionTolerance = 1e-9;
@@ -90,7 +94,10 @@ struct Ctx {
 
 double parseNumber(const Ctx& ctx, const YAML::Node& n, const std::string& key, const char* what) {
   COREDEM_CHECK(n.IsScalar(), "{}: key '{}': expected {} (a number), got a {}", ctx.at(n), key,
-                what, n.IsSequence() ? "sequence" : n.IsMap() ? "mapping" : "null value");
+                what,
+                n.IsSequence() ? "sequence"
+                : n.IsMap()    ? "mapping"
+                               : "null value");
   double v = 0.0;
   try {
     v = n.as<double>();
@@ -103,7 +110,8 @@ double parseNumber(const Ctx& ctx, const YAML::Node& n, const std::string& key, 
 }
 
 template <int D>
-typename TimeSeries<D>::Value parseValue(const Ctx& ctx, const YAML::Node& n, const std::string& key) {
+typename TimeSeries<D>::Value parseValue(const Ctx& ctx, const YAML::Node& n,
+                                         const std::string& key) {
   typename TimeSeries<D>::Value v{};
   if constexpr (D == 1) {
     v[0] = parseNumber(ctx, n, key, "a scalar");
@@ -125,12 +133,15 @@ TimeSeries<D> parseSeries(const Ctx& ctx, const YAML::Node& n, const std::string
   }
   for (const auto& kv : n) {
     const auto k = kv.first.as<std::string>();
-    COREDEM_CHECK(k == "table", "{}: key '{}.{}' is not allowed: a time-dependent value is "
-                  "written {{table: [[t0, v0], [t1, v1], ...]}}", ctx.at(kv.first), key, k);
+    COREDEM_CHECK(k == "table",
+                  "{}: key '{}.{}' is not allowed: a time-dependent value is "
+                  "written {{table: [[t0, v0], [t1, v1], ...]}}",
+                  ctx.at(kv.first), key, k);
   }
   const auto table = n["table"];
   COREDEM_CHECK(table.IsSequence() && table.size() >= 1,
-                "{}: key '{}.table': expected a non-empty list of [t, value] pairs", ctx.at(n), key);
+                "{}: key '{}.table': expected a non-empty list of [t, value] pairs", ctx.at(n),
+                key);
   std::vector<double> times;
   std::vector<typename TimeSeries<D>::Value> values;
   for (std::size_t i = 0; i < table.size(); ++i) {
@@ -159,8 +170,8 @@ std::vector<double> breakpoints(const std::map<std::string, TimeSeries<1>>& ys) 
 }
 
 struct FieldSet {
-  std::optional<TimeSeries<3>> vec[2];                // u_g, grad_p
-  std::optional<TimeSeries<1>> scalar[kFieldCount];   // T_g .. cp_g (indices kTg..kCpG)
+  std::optional<TimeSeries<3>> vec[2];              // u_g, grad_p
+  std::optional<TimeSeries<1>> scalar[kFieldCount]; // T_g .. cp_g (indices kTg..kCpG)
   std::optional<std::map<std::string, TimeSeries<1>>> Y;
   int yLine = 0;
 
@@ -184,8 +195,8 @@ void parseField(const Ctx& ctx, FieldSet& fs, int f, const YAML::Node& n, const 
     auto s = parseSeries<1>(ctx, n, key);
     for (double t : s.times()) {
       const double v = s.at(t)[0];
-      COREDEM_CHECK(v > 0.0, "{}: key '{}': {} must be > 0 {} (got {} at t = {} s)", ctx.at(n),
-                    key, kFieldNames[f], kUnits[f], v, t);
+      COREDEM_CHECK(v > 0.0, "{}: key '{}': {} must be > 0 {} (got {} at t = {} s)", ctx.at(n), key,
+                    kFieldNames[f], kUnits[f], v, t);
     }
     fs.scalar[f] = std::move(s);
     return;
@@ -200,8 +211,10 @@ void parseField(const Ctx& ctx, FieldSet& fs, int f, const YAML::Node& n, const 
     auto s = parseSeries<1>(ctx, kv.second, sk);
     for (double t : s.times()) {
       const double v = s.at(t)[0];
-      COREDEM_CHECK(v >= 0.0 && v <= 1.0, "{}: key '{}': a mass fraction must be in [0, 1] (got {} "
-                    "at t = {} s)", ctx.at(kv.second), sk, v, t);
+      COREDEM_CHECK(v >= 0.0 && v <= 1.0,
+                    "{}: key '{}': a mass fraction must be in [0, 1] (got {} "
+                    "at t = {} s)",
+                    ctx.at(kv.second), sk, v, t);
     }
     ys.emplace(name, std::move(s));
   }
@@ -212,7 +225,8 @@ void parseField(const Ctx& ctx, FieldSet& fs, int f, const YAML::Node& n, const 
     }
     COREDEM_CHECK(std::abs(sum - 1.0) <= kCompositionTolerance,
                   "{}: key '{}': the mass fractions sum to {:.12g} at t = {} s; they must sum to 1 "
-                  "(within {})", ctx.at(n), key, sum, t, kCompositionTolerance);
+                  "(within {})",
+                  ctx.at(n), key, sum, t, kCompositionTolerance);
   }
   fs.Y = std::move(ys);
   fs.yLine = n.Mark().line + 1;
@@ -257,7 +271,8 @@ struct GasModel::Impl {
   }
 };
 
-GasModel::GasModel(std::unique_ptr<Impl> impl) : _impl(std::move(impl)) {}
+GasModel::GasModel(std::unique_ptr<Impl> impl)
+    : _impl(std::move(impl)) {}
 GasModel::GasModel(GasModel&&) noexcept = default;
 GasModel& GasModel::operator=(GasModel&&) noexcept = default;
 GasModel::~GasModel() = default;
@@ -289,8 +304,10 @@ GasModel GasModel::fromYaml(const YAML::Node& node, const std::string& where) {
     parseField(ctx, d, f, kv.second, key);
   }
   if (const auto rs = node["regions"]) {
-    COREDEM_CHECK(rs.IsSequence(), "{}: key 'regions': expected a list of regions, each "
-                  "{{name, box: {{min: [x,y,z], max: [x,y,z]}}, <fields>}}", ctx.at(rs));
+    COREDEM_CHECK(rs.IsSequence(),
+                  "{}: key 'regions': expected a list of regions, each "
+                  "{{name, box: {{min: [x,y,z], max: [x,y,z]}}, <fields>}}",
+                  ctx.at(rs));
     for (std::size_t i = 0; i < rs.size(); ++i) {
       const auto rn = rs[i];
       const std::string rk = fmt::format("regions[{}]", i);
@@ -308,13 +325,15 @@ GasModel GasModel::fromYaml(const YAML::Node& node, const std::string& where) {
         if (key == "box") {
           const auto b = kv.second;
           COREDEM_CHECK(b.IsMap() && b["min"] && b["max"] && b.size() == 2,
-                        "{}: key '{}': expected {{min: [x, y, z], max: [x, y, z]}} (m)",
-                        ctx.at(b), fk);
+                        "{}: key '{}': expected {{min: [x, y, z], max: [x, y, z]}} (m)", ctx.at(b),
+                        fk);
           r.lo = parseVec3(ctx, b["min"], fk + ".min");
           r.hi = parseVec3(ctx, b["max"], fk + ".max");
           for (int a = 0; a < 3; ++a) {
-            COREDEM_CHECK(r.lo[a] < r.hi[a], "{}: key '{}': min must be < max on every axis "
-                          "(axis {}: {} >= {})", ctx.at(b), fk, a, r.lo[a], r.hi[a]);
+            COREDEM_CHECK(r.lo[a] < r.hi[a],
+                          "{}: key '{}': min must be < max on every axis "
+                          "(axis {}: {} >= {})",
+                          ctx.at(b), fk, a, r.lo[a], r.hi[a]);
           }
           hasBox = true;
           continue;
@@ -324,8 +343,10 @@ GasModel GasModel::fromYaml(const YAML::Node& node, const std::string& where) {
                       allowedKeys(true));
         parseField(ctx, r.fields, f, kv.second, fk);
       }
-      COREDEM_CHECK(hasBox, "{}: key '{}' (region '{}') has no 'box: {{min: [x,y,z], max: "
-                    "[x,y,z]}}'", ctx.at(rn), rk, r.name);
+      COREDEM_CHECK(hasBox,
+                    "{}: key '{}' (region '{}') has no 'box: {{min: [x,y,z], max: "
+                    "[x,y,z]}}'",
+                    ctx.at(rn), rk, r.name);
       impl->regions.push_back(std::move(r));
     }
   }
@@ -339,16 +360,18 @@ GasModel GasModel::fromFile(const std::string& file, const std::string& key) {
   } catch (const YAML::BadFile&) {
     COREDEM_CHECK(false, "cannot read the case file '{}': check the path (--case)", file);
   } catch (const YAML::Exception& e) {
-    COREDEM_CHECK(false, "{}:{}:{}: YAML syntax error: {}", file, e.mark.line + 1, e.mark.column + 1,
-                  e.msg);
+    COREDEM_CHECK(false, "{}:{}:{}: YAML syntax error: {}", file, e.mark.line + 1,
+                  e.mark.column + 1, e.msg);
   }
   YAML::Node node = root;
   std::string done;
   std::stringstream ss(key);
   std::string part;
   while (std::getline(ss, part, '.')) {
-    COREDEM_CHECK(node.IsMap() && node[part], "{}: no key '{}{}' (the gas description is taken "
-                  "from --key '{}')", file, done, part, key);
+    COREDEM_CHECK(node.IsMap() && node[part],
+                  "{}: no key '{}{}' (the gas description is taken "
+                  "from --key '{}')",
+                  file, done, part, key);
     node = node[part];
     done += part + ".";
   }
@@ -360,7 +383,8 @@ void GasModel::bind(const CartesianGrid& grid, const std::vector<std::string>& s
   for (int a = 0; a < 3; ++a) {
     COREDEM_CHECK(grid.counts[a] >= 1 && grid.spacing[a] > 0.0,
                   "coupling grid: counts must be >= 1 and spacing > 0 on every axis (axis {}: "
-                  "count {}, spacing {})", a, grid.counts[a], grid.spacing[a]);
+                  "count {}, spacing {})",
+                  a, grid.counts[a], grid.spacing[a]);
   }
   const std::set<std::string> known(species.begin(), species.end());
   auto checkNames = [&](const FieldSet& fs, const std::string& owner) {
@@ -368,9 +392,10 @@ void GasModel::bind(const CartesianGrid& grid, const std::vector<std::string>& s
       return;
     }
     for (const auto& [name, s] : *fs.Y) {
-      COREDEM_CHECK(known.count(name) == 1, "{}:{}: {} Y_g names species '{}', which is not in "
-                    "the case's species list [{}]", m.where, fs.yLine, owner, name,
-                    fmt::join(species, ", "));
+      COREDEM_CHECK(known.count(name) == 1,
+                    "{}:{}: {} Y_g names species '{}', which is not in "
+                    "the case's species list [{}]",
+                    m.where, fs.yLine, owner, name, fmt::join(species, ", "));
     }
   };
   checkNames(m.domain, "the domain");
@@ -402,8 +427,8 @@ void GasModel::bind(const CartesianGrid& grid, const std::vector<std::string>& s
       }
       COREDEM_CHECK(m.owner[f][static_cast<std::size_t>(c)] >= 0,
                     "{}: the case has species [{}] but no Y_g is given for cell {} (centre {}, "
-                    "{}, {} m): add a domain-wide 'Y_g: {{name: fraction, ...}}'", m.where,
-                    fmt::join(species, ", "), c, x[0], x[1], x[2]);
+                    "{}, {} m): add a domain-wide 'Y_g: {{name: fraction, ...}}'",
+                    m.where, fmt::join(species, ", "), c, x[0], x[1], x[2]);
     }
   }
   m.grid = grid;
@@ -450,14 +475,30 @@ void GasModel::evaluate(double t, GasFieldArrays& out) const {
     }
     std::vector<double>* dst = nullptr;
     switch (f) {
-    case kUg: dst = &out.u_g; break;
-    case kGradP: dst = &out.grad_p; break;
-    case kTg: dst = &out.T_g; break;
-    case kRhoG: dst = &out.rho_g; break;
-    case kMuG: dst = &out.mu_g; break;
-    case kKappaG: dst = &out.kappa_g; break;
-    case kCpG: dst = &out.cp_g; break;
-    default: dst = &out.Y_g; break;
+    case kUg:
+      dst = &out.u_g;
+      break;
+    case kGradP:
+      dst = &out.grad_p;
+      break;
+    case kTg:
+      dst = &out.T_g;
+      break;
+    case kRhoG:
+      dst = &out.rho_g;
+      break;
+    case kMuG:
+      dst = &out.mu_g;
+      break;
+    case kKappaG:
+      dst = &out.kappa_g;
+      break;
+    case kCpG:
+      dst = &out.cp_g;
+      break;
+    default:
+      dst = &out.Y_g;
+      break;
     }
     dst->resize(n * width);
     if (width == 0) {
@@ -466,12 +507,15 @@ void GasModel::evaluate(double t, GasFieldArrays& out) const {
     const auto& own = m.owner[f];
     for (std::size_t c = 0; c < n; ++c) {
       const auto s = own.empty() ? 0 : static_cast<std::size_t>(own[c]);
-      std::copy(values[s].begin(), values[s].end(), dst->begin() + static_cast<std::ptrdiff_t>(c * width));
+      std::copy(values[s].begin(), values[s].end(),
+                dst->begin() + static_cast<std::ptrdiff_t>(c * width));
     }
   }
 }
 
-std::size_t GasModel::regionCount() const { return _impl->regions.size(); }
+std::size_t GasModel::regionCount() const {
+  return _impl->regions.size();
+}
 
 std::string GasModel::describe() const {
   const auto& m = *_impl;

@@ -1,15 +1,15 @@
 #include "gas_state.h"
 
-#include "coredem/common/check.h"
-#include "coredem/common/hdf5.h"
-#include "coredem/common/version.h"
-
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
 #include <fcntl.h>
 #include <unistd.h>
+
+#include "coredem/common/check.h"
+#include "coredem/common/hdf5.h"
+#include "coredem/common/version.h"
 
 namespace coredem::gas {
 

@@ -7,12 +7,12 @@
 namespace coredem::gas {
 
 struct GasState {
-  double time = 0.0;           ///< s, end of the step
-  std::int64_t step = 0;       ///< last completed step
-  std::string caseKey;         ///< e.g. "case.yaml:gas"
+  double time = 0.0;     ///< s, end of the step
+  std::int64_t step = 0; ///< last completed step
+  std::string caseKey;   ///< e.g. "case.yaml:gas"
   std::vector<std::string> names;
-  std::vector<double> values;        ///< cumulative sums
-  std::vector<double> compensation;  ///< Kahan compensation of each sum
+  std::vector<double> values;       ///< cumulative sums
+  std::vector<double> compensation; ///< Kahan compensation of each sum
 };
 
 /// Writes `path` via a temp file + rename (a reader never sees a partial file).

@@ -2,7 +2,12 @@
 // every granted step through the coupling client, receives the DEM sources, integrates what a
 // prescribed gas can (heat, species and momentum given to the gas) into ledgers for the
 // orchestrator's balances, and writes its small state on checkpoints.
-#include "gas_state.h"
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+
+#include <CLI/CLI.hpp>
 
 #include "coredem/client/participant.h"
 #include "coredem/common/check.h"
@@ -10,13 +15,7 @@
 #include "coredem/common/log.h"
 #include "coredem/common/version.h"
 #include "coredem/gas/gas_model.h"
-
-#include <CLI/CLI.hpp>
-
-#include <chrono>
-#include <cmath>
-#include <filesystem>
-#include <map>
+#include "gas_state.h"
 
 namespace {
 
@@ -43,10 +42,18 @@ public:
     for (std::size_t i = 0; i < _names.size(); ++i) {
       const std::pair<std::string, double> e{_names[i], _sum[i].value()};
       switch (_kinds[i]) {
-      case Kind::Mass: l.mass.push_back(e); break;
-      case Kind::Energy: l.energy.push_back(e); break;
-      case Kind::Species: l.species.push_back(e); break;
-      case Kind::Diagnostic: l.diagnostics.push_back(e); break;
+      case Kind::Mass:
+        l.mass.push_back(e);
+        break;
+      case Kind::Energy:
+        l.energy.push_back(e);
+        break;
+      case Kind::Species:
+        l.species.push_back(e);
+        break;
+      case Kind::Diagnostic:
+        l.diagnostics.push_back(e);
+        break;
       }
     }
     return l;
@@ -63,8 +70,10 @@ public:
   void restore(const gas::GasState& s) {
     for (std::size_t i = 0; i < s.names.size(); ++i) {
       const auto it = _index.find(s.names[i]);
-      COREDEM_CHECK(it != _index.end(), "restart file has ledger '{}', which this case does not "
-                    "produce (another case or species list?)", s.names[i]);
+      COREDEM_CHECK(it != _index.end(),
+                    "restart file has ledger '{}', which this case does not "
+                    "produce (another case or species list?)",
+                    s.names[i]);
       _sum[it->second] = coredem::CompensatedSum(s.values[i], s.compensation[i]);
     }
   }
@@ -114,9 +123,10 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
   ledgers.define("gas.solid_volume_m3", Kind::Diagnostic);
   if (!restart.empty()) {
     const auto s = gas::readGasState(restart);
-    COREDEM_CHECK(s.step == p.startStep(), "restart file {} is of step {}, but the orchestrator "
-                  "restarts from step {}: pass the coredem-gas checkpoint of that step", restart,
-                  s.step, p.startStep());
+    COREDEM_CHECK(s.step == p.startStep(),
+                  "restart file {} is of step {}, but the orchestrator "
+                  "restarts from step {}: pass the coredem-gas checkpoint of that step",
+                  restart, s.step, p.startStep());
     ledgers.restore(s);
     log->info("restarted from {} (step {}, t = {} s)", restart, s.step, s.time);
   }
@@ -126,7 +136,8 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
     double m = 0.0;
     for (std::size_t c = 0; c < n; ++c) {
       double s = 0.0;
-      for (int a = 0; a < 3; ++a) s += std::abs(u[3 * c + a]) / grid.spacing[a];
+      for (int a = 0; a < 3; ++a)
+        s += std::abs(u[3 * c + a]) / grid.spacing[a];
       m = std::max(m, s);
     }
     return m * dt;
@@ -138,7 +149,9 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
   // D's n_sub sub-steps), the ledgers, and advance (StepDone -> next grant from O).
   using Clock = std::chrono::steady_clock;
   double tEval = 0.0, tExchange = 0.0, tLedger = 0.0, tAdvance = 0.0;
-  auto since = [](Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); };
+  auto since = [](Clock::time_point a) {
+    return std::chrono::duration<double>(Clock::now() - a).count();
+  };
   while (p.isRunning()) {
     const double t = p.time();
     const double dt = p.dt();
@@ -147,9 +160,14 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
     tEval += since(t0);
     t0 = Clock::now();
     const auto& s = p.exchange(p.step(), dt,
-                               {{"u_g", f.u_g}, {"grad_p", f.grad_p}, {"T_g", f.T_g},
-                                {"rho_g", f.rho_g}, {"mu_g", f.mu_g}, {"kappa_g", f.kappa_g},
-                                {"cp_g", f.cp_g}, {"Y_g", f.Y_g}});
+                               {{"u_g", f.u_g},
+                                {"grad_p", f.grad_p},
+                                {"T_g", f.T_g},
+                                {"rho_g", f.rho_g},
+                                {"mu_g", f.mu_g},
+                                {"kappa_g", f.kappa_g},
+                                {"cp_g", f.cp_g},
+                                {"Y_g", f.Y_g}});
     tExchange += since(t0);
     t0 = Clock::now();
     const auto eps = s.field("eps_g"), k = s.field("K_sl"), kus = s.field("K_sl_Us"),
@@ -162,8 +180,10 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
       heat += htp[c] - h[c] * f.T_g[c];
       hom += q[c];
       solid += 1.0 - eps[c];
-      for (int a = 0; a < 3; ++a) mom[a] += kus[3 * c + a] - k[c] * f.u_g[3 * c + a];
-      for (std::size_t j = 0; j < ns; ++j) spec[j] += r[c * ns + j];
+      for (int a = 0; a < 3; ++a)
+        mom[a] += kus[3 * c + a] - k[c] * f.u_g[3 * c + a];
+      for (std::size_t j = 0; j < ns; ++j)
+        spec[j] += r[c * ns + j];
     }
     ledgers.add("gas.heat_from_particles_J", heat * vc * dt);
     ledgers.add("gas.heat_homogeneous_J", hom * vc * dt);
@@ -202,9 +222,10 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
   log->info("run finished after {} steps: {}", steps, p.shutdownReason());
   if (steps > 0) {
     const double k = 1e3 / static_cast<double>(steps);
-    log->info("per step ({} cells): gas evaluation {:.3f} ms, exchange with D {:.3f} ms (incl. "
-              "D's sub-steps), ledgers+checkpoints {:.3f} ms, advance (StepDone -> grant) {:.3f} ms",
-              n, tEval * k, tExchange * k, tLedger * k, tAdvance * k);
+    log->info(
+        "per step ({} cells): gas evaluation {:.3f} ms, exchange with D {:.3f} ms (incl. "
+        "D's sub-steps), ledgers+checkpoints {:.3f} ms, advance (StepDone -> grant) {:.3f} ms",
+        n, tEval * k, tExchange * k, tLedger * k, tAdvance * k);
   }
   p.finalize();
   return 0;
@@ -222,12 +243,15 @@ int main(int argc, char** argv) {
   app.add_option("--case", caseFile, "case YAML file")->required();
   app.add_option("--key", key, "dot-separated key of the gas description in the case file")
       ->capture_default_str();
-  app.add_option("--control", opts.controlEndpoint, "orchestrator control endpoint (else COREDEM_CONTROL_ENDPOINT)");
+  app.add_option("--control", opts.controlEndpoint,
+                 "orchestrator control endpoint (else COREDEM_CONTROL_ENDPOINT)");
   app.add_option("--dem", opts.demEndpoint, "DEM server endpoint (else COREDEM_DEM_ENDPOINT)");
   app.add_option("--session", opts.sessionId, "session id (else COREDEM_SESSION)");
-  app.add_option("--timeout-s", opts.timeoutSeconds, "per-request deadline in s (else COREDEM_TIMEOUT_S or 60)")
+  app.add_option("--timeout-s", opts.timeoutSeconds,
+                 "per-request deadline in s (else COREDEM_TIMEOUT_S or 60)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--restart", restart, "coredem-gas checkpoint (gas.h5) to restore the ledgers from");
+  app.add_option("--restart", restart,
+                 "coredem-gas checkpoint (gas.h5) to restore the ledgers from");
   app.add_flag("--check", check, "validate the gas description and exit (0 valid, 2 invalid)");
   try {
     app.parse(argc, argv);

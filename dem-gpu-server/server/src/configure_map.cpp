@@ -1,30 +1,39 @@
 // v1::Configure -> dem::DemConfig.
 #include "configure_map.h"
 
-#include "coredem/common/check.h"
-#include "coredem/dem/models.h"
-
 #include <algorithm>
 #include <map>
+
+#include "coredem/common/check.h"
+#include "coredem/dem/models.h"
 
 namespace coredem::server {
 
 namespace {
 
-std::array<double, 3> vec(const v1::Vec3& v) { return {v.x(), v.y(), v.z()}; }
+std::array<double, 3> vec(const v1::Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 void addChemistry(const v1::Configure& c, dem::DemConfig& cfg) {
   dem::ChemistryOptions& o = cfg.chemistry;
   for (const auto& r : c.reactions()) {
     dem::ReactionConfig d;
     d.name = r.name();
-    for (const auto& t : r.terms()) d.terms.push_back({t.species(), t.nu()});
+    for (const auto& t : r.terms())
+      d.terms.push_back({t.species(), t.nu()});
     switch (r.rate().law()) {
-    case v1::RATE_LAW_CONSTANT: d.law = dem::kernels::RateLaw::Constant; break;
-    case v1::RATE_LAW_ARRHENIUS: d.law = dem::kernels::RateLaw::Arrhenius; break;
+    case v1::RATE_LAW_CONSTANT:
+      d.law = dem::kernels::RateLaw::Constant;
+      break;
+    case v1::RATE_LAW_ARRHENIUS:
+      d.law = dem::kernels::RateLaw::Arrhenius;
+      break;
     default:
-      COREDEM_CHECK(false, "Configure: reaction '{}' has no rate law; use RATE_LAW_CONSTANT or "
-                    "RATE_LAW_ARRHENIUS", r.name());
+      COREDEM_CHECK(false,
+                    "Configure: reaction '{}' has no rate law; use RATE_LAW_CONSTANT or "
+                    "RATE_LAW_ARRHENIUS",
+                    r.name());
     }
     d.A = r.rate().a();
     d.beta = r.rate().beta();
@@ -39,21 +48,29 @@ void addChemistry(const v1::Configure& c, dem::DemConfig& cfg) {
     const auto& ch = c.chemistry();
     const auto& clg = ch.clg();
     o.clg.charGasification = clg.char_gasification();
-    COREDEM_CHECK(clg.char_stoichiometry() != v1::CHAR_STOICHIOMETRY_SEED,
-                  "Configure: chemistry.clg.char_stoichiometry = seed is not implemented (the seed's "
-                  "pseudo-char lines of R1 and R2 are not mutually consistent, PHYSICS §6.1); use carbon");
+    COREDEM_CHECK(
+        clg.char_stoichiometry() != v1::CHAR_STOICHIOMETRY_SEED,
+        "Configure: chemistry.clg.char_stoichiometry = seed is not implemented (the seed's "
+        "pseudo-char lines of R1 and R2 are not mutually consistent, PHYSICS §6.1); use carbon");
     o.clg.ocReduction = clg.oc_reduction();
     o.clg.wgs = clg.wgs();
     switch (clg.wgs_equilibrium()) {
-    case v1::WGS_EQUILIBRIUM_SEED: o.clg.wgsParams.equilibrium = dem::kernels::WgsEquilibrium::Seed; break;
+    case v1::WGS_EQUILIBRIUM_SEED:
+      o.clg.wgsParams.equilibrium = dem::kernels::WgsEquilibrium::Seed;
+      break;
     case v1::WGS_EQUILIBRIUM_THERMODYNAMIC:
       o.clg.wgsParams.equilibrium = dem::kernels::WgsEquilibrium::Thermodynamic;
       break;
-    default: o.clg.wgsParams.equilibrium = dem::kernels::WgsEquilibrium::YoonDenn; break;
+    default:
+      o.clg.wgsParams.equilibrium = dem::kernels::WgsEquilibrium::YoonDenn;
+      break;
     }
-    for (const auto& kv : clg.kinetics()) dem::setClgKinetic(o.clg, kv.name(), kv.value());
-    if (ch.has_removal_fraction()) o.removalFraction = ch.removal_fraction();
-    if (ch.has_reaction_heat()) o.reactionHeat = ch.reaction_heat();
+    for (const auto& kv : clg.kinetics())
+      dem::setClgKinetic(o.clg, kv.name(), kv.value());
+    if (ch.has_removal_fraction())
+      o.removalFraction = ch.removal_fraction();
+    if (ch.has_reaction_heat())
+      o.reactionHeat = ch.reaction_heat();
   }
   // Partial pressures use the gas pressure of the constant gas properties (Pa).
   if (c.gas().has_constant() && c.gas().constant().pressure() > 0.0) {
@@ -71,7 +88,8 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   std::map<std::uint32_t, double> materialDensity;
   cfg.materials.clear();
   for (const auto& m : c.materials()) {
-    COREDEM_CHECK(materialIndex.count(m.id()) == 0, "Configure: material id {} appears twice", m.id());
+    COREDEM_CHECK(materialIndex.count(m.id()) == 0, "Configure: material id {} appears twice",
+                  m.id());
     dem::Material d;
     d.name = m.name().empty() ? "material-" + std::to_string(m.id()) : m.name();
     d.kn = m.k_n();
@@ -79,7 +97,8 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
     d.mu = m.friction();
     d.ktFactor = m.has_kt_factor() ? m.kt_factor() : 2.0 / 7.0;
     d.etatFactor = m.has_etat_factor() ? m.etat_factor() : 0.5;
-    if (m.cp() > 0.0) d.cp = m.cp();  // 0 (unset): the default 840 J/kg/K, as in the case schema
+    if (m.cp() > 0.0)
+      d.cp = m.cp(); // 0 (unset): the default 840 J/kg/K, as in the case schema
     d.conductivity = m.conductivity();
     d.emissivity = m.emissivity();
     materialIndex[m.id()] = static_cast<int>(cfg.materials.size());
@@ -87,7 +106,7 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
     cfg.materials.push_back(d);
   }
   COREDEM_CHECK(!cfg.materials.empty(), "Configure: no materials; give at least one (k_n, e_n, "
-                "friction, density)");
+                                        "friction, density)");
 
   // Gas species (Y_g / R_species columns).
   for (const auto& s : c.species()) {
@@ -105,9 +124,11 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   for (const auto& ps : c.particle_sets()) {
     if (c.solid_species_size() > 0) {
       for (const auto& nv : ps.composition()) {
-        COREDEM_CHECK(std::find(solid.begin(), solid.end(), nv.name()) != solid.end(),
-                      "Configure: particle set '{}' has composition species '{}', which is not among "
-                      "the solid species", ps.name(), nv.name());
+        COREDEM_CHECK(
+            std::find(solid.begin(), solid.end(), nv.name()) != solid.end(),
+            "Configure: particle set '{}' has composition species '{}', which is not among "
+            "the solid species",
+            ps.name(), nv.name());
       }
       continue;
     }
@@ -134,27 +155,37 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
     int index = 0;
     for (const auto& ps : c.particle_sets()) {
       const auto it = materialIndex.find(ps.material_id());
-      COREDEM_CHECK(it != materialIndex.end(), "Configure: particle set {} ('{}') uses material "
-                    "id {}, which is not among the materials", index, ps.name(), ps.material_id());
+      COREDEM_CHECK(it != materialIndex.end(),
+                    "Configure: particle set {} ('{}') uses material "
+                    "id {}, which is not among the materials",
+                    index, ps.name(), ps.material_id());
       dem::ParticleSet d;
       d.name = ps.name().empty() ? "set-" + std::to_string(index) : ps.name();
       d.material = it->second;
       switch (ps.packing()) {
-      case v1::PACKING_RANDOM: d.packing = dem::Packing::Random; break;
+      case v1::PACKING_RANDOM:
+        d.packing = dem::Packing::Random;
+        break;
       case v1::PACKING_EXPLICIT:
         d.packing = dem::Packing::Explicit;
-        COREDEM_CHECK(ps.positions_size() > 0 && static_cast<std::uint64_t>(ps.positions_size()) == ps.count(),
+        COREDEM_CHECK(ps.positions_size() > 0 &&
+                          static_cast<std::uint64_t>(ps.positions_size()) == ps.count(),
                       "Configure: particle set '{}' has explicit packing with {} positions but "
-                      "count {}; give one position per particle", d.name, ps.positions_size(), ps.count());
+                      "count {}; give one position per particle",
+                      d.name, ps.positions_size(), ps.count());
         for (const auto& p : ps.positions()) {
           d.positions.insert(d.positions.end(), {p.x(), p.y(), p.z()});
         }
         break;
       case v1::PACKING_LATTICE:
-      case v1::PACKING_UNSPECIFIED: d.packing = dem::Packing::Lattice; break;
+      case v1::PACKING_UNSPECIFIED:
+        d.packing = dem::Packing::Lattice;
+        break;
       default:
-        COREDEM_CHECK(false, "Configure: particle set '{}' has an unknown packing {}; use "
-                      "LATTICE, RANDOM or EXPLICIT", d.name, static_cast<int>(ps.packing()));
+        COREDEM_CHECK(false,
+                      "Configure: particle set '{}' has an unknown packing {}; use "
+                      "LATTICE, RANDOM or EXPLICIT",
+                      d.name, static_cast<int>(ps.packing()));
       }
       d.regionMin = vec(ps.region_min());
       d.regionMax = vec(ps.region_max());
@@ -183,11 +214,13 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   for (const auto& p : c.walls().planes()) {
     cfg.walls.push_back(dem::Wall{vec(p.point()), vec(p.normal())});
   }
-  cfg.wallTemperature = c.walls().temperature();  // 0 = adiabatic (docs/heat-coupling.md "Walls")
+  cfg.wallTemperature = c.walls().temperature(); // 0 = adiabatic (docs/heat-coupling.md "Walls")
   if (c.walls().temperature() > 0.0) {
     const auto wm = materialIndex.find(c.walls().material_id());
-    COREDEM_CHECK(wm != materialIndex.end(), "Configure: walls use material id {}, which is not "
-                  "among the materials", c.walls().material_id());
+    COREDEM_CHECK(wm != materialIndex.end(),
+                  "Configure: walls use material id {}, which is not "
+                  "among the materials",
+                  c.walls().material_id());
     cfg.wallMaterial = wm->second;
   }
   cfg.gravity = vec(c.gravity());

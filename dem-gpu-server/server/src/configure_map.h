@@ -1,11 +1,11 @@
 #pragma once
 // v1::Configure -> dem::DemConfig (the server's only translation between protocol and core).
-#include "coredem/dem/dem_system.h"
+#include <string>
+#include <vector>
 
 #include <coredem/v1/configure.pb.h>
 
-#include <string>
-#include <vector>
+#include "coredem/dem/dem_system.h"
 
 namespace coredem::server {
 

@@ -1,16 +1,6 @@
 // coredem-dem: D of docs/session.md over the protocol library and the DEM core.
 #include "coredem/server/dem_server.h"
 
-#include "configure_map.h"
-#include "state_meta.h"
-#include "timers.h"
-
-#include "coredem/common/check.h"
-#include "coredem/common/log.h"
-#include "coredem/dem/dem_system.h"
-#include "coredem/dem/time_handler.h"
-#include "coredem/protocol/protocol.h"
-
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -18,9 +8,19 @@
 #include <map>
 #include <optional>
 #include <random>
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include "configure_map.h"
+#include "coredem/common/check.h"
+#include "coredem/common/log.h"
+#include "coredem/dem/dem_system.h"
+#include "coredem/dem/time_handler.h"
+#include "coredem/protocol/protocol.h"
+#include "state_meta.h"
+#include "timers.h"
 
 namespace coredem::server {
 
@@ -52,17 +52,22 @@ std::string hexPeer(const proto::PeerId& p) {
 
 const char* stateName(SessionState s) {
   switch (s) {
-  case SessionState::Idle: return "idle";
-  case SessionState::Connected: return "connected";
-  case SessionState::Configured: return "configured";
+  case SessionState::Idle:
+    return "idle";
+  case SessionState::Connected:
+    return "connected";
+  case SessionState::Configured:
+    return "configured";
   }
   return "?";
 }
 
 std::string readKey(const fs::path& p) {
   std::ifstream in(p);
-  COREDEM_CHECK(in.good(), "cannot read the CURVE key file {}: create the pair with "
-                "`coredem-dem --generate-curve-keys DIR`", p.string());
+  COREDEM_CHECK(in.good(),
+                "cannot read the CURVE key file {}: create the pair with "
+                "`coredem-dem --generate-curve-keys DIR`",
+                p.string());
   std::string k;
   in >> k;
   COREDEM_CHECK(k.size() == 40, "{} does not hold a 40-character Z85 CURVE key", p.string());
@@ -131,14 +136,17 @@ struct DemServer::Impl {
   std::optional<Grant> grant;
   std::optional<Held> held;
   ServerLedgers ledgers;
-  ExchangeTimes xt;                       ///< --timers: exchange and advance seconds this session
-  std::optional<Clock::time_point> stepEnd;  ///< when the last StepDone left (wait_for_peer starts)
-  Clock::time_point lastReceived{};          ///< when receive() returned the message being handled
+  ExchangeTimes xt;                         ///< --timers: exchange and advance seconds this session
+  std::optional<Clock::time_point> stepEnd; ///< when the last StepDone left (wait_for_peer starts)
+  Clock::time_point lastReceived{};         ///< when receive() returned the message being handled
 
-  explicit Impl(ServerOptions o) : opt(std::move(o)), server(transportOptions(opt)) {}
+  explicit Impl(ServerOptions o)
+      : opt(std::move(o))
+      , server(transportOptions(opt)) {}
 
   // ---- replies ---------------------------------------------------------------------------
-  void send(const proto::PeerId& peer, proto::Message m, std::uint64_t sequence, std::int64_t step) {
+  void send(const proto::PeerId& peer, proto::Message m, std::uint64_t sequence,
+            std::int64_t step) {
     m.setSessionId(session);
     m.setSequence(sequence);
     m.setStep(step);
@@ -182,7 +190,8 @@ struct DemServer::Impl {
       return;
     }
     if (held) {
-      refuse(held->request, code, "the session ended before this step was granted (" + reason + ")");
+      refuse(held->request, code,
+             "the session ended before this step was granted (" + reason + ")");
     }
     if (grant) {
       auto m = proto::makeError(code,
@@ -240,7 +249,8 @@ struct DemServer::Impl {
       return;
     }
     const auto& h = env.hello();
-    const auto n = proto::negotiate(proto::kProtocolVersion, {h.protocol_major(), h.protocol_minor()});
+    const auto n =
+        proto::negotiate(proto::kProtocolVersion, {h.protocol_major(), h.protocol_minor()});
     if (!n.accepted) {
       reject(r, v1::ERROR_CODE_VERSION, n.status.message);
       return;
@@ -273,8 +283,8 @@ struct DemServer::Impl {
       if (env.session_id() != session) {
         reject(r, v1::ERROR_CODE_UNKNOWN_SESSION,
                fmt::format("session id '{}' is not the active session of coredem-dem at {}; use "
-                           "the id the orchestrator passes in COREDEM_SESSION", env.session_id(),
-                           endpoint));
+                           "the id the orchestrator passes in COREDEM_SESSION",
+                           env.session_id(), endpoint));
         return;
       }
       if (!cPeer.empty() && cPeer != r.peer) {
@@ -338,7 +348,8 @@ struct DemServer::Impl {
       return;
     }
     for (const auto& k : ignored) {
-      log->warn("session {}: Configure option '{}' is not a DEM server option (ignored)", session, k);
+      log->warn("session {}: Configure option '{}' is not a DEM server option (ignored)", session,
+                k);
     }
     system = std::move(next);
     ledgers = restored;
@@ -357,11 +368,11 @@ struct DemServer::Impl {
     state = SessionState::Configured;
     const double dtMax = system->dtDemMax();
     log->info("session {}: configured by '{}': {} particles{}, grid {} x {} x {}, {} gas species, "
-              "backend {}, dt_dem_max {:.4g} s, start step {}", session, oName,
-              system->particleCount(),
+              "backend {}, dt_dem_max {:.4g} s, start step {}",
+              session, oName, system->particleCount(),
               c.initial_state_file().empty() ? "" : " from " + c.initial_state_file(),
-              g.counts().x(), g.counts().y(), g.counts().z(), species, system->backendName(),
-              dtMax, lastStep);
+              g.counts().x(), g.counts().y(), g.counts().z(), species, system->backendName(), dtMax,
+              lastStep);
     auto m = proto::makeConfigured(cells, system->particleCount(), species, nSub, dtMax);
     send(r.peer, std::move(m), r.message.envelope().sequence(), lastStep);
   }
@@ -384,8 +395,9 @@ struct DemServer::Impl {
       return;
     }
     if (env.step() != lastStep + 1) {
-      refuse(r, v1::ERROR_CODE_OUT_OF_ORDER,
-             fmt::format("StepGrant for step {}, but the next step is {}", env.step(), lastStep + 1));
+      refuse(
+          r, v1::ERROR_CODE_OUT_OF_ORDER,
+          fmt::format("StepGrant for step {}, but the next step is {}", env.step(), lastStep + 1));
       return;
     }
     const double dtMax = system->dtDemMax();
@@ -398,15 +410,17 @@ struct DemServer::Impl {
     if (g.dt_cfd() / g.n_sub() > dtMax * (1.0 + kDtTolerance)) {
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
              fmt::format("StepGrant of step {}: dt_cfd/n_sub = {:.6g} s exceeds this DEM's "
-                         "dt_dem_max = {:.6g} s; use n_sub >= {}", env.step(),
-                         g.dt_cfd() / g.n_sub(), dtMax,
+                         "dt_dem_max = {:.6g} s; use n_sub >= {}",
+                         env.step(), g.dt_cfd() / g.n_sub(), dtMax,
                          dem::TimeHandler::subStepsFor(g.dt_cfd(), dtMax)));
       return;
     }
-    if (g.dt_dem() > 0.0 && std::abs(g.dt_dem() * g.n_sub() - g.dt_cfd()) > kDtTolerance * g.dt_cfd()) {
+    if (g.dt_dem() > 0.0 &&
+        std::abs(g.dt_dem() * g.n_sub() - g.dt_cfd()) > kDtTolerance * g.dt_cfd()) {
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
              fmt::format("StepGrant of step {}: dt_dem * n_sub = {:.17g} s differs from dt_cfd = "
-                         "{:.17g} s", env.step(), g.dt_dem() * g.n_sub(), g.dt_cfd()));
+                         "{:.17g} s",
+                         env.step(), g.dt_dem() * g.n_sub(), g.dt_cfd()));
       return;
     }
     Grant next;
@@ -418,7 +432,8 @@ struct DemServer::Impl {
     next.nSub = g.n_sub();
     next.checkpointDir = g.has_checkpoint() ? g.checkpoint().directory() : std::string();
     grant = next;
-    log->debug("session {}: step {} granted (dt {} s, n_sub {})", session, next.step, next.dtCfd, next.nSub);
+    log->debug("session {}: step {} granted (dt {} s, n_sub {})", session, next.step, next.dtCfd,
+               next.nSub);
     if (held) {
       auto h = std::move(*held);
       held.reset();
@@ -463,7 +478,8 @@ struct DemServer::Impl {
     if (std::abs(body.dt() - grant->dtCfd) > kDtTolerance * grant->dtCfd) {
       refuse(r, v1::ERROR_CODE_OUT_OF_ORDER,
              fmt::format("GasFields of step {} carry dt = {:.17g} s; the step was granted with "
-                         "dt = {:.17g} s", env.step(), body.dt(), grant->dtCfd));
+                         "dt = {:.17g} s",
+                         env.step(), body.dt(), grant->dtCfd));
       return;
     }
     const auto t0 = Clock::now();
@@ -491,8 +507,10 @@ struct DemServer::Impl {
       s = &system->advance(grant->dtCfd, static_cast<int>(grant->nSub));
     } catch (const std::exception& e) {
       log->error("session {}: step {} failed in the DEM core: {}", session, grant->step, e.what());
-      refuse(r, v1::ERROR_CODE_INTERNAL, fmt::format("step {} failed in the DEM core: {}", grant->step, e.what()));
-      auto m = proto::makeError(v1::ERROR_CODE_INTERNAL, e.what(), grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT);
+      refuse(r, v1::ERROR_CODE_INTERNAL,
+             fmt::format("step {} failed in the DEM core: {}", grant->step, e.what()));
+      auto m = proto::makeError(v1::ERROR_CODE_INTERNAL, e.what(), grant->sequence,
+                                v1::MESSAGE_TYPE_STEP_GRANT);
       send(grant->peer, std::move(m), grant->sequence, grant->step);
       grant.reset();
       return;
@@ -537,8 +555,9 @@ struct DemServer::Impl {
         return std::chrono::duration<double, std::milli>(b - a).count();
       };
       log->debug("session {}: step {}: setGasFields {:.3f} ms, advance ({} sub-steps) {:.3f} ms, "
-                 "ledgers + Sources {:.3f} ms", session, env.step(), ms(t0, tGas), grant->nSub,
-                 ms(tGas, tAdvanced), ms(tAdvanced, Clock::now()));
+                 "ledgers + Sources {:.3f} ms",
+                 session, env.step(), ms(t0, tGas), grant->nSub, ms(tGas, tAdvanced),
+                 ms(tAdvanced, Clock::now()));
     }
 
     // Checkpoint requested with the grant, then StepDone to O.
@@ -564,16 +583,18 @@ struct DemServer::Impl {
     addDiagnostics(done, particles);
     done.set_wall_seconds(std::chrono::duration<double>(Clock::now() - t0).count());
     if (checkpointOk) {
-      send(grant->peer, proto::makeStepDone(grant->step, grant->time, done), grant->sequence, grant->step);
+      send(grant->peer, proto::makeStepDone(grant->step, grant->time, done), grant->sequence,
+           grant->step);
       xt.packSend += std::chrono::duration<double>(Clock::now() - tDone).count();
     } else {
       log->error("session {}: checkpoint of step {} into {} failed: {}", session, grant->step,
                  grant->checkpointDir, checkpointError);
       send(grant->peer,
-           proto::makeError(v1::ERROR_CODE_CHECKPOINT_FAILED,
-                            fmt::format("step {} done, but writing its checkpoint into {} failed: {}",
-                                        grant->step, grant->checkpointDir, checkpointError),
-                            grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT),
+           proto::makeError(
+               v1::ERROR_CODE_CHECKPOINT_FAILED,
+               fmt::format("step {} done, but writing its checkpoint into {} failed: {}",
+                           grant->step, grant->checkpointDir, checkpointError),
+               grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT),
            grant->sequence, grant->step);
     }
     lastStep = grant->step;
@@ -613,8 +634,9 @@ struct DemServer::Impl {
       proto::addNamedValue(l.mutable_species(), "dem.species_to_gas." + speciesNames[k] + "_kg",
                            ledgers.speciesToGas[k]);
     }
-    // Chemistry ledgers (docs/thermochemistry.md): solid converted to gas by the particles' reactions
-    // per gas species, reaction heat into the particles, WGS heat into the gas, removed particles.
+    // Chemistry ledgers (docs/thermochemistry.md): solid converted to gas by the particles'
+    // reactions per gas species, reaction heat into the particles, WGS heat into the gas, removed
+    // particles.
     if (system->config().chemistry.active()) {
       const dem::ChemistryTotals c = system->chemistryTotals();
       for (std::size_t k = 0; k < speciesNames.size() && k < c.gasProduced.size(); ++k) {
@@ -624,10 +646,11 @@ struct DemServer::Impl {
       proto::addNamedValue(l.mutable_mass(), "dem.removed_mass_kg", c.removedMass());
       proto::addNamedValue(l.mutable_energy(), "dem.reaction_heat_J", c.reactionHeat);
       proto::addNamedValue(l.mutable_energy(), "dem.homogeneous_heat_J", c.homogeneousHeat);
-      // Sensible enthalpy of the transferred mass (PHYSICS §3.5): into the gas inside Q_hom, and the
-      // particles' Σ m c_p T change by mass leaving at T_p (closes the particle energy ledger).
+      // Sensible enthalpy of the transferred mass (PHYSICS §3.5): into the gas inside Q_hom, and
+      // the particles' Σ m c_p T change by mass leaving at T_p (closes the particle energy ledger).
       proto::addNamedValue(l.mutable_energy(), "dem.gas_sensible_heat_J", c.gasSensibleHeat);
-      proto::addNamedValue(l.mutable_energy(), "dem.sensible_mass_enthalpy_J", c.sensibleMassEnthalpy);
+      proto::addNamedValue(l.mutable_energy(), "dem.sensible_mass_enthalpy_J",
+                           c.sensibleMassEnthalpy);
     }
     return l;
   }
@@ -666,7 +689,8 @@ struct DemServer::Impl {
   void onCheckpoint(const proto::Request& r) {
     const auto& env = r.message.envelope();
     if (r.peer != oPeer) {
-      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, "only the session's orchestrator asks for checkpoints");
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             "only the session's orchestrator asks for checkpoints");
       return;
     }
     if (state != SessionState::Configured) {
@@ -674,9 +698,10 @@ struct DemServer::Impl {
       return;
     }
     if (grant) {
-      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
-             fmt::format("step {} is running; ask for a checkpoint between steps (or with the grant)",
-                         grant->step));
+      refuse(
+          r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+          fmt::format("step {} is running; ask for a checkpoint between steps (or with the grant)",
+                      grant->step));
       return;
     }
     const auto& dir = env.checkpoint_request().directory();
@@ -688,15 +713,17 @@ struct DemServer::Impl {
       auto files = writeCheckpoint(dir, lastStep);
       send(r.peer, proto::makeCheckpointDone(lastStep, dir, files), env.sequence(), lastStep);
     } catch (const std::exception& e) {
-      refuse(r, v1::ERROR_CODE_CHECKPOINT_FAILED,
-             fmt::format("writing the state of step {} into {} failed: {}", lastStep, dir, e.what()));
+      refuse(
+          r, v1::ERROR_CODE_CHECKPOINT_FAILED,
+          fmt::format("writing the state of step {} into {} failed: {}", lastStep, dir, e.what()));
     }
   }
 
   void onShutdown(const proto::Request& r) {
     const auto& env = r.message.envelope();
     if (r.peer != oPeer) {
-      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, "only the session's orchestrator ends the session");
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             "only the session's orchestrator ends the session");
       return;
     }
     send(r.peer, proto::makeAck("session " + session + " ended"), env.sequence(), env.step());
@@ -729,9 +756,10 @@ struct DemServer::Impl {
       return;
     }
     if (r.peer != oPeer && r.peer != cPeer) {
-      refuse(r, v1::ERROR_CODE_UNKNOWN_SESSION,
-             fmt::format("this connection has not joined session {}: send Hello first",
-                         env.session_id().empty() ? std::string("(none given)") : env.session_id()));
+      refuse(
+          r, v1::ERROR_CODE_UNKNOWN_SESSION,
+          fmt::format("this connection has not joined session {}: send Hello first",
+                      env.session_id().empty() ? std::string("(none given)") : env.session_id()));
       return;
     }
     proto::Expectation e;
@@ -746,7 +774,7 @@ struct DemServer::Impl {
       e.sequenceAfter = lastSequence[r.peer];
     }
     const auto tValidate = Clock::now();
-    if (type == v1::MESSAGE_TYPE_GAS_FIELDS && stepEnd) {  // the CFD's step and the transfer
+    if (type == v1::MESSAGE_TYPE_GAS_FIELDS && stepEnd) { // the CFD's step and the transfer
       xt.waitPeer += std::chrono::duration<double>(lastReceived - *stepEnd).count();
     }
     const auto s = proto::validate(r.message, e);
@@ -760,11 +788,21 @@ struct DemServer::Impl {
     lastSequence[r.peer] = env.sequence();
     lastActivity = Clock::now();
     switch (type) {
-    case v1::MESSAGE_TYPE_CONFIGURE: onConfigure(r); break;
-    case v1::MESSAGE_TYPE_STEP_GRANT: onGrant(r); break;
-    case v1::MESSAGE_TYPE_GAS_FIELDS: onGasFields(r); break;
-    case v1::MESSAGE_TYPE_CHECKPOINT_REQUEST: onCheckpoint(r); break;
-    case v1::MESSAGE_TYPE_SHUTDOWN: onShutdown(r); break;
+    case v1::MESSAGE_TYPE_CONFIGURE:
+      onConfigure(r);
+      break;
+    case v1::MESSAGE_TYPE_STEP_GRANT:
+      onGrant(r);
+      break;
+    case v1::MESSAGE_TYPE_GAS_FIELDS:
+      onGasFields(r);
+      break;
+    case v1::MESSAGE_TYPE_CHECKPOINT_REQUEST:
+      onCheckpoint(r);
+      break;
+    case v1::MESSAGE_TYPE_SHUTDOWN:
+      onShutdown(r);
+      break;
     default:
       refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
              fmt::format("coredem-dem does not take {} messages", proto::messageTypeName(type)));
@@ -783,14 +821,15 @@ struct DemServer::Impl {
     if (state != SessionState::Idle &&
         std::chrono::duration<double>(now - lastActivity).count() > opt.sessionTimeoutSeconds) {
       endSession(fmt::format("no message from orchestrator '{}' or CFD participant '{}' for {} s "
-                             "(--timeout-s)", oName, cName.empty() ? "-" : cName,
-                             opt.sessionTimeoutSeconds),
+                             "(--timeout-s)",
+                             oName, cName.empty() ? "-" : cName, opt.sessionTimeoutSeconds),
                  v1::ERROR_CODE_TIMEOUT);
     }
   }
 };
 
-DemServer::DemServer(ServerOptions options) : _impl(std::make_unique<Impl>(std::move(options))) {
+DemServer::DemServer(ServerOptions options)
+    : _impl(std::make_unique<Impl>(std::move(options))) {
   auto& m = *_impl;
   dem::parseBackend(m.opt.backend); // fail early on a bad name
   if (!proto::isLoopbackEndpoint(m.opt.bind) && m.opt.curveKeysDir.empty()) {
@@ -799,7 +838,8 @@ DemServer::DemServer(ServerOptions options) : _impl(std::make_unique<Impl>(std::
                   "and authentication, DESIGN §1) or, on a trusted network only, --insecure",
                   m.opt.bind);
     m.log->warn("binding {} WITHOUT encryption (--insecure): anyone who reaches this port can "
-                "drive this server", m.opt.bind);
+                "drive this server",
+                m.opt.bind);
   }
   m.endpoint = m.server.bind(m.opt.bind);
   m.log->info("coredem-dem listening on {} (backend {}, threads {}, session timeout {} s)",
@@ -808,8 +848,12 @@ DemServer::DemServer(ServerOptions options) : _impl(std::make_unique<Impl>(std::
 
 DemServer::~DemServer() = default;
 
-std::string DemServer::endpoint() const { return _impl->endpoint; }
-SessionState DemServer::sessionState() const { return _impl->state; }
+std::string DemServer::endpoint() const {
+  return _impl->endpoint;
+}
+SessionState DemServer::sessionState() const {
+  return _impl->state;
+}
 
 bool DemServer::poll(std::chrono::milliseconds wait) {
   auto& m = *_impl;
@@ -845,7 +889,9 @@ int DemServer::run() {
   return 0;
 }
 
-void DemServer::stop() { _impl->stopFlag.store(true); }
+void DemServer::stop() {
+  _impl->stopFlag.store(true);
+}
 
 void generateCurveKeys(const std::string& dir) {
   fs::create_directories(dir);

@@ -1,17 +1,16 @@
 // coredem-dem: the DEM server (docs/client.md "coredem-dem: command line").
-#include "coredem/server/dem_server.h"
-
-#include "coredem/common/check.h"
-#include "coredem/common/log.h"
-
-#include <CLI/CLI.hpp>
-
 #include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "coredem/common/check.h"
+#include "coredem/common/log.h"
+#include "coredem/server/dem_server.h"
 
 namespace {
 
@@ -39,7 +38,8 @@ int main(int argc, char** argv) {
   CLI::App app{"coredem-dem: the CoReDEM DEM server (protocol v1, one session at a time)"};
   coredem::server::ServerOptions o;
   std::string endpointFile, generateKeys;
-  app.add_option("--bind", o.bind, "endpoint to bind, e.g. tcp://127.0.0.1:* or ipc:///tmp/dem.sock")
+  app.add_option("--bind", o.bind,
+                 "endpoint to bind, e.g. tcp://127.0.0.1:* or ipc:///tmp/dem.sock")
       ->capture_default_str();
   app.add_option("--backend", o.backend, "cpu | cuda | auto")
       ->check(CLI::IsMember({"cpu", "cuda", "auto"}))
@@ -51,21 +51,26 @@ int main(int argc, char** argv) {
                  "end a session whose peers are silent this long (s)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  app.add_option("--curve-keys", o.curveKeysDir,
-                 "directory with server.public and server.secret (CURVE; needed for non-loopback binds)");
-  app.add_flag("--insecure", o.insecure, "allow a non-loopback bind without CURVE (trusted networks only)");
-  app.add_flag("--exit-after-session", o.exitAfterSession,
-               "exit when the first session ends (set by the orchestrator that started this server)");
+  app.add_option(
+      "--curve-keys", o.curveKeysDir,
+      "directory with server.public and server.secret (CURVE; needed for non-loopback binds)");
+  app.add_flag("--insecure", o.insecure,
+               "allow a non-loopback bind without CURVE (trusted networks only)");
+  app.add_flag(
+      "--exit-after-session", o.exitAfterSession,
+      "exit when the first session ends (set by the orchestrator that started this server)");
   app.add_option("--endpoint-file", endpointFile, "write the bound endpoint into this file");
   app.add_flag("--timers", o.timers,
                "per-stage timers (DEM stages and the exchange): a log line every --timers-every "
                "steps, a table at the end of each session and a JSON file (--timers-file)");
-  app.add_option("--timers-every", o.timersEvery, "with --timers: log line every N CFD steps (0: only at the end)")
+  app.add_option("--timers-every", o.timersEvery,
+                 "with --timers: log line every N CFD steps (0: only at the end)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app.add_option("--timers-file", o.timersFile,
-                 "with --timers: JSON report path (default: dem-timers.json next to --endpoint-file, "
-                 "else coredem-dem-timers.json in the working directory)");
+  app.add_option(
+      "--timers-file", o.timersFile,
+      "with --timers: JSON report path (default: dem-timers.json next to --endpoint-file, "
+      "else coredem-dem-timers.json in the working directory)");
   app.add_option("--generate-curve-keys", generateKeys,
                  "write a new CURVE key pair into DIR/server.{public,secret} and exit");
   try {
@@ -75,9 +80,10 @@ int main(int argc, char** argv) {
   }
   auto log = coredem::logger("dem.server");
   if (o.timers && o.timersFile.empty()) {
-    o.timersFile = endpointFile.empty()
-                       ? std::string("coredem-dem-timers.json")
-                       : (std::filesystem::path(endpointFile).parent_path() / "dem-timers.json").string();
+    o.timersFile =
+        endpointFile.empty()
+            ? std::string("coredem-dem-timers.json")
+            : (std::filesystem::path(endpointFile).parent_path() / "dem-timers.json").string();
   }
   try {
     if (!generateKeys.empty()) {

@@ -28,7 +28,8 @@ ServerLedgers readServerLedgers(const std::string& path, int species) {
   const std::vector<double> v = h5::readDataset<double>(group, "species_to_gas_kg", path);
   COREDEM_CHECK(v.size() == static_cast<std::size_t>(species),
                 "{}: /server/species_to_gas_kg has {} entries, the case has {} gas species: "
-                "restart with the case that wrote the file", path, v.size(), species);
+                "restart with the case that wrote the file",
+                path, v.size(), species);
   l.speciesToGas = v;
   return l;
 }

@@ -11,7 +11,7 @@ namespace coredem::server {
 /// (/meta heat_convection_J); files of earlier versions also hold /server heat_from_gas_J, which
 /// is not read.
 struct ServerLedgers {
-  std::vector<double> speciesToGas;  ///< kg per gas species, ∫ Σ V_c R_k dt
+  std::vector<double> speciesToGas; ///< kg per gas species, ∫ Σ V_c R_k dt
 };
 
 /// Adds /server (attributes step, session; dataset species_to_gas_kg) to an existing HDF5 file.

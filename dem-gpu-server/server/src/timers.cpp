@@ -1,15 +1,15 @@
 // coredem-dem --timers: the per-stage report (timers.h).
 #include "timers.h"
 
-#include "coredem/common/check.h"
-#include "coredem/common/json.h"
-
-#include <fmt/format.h>
-
 #include <filesystem>
 #include <fstream>
 #include <utility>
 #include <vector>
+
+#include <fmt/format.h>
+
+#include "coredem/common/check.h"
+#include "coredem/common/json.h"
 
 namespace coredem::server {
 
@@ -32,11 +32,16 @@ struct Row {
 
 std::vector<Row> demRows(const ExchangeTimes& x, const dem::StageTimes& st) {
   const double chem = chemistrySeconds(st);
-  const double named = st.neighbour + st.contact + st.drag + st.heat + chem + st.integrate + st.coupling;
-  return {{"neighbour", st.neighbour},     {"contact", st.contact},
-          {"drag", st.drag},               {"heat", st.heat},
-          {"chemistry", chem},             {"integration", st.integrate},
-          {"pcm_deposition", st.coupling}, {"dem_other", x.advance - named}};
+  const double named =
+      st.neighbour + st.contact + st.drag + st.heat + chem + st.integrate + st.coupling;
+  return {{"neighbour", st.neighbour},
+          {"contact", st.contact},
+          {"drag", st.drag},
+          {"heat", st.heat},
+          {"chemistry", chem},
+          {"integration", st.integrate},
+          {"pcm_deposition", st.coupling},
+          {"dem_other", x.advance - named}};
 }
 
 std::vector<Row> exchangeRows(const ExchangeTimes& x) {
@@ -67,7 +72,8 @@ std::string timersReport(const ExchangeTimes& x, const dem::StageTimes& st, doub
     return s;
   }
   s = fmt::format("timers: {} CFD steps, {:.3f} s in the session, {:.3e} particle sub-steps per "
-                  "DEM second ({} rebuilds)\n", x.steps, sessionSeconds, rate, st.rebuilds);
+                  "DEM second ({} rebuilds)\n",
+                  x.steps, sessionSeconds, rate, st.rebuilds);
   s += fmt::format("  {:<22} {:>10} {:>7} {:>12}\n", "stage", "s", "%", "ms/step");
   const double steps = x.steps > 0 ? static_cast<double>(x.steps) : 1.0;
   auto line = [&](const char* name, double sec) {
@@ -75,11 +81,14 @@ std::string timersReport(const ExchangeTimes& x, const dem::StageTimes& st, doub
                      1e3 * sec / steps);
   };
   line("DEM advance", x.advance);
-  for (const Row& r : dem) line((std::string("  ") + r.name).c_str(), r.seconds);
+  for (const Row& r : dem)
+    line((std::string("  ") + r.name).c_str(), r.seconds);
   double exSum = 0.0;
-  for (const Row& r : ex) exSum += r.seconds;
+  for (const Row& r : ex)
+    exSum += r.seconds;
   line("exchange", exSum);
-  for (const Row& r : ex) line((std::string("  ") + r.name).c_str(), r.seconds);
+  for (const Row& r : ex)
+    line((std::string("  ") + r.name).c_str(), r.seconds);
   line("other (server)", sessionSeconds - x.advance - exSum);
   return s;
 }
@@ -124,7 +133,8 @@ void writeTextFile(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".tmp";
   {
     std::ofstream out(tmp, std::ios::trunc);
-    COREDEM_CHECK(out.good(), "cannot write the timers file {}: check --timers-file and its folder", tmp);
+    COREDEM_CHECK(out.good(), "cannot write the timers file {}: check --timers-file and its folder",
+                  tmp);
     out << text;
     COREDEM_CHECK(out.good(), "writing {} failed (disk full?)", tmp);
   }

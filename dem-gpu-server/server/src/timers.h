@@ -6,24 +6,25 @@
 /// checkpoints). Printed to the log every N steps and at the end of the session, and written
 /// as JSON (docs/performance.md "Timers").
 
-#include "coredem/dem/dem_system.h"
-
 #include <cstdint>
 #include <string>
+
+#include "coredem/dem/dem_system.h"
 
 namespace coredem::server {
 
 /// Seconds spent by the server outside the DEM core during one session.
 struct ExchangeTimes {
-  double waitPeer = 0;    ///< from a step's StepDone to the next GasFields in hand (the CFD's step + transfer)
+  double waitPeer =
+      0; ///< from a step's StepDone to the next GasFields in hand (the CFD's step + transfer)
   double validate = 0;    ///< proto::validate of the GasFields (structure, NaN/Inf scan)
   double unpack = 0;      ///< array views + DemSystem::setGasFields (copy into the engine)
   double advance = 0;     ///< DemSystem::advance (split by StageTimes)
   double ledgers = 0;     ///< particle copy, ledgers, diagnostics
   double packSend = 0;    ///< Sources and StepDone built and handed to ZeroMQ
   double checkpoint = 0;  ///< state files written with the grant
-  std::int64_t steps = 0;            ///< CFD steps
-  std::uint64_t particleSubSteps = 0;///< Σ N · n_sub
+  std::int64_t steps = 0; ///< CFD steps
+  std::uint64_t particleSubSteps = 0; ///< Σ N · n_sub
 };
 
 /// The report: one line (`multiLine` false, for the every-N-steps log line) or a table.

@@ -71,18 +71,21 @@ public:
   void markDeviceModified() { _deviceNewer = true; }
   /// Copies host → device if the host copy was modified since the last transfer.
   void toDevice() {
-    if (_hostNewer) Exec::copyToDevice(_d, _h, bytes());
+    if (_hostNewer)
+      Exec::copyToDevice(_d, _h, bytes());
     _hostNewer = false;
   }
   /// Copies device → host if the device copy was modified since the last transfer.
   void toHost() {
-    if (_deviceNewer) Exec::copyToHost(_h, _d, bytes());
+    if (_deviceNewer)
+      Exec::copyToHost(_h, _d, bytes());
     _deviceNewer = false;
   }
 
 private:
   void release() {
-    if (Exec::separateDevice) Exec::freeDevice(_d);
+    if (Exec::separateDevice)
+      Exec::freeDevice(_d);
     Exec::freeHost(_h);
     _h = _d = nullptr;
     _n = 0;

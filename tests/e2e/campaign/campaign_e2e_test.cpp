@@ -33,7 +33,9 @@ const fs::path kCases = COREDEM_CAMPAIGN_CASES;
 
 using coredem::e2e::readAll;
 
-fs::path tempDir(const std::string& name) { return coredem::e2e::tempDir("coredem-camp", name); }
+fs::path tempDir(const std::string& name) {
+  return coredem::e2e::tempDir("coredem-camp", name);
+}
 
 pid_t start(const std::vector<std::string>& args, const fs::path& log) {
   return coredem::e2e::startProgram(kBin / "coredem", args, log);
@@ -41,7 +43,7 @@ pid_t start(const std::vector<std::string>& args, const fs::path& log) {
 using coredem::e2e::waitExit;
 
 int runCoredem(const std::vector<std::string>& args, const fs::path& log,
-            std::chrono::seconds timeout = 50s) {
+               std::chrono::seconds timeout = 50s) {
   return waitExit(start(args, log), timeout);
 }
 
@@ -153,12 +155,13 @@ void expectAllDoneOnce(const fs::path& dir, std::size_t members, long steps) {
 const std::string& referenceKillSummary() {
   static const std::string summary = [] {
     const fs::path d = tempDir("kill-reference");
-    EXPECT_EQ(runCoredem({"campaign", "run", (kCases / "kill.yaml").string(), "--out",
-                       (d / "c").string()},
-                      d / "log.txt"),
+    EXPECT_EQ(runCoredem(
+                  {"campaign", "run", (kCases / "kill.yaml").string(), "--out", (d / "c").string()},
+                  d / "log.txt"),
               0)
         << readAll(d / "log.txt");
-    EXPECT_EQ(runCoredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"), 0);
+    EXPECT_EQ(runCoredem({"campaign", "collect", (d / "c").string(), "--no-plot"}, d / "log.txt"),
+              0);
     expectAllDoneOnce(d / "c", 4, 160);
     const std::string text = readAll(d / "c" / "summary.csv");
     fs::remove_all(d);
@@ -238,7 +241,7 @@ TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
   const fs::path d = tempDir("grid4");
   const fs::path dir = d / "c";
   ASSERT_EQ(runCoredem({"campaign", "run", (kCases / "grid4.yaml").string(), "--out", dir.string()},
-                    d / "log.txt"),
+                       d / "log.txt"),
             0)
       << readAll(d / "log.txt");
   expectAllDoneOnce(dir, 4, 40);
@@ -305,8 +308,8 @@ TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
 
   // a member re-runs alone from its case folder with the same result
   ASSERT_EQ(runCoredem({"run", (dir / "members/m001/case").string(), "--out",
-                     (d / "alone").string(), "--no-plots"},
-                    d / "alone.txt"),
+                        (d / "alone").string(), "--no-plots"},
+                       d / "alone.txt"),
             0)
       << readAll(d / "alone.txt");
   const auto tail = [](const fs::path& f) {
@@ -328,7 +331,7 @@ TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
 
   // a second `run` into the same folder is refused
   EXPECT_EQ(runCoredem({"campaign", "run", (kCases / "grid4.yaml").string(), "--out", dir.string()},
-                    d / "again.txt"),
+                       d / "again.txt"),
             1);
   EXPECT_NE(readAll(d / "again.txt").find("already holds a campaign"), std::string::npos);
   if (!HasFailure()) {
@@ -413,10 +416,10 @@ TEST(CampaignE2E, SigtermStopsTheMembersResumably) {
 TEST(CampaignE2E, DeterministicallyFailingMemberEndsFailedAfterRetries) {
   const fs::path d = tempDir("failing");
   const fs::path dir = d / "c";
-  EXPECT_EQ(runCoredem({"campaign", "run", (kCases / "failing.yaml").string(), "--out",
-                     dir.string()},
-                    d / "log.txt"),
-            1)
+  EXPECT_EQ(
+      runCoredem({"campaign", "run", (kCases / "failing.yaml").string(), "--out", dir.string()},
+                 d / "log.txt"),
+      1)
       << readAll(d / "log.txt");
   const auto rows = readDb(dir);
   ASSERT_EQ(rows.size(), 4u);
@@ -465,13 +468,11 @@ TEST(CampaignE2E, MalformedSweepIsRefusedNamingTheKey) {
        "collect.scalars"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
-    {
-      std::ofstream(d / "bad.yaml") << cases[i].body;
-    }
+    { std::ofstream(d / "bad.yaml") << cases[i].body; }
     const fs::path out = d / ("out" + std::to_string(i));
     const fs::path log = d / ("log" + std::to_string(i));
-    EXPECT_EQ(runCoredem({"campaign", "run", (d / "bad.yaml").string(), "--out", out.string()}, log),
-              2)
+    EXPECT_EQ(
+        runCoredem({"campaign", "run", (d / "bad.yaml").string(), "--out", out.string()}, log), 2)
         << cases[i].body;
     EXPECT_NE(readAll(log).find(cases[i].expect), std::string::npos)
         << "expected '" << cases[i].expect << "' in: " << readAll(log);

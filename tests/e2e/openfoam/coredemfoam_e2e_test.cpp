@@ -337,15 +337,17 @@ TEST_F(CoredemFoamE2E, InPlaceExchangeMatchesCopiesAndTimersAddUp) {
   const std::string yaml = readAll(c / "case.yaml");
   const std::string cfdLine = "cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120}";
   ASSERT_NE(yaml.find(cfdLine), std::string::npos);
-  writeAll(c / "case.yaml",
-           replaceAll(yaml, cfdLine,
-                      "cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120, timers: on}"));
+  writeAll(
+      c / "case.yaml",
+      replaceAll(yaml, cfdLine,
+                 "cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120, timers: on}"));
   ::setenv("COREDEM_FOAM_EXCHANGE", "copy", 1);
   const int rcB = runCoredem({"run", c.string(), "--out", b.string()}, dir / "b.log");
   ::unsetenv("COREDEM_FOAM_EXCHANGE");
   ASSERT_EQ(rcB, 0) << readAll(dir / "b.log") << logTail(b);
   EXPECT_NE(readAll(a / "logs" / "cfd.log").find("Exchange: in place"), std::string::npos);
-  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Exchange: gather/scatter copies"), std::string::npos);
+  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Exchange: gather/scatter copies"),
+            std::string::npos);
 
   const fs::path ca = a / "checkpoints" / "00000012", cb = b / "checkpoints" / "00000012";
   const auto fa = manifestFiles(ca, "cfd"), fb = manifestFiles(cb, "cfd");
@@ -383,7 +385,8 @@ TEST_F(CoredemFoamE2E, InPlaceExchangeMatchesCopiesAndTimersAddUp) {
               std::string::npos);
     const double step = number("step_seconds");
     double sum = 0.0, shares = 0.0;
-    const std::regex stage("\"seconds\": ([-0-9.eE+]+), \"per_step_s\": [-0-9.eE+]+, \"share\": ([-0-9.eE+]+)");
+    const std::regex stage(
+        "\"seconds\": ([-0-9.eE+]+), \"per_step_s\": [-0-9.eE+]+, \"share\": ([-0-9.eE+]+)");
     int stages = 0;
     for (std::sregex_iterator it(j.begin(), j.end(), stage), end; it != end; ++it, ++stages) {
       sum += std::strtod((*it)[1].str().c_str(), nullptr);

@@ -383,7 +383,8 @@ TEST_F(CoredemE2E, CurveRemoteServer) {
                                    "1",
                                    "--endpoint-file",
                                    (dir / "endpoint").string()};
-  const pid_t server = coredem::e2e::startProgram(argv.front(), {argv.begin() + 1, argv.end()}, dir / "server.log");
+  const pid_t server =
+      coredem::e2e::startProgram(argv.front(), {argv.begin() + 1, argv.end()}, dir / "server.log");
   ASSERT_GT(server, 0);
   const auto end = std::chrono::steady_clock::now() + 20s;
   while (!fs::exists(dir / "endpoint") && std::chrono::steady_clock::now() < end) {

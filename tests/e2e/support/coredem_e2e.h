@@ -3,12 +3,10 @@
 /// Helpers shared by the end-to-end tests: temporary folders, whole-file I/O, and running
 /// `coredem` as a child process with a deadline (a test never waits forever on it).
 
-#include <coredem/common/process.h>
-
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -22,6 +20,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <coredem/common/process.h>
 
 namespace coredem::e2e {
 
@@ -54,7 +53,8 @@ inline std::map<std::string, std::vector<double>> readTimeseries(const fs::path&
     return out;
   }
   std::stringstream h(line);
-  for (std::string n; std::getline(h, n, ',');) names.push_back(n);
+  for (std::string n; std::getline(h, n, ',');)
+    names.push_back(n);
   while (std::getline(in, line)) {
     std::stringstream r(line);
     std::size_t i = 0;

@@ -42,7 +42,8 @@ fs::path shortCase(const fs::path& dir, const std::string& caseDir, const std::s
   std::string text = readAll(kCases / caseDir / file);
   const std::regex endLine(R"(\n  end: [0-9.eE+-]+)");
   EXPECT_TRUE(std::regex_search(text, endLine)) << file << ": no time.end line";
-  text = std::regex_replace(text, endLine, "\n  end: " + end, std::regex_constants::format_first_only);
+  text =
+      std::regex_replace(text, endLine, "\n  end: " + end, std::regex_constants::format_first_only);
   writeAll(c / file, text);
   return c / file;
 }
@@ -85,14 +86,15 @@ void checkPatilRun(const fs::path& run, double end, bool coldWalls) {
     }
   }
   EXPECT_LT(worst, 1e-10);
-  EXPECT_LT(qg.back(), 0.0);  // the air cools the beads
+  EXPECT_LT(qg.back(), 0.0); // the air cools the beads
   if (coldWalls) {
-    EXPECT_LT(qw.back(), 0.0);  // and so do walls at 20 °C
+    EXPECT_LT(qw.back(), 0.0); // and so do walls at 20 °C
   }
   const auto& h = ts["gas.enthalpy_J"];
   const double dh = h.back() - h.front();
   const double inflow = ts["gas.enthalpy_inflow_J"].back() - ts["gas.enthalpy_inflow_J"].front();
-  const double fromP = ts["gas.heat_from_particles_J"].back() - ts["gas.heat_from_particles_J"].front();
+  const double fromP =
+      ts["gas.heat_from_particles_J"].back() - ts["gas.heat_from_particles_J"].front();
   EXPECT_NEAR(dh, inflow + fromP, 1e-7 * h.back());
   EXPECT_TRUE(fs::exists(run / "plots" / "timeseries.png")) << run;
 }
@@ -100,12 +102,13 @@ void checkPatilRun(const fs::path& run, double end, bool coldWalls) {
 void expectPlot(const fs::path& png) {
   ASSERT_TRUE(fs::exists(png)) << png;
   EXPECT_GT(fs::file_size(png), 1000u);
-  EXPECT_LE(fs::file_size(png), 150u * 1024u);  // docs/img size limit
+  EXPECT_LE(fs::file_size(png), 150u * 1024u); // docs/img size limit
 }
 
 class ValidationE2E : public coredem::e2e::RunFolderTest {
 protected:
-  ValidationE2E() : RunFolderTest(kBin, {"coredem", "coredem-dem", "coredemFoam"}, "validation-e2e") {}
+  ValidationE2E()
+      : RunFolderTest(kBin, {"coredem", "coredem-dem", "coredemFoam"}, "validation-e2e") {}
 };
 
 } // namespace
@@ -127,11 +130,13 @@ TEST_F(ValidationE2E, PatilSliceCasesRunCloseTheirLedgerAndPlot) {
         << tail(dir / (r.label + ".log"));
     const std::string log = readAll(dir / (r.label + ".log"));
     EXPECT_NE(log.find("ETA"), std::string::npos) << "no progress with ETA";
-    EXPECT_NE(log.find("plots: " + run.string()), std::string::npos) << "plots location not printed";
+    EXPECT_NE(log.find("plots: " + run.string()), std::string::npos)
+        << "plots location not printed";
     checkPatilRun(run, 0.01, r.cold);
     plotArgs.insert(plotArgs.end(), {"--run", r.label + "=" + run.string()});
   }
-  plotArgs.insert(plotArgs.end(), {"--out", (dir / "plots").string(), "--summary", (dir / "summary.md").string()});
+  plotArgs.insert(plotArgs.end(),
+                  {"--out", (dir / "plots").string(), "--summary", (dir / "summary.md").string()});
   ASSERT_EQ(runPython(plotArgs, dir / "plot.log"), 0) << tail(dir / "plot.log");
   expectPlot(dir / "plots" / "patil_temperature.png");
   expectPlot(dir / "plots" / "patil_ledger.png");
@@ -148,7 +153,9 @@ TEST_F(ValidationE2E, PatilFullCaseStarts) {
   for (const Run& r : {Run{"75g-cold-walls.yaml", true}}) {
     const fs::path c = shortCase(dir, "patil-bfb-cooling", r.file, "openfoam", "1e-4");
     const fs::path run = dir / ("run-" + r.file);
-    ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string(), "--no-plots"}, dir / (r.file + ".log")), 0)
+    ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string(), "--no-plots"},
+                         dir / (r.file + ".log")),
+              0)
         << tail(dir / (r.file + ".log"));
     auto ts = readTimeseries(run);
     ASSERT_FALSE(ts["particles"].empty());
@@ -168,12 +175,14 @@ TEST_F(ValidationE2E, PatilFullCaseStarts) {
 TEST_F(ValidationE2E, ClgReducedCaseRunsAndReportsTheOutletGas) {
   const fs::path c = shortCase(dir, "clg", "reduced.yaml", "openfoam-reduced", "0.005");
   const int check = runCoredem({"check", c.string()}, dir / "check.log", 60s);
-  if (check != 0 && readAll(dir / "check.log").find("solid_species: unknown key") != std::string::npos) {
+  if (check != 0 &&
+      readAll(dir / "check.log").find("solid_species: unknown key") != std::string::npos) {
     GTEST_SKIP() << "chemistry is not integrated in this build (solid_species unknown)";
   }
   ASSERT_EQ(check, 0) << tail(dir / "check.log");
   const fs::path run = dir / "clg";
-  ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, dir / "clg.log"), 0) << tail(dir / "clg.log");
+  ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, dir / "clg.log"), 0)
+      << tail(dir / "clg.log");
   auto ts = readTimeseries(run);
   ASSERT_FALSE(ts["t"].empty());
   EXPECT_NEAR(ts["t"].back(), 0.005, 1e-12);
@@ -187,7 +196,8 @@ TEST_F(ValidationE2E, ClgReducedCaseRunsAndReportsTheOutletGas) {
   const double n2In = 0.5 * 0.239 * 0.24 * 0.0096 * 0.004 / mMix;
   EXPECT_NEAR(ts["gas.outflow.N2_kg_per_s"].back() / 0.028014, n2In, 0.05 * n2In);
   EXPECT_TRUE(fs::exists(run / "plots" / "timeseries.png"));
-  ASSERT_EQ(runPython({(kPlots / "validation_clg.py").string(), run.string(), "--out", (dir / "plots").string()},
+  ASSERT_EQ(runPython({(kPlots / "validation_clg.py").string(), run.string(), "--out",
+                       (dir / "plots").string()},
                       dir / "plot.log"),
             0)
       << tail(dir / "plot.log");

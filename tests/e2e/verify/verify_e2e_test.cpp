@@ -21,12 +21,13 @@ const fs::path kCases = COREDEM_VERIFY_CASES;
 
 class VerifyE2E : public coredem::e2e::RunFolderTest {
 protected:
-  VerifyE2E() : RunFolderTest(kBin, {"coredem", "coredem-dem", "coredem-gas"}, "verify-e2e") {}
+  VerifyE2E()
+      : RunFolderTest(kBin, {"coredem", "coredem-dem", "coredem-gas"}, "verify-e2e") {}
 
   /// Copies cases/verification/<name> to dir/cases/<name>, with `end` as time.end (and
   /// replacements in verify.yaml).
-  void copyCase(const std::string& name, const std::string& end,
-                const std::string& verifyFrom = "", const std::string& verifyTo = "") {
+  void copyCase(const std::string& name, const std::string& end, const std::string& verifyFrom = "",
+                const std::string& verifyTo = "") {
     const fs::path to = dir / "cases" / name;
     fs::create_directories(to);
     std::string c = readAll(kCases / name / "case.yaml");
@@ -65,13 +66,13 @@ protected:
 } // namespace
 
 TEST_F(VerifyE2E, OneCasePerFamilyPasses) {
-  copyCase("contact-d36-overlap4e-5", "10.0");     // 1e5 sub-steps, tolerance 6e-6
-  copyCase("lens-touching-smin4e-10", "5.0");      // 2.5e5 sub-steps, tolerance 1.5e-6
+  copyCase("contact-d36-overlap4e-5", "10.0");      // 1e5 sub-steps, tolerance 6e-6
+  copyCase("lens-touching-smin4e-10", "5.0");       // 2.5e5 sub-steps, tolerance 1.5e-6
   copyCase("mfix-convection-ranz-marshall", "2.0"); // 2e5 sub-steps, tolerance 1e-6
-  copyCase("mfix-radiation", "20.0");              // 4e5 sub-steps, tolerance 2e-7 vs RK4
-  copyCase("mfix-reactive-chemistry", "2.0");      // as committed: B runs out at 1.5 s
-  const int rc = verify({"--cases", (dir / "cases").string(), "--out", (dir / "out").string()},
-                        240s);
+  copyCase("mfix-radiation", "20.0");               // 4e5 sub-steps, tolerance 2e-7 vs RK4
+  copyCase("mfix-reactive-chemistry", "2.0");       // as committed: B runs out at 1.5 s
+  const int rc =
+      verify({"--cases", (dir / "cases").string(), "--out", (dir / "out").string()}, 240s);
   const std::string log = readAll(dir / "v.log");
   ASSERT_EQ(rc, 0) << log;
   const std::string json = readAll(dir / "out" / "summary.json");
@@ -100,7 +101,8 @@ TEST_F(VerifyE2E, OneCasePerFamilyPasses) {
   for (const char* family :
        {"contact-conduction", "gas-lens", "convection", "radiation", "reaction"}) {
     EXPECT_TRUE(fs::exists(dir / "out" / "plots" / (std::string(family) + ".png")))
-        << family << "\n" << readAll(dir / "out" / "plot.log");
+        << family << "\n"
+        << readAll(dir / "out" / "plot.log");
   }
   // The table: 2 + 2 + 1 + 1 + 2 comparisons.
   EXPECT_NE(log.find("8 comparisons, all pass; 0 skipped"), std::string::npos) << log;
@@ -108,9 +110,8 @@ TEST_F(VerifyE2E, OneCasePerFamilyPasses) {
 
 TEST_F(VerifyE2E, FailedComparisonExitsNonZero) {
   copyCase("contact-d36-overlap4e-5", "2.0", "tolerance: 6.0e-6", "tolerance: 1.0e-12");
-  const int rc = verify({"--cases", (dir / "cases").string(), "--out", (dir / "out").string(),
-                         "--no-plots"},
-                        120s);
+  const int rc = verify(
+      {"--cases", (dir / "cases").string(), "--out", (dir / "out").string(), "--no-plots"}, 120s);
   const std::string log = readAll(dir / "v.log");
   EXPECT_EQ(rc, 1) << log;
   const std::string json = readAll(dir / "out" / "summary.json");
@@ -125,8 +126,9 @@ TEST_F(VerifyE2E, FailedComparisonExitsNonZero) {
 TEST_F(VerifyE2E, ListAndBadNames) {
   EXPECT_EQ(verify({"--list"}, 30s), 0);
   const std::string list = readAll(dir / "v.log");
-  for (const char* name : {"mfix-contact-conduction", "mfix-gas-lens", "mfix-convection-ranz-marshall",
-                           "convection-li-mason-0.6ms", "mfix-radiation", "mfix-reactive-chemistry"}) {
+  for (const char* name :
+       {"mfix-contact-conduction", "mfix-gas-lens", "mfix-convection-ranz-marshall",
+        "convection-li-mason-0.6ms", "mfix-radiation", "mfix-reactive-chemistry"}) {
     EXPECT_NE(list.find(name), std::string::npos) << name << "\n" << list;
   }
   fs::remove(dir / "v.log");
@@ -143,12 +145,12 @@ TEST_F(VerifyE2E, ForcedDemStepAboveTheStableStepIsRefused) {
   const auto pos = text.find("motion: frozen, ");
   ASSERT_NE(pos, std::string::npos);
   writeAll(c, text.erase(pos, std::string("motion: frozen, ").size()));
-  const int rc = coredem::e2e::waitExit(
-      coredem::e2e::startProgram(kBin / "coredem",
-                                 {"run", c.parent_path().string(), "--out",
-                                  (dir / "run").string(), "--no-plots"},
-                                 dir / "r.log"),
-      60s);
+  const int rc =
+      coredem::e2e::waitExit(coredem::e2e::startProgram(kBin / "coredem",
+                                                        {"run", c.parent_path().string(), "--out",
+                                                         (dir / "run").string(), "--no-plots"},
+                                                        dir / "r.log"),
+                             60s);
   const std::string log = readAll(dir / "r.log");
   EXPECT_EQ(rc, 2) << log;
   EXPECT_NE(log.find("time.dt_dem = 0.0001 s exceeds the DEM server's stable step"),

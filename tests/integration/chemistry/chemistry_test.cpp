@@ -1,16 +1,6 @@
 // Chemistry integrated in the DEM sub-step (PHYSICS §3.5, §4, §6, §8.5; docs/thermochemistry.md).
 // Every case runs a real DemSystem (cpu backend) and compares with the analytic solution, the
 // kernel values, or an independent RK4 integration of the conversion ODE.
-#include "coredem/common/check.h"
-#include "coredem/dem/dem_system.h"
-#include "coredem/dem/kernels/clg_char_gasification.h"
-#include "coredem/dem/kernels/clg_oc_reduction.h"
-#include "coredem/dem/kernels/nasa7.h"
-#include "coredem/dem/kernels/pressure_gradient.h"
-#include "coredem/dem/kernels/wgs.h"
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -19,7 +9,16 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <unistd.h>
+
+#include "coredem/common/check.h"
+#include "coredem/dem/dem_system.h"
+#include "coredem/dem/kernels/clg_char_gasification.h"
+#include "coredem/dem/kernels/clg_oc_reduction.h"
+#include "coredem/dem/kernels/nasa7.h"
+#include "coredem/dem/kernels/pressure_gradient.h"
+#include "coredem/dem/kernels/wgs.h"
 
 using namespace coredem::dem;
 namespace k = coredem::dem::kernels;
@@ -42,7 +41,8 @@ Material soft(double cp = 1000.0) {
   return m;
 }
 
-ParticleSet one(double d, double rho, double t, std::vector<double> comp, std::array<double, 3> x = {0, 0, 0}) {
+ParticleSet one(double d, double rho, double t, std::vector<double> comp,
+                std::array<double, 3> x = {0, 0, 0}) {
   ParticleSet s;
   s.packing = Packing::Explicit;
   s.diameter = d;
@@ -66,25 +66,37 @@ CouplingGrid cube(int nx = 1) {
 struct Gas {
   std::vector<double> u, gp, T, rho, mu, kappa, cp, Y;
   Gas(std::size_t n, double tg, double rhoG, const std::vector<double>& y)
-      : u(3 * n, 0.0), gp(3 * n, 0.0), T(n, tg), rho(n, rhoG), mu(n, 4e-5), kappa(n, 0.08), cp(n, 1200.0) {
-    for (std::size_t c = 0; c < n; ++c) Y.insert(Y.end(), y.begin(), y.end());
+      : u(3 * n, 0.0)
+      , gp(3 * n, 0.0)
+      , T(n, tg)
+      , rho(n, rhoG)
+      , mu(n, 4e-5)
+      , kappa(n, 0.08)
+      , cp(n, 1200.0) {
+    for (std::size_t c = 0; c < n; ++c)
+      Y.insert(Y.end(), y.begin(), y.end());
   }
   void apply(DemSystem& s) const { s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, Y}); }
 };
 
 std::vector<Species> clgGas() {
   using S = k::Species;
-  return {{"CO", k::molarMass(S::CO)}, {"CO2", k::molarMass(S::CO2)}, {"H2", k::molarMass(S::H2)},
-          {"H2O", k::molarMass(S::H2O)}, {"N2", k::molarMass(S::N2)}};
+  return {{"CO", k::molarMass(S::CO)},
+          {"CO2", k::molarMass(S::CO2)},
+          {"H2", k::molarMass(S::H2)},
+          {"H2O", k::molarMass(S::H2O)},
+          {"N2", k::molarMass(S::N2)}};
 }
 
 /// Mass fractions from mole fractions (CLG gas order).
 std::vector<double> massFractions(const std::vector<double>& x) {
   const auto g = clgGas();
   double mmix = 0.0;
-  for (std::size_t i = 0; i < x.size(); ++i) mmix += x[i] * g[i].molarMass;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    mmix += x[i] * g[i].molarMass;
   std::vector<double> y(x.size());
-  for (std::size_t i = 0; i < x.size(); ++i) y[i] = x[i] * g[i].molarMass / mmix;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    y[i] = x[i] * g[i].molarMass / mmix;
   return y;
 }
 
@@ -92,7 +104,8 @@ std::vector<double> massFractions(const std::vector<double>& x) {
 double idealRho(double p, const std::vector<double>& x, double t) {
   const auto g = clgGas();
   double mmix = 0.0;
-  for (std::size_t i = 0; i < x.size(); ++i) mmix += x[i] * g[i].molarMass;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    mmix += x[i] * g[i].molarMass;
   return p * mmix / (k::kGasConstant * t);
 }
 
@@ -126,14 +139,14 @@ TEST(ChemistryStep, MfixReactiveChemistryCaseFollowsTheAnalyticSolution) {
   Gas(1, 300.0, 1.2, {0.5, 0.5}).apply(sys);
   const double m0 = sys.particles().mass[0];
   EXPECT_NEAR(m0, 3.5342917e-5, 1e-12);
-  const double rB = 2.0 * kMB * kOmega;  // −r_B, kg/s
+  const double rB = 2.0 * kMB * kOmega; // −r_B, kg/s
   const double tEnd = m0 * 0.5 / rB;
   auto mass = [&](double t) { return m0 - rB * (1.0 - kMD / (2.0 * kMB)) * std::min(t, tEnd); };
   const double dtCfd = 0.01;
   const int nSub = static_cast<int>(std::ceil(dtCfd / sys.dtDemMax()));
   ASSERT_GE(nSub, 1);
   const double vc = 0.02 * 0.02 * 0.02;
-  double gasA = 0.0, gasC = 0.0;  // ∫ R_species V_c dt, kg
+  double gasA = 0.0, gasC = 0.0; // ∫ R_species V_c dt, kg
   double maxMassErr = 0.0, maxXErr = 0.0;
   for (int step = 1; step <= 160; ++step) {
     const CellSources& s = sys.advance(dtCfd, nSub);
@@ -150,7 +163,8 @@ TEST(ChemistryStep, MfixReactiveChemistryCaseFollowsTheAnalyticSolution) {
       const double xB = (m0 * 0.5 - burnt) / ref;
       const double xD = (kMD / (2.0 * kMB)) * burnt / ref;
       const double xI = m0 * 0.5 / ref;
-      for (auto [got, want] : {std::pair{p.species[0], xB}, {p.species[1], xD}, {p.species[2], xI}}) {
+      for (auto [got, want] :
+           {std::pair{p.species[0], xB}, {p.species[1], xD}, {p.species[2], xI}}) {
         EXPECT_LT(std::fabs(got - want), 3e-5) << "t = " << t;
         maxXErr = std::max(maxXErr, std::fabs(got - want));
       }
@@ -172,14 +186,14 @@ TEST(ChemistryStep, MfixReactiveChemistryCaseFollowsTheAnalyticSolution) {
   EXPECT_NEAR(p.species[1], 0.45454545, 3e-5);
   EXPECT_NEAR(p.species[2], 0.54545455, 3e-5);
   EXPECT_NEAR(p.mass[0], 3.23976742e-5, 8e-6 * 3.23976742e-5);
-  EXPECT_GE(p.species[0], 0.0);  // B exhausted, never negative (availability limiter)
+  EXPECT_GE(p.species[0], 0.0); // B exhausted, never negative (availability limiter)
   EXPECT_LT(p.species[0], 1e-15);
   RecordProperty("rc_mass_rel_err", sci(maxMassErr));
   RecordProperty("rc_fraction_abs_err", sci(maxXErr));
 }
 
 TEST(ChemistryStep, ReactionHeatChangesTheTemperatureAsQOverMcpPredicts) {
-  const double dH = -2.0e5;  // J/mol, exothermic
+  const double dH = -2.0e5; // J/mol, exothermic
   DemConfig cfg = reactiveChemistryCase(dH);
   DemSystem sys(cfg, BackendKind::Cpu, 1);
   Gas(1, 300.0, 1.2, {0.5, 0.5}).apply(sys);
@@ -190,7 +204,8 @@ TEST(ChemistryStep, ReactionHeatChangesTheTemperatureAsQOverMcpPredicts) {
   const double expected = 300.0 + dt * (-dH * kOmega / (p.mass[0] * 1000.0));
   EXPECT_NEAR(p.temperature[0], expected, 1e-13 * expected);
   EXPECT_GT(p.temperature[0], 300.0);
-  EXPECT_NEAR(sys.chemistryTotals().reactionHeat, -dH * kOmega * dt, 1e-13 * std::fabs(dH * kOmega * dt));
+  EXPECT_NEAR(sys.chemistryTotals().reactionHeat, -dH * kOmega * dt,
+              1e-13 * std::fabs(dH * kOmega * dt));
   // reaction_heat off: athermal.
   cfg.chemistry.reactionHeat = false;
   DemSystem off(cfg, BackendKind::Cpu, 1);
@@ -204,8 +219,8 @@ namespace {
 
 struct ClgParticleRun {
   std::vector<double> t, conversion;
-  double firstMdot = 0.0;               ///< Δm_key/Δt of the first sub-step
-  std::vector<double> firstGas;         ///< R_species V_c of the first step (kg/s)
+  double firstMdot = 0.0;       ///< Δm_key/Δt of the first sub-step
+  std::vector<double> firstGas; ///< R_species V_c of the first step (kg/s)
 };
 
 /// One CLG particle at fixed T_p in a fixed gas, advanced with steps dt for tEnd.
@@ -222,7 +237,8 @@ ClgParticleRun runClgParticle(const DemConfig& cfg, const Gas& gas, double dt, d
     const ParticleData p = sys.particles();
     if (s == 1) {
       out.firstMdot = (keyMass(p) - key0) / dt;
-      for (double r : src.rSpecies) out.firstGas.push_back(r * 0.02 * 0.02 * 0.02);
+      for (double r : src.rSpecies)
+        out.firstGas.push_back(r * 0.02 * 0.02 * 0.02);
     }
     out.t.push_back(s * dt);
     out.conversion.push_back(conversion(p));
@@ -231,7 +247,8 @@ ClgParticleRun runClgParticle(const DemConfig& cfg, const Gas& gas, double dt, d
 }
 
 /// RK4 of dX/dt = f(X) from X = 0, returning X at the times of `t` (uniform steps h).
-std::vector<double> rk4(const std::function<double(double)>& f, double h, const std::vector<double>& t) {
+std::vector<double> rk4(const std::function<double(double)>& f, double h,
+                        const std::vector<double>& t) {
   std::vector<double> out;
   double x = 0.0, time = 0.0;
   std::size_t next = 0;
@@ -299,7 +316,7 @@ TEST(ChemistryStep, NoSensibleGasHeatWhenTpEqualsTgButTheParticleLedgerStillClos
   const ChemistryTotals t = sys.chemistryTotals();
   EXPECT_EQ(t.gasSensibleHeat, 0.0);
   EXPECT_EQ(t.reactionHeat, 0.0);
-  EXPECT_EQ(sys.particles().temperature[0], t0);  // athermal: mass leaves at T_p, T_p unchanged
+  EXPECT_EQ(sys.particles().temperature[0], t0); // athermal: mass leaves at T_p, T_p unchanged
   const double de = sys.thermalEnergy() - e0;
   EXPECT_LT(de, 0.0);
   EXPECT_NEAR(de, t.sensibleMassEnthalpy, 1e-12 * std::fabs(de));
@@ -307,7 +324,7 @@ TEST(ChemistryStep, NoSensibleGasHeatWhenTpEqualsTgButTheParticleLedgerStillClos
 
 TEST(ChemistryStep, CharParticleFollowsTheKernelRatesAndTheConversionOde) {
   const double tp = 1400.0, p = 101325.0;
-  const std::vector<double> x = {0.05, 0.15, 0.05, 0.5, 0.25};  // CO, CO2, H2, H2O, N2
+  const std::vector<double> x = {0.05, 0.15, 0.05, 0.5, 0.25}; // CO, CO2, H2, H2O, N2
   DemConfig cfg;
   cfg.gravity = {0, 0, 0};
   cfg.materials = {soft(1200.0)};
@@ -317,30 +334,36 @@ TEST(ChemistryStep, CharParticleFollowsTheKernelRatesAndTheConversionOde) {
   cfg.grid = cube();
   cfg.heat.enabled = false;
   cfg.chemistry.clg.charGasification = true;
-  cfg.chemistry.reactionHeat = false;  // fixed T_p for the ODE comparison
+  cfg.chemistry.reactionHeat = false; // fixed T_p for the ODE comparison
   cfg.chemistry.pressure = p;
   const Gas gas(1, tp, idealRho(p, x, tp), massFractions(x));
   const double m0 = 1500.0 * k::sphereVolume(1e-3);
   const double mC0 = 0.9 * m0;
   const double dt = 1e-3;
   const auto run = runClgParticle(
-      cfg, gas, dt, 10.0, [&](const ParticleData& d) { return 1.0 - d.mass[0] * d.species[0] / mC0; },
+      cfg, gas, dt, 10.0,
+      [&](const ParticleData& d) { return 1.0 - d.mass[0] * d.species[0] / mC0; },
       [](const ParticleData& d) { return d.mass[0] * d.species[0]; });
   // Kernel values at the initial state (partial pressures P_j = x_j p in bar).
   double pBar[k::kGasSpeciesCount];
-  for (int g = 0; g < k::kGasSpeciesCount; ++g) pBar[g] = x[g] * p * 1e-5;
+  for (int g = 0; g < k::kGasSpeciesCount; ++g)
+    pBar[g] = x[g] * p * 1e-5;
   const k::CharGasificationParams cp;
   const k::CharGasificationRates r = k::charGasification(cp, tp, pBar, mC0, mC0);
   EXPECT_NEAR(run.firstMdot, r.mdotC, 1e-9 * std::fabs(r.mdotC));
   ASSERT_EQ(run.firstGas.size(), 5u);
-  for (int g = 0; g < 4; ++g) EXPECT_NEAR(run.firstGas[g], r.mdotGas[g], 1e-12 * std::fabs(r.mdotC)) << g;
+  for (int g = 0; g < 4; ++g)
+    EXPECT_NEAR(run.firstGas[g], r.mdotGas[g], 1e-12 * std::fabs(r.mdotC)) << g;
   EXPECT_EQ(run.firstGas[4], 0.0);
   // Conversion vs RK4 of dX/dt = (r_CO2 + r_H2O)(1 − X)^(2/3) (fixed gas, fixed T_p).
-  const double rate = k::charRateCO2(cp, tp, pBar[1], pBar[0]) + k::charRateH2O(cp, tp, pBar[3], pBar[2]);
+  const double rate =
+      k::charRateCO2(cp, tp, pBar[1], pBar[0]) + k::charRateH2O(cp, tp, pBar[3], pBar[2]);
   const auto ref = rk4([&](double X) { return rate * std::cbrt((1 - X) * (1 - X)); }, 1e-4, run.t);
   double maxErr = 0.0;
-  for (std::size_t i = 0; i < ref.size(); ++i) maxErr = std::max(maxErr, std::fabs(run.conversion[i] - ref[i]));
-  // Explicit Euler, Δt = 1e-3 s: global error ≈ (Δt/2)|dX/dt| ≈ 2e-5; tolerance 5e-5 (X(10 s) ≈ 0.3).
+  for (std::size_t i = 0; i < ref.size(); ++i)
+    maxErr = std::max(maxErr, std::fabs(run.conversion[i] - ref[i]));
+  // Explicit Euler, Δt = 1e-3 s: global error ≈ (Δt/2)|dX/dt| ≈ 2e-5; tolerance 5e-5 (X(10 s) ≈
+  // 0.3).
   EXPECT_GT(run.conversion.back(), 0.2);
   EXPECT_LT(maxErr, 5e-5);
   RecordProperty("char_conversion_abs_err", sci(maxErr));
@@ -354,7 +377,8 @@ TEST(ChemistryStep, OxygenCarrierParticleFollowsTheKernelRatesAndTheConversionOd
   cfg.materials = {soft(900.0)};
   cfg.gasSpecies = clgGas();
   using S = k::Species;
-  cfg.solidSpecies = {{"Fe2O3", k::molarMass(S::Fe2O3)}, {"Fe3O4", k::molarMass(S::Fe3O4)},
+  cfg.solidSpecies = {{"Fe2O3", k::molarMass(S::Fe2O3)},
+                      {"Fe3O4", k::molarMass(S::Fe3O4)},
                       {"Al2O3", k::molarMass(S::Al2O3)}};
   cfg.particleSets.push_back(one(2e-3, 3000.0, tp, {0.6, 0.0, 0.4}));
   cfg.grid = cube();
@@ -366,10 +390,13 @@ TEST(ChemistryStep, OxygenCarrierParticleFollowsTheKernelRatesAndTheConversionOd
   const Gas gas(1, tp, rho, massFractions(x));
   const double m0 = 3000.0 * k::sphereVolume(1e-3);
   const double hem = k::molarMass(S::Fe2O3), mag = k::molarMass(S::Fe3O4);
-  auto meq = [&](const ParticleData& d) { return d.mass[0] * (d.species[0] + d.species[1] * 3 * hem / (2 * mag)); };
+  auto meq = [&](const ParticleData& d) {
+    return d.mass[0] * (d.species[0] + d.species[1] * 3 * hem / (2 * mag));
+  };
   const double dt = 1e-3;
   const auto run = runClgParticle(
-      cfg, gas, dt, 10.0, [&](const ParticleData& d) { return 1.0 - d.mass[0] * d.species[0] / meq(d); },
+      cfg, gas, dt, 10.0,
+      [&](const ParticleData& d) { return 1.0 - d.mass[0] * d.species[0] / meq(d); },
       [](const ParticleData& d) { return d.mass[0] * d.species[0]; });
   const k::OcReductionParams op;
   const double cCO = rho * massFractions(x)[0] / k::molarMass(S::CO);
@@ -377,12 +404,14 @@ TEST(ChemistryStep, OxygenCarrierParticleFollowsTheKernelRatesAndTheConversionOd
   const double mf[3] = {0.6, 0.0, 0.4};
   const k::OcReductionRates r = k::ocReduction(op, tp, m0, mf, cCO, cH2);
   EXPECT_NEAR(run.firstMdot, r.mdotSolid[0], 1e-9 * std::fabs(r.mdotSolid[0]));
-  for (int g = 0; g < 4; ++g) EXPECT_NEAR(run.firstGas[g], r.mdotGas[g], 1e-12 * std::fabs(r.mdotSolid[0])) << g;
+  for (int g = 0; g < 4; ++g)
+    EXPECT_NEAR(run.firstGas[g], r.mdotGas[g], 1e-12 * std::fabs(r.mdotSolid[0])) << g;
   const double kSum = k::ocRateCoefficient(op, op.k0CO, op.eCO, op.nCO, tp, cCO) +
                       k::ocRateCoefficient(op, op.k0H2, op.eH2, op.nH2, tp, cH2);
   const auto ref = rk4([&](double X) { return kSum * std::cbrt((1 - X) * (1 - X)); }, 1e-4, run.t);
   double maxErr = 0.0;
-  for (std::size_t i = 0; i < ref.size(); ++i) maxErr = std::max(maxErr, std::fabs(run.conversion[i] - ref[i]));
+  for (std::size_t i = 0; i < ref.size(); ++i)
+    maxErr = std::max(maxErr, std::fabs(run.conversion[i] - ref[i]));
   EXPECT_GT(run.conversion.back(), 0.1);
   EXPECT_LT(maxErr, 5e-5);
   RecordProperty("oc_conversion_abs_err", sci(maxErr));
@@ -405,30 +434,37 @@ TEST(ChemistryStep, WaterGasShiftCellSourcesEqualTheKernelAndDriveTowardsEquilib
   const double keq = k::wgsEquilibriumConstant(wp, tg);
   auto quotient = [&](const std::vector<double>& yy) {
     const auto g = clgGas();
-    return (yy[1] / g[1].molarMass) * (yy[2] / g[2].molarMass) / ((yy[0] / g[0].molarMass) * (yy[3] / g[3].molarMass));
+    return (yy[1] / g[1].molarMass) * (yy[2] / g[2].molarMass) /
+           ((yy[0] / g[0].molarMass) * (yy[3] / g[3].molarMass));
   };
-  double gap0 = std::fabs(std::log(quotient(y[0]) / keq)), gap1 = std::fabs(std::log(quotient(y[1]) / keq));
+  double gap0 = std::fabs(std::log(quotient(y[0]) / keq)),
+         gap1 = std::fabs(std::log(quotient(y[1]) / keq));
   // τ = 1/(k_f ΣC) ≈ 500 s at 1000 K: 30 steps of 25 s (explicit relaxation, Δt/τ ≈ 0.05).
   const double dt = 25.0;
   for (int step = 0; step < 30; ++step) {
     Gas gas(2, tg, 1.0, y[0]);
     gas.rho = rho;
     gas.Y.clear();
-    for (const auto& yy : y) gas.Y.insert(gas.Y.end(), yy.begin(), yy.end());
+    for (const auto& yy : y)
+      gas.Y.insert(gas.Y.end(), yy.begin(), yy.end());
     gas.apply(sys);
     const CellSources& s = sys.advance(dt, 1);
     for (int c = 0; c < 2; ++c) {
       const k::WgsCellSources w = k::wgsCellSources(wp, tg, 1.0, rho[c], y[c].data(), dt);
-      for (int g = 0; g < 5; ++g) EXPECT_EQ(s.rSpecies[c * 5 + g], w.massSource[g]) << "cell " << c << " species " << g;
+      for (int g = 0; g < 5; ++g)
+        EXPECT_EQ(s.rSpecies[c * 5 + g], w.massSource[g]) << "cell " << c << " species " << g;
       EXPECT_EQ(s.qHom[c], w.heatSource);
       if (step == 0) {
-        EXPECT_LT(s.rSpecies[c * 5 + 0] * (c == 0 ? 1 : -1), 0.0);  // CO consumed in cell 0, produced in cell 1
-        EXPECT_GT(s.qHom[c] * (c == 0 ? 1 : -1), 0.0);               // exothermic forward
+        EXPECT_LT(s.rSpecies[c * 5 + 0] * (c == 0 ? 1 : -1),
+                  0.0);                                // CO consumed in cell 0, produced in cell 1
+        EXPECT_GT(s.qHom[c] * (c == 0 ? 1 : -1), 0.0); // exothermic forward
       }
       // The gas of a closed cell at constant ρ: Y += Δt R/ρ (ε_g = 1).
-      for (int g = 0; g < 5; ++g) y[c][g] += dt * s.rSpecies[c * 5 + g] / rho[c];
+      for (int g = 0; g < 5; ++g)
+        y[c][g] += dt * s.rSpecies[c * 5 + g] / rho[c];
     }
-    const double n0 = std::fabs(std::log(quotient(y[0]) / keq)), n1 = std::fabs(std::log(quotient(y[1]) / keq));
+    const double n0 = std::fabs(std::log(quotient(y[0]) / keq)),
+                 n1 = std::fabs(std::log(quotient(y[1]) / keq));
     EXPECT_LE(n0, gap0);
     EXPECT_LE(n1, gap1);
     gap0 = n0;
@@ -444,14 +480,15 @@ TEST(ChemistryStep, ShrinkingBelowTheThresholdRemovesTheParticleAndLedgersItsMas
   cfg.materials = {soft()};
   cfg.gasSpecies = {{"G", 0.015}};
   cfg.solidSpecies = {{"B", 0.015}, {"I", 0.020}};
-  cfg.particleSets.push_back(one(2e-3, 2000.0, 300.0, {1.0, 0.0}, {-0.005, 0, 0}));  // all B: burns away
-  cfg.particleSets.push_back(one(2e-3, 2000.0, 300.0, {0.0, 1.0}, {0.005, 0, 0}));   // inert
+  cfg.particleSets.push_back(
+      one(2e-3, 2000.0, 300.0, {1.0, 0.0}, {-0.005, 0, 0})); // all B: burns away
+  cfg.particleSets.push_back(one(2e-3, 2000.0, 300.0, {0.0, 1.0}, {0.005, 0, 0})); // inert
   cfg.grid = cube();
   cfg.heat.enabled = false;
   ReactionConfig r;
   r.name = "burn";
   r.terms = {{"B", -1}, {"G", 1}};
-  r.A = 1e-4;  // mol/s: 1.5e-6 kg/s, the particle (8.4e-6 kg) is gone after ≈ 5.6 s
+  r.A = 1e-4; // mol/s: 1.5e-6 kg/s, the particle (8.4e-6 kg) is gone after ≈ 5.6 s
   cfg.chemistry.reactions.push_back(r);
   cfg.chemistry.removalFraction = 0.1;
   DemSystem sys(cfg, BackendKind::Cpu, 1);
@@ -462,9 +499,9 @@ TEST(ChemistryStep, ShrinkingBelowTheThresholdRemovesTheParticleAndLedgersItsMas
     ++steps;
   }
   ASSERT_EQ(sys.particleCount(), 1u) << "not removed after " << steps << " steps";
-  EXPECT_NEAR(steps * 0.01, m0 / (0.015 * 1e-4), 0.02);  // when ≥ 99.9 % of the mass is gone
+  EXPECT_NEAR(steps * 0.01, m0 / (0.015 * 1e-4), 0.02); // when ≥ 99.9 % of the mass is gone
   const ParticleData p = sys.particles();
-  EXPECT_EQ(p.globalId[0], 1);  // the inert particle keeps its id
+  EXPECT_EQ(p.globalId[0], 1); // the inert particle keeps its id
   EXPECT_EQ(p.species[1], 1.0);
   const ChemistryTotals t = sys.chemistryTotals();
   EXPECT_EQ(t.removedCount, 1u);
@@ -493,8 +530,11 @@ DemConfig reactingBed() {
   cfg.addBox({0, 0, 0}, {0.012, 0.012, 0.024});
   cfg.gasSpecies = clgGas();
   using S = k::Species;
-  cfg.solidSpecies = {{"C", k::molarMass(S::C)}, {"ash", 0.1}, {"Fe2O3", k::molarMass(S::Fe2O3)},
-                      {"Fe3O4", k::molarMass(S::Fe3O4)}, {"Al2O3", k::molarMass(S::Al2O3)}};
+  cfg.solidSpecies = {{"C", k::molarMass(S::C)},
+                      {"ash", 0.1},
+                      {"Fe2O3", k::molarMass(S::Fe2O3)},
+                      {"Fe3O4", k::molarMass(S::Fe3O4)},
+                      {"Al2O3", k::molarMass(S::Al2O3)}};
   ParticleSet c;
   c.packing = Packing::Lattice;
   c.regionMin = {0, 0, 0};
@@ -520,7 +560,7 @@ DemConfig reactingBed() {
   cfg.chemistry.clg.charGasification = true;
   cfg.chemistry.clg.ocReduction = true;
   cfg.chemistry.clg.wgs = true;
-  cfg.chemistry.clg.charParams.aH2O = 1e9;  // fast, so a few steps change the state
+  cfg.chemistry.clg.charParams.aH2O = 1e9; // fast, so a few steps change the state
   cfg.chemistry.clg.ocParams.k0CO = 1e-2;
   ReactionConfig r;
   r.name = "extra";
@@ -541,14 +581,15 @@ struct BedRun {
   ChemistryTotals tot;
 };
 
-BedRun runBed(int threads, int steps, const std::string& readFrom = "", const std::string& writeTo = "",
-              int writeAfter = -1) {
+BedRun runBed(int threads, int steps, const std::string& readFrom = "",
+              const std::string& writeTo = "", int writeAfter = -1) {
   DemSystem sys(reactingBed(), BackendKind::Cpu, threads);
   const double dt = 2e-3;
   // Sub-steps from the initial particles (a restart recomputes Δt_DEM,max from the lighter,
   // reacted particles; the server keeps the nSub of the grant).
   const int nSub = static_cast<int>(std::ceil(dt / sys.dtDemMax()));
-  if (!readFrom.empty()) sys.readState(readFrom);
+  if (!readFrom.empty())
+    sys.readState(readFrom);
   const std::vector<double> x = {0.1, 0.2, 0.1, 0.4, 0.2};
   const Gas gas(sys.cellCount(), 1250.0, idealRho(101325.0, x, 1250.0), massFractions(x));
   BedRun out;
@@ -557,7 +598,8 @@ BedRun runBed(int threads, int steps, const std::string& readFrom = "", const st
     const CellSources& src = sys.advance(dt, nSub);
     out.r = src.rSpecies;
     out.qhom = src.qHom;
-    if (s + 1 == writeAfter && !writeTo.empty()) sys.writeState(writeTo);
+    if (s + 1 == writeAfter && !writeTo.empty())
+      sys.writeState(writeTo);
   }
   out.p = sys.particles();
   out.tot = sys.chemistryTotals();
@@ -604,17 +646,21 @@ TEST(ChemistryStep, OneAndTwoThreadsAreBitwiseIdenticalWithChemistryOn) {
   EXPECT_GT(a.tot.solidChange[3], 0.0);
   EXPECT_NE(a.tot.reactionHeat, 0.0);
   EXPECT_NE(a.tot.homogeneousHeat, 0.0);
-  EXPECT_NE(a.tot.gasSensibleHeat, 0.0);       // T_p (1200/1300 K) ≠ T_g (1250 K)
+  EXPECT_NE(a.tot.gasSensibleHeat, 0.0); // T_p (1200/1300 K) ≠ T_g (1250 K)
   EXPECT_NE(a.tot.sensibleMassEnthalpy, 0.0);
-  // Mass: Σ solid change + Σ gas released = 0 (balanced reactions; molar masses balance to round-off).
+  // Mass: Σ solid change + Σ gas released = 0 (balanced reactions; molar masses balance to
+  // round-off).
   double s = 0.0, scale = 0.0;
-  for (double v : a.tot.solidChange) s += v, scale += std::fabs(v);
-  for (double v : a.tot.gasProduced) s += v;
+  for (double v : a.tot.solidChange)
+    s += v, scale += std::fabs(v);
+  for (double v : a.tot.gasProduced)
+    s += v;
   EXPECT_LT(std::fabs(s), 1e-12 * scale);
 }
 
 TEST(ChemistryStep, RestartFromHdf5IsBitwiseWithChemistryOn) {
-  const auto dir = std::filesystem::temp_directory_path() / ("coredem_chem_restart_" + std::to_string(::getpid()));
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("coredem_chem_restart_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const std::string state = (dir / "state.h5").string();
   const BedRun straight = runBed(2, 6, "", state, 3);

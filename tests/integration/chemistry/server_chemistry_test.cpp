@@ -1,22 +1,22 @@
-// Chemistry through coredem-dem's session (real ZeroMQ tcp loopback, ephemeral port, real DEM core):
-// a v1.1 Configure with solid species and a reaction -> Sources.R_species and the StepDone ledger.
-#include "../client/mini_orchestrator.h"
-#include "../dem-server/server_thread.h"
-
-#include "coredem/server/dem_server.h"
-
-#include <gtest/gtest.h>
-
+// Chemistry through coredem-dem's session (real ZeroMQ tcp loopback, ephemeral port, real DEM
+// core): a v1.1 Configure with solid species and a reaction -> Sources.R_species and the StepDone
+// ledger.
 #include <cmath>
 #include <numbers>
 #include <thread>
+
+#include <gtest/gtest.h>
+
+#include "../client/mini_orchestrator.h"
+#include "../dem-server/server_thread.h"
+#include "coredem/server/dem_server.h"
 
 using namespace coredem::testing;
 
 namespace {
 
 constexpr int kN = 40;
-constexpr double kD = 1e-3, kBox = 6e-3, kOmega = 1e-7;  // ω: mol/s per particle
+constexpr double kD = 1e-3, kBox = 6e-3, kOmega = 1e-7; // ω: mol/s per particle
 constexpr int kCells = 3;
 
 v1::Configure reactingCase() {
@@ -54,7 +54,7 @@ v1::Configure reactingCase() {
 } // namespace
 
 TEST(DemServerChemistry, SourcesCarryTheParticlesSpeciesRatesAndTheLedgerTheConvertedMass) {
-  ServerThread server(600.0, 60.0);  // the server defaults
+  ServerThread server(600.0, 60.0); // the server defaults
   MiniOrchestrator o(server.endpoint(), reactingCase());
   ASSERT_EQ(o.particles(), static_cast<std::uint64_t>(kN));
   proto::Client cfd;
@@ -72,8 +72,8 @@ TEST(DemServerChemistry, SourcesCarryTheParticlesSpeciesRatesAndTheLedgerTheConv
   namespace f = proto::fields;
   auto m = proto::makeGasFields(1, 0.0, dt, n, static_cast<std::uint32_t>(ns));
   m.setSessionId(o.session());
-  const std::vector<double> zero3(3 * n, 0.0), T(n, 300.0), rho(n, 1.2), mu(n, 1.8e-5), kap(n, 0.026),
-      cp(n, 1005.0);
+  const std::vector<double> zero3(3 * n, 0.0), T(n, 300.0), rho(n, 1.2), mu(n, 1.8e-5),
+      kap(n, 0.026), cp(n, 1005.0);
   std::vector<double> Y(n * ns, 0.5);
   m.addArray(f::kGasVelocity, zero3, {n, 3});
   m.addArray(f::kPressureGradient, zero3, {n, 3});
@@ -90,7 +90,8 @@ TEST(DemServerChemistry, SourcesCarryTheParticlesSpeciesRatesAndTheLedgerTheConv
   ASSERT_EQ(r.size(), n * ns);
   const double vc = std::pow(kBox / kCells, 3);
   double a = 0.0, c = 0.0;
-  for (std::size_t k = 0; k < n; ++k) a += r[k * ns] * vc, c += r[k * ns + 1] * vc;
+  for (std::size_t k = 0; k < n; ++k)
+    a += r[k * ns] * vc, c += r[k * ns + 1] * vc;
   EXPECT_NEAR(a, -kN * 0.025 * kOmega, 1e-12 * kN * 0.025 * kOmega);
   EXPECT_NEAR(c, kN * 0.030 * kOmega, 1e-12 * kN * 0.030 * kOmega);
   // StepDone ledger: converted mass per gas species and the particle mass loss (2 M_B − M_D) ω.
@@ -98,10 +99,13 @@ TEST(DemServerChemistry, SourcesCarryTheParticlesSpeciesRatesAndTheLedgerTheConv
   ASSERT_TRUE(d.has_value());
   proto::expectType(*d, v1::MESSAGE_TYPE_STEP_DONE);
   const auto& l = d->envelope().step_done().ledger();
-  EXPECT_NEAR(named(l.species(), "dem.solid_to_gas.A_kg"), -kN * 0.025 * kOmega * dt, 1e-12 * kN * 0.025 * kOmega * dt);
-  EXPECT_NEAR(named(l.species(), "dem.solid_to_gas.C_kg"), kN * 0.030 * kOmega * dt, 1e-12 * kN * 0.030 * kOmega * dt);
+  EXPECT_NEAR(named(l.species(), "dem.solid_to_gas.A_kg"), -kN * 0.025 * kOmega * dt,
+              1e-12 * kN * 0.025 * kOmega * dt);
+  EXPECT_NEAR(named(l.species(), "dem.solid_to_gas.C_kg"), kN * 0.030 * kOmega * dt,
+              1e-12 * kN * 0.030 * kOmega * dt);
   const double m0 = kN * 2500.0 * std::numbers::pi * kD * kD * kD / 6.0;
-  EXPECT_NEAR(named(l.mass(), "dem.particle_mass_kg"), m0 - kN * (2 * 0.015 - 0.025) * kOmega * dt, 1e-13 * m0);
+  EXPECT_NEAR(named(l.mass(), "dem.particle_mass_kg"), m0 - kN * (2 * 0.015 - 0.025) * kOmega * dt,
+              1e-13 * m0);
   EXPECT_EQ(named(l.mass(), "dem.removed_mass_kg"), 0.0);
   EXPECT_EQ(named(l.energy(), "dem.reaction_heat_J"), 0.0);
   // Sensible enthalpy of the moved mass (PHYSICS §3.5): the gas-side total is the transfer part of
@@ -112,10 +116,12 @@ TEST(DemServerChemistry, SourcesCarryTheParticlesSpeciesRatesAndTheLedgerTheConv
   const auto qh = src.values<double>(f::kHomogeneousHeat);
   ASSERT_EQ(qh.size(), n);
   double qSum = 0.0;
-  for (double v : qh) qSum += v * vc * dt;
+  for (double v : qh)
+    qSum += v * vc * dt;
   const double gasSens = named(l.energy(), "dem.gas_sensible_heat_J");
   EXPECT_NEAR(gasSens, qSum, 1e-12 * std::fabs(qSum));
-  const double cT = named(l.energy(), "dem.thermal_energy_J") / named(l.mass(), "dem.particle_mass_kg");
+  const double cT =
+      named(l.energy(), "dem.thermal_energy_J") / named(l.mass(), "dem.particle_mass_kg");
   const double dm = -kN * (2 * 0.015 - 0.025) * kOmega * dt;
   EXPECT_NEAR(named(l.energy(), "dem.sensible_mass_enthalpy_J"), dm * cT, 1e-13 * m0 * cT);
   EXPECT_LT(named(l.energy(), "dem.sensible_mass_enthalpy_J"), 0.0);

@@ -4,14 +4,14 @@
 // Configured, StepDone) and forwards each grant to D. Not a mock of any part: both peers are
 // the real programs; this is the smallest orchestrator that lets the participants be tested
 // without the `coredem` CLI.
-#include "coredem/protocol/protocol.h"
-
 #include <chrono>
 #include <cmath>
 #include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "coredem/protocol/protocol.h"
 
 namespace coredem::testing {
 
@@ -85,16 +85,18 @@ inline v1::Configure smallCase(int count, double d, double box, int cells,
 class MiniOrchestrator {
 public:
   struct Result {
-    std::vector<v1::StepDone> cfd;  ///< C's StepDone of each step
-    std::vector<v1::StepDone> dem;  ///< D's StepDone of each step
+    std::vector<v1::StepDone> cfd; ///< C's StepDone of each step
+    std::vector<v1::StepDone> dem; ///< D's StepDone of each step
     std::vector<double> demCheckpointSteps;
   };
 
   MiniOrchestrator(const std::string& demEndpoint, v1::Configure configure,
                    std::chrono::milliseconds timeout = 20s)
-      : _configure(std::move(configure)), _timeout(timeout) {
+      : _configure(std::move(configure))
+      , _timeout(timeout) {
     _dem.connect(demEndpoint);
-    auto w = _dem.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "mini-orchestrator (test)"), _timeout);
+    auto w =
+        _dem.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "mini-orchestrator (test)"), _timeout);
     proto::expectType(w, v1::MESSAGE_TYPE_WELCOME);
     _session = w.envelope().welcome().session_id();
     auto cfg = proto::makeConfigure(_configure);
@@ -121,8 +123,9 @@ public:
     const std::int64_t last = _configure.start_step() + steps;
     const auto nSub = static_cast<std::uint32_t>(std::ceil(dtCfd / _dtDemMax * (1.0 - 1e-12)));
     auto grant = [&](std::int64_t n) {
-      auto g = proto::makeStepGrant(n, _configure.start_time() + static_cast<double>(n - first) * dtCfd,
-                                    dtCfd, nSub, dtCfd / nSub);
+      auto g =
+          proto::makeStepGrant(n, _configure.start_time() + static_cast<double>(n - first) * dtCfd,
+                               dtCfd, nSub, dtCfd / nSub);
       g.setSessionId(_session);
       if (const auto it = checkpoints.find(n); it != checkpoints.end()) {
         g.envelope().mutable_step_grant()->mutable_checkpoint()->set_directory(it->second);
@@ -137,7 +140,8 @@ public:
       }
       auto req = _control.receive(_timeout);
       if (!req) {
-        throw std::runtime_error("mini orchestrator: no request from the CFD participant within the deadline");
+        throw std::runtime_error(
+            "mini orchestrator: no request from the CFD participant within the deadline");
       }
       if (!req->status.ok()) {
         throw std::runtime_error("mini orchestrator: bad request: " + req->status.message);
@@ -173,7 +177,8 @@ public:
         res.cfd.push_back(env.step_done());
         auto d = _dem.receive(_timeout);
         if (!d) {
-          throw std::runtime_error("mini orchestrator: no StepDone from D for step " + std::to_string(env.step()));
+          throw std::runtime_error("mini orchestrator: no StepDone from D for step " +
+                                   std::to_string(env.step()));
         }
         proto::expectType(*d, v1::MESSAGE_TYPE_STEP_DONE);
         res.dem.push_back(d->envelope().step_done());
@@ -214,7 +219,8 @@ private:
 };
 
 /// Value of a named entry in a NamedValue list (NaN if absent).
-inline double named(const google::protobuf::RepeatedPtrField<v1::NamedValue>& l, const std::string& name) {
+inline double named(const google::protobuf::RepeatedPtrField<v1::NamedValue>& l,
+                    const std::string& name) {
   const auto v = proto::findNamedValue(l, name);
   return v ? *v : std::nan("");
 }

@@ -1,16 +1,15 @@
 // The participants against a real coredem-dem process over tcp loopback: the C API program,
 // coredem-gas (checkpoint + restart with identical ledgers) and the C++ client's argument checks.
-#include "mini_orchestrator.h"
-#include "process.h"
-
-#include "coredem/client/participant.h"
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "coredem/client/participant.h"
+#include "mini_orchestrator.h"
+#include "process.h"
 
 using namespace coredem::testing;
 namespace fs = std::filesystem;
@@ -18,7 +17,8 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path tempDir(const std::string& name) {
-  const auto d = fs::temp_directory_path() / ("coredem-participants-" + name + "-" + std::to_string(::getpid()));
+  const auto d = fs::temp_directory_path() /
+                 ("coredem-participants-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -52,7 +52,8 @@ TEST(Participants, CApiProgramRunsStepsAgainstARealServer) {
     // Σ (1 − ε_g) V_c computed by the C program equals the particle volume (round-off).
     EXPECT_NEAR(named(done.ledger().energy(), "c_api.solid_volume_m3"), kVp, 1e-12 * kVp);
   }
-  EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0) << "coredem-dem --exit-after-session did not exit cleanly";
+  EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0)
+      << "coredem-dem --exit-after-session did not exit cleanly";
   fs::remove_all(dir);
 }
 
@@ -70,7 +71,8 @@ TEST(Participants, CoredemGasRunsCheckpointsAndRestartsWithIdenticalLedgers) {
            "      box: {min: [0, 0, 0.004], max: [0.006, 0.006, 0.006]}\n"
            "      u_g: [0.0, 0.0, 0.1]\n";
   }
-  const std::vector<std::string> gasArgs = {COREDEM_GAS_BIN, "--case", caseFile.string(), "--key", "gas"};
+  const std::vector<std::string> gasArgs = {COREDEM_GAS_BIN, "--case", caseFile.string(), "--key",
+                                            "gas"};
   const double dt = 2e-4;
   const auto ck = (dir / "ck6").string();
   std::vector<v1::StepDone> straight;
@@ -144,8 +146,8 @@ TEST(Participants, CppClientChecksArgumentsBeforeSending) {
       std::vector<double> v3(3 * n, 0.0), t(n, 300.0), rho(n, 1.2), mu(n, 1.8e-5), k(n, 0.03),
           cp(n, 1000.0), y(n, 1.0);
       std::vector<coredem::client::NamedField> fields = {
-          {"u_g", v3}, {"grad_p", v3}, {"T_g", t}, {"rho_g", rho}, {"mu_g", mu},
-          {"kappa_g", k}, {"cp_g", cp}, {"Y_g", y}};
+          {"u_g", v3},  {"grad_p", v3}, {"T_g", t},   {"rho_g", rho},
+          {"mu_g", mu}, {"kappa_g", k}, {"cp_g", cp}, {"Y_g", y}};
       auto expectArgument = [&](auto&& call, const char* what, const char* mentions) {
         try {
           call();
@@ -158,7 +160,8 @@ TEST(Participants, CppClientChecksArgumentsBeforeSending) {
         }
       };
       expectArgument([&] { p.exchange(p.step(), 2 * p.dt(), fields); }, "other dt", "granted dt");
-      expectArgument([&] { p.exchange(p.step() + 1, p.dt(), fields); }, "other step", "granted step");
+      expectArgument([&] { p.exchange(p.step() + 1, p.dt(), fields); }, "other step",
+                     "granted step");
       auto missing = fields;
       missing.pop_back();
       expectArgument([&] { p.exchange(p.step(), p.dt(), missing); }, "missing Y_g", "'Y_g'");
@@ -170,7 +173,8 @@ TEST(Participants, CppClientChecksArgumentsBeforeSending) {
       expectArgument([&] { p.exchange(p.step(), p.dt(), shortT); }, "short T_g", "needs");
       while (p.isRunning()) {
         const auto& s = p.exchange(p.step(), p.dt(), fields);
-        if (s.field("eps_g").size != n) failure += "eps_g size; ";
+        if (s.field("eps_g").size != n)
+          failure += "eps_g size; ";
         p.advance(0.0);
       }
       p.finalize();
@@ -202,8 +206,9 @@ TEST(Participants, CommandLinesRefuseBadInputWithExitCode2) {
   Child missing({COREDEM_GAS_BIN, "--case", (dir / "nope.yaml").string(), "--check"});
   EXPECT_EQ(missing.wait(std::chrono::seconds(20)), 2);
   // coredem-gas without peers: exit 2 naming the variable (stderr), not a hang.
-  Child noPeers({COREDEM_GAS_BIN, "--case", good.string()},
-                {{"COREDEM_CONTROL_ENDPOINT", ""}, {"COREDEM_DEM_ENDPOINT", ""}, {"COREDEM_SESSION", ""}});
+  Child noPeers(
+      {COREDEM_GAS_BIN, "--case", good.string()},
+      {{"COREDEM_CONTROL_ENDPOINT", ""}, {"COREDEM_DEM_ENDPOINT", ""}, {"COREDEM_SESSION", ""}});
   EXPECT_EQ(noPeers.wait(std::chrono::seconds(20)), 2);
   fs::remove_all(dir);
 }
@@ -234,7 +239,8 @@ namespace {
 /// per granted step and returns the Sources arrays to record (name -> values).
 using Recorded = std::vector<std::map<std::string, std::vector<double>>>;
 template <class Exchange>
-Recorded runRecording(const std::string& name, int steps, Exchange&& exchange, std::string& failure) {
+Recorded runRecording(const std::string& name, int steps, Exchange&& exchange,
+                      std::string& failure) {
   const auto dir = tempDir(name);
   DemProcess dem(dir);
   MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2"}));
@@ -265,12 +271,15 @@ Recorded runRecording(const std::string& name, int steps, Exchange&& exchange, s
   return rec;
 }
 
-std::vector<coredem::client::NamedField> gasFields(std::size_t n, std::vector<std::vector<double>>& keep) {
-  keep = {std::vector<double>(3 * n, 0.0), std::vector<double>(3 * n, 0.0), std::vector<double>(n, 300.0),
-          std::vector<double>(n, 1.2), std::vector<double>(n, 1.8e-5), std::vector<double>(n, 0.03),
-          std::vector<double>(n, 1000.0), std::vector<double>(n, 1.0)};
-  for (std::size_t c = 0; c < n; ++c) keep[0][3 * c + 1] = 0.3; // gas rising: non-zero drag sources
-  return {{"u_g", keep[0]}, {"grad_p", keep[1]}, {"T_g", keep[2]}, {"rho_g", keep[3]},
+std::vector<coredem::client::NamedField> gasFields(std::size_t n,
+                                                   std::vector<std::vector<double>>& keep) {
+  keep = {std::vector<double>(3 * n, 0.0), std::vector<double>(3 * n, 0.0),
+          std::vector<double>(n, 300.0),   std::vector<double>(n, 1.2),
+          std::vector<double>(n, 1.8e-5),  std::vector<double>(n, 0.03),
+          std::vector<double>(n, 1000.0),  std::vector<double>(n, 1.0)};
+  for (std::size_t c = 0; c < n; ++c)
+    keep[0][3 * c + 1] = 0.3; // gas rising: non-zero drag sources
+  return {{"u_g", keep[0]},  {"grad_p", keep[1]},  {"T_g", keep[2]},  {"rho_g", keep[3]},
           {"mu_g", keep[4]}, {"kappa_g", keep[5]}, {"cp_g", keep[6]}, {"Y_g", keep[7]}};
 }
 
@@ -282,61 +291,72 @@ std::vector<coredem::client::NamedField> gasFields(std::size_t n, std::vector<st
 TEST(Participants, CppClientReceivesIntoCallerBuffersBitwiseAsViews) {
   constexpr int kSteps = 3;
   std::string failure;
-  const Recorded viewed = runRecording("views", kSteps, [&](coredem::client::Participant& p) {
-    std::vector<std::vector<double>> keep;
-    const auto n = static_cast<std::size_t>(p.grid().cellCount());
-    const auto& s = p.exchange(p.step(), p.dt(), gasFields(n, keep));
-    std::map<std::string, std::vector<double>> out;
-    for (const auto& name : s.names()) {
-      const auto v = s.field(name);
-      out[name].assign(v.begin(), v.end());
-    }
-    const auto t = p.lastExchangeTimes();
-    for (double x : {t.serialise, t.send, t.wait, t.receive}) {
-      if (!(std::isfinite(x) && x >= 0.0)) failure += "exchange time not finite and >= 0; ";
-    }
-    return out;
-  }, failure);
+  const Recorded viewed = runRecording(
+      "views", kSteps,
+      [&](coredem::client::Participant& p) {
+        std::vector<std::vector<double>> keep;
+        const auto n = static_cast<std::size_t>(p.grid().cellCount());
+        const auto& s = p.exchange(p.step(), p.dt(), gasFields(n, keep));
+        std::map<std::string, std::vector<double>> out;
+        for (const auto& name : s.names()) {
+          const auto v = s.field(name);
+          out[name].assign(v.begin(), v.end());
+        }
+        const auto t = p.lastExchangeTimes();
+        for (double x : {t.serialise, t.send, t.wait, t.receive}) {
+          if (!(std::isfinite(x) && x >= 0.0))
+            failure += "exchange time not finite and >= 0; ";
+        }
+        return out;
+      },
+      failure);
 
   std::vector<double> eps, kus, h;
-  const Recorded buffered = runRecording("buffers", kSteps, [&](coredem::client::Participant& p) {
-    std::vector<std::vector<double>> keep;
-    const auto n = static_cast<std::size_t>(p.grid().cellCount());
-    const auto fields = gasFields(n, keep);
-    eps.assign(n, -7.0);
-    kus.assign(3 * n, -7.0);
-    h.assign(n, -7.0);
-    // Refusals (nothing is sent or written; the step is then exchanged as usual).
-    auto expectArgument = [&](std::vector<coredem::client::NamedBuffer> into, const char* what,
-                              const char* mentions) {
-      try {
-        p.exchange(p.step(), p.dt(), fields, into);
-        failure += std::string(what) + ": no error; ";
-      } catch (const coredem::client::ClientError& e) {
-        if (e.code() != coredem::client::ErrorCode::Argument ||
-            std::string(e.what()).find(mentions) == std::string::npos)
-          failure += std::string(what) + ": " + e.what() + "; ";
-      }
-    };
-    std::vector<double> tooShort(3 * n - 1, -7.0);
-    expectArgument({{"eps_g", eps.data(), eps.size()}, {"K_sl_Us", tooShort.data(), tooShort.size()}},
-                   "short buffer", "'K_sl_Us' holds");
-    expectArgument({{"T_g", eps.data(), eps.size()}}, "gas name as a Sources buffer", "not a Sources array");
-    if (eps[0] != -7.0 || tooShort[0] != -7.0) failure += "a refused call wrote a buffer; ";
-    const auto& s = p.exchange(p.step(), p.dt(), fields,
-                               {{"eps_g", eps.data(), eps.size()}, {"K_sl_Us", kus.data(), kus.size()},
-                                {"H", h.data(), h.size()}});
-    if (s.field("eps_g").data != eps.data() || s.field("K_sl_Us").data != kus.data() ||
-        s.field("H").data != h.data()) {
-      failure += "field() does not view the caller's buffers; ";
-    }
-    std::map<std::string, std::vector<double>> out;
-    for (const auto& name : s.names()) {
-      const auto v = s.field(name);
-      out[name].assign(v.begin(), v.end());
-    }
-    return out;
-  }, failure);
+  const Recorded buffered = runRecording(
+      "buffers", kSteps,
+      [&](coredem::client::Participant& p) {
+        std::vector<std::vector<double>> keep;
+        const auto n = static_cast<std::size_t>(p.grid().cellCount());
+        const auto fields = gasFields(n, keep);
+        eps.assign(n, -7.0);
+        kus.assign(3 * n, -7.0);
+        h.assign(n, -7.0);
+        // Refusals (nothing is sent or written; the step is then exchanged as usual).
+        auto expectArgument = [&](std::vector<coredem::client::NamedBuffer> into, const char* what,
+                                  const char* mentions) {
+          try {
+            p.exchange(p.step(), p.dt(), fields, into);
+            failure += std::string(what) + ": no error; ";
+          } catch (const coredem::client::ClientError& e) {
+            if (e.code() != coredem::client::ErrorCode::Argument ||
+                std::string(e.what()).find(mentions) == std::string::npos)
+              failure += std::string(what) + ": " + e.what() + "; ";
+          }
+        };
+        std::vector<double> tooShort(3 * n - 1, -7.0);
+        expectArgument(
+            {{"eps_g", eps.data(), eps.size()}, {"K_sl_Us", tooShort.data(), tooShort.size()}},
+            "short buffer", "'K_sl_Us' holds");
+        expectArgument({{"T_g", eps.data(), eps.size()}}, "gas name as a Sources buffer",
+                       "not a Sources array");
+        if (eps[0] != -7.0 || tooShort[0] != -7.0)
+          failure += "a refused call wrote a buffer; ";
+        const auto& s = p.exchange(p.step(), p.dt(), fields,
+                                   {{"eps_g", eps.data(), eps.size()},
+                                    {"K_sl_Us", kus.data(), kus.size()},
+                                    {"H", h.data(), h.size()}});
+        if (s.field("eps_g").data != eps.data() || s.field("K_sl_Us").data != kus.data() ||
+            s.field("H").data != h.data()) {
+          failure += "field() does not view the caller's buffers; ";
+        }
+        std::map<std::string, std::vector<double>> out;
+        for (const auto& name : s.names()) {
+          const auto v = s.field(name);
+          out[name].assign(v.begin(), v.end());
+        }
+        return out;
+      },
+      failure);
   EXPECT_EQ(failure, "");
   ASSERT_EQ(viewed.size(), static_cast<std::size_t>(kSteps));
   ASSERT_EQ(buffered.size(), viewed.size());
@@ -350,7 +370,9 @@ TEST(Participants, CppClientReceivesIntoCallerBuffersBitwiseAsViews) {
       // Bitwise: the same DEM run, the same bytes (no tolerance).
       EXPECT_EQ(std::memcmp(it->second.data(), v.data(), v.size() * sizeof(double)), 0)
           << "step " << k + 1 << ", " << name;
-      if (name == "K_sl") for (double x : v) nonZeroDrag = nonZeroDrag || x > 0.0;
+      if (name == "K_sl")
+        for (double x : v)
+          nonZeroDrag = nonZeroDrag || x > 0.0;
     }
   }
   EXPECT_TRUE(nonZeroDrag) << "the case should give drag (K_sl > 0) somewhere";

@@ -1,8 +1,6 @@
 #pragma once
 // Child processes for the participant tests: start a program with extra environment
 // variables, wait for it with a deadline, kill only our own child (by pid) if it overruns.
-#include <coredem/common/process.h>
-
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -11,10 +9,13 @@
 #include <map>
 #include <stdexcept>
 #include <string>
-#include <sys/wait.h>
 #include <thread>
-#include <unistd.h>
 #include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <coredem/common/process.h>
 
 namespace coredem::testing {
 
@@ -62,7 +63,8 @@ private:
 };
 
 /// Waits until `file` exists with a complete line; returns its first line.
-inline std::string waitForFile(const std::filesystem::path& file, std::chrono::milliseconds timeout) {
+inline std::string waitForFile(const std::filesystem::path& file,
+                               std::chrono::milliseconds timeout) {
   const auto end = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < end) {
     if (std::filesystem::exists(file)) {

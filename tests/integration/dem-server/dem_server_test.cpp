@@ -1,19 +1,18 @@
 // coredem-dem's session over real ZeroMQ tcp loopback (ephemeral ports) with the real DEM core:
 // Configure + GasFields -> Sources, one session at a time, invalid messages refused without
 // changing anything, checkpoint -> fresh server -> bitwise identical continuation.
-#include "../client/mini_orchestrator.h"
-#include "server_thread.h"
-
-#include "coredem/server/dem_server.h"
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 #include <thread>
+
+#include <gtest/gtest.h>
+
+#include "../client/mini_orchestrator.h"
+#include "coredem/server/dem_server.h"
+#include "server_thread.h"
 
 using namespace coredem::testing;
 namespace fs = std::filesystem;
@@ -25,7 +24,8 @@ struct Gas {
   std::vector<double> u, gradP, T, rho, mu, kappa, cp, Y;
   Gas(std::size_t n, std::size_t ns) {
     u.assign(3 * n, 0.0);
-    for (std::size_t c = 0; c < n; ++c) u[3 * c + 2] = 0.3;
+    for (std::size_t c = 0; c < n; ++c)
+      u[3 * c + 2] = 0.3;
     gradP.assign(3 * n, 0.0);
     T.assign(n, 300.0);
     rho.assign(n, 1.2);
@@ -33,7 +33,8 @@ struct Gas {
     kappa.assign(n, 0.026);
     cp.assign(n, 1005.0);
     Y.assign(n * ns, 0.0);
-    for (std::size_t c = 0; c < n && ns > 0; ++c) Y[c * ns] = 1.0;
+    for (std::size_t c = 0; c < n && ns > 0; ++c)
+      Y[c * ns] = 1.0;
   }
   proto::Message message(std::int64_t step, double time, double dt, std::size_t n, std::size_t ns,
                          const std::string& session) const {
@@ -56,7 +57,8 @@ struct Gas {
 struct Cfd {
   proto::Client client;
   std::string session;
-  Cfd(const std::string& ep, const std::string& s) : session(s) {
+  Cfd(const std::string& ep, const std::string& s)
+      : session(s) {
     client.connect(ep);
     auto hello = proto::makeHello(v1::ROLE_CFD, "test cfd");
     hello.setSessionId(session);
@@ -89,9 +91,9 @@ v1::StepDone stepDone(MiniOrchestrator& o) {
 }
 
 /// Runs steps [from, to] through O and C; returns the Sources of the last step.
-proto::Message runSteps(MiniOrchestrator& o, Cfd& c, const Gas& gas, std::int64_t from, std::int64_t to,
-                        double dt, std::uint32_t nSub, std::size_t cells, std::size_t ns,
-                        const std::map<std::int64_t, std::string>& checkpoints = {},
+proto::Message runSteps(MiniOrchestrator& o, Cfd& c, const Gas& gas, std::int64_t from,
+                        std::int64_t to, double dt, std::uint32_t nSub, std::size_t cells,
+                        std::size_t ns, const std::map<std::int64_t, std::string>& checkpoints = {},
                         std::vector<double>* contacts = nullptr) {
   proto::Message last;
   for (std::int64_t n = from; n <= to; ++n) {
@@ -109,8 +111,8 @@ proto::Message runSteps(MiniOrchestrator& o, Cfd& c, const Gas& gas, std::int64_
 }
 
 fs::path tempDir(const std::string& name) {
-  const auto d = fs::temp_directory_path() /
-                 ("coredem-dem-test-" + name + "-" + std::to_string(::getpid()));
+  const auto d =
+      fs::temp_directory_path() / ("coredem-dem-test-" + name + "-" + std::to_string(::getpid()));
   fs::remove_all(d);
   fs::create_directories(d);
   return d;
@@ -119,7 +121,7 @@ fs::path tempDir(const std::string& name) {
 constexpr int kParticles = 60;
 constexpr double kD = 1e-3;
 constexpr double kBox = 6e-3;
-constexpr int kCells = 3;  // 2 mm cells = 2 d_p
+constexpr int kCells = 3; // 2 mm cells = 2 d_p
 
 } // namespace
 
@@ -158,11 +160,13 @@ TEST(DemServer, ServesConfigureAndGasFieldsWithSourcesOfTheRightShape) {
   // Upward gas through particles: drag coefficient positive where there are particles.
   const auto k = src.values<double>(f::kDragCoefficient);
   double kSum = 0.0;
-  for (double v : k) kSum += v;
+  for (double v : k)
+    kSum += v;
   EXPECT_GT(kSum, 0.0);
   // D's StepDone: the particle mass ledger is N ρ π d³/6.
   const auto done = stepDone(o);
-  EXPECT_NEAR(named(done.ledger().mass(), "dem.particle_mass_kg"), 2500.0 * vp, 1e-12 * 2500.0 * vp);
+  EXPECT_NEAR(named(done.ledger().mass(), "dem.particle_mass_kg"), 2500.0 * vp,
+              1e-12 * 2500.0 * vp);
   EXPECT_EQ(named(done.diagnostics(), "particles"), kParticles);
   o.shutdown();
 }
@@ -193,7 +197,8 @@ TEST(DemServer, OneSessionAtATime) {
   ASSERT_EQ(rv.type(), v1::MESSAGE_TYPE_REJECT);
   EXPECT_EQ(rv.envelope().reject().code(), v1::ERROR_CODE_VERSION);
   EXPECT_NE(rv.envelope().reject().reason().find("2.0"), std::string::npos);
-  EXPECT_NE(rv.envelope().reject().reason().find(proto::kProtocolVersion.toString()), std::string::npos);
+  EXPECT_NE(rv.envelope().reject().reason().find(proto::kProtocolVersion.toString()),
+            std::string::npos);
   // Heartbeats are answered to anyone, with the server's state.
   auto hb = future.request(proto::makeHeartbeat("probe"), 10s);
   ASSERT_EQ(hb.type(), v1::MESSAGE_TYPE_HEARTBEAT);
@@ -271,19 +276,24 @@ TEST(DemServer, InvalidGasFieldsGetAnErrorAndChangeNothing) {
         };
         Gas nan = gas;
         nan.T[n / 2] = std::nan("");
-        expectError(nan.message(step, t, dt, n, ns, o.session()), v1::ERROR_CODE_NON_FINITE, "NaN in T_g");
+        expectError(nan.message(step, t, dt, n, ns, o.session()), v1::ERROR_CODE_NON_FINITE,
+                    "NaN in T_g");
         Gas inf = gas;
         inf.u[4] = HUGE_VAL;
-        expectError(inf.message(step, t, dt, n, ns, o.session()), v1::ERROR_CODE_NON_FINITE, "Inf in u_g");
+        expectError(inf.message(step, t, dt, n, ns, o.session()), v1::ERROR_CODE_NON_FINITE,
+                    "Inf in u_g");
         // Wrong shape: a grid of n-1 cells.
         Gas small(n - 1, ns);
-        expectError(small.message(step, t, dt, n - 1, ns, o.session()), v1::ERROR_CODE_SHAPE, "n-1 cells");
-        expectError(gas.message(step + 1, t, dt, n, ns, o.session()), v1::ERROR_CODE_OUT_OF_ORDER, "next step");
-        expectError(gas.message(step, t, 2 * dt, n, ns, o.session()), v1::ERROR_CODE_OUT_OF_ORDER, "other dt");
+        expectError(small.message(step, t, dt, n - 1, ns, o.session()), v1::ERROR_CODE_SHAPE,
+                    "n-1 cells");
+        expectError(gas.message(step + 1, t, dt, n, ns, o.session()), v1::ERROR_CODE_OUT_OF_ORDER,
+                    "next step");
+        expectError(gas.message(step, t, 2 * dt, n, ns, o.session()), v1::ERROR_CODE_OUT_OF_ORDER,
+                    "other dt");
         Gas neg = gas;
         neg.rho[0] = -1.0;
-        expectError(neg.message(step, t, dt, n, ns, o.session()), v1::ERROR_CODE_INVALID_CONFIGURATION,
-                    "negative density");
+        expectError(neg.message(step, t, dt, n, ns, o.session()),
+                    v1::ERROR_CODE_INVALID_CONFIGURATION, "negative density");
         // Garbage frames.
         c.client.sendFrames({std::string("\x01\x02garbage", 9)});
         auto g = c.client.receive(10s);
@@ -303,7 +313,7 @@ TEST(DemServer, InvalidGasFieldsGetAnErrorAndChangeNothing) {
   }
   ASSERT_EQ(eps[0].size(), eps[1].size());
   for (std::size_t s = 0; s < eps[0].size(); ++s) {
-    EXPECT_EQ(eps[0][s], eps[1][s]) << "step " << s + 1;  // bitwise
+    EXPECT_EQ(eps[0][s], eps[1][s]) << "step " << s + 1; // bitwise
   }
 }
 
@@ -341,8 +351,9 @@ TEST(DemServer, RestartFromCheckpointIsBitwiseIdentical) {
     Cfd c(server.endpoint(), o.session());
     const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
     std::vector<double> contacts;
-    auto src = runSteps(o, c, gas, 1, 200, dt, nSub, n, ns,
-                        {{100, (dir / "a100").string()}, {200, (dir / "a200").string()}}, &contacts);
+    auto src =
+        runSteps(o, c, gas, 1, 200, dt, nSub, n, ns,
+                 {{100, (dir / "a100").string()}, {200, (dir / "a200").string()}}, &contacts);
     // The restart must carry contact history: contacts exist at the checkpoint step.
     EXPECT_GT(contacts[99], 0.0) << "no contacts at step 100: the test would not exercise history";
     const auto e = src.values<double>(proto::fields::kDragCoefficientTimesUs);
@@ -367,8 +378,9 @@ TEST(DemServer, RestartFromCheckpointIsBitwiseIdentical) {
   }
   EXPECT_EQ(lastEps[0], lastEps[1]);
   for (const char* group : {"/particles", "/contacts"}) {
-    const std::string cmd = std::string(COREDEM_H5DIFF) + " -q " + (dir / "a200" / "dem.h5").string() +
-                            " " + (dir / "b200" / "dem.h5").string() + " " + group + " " + group;
+    const std::string cmd = std::string(COREDEM_H5DIFF) + " -q " +
+                            (dir / "a200" / "dem.h5").string() + " " +
+                            (dir / "b200" / "dem.h5").string() + " " + group + " " + group;
     EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
   }
   fs::remove_all(dir);
@@ -411,12 +423,14 @@ TEST(DemServer, CurveKeysAdmitOnlyClientsWithTheServerKey) {
   // message reaches the server, so the request times out.
   proto::Client plain;
   plain.connect(server.endpoint());
-  EXPECT_THROW(plain.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "plain"), 1s), proto::TimeoutError);
+  EXPECT_THROW(plain.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "plain"), 1s),
+               proto::TimeoutError);
   proto::TransportOptions wrong = good;
   wrong.curve.serverPublicKey = proto::generateCurveKeyPair().first;
   proto::Client wrongKey(wrong);
   wrongKey.connect(server.endpoint());
-  EXPECT_THROW(wrongKey.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "wrong"), 1s), proto::TimeoutError);
+  EXPECT_THROW(wrongKey.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "wrong"), 1s),
+               proto::TimeoutError);
   server.stop();
   t.join();
   fs::remove_all(dir);
@@ -439,12 +453,14 @@ TEST(DemServer, InvalidConfigureIsRefusedAndTheSessionStaysUsable) {
   bad.mutable_particle_sets(0)->set_material_id(7);
   auto e = configure(bad);
   ASSERT_EQ(e.type(), v1::MESSAGE_TYPE_ERROR);
-  EXPECT_EQ(e.envelope().error().code(), v1::ERROR_CODE_INVALID_CONFIGURATION) << e.envelope().error().message();
+  EXPECT_EQ(e.envelope().error().code(), v1::ERROR_CODE_INVALID_CONFIGURATION)
+      << e.envelope().error().message();
   // More particles than fit in the region (random packing cannot place them).
-  auto crowded = smallCase(500, kD, kBox, kCells);  // 500 beads need 1.2 times the region
+  auto crowded = smallCase(500, kD, kBox, kCells); // 500 beads need 1.2 times the region
   auto e2 = configure(crowded);
   ASSERT_EQ(e2.type(), v1::MESSAGE_TYPE_ERROR);
-  EXPECT_EQ(e2.envelope().error().code(), v1::ERROR_CODE_INVALID_CONFIGURATION) << e2.envelope().error().message();
+  EXPECT_EQ(e2.envelope().error().code(), v1::ERROR_CODE_INVALID_CONFIGURATION)
+      << e2.envelope().error().message();
   // An initial state file that does not exist.
   auto missing = smallCase(kParticles, kD, kBox, kCells);
   missing.set_initial_state_file("/nonexistent/dem.h5");

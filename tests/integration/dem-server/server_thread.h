@@ -1,11 +1,11 @@
 #pragma once
 // An in-process coredem-dem server (cpu backend, one thread) on an ephemeral loopback port,
 // serving from a background thread for the lifetime of the object.
-#include "coredem/server/dem_server.h"
-
 #include <memory>
 #include <string>
 #include <thread>
+
+#include "coredem/server/dem_server.h"
 
 class ServerThread {
 public:

@@ -1,10 +1,9 @@
 // coredem-dem --timers: the JSON report is valid JSON whose stage times add up to the session
 // (every stage is named once; what is not named is "dem_other" or "server_other_s").
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include "timers.h"
-
-#include <yaml-cpp/yaml.h>
 
 namespace {
 
@@ -24,8 +23,7 @@ TEST(DemTimers, JsonReportParsesAndAddsUp) {
   st.contact = 0.5;
   st.integrate = 0.125;
   st.rebuilds = 3;
-  const std::string json =
-      coredem::server::timersJson(x, st, 3.0, "session \"x\"", "cpu", 2);
+  const std::string json = coredem::server::timersJson(x, st, 3.0, "session \"x\"", "cpu", 2);
   const YAML::Node n = YAML::Load(json);
   EXPECT_EQ(n["program"].as<std::string>(), "coredem-dem");
   EXPECT_EQ(n["session"].as<std::string>(), "session \"x\""); // escaped, not broken

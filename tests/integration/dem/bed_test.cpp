@@ -1,15 +1,15 @@
 // A settled packed bed: the walls carry exactly its weight.
-#include "dem_test_util.h"
-
 #include <gtest/gtest.h>
+
+#include "dem_test_util.h"
 
 using namespace coredem::dem;
 using namespace coredem::dem::testing;
 
 TEST(PackedBed, SettledBedWallForceEqualsWeight) {
   DemConfig c;
-  c.materials[0].kn = 100;   // softer than glass: 2.2× longer Δt_DEM, overlaps still < 0.2 % d
-  c.materials[0].en = 0.3;   // settles quickly
+  c.materials[0].kn = 100; // softer than glass: 2.2× longer Δt_DEM, overlaps still < 0.2 % d
+  c.materials[0].en = 0.3; // settles quickly
   c.materials[0].mu = 0.3;
   const double d = 1e-3, L = 8 * d;
   ParticleSet s;
@@ -24,12 +24,14 @@ TEST(PackedBed, SettledBedWallForceEqualsWeight) {
   DemSystem sys(c, BackendKind::Cpu, 1);
   const double dtCfd = 1e-3;
   const int nSub = TimeHandler::subStepsFor(dtCfd, sys.dtDemMax());
-  for (int k = 0; k < 400; ++k) sys.advance(dtCfd, nSub);  // 0.4 s: fall + settle
+  for (int k = 0; k < 400; ++k)
+    sys.advance(dtCfd, nSub); // 0.4 s: fall + settle
   const ParticleData p = sys.particles();
   double weight = 0, vmax = 0;
   for (std::size_t i = 0; i < p.count; ++i) {
     weight += p.mass[i] * 9.81;
-    vmax = std::max(vmax, std::hypot(p.velocity[3 * i], p.velocity[3 * i + 1], p.velocity[3 * i + 2]));
+    vmax =
+        std::max(vmax, std::hypot(p.velocity[3 * i], p.velocity[3 * i + 1], p.velocity[3 * i + 2]));
   }
   EXPECT_LT(vmax, 1e-3) << "bed not settled";
   // Wall force averaged over 200 sub-steps (residual vibration averages out; the average
@@ -39,12 +41,13 @@ TEST(PackedBed, SettledBedWallForceEqualsWeight) {
   for (int k = 0; k < samples; ++k) {
     sys.advance(sys.dtDemMax(), 1);
     const auto f = sys.wallForce();
-    for (int q = 0; q < 3; ++q) mean[q] += f[q] / samples;
+    for (int q = 0; q < 3; ++q)
+      mean[q] += f[q] / samples;
   }
   EXPECT_NEAR(mean[2], weight, 1e-3 * weight);
   EXPECT_NEAR(mean[0], 0.0, 1e-3 * weight);
   EXPECT_NEAR(mean[1], 0.0, 1e-3 * weight);
-  EXPECT_GT(sys.pairContactCount(), p.count);  // a real bed: more than one contact per particle
+  EXPECT_GT(sys.pairContactCount(), p.count); // a real bed: more than one contact per particle
 }
 
 TEST(PackedBed, TooFewHistorySlotsIsAUserError) {

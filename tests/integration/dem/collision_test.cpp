@@ -1,7 +1,7 @@
 // Binary collisions (PHYSICS §2.1): restitution, contact duration, momentum.
-#include "dem_test_util.h"
-
 #include <gtest/gtest.h>
+
+#include "dem_test_util.h"
 
 using namespace coredem::dem;
 using namespace coredem::dem::testing;
@@ -29,7 +29,8 @@ CollisionResult collide(double v, double phase, double d1 = 1e-3, double d2 = 1e
   const double m1 = 2500 * kPi / 6 * d1 * d1 * d1, m2 = 2500 * kPi / 6 * d2 * d2 * d2;
   const double meff = m1 * m2 / (m1 + m2);
   const double ln = std::log(0.97);
-  const double tcol = std::sqrt(meff / 1000.0) * std::sqrt(kPi * kPi + ln * ln);  // Eq. 12 with Eq. 13
+  const double tcol =
+      std::sqrt(meff / 1000.0) * std::sqrt(kPi * kPi + ln * ln); // Eq. 12 with Eq. 13
   const double mmin = std::min(m1, m2);
   const double dt = std::sqrt(mmin / 2 / 1000.0) * std::sqrt(kPi * kPi + ln * ln) / 50;
   const double gap = 2 * v * dt * (5 + phase);
@@ -77,7 +78,8 @@ TEST(BinaryCollision, UnequalSizesUseReducedMass) {
   const CollisionResult r = collide(0.3, 0.5, 1e-3, 1.5e-3);
   EXPECT_NEAR(r.contactSteps * r.dt, r.tcol, 2 * r.dt);
   // momentum is conserved to round-off (|p| ~ 1e-6 kg m/s)
-  for (int d = 0; d < 3; ++d) EXPECT_NEAR(r.p1[d], r.p0[d], 1e-20);
+  for (int d = 0; d < 3; ++d)
+    EXPECT_NEAR(r.p1[d], r.p0[d], 1e-20);
 }
 
 TEST(ParticleCollisions, ConserveMomentumToRoundOff) {
@@ -85,18 +87,20 @@ TEST(ParticleCollisions, ConserveMomentumToRoundOff) {
   DemSystem sys(agitatedDeck(343, false), BackendKind::Cpu, 1);
   const ParticleData p0 = sys.particles();
   const auto m0 = momentum(p0);
-  double scale = 0;  // Σ m|v|
+  double scale = 0; // Σ m|v|
   for (std::size_t i = 0; i < p0.count; ++i)
-    scale += p0.mass[i] * std::hypot(p0.velocity[3 * i], p0.velocity[3 * i + 1], p0.velocity[3 * i + 2]);
+    scale +=
+        p0.mass[i] * std::hypot(p0.velocity[3 * i], p0.velocity[3 * i + 1], p0.velocity[3 * i + 2]);
   std::size_t contacts = 0;
   const double dt = sys.dtDemMax();
   for (int k = 0; k < 40; ++k) {
     sys.advance(50 * dt, 50);
     contacts += sys.pairContactCount();
   }
-  EXPECT_GT(contacts, 50u);  // the run really has collisions
+  EXPECT_GT(contacts, 50u); // the run really has collisions
   const auto m1 = momentum(sys.particles());
-  for (int d = 0; d < 3; ++d) EXPECT_NEAR(m1[d], m0[d], 1e-13 * scale) << "component " << d;
+  for (int d = 0; d < 3; ++d)
+    EXPECT_NEAR(m1[d], m0[d], 1e-13 * scale) << "component " << d;
 }
 
 TEST(BadInput, NonFinitePositionsAreRefusedAndRunawaysSurvive) {
@@ -112,7 +116,8 @@ TEST(BadInput, NonFinitePositionsAreRefusedAndRunawaysSurvive) {
   c.particleSets[0].positions = {0, 0, 0, 0.01, 0, 0};
   c.particleSets[0].velocities = {0, 0, 0, 1e300, 0, 0};
   DemSystem sys(c, BackendKind::Cpu, 1);
-  for (int k = 0; k < 3; ++k) sys.advance(sys.dtDemMax(), 1);
+  for (int k = 0; k < 3; ++k)
+    sys.advance(sys.dtDemMax(), 1);
   EXPECT_GE(sys.stageTimes().rebuilds, 2u);
   const ParticleData p = sys.particles();
   const auto idx = indexByGid(p);

@@ -1,7 +1,7 @@
 // PCM coupling: ε_g conserves the particle volume; sources are sub-step averages.
-#include "dem_test_util.h"
-
 #include <gtest/gtest.h>
+
+#include "dem_test_util.h"
 
 using namespace coredem::dem;
 using namespace coredem::dem::testing;
@@ -13,7 +13,8 @@ DemConfig coupledBox(std::size_t n) {
   c.gravity = {0, 0, -9.81};
   c.grid.origin = {0, 0, 0};
   c.grid.counts = {3, 3, 4};
-  for (int d = 0; d < 3; ++d) c.grid.spacing[d] = p.regionMax[d] / c.grid.counts[d];
+  for (int d = 0; d < 3; ++d)
+    c.grid.spacing[d] = p.regionMax[d] / c.grid.counts[d];
   return c;
 }
 } // namespace
@@ -23,13 +24,15 @@ TEST(Coupling, GasFractionSumsToParticleVolume) {
   const std::size_t nc = sys.cellCount();
   ASSERT_EQ(nc, 36u);
   std::vector<double> ug(3 * nc), gp(3 * nc, 0.0), rho(nc, 1.2), mu(nc, 1.8e-5);
-  for (std::size_t k = 0; k < nc; ++k) ug[3 * k + 2] = 0.5 + 0.01 * k;
+  for (std::size_t k = 0; k < nc; ++k)
+    ug[3 * k + 2] = 0.5 + 0.01 * k;
   sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}});
   const auto& cfg = sys.config().grid;
   const double vc = cfg.spacing[0] * cfg.spacing[1] * cfg.spacing[2];
   const ParticleData p = sys.particles();
   double vp = 0;
-  for (std::size_t i = 0; i < p.count; ++i) vp += 4.0 / 3.0 * kPi * std::pow(p.radius[i], 3);
+  for (std::size_t i = 0; i < p.count; ++i)
+    vp += 4.0 / 3.0 * kPi * std::pow(p.radius[i], 3);
   const double dt = sys.dtDemMax();
   for (int k = 0; k < 5; ++k) {
     const CellSources& s = sys.advance(20 * dt, 20);
@@ -72,17 +75,21 @@ TEST(Coupling, SourcesOfAParticleAtRestMatchTheDragLaw) {
   EXPECT_NEAR(src.epsG[1], eps, 1e-15);
   EXPECT_EQ(src.kSl[0], 0.0);
   EXPECT_NEAR(src.kSl[1] * vc, beta * vp / (1 - eps), 1e-9 * beta * vp / (1 - eps));
-  EXPECT_EQ(src.kSlUs[5], 0.0);  // v_p = 0 during the only sub-step
+  EXPECT_EQ(src.kSlUs[5], 0.0); // v_p = 0 during the only sub-step
 }
 
 TEST(Coupling, RejectsBadGasFields) {
   DemSystem sys(coupledBox(8), BackendKind::Cpu, 1);
-  std::vector<double> ug(3 * 36, 0.0), gp(3 * 36, 0.0), rho(36, 1.2), mu(36, 1.8e-5), shortv(5, 1.0);
-  EXPECT_THROW(sys.setGasFields(GasFieldsView{shortv, gp, {}, rho, mu, {}, {}, {}}), coredem::UserError);
+  std::vector<double> ug(3 * 36, 0.0), gp(3 * 36, 0.0), rho(36, 1.2), mu(36, 1.8e-5),
+      shortv(5, 1.0);
+  EXPECT_THROW(sys.setGasFields(GasFieldsView{shortv, gp, {}, rho, mu, {}, {}, {}}),
+               coredem::UserError);
   rho[3] = -1;
-  EXPECT_THROW(sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}}), coredem::UserError);
+  EXPECT_THROW(sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}}),
+               coredem::UserError);
   rho[3] = 1.2;
   ug[7] = NAN;
-  EXPECT_THROW(sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}}), coredem::UserError);
-  EXPECT_THROW(sys.advance(10 * sys.dtDemMax(), 1), coredem::UserError);  // Δt too large
+  EXPECT_THROW(sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}}),
+               coredem::UserError);
+  EXPECT_THROW(sys.advance(10 * sys.dtDemMax(), 1), coredem::UserError); // Δt too large
 }

@@ -1,11 +1,11 @@
 #pragma once
 // Helpers shared by the DEM integration tests.
-#include "coredem/dem/dem_system.h"
-#include "coredem/dem/time_handler.h"
-
 #include <cmath>
 #include <cstdint>
 #include <vector>
+
+#include "coredem/dem/dem_system.h"
+#include "coredem/dem/time_handler.h"
 
 namespace coredem::dem::testing {
 
@@ -14,7 +14,8 @@ constexpr double kPi = 3.14159265358979323846;
 /// Index of each global id in a ParticleData.
 inline std::vector<std::size_t> indexByGid(const ParticleData& p) {
   std::vector<std::size_t> idx(p.count);
-  for (std::size_t i = 0; i < p.count; ++i) idx[static_cast<std::size_t>(p.globalId[i])] = i;
+  for (std::size_t i = 0; i < p.count; ++i)
+    idx[static_cast<std::size_t>(p.globalId[i])] = i;
   return idx;
 }
 
@@ -23,7 +24,8 @@ inline std::vector<double> momentum(const ParticleData& p) {
   std::vector<double> s(3, 0.0);
   const auto idx = indexByGid(p);
   for (std::size_t g = 0; g < p.count; ++g)
-    for (int d = 0; d < 3; ++d) s[d] += p.mass[idx[g]] * p.velocity[3 * idx[g] + d];
+    for (int d = 0; d < 3; ++d)
+      s[d] += p.mass[idx[g]] * p.velocity[3 * idx[g] + d];
   return s;
 }
 
@@ -44,7 +46,8 @@ inline DemConfig agitatedDeck(std::size_t n, bool walls, std::uint64_t seed = 20
   p.velocityJitter = 0.5;
   p.seed = seed;
   c.particleSets.push_back(p);
-  if (walls) c.addBox({0, 0, 0}, p.regionMax);
+  if (walls)
+    c.addBox({0, 0, 0}, p.regionMax);
   return c;
 }
 

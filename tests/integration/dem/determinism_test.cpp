@@ -1,11 +1,10 @@
 // Bitwise reproducibility: repeated runs, thread counts, HDF5 restart.
-#include "dem_test_util.h"
+#include <filesystem>
 
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
-#include <filesystem>
+#include "dem_test_util.h"
 
 using namespace coredem::dem;
 using namespace coredem::dem::testing;
@@ -17,7 +16,8 @@ DemConfig mixedDeck() {
   c.gravity = {0, 0, -9.81};
   const auto& p = c.particleSets[0];
   c.grid.counts = {3, 3, 3};
-  for (int d = 0; d < 3; ++d) c.grid.spacing[d] = p.regionMax[d] / 3;
+  for (int d = 0; d < 3; ++d)
+    c.grid.spacing[d] = p.regionMax[d] / 3;
   return c;
 }
 
@@ -46,7 +46,7 @@ void run(DemSystem& sys, int windows, std::vector<double>* lastSources = nullptr
 
 void expectBitwiseEqual(const ParticleData& a, const ParticleData& b) {
   ASSERT_EQ(a.count, b.count);
-  EXPECT_EQ(a.globalId, b.globalId);  // same internal order too
+  EXPECT_EQ(a.globalId, b.globalId); // same internal order too
   EXPECT_EQ(a.position, b.position);
   EXPECT_EQ(a.velocity, b.velocity);
   EXPECT_EQ(a.angularVelocity, b.angularVelocity);

@@ -1,7 +1,7 @@
 // Single-particle motion: friction-driven rolling on a wall and Gidaspow terminal velocity.
-#include "dem_test_util.h"
-
 #include <gtest/gtest.h>
+
+#include "dem_test_util.h"
 
 using namespace coredem::dem;
 using namespace coredem::dem::testing;
@@ -16,14 +16,15 @@ TEST(Wall, SlidingSphereReachesRollingAtFiveSevenths) {
   s.packing = Packing::Explicit;
   const double r = 0.5e-3, m = 2500 * 4.0 / 3.0 * kPi * r * r * r;
   const double v0 = 0.4;
-  s.positions = {0, 0, r - m * 9.81 / 1000.0};  // resting overlap δ = m g / k_n
+  s.positions = {0, 0, r - m * 9.81 / 1000.0}; // resting overlap δ = m g / k_n
   s.velocities = {v0, 0, 0};
   c.particleSets.push_back(s);
   DemSystem sys(c, BackendKind::Cpu, 1);
   // Sliding lasts 2 v0/(7 μ g) = 0.039 s; run 0.1 s.
   const double dtCfd = 1e-3;
   const int nSub = coredem::dem::TimeHandler::subStepsFor(dtCfd, sys.dtDemMax());
-  for (int k = 0; k < 100; ++k) sys.advance(dtCfd, nSub);
+  for (int k = 0; k < 100; ++k)
+    sys.advance(dtCfd, nSub);
   const ParticleData p = sys.particles();
   EXPECT_NEAR(p.velocity[0], 5.0 / 7.0 * v0, 0.01 * 5.0 / 7.0 * v0);
   // rolling without slip: ω_y R_contact = v_x (lever arm R − δ)
@@ -54,7 +55,7 @@ double terminalVelocity(double rhoP, double rhoG, double mu, double d, double ep
 TEST(Drag, SingleSphereSettlesAtGidaspowTerminalVelocity) {
   const double d = 0.2e-3, rhoP = 2500, rhoG = 1.2, mu = 1.8e-5, g = 9.81;
   DemConfig c;
-  c.materials[0].kn = 1e-3;  // no contacts here: a soft spring only lengthens Δt_DEM
+  c.materials[0].kn = 1e-3; // no contacts here: a soft spring only lengthens Δt_DEM
   c.gravity = {0, 0, -g};
   c.grid.origin = {-0.05, -0.05, -10};
   c.grid.spacing = {0.1, 0.1, 11};
@@ -74,7 +75,8 @@ TEST(Drag, SingleSphereSettlesAtGidaspowTerminalVelocity) {
   const double vt = terminalVelocity(rhoP, rhoG, mu, d, eps, g);
   const double dtCfd = 5e-3;
   const int nSub = coredem::dem::TimeHandler::subStepsFor(dtCfd, sys.dtDemMax());
-  for (int k = 0; k < 200; ++k) sys.advance(dtCfd, nSub);  // 1 s ≈ 10 relaxation times
+  for (int k = 0; k < 200; ++k)
+    sys.advance(dtCfd, nSub); // 1 s ≈ 10 relaxation times
   const ParticleData p = sys.particles();
   EXPECT_NEAR(-p.velocity[2], vt, 0.005 * vt) << "analytic v_t = " << vt;
   EXPECT_NEAR(p.velocity[0], 0.0, 1e-15);

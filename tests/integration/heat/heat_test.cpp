@@ -1,13 +1,5 @@
 // Heat transfer integrated in the DEM sub-step (PHYSICS §3, §8; docs/heat-coupling.md).
 // Every case runs a real DemSystem (cpu backend) and compares with verification/analytic.h.
-#include "coredem/common/check.h"
-#include "coredem/dem/dem_system.h"
-#include "coredem/dem/kernels/drag_gidaspow.h"
-#include "coredem/dem/models.h"
-#include "coredem/dem/verification/analytic.h"
-
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,7 +8,14 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <unistd.h>
+
+#include "coredem/common/check.h"
+#include "coredem/dem/dem_system.h"
+#include "coredem/dem/kernels/drag_gidaspow.h"
+#include "coredem/dem/models.h"
+#include "coredem/dem/verification/analytic.h"
 
 using namespace coredem::dem;
 namespace va = coredem::dem::verification;
@@ -53,7 +52,8 @@ ParticleSet one(int material, double d, double rho, double t, std::array<double,
 std::vector<double> temperatures(const DemSystem& sys) {
   const ParticleData p = sys.particles();
   std::vector<double> t(p.count);
-  for (std::size_t i = 0; i < p.count; ++i) t[static_cast<std::size_t>(p.globalId[i])] = p.temperature[i];
+  for (std::size_t i = 0; i < p.count; ++i)
+    t[static_cast<std::size_t>(p.globalId[i])] = p.temperature[i];
   return t;
 }
 
@@ -61,8 +61,16 @@ std::vector<double> temperatures(const DemSystem& sys) {
 struct Gas {
   std::vector<double> u, gp, T, rho, mu, kappa, cp;
   Gas(std::size_t n, double tg, double rhoG, double muG, double kG, double cpG)
-      : u(3 * n, 0.0), gp(3 * n, 0.0), T(n, tg), rho(n, rhoG), mu(n, muG), kappa(n, kG), cp(n, cpG) {}
-  void apply(DemSystem& s) const { s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, {}}); }
+      : u(3 * n, 0.0)
+      , gp(3 * n, 0.0)
+      , T(n, tg)
+      , rho(n, rhoG)
+      , mu(n, muG)
+      , kappa(n, kG)
+      , cp(n, cpG) {}
+  void apply(DemSystem& s) const {
+    s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, {}});
+  }
 };
 
 /// Two fixed particles of a verification case along y (no gravity, no walls).
@@ -75,7 +83,9 @@ DemConfig twoParticles(const va::TwoParticleCase& c) {
   return cfg;
 }
 
-double mc(const va::Material& m, double d) { return va::sphereMass(m, d) * m.cp; }
+double mc(const va::Material& m, double d) {
+  return va::sphereMass(m, d) * m.cp;
+}
 
 /// Three significant digits for RecordProperty.
 std::string sci(double v) {
@@ -96,7 +106,7 @@ TEST(HeatStep, TwoTouchingParticlesConserveEnergyAndFollowTheAnalyticSolution) {
   EXPECT_NEAR(e0, mc(c.m1, c.d1) * c.t10 + mc(c.m2, c.d2) * c.t20, 1e-14 * e0);
   const double dt = 1e-4;
   double worst = 0.0, worstEnergy = 0.0;
-  for (int w = 1; w <= 500; ++w) {  // 50 s in windows of 0.1 s
+  for (int w = 1; w <= 500; ++w) { // 50 s in windows of 0.1 s
     sys.advance(0.1, 1000);
     const std::vector<double> t = temperatures(sys);
     const va::TwoTemperatures ref = va::twoParticleExchange(k.a, k.b, c.t10, c.t20, sys.time());
@@ -121,7 +131,7 @@ TEST(HeatStep, TwoTouchingParticlesConserveEnergyAndFollowTheAnalyticSolution) {
 TEST(HeatStep, GasLensPairFollowsTheAnalyticSolution) {
   const va::TwoParticleCase c = va::mfixLensCase();
   DemConfig cfg = twoParticles(c);
-  cfg.materials[0].emissivity = cfg.materials[1].emissivity = 0.0;  // conduction only
+  cfg.materials[0].emissivity = cfg.materials[1].emissivity = 0.0; // conduction only
   cfg.grid.origin = {-0.01, -0.01, -0.01};
   cfg.grid.spacing = {0.02, 0.02, 0.02};
   cfg.grid.counts = {1, 1, 1};
@@ -132,7 +142,7 @@ TEST(HeatStep, GasLensPairFollowsTheAnalyticSolution) {
   const va::ExchangeCoefficients k = va::gasLensCoefficients(c);
   const double e0 = sys.thermalEnergy();
   double worst = 0.0, worstEnergy = 0.0;
-  for (int w = 1; w <= 100; ++w) {  // 10 s
+  for (int w = 1; w <= 100; ++w) { // 10 s
     sys.advance(0.1, 1000);
     const std::vector<double> t = temperatures(sys);
     const va::TwoTemperatures ref = va::twoParticleExchange(k.a, k.b, c.t10, c.t20, sys.time());
@@ -144,7 +154,7 @@ TEST(HeatStep, GasLensPairFollowsTheAnalyticSolution) {
   RecordProperty("lens_max_rel_error", sci(worst));
   RecordProperty("lens_energy_drift", sci(worstEnergy));
   const CellSources& s = sys.advance(0.1, 1000);
-  EXPECT_EQ(s.heatH[0], 0.0);  // convection off: no exchange with the gas
+  EXPECT_EQ(s.heatH[0], 0.0); // convection off: no exchange with the gas
 }
 
 namespace {
@@ -171,8 +181,9 @@ struct ConvectionCase {
     out.u[1] = u;
     kernels::GidaspowParams p;
     const double vol = va::sphereVolume(d);
-    const double kc = kernels::gidaspowParticleCoefficient(p, va::mfixConvectionCellVoidage(), g.rho, g.mu, d, vol, u);
-    out.gp[1] = kc * u / vol;  // −V_p ∇p = −K u: no net force on a particle at rest
+    const double kc = kernels::gidaspowParticleCoefficient(p, va::mfixConvectionCellVoidage(),
+                                                           g.rho, g.mu, d, vol, u);
+    out.gp[1] = kc * u / vol; // −V_p ∇p = −K u: no net force on a particle at rest
     return out;
   }
 };
@@ -187,7 +198,7 @@ TEST(HeatStep, SingleParticleInHotGasFollowsTheConvectiveHeatingCurve) {
   cc.gas().apply(sys);
   const kernels::GasState g = va::musserConvectionGas(cc.tg, va::mfixConvectionCellVoidage());
   const double coef = va::convectionCoefficient(kernels::ConvectionParams{}, g, cc.d, cc.m, cc.u);
-  EXPECT_NEAR(coef, 0.960850, 2e-6);  // PHYSICS §8.3 table, Li–Mason with ε
+  EXPECT_NEAR(coef, 0.960850, 2e-6); // PHYSICS §8.3 table, Li–Mason with ε
   double worst = 0.0, worstDiff = 0.0;
   for (int w = 1; w <= 20; ++w) {
     sys.advance(0.1, 1000);
@@ -197,10 +208,10 @@ TEST(HeatStep, SingleParticleInHotGasFollowsTheConvectiveHeatingCurve) {
     worstDiff = std::max(worstDiff, std::fabs(t - ref) / (cc.tg - ref));
   }
   EXPECT_LT(worst, 1e-4);
-  EXPECT_LT(worstDiff, 2e-4);  // relative to T_g − T_p as well (Euler: ≈ k²Δt t/2 = 9e-5)
+  EXPECT_LT(worstDiff, 2e-4); // relative to T_g − T_p as well (Euler: ≈ k²Δt t/2 = 9e-5)
   RecordProperty("convection_max_rel_error", sci(worst));
   const ParticleData p = sys.particles();
-  EXPECT_LT(std::fabs(p.velocity[1]), 1e-12);  // the particle did not move
+  EXPECT_LT(std::fabs(p.velocity[1]), 1e-12); // the particle did not move
 }
 
 // The cell sources are the particles' convective heat gain: Σ_c (H T_g − H_Tp) V_c Δt_CFD =
@@ -253,7 +264,7 @@ TEST(HeatStep, CellHeatSourcesEqualTheParticlesConvectiveGain) {
     totalGain += gain;
   }
   EXPECT_NEAR(sys.heatTotals().convection, totalGain, 1e-11 * totalGain);
-  EXPECT_EQ(sys.heatTotals().radiation, 0.0);  // emissivity 0
+  EXPECT_EQ(sys.heatTotals().radiation, 0.0); // emissivity 0
 }
 
 // PHYSICS §8.4 MFiX-RAD: A and B in one 1.5 × 1.0 × 0.36 cm cell, gas held at 400 K,
@@ -273,13 +284,15 @@ TEST(HeatStep, RadiationOfTwoParticlesFollowsTheRk4Reference) {
   DemSystem sys(cfg, BackendKind::Cpu, 1);
   Gas(1, rc.tG, 1.2, 1.8e-5, 0.05, 1000.0).apply(sys);
   std::vector<double> times;
-  for (int w = 1; w <= 50; ++w) times.push_back(1.0 * w);
+  for (int w = 1; w <= 50; ++w)
+    times.push_back(1.0 * w);
   const auto ref = va::radiationReferenceRK4(rc, times);
   double worst = 0.0;
   for (int w = 0; w < 50; ++w) {
-    sys.advance(1.0, 20000);  // Δt = 5e-5 s
+    sys.advance(1.0, 20000); // Δt = 5e-5 s
     const std::vector<double> t = temperatures(sys);
-    worst = std::max({worst, std::fabs(t[0] - ref[w].t1) / ref[w].t1, std::fabs(t[1] - ref[w].t2) / ref[w].t2});
+    worst = std::max(
+        {worst, std::fabs(t[0] - ref[w].t1) / ref[w].t1, std::fabs(t[1] - ref[w].t2) / ref[w].t2});
   }
   EXPECT_LT(worst, 2e-7);
   RecordProperty("radiation_max_rel_error", sci(worst));
@@ -306,7 +319,7 @@ DemConfig heatedBed() {
   cfg.materials = {glass};
   ParticleSet s;
   s.packing = Packing::Random;
-  s.count = 1100;  // > 2 OpenMP chunks of 512: both threads get work
+  s.count = 1100; // > 2 OpenMP chunks of 512: both threads get work
   s.diameter = 1e-3;
   s.temperature = 300.0;
   s.regionMin = {0, 0, 0};
@@ -323,13 +336,14 @@ DemConfig heatedBed() {
 struct BedRun {
   std::vector<double> t, x, h, htp;
   HeatTotals totals;
-  double e0 = 0, e = 0;  ///< Σ m c_p T at the start and the end
+  double e0 = 0, e = 0; ///< Σ m c_p T at the start and the end
 };
 
-BedRun runBed(int threads, int windows, const std::string& stateIn = "", const std::string& stateOut = "",
-           int writeAfter = -1) {
+BedRun runBed(int threads, int windows, const std::string& stateIn = "",
+              const std::string& stateOut = "", int writeAfter = -1) {
   DemSystem sys(heatedBed(), BackendKind::Cpu, threads);
-  if (!stateIn.empty()) sys.readState(stateIn);
+  if (!stateIn.empty())
+    sys.readState(stateIn);
   Gas gas(sys.cellCount(), 600.0, 0.588, 3e-5, 0.046, 1051.0);
   gas.apply(sys);
   const double dtCfd = 1e-3;
@@ -340,7 +354,8 @@ BedRun runBed(int threads, int windows, const std::string& stateIn = "", const s
     const CellSources& s = sys.advance(dtCfd, nSub);
     r.h = s.heatH;
     r.htp = s.heatHTp;
-    if (w + 1 == writeAfter) sys.writeState(stateOut);
+    if (w + 1 == writeAfter)
+      sys.writeState(stateOut);
   }
   const ParticleData p = sys.particles();
   r.t.resize(p.count);
@@ -348,7 +363,8 @@ BedRun runBed(int threads, int windows, const std::string& stateIn = "", const s
   for (std::size_t i = 0; i < p.count; ++i) {
     const auto g = static_cast<std::size_t>(p.globalId[i]);
     r.t[g] = p.temperature[i];
-    for (int d = 0; d < 3; ++d) r.x[3 * g + d] = p.position[3 * i + d];
+    for (int d = 0; d < 3; ++d)
+      r.x[3 * g + d] = p.position[3 * i + d];
   }
   r.totals = sys.heatTotals();
   r.e = sys.thermalEnergy();
@@ -363,7 +379,8 @@ TEST(HeatStep, OneAndTwoThreadsAreBitwiseIdenticalWithHeatOn) {
   ASSERT_EQ(a.t.size(), b.t.size());
   for (std::size_t i = 0; i < a.t.size(); ++i) {
     ASSERT_EQ(a.t[i], b.t[i]) << "particle " << i;
-    for (int d = 0; d < 3; ++d) ASSERT_EQ(a.x[3 * i + d], b.x[3 * i + d]);
+    for (int d = 0; d < 3; ++d)
+      ASSERT_EQ(a.x[3 * i + d], b.x[3 * i + d]);
   }
   EXPECT_EQ(a.h, b.h);
   EXPECT_EQ(a.htp, b.htp);
@@ -381,7 +398,8 @@ TEST(HeatStep, OneAndTwoThreadsAreBitwiseIdenticalWithHeatOn) {
   // Heat balance of the run: Δ Σ m c_p T = convection + radiation (conduction moves heat
   // between particles only), to round-off.
   EXPECT_NEAR(a.e - a.e0, a.totals.convection + a.totals.radiation, 1e-12 * a.e0);
-  RecordProperty("bed_energy_residual_rel", sci((a.e - a.e0 - a.totals.convection - a.totals.radiation) / a.e0));
+  RecordProperty("bed_energy_residual_rel",
+                 sci((a.e - a.e0 - a.totals.convection - a.totals.radiation) / a.e0));
 }
 
 TEST(HeatStep, RestartFromHdf5IsBitwiseWithHeatOn) {
@@ -393,7 +411,8 @@ TEST(HeatStep, RestartFromHdf5IsBitwiseWithHeatOn) {
   const BedRun resumed = runBed(2, 3, state);
   for (std::size_t i = 0; i < straight.t.size(); ++i) {
     ASSERT_EQ(straight.t[i], resumed.t[i]) << "particle " << i;
-    for (int d = 0; d < 3; ++d) ASSERT_EQ(straight.x[3 * i + d], resumed.x[3 * i + d]);
+    for (int d = 0; d < 3; ++d)
+      ASSERT_EQ(straight.x[3 * i + d], resumed.x[3 * i + d]);
   }
   EXPECT_EQ(straight.h, resumed.h);
   EXPECT_EQ(straight.htp, resumed.htp);
@@ -408,8 +427,10 @@ TEST(HeatStep, HeatOffKeepsTemperaturesAndSendsNoHeat) {
   DemSystem sys(cfg, BackendKind::Cpu, 1);
   Gas(sys.cellCount(), 600.0, 0.588, 3e-5, 0.046, 1051.0).apply(sys);
   const CellSources& s = sys.advance(1e-3, static_cast<int>(std::ceil(1e-3 / sys.dtDemMax())));
-  for (double h : s.heatH) EXPECT_EQ(h, 0.0);
-  for (double t : temperatures(sys)) EXPECT_EQ(t, 300.0);
+  for (double h : s.heatH)
+    EXPECT_EQ(h, 0.0);
+  for (double t : temperatures(sys))
+    EXPECT_EQ(t, 300.0);
 }
 
 TEST(HeatOptions, ParseAndRejectWithAClearMessage) {
@@ -432,7 +453,8 @@ TEST(HeatOptions, ParseAndRejectWithAClearMessage) {
   EXPECT_THROW(applyModelOption(o, "s_min", "-1"), coredem::UserError);
   EXPECT_THROW(applyModelOption(o, "heat", "maybe"), coredem::UserError);
   // The neighbour-mean radiation environment is not offered: its key is refused by validation.
-  const std::vector<std::pair<std::string, std::string>> bad = {{"radiation_environment", "neighbour-mean"}};
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"radiation_environment", "neighbour-mean"}};
   EXPECT_EQ(validateModels(bad).size(), 1u);
 }
 
@@ -443,7 +465,7 @@ TEST(HeatOptions, ParseAndRejectWithAClearMessage) {
 int main(int argc, char** argv) {
   if (std::getenv("OMP_WAIT_POLICY") == nullptr) {
     ::setenv("OMP_WAIT_POLICY", "PASSIVE", 1);
-    ::execv("/proc/self/exe", argv);  // returns only on failure: then run as is
+    ::execv("/proc/self/exe", argv); // returns only on failure: then run as is
   }
   ::testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();

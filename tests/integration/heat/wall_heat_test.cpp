@@ -2,16 +2,16 @@
 // docs/heat-coupling.md "Walls"): one particle resting on a hot wall heats towards the wall
 // temperature at the rate the kernel predicts, the wall heat is booked in HeatTotals::wall, and
 // adiabatic walls transfer nothing. Real DemSystem runs on the cpu backend.
-#include "coredem/dem/dem_system.h"
-#include "coredem/dem/models.h"
-#include "coredem/dem/kernels/wall_conduction.h"
-
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include <gtest/gtest.h>
+
+#include "coredem/dem/dem_system.h"
+#include "coredem/dem/kernels/wall_conduction.h"
+#include "coredem/dem/models.h"
 
 using namespace coredem::dem;
 namespace k = coredem::dem::kernels;
@@ -19,7 +19,7 @@ namespace k = coredem::dem::kernels;
 namespace {
 
 constexpr double kD = 1.0e-3, kRho = 2500.0, kCp = 840.0, kKp = 1.0, kKw = 16.0;
-constexpr double kDelta = 1.0e-5;  // particle–wall overlap (m)
+constexpr double kDelta = 1.0e-5; // particle–wall overlap (m)
 constexpr double kT0 = 293.15, kTw = 363.15;
 
 /// One glass bead resting on the floor z = 0 of a box (walls of material 1, steel-like k), with
@@ -54,9 +54,13 @@ DemConfig bead(double wallTemperature) {
   return cfg;
 }
 
-double massHeatCapacity() { return kRho * M_PI * kD * kD * kD / 6.0 * kCp; }
+double massHeatCapacity() {
+  return kRho * M_PI * kD * kD * kD / 6.0 * kCp;
+}
 
-double onlyTemperature(const DemSystem& s) { return s.particles().temperature[0]; }
+double onlyTemperature(const DemSystem& s) {
+  return s.particles().temperature[0];
+}
 
 std::string sci(double v) {
   char b[32];
@@ -76,10 +80,10 @@ TEST(WallHeat, BeadOnHotWallHeatsAtTheKernelRate) {
   const double g = k::wallContactConductance(kKp, kKw, 0.5 * kD, 0.5 * kD - kDelta);
   ASSERT_GT(g, 0.0);
   const double mc = massHeatCapacity();
-  const double rate = g / mc;  // 1/s
+  const double rate = g / mc; // 1/s
   const double e0 = sys.thermalEnergy();
   const double dt = 1e-4;
-  const int nWin = 20, nSub = 1000;  // 2 s
+  const int nWin = 20, nSub = 1000; // 2 s
   double worstDiscrete = 0.0, worstContinuous = 0.0;
   for (int w = 1; w <= nWin; ++w) {
     sys.advance(nSub * dt, nSub);
@@ -88,7 +92,8 @@ TEST(WallHeat, BeadOnHotWallHeatsAtTheKernelRate) {
     const double discrete = kTw + (kT0 - kTw) * std::pow(1.0 - rate * dt, n);
     const double continuous = kTw + (kT0 - kTw) * std::exp(-rate * n * dt);
     worstDiscrete = std::max(worstDiscrete, std::fabs(t - discrete));
-    worstContinuous = std::max(worstContinuous, std::fabs(t - continuous) / std::fabs(continuous - kTw));
+    worstContinuous =
+        std::max(worstContinuous, std::fabs(t - continuous) / std::fabs(continuous - kTw));
   }
   EXPECT_LT(worstDiscrete, 1e-9);
   EXPECT_LT(worstContinuous, 0.5 * rate * dt * rate * 2.0 * 1.01);
@@ -133,9 +138,10 @@ TEST(WallHeat, CoupledWallLensAddsToContact) {
   sys.setGasFields(GasFieldsView{u, gp, tg, rho, mu, kappa, cp, {}});
   k::WallConductionParams wp;
   const double h = 0.5 * kD - kDelta;
-  const double g = k::wallContactConductance(kKp, kKw, 0.5 * kD, h) + kg * k::wallLensIntegral(wp, 0.5 * kD, h);
+  const double g =
+      k::wallContactConductance(kKp, kKw, 0.5 * kD, h) + kg * k::wallLensIntegral(wp, 0.5 * kD, h);
   const double lensShare = kg * k::wallLensIntegral(wp, 0.5 * kD, h) / g;
-  EXPECT_GT(lensShare, 0.05);  // the lens matters for a 1 mm bead in air
+  EXPECT_GT(lensShare, 0.05); // the lens matters for a 1 mm bead in air
   const double mc = massHeatCapacity(), dt = 1e-4;
   const double e0 = sys.thermalEnergy();
   sys.advance(100 * dt, 100);

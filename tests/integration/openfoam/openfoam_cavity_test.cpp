@@ -5,8 +5,6 @@
 // Case (tests/integration/openfoam/cavity): 0.1 m square, 20 x 20 cells, lid speed 1 m/s,
 // nu = 0.01 m^2/s (Re = 10), dt = 0.005 s (Courant <= 1), 100 steps to t = 0.5 s, fields written
 // every 0.1 s with 12 significant digits. Solver tolerances are 1e-8 (pFinal, U).
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -16,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,7 +22,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kLidSpeed = 1.0;  // m/s, 0/U of the case
+constexpr double kLidSpeed = 1.0; // m/s, 0/U of the case
 constexpr int kCells = 20 * 20;
 constexpr int kSteps = 100;
 const std::vector<std::string> kWriteTimes{"0.1", "0.2", "0.3", "0.4", "0.5"};
@@ -94,13 +93,17 @@ std::vector<double> sumLocalContinuityErrors(const fs::path& log) {
   return errs;
 }
 
-double magnitude(const Vec3& v) { return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z); }
+double magnitude(const Vec3& v) {
+  return std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+}
 
 // Cell index of column i (x) and row j (y) in blockMesh's ordering of a 20 x 20 x 1 block.
-int cell(int i, int j) { return j * 20 + i; }
+int cell(int i, int j) {
+  return j * 20 + i;
+}
 
 class OpenFoamCavity : public ::testing::Test {
- protected:
+protected:
   void SetUp() override {
     std::string tmpl = (fs::temp_directory_path() / "coredem-foam-XXXXXX").string();
     ASSERT_NE(mkdtemp(tmpl.data()), nullptr) << "mkdtemp failed";
@@ -141,7 +144,9 @@ class OpenFoamCavity : public ::testing::Test {
     out << "FoamFile\n{\n    version 2.0;\n    format ascii;\n    class volScalarField;\n"
            "    object alphac;\n}\n"
            "dimensions [0 0 0 0 0 0 0];\n"
-           "internalField " << internalField << ";\n"
+           "internalField "
+        << internalField
+        << ";\n"
            "boundaryField\n{\n    lid { type zeroGradient; }\n    walls { type zeroGradient; }\n"
            "    sides { type empty; }\n}\n";
   }
@@ -154,8 +159,8 @@ void expectClose(const std::vector<Vec3>& a, const std::vector<Vec3>& b, double 
   ASSERT_EQ(a.size(), b.size());
   double worst = 0;
   for (size_t c = 0; c < a.size(); ++c) {
-    worst = std::max({worst, std::abs(a[c].x - b[c].x), std::abs(a[c].y - b[c].y),
-                      std::abs(a[c].z - b[c].z)});
+    worst = std::max(
+        {worst, std::abs(a[c].x - b[c].x), std::abs(a[c].y - b[c].y), std::abs(a[c].z - b[c].z)});
   }
   EXPECT_LE(worst, tol) << what << ": largest velocity difference " << worst << " m/s";
 }
@@ -170,12 +175,12 @@ void expectClose(const std::vector<double>& a, const std::vector<double>& b, dou
   EXPECT_LE(worst, tol) << what << ": largest pressure difference " << worst << " m^2/s^2";
 }
 
-}  // namespace
+} // namespace
 
 TEST_F(OpenFoamCavity, RunsConservesMassAndTheLidDrivesAVortex) {
   const fs::path dir = meshedCase("cavity");
-  ASSERT_EQ(run(COREDEM_FOAM_CHECK_EXE, dir, "log.run"), 0)
-      << "coredemFoamCheck failed:\n" << readFile(dir / "log.run");
+  ASSERT_EQ(run(COREDEM_FOAM_CHECK_EXE, dir, "log.run"), 0) << "coredemFoamCheck failed:\n"
+                                                            << readFile(dir / "log.run");
   EXPECT_NE(readFile(dir / "log.run").find("\nEnd\n"), std::string::npos);
 
   for (const auto& t : kWriteTimes) {

@@ -1,7 +1,5 @@
 // scripts/openfoam-headers.sh on the cache this build was configured with: a second run is a
 // no-op that keeps the prepared tree, and bad invocations fail with a message saying what to do.
-#include <gtest/gtest.h>
-
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 namespace fs = std::filesystem;
@@ -39,20 +38,20 @@ Result runShell(const std::string& command) {
 
 const std::string kScript = std::string("bash '") + COREDEM_OPENFOAM_HEADERS_SCRIPT + "'";
 
-}  // namespace
+} // namespace
 
 TEST(OpenFoamHeaders, SecondRunIsANoOpAndKeepsTheTree) {
   const fs::path cache = COREDEM_OPENFOAM_HEADERS_DIR;
   const fs::path stamp = cache / "openfoam-headers.stamp";
   ASSERT_TRUE(fs::exists(stamp)) << "configure should have prepared " << cache;
   const auto fvCFD = cache / "src/finiteVolume/lnInclude/fvCFD.H";
-  ASSERT_TRUE(fs::exists(fvCFD)) << fvCFD;  // follows the link: the target is there too
+  ASSERT_TRUE(fs::exists(fvCFD)) << fvCFD; // follows the link: the target is there too
 
   const Result r = runShell(kScript + " '" + cache.string() + "'");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("nothing to do"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("apt-get"), std::string::npos) << "a no-op run must not download\n"
-                                                          << r.output;
+                                                         << r.output;
   EXPECT_TRUE(fs::exists(fvCFD));
 
   std::ifstream in(stamp);

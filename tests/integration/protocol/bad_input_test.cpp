@@ -1,9 +1,9 @@
 // Bad input over real tcp loopback sockets (DESIGN §3): every malformed or inconsistent
 // message gets an Error reply with its specific code, and the server then serves the next
 // valid request correctly.
-#include "loopback_fixture.h"
-
 #include <limits>
+
+#include "loopback_fixture.h"
 
 using namespace coredem::protocol;
 using namespace coredem::protocol::test;
@@ -164,9 +164,9 @@ TEST_F(BadInput, ShapeContradictingTheConfiguration) {
 }
 
 TEST_F(BadInput, NaNAndInfInAField) {
-  for (double bad : {std::numeric_limits<double>::quiet_NaN(),
-                     std::numeric_limits<double>::infinity(),
-                     -std::numeric_limits<double>::infinity()}) {
+  for (double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+        -std::numeric_limits<double>::infinity()}) {
     Message full = gasFields(session.nextStep, session.id);
     Message m(full.envelope());
     for (std::size_t i = 0; i < full.arrayCount(); ++i) {
@@ -225,8 +225,7 @@ TEST_F(BadInput, UnknownMessageType) {
     std::vector<double> v(kCells * fields::componentsOf(spec.extent, kSpecies), 0.0);
     s.addArray<double>(spec.name, v, fields::shapeOf(spec.extent, kCells, kSpecies));
   }
-  expectError(session.client.request(std::move(s), kTimeout),
-              v1::ERROR_CODE_UNEXPECTED_MESSAGE);
+  expectError(session.client.request(std::move(s), kTimeout), v1::ERROR_CODE_UNEXPECTED_MESSAGE);
   expectStillServing();
 }
 
@@ -260,7 +259,8 @@ TEST_F(BadInput, WrongMajorVersionFromTheSessionPeer) {
   Message reply = session.client.request(std::move(hello), kTimeout);
   ASSERT_EQ(reply.type(), v1::MESSAGE_TYPE_REJECT);
   EXPECT_EQ(reply.envelope().reject().code(), v1::ERROR_CODE_VERSION);
-  EXPECT_NE(reply.envelope().reject().reason().find(kProtocolVersion.toString()), std::string::npos);
+  EXPECT_NE(reply.envelope().reject().reason().find(kProtocolVersion.toString()),
+            std::string::npos);
   EXPECT_NE(reply.envelope().reject().reason().find("2.0"), std::string::npos);
   expectStillServing(); // the existing session is untouched
 }

@@ -83,7 +83,8 @@ TEST(Handshake, DataBeforeConfigureIsRefused) {
   ASSERT_EQ(cerr.type(), v1::MESSAGE_TYPE_ERROR);
   EXPECT_EQ(cerr.envelope().error().code(), v1::ERROR_CODE_INVALID_CONFIGURATION);
 
-  Message ok = client.request(std::move(makeConfigure(smallConfigure()).setSessionId(id)), kTimeout);
+  Message ok =
+      client.request(std::move(makeConfigure(smallConfigure()).setSessionId(id)), kTimeout);
   ASSERT_EQ(ok.type(), v1::MESSAGE_TYPE_CONFIGURED);
   EXPECT_EQ(ok.envelope().configured().cell_count(), kCells);
   EXPECT_EQ(ok.envelope().configured().species_count(), kSpecies);
@@ -93,13 +94,13 @@ TEST(Handshake, DataBeforeConfigureIsRefused) {
 TEST(Handshake, ControlMessagesAndShutdown) {
   LoopbackThread server;
   Session s(server.endpoint());
-  Message done = s.client.request(std::move(makeStepGrant(0, 0, 1e-3, 4, 2.5e-4).setSessionId(s.id)),
-                                  kTimeout);
+  Message done = s.client.request(
+      std::move(makeStepGrant(0, 0, 1e-3, 4, 2.5e-4).setSessionId(s.id)), kTimeout);
   ASSERT_EQ(done.type(), v1::MESSAGE_TYPE_STEP_DONE);
   EXPECT_EQ(done.envelope().step(), 0);
   EXPECT_DOUBLE_EQ(done.envelope().time(), 1e-3);
-  Message cp = s.client.request(std::move(makeCheckpointRequest(0, "cp/0").setSessionId(s.id)),
-                                kTimeout);
+  Message cp =
+      s.client.request(std::move(makeCheckpointRequest(0, "cp/0").setSessionId(s.id)), kTimeout);
   ASSERT_EQ(cp.type(), v1::MESSAGE_TYPE_CHECKPOINT_DONE);
   EXPECT_EQ(cp.envelope().checkpoint_done().directory(), "cp/0");
   Message hb = s.client.request(std::move(makeHeartbeat().setSessionId(s.id)), kTimeout);

@@ -1,14 +1,14 @@
 #pragma once
 // A loopback server on tcp://127.0.0.1:<ephemeral> served by a background thread, and a
 // client that has done Hello + Configure (4 x 3 x 2 = 24 cells, 2 species).
-#include <coredem/protocol/fields.h>
-#include <coredem/protocol/loopback.h>
-#include <coredem/protocol/validate.h>
+#include <atomic>
+#include <thread>
 
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <thread>
+#include <coredem/protocol/fields.h>
+#include <coredem/protocol/loopback.h>
+#include <coredem/protocol/validate.h>
 
 namespace coredem::protocol::test {
 
@@ -91,7 +91,8 @@ public:
     Message w = client.request(makeHello(v1::ROLE_CFD, "test 1.0"), kTimeout);
     expectType(w, v1::MESSAGE_TYPE_WELCOME);
     id = w.envelope().welcome().session_id();
-    Message c = client.request(std::move(makeConfigure(smallConfigure()).setSessionId(id)), kTimeout);
+    Message c =
+        client.request(std::move(makeConfigure(smallConfigure()).setSessionId(id)), kTimeout);
     expectType(c, v1::MESSAGE_TYPE_CONFIGURED);
   }
   Client client;

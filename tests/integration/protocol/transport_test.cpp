@@ -1,11 +1,11 @@
 // Transport: ephemeral tcp ports, ipc, timeouts naming endpoint and awaited reply, refusal of
 // non-loopback binds without CURVE, CURVE on loopback, receiving into caller buffers.
-#include "loopback_fixture.h"
-
 #include <filesystem>
 #include <map>
 
 #include <unistd.h>
+
+#include "loopback_fixture.h"
 
 using namespace coredem::protocol;
 using namespace coredem::protocol::test;
@@ -106,7 +106,8 @@ TEST(Transport, StaleRepliesAfterATimeoutAreDiscarded) {
   auto first = server.receive(std::chrono::milliseconds(2000));
   ASSERT_TRUE(first.has_value());
   // Late reply to the first request, then the client asks again.
-  server.reply(first->peer, std::move(makeHeartbeat("late").setSequence(first->message.envelope().sequence())));
+  server.reply(first->peer,
+               std::move(makeHeartbeat("late").setSequence(first->message.envelope().sequence())));
   std::uint64_t second = client.send(makeHeartbeat("b"));
   auto req = server.receive(std::chrono::milliseconds(2000));
   ASSERT_TRUE(req.has_value());
@@ -248,8 +249,9 @@ TEST(Transport, CurveOnLoopback) {
 
   Client plain; // no keys: the handshake fails at the ZeroMQ level, the request times out
   plain.connect(ep);
-  EXPECT_THROW((void)plain.request(makeHello(v1::ROLE_CFD, "plain"), std::chrono::milliseconds(300)),
-               TimeoutError);
+  EXPECT_THROW(
+      (void)plain.request(makeHello(v1::ROLE_CFD, "plain"), std::chrono::milliseconds(300)),
+      TimeoutError);
 
   TransportOptions bad = co;
   bad.curve.clientSecretKey = "short";

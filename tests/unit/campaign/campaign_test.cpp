@@ -4,8 +4,8 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
-#include <yaml-cpp/yaml.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/campaign_db.h>
@@ -53,8 +53,7 @@ TEST(CampaignKeys, BadPathsNameThePath) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(msg("l[2]").find("'l[2]': index 2 out of range ('l' has 2 entries"),
-            std::string::npos)
+  EXPECT_NE(msg("l[2]").find("'l[2]': index 2 out of range ('l' has 2 entries"), std::string::npos)
       << msg("l[2]");
   EXPECT_NE(msg("a.b.c").find("'a.b.c': 'a.b' is not a mapping"), std::string::npos)
       << msg("a.b.c");

@@ -1,13 +1,13 @@
 // Unit tests of coredem-gas's prescribed gas model (docs/client.md, "coredem-gas input").
-#include "coredem/common/check.h"
-#include "coredem/gas/gas_model.h"
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
+#include "coredem/common/check.h"
+#include "coredem/gas/gas_model.h"
 
 using coredem::UserError;
 using coredem::gas::CartesianGrid;
@@ -24,10 +24,13 @@ CartesianGrid grid4x2x2() {
   return g;
 }
 
-GasModel load(const std::string& text) { return GasModel::fromYaml(YAML::Load(text), "case.yaml"); }
+GasModel load(const std::string& text) {
+  return GasModel::fromYaml(YAML::Load(text), "case.yaml");
+}
 
 /// The message of the UserError thrown by f (empty when nothing is thrown).
-template <class F> std::string errorOf(F&& f) {
+template <class F>
+std::string errorOf(F&& f) {
   try {
     f();
   } catch (const UserError& e) {
@@ -119,13 +122,14 @@ TEST(GasModel, RejectsBadValues) {
   EXPECT_NE(errorOf([] { load("T_g: -3"); }).find("must be > 0"), std::string::npos);
   EXPECT_NE(errorOf([] { load("T_g: hot"); }).find("'hot' is not a number"), std::string::npos);
   EXPECT_NE(errorOf([] { load("u_g: [1, 2]"); }).find("3-vector"), std::string::npos);
-  EXPECT_NE(errorOf([] { load("T_g: {table: [[0.5, 300], [0.5, 400]]}"); })
-                .find("strictly increasing"),
-            std::string::npos);
+  EXPECT_NE(
+      errorOf([] { load("T_g: {table: [[0.5, 300], [0.5, 400]]}"); }).find("strictly increasing"),
+      std::string::npos);
   EXPECT_NE(errorOf([] { load("T_g: {tabel: [[0, 300]]}"); }).find("tabel"), std::string::npos);
   EXPECT_NE(errorOf([] { load("regions: [{T_g: 300}]"); }).find("has no 'box"), std::string::npos);
-  EXPECT_NE(errorOf([] { load("regions: [{box: {min: [0,0,0], max: [1,0,1]}}]"); })
-                .find("min must be < max"),
+  EXPECT_NE(errorOf([] {
+              load("regions: [{box: {min: [0,0,0], max: [1,0,1]}}]");
+            }).find("min must be < max"),
             std::string::npos);
   EXPECT_NE(errorOf([] { load("mu_g: .nan"); }).find("not finite"), std::string::npos);
 }
@@ -148,7 +152,8 @@ TEST(GasModel, CompositionMustSumToOneAtEveryBreakpoint) {
 }
 
 TEST(GasModel, SpeciesMustBeInTheCaseList) {
-  auto m = load("Y_g: {N2: 1.0}\nregions: [{name: r, box: {min: [0,0,0], max: [1,1,1]}, Y_g: {XX: 1}}]");
+  auto m =
+      load("Y_g: {N2: 1.0}\nregions: [{name: r, box: {min: [0,0,0], max: [1,1,1]}, Y_g: {XX: 1}}]");
   const auto msg = errorOf([&] { m.bind(grid4x2x2(), {"N2", "CO"}); });
   EXPECT_NE(msg.find("region 'r'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("'XX'"), std::string::npos) << msg;
@@ -158,8 +163,8 @@ TEST(GasModel, SpeciesMustBeInTheCaseList) {
 }
 
 TEST(GasModel, FromFileWithNestedKey) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("coredem-gas-model-" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("coredem-gas-model-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   const auto file = (dir / "case.yaml").string();
   {

@@ -2,13 +2,13 @@
 // StateError naming the call and the state; missing peers in the environment are Argument
 // errors naming the variable. This file is compiled as C++14 (CMake CXX_STANDARD 14) to prove
 // that the public header works in OpenFOAM translation units.
-#include "coredem/client/coredem_client.h"
-#include "coredem/client/participant.h"
+#include <cstdlib>
+#include <string>
 
 #include <gtest/gtest.h>
 
-#include <cstdlib>
-#include <string>
+#include "coredem/client/coredem_client.h"
+#include "coredem/client/participant.h"
 
 #if __cplusplus >= 201703L
 #error "participant_state_test.cpp must be compiled as C++14"
@@ -22,7 +22,8 @@ using coredem::client::StateError;
 
 namespace {
 
-template <class F> std::string stateErrorOf(F f) {
+template <class F>
+std::string stateErrorOf(F f) {
   try {
     f();
   } catch (const StateError& e) {
@@ -45,11 +46,13 @@ TEST(ParticipantState, CallsBeforeInitializeAreRefused) {
   EXPECT_NE(e1.find("exchange() called in state Created"), std::string::npos) << e1;
   const auto e2 = stateErrorOf([&] { p.advance(0.5); });
   EXPECT_NE(e2.find("advance() called in state Created"), std::string::npos) << e2;
-  EXPECT_NE(stateErrorOf([&] { p.step(); }).find("step() called in state Created"), std::string::npos);
+  EXPECT_NE(stateErrorOf([&] { p.step(); }).find("step() called in state Created"),
+            std::string::npos);
   EXPECT_NE(stateErrorOf([&] { p.dt(); }).find("dt()"), std::string::npos);
   EXPECT_NE(stateErrorOf([&] { p.grid(); }).find("grid()"), std::string::npos);
   EXPECT_NE(stateErrorOf([&] { p.sources(); }).find("sources()"), std::string::npos);
-  EXPECT_NE(stateErrorOf([&] { p.requiresCheckpoint(); }).find("checkpointDir()"), std::string::npos);
+  EXPECT_NE(stateErrorOf([&] { p.requiresCheckpoint(); }).find("checkpointDir()"),
+            std::string::npos);
 }
 
 TEST(ParticipantState, MissingEnvironmentNamesTheVariable) {
@@ -62,7 +65,8 @@ TEST(ParticipantState, MissingEnvironmentNamesTheVariable) {
     FAIL() << "initialize() without endpoints must fail";
   } catch (const ClientError& e) {
     EXPECT_EQ(e.code(), ErrorCode::Argument);
-    EXPECT_NE(std::string(e.what()).find("COREDEM_CONTROL_ENDPOINT"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("COREDEM_CONTROL_ENDPOINT"), std::string::npos)
+        << e.what();
   }
   coredem::client::Options o;
   o.controlEndpoint = "tcp://127.0.0.1:1";

@@ -1,13 +1,13 @@
 // CompensatedSum (Kahan) and parseSwitch.
+#include <cmath>
+#include <cstring>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include <coredem/common/compensated_sum.h>
 #include <coredem/common/switch.h>
 #include <coredem/common/version.h>
-
-#include <cmath>
-#include <cstring>
-#include <string>
 
 namespace {
 
@@ -54,8 +54,9 @@ TEST(Switch, AcceptsOneSpellingSetAndRefusesTheRest) {
 
 TEST(Version, ComesFromTheProject) {
   const std::string v = coredem::kVersion;
-  EXPECT_EQ(v, std::to_string(coredem::kVersionMajor) + "." + std::to_string(coredem::kVersionMinor) +
-                   "." + std::to_string(coredem::kVersionPatch));
+  EXPECT_EQ(v, std::to_string(coredem::kVersionMajor) + "." +
+                   std::to_string(coredem::kVersionMinor) + "." +
+                   std::to_string(coredem::kVersionPatch));
 }
 
 } // namespace

@@ -1,29 +1,30 @@
 // h5:: handles and helpers: exact round trips, and errors that name the file and the object.
-#include <gtest/gtest.h>
-
-#include <coredem/common/hdf5.h>
-
 #include <cstdint>
 #include <cstring>
-#include <unistd.h>
 #include <filesystem>
 #include <fstream>
 #include <limits>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <coredem/common/hdf5.h>
 
 namespace fs = std::filesystem;
 
 namespace {
 
 fs::path tempFile(const char* name) {
-  const fs::path dir = fs::temp_directory_path() / ("coredem-common-h5-" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("coredem-common-h5-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   return dir / name;
 }
 
 TEST(Hdf5, RoundTripIsExact) {
   const fs::path p = tempFile("rt.h5");
-  const std::vector<double> x = {0.1, -2.5e-300, std::numeric_limits<double>::max(), 1.0 / 3.0,
-                                 0.0, -0.0};
+  const std::vector<double> x = {0.1,       -2.5e-300, std::numeric_limits<double>::max(),
+                                 1.0 / 3.0, 0.0,       -0.0};
   const std::vector<std::int64_t> ids = {1, -7, std::numeric_limits<std::int64_t>::max()};
   {
     auto f = coredem::h5::createFile(p);
@@ -61,7 +62,8 @@ TEST(Hdf5, ErrorsNameTheFileAndTheObject) {
     (void)coredem::h5::readDataset<double>(f, "v", p.string(), 4);
     FAIL();
   } catch (const coredem::UserError& e) {
-    EXPECT_NE(std::string(e.what()).find("dataset 'v' has 3 values, expected 4"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("dataset 'v' has 3 values, expected 4"),
+              std::string::npos);
   }
   EXPECT_THROW((void)coredem::h5::readDataset<double>(f, "w", p.string()), coredem::UserError);
   EXPECT_THROW((void)coredem::h5::readAttribute<double>(f, "t", p.string()), coredem::UserError);

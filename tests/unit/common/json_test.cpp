@@ -1,12 +1,11 @@
 // JsonWriter and jsonEscape: output is valid JSON that yaml-cpp reads back to the same values.
+#include <limits>
+
 #include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
 
 #include <coredem/common/check.h>
 #include <coredem/common/json.h>
-
-#include <yaml-cpp/yaml.h>
-
-#include <limits>
 
 namespace {
 

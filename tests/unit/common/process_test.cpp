@@ -1,17 +1,16 @@
 // Child processes: spawn with a log, exit reasons, stop with SIGTERM then SIGKILL.
-#include <gtest/gtest.h>
-
-#include <coredem/common/check.h>
-#include <coredem/common/process.h>
-
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <thread>
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <coredem/common/check.h>
+#include <coredem/common/process.h>
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
@@ -19,7 +18,8 @@ using namespace std::chrono_literals;
 namespace {
 
 fs::path tempLog(const char* name) {
-  const fs::path dir = fs::temp_directory_path() / ("coredem-common-proc-" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::temp_directory_path() / ("coredem-common-proc-" + std::to_string(::getpid()));
   fs::create_directories(dir);
   fs::remove(dir / name);
   return dir / name;
@@ -27,7 +27,8 @@ fs::path tempLog(const char* name) {
 
 TEST(Process, OutputEnvironmentAndExitCodeAreReported) {
   const fs::path log = tempLog("echo.log");
-  coredem::ChildProcess p("echo test", {"/bin/sh", "-c", "echo out-$COREDEM_T; echo err >&2; exit 3"},
+  coredem::ChildProcess p("echo test",
+                          {"/bin/sh", "-c", "echo out-$COREDEM_T; echo err >&2; exit 3"},
                           {{"COREDEM_T", "42"}}, log);
   ASSERT_TRUE(p.waitFor(10s));
   EXPECT_EQ(p.exitReason(), "exited with code 3");
@@ -40,9 +41,9 @@ TEST(Process, OutputEnvironmentAndExitCodeAreReported) {
 
 TEST(Process, StopEscalatesToSigkill) {
   const fs::path log = tempLog("trap.log");
-  coredem::ChildProcess p("stubborn",
-                          {"/bin/sh", "-c", "trap '' TERM; echo ready; while :; do sleep 0.05; done"},
-                          {}, log);
+  coredem::ChildProcess p(
+      "stubborn", {"/bin/sh", "-c", "trap '' TERM; echo ready; while :; do sleep 0.05; done"}, {},
+      log);
   // Wait until the trap is set, else SIGTERM may still end the shell.
   for (int i = 0; i < 1000 && p.logTail(1).find("ready") == std::string::npos; ++i) {
     std::this_thread::sleep_for(10ms);

@@ -1,9 +1,9 @@
 // yaml::Section: every error names file:line:col, the full key and what is allowed.
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include <coredem/common/yaml_section.h>
-
-#include <string>
 
 namespace {
 
@@ -47,7 +47,9 @@ TEST(YamlSection, NestedSectionsAndListsCarryTheFullKey) {
 
 TEST(YamlSection, ChoicesAndSwitches) {
   EXPECT_EQ(errorOf("a: maybe\n",
-                    [](const Section& s) { (void)s.choice("a", std::nullopt, {"yes", "no"}); }),
+                    [](const Section& s) {
+                      (void)s.choice("a", std::nullopt, {"yes", "no"});
+                    }),
             "in.yaml:1:4: a: 'maybe' is not allowed; allowed: yes, no");
   EXPECT_EQ(errorOf("a: sometimes\n", [](const Section& s) { (void)s.onOff("a", false); }),
             "in.yaml:1:4: a: expected on or off, got 'sometimes'");

@@ -1,18 +1,17 @@
 // Backend tests. The primitives of the cpu backend are tested directly; the conformance
 // tests are written once, templated on the backend, and instantiated for cpu and cuda
 // (cuda skips when it is not built or no device is present).
-#include "backend/cpu/cpu_exec.h"
-
-#include "coredem/common/check.h"
-#include "coredem/dem/dem_system.h"
-
-#include <gtest/gtest.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
 #include <vector>
+
+#include <gtest/gtest.h>
+
+#include "backend/cpu/cpu_exec.h"
+#include "coredem/common/check.h"
+#include "coredem/dem/dem_system.h"
 
 using namespace coredem::dem;
 
@@ -22,18 +21,23 @@ TEST(CpuBackend, ParallelForTouchesEveryIndexOnce) {
   std::vector<int> hits(10007, 0);
   int* h = hits.data();
   exec.parallelFor(hits.size(), [=](std::size_t i) { h[i] += 1; });
-  for (int v : hits) ASSERT_EQ(v, 1);
+  for (int v : hits)
+    ASSERT_EQ(v, 1);
 }
 
 TEST(CpuBackend, ReduceMaxIsExact) {
   backend::CpuExec exec;
   exec.threads = 2;
   std::vector<double> v(5000);
-  for (std::size_t i = 0; i < v.size(); ++i) v[i] = std::sin(0.37 * i);
+  for (std::size_t i = 0; i < v.size(); ++i)
+    v[i] = std::sin(0.37 * i);
   const double* p = v.data();
-  const double r = exec.reduceMax(v.size(), [=](std::size_t i) { return p[i]; }, -1e300);
+  const double r = exec.reduceMax(
+      v.size(), [=](std::size_t i) { return p[i]; }, -1e300);
   EXPECT_EQ(r, *std::max_element(v.begin(), v.end()));
-  EXPECT_EQ(exec.reduceMax(0, [=](std::size_t) { return 1.0; }, -5.0), -5.0);
+  EXPECT_EQ(exec.reduceMax(
+                0, [=](std::size_t) { return 1.0; }, -5.0),
+            -5.0);
 }
 
 TEST(CpuBackend, ExclusiveScan) {
@@ -55,12 +59,14 @@ TEST(CpuBackend, SortByKeyIsStableAndSorted) {
   }
   exec.sortByKey(keys.data(), n, 517, perm.data());
   std::vector<int> seen(n, 0);
-  for (std::size_t k = 0; k < n; ++k) ++seen[perm[k]];
-  for (int v : seen) ASSERT_EQ(v, 1);
+  for (std::size_t k = 0; k < n; ++k)
+    ++seen[perm[k]];
+  for (int v : seen)
+    ASSERT_EQ(v, 1);
   for (std::size_t k = 1; k < n; ++k) {
     ASSERT_LE(keys[perm[k - 1]], keys[perm[k]]);
     if (keys[perm[k - 1]] == keys[perm[k]]) {
-      ASSERT_LT(perm[k - 1], perm[k]);  // stable
+      ASSERT_LT(perm[k - 1], perm[k]); // stable
     }
   }
 }
@@ -119,7 +125,8 @@ TYPED_TEST(BackendConformance, AgitatedBoxMatchesCpuReference) {
   const ParticleData a = ref.particles(), b = sys.particles();
   ASSERT_EQ(a.count, b.count);
   std::vector<std::size_t> ia(a.count), ib(b.count);
-  for (std::size_t i = 0; i < a.count; ++i) ia[a.globalId[i]] = i, ib[b.globalId[i]] = i;
+  for (std::size_t i = 0; i < a.count; ++i)
+    ia[a.globalId[i]] = i, ib[b.globalId[i]] = i;
   // cpu vs cpu is bitwise; cuda vs cpu may differ by FMA contraction: 1e-9 m after 1000 steps.
   for (std::size_t g = 0; g < a.count; ++g)
     for (int d = 0; d < 3; ++d)
@@ -133,12 +140,13 @@ TYPED_TEST(BackendConformance, HeadOnCollisionRestitution) {
   s.packing = Packing::Explicit;
   const double v = 0.4;
   const double dt0 = 1.6075e-6;
-  s.positions = {0, 0, 0, 1e-3 + 2 * v * dt0 * 0.5, 0, 0};  // contact starts mid-step
+  s.positions = {0, 0, 0, 1e-3 + 2 * v * dt0 * 0.5, 0, 0}; // contact starts mid-step
   s.velocities = {v, 0, 0, -v, 0, 0};
   c.particleSets.push_back(s);
   DemSystem sys(c, TypeParam::kind, 1);
   const double dt = sys.dtDemMax();
-  for (int k = 0; k < 200; ++k) sys.advance(dt, 1);
+  for (int k = 0; k < 200; ++k)
+    sys.advance(dt, 1);
   const ParticleData p = sys.particles();
   const std::size_t i0 = p.globalId[0] == 0 ? 0 : 1;
   const double rel = p.velocity[3 * (1 - i0)] - p.velocity[3 * i0];
@@ -158,6 +166,6 @@ TEST(BackendChoice, AutoPicksCudaOnlyWithADevice) {
   EXPECT_EQ(parseBackend("auto"), BackendKind::Auto);
   EXPECT_THROW(parseBackend("gpu"), coredem::UserError);
   if (cudaDeviceCount() == 0) {
-    EXPECT_THROW(DemSystem(c, BackendKind::Cuda, 1), coredem::UserError);  // clear error, no crash
+    EXPECT_THROW(DemSystem(c, BackendKind::Cuda, 1), coredem::UserError); // clear error, no crash
   }
 }

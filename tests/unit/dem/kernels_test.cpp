@@ -1,4 +1,8 @@
 // Kernel unit tests on the CPU against PHYSICS.md §1.1 and §2 (Eqs. 9–17).
+#include <cmath>
+
+#include <gtest/gtest.h>
+
 #include "coredem/dem/kernels/body_force.h"
 #include "coredem/dem/kernels/cell_sources.h"
 #include "coredem/dem/kernels/collision_time.h"
@@ -8,10 +12,6 @@
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
 #include "coredem/dem/kernels/wall_contact.h"
-
-#include <gtest/gtest.h>
-
-#include <cmath>
 
 using namespace coredem::dem::kernels;
 
@@ -26,10 +26,10 @@ TEST(Damping, Eq13MatchesClosedFormAndLimits) {
   const double l = std::log(en);
   const double expected = 2 * std::sqrt(kn * meff) * std::fabs(l) / std::sqrt(kPi * kPi + l * l);
   EXPECT_NEAR(normalDamping(kn, meff, en), expected, 1e-15 * expected);
-  EXPECT_DOUBLE_EQ(normalDamping(kn, meff, 1.0), 0.0);           // elastic
-  EXPECT_DOUBLE_EQ(normalDamping(kn, meff, 0.0), 2 * std::sqrt(kn * meff));  // critical
+  EXPECT_DOUBLE_EQ(normalDamping(kn, meff, 1.0), 0.0);                      // elastic
+  EXPECT_DOUBLE_EQ(normalDamping(kn, meff, 0.0), 2 * std::sqrt(kn * meff)); // critical
   EXPECT_DOUBLE_EQ(effectiveMass(2.0, 2.0), 1.0);
-  EXPECT_DOUBLE_EQ(effectiveMass(2.0, 0.0), 2.0);  // wall
+  EXPECT_DOUBLE_EQ(effectiveMass(2.0, 0.0), 2.0); // wall
 }
 
 TEST(Damping, Eq11RestitutionRecoveredFromEq12And13) {
@@ -45,10 +45,11 @@ TEST(Damping, Eq11RestitutionRecoveredFromEq12And13) {
 TEST(CollisionTime, Eq12PatilValue) {
   // PHYSICS §7 [V]: t_col = 8.04e-5 s, Δt_DEM = 1.61e-6 s for the glass pair.
   const double t = collisionTimeFromRestitution(1000.0, kMass / 2, 0.97);
-  EXPECT_NEAR(t, std::sqrt(kMass / 2 / 1000.0) * std::sqrt(kPi * kPi + std::pow(std::log(0.97), 2)), 1e-18);
+  EXPECT_NEAR(t, std::sqrt(kMass / 2 / 1000.0) * std::sqrt(kPi * kPi + std::pow(std::log(0.97), 2)),
+              1e-18);
   EXPECT_NEAR(t, 8.04e-5, 0.005e-5);
   EXPECT_NEAR(t / 50, 1.61e-6, 0.005e-6);
-  EXPECT_TRUE(std::isinf(collisionTime(1.0, 1.0, 2.0)));  // critically damped
+  EXPECT_TRUE(std::isinf(collisionTime(1.0, 1.0, 2.0))); // critically damped
 }
 
 TEST(LsdContact, NormalSpringAndDashpotEq9) {
@@ -65,7 +66,7 @@ TEST(LsdContact, NormalSpringAndDashpotEq9) {
 TEST(LsdContact, TangentialSpringBelowCoulombLimitEq10) {
   const LsdParams p{1000, 2000.0 / 7, 0.0, 0.002, 0.5};
   const Vec3 n{0, 0, 1};
-  const Vec3 old{1e-7, 0, 3e-8};  // has a normal component: projected away
+  const Vec3 old{1e-7, 0, 3e-8}; // has a normal component: projected away
   const double dt = 1e-6;
   const LsdResult r = lsdContact(p, n, 1e-4, Vec3{0.01, 0, 0}, 5e-4, old, dt);
   const double dT = 1e-7 + 0.01 * dt;
@@ -97,8 +98,10 @@ TEST(LsdContact, MirrorExactForBothSides) {
   const Vec3 nij = (1.0 / l) * dij, nji = (1.0 / norm(dji)) * dji;
   const double lij = leverArm(l, ri, rj), lji = leverArm(l, rj, ri);
   const Vec3 hist{3e-7, -1e-7, 2e-7};
-  const LsdResult a = lsdContact(p, nij, ri + rj - l, relativeVelocity(vi, vj, wi, wj, lij, lji, nij), lij, hist, 1e-6);
-  const LsdResult b = lsdContact(p, nji, ri + rj - l, relativeVelocity(vj, vi, wj, wi, lji, lij, nji), lji, -hist, 1e-6);
+  const LsdResult a = lsdContact(p, nij, ri + rj - l,
+                                 relativeVelocity(vi, vj, wi, wj, lij, lji, nij), lij, hist, 1e-6);
+  const LsdResult b = lsdContact(p, nji, ri + rj - l,
+                                 relativeVelocity(vj, vi, wj, wi, lji, lij, nji), lji, -hist, 1e-6);
   EXPECT_EQ(a.force.x, -b.force.x);
   EXPECT_EQ(a.force.y, -b.force.y);
   EXPECT_EQ(a.force.z, -b.force.z);
@@ -116,14 +119,15 @@ TEST(WallContact, OverlapNormalAndLever) {
   const PlaneWall w{{0, 0, 0}, {0, 0, 1}};
   EXPECT_DOUBLE_EQ(wallOverlap(w, Vec3{5, 5, 4e-4}, 5e-4), 1e-4);
   const LsdParams p{1000, 2000.0 / 7, 0.0, 0.0, 0.1};
-  const LsdResult r = wallContact(p, w, 1e-4, Vec3{0, 0, 0}, Vec3{0, 0, 0}, 5e-4, Vec3{0, 0, 0}, 1e-6);
-  EXPECT_NEAR(r.force.z, 1000 * 1e-4, 1e-15);  // pushes the particle up
+  const LsdResult r =
+      wallContact(p, w, 1e-4, Vec3{0, 0, 0}, Vec3{0, 0, 0}, 5e-4, Vec3{0, 0, 0}, 1e-6);
+  EXPECT_NEAR(r.force.z, 1000 * 1e-4, 1e-15); // pushes the particle up
   // Spinning about y with ω: the contact point (0,0,-L) moves at ω×(−L e_z) = (−ωL, 0, 0).
-  const LsdResult s = wallContact(LsdParams{1000, 100, 0, 0.5, 10}, w, 1e-4, Vec3{0, 0, 0}, Vec3{0, 100, 0}, 5e-4,
-                                  Vec3{0, 0, 0}, 1e-6);
+  const LsdResult s = wallContact(LsdParams{1000, 100, 0, 0.5, 10}, w, 1e-4, Vec3{0, 0, 0},
+                                  Vec3{0, 100, 0}, 5e-4, Vec3{0, 0, 0}, 1e-6);
   const double L = 5e-4 - 1e-4;
   EXPECT_NEAR(s.deltaT.x, -100 * L * 1e-6, 1e-18);
-  EXPECT_GT(s.force.x, 0.0);  // friction opposes the contact point's slip
+  EXPECT_GT(s.force.x, 0.0); // friction opposes the contact point's slip
 }
 
 TEST(Drag, GidaspowErgunBranch) {
@@ -132,13 +136,13 @@ TEST(Drag, GidaspowErgunBranch) {
   const double beta = 150 * s * s * mu / (eps * d * d) + 1.75 * s * rho * slip / d;
   EXPECT_NEAR(gidaspowBeta(eps, rho, mu, d, slip), beta, 1e-12 * beta);
   const double vol = kPi / 6 * d * d * d;
-  EXPECT_NEAR(gidaspowParticleCoefficient(GidaspowParams{}, eps, rho, mu, d, vol, slip), beta * vol / s,
-              1e-12 * beta * vol / s);
+  EXPECT_NEAR(gidaspowParticleCoefficient(GidaspowParams{}, eps, rho, mu, d, vol, slip),
+              beta * vol / s, 1e-12 * beta * vol / s);
 }
 
 TEST(Drag, GidaspowWenYuBranchBothReRegimes) {
   const double rho = 1.2, mu = 1.8e-5, d = 1e-3;
-  for (double slip : {0.05, 3.0, 30.0}) {  // Re_p ≈ 3, 190, >1000
+  for (double slip : {0.05, 3.0, 30.0}) { // Re_p ≈ 3, 190, >1000
     const double eps = 0.9;
     const double re = eps * rho * d * slip / mu;
     const double cd = re < 1000 ? 24 / re * (1 + 0.15 * std::pow(re, 0.687)) : 0.44;
@@ -186,7 +190,7 @@ TEST(Pcm, CellIndexLayoutAndOutside) {
   const GridParams g{{0, 0, 0}, {1.0 / 0.01, 1.0 / 0.02, 1.0 / 0.03}, 4, 3, 2};
   EXPECT_EQ(pcmCell(g, Vec3{0.005, 0.005, 0.005}), 0);
   EXPECT_EQ(pcmCell(g, Vec3{0.035, 0.005, 0.005}), 3);
-  EXPECT_EQ(pcmCell(g, Vec3{0.005, 0.025, 0.005}), 4);      // i + nx j
+  EXPECT_EQ(pcmCell(g, Vec3{0.005, 0.025, 0.005}), 4); // i + nx j
   EXPECT_EQ(pcmCell(g, Vec3{0.015, 0.045, 0.035}), 1 + 4 * (2 + 3 * 1));
   EXPECT_EQ(pcmCell(g, Vec3{-1e-9, 0.005, 0.005}), -1);
   EXPECT_EQ(pcmCell(g, Vec3{0.04, 0.005, 0.005}), -1);

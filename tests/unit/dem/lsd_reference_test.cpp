@@ -1,22 +1,25 @@
 // LSD pair contact against reference data (STYLE §8): data/lsd_contact.yaml holds inputs and
 // expected force/torque/δ_t computed by an independent Python implementation of PHYSICS §2.1
 // (data/make_lsd_reference.py).
-#include "coredem/dem/kernels/damping.h"
-#include "coredem/dem/kernels/lsd_contact.h"
+#include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
-#include <cmath>
-#include <string>
+#include "coredem/dem/kernels/damping.h"
+#include "coredem/dem/kernels/lsd_contact.h"
 
 using namespace coredem::dem::kernels;
 
 namespace {
-Vec3 vec(const YAML::Node& n) { return Vec3{n[0].as<double>(), n[1].as<double>(), n[2].as<double>()}; }
+Vec3 vec(const YAML::Node& n) {
+  return Vec3{n[0].as<double>(), n[1].as<double>(), n[2].as<double>()};
+}
 
 void expectVec(const Vec3& got, const Vec3& want, double eps, const std::string& what) {
-  const double scale = std::fmax(std::fmax(std::fabs(want.x), std::fabs(want.y)), std::fabs(want.z));
+  const double scale =
+      std::fmax(std::fmax(std::fabs(want.x), std::fabs(want.y)), std::fabs(want.z));
   const double tol = eps * (scale > 0 ? scale : 1.0) + 1e-300;
   EXPECT_NEAR(got.x, want.x, tol) << what;
   EXPECT_NEAR(got.y, want.y, tol) << what;
@@ -41,8 +44,10 @@ TEST(LsdReference, MatchesIndependentPythonImplementation) {
     const double l = norm(d);
     const Vec3 n = (1.0 / l) * d;
     const double lij = leverArm(l, ri, rj), lji = leverArm(l, rj, ri);
-    const Vec3 vij = relativeVelocity(vec(c["vi"]), vec(c["vj"]), vec(c["wi"]), vec(c["wj"]), lij, lji, n);
-    const LsdResult r = lsdContact(p, n, ri + rj - l, vij, lij, vec(c["dt_old"]), c["dt"].as<double>());
+    const Vec3 vij =
+        relativeVelocity(vec(c["vi"]), vec(c["vj"]), vec(c["wi"]), vec(c["wj"]), lij, lji, n);
+    const LsdResult r =
+        lsdContact(p, n, ri + rj - l, vij, lij, vec(c["dt_old"]), c["dt"].as<double>());
     expectVec(r.force, vec(c["force"]), eps, name + " force");
     expectVec(r.torque, vec(c["torque"]), eps, name + " torque");
     expectVec(r.deltaT, vec(c["dt_new"]), eps, name + " dt_new");

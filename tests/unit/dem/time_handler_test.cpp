@@ -1,10 +1,10 @@
 // TimeHandler: sub-step count and drift-free accumulation (STYLE §9, preCICE ManyTinyTimesteps).
-#include "coredem/dem/time_handler.h"
+#include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <limits>
+#include "coredem/dem/time_handler.h"
 
 using coredem::dem::TimeHandler;
 
@@ -19,7 +19,7 @@ TEST(TimeHandler, ManyTinySubSteps) {
     naive += dt;
   }
   EXPECT_NEAR(t.time(), 0.1, 2e-17);
-  EXPECT_GT(std::fabs(naive - 0.1), 1e-13);  // shows the test would catch plain summation
+  EXPECT_GT(std::fabs(naive - 0.1), 1e-13); // shows the test would catch plain summation
   EXPECT_TRUE(coredem::dem::timeEquals(t.time(), 0.1));
 }
 
@@ -30,13 +30,15 @@ TEST(TimeHandler, WindowsOfSubStepsEndExactly) {
   const int nSub = TimeHandler::subStepsFor(dtCfd, 1.77e-6);
   EXPECT_EQ(nSub, 57);
   for (int k = 1; k <= 1000; ++k) {
-    for (int s = 0; s < nSub; ++s) t.add(dtCfd / nSub);
-    ASSERT_NEAR(t.time(), k * dtCfd, 4 * std::numeric_limits<double>::epsilon() * k * dtCfd) << "window " << k;
+    for (int s = 0; s < nSub; ++s)
+      t.add(dtCfd / nSub);
+    ASSERT_NEAR(t.time(), k * dtCfd, 4 * std::numeric_limits<double>::epsilon() * k * dtCfd)
+        << "window " << k;
   }
 }
 
 TEST(TimeHandler, SubStepsFor) {
-  EXPECT_EQ(TimeHandler::subStepsFor(1e-4, 1e-5), 10);              // exact ratio
+  EXPECT_EQ(TimeHandler::subStepsFor(1e-4, 1e-5), 10); // exact ratio
   EXPECT_EQ(TimeHandler::subStepsFor(1e-4, 1e-5 * (1 + 1e-15)), 10);
   EXPECT_EQ(TimeHandler::subStepsFor(1e-4, 0.99e-5), 11);
   EXPECT_EQ(TimeHandler::subStepsFor(1e-6, 1e-5), 1);
@@ -47,7 +49,8 @@ TEST(TimeHandler, SubStepsFor) {
 
 TEST(TimeHandler, RestoreIsBitwise) {
   TimeHandler a;
-  for (int i = 0; i < 1000; ++i) a.add(1.3e-6);
+  for (int i = 0; i < 1000; ++i)
+    a.add(1.3e-6);
   TimeHandler b;
   b.restore(a.time(), a.compensation());
   for (int i = 0; i < 1000; ++i) {

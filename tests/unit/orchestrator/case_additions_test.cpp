@@ -53,13 +53,15 @@ TEST(CaseAdditions, PositionsGiveCountAndExplicitPacking) {
 }
 
 TEST(CaseAdditions, CountMatchingPositionsIsAccepted) {
-  const std::string text = replace(kCase, "    diameter: 3.0e-3\n", "    diameter: 3.0e-3\n    count: 2\n");
+  const std::string text =
+      replace(kCase, "    diameter: 3.0e-3\n", "    diameter: 3.0e-3\n    count: 2\n");
   EXPECT_EQ(errorOf(text), "");
 }
 
 TEST(CaseAdditions, BadPositionsAreRefused) {
   // count disagreeing with the positions
-  std::string e = errorOf(replace(kCase, "    diameter: 3.0e-3\n", "    diameter: 3.0e-3\n    count: 3\n"));
+  std::string e =
+      errorOf(replace(kCase, "    diameter: 3.0e-3\n", "    diameter: 3.0e-3\n    count: 3\n"));
   EXPECT_NE(e.find("particles[0].count"), std::string::npos) << e;
   EXPECT_NE(e.find("3 particles but 2 positions"), std::string::npos) << e;
   // a centre with two numbers
@@ -78,7 +80,8 @@ TEST(CaseAdditions, BadPositionsAreRefused) {
   EXPECT_NE(e.find("particles[0].region"), std::string::npos) << e;
   EXPECT_NE(e.find("not used with 'positions'"), std::string::npos) << e;
   // packing other than explicit with positions
-  e = errorOf(replace(kCase, "    diameter: 3.0e-3\n", "    diameter: 3.0e-3\n    packing: random\n"));
+  e = errorOf(
+      replace(kCase, "    diameter: 3.0e-3\n", "    diameter: 3.0e-3\n    packing: random\n"));
   EXPECT_NE(e.find("particles[0].packing"), std::string::npos) << e;
   // no positions and no region
   e = errorOf(replace(kCase, "    positions: [[0.005, 0.002, 0.005], [0.005, 0.0049, 0.005]]\n",
@@ -102,8 +105,8 @@ TEST(CaseAdditions, DtDemMustDivideDt) {
                       "  dt_dem: 1.0e-3\n  adaptive: {courant: 0.5, dt_min: 0.01, dt_max: 0.2}\n"));
   EXPECT_NE(e.find("needs a fixed time.dt"), std::string::npos) << e;
   // absent: 0, the plan comes from the DEM's stable step
-  const CaseConfig c = parseCase(replace(kCase, "  dt_dem: 1.0e-3\n", ""), "case.yaml",
-                                 fs::temp_directory_path());
+  const CaseConfig c =
+      parseCase(replace(kCase, "  dt_dem: 1.0e-3\n", ""), "case.yaml", fs::temp_directory_path());
   EXPECT_EQ(c.dtDem, 0.0);
 }
 

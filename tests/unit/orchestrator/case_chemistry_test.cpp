@@ -9,10 +9,9 @@
 #include <coredem/common/check.h>
 #include <coredem/dem/dem_system.h>
 #include <coredem/orchestrator/case_config.h>
-
-#include "case_text.h"
 #include <coredem/v1/configure.pb.h>
 
+#include "case_text.h"
 #include "configure_map.h"
 
 using namespace coredem::orchestrator;
@@ -76,19 +75,25 @@ TEST(CaseChemistry, AGoodSectionIsParsed) {
   ASSERT_TRUE(c.chemistry.reactionHeat);
   EXPECT_FALSE(*c.chemistry.reactionHeat);
   // Without the new sections a case does not use chemistry (needs no v1.1 server).
-  const std::string plain = replace(replace(replace(kCase, "reactions:", "xreactions:"), "", ""), "", "");
+  const std::string plain =
+      replace(replace(replace(kCase, "reactions:", "xreactions:"), "", ""), "", "");
   (void)plain;
 }
 
 TEST(CaseChemistry, ClgSectionWithKineticOverrides) {
   const std::string text = replace(
-      replace(replace(kCase, "  - {name: A, molar_mass: 0.025}\n  - {name: C, molar_mass: 0.030}\n",
-                      "  - {name: CO, molar_mass: 0.02801}\n  - {name: CO2, molar_mass: 0.04401}\n"
-                      "  - {name: H2, molar_mass: 0.002016}\n  - {name: H2O, molar_mass: 0.018015}\n"),
-              "chemistry:\n", "chemistry:\n  clg: {char_gasification: on, wgs: on, wgs_equilibrium: seed, A_H2O: 2.0e7}\n"),
-      "  - {name: B, molar_mass: 0.015}\n", "  - {name: C, molar_mass: 0.012011}\n  - {name: B, molar_mass: 0.015}\n");
+      replace(
+          replace(kCase, "  - {name: A, molar_mass: 0.025}\n  - {name: C, molar_mass: 0.030}\n",
+                  "  - {name: CO, molar_mass: 0.02801}\n  - {name: CO2, molar_mass: 0.04401}\n"
+                  "  - {name: H2, molar_mass: 0.002016}\n  - {name: H2O, molar_mass: 0.018015}\n"),
+          "chemistry:\n",
+          "chemistry:\n  clg: {char_gasification: on, wgs: on, wgs_equilibrium: seed, A_H2O: "
+          "2.0e7}\n"),
+      "  - {name: B, molar_mass: 0.015}\n",
+      "  - {name: C, molar_mass: 0.012011}\n  - {name: B, molar_mass: 0.015}\n");
   // reactions use A and C as gas species, which are gone: drop them.
-  const std::string noReactions = text.substr(0, text.find("reactions:")) + text.substr(text.find("chemistry:"));
+  const std::string noReactions =
+      text.substr(0, text.find("reactions:")) + text.substr(text.find("chemistry:"));
   const CaseConfig c = parseCase(noReactions, "case.yaml", fs::temp_directory_path());
   EXPECT_TRUE(c.chemistry.charGasification);
   EXPECT_TRUE(c.chemistry.wgs);

@@ -134,7 +134,8 @@ TEST(CaseConfig, AdaptiveBounds) {
 // `models:` is checked with the DEM server's model registry (coredem/dem/models.h): a misspelled
 // key or a bad value fails `coredem check` with file:line:col, the key and the allowed ones.
 TEST(CaseConfig, ModelsMisspelledKeyNamesLineAndAllowedKeys) {
-  const std::string text = std::string(kGood) + "models:\n  motion: frozen\n  convecton: li-mason\n";
+  const std::string text =
+      std::string(kGood) + "models:\n  motion: frozen\n  convecton: li-mason\n";
   const std::string e = errorOf(text);
   EXPECT_NE(e.find("cases/x/case.yaml:23:3: models.convecton: unknown model key (did you mean "
                    "'convection'?); allowed keys: drag, "),
@@ -155,7 +156,9 @@ TEST(CaseConfig, ModelsBadValueNamesLineAndAllowedValues) {
             std::string::npos)
       << d;
   const std::string n = errorOf(std::string(kGood) + "models:\n  flpc: 2\n");
-  EXPECT_NE(n.find("models.flpc: '2' is not allowed; expected a number in [0, 1]"), std::string::npos) << n;
+  EXPECT_NE(n.find("models.flpc: '2' is not allowed; expected a number in [0, 1]"),
+            std::string::npos)
+      << n;
 }
 
 TEST(CaseConfig, ModelsValidPass) {

@@ -1,11 +1,11 @@
 #pragma once
 // Helpers of the case-file unit tests: parse a case text and return its error, edit a case text.
-#include "coredem/orchestrator/case_config.h"
+#include <filesystem>
+#include <string>
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
-#include <string>
+#include "coredem/orchestrator/case_config.h"
 
 namespace coredem::orchestrator::test {
 
@@ -23,7 +23,8 @@ inline std::string errorOf(const std::string& text) {
 inline std::string replace(std::string s, const std::string& from, const std::string& to) {
   const auto pos = s.find(from);
   EXPECT_NE(pos, std::string::npos) << from;
-  if (pos == std::string::npos) return s;
+  if (pos == std::string::npos)
+    return s;
   return s.replace(pos, from.size(), to);
 }
 

@@ -1,16 +1,15 @@
 // Codec: building, encoding and decoding multipart messages; structural checks on decode.
-#include "test_messages.h"
-
-#include <coredem/protocol/message.h>
-#include <coredem/protocol/multipart_file.h>
-
-#include <gtest/gtest.h>
-
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 
+#include <gtest/gtest.h>
 #include <unistd.h>
+
+#include <coredem/protocol/message.h>
+#include <coredem/protocol/multipart_file.h>
+
+#include "test_messages.h"
 
 using namespace coredem::protocol;
 namespace v1 = coredem::v1;
@@ -214,8 +213,7 @@ TEST(Fields, NamesShapesAndUnitsAreFixedInOnePlace) {
 }
 
 TEST(MultipartFile, RoundTripAndClearErrors) {
-  auto dir = std::filesystem::temp_directory_path() /
-             ("coredem-mpf-" + std::to_string(::getpid()));
+  auto dir = std::filesystem::temp_directory_path() / ("coredem-mpf-" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   Frames frames = test::gasFieldsMessage(3, 1).encode();
   writeMultipartFile(dir / "m.cdmf", frames);
@@ -230,9 +228,7 @@ TEST(MultipartFile, RoundTripAndClearErrors) {
   } catch (const coredem::UserError& e) {
     EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
   }
-  {
-    std::ofstream(dir / "bad.cdmf") << "not a multipart file";
-  }
+  { std::ofstream(dir / "bad.cdmf") << "not a multipart file"; }
   EXPECT_THROW((void)readMultipartFile(dir / "bad.cdmf"), coredem::UserError);
   std::filesystem::remove_all(dir);
 }

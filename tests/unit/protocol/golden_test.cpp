@@ -1,14 +1,14 @@
 // Golden v1.0 messages (protocol/golden/v1.0, written once by coredem-golden-gen): decoded
 // with the current code forever; every value is checked against the literals below.
 // A failure here means a wire-incompatible change: fix the code, do not regenerate the files.
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
 #include <coredem/protocol/fields.h>
 #include <coredem/protocol/message.h>
 #include <coredem/protocol/multipart_file.h>
 #include <coredem/protocol/validate.h>
-
-#include <gtest/gtest.h>
-
-#include <filesystem>
 
 using namespace coredem::protocol;
 namespace v1 = coredem::v1;
@@ -50,7 +50,8 @@ void expectFieldArrays(const Message& m, std::span<const fields::FieldSpec> spec
     auto values = v.as<double>();
     ASSERT_EQ(values.size(), 2 * fields::componentsOf(spec.extent, 2));
     for (std::size_t i = 0; i < values.size(); ++i) {
-      EXPECT_EQ(values[i], 0.25 * double(f + 1) + 0.125 * double(i)) << spec.name << "[" << i << "]";
+      EXPECT_EQ(values[i], 0.25 * double(f + 1) + 0.125 * double(i))
+          << spec.name << "[" << i << "]";
     }
     ++f;
   }

@@ -2,14 +2,14 @@
 // decoded with the current code forever. v1.1 = v1.0 + explicit particle positions, the
 // frozen-motion option and the chemistry fields of Configure; the Hello/Welcome/Reject carry
 // minor 1. The v1.0 files keep decoding (golden_test.cpp) and carry no v1.1 fields.
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
 #include <coredem/protocol/message.h>
 #include <coredem/protocol/multipart_file.h>
 #include <coredem/protocol/validate.h>
 #include <coredem/protocol/version.h>
-
-#include <gtest/gtest.h>
-
-#include <filesystem>
 
 using namespace coredem::protocol;
 namespace v1 = coredem::v1;
@@ -113,5 +113,6 @@ TEST(GoldenV1_1, V10ConfigureHasNoV11Fields) {
   EXPECT_EQ(c.solid_species_size(), 0);
   EXPECT_EQ(c.reactions_size(), 0);
   EXPECT_FALSE(c.has_chemistry());
-  for (const auto& p : c.particle_sets()) EXPECT_EQ(p.positions_size(), 0);
+  for (const auto& p : c.particle_sets())
+    EXPECT_EQ(p.positions_size(), 0);
 }

@@ -2,14 +2,14 @@
 // MessageType value has one row, every Envelope.body field has one row, and each row's body
 // type, field and type value agree. A message added to the .proto files but not to the table
 // (or the other way round) fails here.
+#include <cctype>
+#include <set>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include <coredem/protocol/message.h>
 #include <coredem/protocol/message_types.h>
-
-#include <cctype>
-#include <set>
-#include <string>
 
 using namespace coredem::protocol;
 namespace v1 = coredem::v1;

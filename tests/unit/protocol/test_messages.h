@@ -1,9 +1,9 @@
 #pragma once
 // Helpers shared by the protocol unit tests.
+#include <vector>
+
 #include <coredem/protocol/fields.h>
 #include <coredem/protocol/message.h>
-
-#include <vector>
 
 namespace coredem::protocol::test {
 

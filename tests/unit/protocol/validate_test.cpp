@@ -1,13 +1,13 @@
 // Validation of received messages (DESIGN §3): each violation yields its own code and a
 // message naming the field.
-#include "test_messages.h"
-
-#include <coredem/protocol/validate.h>
+#include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
-#include <cmath>
-#include <limits>
+#include <coredem/protocol/validate.h>
+
+#include "test_messages.h"
 
 using namespace coredem::protocol;
 namespace v1 = coredem::v1;
@@ -136,7 +136,8 @@ TEST(Validate, ExtraArraysAreAllowedButChecked) {
 
 TEST(Validate, CountsDeclaredInTheBodyMustMatch) {
   Message m = test::gasFieldsMessage(kCells, kSpecies);
-  Message other = withEnvelope(m, [](v1::Envelope& e) { e.mutable_gas_fields()->set_cell_count(11); });
+  Message other =
+      withEnvelope(m, [](v1::Envelope& e) { e.mutable_gas_fields()->set_cell_count(11); });
   EXPECT_EQ(validate(other, gasExpectation()).code, v1::ERROR_CODE_SHAPE);
 }
 
@@ -144,12 +145,14 @@ TEST(Validate, TypeSessionSequenceAndStep) {
   Message m = test::gasFieldsMessage(kCells, kSpecies, 3, 10);
   m.setSessionId("abc");
 
-  Message unknown = withEnvelope(m, [](v1::Envelope& e) { e.set_type(static_cast<v1::MessageType>(99)); });
+  Message unknown =
+      withEnvelope(m, [](v1::Envelope& e) { e.set_type(static_cast<v1::MessageType>(99)); });
   Status s = validate(unknown, {});
   EXPECT_EQ(s.code, v1::ERROR_CODE_UNKNOWN_TYPE);
   EXPECT_NE(s.message.find("99"), std::string::npos);
 
-  Message unspecified = withEnvelope(m, [](v1::Envelope& e) { e.set_type(v1::MESSAGE_TYPE_UNSPECIFIED); });
+  Message unspecified =
+      withEnvelope(m, [](v1::Envelope& e) { e.set_type(v1::MESSAGE_TYPE_UNSPECIFIED); });
   EXPECT_EQ(validate(unspecified, {}).code, v1::ERROR_CODE_UNKNOWN_TYPE);
 
   Message mismatch = withEnvelope(m, [](v1::Envelope& e) { e.set_type(v1::MESSAGE_TYPE_SOURCES); });

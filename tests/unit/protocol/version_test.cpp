@@ -1,7 +1,7 @@
 // Version negotiation rule (DESIGN §3).
-#include <coredem/protocol/version.h>
-
 #include <gtest/gtest.h>
+
+#include <coredem/protocol/version.h>
 
 using namespace coredem::protocol;
 

@@ -45,8 +45,9 @@ __global__ void thermochemKernelsCompileCheck(const double* in, double* out, int
   acc += k::ocReduction(k::OcReductionParams{}, t, 1e-6, x, 1.0, 1.0).heat;
   // The engine's hoisted kernels with combined ΔH_r polynomials (built on the device here only
   // to compile combineReactionEnthalpy for it; the engine builds them on the host).
-  const k::ReactionEnthalpyPoly dh[2] = {k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R4)),
-                                         k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R5))};
+  const k::ReactionEnthalpyPoly dh[2] = {
+      k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R4)),
+      k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R5))};
   acc += k::reactionEnthalpy(dh[0], t);
   acc += k::charGasificationHoisted(k::CharGasificationParams{}, dh, t, pBar, 1e-9, 2e-9).heat;
   acc += k::ocReductionHoisted(k::OcReductionParams{}, dh, t, 1e-6, x, 1.0, 1.0).heat;

@@ -187,18 +187,20 @@ TEST(ReactionEnthalpy, ReactionsBalanceMassToRoundOff) {
 TEST(ReactionEnthalpy, CombinedPolynomialEqualsSpeciesSum) {
   std::vector<std::pair<const char*, k::Stoichiometry>> reactions;
   const char* names[] = {"R1", "R2", "R3", "R4", "R5"};
-  for (int i = 0; i < 5; ++i) reactions.emplace_back(names[i], k::clgStoichiometry(static_cast<k::ClgReaction>(i)));
+  for (int i = 0; i < 5; ++i)
+    reactions.emplace_back(names[i], k::clgStoichiometry(static_cast<k::ClgReaction>(i)));
   // Generic (not a real reaction; the identity holds for any ν): six species, four breaks.
   reactions.emplace_back("generic", k::Stoichiometry{6,
-                                                     {Species::Fe3O4, Species::Al2O3, Species::H2, Species::Fe2O3,
-                                                      Species::N2, Species::C},
+                                                     {Species::Fe3O4, Species::Al2O3, Species::H2,
+                                                      Species::Fe2O3, Species::N2, Species::C},
                                                      {-1.0, 0.5, 2.0, 1.5, -0.25, -3.0}});
   for (const auto& [name, st] : reactions) {
     SCOPED_TRACE(name);
     const k::ReactionEnthalpyPoly h = k::combineReactionEnthalpy(st);
     ASSERT_GT(h.n, 0);
     std::vector<double> temps;
-    for (double t = 250.0; t <= 3000.0; t += 1.0) temps.push_back(t);
+    for (double t = 250.0; t <= 3000.0; t += 1.0)
+      temps.push_back(t);
     // Every break of every species, from both sides.
     int breaks = 0;
     for (int s = 0; s < st.n; ++s) {
@@ -206,7 +208,8 @@ TEST(ReactionEnthalpy, CombinedPolynomialEqualsSpeciesSum) {
       for (int i = 0; i + 1 < d.n; ++i) {
         const double b = d.iv[i].tMax;
         ++breaks;
-        for (double t : {std::nextafter(b, 0.0), b, std::nextafter(b, 1e9), b - 1e-6, b + 1e-6}) temps.push_back(t);
+        for (double t : {std::nextafter(b, 0.0), b, std::nextafter(b, 1e9), b - 1e-6, b + 1e-6})
+          temps.push_back(t);
       }
     }
     EXPECT_GE(h.n, 2);
@@ -217,7 +220,8 @@ TEST(ReactionEnthalpy, CombinedPolynomialEqualsSpeciesSum) {
       const double ref = k::reactionEnthalpy(st, t);
       const double got = k::reactionEnthalpy(h, t);
       double scale = 0.0;
-      for (int s = 0; s < st.n; ++s) scale += std::fabs(st.nu[s] * k::nasa7EnthalpyMolar(st.species[s], t));
+      for (int s = 0; s < st.n; ++s)
+        scale += std::fabs(st.nu[s] * k::nasa7EnthalpyMolar(st.species[s], t));
       ASSERT_NEAR(got, ref, 1e-12 * scale) << "T = " << t;
       if (std::fabs(ref) >= 1e-3 * scale) {
         ++relChecked;
@@ -225,7 +229,7 @@ TEST(ReactionEnthalpy, CombinedPolynomialEqualsSpeciesSum) {
         ASSERT_NEAR(got, ref, 1e-12 * std::fabs(ref)) << "T = " << t;
       }
     }
-    EXPECT_GT(relChecked, temps.size() * 3 / 4);  // the relative bound covers most of the range
+    EXPECT_GT(relChecked, temps.size() * 3 / 4); // the relative bound covers most of the range
     RecordProperty(std::string("worst_rel_") + name, std::to_string(worst));
   }
   // The generic reaction's pieces split at 850, 960, 1000 and 1200 K.

@@ -227,26 +227,31 @@ TEST(OcReduction, ConservationAlongAReductionPath) {
 // one exp instead of exp·pow, combined ΔH_r polynomials) give the reference kernels' rates and
 // heat to 1e-12 relative (round-off of the reordered arithmetic: exp of an argument |x| ≲ 30
 // carries ~|x|·1e-16), over 600–1600 K and several compositions, including absent gases. The
-// heat is a cancelling sum (ΔH_R5 changes sign near 900 K): its bound is 1e-12 Σ_j ṅ_j Σ_n |ν_n H_n|.
+// heat is a cancelling sum (ΔH_R5 changes sign near 900 K): its bound is 1e-12 Σ_j ṅ_j Σ_n |ν_n
+// H_n|.
 namespace {
 double enthalpyScale(k::ClgReaction r, double t) {
   const k::Stoichiometry st = k::clgStoichiometry(r);
   double s = 0.0;
-  for (int n = 0; n < st.n; ++n) s += std::fabs(st.nu[n] * k::nasa7EnthalpyMolar(st.species[n], t));
+  for (int n = 0; n < st.n; ++n)
+    s += std::fabs(st.nu[n] * k::nasa7EnthalpyMolar(st.species[n], t));
   return s;
 }
 } // namespace
 TEST(HoistedKernels, CharAndOcEqualTheReferenceKernels) {
   const k::CharGasificationParams cp;
   const k::OcReductionParams op;
-  const k::ReactionEnthalpyPoly charDh[2] = {k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R1)),
-                                              k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R2))};
-  const k::ReactionEnthalpyPoly ocDh[2] = {k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R4)),
-                                            k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R5))};
+  const k::ReactionEnthalpyPoly charDh[2] = {
+      k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R1)),
+      k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R2))};
+  const k::ReactionEnthalpyPoly ocDh[2] = {
+      k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R4)),
+      k::combineReactionEnthalpy(k::clgStoichiometry(k::ClgReaction::R5))};
   auto near = [](double got, double ref, const char* what, double t) {
     EXPECT_NEAR(got, ref, 1e-12 * std::fabs(ref)) << what << " T = " << t;
   };
-  const double pBars[3][5] = {{0.05, 0.2, 0.05, 0.5, 0.2}, {0.1, 0.0, 0.1, 0.3, 0.5}, {0.2, 0.3, 0.0, 0.0, 0.5}};
+  const double pBars[3][5] = {
+      {0.05, 0.2, 0.05, 0.5, 0.2}, {0.1, 0.0, 0.1, 0.3, 0.5}, {0.2, 0.3, 0.0, 0.0, 0.5}};
   const double mC0 = 1540.0 * v::sphereVolume(0.48e-3);
   const double m = 3734.0 * v::sphereVolume(0.48e-3);
   const double x[3] = {0.3, 0.2, 0.5};
@@ -259,9 +264,11 @@ TEST(HoistedKernels, CharAndOcEqualTheReferenceKernels) {
       near(got.nR1, ref.nR1, "nR1", t);
       near(got.nR2, ref.nR2, "nR2", t);
       near(got.mdotC, ref.mdotC, "mdotC", t);
-      for (int g = 0; g < k::kGasSpeciesCount; ++g) near(got.mdotGas[g], ref.mdotGas[g], "mdotGas", t);
+      for (int g = 0; g < k::kGasSpeciesCount; ++g)
+        near(got.mdotGas[g], ref.mdotGas[g], "mdotGas", t);
       EXPECT_NEAR(got.heat, ref.heat,
-                  1e-12 * (enthalpyScale(k::ClgReaction::R1, t) * ref.nR1 + enthalpyScale(k::ClgReaction::R2, t) * ref.nR2))
+                  1e-12 * (enthalpyScale(k::ClgReaction::R1, t) * ref.nR1 +
+                           enthalpyScale(k::ClgReaction::R2, t) * ref.nR2))
           << t;
       EXPECT_EQ(k::charGasificationHoisted(cp, nullptr, t, pb, 0.3 * mC0, mC0).heat, 0.0);
       nonzero += ref.nR1 > 0.0 && ref.nR2 > 0.0 ? 1 : 0;
@@ -272,10 +279,13 @@ TEST(HoistedKernels, CharAndOcEqualTheReferenceKernels) {
       near(got.nR4, ref.nR4, "nR4", t);
       near(got.nR5, ref.nR5, "nR5", t);
       EXPECT_EQ(got.conversion, ref.conversion);
-      for (int s = 0; s < 3; ++s) near(got.mdotSolid[s], ref.mdotSolid[s], "mdotSolid", t);
-      for (int g = 0; g < k::kGasSpeciesCount; ++g) near(got.mdotGas[g], ref.mdotGas[g], "mdotGas", t);
+      for (int s = 0; s < 3; ++s)
+        near(got.mdotSolid[s], ref.mdotSolid[s], "mdotSolid", t);
+      for (int g = 0; g < k::kGasSpeciesCount; ++g)
+        near(got.mdotGas[g], ref.mdotGas[g], "mdotGas", t);
       EXPECT_NEAR(got.heat, ref.heat,
-                  1e-12 * (enthalpyScale(k::ClgReaction::R4, t) * ref.nR4 + enthalpyScale(k::ClgReaction::R5, t) * ref.nR5))
+                  1e-12 * (enthalpyScale(k::ClgReaction::R4, t) * ref.nR4 +
+                           enthalpyScale(k::ClgReaction::R5, t) * ref.nR5))
           << t;
     }
   }

@@ -14,17 +14,19 @@ namespace k = coredem::dem::kernels;
 
 namespace {
 constexpr double kPi = 3.141592653589793;
-constexpr double kR = 5.0e-4;  // 1 mm particle
+constexpr double kR = 5.0e-4; // 1 mm particle
 
 // Independent reference: I = ∫_{R_in}^{R_out} 2π r dr / max(h − √(R² − r²), s_min), gap from
 // the direct formula in long double, the clipped disc exact (root by bisection), the rest by
 // 10-point Gauss–Legendre on panels graded geometrically towards the inner end (ratio 1.02).
 long double fineWallLens(long double r, long double h, long double flpc, long double sMin) {
   const long double rl = (1 + flpc) * r;
-  if (h >= rl) return 0;
+  if (h >= rl)
+    return 0;
   const long double rIn = h < r ? std::sqrt(r * r - h * h) : 0.0L;
   const long double rOut = std::min(r, std::sqrt(rl * rl - h * h));
-  if (rOut <= rIn) return 0;
+  if (rOut <= rIn)
+    return 0;
   auto gap = [&](long double s) { return h - std::sqrt(r * r - s * s); };
   long double lo = rIn;
   long double value = 0;
@@ -41,7 +43,8 @@ long double fineWallLens(long double r, long double h, long double flpc, long do
     value += kPi * (a * a - rIn * rIn) / sMin;
     lo = a;
   }
-  if (rOut <= lo) return value;
+  if (rOut <= lo)
+    return value;
   static const long double x[5] = {0.1488743389816312108848260L, 0.4333953941292471907992659L,
                                    0.6794095682990244062343274L, 0.8650633666889845107320967L,
                                    0.9739065285171717200779640L};
@@ -83,7 +86,7 @@ k::WallConductionParams params(double flpc = 0.2, double sMin = 1e-6) {
   p.minSeparation = sMin;
   return p;
 }
-}  // namespace
+} // namespace
 
 TEST(WallConduction, ContactRadiusAndConductance) {
   const double delta = 1.0e-5, h = kR - delta;
@@ -94,7 +97,7 @@ TEST(WallConduction, ContactRadiusAndConductance) {
   // 4 kp kw/(kp + kw) r_c, glass (1 W/m/K) on steel (16 W/m/K).
   const double g = k::wallContactConductance(1.0, 16.0, kR, h);
   EXPECT_NEAR(g, 4.0 * 16.0 / 17.0 * rc, 2e-15 * g);
-  EXPECT_EQ(k::wallContactConductance(1.0, 16.0, kR, kR), 0.0);       // touching: r_c = 0
+  EXPECT_EQ(k::wallContactConductance(1.0, 16.0, kR, kR), 0.0);        // touching: r_c = 0
   EXPECT_EQ(k::wallContactConductance(1.0, 16.0, kR, kR + 1e-9), 0.0); // apart
   EXPECT_EQ(k::wallContactConductance(0.0, 0.0, kR, h), 0.0);          // no conductivity
 }
@@ -116,16 +119,15 @@ TEST(WallConduction, LensClosedFormMatchesQuadrature) {
     double h, flpc, sMin;
   };
   const Case cases[] = {
-      {kR - 1e-5, 0.2, 1e-6},   // in contact (R_in = r_c)
-      {kR - 1e-7, 0.2, 1e-6},   // slight contact
-      {kR, 0.2, 1e-6},          // touching
-      {kR + 5e-7, 0.2, 1e-6},   // gap below s_min: clipped disc + annulus
-      {kR + 1e-5, 0.2, 1e-6},   // gap 10 µm: no clipping
-      {kR + 5e-5, 0.2, 1e-6},
-      {1.15 * kR, 0.2, 1e-6},   // lens barely reaches the wall
-      {kR + 2e-6, 0.5, 4e-10},  // wide lens (R_out = R), MFiX's commented s_min
-      {kR - 2e-5, 0.2, 1e-4},   // large s_min: mostly clipped
-      {5e-7, 0.2, 1e-6},        // centre within s_min of the wall: all clipped
+      {kR - 1e-5, 0.2, 1e-6},                          // in contact (R_in = r_c)
+      {kR - 1e-7, 0.2, 1e-6},                          // slight contact
+      {kR, 0.2, 1e-6},                                 // touching
+      {kR + 5e-7, 0.2, 1e-6},                          // gap below s_min: clipped disc + annulus
+      {kR + 1e-5, 0.2, 1e-6},                          // gap 10 µm: no clipping
+      {kR + 5e-5, 0.2, 1e-6},  {1.15 * kR, 0.2, 1e-6}, // lens barely reaches the wall
+      {kR + 2e-6, 0.5, 4e-10}, // wide lens (R_out = R), MFiX's commented s_min
+      {kR - 2e-5, 0.2, 1e-4},  // large s_min: mostly clipped
+      {5e-7, 0.2, 1e-6},       // centre within s_min of the wall: all clipped
   };
   for (const Case& c : cases) {
     const double got = k::wallLensIntegral(params(c.flpc, c.sMin), kR, c.h);
@@ -134,7 +136,7 @@ TEST(WallConduction, LensClosedFormMatchesQuadrature) {
     // 1e-9: the reference quadrature's accuracy (panels graded towards the inner end).
     EXPECT_NEAR(got, want, 1e-9 * want) << "h = " << c.h << " flpc = " << c.flpc;
   }
-  EXPECT_EQ(k::wallLensIntegral(params(), kR, 1.2 * kR), 0.0);  // lens ends at the wall
+  EXPECT_EQ(k::wallLensIntegral(params(), kR, 1.2 * kR), 0.0); // lens ends at the wall
   EXPECT_EQ(k::wallLensIntegral(params(), kR, 2.0 * kR), 0.0);
 }
 
@@ -165,7 +167,7 @@ TEST(WallConduction, LensIsTheLargeSphereLimit) {
     const double pair = k::gasLensIntegral(lp, kR, big, big + h).value;
     const double wall = k::wallLensIntegral(params(0.5, 1e-6), kR, h);
     EXPECT_NEAR(pair, wall, 1e-4 * wall) << "h = " << h;
-    EXPECT_LT(pair, wall);  // the curved partner is farther away everywhere
+    EXPECT_LT(pair, wall); // the curved partner is farther away everywhere
   }
 }
 
@@ -181,7 +183,7 @@ TEST(WallConduction, HeatSignAndSwitches) {
               1e-12 * (gC + gL) * 70.0);
   p.lens = false;
   EXPECT_EQ(k::wallConductance(p, 1.0, 1.0, 0.0257, kR, h), gC);
-  EXPECT_EQ(k::wallConductance(params(), 1.0, 1.0, 0.0, kR, h), gC);  // no gas: contact only
+  EXPECT_EQ(k::wallConductance(params(), 1.0, 1.0, 0.0, kR, h), gC); // no gas: contact only
   p.contact = false;
   EXPECT_EQ(k::wallConductance(p, 1.0, 1.0, 0.0257, kR, h), 0.0);
 }

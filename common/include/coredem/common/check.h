@@ -7,10 +7,10 @@
 /// what to do. COREDEM_ASSERT(cond) guards internal invariants; it is compiled out in
 /// release builds unless COREDEM_ENABLE_ASSERTS is defined.
 
-#include <spdlog/fmt/fmt.h>
-
 #include <stdexcept>
 #include <string>
+
+#include <spdlog/fmt/fmt.h>
 
 namespace coredem {
 
@@ -28,24 +28,23 @@ public:
 
 } // namespace coredem
 
-#define COREDEM_CHECK(cond, ...)                                                              \
-  do {                                                                                        \
-    if (!(cond)) {                                                                            \
-      throw ::coredem::UserError(fmt::format(__VA_ARGS__));                                   \
-    }                                                                                         \
+#define COREDEM_CHECK(cond, ...)                                                                   \
+  do {                                                                                             \
+    if (!(cond)) {                                                                                 \
+      throw ::coredem::UserError(fmt::format(__VA_ARGS__));                                        \
+    }                                                                                              \
   } while (false)
 
 #if !defined(NDEBUG) || defined(COREDEM_ENABLE_ASSERTS)
-#define COREDEM_ASSERT(cond)                                                                  \
-  do {                                                                                        \
-    if (!(cond)) {                                                                            \
-      throw ::coredem::InternalError(                                                         \
-          fmt::format("internal error: assertion '{}' failed at {}:{}", #cond, __FILE__,     \
-                      __LINE__));                                                             \
-    }                                                                                         \
+#define COREDEM_ASSERT(cond)                                                                       \
+  do {                                                                                             \
+    if (!(cond)) {                                                                                 \
+      throw ::coredem::InternalError(fmt::format("internal error: assertion '{}' failed at {}:{}", \
+                                                 #cond, __FILE__, __LINE__));                      \
+    }                                                                                              \
   } while (false)
 #else
-#define COREDEM_ASSERT(cond)                                                                  \
-  do {                                                                                        \
+#define COREDEM_ASSERT(cond)                                                                       \
+  do {                                                                                             \
   } while (false)
 #endif

@@ -62,17 +62,29 @@ private:
 template <class T>
 hid_t nativeType();
 template <>
-inline hid_t nativeType<double>() { return H5T_NATIVE_DOUBLE; }
+inline hid_t nativeType<double>() {
+  return H5T_NATIVE_DOUBLE;
+}
 template <>
-inline hid_t nativeType<float>() { return H5T_NATIVE_FLOAT; }
+inline hid_t nativeType<float>() {
+  return H5T_NATIVE_FLOAT;
+}
 template <>
-inline hid_t nativeType<std::int32_t>() { return H5T_NATIVE_INT32; }
+inline hid_t nativeType<std::int32_t>() {
+  return H5T_NATIVE_INT32;
+}
 template <>
-inline hid_t nativeType<std::int64_t>() { return H5T_NATIVE_INT64; }
+inline hid_t nativeType<std::int64_t>() {
+  return H5T_NATIVE_INT64;
+}
 template <>
-inline hid_t nativeType<std::uint64_t>() { return H5T_NATIVE_UINT64; }
+inline hid_t nativeType<std::uint64_t>() {
+  return H5T_NATIVE_UINT64;
+}
 template <>
-inline hid_t nativeType<std::uint8_t>() { return H5T_NATIVE_UINT8; }
+inline hid_t nativeType<std::uint8_t>() {
+  return H5T_NATIVE_UINT8;
+}
 
 /// Creates (truncates) a file. Throws UserError naming the path.
 Handle createFile(const std::filesystem::path& path);
@@ -123,9 +135,9 @@ void writeDataset(hid_t loc, const std::string& name, const std::vector<T>& v,
   COREDEM_CHECK(total == v.size(), "HDF5 dataset '{}': {} values for a shape of {} (internal)",
                 name, v.size(), total);
   Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose);
-  Handle ds(H5Dcreate2(loc, name.c_str(), nativeType<T>(), space, H5P_DEFAULT, H5P_DEFAULT,
-                       H5P_DEFAULT),
-            H5Dclose);
+  Handle ds(
+      H5Dcreate2(loc, name.c_str(), nativeType<T>(), space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+      H5Dclose);
   COREDEM_CHECK(ds.valid(), "cannot create HDF5 dataset '{}'", name);
   if (total > 0) {
     COREDEM_CHECK(H5Dwrite(ds, nativeType<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, v.data()) >= 0,

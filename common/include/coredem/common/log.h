@@ -4,10 +4,10 @@
 /// Loggers print "[time] [name] [level] message" to stderr; the level comes from the
 /// COREDEM_LOG_LEVEL environment variable (trace|debug|info|warn|error|off, default info).
 
-#include <spdlog/spdlog.h>
-
 #include <memory>
 #include <string>
+
+#include <spdlog/spdlog.h>
 
 namespace coredem {
 

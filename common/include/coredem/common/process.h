@@ -17,7 +17,7 @@ namespace coredem {
 /// How spawnProcess() starts a program.
 struct SpawnOptions {
   std::map<std::string, std::string> env; ///< set (or override) these environment variables
-  bool ownProcessGroup = true; ///< own process group: a terminal Ctrl-C reaches only the parent
+  bool ownProcessGroup = true;  ///< own process group: a terminal Ctrl-C reaches only the parent
   bool stdinFromDevNull = true; ///< stdin from /dev/null (else inherited)
 };
 
@@ -29,7 +29,6 @@ int spawnProcess(const std::string& what, const std::vector<std::string>& argv,
 
 /// "exited with code 1", "killed by signal 9 (SIGKILL)" for a waitpid() status.
 std::string describeWaitStatus(int status);
-
 
 class ChildProcess {
 public:

@@ -4,10 +4,10 @@
 /// both compute the same sub-cycling plan: n_sub = ceil(Δt_CFD/Δt_DEM,max) with a ratio
 /// within 1e-12 of an integer counted as that integer, and tolerant time comparisons.
 
-#include "coredem/common/check.h"
-
 #include <algorithm>
 #include <cmath>
+
+#include "coredem/common/check.h"
 
 namespace coredem {
 

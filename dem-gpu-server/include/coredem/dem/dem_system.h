@@ -14,10 +14,6 @@
 /// Units are SI everywhere. Coupling cells are numbered cell = i + nx*(j + ny*k).
 /// All methods throw coredem::UserError on bad input, with a message that says what to fix.
 
-#include "coredem/dem/chemistry_options.h"
-#include "coredem/dem/heat_options.h"
-#include "coredem/dem/kernels/drag.h"
-
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -25,6 +21,10 @@
 #include <span>
 #include <string>
 #include <vector>
+
+#include "coredem/dem/chemistry_options.h"
+#include "coredem/dem/heat_options.h"
+#include "coredem/dem/kernels/drag.h"
 
 namespace coredem::dem {
 
@@ -46,48 +46,51 @@ int cudaDeviceCount();
 /// m_eff = m_i (the wall is rigid, immobile, and has the particle's properties).
 struct Material {
   std::string name = "default";
-  double kn = 1000.0;              ///< normal spring stiffness k_n (N/m)
-  double en = 0.97;                ///< normal restitution coefficient e_n (-), 0 < e_n <= 1
-  double mu = 0.1;                 ///< Coulomb friction coefficient μ (-)
-  double ktFactor = 2.0 / 7.0;     ///< k_t = ktFactor·k_n (MFiX KT_FAC)
-  double etatFactor = 0.5;         ///< η_t = etatFactor·η_n (MFiX DES_ETAT_FAC)
-  double cp = 840.0;               ///< specific heat c_p (J/kg/K), > 0 (Eq. 18)
-  double conductivity = 1.0;       ///< k_p (W/m/K), ≥ 0 (contact conduction, Eq. 22)
-  double emissivity = 0.0;         ///< e_p (-), in [0, 1]; 0: the particle does not radiate (Eq. 27)
+  double kn = 1000.0;          ///< normal spring stiffness k_n (N/m)
+  double en = 0.97;            ///< normal restitution coefficient e_n (-), 0 < e_n <= 1
+  double mu = 0.1;             ///< Coulomb friction coefficient μ (-)
+  double ktFactor = 2.0 / 7.0; ///< k_t = ktFactor·k_n (MFiX KT_FAC)
+  double etatFactor = 0.5;     ///< η_t = etatFactor·η_n (MFiX DES_ETAT_FAC)
+  double cp = 840.0;           ///< specific heat c_p (J/kg/K), > 0 (Eq. 18)
+  double conductivity = 1.0;   ///< k_p (W/m/K), ≥ 0 (contact conduction, Eq. 22)
+  double emissivity = 0.0;     ///< e_p (-), in [0, 1]; 0: the particle does not radiate (Eq. 27)
 };
 
 /// How a ParticleSet places its particles.
 enum class Packing {
-  Lattice,  ///< simple cubic, spacing `spacing` (0: the diameter), sites from regionMin + s/2, x fastest
-  Random,   ///< non-overlapping uniform random positions in the region, from `seed`
-  Explicit  ///< the `positions` (and optional `velocities`) given below, one entry per particle
+  Lattice, ///< simple cubic, spacing `spacing` (0: the diameter), sites from regionMin + s/2, x
+           ///< fastest
+  Random,  ///< non-overlapping uniform random positions in the region, from `seed`
+  Explicit ///< the `positions` (and optional `velocities`) given below, one entry per particle
 };
 
 /// A group of identical particles placed in an axis-aligned box region.
 struct ParticleSet {
   std::string name = "particles";
-  int material = 0;                            ///< index into DemConfig::materials
+  int material = 0; ///< index into DemConfig::materials
   Packing packing = Packing::Lattice;
-  std::array<double, 3> regionMin{0, 0, 0};    ///< region (m): Random keeps spheres inside, Lattice its site centres
+  std::array<double, 3> regionMin{
+      0, 0, 0}; ///< region (m): Random keeps spheres inside, Lattice its site centres
   std::array<double, 3> regionMax{0, 0, 0};
-  std::size_t count = 0;                       ///< number of particles (Explicit: positions.size()/3)
-  double diameter = 1e-3;                      ///< d_p (m)
-  double density = 2500.0;                     ///< ρ_p (kg/m³)
-  double temperature = 293.15;                 ///< T_p (K)
-  std::vector<double> composition;             ///< solid species mass fractions (sum 1), size = solidSpecies; empty: all in the first
-  double spacing = 0.0;                        ///< Lattice spacing (m); 0 = diameter
-  std::array<double, 3> velocity{0, 0, 0};     ///< initial velocity (m/s), added to the jitter
-  double velocityJitter = 0.0;                 ///< each component + uniform[-a, a] (m/s)
-  std::uint64_t seed = 12345;                  ///< for Random packing and the jitter
-  std::vector<double> positions;               ///< Explicit: x0,y0,z0,x1,... (m)
-  std::vector<double> velocities;              ///< Explicit (optional): same layout (m/s)
-  std::vector<double> angularVelocities;       ///< Explicit (optional): same layout (rad/s)
+  std::size_t count = 0;           ///< number of particles (Explicit: positions.size()/3)
+  double diameter = 1e-3;          ///< d_p (m)
+  double density = 2500.0;         ///< ρ_p (kg/m³)
+  double temperature = 293.15;     ///< T_p (K)
+  std::vector<double> composition; ///< solid species mass fractions (sum 1), size = solidSpecies;
+                                   ///< empty: all in the first
+  double spacing = 0.0;            ///< Lattice spacing (m); 0 = diameter
+  std::array<double, 3> velocity{0, 0, 0}; ///< initial velocity (m/s), added to the jitter
+  double velocityJitter = 0.0;             ///< each component + uniform[-a, a] (m/s)
+  std::uint64_t seed = 12345;              ///< for Random packing and the jitter
+  std::vector<double> positions;           ///< Explicit: x0,y0,z0,x1,... (m)
+  std::vector<double> velocities;          ///< Explicit (optional): same layout (m/s)
+  std::vector<double> angularVelocities;   ///< Explicit (optional): same layout (rad/s)
 };
 
 /// An infinite rigid plane wall; particles live on the side its normal points to.
 struct Wall {
   std::array<double, 3> point{0, 0, 0};
-  std::array<double, 3> normal{0, 0, 1};  ///< need not be unit length (normalised)
+  std::array<double, 3> normal{0, 0, 1}; ///< need not be unit length (normalised)
 };
 
 /// Uniform Cartesian coupling grid (PCM cells): cell = i + nx*(j + ny*k). counts = 0: no coupling.
@@ -112,9 +115,11 @@ inline constexpr int kMaxHistorySlots = 32;
 /// Tuning of neighbour search and contact storage (defaults from bench measurements,
 /// docs/performance.md "## DEM core").
 struct NeighbourOptions {
-  double skinFactor = 0.1;       ///< Verlet skin = skinFactor · d_max; lists rebuilt when a particle moved > skin/2
-  int historySlots = 12;         ///< tangential-history slots per particle (contacts incl. walls), 1..kMaxHistorySlots
-  int initialNeighbourSlots = 16;///< neighbour-list width per particle (grows automatically)
+  double skinFactor =
+      0.1; ///< Verlet skin = skinFactor · d_max; lists rebuilt when a particle moved > skin/2
+  int historySlots =
+      12; ///< tangential-history slots per particle (contacts incl. walls), 1..kMaxHistorySlots
+  int initialNeighbourSlots = 16; ///< neighbour-list width per particle (grows automatically)
 };
 
 /// Everything needed to build a DemSystem. Plain data; validated by the constructor. The
@@ -123,25 +128,25 @@ struct DemConfig {
   std::vector<Material> materials{Material{}};
   std::vector<ParticleSet> particleSets;
   std::vector<Wall> walls;
-  std::array<double, 3> gravity{0.0, 0.0, -9.81};   ///< m/s²
+  std::array<double, 3> gravity{0.0, 0.0, -9.81}; ///< m/s²
   CouplingGrid grid;
-  std::vector<Species> solidSpecies;   ///< per-particle composition entries
-  std::vector<Species> gasSpecies;     ///< Y_g and R_species entries
+  std::vector<Species> solidSpecies; ///< per-particle composition entries
+  std::vector<Species> gasSpecies;   ///< Y_g and R_species entries
   NeighbourOptions neighbour;
-  kernels::DragLaw drag = kernels::DragLaw::Gidaspow;  ///< `models: {drag: ...}` (kernels/drag.h)
-  double epsMinDrag = 0.35;            ///< ε_min clip in drag (PHYSICS §1.1 [C])
-  double dtFactor = 50.0;              ///< Δt_DEM,max = t_col,min / dtFactor (PHYSICS Eq. 12)
-  HeatOptions heat;                    ///< particle heat transfer (docs/heat-coupling.md)
+  kernels::DragLaw drag = kernels::DragLaw::Gidaspow; ///< `models: {drag: ...}` (kernels/drag.h)
+  double epsMinDrag = 0.35;                           ///< ε_min clip in drag (PHYSICS §1.1 [C])
+  double dtFactor = 50.0; ///< Δt_DEM,max = t_col,min / dtFactor (PHYSICS Eq. 12)
+  HeatOptions heat;       ///< particle heat transfer (docs/heat-coupling.md)
   /// Hold every particle in place (`models: {motion: frozen}`, as MFiX's verification cases do):
   /// forces, torques and gravity do not move it, positions stay fixed, velocities are zeroed
   /// every sub-step. Contacts and heat transfer are evaluated as usual; the collision time then
   /// does not limit Δt_DEM (dtDemMax() returns the largest finite double).
   bool frozenMotion = false;
-  ChemistryOptions chemistry;          ///< reactions, CLG models, removal (docs/thermochemistry.md)
+  ChemistryOptions chemistry; ///< reactions, CLG models, removal (docs/thermochemistry.md)
   /// Wall thermal condition (docs/heat-coupling.md "Walls"): > 0 holds every wall at this
   /// temperature (K) with particle–wall conduction (kernels/wall_conduction.h); 0 = adiabatic.
   double wallTemperature = 0.0;
-  int wallMaterial = 0;                ///< material of the walls (its conductivity is k_w)
+  int wallMaterial = 0; ///< material of the walls (its conductivity is k_w)
 
   /// Adds the six planes of the axis-aligned box [lo, hi] (normals pointing inwards).
   void addBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi);
@@ -150,14 +155,14 @@ struct DemConfig {
 /// Read-only view of the per-cell gas fields of one CFD step (N = grid cell count,
 /// ns = gasSpecies.size()). Spans must outlive the setGasFields call only (they are copied).
 struct GasFieldsView {
-  std::span<const double> ug;       ///< u_g, N*3 (m/s), interleaved x,y,z per cell
-  std::span<const double> gradP;    ///< ∇p, N*3 (Pa/m)
-  std::span<const double> Tg;       ///< T_g, N (K)
-  std::span<const double> rhoG;     ///< ρ_g, N (kg/m³)
-  std::span<const double> muG;      ///< μ_g, N (Pa s)
-  std::span<const double> kappaG;   ///< κ_g, N (W/m/K)
-  std::span<const double> cpG;      ///< c_p,g, N (J/kg/K)
-  std::span<const double> Yg;       ///< Y_g, N*ns (-), species fastest
+  std::span<const double> ug;     ///< u_g, N*3 (m/s), interleaved x,y,z per cell
+  std::span<const double> gradP;  ///< ∇p, N*3 (Pa/m)
+  std::span<const double> Tg;     ///< T_g, N (K)
+  std::span<const double> rhoG;   ///< ρ_g, N (kg/m³)
+  std::span<const double> muG;    ///< μ_g, N (Pa s)
+  std::span<const double> kappaG; ///< κ_g, N (W/m/K)
+  std::span<const double> cpG;    ///< c_p,g, N (J/kg/K)
+  std::span<const double> Yg;     ///< Y_g, N*ns (-), species fastest
 };
 
 /// Per-cell sources for the CFD, averaged over the sub-steps of one advance() (PHYSICS §1.1).
@@ -165,13 +170,13 @@ struct GasFieldsView {
 /// (docs/heat-coupling.md). Species: R_species = (1/V_c) Σ ṁ_gas,i (heterogeneous, averaged over
 /// the sub-steps) + WGS per cell; Q_hom: WGS heat into the gas (docs/thermochemistry.md).
 struct CellSources {
-  std::vector<double> epsG;      ///< ε_g (-), N
-  std::vector<double> kSl;       ///< K_sl = (1/V_c) Σ β V_p/(1-ε) (kg/m³/s), N
-  std::vector<double> kSlUs;     ///< K_sl·U_s = (1/V_c) Σ β V_p/(1-ε) v_p (kg/m²/s²), N*3
-  std::vector<double> heatH;     ///< H, implicit gas→particle heat coefficient (W/m³/K), N
-  std::vector<double> heatHTp;   ///< H·T̄_p (W/m³), N
-  std::vector<double> rSpecies;  ///< R_species (kg/m³/s), N*ns
-  std::vector<double> qHom;      ///< homogeneous reaction heat (W/m³), N
+  std::vector<double> epsG;     ///< ε_g (-), N
+  std::vector<double> kSl;      ///< K_sl = (1/V_c) Σ β V_p/(1-ε) (kg/m³/s), N
+  std::vector<double> kSlUs;    ///< K_sl·U_s = (1/V_c) Σ β V_p/(1-ε) v_p (kg/m²/s²), N*3
+  std::vector<double> heatH;    ///< H, implicit gas→particle heat coefficient (W/m³/K), N
+  std::vector<double> heatHTp;  ///< H·T̄_p (W/m³), N
+  std::vector<double> rSpecies; ///< R_species (kg/m³/s), N*ns
+  std::vector<double> qHom;     ///< homogeneous reaction heat (W/m³), N
 };
 
 /// Host copy of the particle state (for tests, snapshots and the server), in the system's
@@ -179,23 +184,24 @@ struct CellSources {
 struct ParticleData {
   std::size_t count = 0;
   int nSpecies = 0;
-  std::vector<double> position, velocity, angularVelocity, force;  ///< N*3 (force: last sub-step, contacts+walls+gas, no gravity)
-  std::vector<double> radius, mass, density, temperature;          ///< N
-  std::vector<double> species;                                     ///< N*nSpecies
-  std::vector<std::int32_t> material;                              ///< N
-  std::vector<std::int64_t> globalId;                              ///< N
-  std::vector<double> initialDiameter;                             ///< N, d_p0 (m): removal reference
+  std::vector<double> position, velocity, angularVelocity,
+      force; ///< N*3 (force: last sub-step, contacts+walls+gas, no gravity)
+  std::vector<double> radius, mass, density, temperature; ///< N
+  std::vector<double> species;                            ///< N*nSpecies
+  std::vector<std::int32_t> material;                     ///< N
+  std::vector<std::int64_t> globalId;                     ///< N
+  std::vector<double> initialDiameter;                    ///< N, d_p0 (m): removal reference
 };
 
 /// Wall-clock seconds spent per stage since construction (or resetStageTimes()).
 struct StageTimes {
-  double neighbour = 0;  ///< cell keys, sort, reorder, neighbour lists
-  double contact = 0;    ///< particle–particle and wall contact forces
-  double drag = 0;       ///< gas forces: PCM cell, drag law, −V_p∇p (coupled runs only)
-  double integrate = 0;  ///< motion update and temperature updates
-  double coupling = 0;   ///< PCM ε_g and cell-source deposition
-  double heat = 0;       ///< heat sources (conduction, convection, radiation) and their deposition
-  double chemistry = 0;  ///< reaction rates, mass/diameter update, species deposition, WGS, removal
+  double neighbour = 0; ///< cell keys, sort, reorder, neighbour lists
+  double contact = 0;   ///< particle–particle and wall contact forces
+  double drag = 0;      ///< gas forces: PCM cell, drag law, −V_p∇p (coupled runs only)
+  double integrate = 0; ///< motion update and temperature updates
+  double coupling = 0;  ///< PCM ε_g and cell-source deposition
+  double heat = 0;      ///< heat sources (conduction, convection, radiation) and their deposition
+  double chemistry = 0; ///< reaction rates, mass/diameter update, species deposition, WGS, removal
   std::uint64_t rebuilds = 0;
 };
 
@@ -238,21 +244,24 @@ public:
   /// @pre written by a system with the same config hash (else UserError naming both).
   void readState(const std::string& path);
 
-  double time() const;                 ///< simulated time (s)
-  std::uint64_t step() const;          ///< DEM sub-steps taken
+  double time() const;        ///< simulated time (s)
+  std::uint64_t step() const; ///< DEM sub-steps taken
   std::size_t particleCount() const;
-  std::size_t cellCount() const;       ///< coupling cells (0 without a grid)
-  std::string backendName() const;     ///< "cpu" or "cuda"
-  std::string configHash() const;      ///< 16 hex digits over materials, walls, gravity, grid, species, options
+  std::size_t cellCount() const;   ///< coupling cells (0 without a grid)
+  std::string backendName() const; ///< "cpu" or "cuda"
+  std::string
+  configHash() const; ///< 16 hex digits over materials, walls, gravity, grid, species, options
   const DemConfig& config() const;
 
-  ParticleData particles() const;      ///< host copy of the state
+  ParticleData particles() const; ///< host copy of the state
   /// Overwrites velocities / angular velocities by global id order (size N*3 each; empty = keep).
   void setVelocities(std::span<const double> velocityByGid, std::span<const double> omegaByGid);
-  std::size_t contactCount() const;    ///< particle–particle contacts (pairs) + wall contacts, last sub-step
-  std::size_t pairContactCount() const;///< particle–particle contact pairs, last sub-step
-  std::array<double, 3> wallForce() const;  ///< Σ force exerted by all walls on particles, last sub-step (N)
-  std::size_t memoryBytes() const;     ///< bytes of particle, neighbour and contact storage
+  std::size_t
+  contactCount() const; ///< particle–particle contacts (pairs) + wall contacts, last sub-step
+  std::size_t pairContactCount() const; ///< particle–particle contact pairs, last sub-step
+  std::array<double, 3>
+  wallForce() const; ///< Σ force exerted by all walls on particles, last sub-step (N)
+  std::size_t memoryBytes() const; ///< bytes of particle, neighbour and contact storage
   StageTimes stageTimes() const;
   /// Heat the particles received from the gas and from radiation since construction (kept
   /// across writeState/readState), J.

@@ -4,11 +4,11 @@
 /// simulated time accumulated with Kahan (compensated) summation, so 10^6 tiny steps do
 /// not drift.
 
-#include "coredem/common/time.h"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+
+#include "coredem/common/time.h"
 
 namespace coredem::dem {
 
@@ -16,7 +16,8 @@ using coredem::timeEquals;
 
 class TimeHandler {
 public:
-  explicit TimeHandler(double t0 = 0.0) : _sum(t0) {}
+  explicit TimeHandler(double t0 = 0.0)
+      : _sum(t0) {}
 
   /// n_sub = ceil(Δt_CFD/Δt_DEM,max) (at least 1): the plan the orchestrator grants too.
   static int subStepsFor(double dtCfd, double dtDemMax) {

@@ -5,10 +5,6 @@
 /// thread runs which index. Dynamic scheduling in chunks of 512 lets a running thread take
 /// over the work of a descheduled one (shared/oversubscribed machines).
 
-#include "../exec_common.h"
-
-#include <omp.h>
-
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -18,12 +14,16 @@
 #include <utility>
 #include <vector>
 
+#include <omp.h>
+
+#include "../exec_common.h"
+
 namespace coredem::dem::backend {
 
 struct CpuExec {
   static constexpr bool separateDevice = false;
   static constexpr const char* name = "cpu";
-  int threads = 0;  ///< 0: OpenMP default
+  int threads = 0; ///< 0: OpenMP default
 
   int threadCount() const { return threads > 0 ? threads : omp_get_max_threads(); }
 
@@ -31,15 +31,19 @@ struct CpuExec {
   void parallelFor(std::size_t n, F f) const {
     const std::int64_t m = static_cast<std::int64_t>(n);
 #pragma omp parallel for schedule(dynamic, 512) num_threads(threadCount()) if (m > 256)
-    for (std::int64_t i = 0; i < m; ++i) f(static_cast<std::size_t>(i));
+    for (std::int64_t i = 0; i < m; ++i)
+      f(static_cast<std::size_t>(i));
   }
 
   template <class F>
   double reduceMax(std::size_t n, F f, double init) const {
     const std::int64_t m = static_cast<std::int64_t>(n);
     double r = init;
-#pragma omp parallel for schedule(dynamic, 512) num_threads(threadCount()) reduction(max : r) if (m > 256)
-    for (std::int64_t i = 0; i < m; ++i) r = std::max(r, f(static_cast<std::size_t>(i)));
+#pragma omp parallel for schedule(dynamic, 512) num_threads(threadCount())                         \
+    reduction(max                                                                                  \
+              : r) if (m > 256)
+    for (std::int64_t i = 0; i < m; ++i)
+      r = std::max(r, f(static_cast<std::size_t>(i)));
     return r;
   }
 
@@ -58,10 +62,12 @@ struct CpuExec {
   void sortByKey(const std::uint32_t* keys, std::size_t n, std::uint32_t numKeys,
                  std::uint32_t* perm) const {
     _hist.assign(static_cast<std::size_t>(numKeys) + 1, 0u);
-    for (std::size_t i = 0; i < n; ++i) ++_hist[keys[i]];
+    for (std::size_t i = 0; i < n; ++i)
+      ++_hist[keys[i]];
     _offsets.resize(_hist.size());
     exclusiveScan(_hist.data(), _offsets.data(), _hist.size());
-    for (std::size_t i = 0; i < n; ++i) perm[_offsets[keys[i]]++] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = 0; i < n; ++i)
+      perm[_offsets[keys[i]]++] = static_cast<std::uint32_t>(i);
   }
 
   /// Stable LSD radix sort (8-bit digits over the bits numKeys needs): the same permutation as
@@ -71,28 +77,52 @@ struct CpuExec {
   void sortByKeyRadix(const std::uint32_t* keys, std::size_t n, std::uint32_t numKeys,
                       std::uint32_t* perm) const {
     int bits = 1;
-    while (bits < 32 && (std::uint64_t{1} << bits) < numKeys) ++bits;
+    while (bits < 32 && (std::uint64_t{1} << bits) < numKeys)
+      ++bits;
     _radixTmp.resize(n);
     std::uint32_t* src = perm;
     std::uint32_t* dst = _radixTmp.data();
-    for (std::size_t i = 0; i < n; ++i) src[i] = static_cast<std::uint32_t>(i);
+    for (std::size_t i = 0; i < n; ++i)
+      src[i] = static_cast<std::uint32_t>(i);
     for (int shift = 0; shift < bits; shift += 8) {
       std::size_t count[257] = {};
-      for (std::size_t i = 0; i < n; ++i) ++count[((keys[src[i]] >> shift) & 255u) + 1];
-      for (int d = 0; d < 256; ++d) count[d + 1] += count[d];
-      for (std::size_t i = 0; i < n; ++i) dst[count[(keys[src[i]] >> shift) & 255u]++] = src[i];
+      for (std::size_t i = 0; i < n; ++i)
+        ++count[((keys[src[i]] >> shift) & 255u) + 1];
+      for (int d = 0; d < 256; ++d)
+        count[d + 1] += count[d];
+      for (std::size_t i = 0; i < n; ++i)
+        dst[count[(keys[src[i]] >> shift) & 255u]++] = src[i];
       std::swap(src, dst);
     }
-    if (src != perm && n) std::memcpy(perm, src, n * sizeof(std::uint32_t));
+    if (src != perm && n)
+      std::memcpy(perm, src, n * sizeof(std::uint32_t));
   }
 
-  static void* allocHost(std::size_t bytes) { return bytes ? ::operator new(bytes, std::align_val_t{64}) : nullptr; }
-  static void freeHost(void* p) { if (p) ::operator delete(p, std::align_val_t{64}); }
-  static void* allocDevice(std::size_t bytes) { return allocHost(bytes); }
-  static void freeDevice(void* p) { freeHost(p); }
-  static void copyToDevice(void* d, const void* h, std::size_t bytes) { if (d != h && bytes) std::memcpy(d, h, bytes); }
-  static void copyToHost(void* h, const void* d, std::size_t bytes) { if (d != h && bytes) std::memcpy(h, d, bytes); }
-  static void copyDeviceToDevice(void* dst, const void* src, std::size_t bytes) { if (dst != src && bytes) std::memcpy(dst, src, bytes); }
+  static void* allocHost(std::size_t bytes) {
+    return bytes ? ::operator new (bytes, std::align_val_t{64}) : nullptr;
+  }
+  static void freeHost(void* p) {
+    if (p)
+      ::operator delete (p, std::align_val_t{64});
+  }
+  static void* allocDevice(std::size_t bytes) {
+    return allocHost(bytes);
+  }
+  static void freeDevice(void* p) {
+    freeHost(p);
+  }
+  static void copyToDevice(void* d, const void* h, std::size_t bytes) {
+    if (d != h && bytes)
+      std::memcpy(d, h, bytes);
+  }
+  static void copyToHost(void* h, const void* d, std::size_t bytes) {
+    if (d != h && bytes)
+      std::memcpy(h, d, bytes);
+  }
+  static void copyDeviceToDevice(void* dst, const void* src, std::size_t bytes) {
+    if (dst != src && bytes)
+      std::memcpy(dst, src, bytes);
+  }
   static void synchronize() {}
 
 private:

@@ -15,7 +15,7 @@ std::unique_ptr<Engine> makeCudaEngine(const EngineSetup& setup) {
 int cudaDevices() {
   int n = 0;
   if (cudaGetDeviceCount(&n) != cudaSuccess) {
-    cudaGetLastError();  // clear the sticky "no driver / no device" error
+    cudaGetLastError(); // clear the sticky "no driver / no device" error
     return 0;
   }
   return n;

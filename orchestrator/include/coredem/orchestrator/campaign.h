@@ -21,7 +21,7 @@ struct ScalarSpec {
 
 /// One member: the value (YAML text, flow style) of every varied key, in sweep order.
 struct SweepMember {
-  std::string id; ///< m000, m001, ...
+  std::string id;                                          ///< m000, m001, ...
   std::vector<std::pair<std::string, std::string>> values; ///< key path -> YAML value text
 };
 
@@ -33,7 +33,7 @@ struct Sweep {
   std::filesystem::path baseCase; ///< absolute case folder
   std::string executor = "local";
   int concurrency = 1;
-  int retries = 0; ///< failed attempts tolerated per member beyond the first
+  int retries = 0;                     ///< failed attempts tolerated per member beyond the first
   std::vector<std::string> parameters; ///< key paths, in file order
   std::vector<SweepMember> members;
   std::vector<ScalarSpec> scalars;

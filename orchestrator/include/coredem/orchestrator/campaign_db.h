@@ -52,7 +52,8 @@ public:
   int doneEvents(const std::string& id) const;
 
   /// BEGIN IMMEDIATE ... COMMIT around `fn` (rolled back on an exception).
-  template <class Fn> void transaction(Fn&& fn) {
+  template <class Fn>
+  void transaction(Fn&& fn) {
     begin();
     try {
       fn();

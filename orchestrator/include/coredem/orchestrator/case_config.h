@@ -86,10 +86,10 @@ struct DemConfig {
 struct CfdConfig {
   /// A row of the participant table (participants.h); the default is its first row.
   std::string participant = "coredem-gas";
-  std::string gasKey = "gas";  ///< cfd.gas_key: key of the prescribed-gas section
-  std::string caseFolder;      ///< cfd.case: the participant's input folder, relative to the case folder
-  double timeoutSeconds = 60;  ///< deadline for C's next StepDone
-  bool timers = false;         ///< cfd.timers: the participant's stage timers (RUN/timers-cfd.json)
+  std::string gasKey = "gas"; ///< cfd.gas_key: key of the prescribed-gas section
+  std::string caseFolder; ///< cfd.case: the participant's input folder, relative to the case folder
+  double timeoutSeconds = 60; ///< deadline for C's next StepDone
+  bool timers = false;        ///< cfd.timers: the participant's stage timers (RUN/timers-cfd.json)
 };
 
 struct CheckpointConfig {
@@ -115,23 +115,23 @@ struct ReactionConfig {
   std::vector<ReactionTermConfig> terms;
   std::string law = "constant"; ///< constant | arrhenius
   double A = 0.0, beta = 0.0, E = 0.0;
-  std::string orderSpecies;     ///< arrhenius: gas species of the concentration factor (empty: none)
+  std::string orderSpecies; ///< arrhenius: gas species of the concentration factor (empty: none)
   double order = 0.0;
-  double heatOfReaction = 0.0;  ///< J/mol (> 0 endothermic)
-  bool heatFromNasa7 = false;   ///< heat_of_reaction: nasa7
+  double heatOfReaction = 0.0; ///< J/mol (> 0 endothermic)
+  bool heatFromNasa7 = false;  ///< heat_of_reaction: nasa7
 };
 
 /// Built-in models and switches (docs/case-schema.md "chemistry").
 struct ChemistryConfig {
-  bool present = false;                  ///< the case has a chemistry section
-  bool charGasification = false;         ///< clg.char_gasification
+  bool present = false;          ///< the case has a chemistry section
+  bool charGasification = false; ///< clg.char_gasification
   std::string charStoichiometry = "carbon";
-  bool ocReduction = false;              ///< clg.oc_reduction
-  bool wgs = false;                      ///< clg.wgs
+  bool ocReduction = false; ///< clg.oc_reduction
+  bool wgs = false;         ///< clg.wgs
   std::string wgsEquilibrium = "yoon_denn";
   std::vector<std::pair<std::string, double>> kinetics; ///< clg kinetic overrides by name
-  std::optional<double> removalFraction; ///< default 0.1
-  std::optional<bool> reactionHeat;      ///< default on
+  std::optional<double> removalFraction;                ///< default 0.1
+  std::optional<bool> reactionHeat;                     ///< default on
 };
 
 /// A validated case.
@@ -164,8 +164,11 @@ struct CaseConfig {
   std::vector<SpeciesConfig> solidSpecies; ///< particle species (composition columns)
   std::vector<ReactionConfig> reactions;
   ChemistryConfig chemistry;
-  /// True when the case uses chemistry (solid_species, reactions or chemistry): needs a v1.1 server.
-  bool usesChemistry() const { return !solidSpecies.empty() || !reactions.empty() || chemistry.present; }
+  /// True when the case uses chemistry (solid_species, reactions or chemistry): needs a v1.1
+  /// server.
+  bool usesChemistry() const {
+    return !solidSpecies.empty() || !reactions.empty() || chemistry.present;
+  }
 };
 
 /// Loads and validates CASE_DIR/case.yaml (or a file path). Throws CaseError.
@@ -175,8 +178,9 @@ CaseConfig loadCase(const std::filesystem::path& caseDirOrFile);
 CaseConfig parseCase(const std::string& text, const std::filesystem::path& file,
                      const std::filesystem::path& caseDir);
 
-/// Adds the chemistry of `config` (solid species, reactions, chemistry) to a Configure (v1.1 fields).
-/// Defined in case_chemistry.cpp (library coredem::orchestrator, which links the protocol).
+/// Adds the chemistry of `config` (solid species, reactions, chemistry) to a Configure (v1.1
+/// fields). Defined in case_chemistry.cpp (library coredem::orchestrator, which links the
+/// protocol).
 void addChemistryToConfigure(const CaseConfig& config, v1::Configure& configure);
 
 /// Index of a material by name, or -1.

@@ -12,12 +12,12 @@
 namespace coredem::orchestrator {
 
 struct VerifyOptions {
-  std::filesystem::path outDir;       ///< DIR: DIR/<case>/ runs, DIR/summary.json, DIR/plots/
-  std::filesystem::path casesDir;     ///< empty: found next to the program or in the source tree
-  std::vector<std::string> only;      ///< case names to run (empty: all)
-  bool list = false;                  ///< print the cases and exit
-  bool plots = true;                  ///< run scripts/plot/verify_plots.py at the end
-  bool verbose = false;               ///< keep the session's info log
+  std::filesystem::path outDir;   ///< DIR: DIR/<case>/ runs, DIR/summary.json, DIR/plots/
+  std::filesystem::path casesDir; ///< empty: found next to the program or in the source tree
+  std::vector<std::string> only;  ///< case names to run (empty: all)
+  bool list = false;              ///< print the cases and exit
+  bool plots = true;              ///< run scripts/plot/verify_plots.py at the end
+  bool verbose = false;           ///< keep the session's info log
 };
 
 /// The folder that holds the verification cases: `casesDir` when given, else

@@ -13,33 +13,33 @@
 ///              fields::shapeOf(fields::kGasVelocity, cells, nSpecies));
 /// @endcode
 
-#include <coredem/v1/common.pb.h>
-
 #include <cstdint>
 #include <span>
 #include <string_view>
 #include <vector>
 
+#include <coredem/v1/common.pb.h>
+
 namespace coredem::protocol::fields {
 
 // GasFields (CFD -> DEM)
-inline constexpr std::string_view kGasVelocity = "u_g";            ///< [N,3] m/s
-inline constexpr std::string_view kPressureGradient = "grad_p";    ///< [N,3] Pa/m
-inline constexpr std::string_view kGasTemperature = "T_g";         ///< [N] K
-inline constexpr std::string_view kGasDensity = "rho_g";           ///< [N] kg/m3
-inline constexpr std::string_view kGasViscosity = "mu_g";          ///< [N] Pa s
-inline constexpr std::string_view kGasConductivity = "kappa_g";    ///< [N] W/m/K
-inline constexpr std::string_view kGasHeatCapacity = "cp_g";       ///< [N] J/kg/K
-inline constexpr std::string_view kGasMassFractions = "Y_g";       ///< [N,n_species] -
+inline constexpr std::string_view kGasVelocity = "u_g";         ///< [N,3] m/s
+inline constexpr std::string_view kPressureGradient = "grad_p"; ///< [N,3] Pa/m
+inline constexpr std::string_view kGasTemperature = "T_g";      ///< [N] K
+inline constexpr std::string_view kGasDensity = "rho_g";        ///< [N] kg/m3
+inline constexpr std::string_view kGasViscosity = "mu_g";       ///< [N] Pa s
+inline constexpr std::string_view kGasConductivity = "kappa_g"; ///< [N] W/m/K
+inline constexpr std::string_view kGasHeatCapacity = "cp_g";    ///< [N] J/kg/K
+inline constexpr std::string_view kGasMassFractions = "Y_g";    ///< [N,n_species] -
 
 // Sources (DEM -> CFD), averaged over the n_sub DEM sub-steps of the CFD step
-inline constexpr std::string_view kVoidFraction = "eps_g";         ///< [N] -
-inline constexpr std::string_view kDragCoefficient = "K_sl";       ///< [N] kg/m3/s
+inline constexpr std::string_view kVoidFraction = "eps_g";             ///< [N] -
+inline constexpr std::string_view kDragCoefficient = "K_sl";           ///< [N] kg/m3/s
 inline constexpr std::string_view kDragCoefficientTimesUs = "K_sl_Us"; ///< [N,3] N/m3
-inline constexpr std::string_view kHeatCoefficient = "H";          ///< [N] W/m3/K (implicit)
-inline constexpr std::string_view kHeatCoefficientTimesTp = "H_Tp"; ///< [N] W/m3 (explicit)
-inline constexpr std::string_view kSpeciesSources = "R_species";   ///< [N,n_species] kg/m3/s
-inline constexpr std::string_view kHomogeneousHeat = "Q_hom";      ///< [N] W/m3
+inline constexpr std::string_view kHeatCoefficient = "H";              ///< [N] W/m3/K (implicit)
+inline constexpr std::string_view kHeatCoefficientTimesTp = "H_Tp";    ///< [N] W/m3 (explicit)
+inline constexpr std::string_view kSpeciesSources = "R_species";       ///< [N,n_species] kg/m3/s
+inline constexpr std::string_view kHomogeneousHeat = "Q_hom";          ///< [N] W/m3
 
 /// One coupling field.
 struct FieldSpec {

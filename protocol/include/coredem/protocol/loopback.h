@@ -17,14 +17,14 @@
 /// Sequence numbers of the session peer must increase; the session id of Welcome is required
 /// in every later message.
 
-#include <coredem/protocol/transport.h>
-#include <coredem/protocol/version.h>
-
 #include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
 #include <string>
+
+#include <coredem/protocol/transport.h>
+#include <coredem/protocol/version.h>
 
 namespace coredem::protocol {
 

@@ -25,10 +25,6 @@
 /// Received arrays are always at least 8-byte aligned (misaligned frames are copied once).
 /// A Message is move-only; it is not thread-safe.
 
-#include <coredem/protocol/message_types.h>
-#include <coredem/protocol/status.h>
-#include <coredem/v1/envelope.pb.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
@@ -38,6 +34,10 @@
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <coredem/protocol/message_types.h>
+#include <coredem/protocol/status.h>
+#include <coredem/v1/envelope.pb.h>
 
 namespace coredem::protocol {
 
@@ -49,13 +49,34 @@ std::string dtypeName(v1::DType dtype);
 /// The DType of a C++ element type.
 template <class T>
 constexpr v1::DType dtypeOf();
-template <> constexpr v1::DType dtypeOf<double>() { return v1::DTYPE_FLOAT64; }
-template <> constexpr v1::DType dtypeOf<float>() { return v1::DTYPE_FLOAT32; }
-template <> constexpr v1::DType dtypeOf<std::int32_t>() { return v1::DTYPE_INT32; }
-template <> constexpr v1::DType dtypeOf<std::int64_t>() { return v1::DTYPE_INT64; }
-template <> constexpr v1::DType dtypeOf<std::uint8_t>() { return v1::DTYPE_UINT8; }
-template <> constexpr v1::DType dtypeOf<std::uint32_t>() { return v1::DTYPE_UINT32; }
-template <> constexpr v1::DType dtypeOf<std::uint64_t>() { return v1::DTYPE_UINT64; }
+template <>
+constexpr v1::DType dtypeOf<double>() {
+  return v1::DTYPE_FLOAT64;
+}
+template <>
+constexpr v1::DType dtypeOf<float>() {
+  return v1::DTYPE_FLOAT32;
+}
+template <>
+constexpr v1::DType dtypeOf<std::int32_t>() {
+  return v1::DTYPE_INT32;
+}
+template <>
+constexpr v1::DType dtypeOf<std::int64_t>() {
+  return v1::DTYPE_INT64;
+}
+template <>
+constexpr v1::DType dtypeOf<std::uint8_t>() {
+  return v1::DTYPE_UINT8;
+}
+template <>
+constexpr v1::DType dtypeOf<std::uint32_t>() {
+  return v1::DTYPE_UINT32;
+}
+template <>
+constexpr v1::DType dtypeOf<std::uint64_t>() {
+  return v1::DTYPE_UINT64;
+}
 
 /// Read-only view of one array of a message. Valid while the Message (or the message it was
 /// moved into: moving does not relocate array data) lives; with a BufferProvider, while the
@@ -139,11 +160,10 @@ public:
   }
   /// Untyped forms of the above. byte_length = bytes.size() must equal
   /// prod(shape) * dtypeSize(dtype).
-  Message& addArrayBytes(std::string_view name, v1::DType dtype,
-                         std::vector<std::uint64_t> shape, std::span<const std::byte> bytes);
+  Message& addArrayBytes(std::string_view name, v1::DType dtype, std::vector<std::uint64_t> shape,
+                         std::span<const std::byte> bytes);
   Message& addArraySharedBytes(std::string_view name, v1::DType dtype,
-                               std::vector<std::uint64_t> shape,
-                               std::shared_ptr<const void> owner,
+                               std::vector<std::uint64_t> shape, std::shared_ptr<const void> owner,
                                std::span<const std::byte> bytes);
 
   // ---- arrays (reading) ----------------------------------------------------------------

@@ -12,27 +12,27 @@
 /// protocol/tools/golden_gen.cpp (and its check in the golden test), then who sends and who
 /// handles it.
 
-#include <coredem/v1/envelope.pb.h>
-
 #include <array>
 #include <string_view>
 
+#include <coredem/v1/envelope.pb.h>
+
 // X(BodyType, envelope_field, TYPE_SUFFIX)
-#define COREDEM_PROTOCOL_MESSAGES(X)                                                          \
-  X(Hello, hello, HELLO)                                                                      \
-  X(Welcome, welcome, WELCOME)                                                                \
-  X(Reject, reject, REJECT)                                                                   \
-  X(Configure, configure, CONFIGURE)                                                          \
-  X(Configured, configured, CONFIGURED)                                                       \
-  X(GasFields, gas_fields, GAS_FIELDS)                                                        \
-  X(Sources, sources, SOURCES)                                                                \
-  X(StepGrant, step_grant, STEP_GRANT)                                                        \
-  X(StepDone, step_done, STEP_DONE)                                                           \
-  X(CheckpointRequest, checkpoint_request, CHECKPOINT_REQUEST)                                \
-  X(CheckpointDone, checkpoint_done, CHECKPOINT_DONE)                                         \
-  X(Heartbeat, heartbeat, HEARTBEAT)                                                          \
-  X(Error, error, ERROR)                                                                      \
-  X(Shutdown, shutdown, SHUTDOWN)                                                             \
+#define COREDEM_PROTOCOL_MESSAGES(X)                                                               \
+  X(Hello, hello, HELLO)                                                                           \
+  X(Welcome, welcome, WELCOME)                                                                     \
+  X(Reject, reject, REJECT)                                                                        \
+  X(Configure, configure, CONFIGURE)                                                               \
+  X(Configured, configured, CONFIGURED)                                                            \
+  X(GasFields, gas_fields, GAS_FIELDS)                                                             \
+  X(Sources, sources, SOURCES)                                                                     \
+  X(StepGrant, step_grant, STEP_GRANT)                                                             \
+  X(StepDone, step_done, STEP_DONE)                                                                \
+  X(CheckpointRequest, checkpoint_request, CHECKPOINT_REQUEST)                                     \
+  X(CheckpointDone, checkpoint_done, CHECKPOINT_DONE)                                              \
+  X(Heartbeat, heartbeat, HEARTBEAT)                                                               \
+  X(Error, error, ERROR)                                                                           \
+  X(Shutdown, shutdown, SHUTDOWN)                                                                  \
   X(Ack, ack, ACK)
 
 namespace coredem::protocol {
@@ -44,7 +44,7 @@ struct MessageTypeInfo {
   std::string_view field; ///< the Envelope.body field, also the golden file's name
 };
 
-#define COREDEM_PROTOCOL_INFO_ROW(Body, field, TYPE)                                          \
+#define COREDEM_PROTOCOL_INFO_ROW(Body, field, TYPE)                                               \
   MessageTypeInfo{v1::MESSAGE_TYPE_##TYPE, v1::Envelope::k##Body, #field},
 inline constexpr std::array kMessageTypes = {COREDEM_PROTOCOL_MESSAGES(COREDEM_PROTOCOL_INFO_ROW)};
 #undef COREDEM_PROTOCOL_INFO_ROW
@@ -62,12 +62,12 @@ constexpr const MessageTypeInfo* findMessageType(v1::MessageType type) {
 /// Compile-time traits of a body type: MessageTraits<v1::StepGrant>::type.
 template <class Body>
 struct MessageTraits;
-#define COREDEM_PROTOCOL_TRAITS(Body, envelopeField, TYPE)                                    \
-  template <>                                                                                 \
-  struct MessageTraits<v1::Body> {                                                            \
-    static constexpr v1::MessageType type = v1::MESSAGE_TYPE_##TYPE;                          \
-    static constexpr v1::Envelope::BodyCase bodyCase = v1::Envelope::k##Body;                 \
-    static constexpr std::string_view field = #envelopeField;                                 \
+#define COREDEM_PROTOCOL_TRAITS(Body, envelopeField, TYPE)                                         \
+  template <>                                                                                      \
+  struct MessageTraits<v1::Body> {                                                                 \
+    static constexpr v1::MessageType type = v1::MESSAGE_TYPE_##TYPE;                               \
+    static constexpr v1::Envelope::BodyCase bodyCase = v1::Envelope::k##Body;                      \
+    static constexpr std::string_view field = #envelopeField;                                      \
   };
 COREDEM_PROTOCOL_MESSAGES(COREDEM_PROTOCOL_TRAITS)
 #undef COREDEM_PROTOCOL_TRAITS

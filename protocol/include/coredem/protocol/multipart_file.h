@@ -9,9 +9,9 @@
 ///   k+1 times:   uint64 frame length L, then L bytes of the frame
 /// Frame 0 is the serialized Envelope, frames 1..k the raw arrays, exactly as on the wire.
 
-#include <coredem/protocol/message.h>
-
 #include <filesystem>
+
+#include <coredem/protocol/message.h>
 
 namespace coredem::protocol {
 

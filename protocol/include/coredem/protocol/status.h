@@ -9,11 +9,11 @@
 /// its subclasses; those derive from `coredem::UserError`, so `catch (const UserError&)` at a
 /// program's top level reports them.
 
-#include <coredem/common/check.h>
-#include <coredem/v1/common.pb.h>
-
 #include <string>
 #include <string_view>
+
+#include <coredem/common/check.h>
+#include <coredem/v1/common.pb.h>
 
 namespace coredem::protocol {
 
@@ -42,8 +42,10 @@ std::string messageTypeName(v1::MessageType type);
 class ProtocolError : public UserError {
 public:
   ProtocolError(v1::ErrorCode code, const std::string& message)
-      : UserError(message), _code(code) {}
-  explicit ProtocolError(const Status& status) : ProtocolError(status.code, status.message) {}
+      : UserError(message)
+      , _code(code) {}
+  explicit ProtocolError(const Status& status)
+      : ProtocolError(status.code, status.message) {}
   [[nodiscard]] v1::ErrorCode code() const { return _code; }
 
 private:
@@ -54,8 +56,9 @@ private:
 class TimeoutError : public ProtocolError {
 public:
   TimeoutError(std::string endpoint, std::string awaited, const std::string& message)
-      : ProtocolError(v1::ERROR_CODE_TIMEOUT, message), _endpoint(std::move(endpoint)),
-        _awaited(std::move(awaited)) {}
+      : ProtocolError(v1::ERROR_CODE_TIMEOUT, message)
+      , _endpoint(std::move(endpoint))
+      , _awaited(std::move(awaited)) {}
   [[nodiscard]] const std::string& endpoint() const { return _endpoint; }
   [[nodiscard]] const std::string& awaited() const { return _awaited; }
 

@@ -37,9 +37,6 @@
 /// * zmq::error_t never escapes: it becomes TransportError (or a Status).
 /// * A Server or Client is used from one thread at a time.
 
-#include <coredem/protocol/message.h>
-#include <coredem/protocol/status.h>
-
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -48,6 +45,9 @@
 #include <span>
 #include <string>
 #include <string_view>
+
+#include <coredem/protocol/message.h>
+#include <coredem/protocol/status.h>
 
 namespace coredem::protocol {
 

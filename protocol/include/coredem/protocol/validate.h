@@ -13,14 +13,14 @@
 ///   if (Status s = validate(req.message, e); !s.ok()) { server.reply(peer, makeError(s, ...)); }
 /// @endcode
 
-#include <coredem/protocol/message.h>
-#include <coredem/protocol/status.h>
-#include <coredem/v1/configure.pb.h>
-
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
+
+#include <coredem/protocol/message.h>
+#include <coredem/protocol/status.h>
+#include <coredem/v1/configure.pb.h>
 
 namespace coredem::protocol {
 
@@ -28,10 +28,10 @@ namespace coredem::protocol {
 struct Expectation {
   /// Allowed types (UNEXPECTED_MESSAGE otherwise). Empty: any type known to this version.
   std::vector<v1::MessageType> types;
-  std::optional<std::uint64_t> sequence;       ///< OUT_OF_ORDER if different
-  std::optional<std::uint64_t> sequenceAfter;  ///< OUT_OF_ORDER unless sequence > this
-  std::optional<std::int64_t> step;       ///< OUT_OF_ORDER if different
-  std::optional<std::string> sessionId;   ///< UNKNOWN_SESSION if different
+  std::optional<std::uint64_t> sequence;      ///< OUT_OF_ORDER if different
+  std::optional<std::uint64_t> sequenceAfter; ///< OUT_OF_ORDER unless sequence > this
+  std::optional<std::int64_t> step;           ///< OUT_OF_ORDER if different
+  std::optional<std::string> sessionId;       ///< UNKNOWN_SESSION if different
   /// Counts for the shapes of GasFields/Sources arrays (and body.cell_count/species_count).
   /// If unset for a GasFields/Sources message: NOT_CONFIGURED.
   std::optional<std::uint64_t> cells;

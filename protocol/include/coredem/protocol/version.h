@@ -3,10 +3,10 @@
 /// Protocol version and the negotiation rule (DESIGN §3):
 /// same major -> accept and use min(minor); different major -> reject naming both versions.
 
-#include <coredem/protocol/status.h>
-
 #include <cstdint>
 #include <string>
+
+#include <coredem/protocol/status.h>
 
 namespace coredem::protocol {
 
@@ -24,8 +24,8 @@ inline constexpr Version kProtocolVersion{1, 1};
 /// Outcome of a handshake.
 struct Negotiation {
   bool accepted = false;
-  Version agreed;       ///< valid when accepted: {major, min(minor_ours, minor_theirs)}
-  Status status;        ///< ERROR_CODE_VERSION with a message naming both versions if refused
+  Version agreed; ///< valid when accepted: {major, min(minor_ours, minor_theirs)}
+  Status status;  ///< ERROR_CODE_VERSION with a message naming both versions if refused
 };
 
 /// Applies the rule. `ours` is the server's version, `theirs` the client's Hello.

@@ -51,12 +51,12 @@ typedef enum coredem_state {
 
 /* The current grant (docs/session.md). */
 typedef struct coredem_grant {
-  int64_t step;            /* step number n */
-  double time;             /* s, start of the step */
-  double dt;               /* s, Delta t_CFD: advance exactly this much */
-  int32_t n_sub;           /* DEM sub-steps */
-  double dt_dem;           /* s */
-  int requires_checkpoint; /* 1: write your state after this step into checkpoint_dir */
+  int64_t step;               /* step number n */
+  double time;                /* s, start of the step */
+  double dt;                  /* s, Delta t_CFD: advance exactly this much */
+  int32_t n_sub;              /* DEM sub-steps */
+  double dt_dem;              /* s */
+  int requires_checkpoint;    /* 1: write your state after this step into checkpoint_dir */
   const char* checkpoint_dir; /* "" when not requested */
 } coredem_grant;
 
@@ -88,9 +88,9 @@ coredem_status coredem_client_species_name(const coredem_client* c, int32_t k, c
 
 /* Sends n_fields named arrays (u_g, grad_p, T_g, rho_g, mu_g, kappa_g, cp_g, Y_g; sizes in
  * doubles) of step `step` to D and receives the sources. */
-coredem_status coredem_client_exchange(coredem_client* c, int64_t step, double dt,
-                                       int32_t n_fields, const char* const* names,
-                                       const double* const* values, const size_t* sizes);
+coredem_status coredem_client_exchange(coredem_client* c, int64_t step, double dt, int32_t n_fields,
+                                       const char* const* names, const double* const* values,
+                                       const size_t* sizes);
 /* View of a source array of the last exchange (eps_g, K_sl, K_sl_Us, H, H_Tp, R_species,
  * Q_hom); *size in doubles. */
 coredem_status coredem_client_source(const coredem_client* c, const char* name,
@@ -99,9 +99,8 @@ coredem_status coredem_client_source(const coredem_client* c, const char* name,
 /* StepDone to O: Courant number, energy ledgers (name/value pairs, J) and the checkpoint files
  * written for this step; then waits for the next grant or Shutdown. */
 coredem_status coredem_client_advance(coredem_client* c, double courant, int32_t n_ledgers,
-                                      const char* const* ledger_names,
-                                      const double* ledger_values, int32_t n_files,
-                                      const char* const* checkpoint_files);
+                                      const char* const* ledger_names, const double* ledger_values,
+                                      int32_t n_files, const char* const* checkpoint_files);
 
 coredem_status coredem_client_finalize(coredem_client* c);
 void coredem_client_destroy(coredem_client* c);

@@ -40,12 +40,16 @@ struct ConstView {
   std::size_t size = 0;
 
   ConstView() = default;
-  ConstView(const double* d, std::size_t n) : data(d), size(n) {}
+  ConstView(const double* d, std::size_t n)
+      : data(d)
+      , size(n) {}
   /// Any contiguous container of doubles (std::vector, std::array, std::span, Foam::List...).
   template <class Container,
             class = decltype(static_cast<const double*>(std::declval<const Container&>().data())),
             class = decltype(static_cast<std::size_t>(std::declval<const Container&>().size()))>
-  ConstView(const Container& c) : data(c.data()), size(static_cast<std::size_t>(c.size())) {}
+  ConstView(const Container& c)
+      : data(c.data())
+      , size(static_cast<std::size_t>(c.size())) {}
 
   const double* begin() const { return data; }
   const double* end() const { return data + size; }
@@ -89,7 +93,8 @@ enum class ErrorCode {
 class ClientError : public std::runtime_error {
 public:
   ClientError(ErrorCode code, const std::string& message)
-      : std::runtime_error(message), _code(code) {}
+      : std::runtime_error(message)
+      , _code(code) {}
   ErrorCode code() const { return _code; }
 
 private:
@@ -99,7 +104,8 @@ private:
 /// A call was made in a state that does not allow it.
 class StateError : public ClientError {
 public:
-  explicit StateError(const std::string& message) : ClientError(ErrorCode::State, message) {}
+  explicit StateError(const std::string& message)
+      : ClientError(ErrorCode::State, message) {}
 };
 
 /// The participant's life cycle. Allowed calls:
@@ -118,9 +124,9 @@ struct Options {
   std::string controlEndpoint;
   std::string demEndpoint;
   std::string sessionId;
-  double timeoutSeconds = 0.0;   ///< per-request deadline; 0 = environment or 60 s
-  std::string name = "cfd";      ///< this participant's name in logs and messages
-  std::string softwareVersion;   ///< e.g. "coredemFoam 0.1.0"; empty = the library's version
+  double timeoutSeconds = 0.0; ///< per-request deadline; 0 = environment or 60 s
+  std::string name = "cfd";    ///< this participant's name in logs and messages
+  std::string softwareVersion; ///< e.g. "coredemFoam 0.1.0"; empty = the library's version
   /// CURVE keys (Z85) when D requires them (remote D): D's public key; the client key pair is
   /// generated when empty. Environment: COREDEM_DEM_SERVER_KEY.
   std::string demServerPublicKey;
@@ -128,11 +134,11 @@ struct Options {
 
 /// The coupling grid and species from O's Configure.
 struct Grid {
-  double origin[3] = {0.0, 0.0, 0.0};   ///< m, lower corner of cell (0,0,0)
-  double spacing[3] = {0.0, 0.0, 0.0};  ///< m
-  std::int64_t counts[3] = {0, 0, 0};   ///< cells per axis; cell = i + nx*(j + ny*k)
-  std::vector<std::string> species;     ///< gas species, the column order of Y_g / R_species
-  std::vector<double> molarMasses;      ///< kg/mol, same order
+  double origin[3] = {0.0, 0.0, 0.0};  ///< m, lower corner of cell (0,0,0)
+  double spacing[3] = {0.0, 0.0, 0.0}; ///< m
+  std::int64_t counts[3] = {0, 0, 0};  ///< cells per axis; cell = i + nx*(j + ny*k)
+  std::vector<std::string> species;    ///< gas species, the column order of Y_g / R_species
+  std::vector<double> molarMasses;     ///< kg/mol, same order
   std::int64_t cellCount() const { return counts[0] * counts[1] * counts[2]; }
 };
 
@@ -147,7 +153,7 @@ public:
   bool has(const std::string& name) const;
   std::vector<std::string> names() const;
   std::int64_t step = 0;
-  std::uint32_t substeps = 0;   ///< DEM sub-steps averaged
+  std::uint32_t substeps = 0;                        ///< DEM sub-steps averaged
   std::map<std::string, ConstView> views;            ///< every array D sent, by name
   std::map<std::string, std::vector<double>> arrays; ///< arrays that had to be converted
   std::shared_ptr<const void> storage;               ///< owns the frames `views` point into
@@ -181,12 +187,12 @@ public:
   bool isRunning() const;
 
   // ---- the current grant (valid in Granted / Exchanged) ---------------------------------
-  std::int64_t step() const;       ///< step number n of the grant
-  double time() const;             ///< s, simulated time at the start of step n
-  double dt() const;               ///< s, Δt_CFD of step n: advance exactly this much
-  int nSub() const;                ///< DEM sub-steps of the step
-  double dtDem() const;            ///< s, Δt_DEM = dt()/nSub()
-  bool requiresCheckpoint() const; ///< write your state after this step
+  std::int64_t step() const;         ///< step number n of the grant
+  double time() const;               ///< s, simulated time at the start of step n
+  double dt() const;                 ///< s, Δt_CFD of step n: advance exactly this much
+  int nSub() const;                  ///< DEM sub-steps of the step
+  double dtDem() const;              ///< s, Δt_DEM = dt()/nSub()
+  bool requiresCheckpoint() const;   ///< write your state after this step
   std::string checkpointDir() const; ///< where to write it ("" if not requested)
   /// Why O ended the run (valid in Finished).
   std::string shutdownReason() const;

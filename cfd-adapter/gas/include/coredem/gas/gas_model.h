@@ -52,11 +52,14 @@ struct GasFieldArrays {
 };
 
 /// A piecewise-linear function of time with D components; one point = a constant.
-template <int D> class TimeSeries {
+template <int D>
+class TimeSeries {
 public:
   using Value = std::array<double, D>;
   TimeSeries() = default;
-  explicit TimeSeries(Value constant) : _times{0.0}, _values{constant} {}
+  explicit TimeSeries(Value constant)
+      : _times{0.0}
+      , _values{constant} {}
   /// @pre times strictly increasing, times.size() == values.size() >= 1
   TimeSeries(std::vector<double> times, std::vector<Value> values);
 

@@ -7,6 +7,8 @@
 
 namespace coredem::dem::kernels {
 
-DEM_HD Vec3 gravityForce(double mass, Vec3 g) { return mass * g; }
+DEM_HD Vec3 gravityForce(double mass, Vec3 g) {
+  return mass * g;
+}
 
 } // namespace coredem::dem::kernels

@@ -2,7 +2,8 @@
 /// @file
 /// Cell sources for the CFD, accumulated over the DEM sub-steps and averaged — PHYSICS §1.1
 /// and §5 [C] (MFiX explicit coupling): per sub-step s and cell c
-///   V_s,c = Σ_{i∈c} V_p,i,   K_c = Σ_{i∈c} β_i V_p,i/(1−ε),   (K U)_c = Σ_{i∈c} β_i V_p,i/(1−ε) v_i
+///   V_s,c = Σ_{i∈c} V_p,i,   K_c = Σ_{i∈c} β_i V_p,i/(1−ε),   (K U)_c = Σ_{i∈c} β_i V_p,i/(1−ε)
+///   v_i
 /// and after n_sub sub-steps ε_g = 1 − ⟨V_s⟩/V_c, K_sl = ⟨K⟩/V_c, K_sl·U_s = ⟨K U⟩/V_c.
 /// The gas drag source is then I_gs = K_sl u_g − K_sl·U_s (implicit in u_g).
 
@@ -13,9 +14,9 @@ namespace coredem::dem::kernels {
 
 /// One particle's contribution to its cell in one sub-step.
 struct CellContribution {
-  double solidVolume;  ///< V_p (m³)
-  double kCoeff;       ///< β V_p/(1−ε) (kg/s)
-  Vec3 kVel;           ///< β V_p/(1−ε) v (kg m/s²)
+  double solidVolume; ///< V_p (m³)
+  double kCoeff;      ///< β V_p/(1−ε) (kg/s)
+  Vec3 kVel;          ///< β V_p/(1−ε) v (kg m/s²)
 };
 
 DEM_HD CellContribution cellContribution(double volume, double kCoeff, Vec3 v) {
@@ -37,9 +38,9 @@ DEM_HD void accumulate(CellAccumulator& acc, const CellContribution& c) {
 
 /// Averaged sources of one cell after nSub sub-steps.
 struct CellAverages {
-  double epsG;   ///< -
-  double kSl;    ///< kg/m³/s
-  Vec3 kSlUs;    ///< kg/m²/s²
+  double epsG; ///< -
+  double kSl;  ///< kg/m³/s
+  Vec3 kSlUs;  ///< kg/m²/s²
 };
 
 DEM_HD CellAverages averageSources(const CellAccumulator& acc, int nSub, double cellVolume) {

@@ -116,14 +116,16 @@ DEM_HD CharGasificationRates charGasificationHoisted(const CharGasificationParam
   const double scale = mC0 / molarMass(Species::C) * std::cbrt(unreacted * unreacted);
   if (pCO2 > 0.0) {
     const double kc = adsorptionHoisted(p.kCO2, invRT);
-    const double r = p.aCO2 * std::exp(-p.eCO2 * invRT) * kc * pCO2 /
-                     (1.0 + kc * pCO2 + adsorptionHoisted(p.kCO, invRT) * pBar[idx(GasSpecies::CO)]);
+    const double r =
+        p.aCO2 * std::exp(-p.eCO2 * invRT) * kc * pCO2 /
+        (1.0 + kc * pCO2 + adsorptionHoisted(p.kCO, invRT) * pBar[idx(GasSpecies::CO)]);
     out.nR1 = scale * r;
   }
   if (pH2O > 0.0) {
     const double kw = adsorptionHoisted(p.kH2O, invRT);
-    const double r = p.aH2O * std::exp(-p.eH2O * invRT) * kw * pH2O /
-                     (1.0 + kw * pH2O + adsorptionHoisted(p.kH2, invRT) * pBar[idx(GasSpecies::H2)]);
+    const double r =
+        p.aH2O * std::exp(-p.eH2O * invRT) * kw * pH2O /
+        (1.0 + kw * pH2O + adsorptionHoisted(p.kH2, invRT) * pBar[idx(GasSpecies::H2)]);
     out.nR2 = scale * r;
   }
   out.mdotC = -molarMass(Species::C) * (out.nR1 + out.nR2);

@@ -102,8 +102,8 @@ DEM_HD double ocRateCoefficientHoisted(const OcReductionParams& p, double k0, do
   if (!(conc > 0.0)) {
     return 0.0;
   }
-  const double ksCn = n == 1.0 ? k0 * std::exp(-e * invRT) * conc
-                               : k0 * std::exp(n * std::log(conc) - e * invRT);
+  const double ksCn =
+      n == 1.0 ? k0 * std::exp(-e * invRT) * conc : k0 * std::exp(n * std::log(conc) - e * invRT);
   return 3.0 * p.b * ksCn / (p.rhoMolar * p.grainRadius);
 }
 

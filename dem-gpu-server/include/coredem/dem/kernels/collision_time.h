@@ -4,10 +4,10 @@
 ///   t_col = π / √( k_n/m_eff − η_n²/(4 m_eff²) )        (s)
 /// With η_n from Eq. 13 this equals √(m_eff/k_n)·√(π² + ln² e_n); Δt_DEM = t_col,min / 50.
 
+#include <math.h>
+
 #include "coredem/dem/kernels/common.h"
 #include "coredem/dem/kernels/damping.h"
-
-#include <math.h>
 
 namespace coredem::dem::kernels {
 

@@ -5,9 +5,9 @@
 ///   η_n = 2 √(k_n m_eff) |ln e_n| / √(π² + ln² e_n)      (e_n = 0 → η_n = 2 √(k_n m_eff))
 /// Units: k_n N/m, m_eff kg → η_n kg/s. m_eff = m_i m_j/(m_i+m_j), wall: m_eff = m_i.
 
-#include "coredem/dem/kernels/common.h"
-
 #include <math.h>
+
+#include "coredem/dem/kernels/common.h"
 
 namespace coredem::dem::kernels {
 
@@ -15,7 +15,8 @@ namespace coredem::dem::kernels {
 /// @pre 0 <= e_n <= 1.
 DEM_HD double dampingFactor(double en) {
   const double pi = 3.14159265358979323846;
-  if (en <= 0.0) return 2.0;
+  if (en <= 0.0)
+    return 2.0;
   const double l = ::log(en);
   return 2.0 * ::fabs(l) / ::sqrt(pi * pi + l * l);
 }
@@ -26,6 +27,8 @@ DEM_HD double normalDamping(double kn, double meff, double en) {
 }
 
 /// Effective mass of a pair (kg); mj <= 0 denotes a wall (m_eff = m_i).
-DEM_HD double effectiveMass(double mi, double mj) { return mj > 0.0 ? mi * mj / (mi + mj) : mi; }
+DEM_HD double effectiveMass(double mi, double mj) {
+  return mj > 0.0 ? mi * mj / (mi + mj) : mi;
+}
 
 } // namespace coredem::dem::kernels

@@ -9,16 +9,16 @@
 ///   f_d = β V_p/(1−ε) (u_g − v)       (N);  the coefficient β V_p/(1−ε) (kg/s) is what
 ///   the cell source K_sl sums (PCM, §1.1). ε is clipped to ≥ ε_min (0.35) first [C].
 
+#include <math.h>
+
 #include "coredem/dem/kernels/common.h"
 #include "coredem/dem/kernels/vec3.h"
-
-#include <math.h>
 
 namespace coredem::dem::kernels {
 
 struct GidaspowParams {
-  double epsMin = 0.35;     ///< ε clip (PHYSICS §1.1 [C])
-  double epsSwitch = 0.8;   ///< Ergun / Wen–Yu switch
+  double epsMin = 0.35;   ///< ε clip (PHYSICS §1.1 [C])
+  double epsSwitch = 0.8; ///< Ergun / Wen–Yu switch
 };
 
 /// Particle Reynolds number with ε included (-).
@@ -28,8 +28,10 @@ DEM_HD double reynoldsParticle(double eps, double rhoG, double dp, double slip, 
 
 /// Wen–Yu single-sphere drag coefficient (Schiller–Naumann below Re = 1000). Re = 0 → +inf.
 DEM_HD double dragCoefficientWenYu(double re) {
-  if (re >= 1000.0) return 0.44;
-  if (re <= 0.0) return HUGE_VAL;
+  if (re >= 1000.0)
+    return 0.44;
+  if (re <= 0.0)
+    return HUGE_VAL;
   return 24.0 / re * (1.0 + 0.15 * ::pow(re, 0.687));
 }
 
@@ -52,21 +54,24 @@ DEM_HD double gidaspowBeta(double eps, double rhoG, double muG, double dp, doubl
 DEM_HD double gidaspowParticleCoefficient(const GidaspowParams& p, double epsCell, double rhoG,
                                           double muG, double dp, double volume, double slip) {
   double eps = epsCell < p.epsMin ? p.epsMin : epsCell;
-  if (eps >= 1.0) eps = 1.0 - 1e-12;  // no particle volume in the cell: dilute limit
+  if (eps >= 1.0)
+    eps = 1.0 - 1e-12; // no particle volume in the cell: dilute limit
   const double s = 1.0 - eps;
   double betaOverS;
   if (eps <= p.epsSwitch) {
     betaOverS = 150.0 * s * muG / (eps * dp * dp) + 1.75 * rhoG * slip / dp;
   } else {
     const double re = reynoldsParticle(eps, rhoG, dp, slip, muG);
-    betaOverS = re <= 0.0 ? 18.0 * muG * ::pow(eps, -2.65) / (dp * dp)
-                          : 0.75 * dragCoefficientWenYu(re) * eps * rhoG * slip *
-                                ::pow(eps, -2.65) / dp;
+    betaOverS = re <= 0.0
+                    ? 18.0 * muG * ::pow(eps, -2.65) / (dp * dp)
+                    : 0.75 * dragCoefficientWenYu(re) * eps * rhoG * slip * ::pow(eps, -2.65) / dp;
   }
   return betaOverS * volume;
 }
 
 /// f_d = coefficient·(u_g − v) (N).
-DEM_HD Vec3 dragForce(double coefficient, Vec3 ug, Vec3 v) { return coefficient * (ug - v); }
+DEM_HD Vec3 dragForce(double coefficient, Vec3 ug, Vec3 v) {
+  return coefficient * (ug - v);
+}
 
 } // namespace coredem::dem::kernels

@@ -22,17 +22,17 @@ namespace coredem::dem::kernels {
 
 /// Per-contact LSD parameters (SI). η_n from Eq. 13 with the pair's m_eff.
 struct LsdParams {
-  double kn;    ///< N/m
-  double kt;    ///< N/m
-  double etan;  ///< kg/s
-  double etat;  ///< kg/s
-  double mu;    ///< -
+  double kn;   ///< N/m
+  double kt;   ///< N/m
+  double etan; ///< kg/s
+  double etat; ///< kg/s
+  double mu;   ///< -
 };
 
 struct LsdResult {
-  Vec3 force;    ///< f_n + f_t on particle i (N)
-  Vec3 torque;   ///< torque on i (N m)
-  Vec3 deltaT;   ///< updated accumulated tangential displacement (m), to store
+  Vec3 force;  ///< f_n + f_t on particle i (N)
+  Vec3 torque; ///< torque on i (N m)
+  Vec3 deltaT; ///< updated accumulated tangential displacement (m), to store
 };
 
 /// Contact point velocity difference v_ij (m/s).

@@ -9,8 +9,12 @@
 namespace coredem::dem::kernels {
 
 /// Sphere volume from its radius (m³).
-DEM_HD double sphereVolume(double r) { return 4.0 / 3.0 * 3.14159265358979323846 * r * r * r; }
+DEM_HD double sphereVolume(double r) {
+  return 4.0 / 3.0 * 3.14159265358979323846 * r * r * r;
+}
 
-DEM_HD Vec3 pressureGradientForce(double volume, Vec3 gradP) { return -volume * gradP; }
+DEM_HD Vec3 pressureGradientForce(double volume, Vec3 gradP) {
+  return -volume * gradP;
+}
 
 } // namespace coredem::dem::kernels

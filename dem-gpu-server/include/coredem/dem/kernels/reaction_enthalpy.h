@@ -73,9 +73,9 @@ DEM_HD double reactionEnthalpy(ClgReaction r, double T) {
 inline constexpr int kMaxEnthalpyPieces = 8;
 
 struct ReactionEnthalpyPoly {
-  int n = 0;                                  ///< pieces (0: none; −1: too many breaks)
-  double tUpper[kMaxEnthalpyPieces] = {};     ///< upper end of piece k, K (k < n − 1)
-  double c[kMaxEnthalpyPieces][6] = {};       ///< coefficients of piece k (see above)
+  int n = 0;                              ///< pieces (0: none; −1: too many breaks)
+  double tUpper[kMaxEnthalpyPieces] = {}; ///< upper end of piece k, K (k < n − 1)
+  double c[kMaxEnthalpyPieces][6] = {};   ///< coefficients of piece k (see above)
 };
 
 /// Combined coefficients of a reaction (pieces at every species interval break; n = −1 if
@@ -90,14 +90,17 @@ DEM_HD constexpr ReactionEnthalpyPoly combineReactionEnthalpy(const Stoichiometr
     for (int i = 0; i + 1 < d.n; ++i) {
       const double b = d.iv[i].tMax;
       bool seen = false;
-      for (int j = 0; j < nb; ++j) seen = seen || breaks[j] == b;
-      if (seen) continue;
+      for (int j = 0; j < nb; ++j)
+        seen = seen || breaks[j] == b;
+      if (seen)
+        continue;
       if (nb >= kMaxEnthalpyPieces - 1) {
         out.n = -1;
         return out;
       }
       int j = nb++;
-      for (; j > 0 && breaks[j - 1] > b; --j) breaks[j] = breaks[j - 1];  // keep sorted
+      for (; j > 0 && breaks[j - 1] > b; --j)
+        breaks[j] = breaks[j - 1]; // keep sorted
       breaks[j] = b;
     }
   }
@@ -110,7 +113,8 @@ DEM_HD constexpr ReactionEnthalpyPoly combineReactionEnthalpy(const Stoichiometr
     for (int k = 0; k < s.n; ++k) {
       const Nasa7Data d = nasa7Data(s.species[k]);
       const double* a = d.iv[nasa7IntervalIndex(d, tLow)].a;
-      for (int m = 0; m < 5; ++m) out.c[p][m] += s.nu[k] * (a[m] / (m + 1.0));
+      for (int m = 0; m < 5; ++m)
+        out.c[p][m] += s.nu[k] * (a[m] / (m + 1.0));
       out.c[p][5] += s.nu[k] * a[5];
     }
   }
@@ -120,7 +124,8 @@ DEM_HD constexpr ReactionEnthalpyPoly combineReactionEnthalpy(const Stoichiometr
 /// Heat of reaction ΔH_r(T) from the combined coefficients, J per mol of reaction (Eq. 29).
 DEM_HD double reactionEnthalpy(const ReactionEnthalpyPoly& h, double T) {
   int p = 0;
-  while (p + 1 < h.n && T >= h.tUpper[p]) ++p;
+  while (p + 1 < h.n && T >= h.tUpper[p])
+    ++p;
   const double* c = h.c[p];
   return kGasConstant * (T * (c[0] + T * (c[1] + T * (c[2] + T * (c[3] + T * c[4])))) + c[5]);
 }

@@ -41,8 +41,10 @@ struct WallConductionParams {
 /// Radius (m) of the circle in which a sphere of radius r whose centre is at distance h from a
 /// plane cuts it; 0 if h ≥ r (no contact), r if h ≤ 0.
 DEM_HD double wallContactRadius(double r, double h) {
-  if (h >= r) return 0.0;
-  if (h <= 0.0) return r;
+  if (h >= r)
+    return 0.0;
+  if (h <= 0.0)
+    return r;
   return ::sqrt((r - h) * (r + h));
 }
 
@@ -50,7 +52,8 @@ DEM_HD double wallContactRadius(double r, double h) {
 /// 4 kp kw/(kp + kw) r_c; 0 without contact or if kp + kw = 0.
 DEM_HD double wallContactConductance(double kp, double kw, double r, double h) {
   const double rc = wallContactRadius(r, h);
-  if (rc <= 0.0 || !(kp + kw > 0.0)) return 0.0;
+  if (rc <= 0.0 || !(kp + kw > 0.0))
+    return 0.0;
   return 4.0 * kp * kw / (kp + kw) * rc;
 }
 
@@ -64,7 +67,8 @@ DEM_HD double wallGap(double r, double h, double s) {
 /// does not reach the wall. Requires p.minSeparation > 0.
 DEM_HD double wallLensIntegral(const WallConductionParams& p, double r, double h) {
   const double rl = (1.0 + p.lensFraction) * r;
-  if (h >= rl) return 0.0;
+  if (h >= rl)
+    return 0.0;
   const double smin = p.minSeparation;
   const double rin = wallContactRadius(r, h);
   double rout = r;
@@ -72,7 +76,8 @@ DEM_HD double wallLensIntegral(const WallConductionParams& p, double r, double h
     const double w = ::sqrt((rl - h) * (rl + h));
     rout = w < r ? w : r;
   }
-  if (!(rout > rin)) return 0.0;
+  if (!(rout > rin))
+    return 0.0;
   // Clipped disc: gap < s_min for r < r*, r*² = R² − (h − s_min)² (all of it if h ≤ s_min).
   double rs2 = r * r;
   if (h > smin) {
@@ -80,8 +85,10 @@ DEM_HD double wallLensIntegral(const WallConductionParams& p, double r, double h
     rs2 = (r - hs) * (r + hs);
   }
   const double rin2 = rin * rin, rout2 = rout * rout;
-  if (rs2 < rin2) rs2 = rin2;
-  if (rs2 > rout2) rs2 = rout2;
+  if (rs2 < rin2)
+    rs2 = rin2;
+  if (rs2 > rout2)
+    rs2 = rout2;
   const double pi = 3.14159265358979323846;
   double value = pi * (rs2 - rin2) / smin;
   if (rs2 < rout2) {
@@ -101,8 +108,10 @@ DEM_HD double wallLensIntegral(const WallConductionParams& p, double r, double h
 DEM_HD double wallConductance(const WallConductionParams& p, double kp, double kw, double kG,
                               double r, double h) {
   double g = 0.0;
-  if (p.contact) g += wallContactConductance(kp, kw, r, h);
-  if (p.lens && kG > 0.0) g += kG * wallLensIntegral(p, r, h);
+  if (p.contact)
+    g += wallContactConductance(kp, kw, r, h);
+  if (p.lens && kG > 0.0)
+    g += kG * wallLensIntegral(p, r, h);
   return g;
 }
 

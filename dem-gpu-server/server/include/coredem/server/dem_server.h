@@ -27,9 +27,9 @@ struct ServerOptions {
   double sessionTimeoutSeconds = 600; ///< a session whose peers are silent this long ends
   /// How long a GasFields may wait for the orchestrator's StepGrant of its step.
   double grantWaitSeconds = 60;
-  std::string curveKeysDir;           ///< DIR/server.public + DIR/server.secret (Z85)
-  bool insecure = false;              ///< allow a non-loopback bind without CURVE
-  bool exitAfterSession = false;      ///< run() returns when the first session ends
+  std::string curveKeysDir;      ///< DIR/server.public + DIR/server.secret (Z85)
+  bool insecure = false;         ///< allow a non-loopback bind without CURVE
+  bool exitAfterSession = false; ///< run() returns when the first session ends
   /// Per-stage timers (docs/performance.md "Timers"): a report in the log every `timersEvery`
   /// CFD steps (0: only at the end) and at the end of each session, written as JSON to
   /// `timersFile` (empty: coredem-dem-timers.json in the working directory).
@@ -39,7 +39,8 @@ struct ServerOptions {
 };
 
 /// Session life cycle (one at a time):
-/// Idle --Hello(O)--> Connected --Configure--> Configured --StepGrant/GasFields...--> Shutdown → Idle
+/// Idle --Hello(O)--> Connected --Configure--> Configured --StepGrant/GasFields...--> Shutdown →
+/// Idle
 enum class SessionState { Idle, Connected, Configured };
 
 class DemServer {
