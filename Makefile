@@ -6,7 +6,7 @@ JOBS ?= $(shell nproc)
 BUILD_TYPE ?= Release
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build run test bench format clean
+.PHONY: all deps configure build run test bench format format-check clean
 
 all: build
 
@@ -27,6 +27,9 @@ test: build
 
 format:
 	git ls-files '*.h' '*.cpp' '*.cu' | xargs clang-format -i
+
+format-check:
+	scripts/check-format.sh
 
 clean:
 	rm -rf $(BUILD_DIR)
