@@ -314,21 +314,8 @@ std::string hashConfig(const DemConfig& c) {
     t += "|drag:";
     num(static_cast<int>(c.drag));
   }
-  if (c.heat.enabled) { // heat off keeps the hash of configurations without heat transfer
-    const HeatOptions& h = c.heat;
-    t += "|heat:";
-    for (double v :
-         {double(h.convection), double(static_cast<int>(h.nusselt)), double(h.reynoldsWithVoidage),
-          h.voidageExponent, double(h.contactConduction), double(h.lensConduction), h.lensFraction,
-          h.minSeparation, h.lensRelTol, double(h.radiation)})
-      num(v);
-    if (c.wallTemperature > 0.0) { // absent for adiabatic walls: earlier hashes unchanged
-      t += "|wallT:";
-      for (double v : {c.wallTemperature, double(c.wallMaterial), double(h.wallConduction),
-                       double(h.wallLensConduction)})
-        num(v);
-    }
-  }
+  if (c.heat.enabled) // heat off keeps the hash of configurations without heat transfer
+    appendHeatHashText(c.heat, c.wallTemperature, static_cast<int>(c.wallMaterial), t);
   t += chemistryHashText(c); // empty without chemistry
   std::uint64_t h = 0xcbf29ce484222325ull;
   for (unsigned char ch : t) {
@@ -643,10 +630,7 @@ void DemSystem::writeState(const std::string& path, const std::string& protocolV
   meta.softwareVersion = std::string(
       coredem::kVersion); // (not operator=(const char*): GCC 12 -Wrestrict false positive)
   meta.protocolVersion = protocolVersion.empty() ? std::string("none") : protocolVersion;
-  const HeatTotals heat = m.engine->heatTotals();
-  meta.heatConvection = heat.convection;
-  meta.heatRadiation = heat.radiation;
-  meta.heatWall = heat.wall;
+  meta.heat = m.engine->heatTotals();
   meta.hasChemistry = m.config.chemistry.active();
   meta.chemistry = m.engine->chemistryTotals();
   writeStateFile(path, m.engine->state(), meta);
@@ -689,7 +673,7 @@ void DemSystem::readState(const std::string& path) {
     m.engine = m.makeEngine();
   }
   m.engine->setState(st);
-  m.engine->restoreHeatTotals(HeatTotals{meta.heatConvection, meta.heatRadiation, meta.heatWall});
+  m.engine->restoreHeatTotals(meta.heat);
   if (meta.hasChemistry)
     m.engine->restoreChemistryTotals(meta.chemistry);
   m.nParticles = st.n;

@@ -76,9 +76,8 @@ void writeStateFile(const std::string& path, const HostState& s, const StateMeta
   h5::writeAttribute(g, "history_slots", static_cast<std::int32_t>(s.historySlots));
   h5::writeAttribute(g, "neighbour_slots", static_cast<std::int32_t>(s.neighbourSlots));
   h5::writeAttribute(g, "neighbour_list_valid", static_cast<std::int32_t>(s.listValid));
-  h5::writeAttribute(g, "heat_convection_J", meta.heatConvection);
-  h5::writeAttribute(g, "heat_radiation_J", meta.heatRadiation);
-  h5::writeAttribute(g, "heat_wall_J", meta.heatWall);
+  for (const HeatLedgerEntry& e : kHeatLedger)
+    h5::writeAttribute(g, e.stateAttribute, meta.heat.*e.value);
   COREDEM_CHECK(H5Fflush(file, H5F_SCOPE_GLOBAL) >= 0, "cannot flush state file '{}'", path);
 }
 
@@ -111,10 +110,9 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
   s.historySlots = h5::readAttribute<std::int32_t>(gm, "history_slots", what);
   s.neighbourSlots = h5::readAttribute<std::int32_t>(gm, "neighbour_slots", what);
   s.listValid = h5::readAttribute<std::int32_t>(gm, "neighbour_list_valid", what);
-  // Heat totals: absent in files written before heat transfer was integrated.
-  meta.heatConvection = optionalAttribute(gm, "heat_convection_J", 0.0, what);
-  meta.heatRadiation = optionalAttribute(gm, "heat_radiation_J", 0.0, what);
-  meta.heatWall = optionalAttribute(gm, "heat_wall_J", 0.0, what);
+  // Heat totals: absent in files written before heat transfer was integrated (or the term).
+  for (const HeatLedgerEntry& e : kHeatLedger)
+    meta.heat.*e.value = optionalAttribute(gm, e.stateAttribute, 0.0, what);
   {
     h5::Handle gp = h5::openGroup(file, "particles", what);
     h5::Handle gc = h5::openGroup(file, "contacts", what);

@@ -21,11 +21,9 @@ struct StateMeta {
   std::string configHash;
   std::string softwareVersion;
   std::string protocolVersion; ///< coupling protocol of the writing server ("none" without one)
-  double heatWall = 0;         ///< HeatTotals::wall (J); optional in the file
-  double heatConvection = 0;   ///< HeatTotals (J); optional in the file (0 when absent)
-  double heatRadiation = 0;
-  bool hasChemistry = false; ///< write/read the chemistry ledgers (/chemistry)
-  ChemistryTotals chemistry; ///< ledgers; read only when the file has /chemistry
+  HeatTotals heat;             ///< the heat ledger (kHeatLedger rows; 0 when a file lacks one)
+  bool hasChemistry = false;   ///< write/read the chemistry ledgers (/chemistry)
+  ChemistryTotals chemistry;   ///< ledgers; read only when the file has /chemistry
 };
 
 /// Writes every checkpointed schema field and `meta`. Throws InternalError when a field of `s`

@@ -470,3 +470,17 @@ int main(int argc, char** argv) {
   ::testing::InitGoogleTest(&argc, argv);
   return RUN_ALL_TESTS();
 }
+
+// The configuration hash guards restarts against other options. Its heat part moved next to
+// HeatOptions (appendHeatHashText); the hashes of earlier configurations must not change, or
+// existing checkpoints would be refused. Pinned values: computed by the code before the move.
+TEST(HeatOptions, ConfigHashOfEarlierConfigurationsIsUnchanged) {
+  DemConfig cfg = heatedBed();
+  EXPECT_EQ(DemSystem(cfg, BackendKind::Cpu, 1).configHash(), std::string("73285c92c8a98cbe"));
+  cfg.wallTemperature = 400.0;
+  cfg.materials.push_back(cfg.materials.front());
+  cfg.wallMaterial = 1;
+  EXPECT_EQ(DemSystem(cfg, BackendKind::Cpu, 1).configHash(), std::string("d0aa869891a6f856"));
+  ASSERT_TRUE(applyModelOption(cfg, "heat", "off"));
+  EXPECT_EQ(DemSystem(cfg, BackendKind::Cpu, 1).configHash(), std::string("af0603ba4db2dcd8"));
+}

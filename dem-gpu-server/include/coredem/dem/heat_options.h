@@ -4,6 +4,9 @@
 /// Plain data; set from `Configure.options` (case.yaml `models:`) through the model registry
 /// (coredem/dem/models.h, applyModelOption).
 
+#include <cstdio>
+#include <string>
+
 #include "coredem/dem/kernels/convection.h"
 
 namespace coredem::dem {
@@ -38,17 +41,44 @@ struct HeatTotals {
   double wall = 0.0;       ///< from fixed-temperature walls (kernels/wall_conduction.h)
 };
 
-/// One entry of the heat ledger as the DEM server reports it (StepDone ledger, energy, J).
+/// One entry of the heat ledger: how the DEM server reports it (StepDone ledger, energy, J) and
+/// how the state file keeps it (/meta attribute, 0 when a file predates it).
 struct HeatLedgerEntry {
-  const char* name;          ///< ledger name, e.g. "dem.heat_from_gas_J"
-  double HeatTotals::*value; ///< the total it reports
+  const char* name;           ///< ledger name, e.g. "dem.heat_from_gas_J"
+  double HeatTotals::*value;  ///< the total it reports
+  const char* stateAttribute; ///< /meta attribute of the DEM state file
 };
 
-/// The heat ledger in report order: a new HeatTotals field is reported by adding its row here.
+/// The heat ledger in report order: a new HeatTotals field is reported, checkpointed and restored
+/// by adding its row here.
 inline constexpr HeatLedgerEntry kHeatLedger[] = {
-    {"dem.heat_from_gas_J", &HeatTotals::convection},
-    {"dem.heat_radiation_J", &HeatTotals::radiation},
-    {"dem.heat_wall_J", &HeatTotals::wall},
+    {"dem.heat_from_gas_J", &HeatTotals::convection, "heat_convection_J"},
+    {"dem.heat_radiation_J", &HeatTotals::radiation, "heat_radiation_J"},
+    {"dem.heat_wall_J", &HeatTotals::wall, "heat_wall_J"},
 };
+
+/// The heat options' part of the configuration hash (a restart with other options is refused),
+/// appended to `text` as "%.17g;" values. A new option appends its value only when it differs
+/// from its default, so that the hashes of earlier configurations stay the same.
+inline void appendHeatHashText(const HeatOptions& h, double wallTemperature, int wallMaterial,
+                               std::string& text) {
+  auto num = [&](double v) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%.17g;", v);
+    text += b;
+  };
+  text += "|heat:";
+  for (double v :
+       {double(h.convection), double(static_cast<int>(h.nusselt)), double(h.reynoldsWithVoidage),
+        h.voidageExponent, double(h.contactConduction), double(h.lensConduction), h.lensFraction,
+        h.minSeparation, h.lensRelTol, double(h.radiation)})
+    num(v);
+  if (wallTemperature > 0.0) { // absent for adiabatic walls: earlier hashes unchanged
+    text += "|wallT:";
+    for (double v : {wallTemperature, double(wallMaterial), double(h.wallConduction),
+                     double(h.wallLensConduction)})
+      num(v);
+  }
+}
 
 } // namespace coredem::dem
