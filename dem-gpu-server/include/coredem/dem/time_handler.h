@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "coredem/common/compensated_sum.h"
 #include "coredem/common/time.h"
 
 namespace coredem::dem {
@@ -17,7 +18,7 @@ using coredem::timeEquals;
 class TimeHandler {
 public:
   explicit TimeHandler(double t0 = 0.0)
-      : _sum(t0) {}
+      : _time(t0) {}
 
   /// n_sub = ceil(Δt_CFD/Δt_DEM,max) (at least 1): the plan the orchestrator grants too.
   static int subStepsFor(double dtCfd, double dtDemMax) {
@@ -25,24 +26,15 @@ public:
   }
 
   /// Adds dt to the time with compensated summation.
-  void add(double dt) {
-    const double y = dt - _c;
-    const double t = _sum + y;
-    _c = (t - _sum) - y;
-    _sum = t;
-  }
+  void add(double dt) { _time.add(dt); }
 
-  double time() const { return _sum; }
-  double compensation() const { return _c; }
+  double time() const { return _time.value(); }
+  double compensation() const { return _time.compensation(); }
   /// Restores a saved state (time and its Kahan compensation) for bitwise restarts.
-  void restore(double time, double compensation) {
-    _sum = time;
-    _c = compensation;
-  }
+  void restore(double time, double compensation) { _time = CompensatedSum(time, compensation); }
 
 private:
-  double _sum = 0.0;
-  double _c = 0.0;
+  CompensatedSum _time;
 };
 
 } // namespace coredem::dem
