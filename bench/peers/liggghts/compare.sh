@@ -20,6 +20,8 @@
 #   REPEAT         runs of each code per deck and core count, interleaved (default: 3)
 #   WARMUP         untimed steps before the timed ones, both codes (default: 20)
 #   LOAD_MAX       refuse to start a run while the 1-min load average is >= this (default 0.5)
+#   LOAD_WAIT      seconds to wait for the load to fall below LOAD_MAX before refusing
+#                  (default 180; the previous run itself raises the 1-min average)
 #   ALLOW_LOAD     1: run anyway; such runs are labelled LOADED in the table
 #   BUILD_DIR      where bin/coredem-bench lives        (default: <project>/build)
 #   LIGGGHTS       LIGGGHTS executable                   (default: liggghts)
@@ -39,7 +41,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/../../.." && pwd)"
 
 usage() {
-  sed -n '2,38p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2
+  sed -n '2,40p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2
   exit 2
 }
 die() { echo "compare.sh: error: $*" >&2; exit 2; }
@@ -61,6 +63,7 @@ RUN_TIMEOUT="${RUN_TIMEOUT:-3600}"
 REPEAT="${REPEAT:-3}"
 WARMUP="${WARMUP:-20}"
 LOAD_MAX="${LOAD_MAX:-0.5}"
+LOAD_WAIT="${LOAD_WAIT:-180}"
 ALLOW_LOAD="${ALLOW_LOAD:-0}"
 LIGGGHTS_ONLY="${LIGGGHTS_ONLY:-0}"
 for d in $DECKS; do
@@ -84,6 +87,7 @@ fi
 [[ "$REPEAT" =~ ^[0-9]+$ && "$REPEAT" -ge 1 ]] || die "REPEAT must be a positive integer, got '$REPEAT'"
 [[ "$WARMUP" =~ ^[0-9]+$ ]] || die "WARMUP must be a non-negative integer, got '$WARMUP'"
 [[ "$LOAD_MAX" =~ ^[0-9]*\.?[0-9]+$ ]] || die "LOAD_MAX must be a number, got '$LOAD_MAX'"
+[[ "$LOAD_WAIT" =~ ^[0-9]+$ ]] || die "LOAD_WAIT must be a non-negative integer (seconds), got '$LOAD_WAIT'"
 
 command -v python3 >/dev/null || die "python3 not found (it generates the deck)"
 command -v timeout >/dev/null || die "timeout (coreutils) not found"
@@ -114,15 +118,24 @@ echo "machine: $(nproc) cores visible, ${cpu_model:-unknown CPU}; load average n
 [[ "$ALLOW_LOAD" == 1 ]] && echo "ALLOW_LOAD=1: runs started at load >= $LOAD_MAX are labelled LOADED"
 
 # The load average before a run; refuses (exit 5) at >= LOAD_MAX unless ALLOW_LOAD=1.
+above_max() { python3 -c "import sys; sys.exit(0 if float('$1') >= float('$LOAD_MAX') else 1)"; }
 check_load() { # $1 = file to record it in, $2 = label
-  local load
+  local load waited=0
   load="$(cut -d' ' -f1 /proc/loadavg)"
+  if [[ "$ALLOW_LOAD" != 1 ]]; then
+    while above_max "$load" && [[ $waited -lt $LOAD_WAIT ]]; do
+      sleep 5
+      waited=$((waited + 5))
+      load="$(cut -d' ' -f1 /proc/loadavg)"
+    done
+    [[ $waited -gt 0 ]] && echo "  (waited $waited s for the load average to fall)"
+  fi
   echo "$load" >"$1"
-  if python3 -c "import sys; sys.exit(0 if float('$load') >= float('$LOAD_MAX') else 1)"; then
+  if above_max "$load"; then
     if [[ "$ALLOW_LOAD" == 1 ]]; then
       echo "  $2: load average $load >= $LOAD_MAX: LOADED (ALLOW_LOAD=1)"
     else
-      echo "compare.sh: error: load average $load >= LOAD_MAX=$LOAD_MAX before $2; wait for a quiet machine or set ALLOW_LOAD=1 (such runs are labelled LOADED)" >&2
+      echo "compare.sh: error: load average $load >= LOAD_MAX=$LOAD_MAX before $2 after waiting $LOAD_WAIT s; wait for a quiet machine or set ALLOW_LOAD=1 (such runs are labelled LOADED)" >&2
       exit 5
     fi
   else
