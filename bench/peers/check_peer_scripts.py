@@ -11,7 +11,9 @@
    pair R = d/4, U = 2 U_max; wall R = d/2, U = U_max) equal to dt_DEM at the design speed,
    to 1e-12 relative, for the pair and the wall model;
 4. dpmfoam/report.py's sub-step check passes a synthetic log with the intended counts and
-   fails (exit 4) one with 2x the counts.
+   fails (exit 4) one with 2x the counts;
+5. liggghts/report.py's deck check passes a synthetic LIGGGHTS screen output that matches the
+   deck and reports each of a wrong timestep, skin, step count and initial kinetic energy.
 No timing is measured or asserted.
 """
 
@@ -46,6 +48,62 @@ def ours_ke(bench, n, vel=None):
     return json.loads(out)["ke_initial"]
 
 
+def load(name, path):
+    import importlib.util
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def liggghts_screen(n, steps, warmup, np_, dt, skin, ke0):
+    """A LIGGGHTS 3.8 screen output (-echo screen) of make_deck.py's input, as it prints it."""
+    def thermo(a, b):
+        return (f"    Step    Atoms         KinEng             Dt \n"
+                f"{a:8d} {n:8d} {ke0!r} {dt!r} \n{b:8d} {n:8d} {ke0!r} {dt!r} \n")
+
+    def loop(k):
+        return (f"Loop time of 0.5 on {np_} procs for {k} steps with {n} atoms, finish time x\n\n"
+                "Pair  time (%) = 0.3 (60)\nNeigh time (%) = 0 (0)\nComm  time (%) = 0.1 (20)\n"
+                "Outpt time (%) = 0 (0)\nOther time (%) = 0.1 (20)\n"
+                "Neighbor list builds = 0\nDangerous builds = 0\n")
+    return (f"read_data agitated.data\n  1 by 1 by {np_} MPI processor grid\n"
+            f"neighbor        {skin!r} bin\nneigh_modify    delay 0 every 1 check yes\n"
+            f"timestep        {dt!r}\nthermo {warmup}\nrun {warmup}\n"
+            f"Memory usage per processor = 8.2 Mbytes\n{thermo(0, warmup)}{loop(warmup)}"
+            f"thermo          {steps}\nrun             {steps} pre no\n"
+            f"{thermo(warmup, warmup + steps)}{loop(steps)}")
+
+
+def check_liggghts_report(tmp):
+    rep = load("lig_report", os.path.join(HERE, "liggghts", "report.py"))
+    mat = make_deck.material()
+    n, steps, warmup, np_, skin = 1000, 30, 20, 2, 1e-4
+    ke = make_deck.kinetic_energy(make_deck.agitated_velocities(n), mat["mass"])
+    par = {"dt": repr(mat["dt"]), "ke_initial": repr(ke)}
+    good = liggghts_screen(n, steps, warmup, np_, mat["dt"], skin, ke)
+    cases = {
+        "matching": (good, None),
+        "timestep": (good.replace(f"timestep        {mat['dt']!r}", "timestep 1.7e-06"), "timestep"),
+        "skin": (good.replace(f"neighbor        {skin!r}", "neighbor 0.0002"), "skin"),
+        "steps": (good.replace(f"for {steps} steps", f"for {steps - 1} steps"), "loops of"),
+        "kinetic energy": (good.replace(f" {ke!r} ", f" {1.01 * ke!r} ", 1), "kinetic energy"),
+    }
+    for name, (text, expect) in cases.items():
+        path = os.path.join(tmp, "screen")
+        with open(path, "w") as f:
+            f.write(text)
+        try:
+            _, bad = rep.parse_liggghts(path, n, steps, warmup, np_, par, skin)
+        except ValueError as e:
+            bad = [str(e)]
+        if expect is None:
+            check(not bad, f"liggghts report.py accepts a matching screen output ({bad})")
+        else:
+            check(any(expect in b for b in bad),
+                  f"liggghts report.py reports a wrong {name} ({bad})")
+
+
 def main(bench):
     mass = make_deck.material()["mass"]
     with tempfile.TemporaryDirectory() as tmp:
@@ -77,11 +135,7 @@ def main(bench):
             check(abs(dtp - par["dt_dem"]) <= 1e-12 * par["dt_dem"],
                   f"design speed {u} m/s: OpenFOAM pair estimate with R = d/4, U = 2u")
 
-        import importlib.util
-        spec = importlib.util.spec_from_file_location(
-            "dpm_report", os.path.join(HERE, "dpmfoam", "report.py"))
-        dpm_report = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(dpm_report)
+        dpm_report = load("dpm_report", os.path.join(HERE, "dpmfoam", "report.py"))
         par = make_case.parameters()
         params = os.path.join(tmp, "parameters.txt")
         with open(params, "w") as f:
@@ -98,6 +152,7 @@ def main(bench):
             check(ok == expect_ok and abs(ratio - factor) < 1e-12,
                   f"dpmfoam report.py sub-step check on {factor}x the intended counts: "
                   f"{'passes' if expect_ok else 'fails'} (ratio {ratio})")
+        check_liggghts_report(tmp)
     if failures:
         print(f"{len(failures)} check(s) failed")
         return 1
