@@ -124,7 +124,7 @@ def main(bench):
         check(r.returncode != 0 and "1000 velocities for 999" in r.stderr,
               "a velocity file for another N is refused")
 
-        for u in (0.015, 0.5):
+        for u in (make_case.U_SUB, 0.5):
             par = make_case.parameters(u)
             for key in ("dt_dem_dpmfoam_pair", "dt_dem_dpmfoam_wall"):
                 check(abs(par[key] - par["dt_dem"]) <= 1e-12 * par["dt_dem"],

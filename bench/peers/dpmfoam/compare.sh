@@ -18,7 +18,7 @@
 #   TIMERS         1: `coredem run --timers` (per-stage timers of both participants,
 #                  timers-cfd.json / timers-dem.json in the run folder)
 #   SUBSTEP_VELOCITY  fastest-particle speed (m/s) at which DPMFoam's collision sub-step
-#                  equals CoReDEM's dt_DEM (make_case.py --substep-velocity; default 0.015)
+#                  equals CoReDEM's dt_DEM (make_case.py --substep-velocity; default 0.025)
 #   SUBSTEP_TOL    allowed relative difference of DPMFoam's logged collision sub-cycles
 #                  from the intended ceil(deltaT/dt_DEM) (report.py; default 0.10)
 #
