@@ -1,8 +1,9 @@
 // coredem-bench dem: throughput of the DEM core on the decks of bench/decks.md.
 //   coredem-bench dem --case packed --particles 100000 --steps 500 --backend cpu --threads 2
-//   [--json]
+//   [--json] [--velocities FILE]
 // Prints particle_steps_per_s, contacts per particle, bytes per particle and the time per
-// stage. Figures are measured, never asserted.
+// stage, and the translational kinetic energy at the start and the end (the peer scripts
+// compare it with LIGGGHTS'). Figures are measured, never asserted.
 #include "dem.h"
 
 #include <algorithm>
@@ -11,6 +12,8 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -27,10 +30,48 @@ using coredem::bench::addCouplingGrid;
 using coredem::bench::BenchGas;
 using coredem::bench::deck;
 
+/// Initial velocities, one particle per line "vx vy vz" (m/s), in the deck's site order
+/// (bench/peers/liggghts/make_deck.py writes them for the agitated deck).
+std::vector<double> readVelocities(const std::string& path, std::size_t n) {
+  std::ifstream in(path);
+  if (!in)
+    throw coredem::UserError("cannot open the velocity file '" + path + "'");
+  std::vector<double> v;
+  v.reserve(3 * n);
+  std::string line;
+  std::size_t lineNo = 0;
+  while (std::getline(in, line)) {
+    ++lineNo;
+    if (line.empty() || line[0] == '#')
+      continue;
+    std::istringstream ls(line);
+    double x, y, z;
+    if (!(ls >> x >> y >> z))
+      throw coredem::UserError(path + ":" + std::to_string(lineNo) +
+                               ": expected three velocity components 'vx vy vz'");
+    v.insert(v.end(), {x, y, z});
+  }
+  if (v.size() != 3 * n)
+    throw coredem::UserError(path + ": " + std::to_string(v.size() / 3) + " velocities for " +
+                             std::to_string(n) + " particles");
+  return v;
+}
+
+/// Translational kinetic energy ½ Σ m v² (J), as LIGGGHTS' thermo `ke` with `norm no`.
+double kineticEnergy(const DemSystem& sys) {
+  const ParticleData p = sys.particles();
+  double e = 0;
+  for (std::size_t i = 0; i < p.count; ++i)
+    e += 0.5 * p.mass[i] *
+         (p.velocity[3 * i] * p.velocity[3 * i] + p.velocity[3 * i + 1] * p.velocity[3 * i + 1] +
+          p.velocity[3 * i + 2] * p.velocity[3 * i + 2]);
+  return e;
+}
+
 int runDem(int argc, char** argv) {
   CLI::App app{"DEM core throughput on the packed / agitated decks (bench/decks.md)",
                "coredem-bench dem"};
-  std::string deckName = "packed", backend = "cpu";
+  std::string deckName = "packed", backend = "cpu", velocityFile;
   std::size_t n = 10000;
   int steps = 500, threads = 2, warmup = 20;
   double skin = -1;
@@ -47,6 +88,9 @@ int runDem(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--skin", skin, "Verlet skin as a fraction of d_max (default: the library's)");
   app.add_flag("--json", json, "print one JSON object");
+  app.add_option("--velocities", velocityFile,
+                 "initial velocities from a file, one particle per line 'vx vy vz' (m/s), in "
+                 "the deck's site order (replaces the deck's seeded ones)");
   app.add_flag("--coupled", coupled,
                "add a PCM coupling grid (cells of 4 d_p) with air rising at 0.5 m/s");
   app.add_flag("--heat", heat,
@@ -67,11 +111,16 @@ int runDem(int argc, char** argv) {
       cfg.heat.enabled = true; // default options: contact conduction; the rest needs gas
     if (coupled)
       addCouplingGrid(cfg, 4e-3);
+    if (!velocityFile.empty()) {
+      cfg.particleSets.at(0).velocities = readVelocities(velocityFile, n);
+      cfg.particleSets.at(0).velocityJitter = 0;
+    }
     const auto t0 = std::chrono::steady_clock::now();
     DemSystem sys(cfg, parseBackend(backend), threads);
     const double setup =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double dt = sys.dtDemMax();
+    const double keInitial = kineticEnergy(sys);
     if (coupled) {
       const BenchGas gas(sys.cellCount(), 0.5, 293.15);
       sys.setGasFields(gas.view());
@@ -96,6 +145,7 @@ int runDem(int argc, char** argv) {
     const double cpu = static_cast<double>(std::clock() - c1) / CLOCKS_PER_SEC;
     const int usedThreads = threads > 0 ? threads : 1;
     const StageTimes st = sys.stageTimes();
+    const double keFinal = kineticEnergy(sys);
     const double pairsPer =
         2.0 * static_cast<double>(sys.pairContactCount()) / static_cast<double>(n);
     const double wallPer =
@@ -113,12 +163,14 @@ int runDem(int argc, char** argv) {
           "\"coupling\":%.6f,"
           "\"heat\":%.6f,\"drag\":%.6f},"
           "\"rebuilds\":%llu,\"cpu_s\":%.6f,\"cpu_utilisation\":%.3f,"
-          "\"particle_steps_per_cpu_s\":%.6e}\n",
+          "\"particle_steps_per_cpu_s\":%.6e,\"warmup\":%d,\"ke_initial\":%.17g,"
+          "\"ke_final\":%.17g,\"velocities\":\"%s\"}\n",
           deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt,
           cfg.neighbour.skinFactor, wall, setup, rate, pairsPer, wallPer, bytesPer,
           heat ? "true" : "false", st.neighbour, st.contact, st.integrate, st.coupling, st.heat,
           st.drag, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads),
-          static_cast<double>(n) * steps / cpu);
+          static_cast<double>(n) * steps / cpu, warmup, keInitial, keFinal,
+          velocityFile.empty() ? "deck" : "file");
     } else {
       std::printf(
           "case %s, backend %s, threads %d, N = %zu, %d steps of dt_DEM = %.4e s (skin %.3g d)\n",
@@ -127,6 +179,8 @@ int runDem(int argc, char** argv) {
       std::printf("particle_steps_per_s     %.4e\n", rate);
       std::printf("contacts_per_particle    %.3f  (+ %.3f wall contacts)\n", pairsPer, wallPer);
       std::printf("bytes_per_particle       %.0f\n", bytesPer);
+      std::printf("kinetic energy           %.10e J at the start, %.10e J at the end\n", keInitial,
+                  keFinal);
       std::printf("wall time                %.3f s  (set-up %.3f s)\n", wall, setup);
       std::printf("cpu time                 %.3f s  (utilisation %.0f %% of %d threads; %.4e "
                   "particle steps per cpu s)\n",

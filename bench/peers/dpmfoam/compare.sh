@@ -17,14 +17,20 @@
 #   ONLY           dpmfoam or coredem: run one code only             (default: both)
 #   TIMERS         1: `coredem run --timers` (per-stage timers of both participants,
 #                  timers-cfd.json / timers-dem.json in the run folder)
+#   SUBSTEP_VELOCITY  fastest-particle speed (m/s) at which DPMFoam's collision sub-step
+#                  equals CoReDEM's dt_DEM (make_case.py --substep-velocity; default 0.025)
+#   SUBSTEP_TOL    allowed relative difference of DPMFoam's logged collision sub-cycles
+#                  from the intended ceil(deltaT/dt_DEM) (report.py; default 0.10)
 #
-# Exit status: 0 both ran; 2 bad usage, a program missing or DPMFoam failed; 3 CoReDEM failed.
+# Exit status: 0 both ran; 2 bad usage, a program missing or DPMFoam failed; 3 CoReDEM failed;
+# 4 DPMFoam's logged sub-cycle count is off the intended one by more than SUBSTEP_TOL (the
+# figures are printed, marked as not like-for-like).
 set -euo pipefail
 
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/../../.." && pwd)"
 
-usage() { sed -n '2,20p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '2,27p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 die() { echo "compare.sh: error: $*" >&2; exit 2; }
 
 [[ $# -eq 2 ]] || usage
@@ -68,7 +74,9 @@ echo "machine: $(nproc) cores visible, ${cpu_model:-unknown CPU}; load average b
 
 timer_flag=()
 [[ "$TIMERS" == 1 ]] && timer_flag=(--timers)
-python3 "$here/make_case.py" "$N" "$SIM" "$work" --seed "$SEED" >"$work/parameters.txt" ||
+substep_flag=()
+[[ -n "${SUBSTEP_VELOCITY:-}" ]] && substep_flag=(--substep-velocity "$SUBSTEP_VELOCITY")
+python3 "$here/make_case.py" "$N" "$SIM" "$work" --seed "$SEED" "${substep_flag[@]}" >"$work/parameters.txt" ||
   die "make_case.py failed for N=$N SIM_SECONDS=$SIM"
 sed 's/^/  /' "$work/parameters.txt"
 (cd "$work/dpmfoam" && blockMesh >log.blockMesh 2>&1) || die "blockMesh failed: $work/dpmfoam/log.blockMesh"
@@ -100,5 +108,12 @@ if [[ "$ONLY" != dpmfoam ]]; then
   fi
 fi
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
-python3 "$here/report.py" "$work" "$N" "$SIM" || die "could not read the runs (set KEEP_DIR to keep them)"
+rc=0
+python3 "$here/report.py" "$work" "$N" "$SIM" || rc=$?
+if [[ $rc -eq 4 ]]; then
+  echo "compare.sh: DPMFoam did not run the intended collision sub-step (see SUB-STEP MISMATCH above)" >&2
+  [[ $status -eq 0 ]] && status=4
+elif [[ $rc -ne 0 ]]; then
+  die "could not read the runs (set KEEP_DIR to keep them)"
+fi
 exit $status

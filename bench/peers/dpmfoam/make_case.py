@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write the fluidized bed of the DPMFoam peer comparison for both codes.
 
-    make_case.py N SIM_SECONDS OUTDIR [--seed S]
+    make_case.py N SIM_SECONDS OUTDIR [--seed S] [--substep-velocity U]
 
 writes
 
@@ -26,9 +26,15 @@ The mapping chosen here:
   * E* so that a contact at the reference impact velocity V_REF lasts as long as the linear
     one (t_col = pi / sqrt(k/m - eta^2/4m^2)); pair and wall separately (the wall contact of
     the linear model has m_eff = m, so it lasts sqrt(2) times longer);
-  * collisionResolutionSteps so that DPMFoam's collision sub-step at V_REF equals
-    CoReDEM's dt_DEM = t_col/50 (DPMFoam re-estimates it every CFD step from the fastest
-    particle, so its sub-step shrinks when particles move faster than V_REF);
+  * collisionResolutionSteps so that DPMFoam's collision sub-step equals CoReDEM's
+    dt_DEM = t_col/50 when its fastest particle moves at the design speed U_SUB (default
+    0.025 m/s, about the speed of the 0.01 s benchmark runs; --substep-velocity). OpenFOAM
+    1912 estimates the sub-step every CFD step as
+    5.429675 R (rho/(E* sqrt(U)))^0.4 / collisionResolutionSteps with, for the pair model,
+    R = d_min/4 and U = 2 max(|U_p| + |omega_p| d/2) and, for the wall model, R = d_min/2 and
+    U = max(|U_p| + |omega_p| d/2); it sub-cycles max(pair, wall) times. The sub-step goes
+    as U^(-1/5): faster particles than U_SUB make it shorter than dt_DEM, slower ones longer
+    (report.py compares DPMFoam's logged sub-cycle counts with the intended ones);
   * friction mu = 0.1 for both; DPMFoam's tangential spring is Hertz-Mindlin
     (k_T = 8 sqrt(R d) G*), CoReDEM's linear (k_t = 2/7 k_n), not matched.
 """
@@ -55,6 +61,13 @@ U_IN = 1.2                       # m/s superficial, at the inlet
 G = 9.81
 POISSON = 0.35                   # DPMFoam needs one; only enters through E* and G*
 V_REF = 0.5                      # m/s, impact velocity at which the contact times are matched
+# m/s, fastest-particle speed at which DPMFoam's collision sub-step equals dt_DEM (default of
+# --substep-velocity): about what DPMFoam's logged sub-cycle counts imply over the first
+# 0.01 s of this bed from rest (0.005 m/s at the start to 0.03 m/s at N = 1000; the count-
+# weighted mean 0.012-0.036 m/s in the N = 4000 and 20 000 runs of Nov 2026). The counts go
+# as U^(1/5), so a factor 1.5 off U costs < 9 %. A bubbling bed needs about V_REF.
+# report.py checks every run's counts.
+U_SUB = 0.025
 DT_FACTOR = 50                   # CoReDEM: dt_DEM = t_col / 50 (PHYSICS Eq. 12)
 LATTICE_FAC = 1.05               # start lattice spacing / d_p
 JITTER_FAC = 0.02                # +- jitter of each start position / d_p (< (fac - 1)/2)
@@ -118,12 +131,32 @@ def hertz_estar_for_tcol(t_target, r_eff, m, alpha, v):
     return e0 * (t0 / t_target) ** 2.5          # t ~ E*^(-2/5)
 
 
-def openfoam_min_collision_dt(estar, d_min, rho_max, u_max, steps):
-    """DPMFoam's collision sub-step estimate (Pair/WallSpringSliderDashpot::nSubCycles)."""
-    return 5.429675 * d_min * (rho_max / (estar * math.sqrt(u_max))) ** 0.4 / steps
+def openfoam_collision_dt(estar, r_char, rho_max, u_char, steps):
+    """5.429675 R (rho/(E* sqrt(U)))^0.4 / steps: the collision-time estimate of OpenFOAM 1912's
+    Pair/WallSpringSliderDashpot::nSubCycles for its characteristic radius R and velocity U."""
+    return 5.429675 * r_char * (rho_max / (estar * math.sqrt(u_char))) ** 0.4 / steps
 
 
-def parameters():
+def pair_collision_dt(estar_pp, d_min, rho_max, u_fastest, steps):
+    """PairSpringSliderDashpot (findMinMaxProperties): R = d_min/4 (two equal spheres of the
+    smallest diameter), U = 2 x the fastest particle's |U| + |omega| d/2 (head-on worst case)."""
+    return openfoam_collision_dt(estar_pp, d_min / 4.0, rho_max, 2.0 * u_fastest, steps)
+
+
+def wall_collision_dt(estar_pw, d_min, rho_max, u_fastest, steps):
+    """WallSpringSliderDashpot: R = d_min/2, U = the fastest particle's |U| + |omega| d/2."""
+    return openfoam_collision_dt(estar_pw, d_min / 2.0, rho_max, u_fastest, steps)
+
+
+def dpmfoam_substep(dt_cfd, estar_pp, estar_pw, steps_pp, steps_pw, u_fastest):
+    """DPMFoam's collision sub-step for a CFD step dt_cfd: PairCollision::nSubCycles is the
+    larger of the pair and wall models' ceil(dt_cfd / collision dt)."""
+    n = max(math.ceil(dt_cfd / pair_collision_dt(estar_pp, D_P, RHO_P, u_fastest, steps_pp)),
+            math.ceil(dt_cfd / wall_collision_dt(estar_pw, D_P, RHO_P, u_fastest, steps_pw)), 1)
+    return dt_cfd / n, n
+
+
+def parameters(u_sub=U_SUB):
     m = RHO_P * math.pi * D_P ** 3 / 6.0
     m_pp, m_pw = 0.5 * m, m
     tcol_pp = linear_tcol(K_N, m_pp, E_N)
@@ -139,17 +172,21 @@ def parameters():
     if inv_w <= 0.0:
         raise RuntimeError("no wall modulus gives the wall contact time")
     e_w = (1.0 - POISSON ** 2) / inv_w
-    steps_pp = openfoam_min_collision_dt(estar_pp, D_P, RHO_P, V_REF, 1) / dt_dem
-    # the pair model's size is the smallest diameter, the wall model's the smallest radius
-    steps_pw = openfoam_min_collision_dt(estar_pw, 0.5 * D_P, RHO_P, V_REF, 1) / dt_dem
+    # collisionResolutionSteps: DPMFoam's collision dt at the design speed u_sub = dt_DEM.
+    # Not rounded: OpenFOAM reads it as a scalar, so the sub-steps match exactly at u_sub.
+    steps_pp = pair_collision_dt(estar_pp, D_P, RHO_P, u_sub, 1) / dt_dem
+    steps_pw = wall_collision_dt(estar_pw, D_P, RHO_P, u_sub, 1) / dt_dem
     _, t_check = hertz_contact(4.0 / 3.0 * math.sqrt(r_pp) * estar_pp, m_pp, alpha, V_REF)
     e_check, _ = hertz_contact(4.0 / 3.0 * math.sqrt(r_pp) * estar_pp, m_pp, alpha, 0.1)
     return {
         "mass": m, "tcol_pp": tcol_pp, "tcol_pw": tcol_pw, "dt_dem": dt_dem,
         "alpha": alpha, "estar_pp": estar_pp, "estar_pw": estar_pw,
         "youngs_particle": e_p, "youngs_wall": e_w,
-        "resolution_steps_pair": max(1, round(steps_pp)),
-        "resolution_steps_wall": max(1, round(steps_pw)),
+        "substep_velocity": u_sub,
+        "resolution_steps_pair": steps_pp,
+        "resolution_steps_wall": steps_pw,
+        "dt_dem_dpmfoam_pair": pair_collision_dt(estar_pp, D_P, RHO_P, u_sub, steps_pp),
+        "dt_dem_dpmfoam_wall": wall_collision_dt(estar_pw, D_P, RHO_P, u_sub, steps_pw),
         "hertz_tcol_check": t_check, "hertz_e_at_0.1": e_check,
     }
 
@@ -381,13 +418,13 @@ subModels
             b               1.5;
             mu              {MU};
             cohesionEnergyDensity 0;
-            collisionResolutionSteps {par['resolution_steps_pair']};
+            collisionResolutionSteps {par['resolution_steps_pair']!r};
         }};
         wallModel wallSpringSliderDashpot;
         wallSpringSliderDashpotCoeffs
         {{
             useEquivalentSize no;
-            collisionResolutionSteps {par['resolution_steps_wall']};
+            collisionResolutionSteps {par['resolution_steps_wall']!r};
             youngsModulus   {par['youngs_wall']!r};
             poissonsRatio   {POISSON};
             alpha           {par['alpha']!r};
@@ -554,12 +591,17 @@ def main():
     ap.add_argument("sim_seconds", type=float)
     ap.add_argument("outdir")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--substep-velocity", type=float, default=U_SUB, metavar="U",
+                    help="speed (m/s) of the fastest particle at which DPMFoam's collision "
+                         f"sub-step equals CoReDEM's dt_DEM (default {U_SUB})")
     a = ap.parse_args()
     if a.n < 1:
         sys.exit("make_case.py: N must be >= 1")
     if a.sim_seconds <= 0:
         sys.exit("make_case.py: SIM_SECONDS must be > 0")
-    par = parameters()
+    if not a.substep_velocity > 0:
+        sys.exit("make_case.py: --substep-velocity must be > 0 (m/s)")
+    par = parameters(a.substep_velocity)
     pos, height = positions(a.n, a.seed)
     wi = a.sim_seconds / 20.0            # 20 field writes: the averages use the second half
     for sub in ("dpmfoam", "coredem"):
@@ -573,10 +615,22 @@ def main():
     print(f"start_lattice_height_m = {height:.4f}")
     print(f"bed_weight_per_area_Pa = {bed_weight:.2f}")
     for k in ("tcol_pp", "tcol_pw", "dt_dem", "alpha", "estar_pp", "estar_pw",
-              "youngs_particle", "youngs_wall", "resolution_steps_pair", "resolution_steps_wall", "hertz_tcol_check",
-              "hertz_e_at_0.1"):
+              "youngs_particle", "youngs_wall", "hertz_tcol_check", "hertz_e_at_0.1"):
         v = par[k]
         print(f"{k} = {v:.6g}" if isinstance(v, float) else f"{k} = {v}")
+    # Full precision: report.py reads these back to check DPMFoam's sub-cycle counts.
+    for k in ("substep_velocity", "resolution_steps_pair", "resolution_steps_wall",
+              "estar_pp", "estar_pw"):
+        print(f"{k}_exact = {par[k]!r}")
+    print(f"dt_dem_coredem = {par['dt_dem']:.6g}")
+    print(f"dt_dem_dpmfoam = {min(par['dt_dem_dpmfoam_pair'], par['dt_dem_dpmfoam_wall']):.6g}"
+          f"  (pair {par['dt_dem_dpmfoam_pair']:.6g}, wall {par['dt_dem_dpmfoam_wall']:.6g}; "
+          f"at a fastest particle of {a.substep_velocity} m/s)")
+    for u in (0.005, U_SUB, 0.1, 0.5):
+        dt_p = pair_collision_dt(par["estar_pp"], D_P, RHO_P, u, par["resolution_steps_pair"])
+        dt_w = wall_collision_dt(par["estar_pw"], D_P, RHO_P, u, par["resolution_steps_wall"])
+        print(f"dt_dem_dpmfoam_at_{u}_m_s = {min(dt_p, dt_w):.6g}  "
+              f"({min(dt_p, dt_w) / par['dt_dem']:.3f} x dt_dem_coredem)")
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 """Summarise a bench/peers/dpmfoam/compare.sh run.
 
     report.py WORK_DIR N SIM_SECONDS
+    report.py --check-substeps LOG.DPMFoam PARAMETERS.txt   (the sub-step check alone)
 
 WORK_DIR holds dpmfoam/ (the DPMFoam case after its run, with time.txt) and coredem-run/ (the
 `coredem run` folder) with coredem.time.txt. Prints wall and CPU seconds per simulated second
@@ -12,6 +13,15 @@ field writes of the second half of the run:
     (cell centres, the same for both codes; it includes the gas column, rho_g g H ~ 2.4 Pa);
   * bed height: 2 x the solid-volume-weighted mean height of the cells,
     2 sum((1-alpha) y) / sum(1-alpha): the height of a uniform bed with the same centroid.
+
+Sub-step check: DPMFoam logs "N move-collide subCycles" for every CFD step (no line: 1). The
+intended count of a CFD step of deltaT is ceil(deltaT / dt_dem_coredem), CoReDEM's own
+sub-cycling, with dt_dem_coredem from WORK_DIR/parameters.txt (make_case.py's output). The
+report prints both totals, DPMFoam's mean sub-step and the speed of its fastest particle
+that its counts imply (its sub-step goes as U^(-1/5), equal to dt_DEM at the design speed
+substep_velocity); if the totals differ by more than SUBSTEP_TOL (env, default 0.10), the
+codes did not run the same collision sub-step: it says so loudly, prints the CPU-time ratio
+also per collision sub-cycle, and exits with status 4 (the figures are still printed).
 """
 
 import csv
@@ -110,12 +120,85 @@ def ours_dp_ledger(run, sim):
     return sum(vals) / len(vals) if vals else None
 
 
-def dpm_substeps(log):
-    cyc = [int(m.group(1)) for m in re.finditer(r"(\d+) move-collide subCycles", open(log).read())]
-    return (sum(cyc) / len(cyc), max(cyc), len(cyc)) if cyc else None
+def read_parameters(path):
+    """key = value lines of make_case.py (value: the first word)."""
+    out = {}
+    with open(path) as f:
+        for line in f:
+            if " = " in line:
+                k, v = line.split(" = ", 1)
+                out[k.strip()] = v.split()[0] if v.split() else ""
+    return out
+
+
+def dpm_steps(log):
+    """[(deltaT, subCycles)] per CFD step of a DPMFoam log (no subCycles line: 1)."""
+    steps, dt = [], None
+    with open(log) as f:
+        for line in f:
+            m = re.match(r"^deltaT = (\S+)", line)
+            if m:
+                dt = float(m.group(1))
+                continue
+            if re.match(r"^Time = \S+", line):
+                if dt is None:
+                    raise ValueError(f"{log}: 'Time =' before any 'deltaT =' line")
+                steps.append([dt, 1])
+                continue
+            m = re.search(r"(\d+) move-collide subCycles", line)
+            if m and steps:
+                steps[-1][1] = int(m.group(1))
+    return [tuple(s) for s in steps]
+
+
+def check_substeps(log, params_path, tol):
+    """Compares DPMFoam's sub-cycle counts with ceil(deltaT/dt_DEM); returns (ok, ratio, lines)."""
+    par = read_parameters(params_path)
+    try:
+        dt_dem = float(par["dt_dem_coredem"])
+        u_sub = float(par["substep_velocity_exact"])
+    except KeyError as e:
+        raise ValueError(f"{params_path}: no {e} (written by make_case.py of this version)")
+    steps = dpm_steps(log)
+    if not steps:
+        raise ValueError(f"{log}: no CFD step ('deltaT =' / 'Time =' lines)")
+    n_dpm = sum(n for _, n in steps)
+    # the float division can land a hair above an integer: do not count that as one more
+    n_int = sum(max(1, math.ceil(dt / dt_dem * (1 - 1e-12))) for dt, _ in steps)
+    t = sum(dt for dt, _ in steps)
+    sub = t / n_dpm
+    ratio = n_dpm / n_int
+    # dt_col(U) = dt_DEM (U/u_sub)^(-1/5)  =>  U = u_sub (dt_DEM/dt_col)^5 (approximate: ceil)
+    u_of = lambda dt, n: u_sub * (dt_dem * n / dt) ** 5
+    u_first, u_last = u_of(*steps[0]), u_of(*steps[-1])
+    ok = abs(ratio - 1.0) <= tol
+    lines = [
+        f"DPMFoam collision sub-cycles: {n_dpm} over {len(steps)} CFD steps "
+        f"(mean {n_dpm / len(steps):.1f}, max {max(n for _, n in steps)}); intended "
+        f"(ceil(deltaT / dt_DEM), dt_DEM = {dt_dem:.6g} s as CoReDEM): {n_int}; ratio {ratio:.3f}",
+        f"DPMFoam mean collision sub-step {sub:.4g} s = {sub / dt_dem:.3f} x dt_DEM; its counts "
+        f"imply a fastest particle of ~{u_first:.3g} m/s (first step) to ~{u_last:.3g} m/s (last) "
+        f"against the design speed {u_sub:g} m/s",
+    ]
+    if not ok:
+        lines.append(
+            f"SUB-STEP MISMATCH: DPMFoam took {ratio:.2f} x the intended collision sub-cycles "
+            f"(tolerance {tol:g}): the codes did not run the same dt_DEM, so the time ratio is not "
+            f"like-for-like. DPMFoam's sub-step follows its fastest particle (U^-1/5); regenerate "
+            f"with make_case.py --substep-velocity (compare.sh: SUBSTEP_VELOCITY=) near the "
+            f"speeds above.")
+    return ok, ratio, lines
 
 
 def main():
+    tol = float(os.environ.get("SUBSTEP_TOL", "0.10"))
+    if len(sys.argv) == 4 and sys.argv[1] == "--check-substeps":
+        ok, _, lines = check_substeps(sys.argv[2], sys.argv[3], tol)
+        print("\n".join(lines))
+        return 0 if ok else 4
+    if len(sys.argv) != 4:
+        print(__doc__, file=sys.stderr)
+        return 2
     work, n, sim = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
     rows = {}
     dpm = os.path.join(work, "dpmfoam")
@@ -154,14 +237,24 @@ def main():
     ledger = ours_dp_ledger(run, sim) if "CoReDEM" in rows else None
     if ledger is not None:
         print(f"CoReDEM gas.pressure_drop_Pa (inlet - outlet patch means, every step, second half): {ledger:.1f} Pa")
+    status, sub_ratio = 0, None
     if "DPMFoam" in rows:
-        sc = dpm_substeps(os.path.join(dpm, "log.DPMFoam"))
-        if sc:
-            print(f"DPMFoam collision sub-cycles per CFD step: mean {sc[0]:.0f}, max {sc[1]} over {sc[2]} steps")
+        params = os.path.join(work, "parameters.txt")
+        if not os.path.exists(params):
+            print(f"DPMFoam sub-step check: {params} missing (make_case.py output)", file=sys.stderr)
+            status = 4
+        else:
+            ok, sub_ratio, lines = check_substeps(os.path.join(dpm, "log.DPMFoam"), params, tol)
+            print("\n".join(lines))
+            status = 0 if ok else 4
     if "DPMFoam" in rows and "CoReDEM" in rows:
         print(f"ratio DPMFoam/CoReDEM wall time: {rows['DPMFoam'][0] / rows['CoReDEM'][0]:.2f}  "
               f"(CPU time: {rows['DPMFoam'][1] / rows['CoReDEM'][1]:.2f})")
-    return 0
+        if status == 4 and sub_ratio:
+            print(f"  per collision sub-cycle (CPU time / {sub_ratio:.3f}): "
+                  f"{rows['DPMFoam'][1] / sub_ratio / rows['CoReDEM'][1]:.2f}  (an estimate: "
+                  "DPMFoam's cost taken as proportional to its sub-cycles)")
+    return status
 
 
 if __name__ == "__main__":
