@@ -144,6 +144,9 @@ int Session::run() {
     fs::remove_all(_o.runDir / "snapshots");
     fs::create_directories(_o.runDir / "snapshots");
     fs::remove(_o.runDir / "particles.xdmf");
+    if (!_cfd.workDir.empty()) {
+      fs::remove_all(_o.runDir / _cfd.workDir); // a fresh copy of cfd.case (prepareWorkDir)
+    }
   }
   if (fromCheckpoint) {
     const ResumePoint r = findResumePoint(_c, _o.runDir);
@@ -151,6 +154,7 @@ int Session::run() {
     initialState = r.demState;
     cfdRestart = r.cfdRestart;
     startStep = m.step;
+    _lastCheckpointStep = m.step; // an interrupt right away needs no new one
     _time = TimeHandler(m.time, m.timeCompensation);
     _policy = DtPolicy(_c.dt, m.lastDt);
     _lastCourant = m.lastCourant;

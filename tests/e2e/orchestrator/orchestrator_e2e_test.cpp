@@ -426,3 +426,113 @@ TEST_F(CoredemE2E, CurveRemoteServer) {
   int status = 0;
   ::waitpid(server, &status, 0);
 }
+
+// SIGTERM mid-run (as a batch scheduler sends it): coredem finishes the CFD step in flight,
+// writes a checkpoint, stops both participants and exits 130; `coredem resume` continues and
+// ends in the same state as an uninterrupted run (bitwise DEM datasets), with one timeseries
+// row per step.
+TEST_F(CoredemE2E, SigtermCheckpointsAndResumeMatches) {
+  const fs::path a = dir / "straight", k = dir / "term";
+  ASSERT_EQ(
+      runCoredem({"run", restartCase.string(), "--out", a.string(), "--no-plots"}, dir / "a.log"),
+      0)
+      << readAll(dir / "a.log");
+  const pid_t o =
+      startCoredem({"run", restartCase.string(), "--out", k.string(), "--no-plots"}, dir / "k.log");
+  const auto end = std::chrono::steady_clock::now() + 40s;
+  std::vector<pid_t> children;
+  while (std::chrono::steady_clock::now() < end && children.empty()) {
+    if (fs::exists(k / "checkpoints/00000040/manifest.json")) {
+      children = childrenNamed(o, "coredem-dem");
+      const auto gases = childrenNamed(o, "coredem-gas");
+      children.insert(children.end(), gases.begin(), gases.end());
+      ASSERT_EQ(children.size(), 2u);
+      ::kill(o, SIGTERM);
+    }
+    std::this_thread::sleep_for(2ms);
+  }
+  ASSERT_FALSE(children.empty()) << "never saw checkpoint 40";
+  ASSERT_EQ(waitExit(o, 50s), 130) << readAll(dir / "k.log");
+  const std::string log = readAll(dir / "k.log");
+  std::smatch m;
+  const std::regex re("stopped after step ([0-9]+) with checkpoint");
+  ASSERT_TRUE(std::regex_search(log, m, re)) << log;
+  const int stopped = std::stoi(m[1].str());
+  EXPECT_GT(stopped, 40);
+  EXPECT_LT(stopped, 200);
+  char ck[64];
+  std::snprintf(ck, sizeof ck, "checkpoints/%08d/manifest.json", stopped);
+  EXPECT_TRUE(fs::exists(k / ck)) << log;
+  EXPECT_NE(log.find("coredem resume " + k.string()), std::string::npos) << log;
+  for (const pid_t c : children) {
+    EXPECT_NE(::kill(c, 0), 0) << "participant " << c << " still runs";
+  }
+  EXPECT_TRUE(leftovers(k).empty());
+
+  ASSERT_EQ(runCoredem({"resume", k.string(), "--no-plots"}, dir / "r.log"), 0)
+      << readAll(dir / "r.log");
+  expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(k / finalCheckpoint));
+  const std::string ts = readAll(k / "timeseries.csv");
+  EXPECT_EQ(std::count(ts.begin(), ts.end(), '\n'), 201);
+}
+
+// A run folder without a complete checkpoint (interrupted before the first one) is no dead
+// end: `coredem run --out` on it points to `coredem resume`, which starts it again from step 0
+// and ends in the same state as an uninterrupted run.
+TEST_F(CoredemE2E, ResumeWithoutCheckpointStartsFromStepZero) {
+  const fs::path a = dir / "straight", k = dir / "nock";
+  ASSERT_EQ(
+      runCoredem({"run", restartCase.string(), "--out", a.string(), "--no-plots"}, dir / "a.log"),
+      0)
+      << readAll(dir / "a.log");
+  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", k.string(), "--stop-after", "10",
+                        "--no-plots"},
+                       dir / "k1.log"),
+            0)
+      << readAll(dir / "k1.log");
+  fs::remove_all(k / "checkpoints"); // as after an interrupt before the first checkpoint
+  // `run` into the same folder: exit 2, naming resume and what it does without a checkpoint.
+  EXPECT_EQ(
+      runCoredem({"run", restartCase.string(), "--out", k.string(), "--no-plots"}, dir / "k2.log"),
+      2);
+  const std::string runLog = readAll(dir / "k2.log");
+  EXPECT_NE(runLog.find("coredem resume " + k.string()), std::string::npos) << runLog;
+  EXPECT_NE(runLog.find("from step 0 when it has none"), std::string::npos) << runLog;
+  ASSERT_EQ(runCoredem({"resume", k.string(), "--no-plots"}, dir / "k3.log"), 0)
+      << readAll(dir / "k3.log");
+  const std::string resumeLog = readAll(dir / "k3.log");
+  EXPECT_NE(resumeLog.find("no complete checkpoint; starting the run again from step 0"),
+            std::string::npos)
+      << resumeLog;
+  expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(k / finalCheckpoint));
+  const std::string ts = readAll(k / "timeseries.csv");
+  EXPECT_EQ(std::count(ts.begin(), ts.end(), '\n'), 201);
+  EXPECT_TRUE(fs::exists(k / "snapshots/particles_00000000.h5"));
+}
+
+// --walltime: a limit shorter than the reserve stops after the first step with a checkpoint
+// (exit 0, the reason logged); resume finishes and matches an uninterrupted run. A generous
+// limit does not stop the run.
+TEST_F(CoredemE2E, WalltimeStopsWithCheckpoint) {
+  const fs::path a = dir / "straight", w = dir / "wall";
+  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", a.string(), "--no-plots",
+                        "--walltime", "100000"},
+                       dir / "a.log"),
+            0)
+      << readAll(dir / "a.log");
+  EXPECT_EQ(readAll(dir / "a.log").find("wall-time limit"), std::string::npos);
+  EXPECT_TRUE(fs::exists(a / finalCheckpoint));
+  ASSERT_EQ(runCoredem(
+                {"run", restartCase.string(), "--out", w.string(), "--no-plots", "--walltime", "1"},
+                dir / "w1.log"),
+            0)
+      << readAll(dir / "w1.log");
+  const std::string log = readAll(dir / "w1.log");
+  EXPECT_NE(log.find("stopped after step 1 "), std::string::npos) << log;
+  EXPECT_NE(log.find("before the wall-time limit (--walltime 1 s)"), std::string::npos) << log;
+  EXPECT_TRUE(fs::exists(w / "checkpoints/00000001/manifest.json"));
+  EXPECT_FALSE(fs::exists(w / finalCheckpoint));
+  ASSERT_EQ(runCoredem({"resume", w.string(), "--no-plots"}, dir / "w2.log"), 0)
+      << readAll(dir / "w2.log");
+  expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(w / finalCheckpoint));
+}

@@ -148,6 +148,11 @@ gas: {T_g: 300.0}
   EXPECT_TRUE(contains(e, "case.yaml:11:9: particles[0].positions[1]:")) << e;
   EXPECT_TRUE(contains(e, "overlaps particles[0].positions[0]")) << e;
   EXPECT_TRUE(contains(e, "0.25 of the smaller diameter (at most 0.05 allowed)")) << e;
+  // A centre outside the grid (the particle is coupled to the cell of its centre).
+  const std::string g = failureOf(replace(base, "[0.010, 0.01, 0.01]", "[0.010, 0.01, 0.021]"));
+  EXPECT_TRUE(contains(g, "case.yaml:10:7: particles[0].positions:")) << g;
+  EXPECT_TRUE(contains(g, "centres span")) << g;
+  EXPECT_TRUE(contains(g, "z = 0.021 m > 0.02 m")) << g;
   // 0.05 mm = 0.025 of the diameter (as the contact verification cases): accepted.
   EXPECT_EQ(failureOf(replace(base, "[0.0115, 0.01, 0.01]", "[0.01195, 0.01, 0.01]")), "");
 }
