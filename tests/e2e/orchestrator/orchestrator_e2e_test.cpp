@@ -1,6 +1,8 @@
 // End-to-end tests of `coredem run/resume` with the real DEM server and coredem-gas:
 // restart identity (200 straight == 100 + resume + 100, bitwise DEM state on the cpu
-// backend), kill -9 of the DEM server (with and without --auto-restart), bad case files.
+// backend), kill -9 of the DEM server (with and without --auto-restart), bad case files,
+// SIGTERM with a checkpoint and resume, resume without a checkpoint, --walltime, a CFD
+// participant dying of SIGFPE, pre-flight failures and warnings of `coredem check`.
 #include <algorithm>
 #include <chrono>
 #include <csignal>
@@ -535,4 +537,67 @@ TEST_F(CoredemE2E, WalltimeStopsWithCheckpoint) {
   ASSERT_EQ(runCoredem({"resume", w.string(), "--no-plots"}, dir / "w2.log"), 0)
       << readAll(dir / "w2.log");
   expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(w / finalCheckpoint));
+}
+
+// A CFD participant killed by SIGFPE (a diverged solution) is reported with the step, its
+// Δt_CFD, the last Courant number coredem-gas reported (0.2 m/s · 0.5 ms / 5 mm = 0.02) and a
+// Δt to try; exit 1, the DEM server is stopped.
+TEST_F(CoredemE2E, CfdSigfpeReportsCourantAndSuggestsDt) {
+  const fs::path k = dir / "fpe";
+  const pid_t o =
+      startCoredem({"run", restartCase.string(), "--out", k.string(), "--no-plots"}, dir / "k.log");
+  const auto end = std::chrono::steady_clock::now() + 40s;
+  pid_t dem = 0;
+  while (std::chrono::steady_clock::now() < end && !dem) {
+    if (fs::exists(k / "checkpoints/00000020/manifest.json")) {
+      const auto dems = childrenNamed(o, "coredem-dem");
+      const auto gases = childrenNamed(o, "coredem-gas");
+      ASSERT_EQ(dems.size(), 1u);
+      ASSERT_EQ(gases.size(), 1u);
+      dem = dems[0];
+      ::kill(gases[0], SIGFPE);
+    }
+    std::this_thread::sleep_for(2ms);
+  }
+  ASSERT_NE(dem, 0) << "never saw checkpoint 20";
+  EXPECT_EQ(waitExit(o, 50s), 1);
+  const std::string log = readAll(dir / "k.log");
+  EXPECT_NE(log.find("killed by signal 8 (SIGFPE); floating-point exception: the CFD solution "
+                     "probably diverged in step"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("(dt_CFD = 0.0005 s; last reported Courant number 0.02). Try time.dt <= "
+                     "0.00025 s"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(::kill(dem, 0), 0) << "coredem-dem (pid " << dem << ") still runs";
+}
+
+// `coredem check` on the command line: a pre-flight failure exits 2 with file:line:col and
+// both values; a temperature in °C is a warning (exit 0).
+TEST(CoredemCli, CheckPreflightFailsAndWarns) {
+  const fs::path d = tempDir("check-preflight");
+  const std::string text = readAll(kCases / "restart" / "case.yaml");
+  auto write = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    const auto pos = t.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    t.replace(pos, from.size(), to);
+    fs::create_directories(d / "case");
+    std::ofstream(d / "case" / "case.yaml") << t;
+  };
+  write("max: [0.0095, 0.0095, 0.014]", "max: [0.0095, 0.0095, 0.025]");
+  EXPECT_EQ(runCoredem({"check", (d / "case").string()}, d / "log1", 30s), 2);
+  const std::string l1 = readAll(d / "log1");
+  EXPECT_NE(l1.find("case.yaml:24:13: particles[0].region: particles[0] (beads): the particle "
+                    "region is"),
+            std::string::npos)
+      << l1;
+  EXPECT_NE(l1.find("(z = 0.025 m > 0.02 m)"), std::string::npos) << l1;
+  write("temperature: 300.0", "temperature: 27.0");
+  EXPECT_EQ(runCoredem({"check", (d / "case").string()}, d / "log2", 30s), 0);
+  const std::string l2 = readAll(d / "log2");
+  EXPECT_NE(l2.find("particles[0].temperature: 27 K is below 200 K: °C given?"), std::string::npos)
+      << l2;
+  fs::remove_all(d);
 }
