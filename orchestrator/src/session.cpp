@@ -36,7 +36,8 @@ int interruptCount() {
 }
 
 double secondsSinceInterrupt() {
-  if (gSignals == 0) {
+  // The handler may run on another thread (ZeroMQ's): the time may not be stored yet.
+  if (gSignals == 0 || gFirstSignalNs == 0) {
     return 0.0;
   }
   const std::int64_t now =
@@ -193,6 +194,9 @@ int Session::run() {
   }
   shutdownAll(clean);
   _overhead.report(*_log, _o.runDir);
+  if (_time.reached(_c.endTime)) {
+    _earlyStop = EarlyStop::None; // the step that ended early was the last one anyway
+  }
   const std::string ck =
       _lastCheckpointStep == _step
           ? fmt::format("with checkpoint {}", checkpointDir(_o.runDir, _step).string())

@@ -142,8 +142,8 @@ void Session::stepLoop(std::int64_t startStep) {
     _pendingCfd = std::move(cfdDone);
     afterPrevious = SteadyClock::now();
     const double wall = std::chrono::duration<double>(afterPrevious - t0).count();
-    (checkpoint ? checkpointStepEst : stepEst) =
-        std::max(checkpoint ? checkpointStepEst : stepEst, wall);
+    double& estimate = checkpoint ? checkpointStepEst : stepEst;
+    estimate = std::max(estimate, wall);
     _overhead.overhead += std::chrono::duration<double>(afterPrevious - tDone).count() -
                           std::chrono::duration<double>(tIo2 - tIo0).count();
   }
