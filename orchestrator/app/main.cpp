@@ -1,6 +1,6 @@
 // coredem: the CoReDEM orchestrator CLI (docs/orchestrator.md).
-//   coredem run CASE_DIR [--out RUN_DIR] [--auto-restart N] [--stop-after STEP]
-//   coredem resume RUN_DIR [--auto-restart N] [--stop-after STEP]
+//   coredem run CASE_DIR [--out RUN_DIR] [--auto-restart N] [--stop-after STEP] [--walltime S]
+//   coredem resume RUN_DIR [--auto-restart N] [--stop-after STEP] [--walltime S]
 //   coredem inspect FILE
 //   coredem check CASE_DIR
 //   coredem verify [--out DIR] [--only NAME[,NAME]] [--list] [--cases DIR] [--no-plots]
@@ -73,16 +73,24 @@ int main(int argc, char** argv) {
   run->add_option("--stop-after", stopAfter,
                   "stop after this step with a checkpoint (continue with coredem resume)");
   run->add_flag("--no-plots", noPlots, "do not make the PNG plots at the end");
+  double walltime = 0.0;
+  run->add_option("--walltime", walltime,
+                  "stop with a checkpoint before this many seconds of wall time (a batch "
+                  "limit; continue with coredem resume)")
+      ->check(CLI::PositiveNumber);
   bool timers = false;
   run->add_flag("--timers", timers,
                 "per-stage timers in coredem-dem and coredemFoam: RUN/timers-dem.json, "
                 "RUN/timers-cfd.json and tables in logs/ (docs/performance.md)");
 
-  auto* resume = app.add_subcommand("resume", "continue a run from its latest complete checkpoint");
+  auto* resume = app.add_subcommand(
+      "resume",
+      "continue a run from its latest complete checkpoint (from step 0 when it has none)");
   resume->add_option("RUN_DIR", runDir, "run folder created by coredem run")->required();
   resume->add_option("--auto-restart", autoRestart, "as for run")->check(CLI::NonNegativeNumber);
   resume->add_option("--stop-after", stopAfter, "as for run");
   resume->add_flag("--no-plots", noPlots, "as for run");
+  resume->add_option("--walltime", walltime, "as for run")->check(CLI::PositiveNumber);
   resume->add_flag("--timers", timers, "as for run");
 
   app.add_subcommand("campaign", "parameter sweeps: campaign run|resume|status|collect ...");
@@ -139,6 +147,9 @@ int main(int argc, char** argv) {
     }
     opts.tty = ::isatty(STDERR_FILENO) != 0;
     opts.timers = timers;
+    if (walltime > 0.0) {
+      opts.walltimeSeconds = walltime;
+    }
     CaseConfig config;
     if (*run) {
       config = loadCase(caseDir);    // throws CaseError: nothing written yet

@@ -5,9 +5,11 @@
 
 #include <fnmatch.h>
 
+#include <coredem/common/log.h>
 #include <coredem/common/process.h>
 #include <coredem/gas/gas_model.h>
 #include <coredem/orchestrator/participants.h>
+#include <coredem/orchestrator/preflight.h>
 
 namespace fs = std::filesystem;
 
@@ -53,6 +55,7 @@ std::vector<ParticipantDescriptor> makeTable() {
     p.caseFolderMarker = "system/controlDict";
     p.caseFolderHint = "give the folder with system/, constant/ and 0/";
     p.workDir = "openfoam";
+    p.preflight = &checkOpenFoamCase; // gravity and gas properties equal case.yaml's
     t.push_back(std::move(p));
   }
   return t;
@@ -207,6 +210,9 @@ void checkParticipantInput(const CaseConfig& config) {
   }
   if (p.preflight != nullptr) {
     p.preflight(config);
+  }
+  for (const auto& w : checkCaseConsistency(config)) {
+    logger("orchestrator")->warn("{}", w);
   }
 }
 

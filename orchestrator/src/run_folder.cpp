@@ -21,7 +21,8 @@ fs::path prepareRunDir(const CaseConfig& config, const std::optional<fs::path>& 
     dir = *out;
     if (fs::exists(dir / "case.yaml")) {
       throw CaseError(fmt::format("{} already holds a run; continue it with 'coredem resume {}' "
-                                  "or choose another --out",
+                                  "(from its latest complete checkpoint, or from step 0 when it "
+                                  "has none) or choose another --out",
                                   dir.string(), dir.string()));
     }
   } else {
@@ -78,8 +79,9 @@ ResumePoint findResumePoint(const CaseConfig& config, const fs::path& runDir) {
     log->warn("skipping checkpoint {}: {}", s.dir.string(), s.reason);
   }
   COREDEM_CHECK(choice.dir.has_value(),
-                "{}: no complete checkpoint to resume from; start the run again with coredem run",
-                runDir.string());
+                "{}: no complete checkpoint to resume from; 'coredem resume {}' starts it again "
+                "from step 0",
+                runDir.string(), runDir.string());
   ResumePoint r;
   r.dir = *choice.dir;
   r.manifest = *choice.manifest;

@@ -1,6 +1,7 @@
 // A coupled run (session.h): Session::run (resume point, start, step loop, shutdown), liveness
 // of the participants, their shutdown, and runSession with signals and automatic restarts. The
 // other members of Session are in session_start.cpp, step_loop.cpp and records.cpp.
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 
@@ -13,23 +14,49 @@ using namespace std::chrono_literals;
 namespace coredem::orchestrator {
 namespace {
 
-std::atomic<bool> gInterrupted{false};
+std::atomic<int> gSignals{0};
+std::atomic<std::int64_t> gFirstSignalNs{0};
 extern "C" void onSignal(int) {
-  gInterrupted = true;
+  // clock_gettime (steady_clock) is async-signal-safe.
+  if (gSignals.fetch_add(1) == 0) {
+    gFirstSignalNs =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(SteadyClock::now().time_since_epoch())
+            .count();
+  }
 }
 
 } // namespace
 
 bool interruptRequested() {
-  return gInterrupted;
+  return gSignals > 0;
+}
+
+int interruptCount() {
+  return gSignals;
+}
+
+double secondsSinceInterrupt() {
+  // The handler may run on another thread (ZeroMQ's): the time may not be stored yet.
+  if (gSignals == 0 || gFirstSignalNs == 0) {
+    return 0.0;
+  }
+  const std::int64_t now =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(SteadyClock::now().time_since_epoch())
+          .count();
+  return double(now - gFirstSignalNs) * 1e-9;
+}
+
+void Session::checkInterrupt() const {
+  if (interruptRequested() &&
+      (!_inStepLoop || interruptCount() >= 2 || secondsSinceInterrupt() > kInterruptGraceSeconds)) {
+    throw Interrupted();
+  }
 }
 
 using protocol::Message;
 
 void Session::checkAlive() {
-  if (interruptRequested()) {
-    throw Interrupted();
-  }
+  checkInterrupt();
   if (_demProc) {
     if (auto why = _demProc->exitReason()) {
       throw ParticipantFault(kDemName,
@@ -39,9 +66,13 @@ void Session::checkAlive() {
   }
   if (_cfdProc) {
     if (auto why = _cfdProc->exitReason()) {
+      // SIGFPE: a diverged CFD solution, reported with the Courant number and a Δt to try.
+      const std::string hint = why->find("SIGFPE") != std::string::npos
+                                   ? "; " + divergenceHint(_step + 1, _dtInFlight, _lastCourant)
+                                   : std::string();
       throw ParticipantFault(cfdName(),
-                             fmt::format("process {} {} (log {}):\n{}", _cfdProc->pid(), *why,
-                                         _cfdProc->logFile().string(), _cfdProc->logTail()));
+                             fmt::format("process {} {}{} (log {}):\n{}", _cfdProc->pid(), *why,
+                                         hint, _cfdProc->logFile().string(), _cfdProc->logTail()));
     }
   }
 }
@@ -101,12 +132,30 @@ int Session::run() {
   fs::create_directories(_o.runDir / "snapshots");
   fs::path initialState, cfdRestart;
   std::int64_t startStep = 0;
-  if (_o.resume) {
+  // A run folder without a complete checkpoint (interrupted before the first one) resumes from
+  // step 0: the same folder, its case.yaml, the earlier attempt's records replaced.
+  bool fromCheckpoint = _o.resume;
+  if (_o.resume && !selectResumeCheckpoint(_o.runDir).dir) {
+    for (const auto& s : selectResumeCheckpoint(_o.runDir).skipped) {
+      _log->warn("skipping checkpoint {}: {}", s.dir.string(), s.reason);
+    }
+    _log->warn("{}: no complete checkpoint; starting the run again from step 0 in this folder",
+               _o.runDir.string());
+    fromCheckpoint = false;
+    fs::remove_all(_o.runDir / "snapshots");
+    fs::create_directories(_o.runDir / "snapshots");
+    fs::remove(_o.runDir / "particles.xdmf");
+    if (!_cfd.workDir.empty()) {
+      fs::remove_all(_o.runDir / _cfd.workDir); // a fresh copy of cfd.case (prepareWorkDir)
+    }
+  }
+  if (fromCheckpoint) {
     const ResumePoint r = findResumePoint(_c, _o.runDir);
     const Manifest& m = r.manifest;
     initialState = r.demState;
     cfdRestart = r.cfdRestart;
     startStep = m.step;
+    _lastCheckpointStep = m.step; // an interrupt right away needs no new one
     _time = TimeHandler(m.time, m.timeCompensation);
     _policy = DtPolicy(_c.dt, m.lastDt);
     _lastCourant = m.lastCourant;
@@ -134,7 +183,7 @@ int Session::run() {
     configureDem(startStep, _time.time(), initialState);
     startCfd(cfdRestart);
     handshakeCfd();
-    if (!_o.resume && _c.output.snapshotEvery > 0) {
+    if (!fromCheckpoint && _c.output.snapshotEvery > 0) {
       takeSnapshot(0, 0.0);
     }
     stepLoop(startStep);
@@ -145,6 +194,24 @@ int Session::run() {
   }
   shutdownAll(clean);
   _overhead.report(*_log, _o.runDir);
+  if (_time.reached(_c.endTime)) {
+    _earlyStop = EarlyStop::None; // the step that ended early was the last one anyway
+  }
+  const std::string ck =
+      _lastCheckpointStep == _step
+          ? fmt::format("with checkpoint {}", checkpointDir(_o.runDir, _step).string())
+          : "without a new checkpoint (the step estimate did not fit the grace)";
+  if (_earlyStop == EarlyStop::Interrupt) {
+    _log->error("interrupted (SIGINT/SIGTERM): stopped after step {} {}; participants stopped. "
+                "Continue with: coredem resume {}",
+                _step, ck, _o.runDir.string());
+    return kExitInterrupted;
+  }
+  if (_earlyStop == EarlyStop::Walltime) {
+    _log->warn("stopped after step {} (t = {:.6g} s of {:.6g} s) {} before the wall-time limit "
+               "(--walltime {} s). Continue with: coredem resume {}",
+               _step, _time.time(), _c.endTime, ck, *_o.walltimeSeconds, _o.runDir.string());
+  }
   return kExitOk;
 }
 
@@ -161,8 +228,10 @@ int runSession(const CaseConfig& config, const RunOptions& options) {
       return session.run();
     } catch (const Interrupted& e) {
       removeIncomplete(opts.runDir);
-      log->error("{}; participants stopped. Continue with: coredem resume {}", e.what(),
-                 opts.runDir.string());
+      log->error("{}; participants stopped, no checkpoint written for the step in flight. "
+                 "Continue with: coredem resume {} (from its latest complete checkpoint, or "
+                 "from step 0 when it has none)",
+                 e.what(), opts.runDir.string());
       return kExitInterrupted;
     } catch (const ParticipantFault& e) {
       log->error("{}", e.what());

@@ -42,6 +42,9 @@ public:
 
 /// True after SIGINT/SIGTERM (set by runSession's handler).
 bool interruptRequested();
+/// Number of SIGINT/SIGTERM received, and seconds since the first one (0 when none).
+int interruptCount();
+double secondsSinceInterrupt();
 
 inline const std::string kDemName = "DEM server coredem-dem";
 
@@ -103,6 +106,9 @@ public:
 private:
   // session.cpp
   void checkAlive();
+  /// Throws Interrupted when a signal must stop the run at once: before the step loop, at a
+  /// second signal, or when the grace (kInterruptGraceSeconds) has passed.
+  void checkInterrupt() const;
   void shutdownAll(bool clean);
   std::string cfdName() const { return "CFD participant " + _cfd.name; }
   // session_start.cpp
@@ -138,6 +144,13 @@ private:
   protocol::PeerId _cfdPeer;
   std::optional<protocol::Request> _pendingCfd; ///< C's request awaiting O's reply
   bool _demUnresponsive = false;                ///< D missed a deadline: do not wait on it
+  bool _inStepLoop = false;                     ///< a signal lets the step in flight finish
+  double _dtInFlight = 0.0;                     ///< Δt_CFD of the step granted last
+
+  /// Why the step loop ended before time.end (none: it reached it, or --stop-after).
+  enum class EarlyStop { None, Interrupt, Walltime };
+  EarlyStop _earlyStop = EarlyStop::None;
+  std::int64_t _lastCheckpointStep = -1; ///< newest checkpoint written in this session
 
   TimeHandler _time;
   DtPolicy _policy{DtPolicyConfig{}};

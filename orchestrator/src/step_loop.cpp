@@ -1,6 +1,8 @@
 // The step loop of a run (docs/orchestrator.md "A run, step by step", 5): Δt from the dt policy,
 // the sub-cycling plan, the checkpoint decision, the same StepGrant to both participants, their
 // StepDone, then the records of the step (records.cpp).
+#include <algorithm>
+
 #include <coredem/orchestrator/progress.h>
 
 #include "configure.h"
@@ -20,20 +22,46 @@ void Session::stepLoop(std::int64_t startStep) {
   Progress progress(_time.time(), _c.endTime, _step, _o.tty);
   auto lastCheckpointWall = SteadyClock::now();
   auto afterPrevious = SteadyClock::now();
+  // Wall-time estimates for an early stop (SIGINT/SIGTERM, --walltime): the largest wall time
+  // of a step (grant to records) without and with a checkpoint so far.
+  double stepEst = 0.0, checkpointStepEst = 0.0;
+  bool lastGranted = false; ///< the step just done was granted as the last one (early stop)
+  _inStepLoop = true;
 
   while (true) {
     const bool stopHere = _o.stopAfterStep && _step >= *_o.stopAfterStep;
-    if (_time.reached(_c.endTime) || stopHere) {
+    if (_time.reached(_c.endTime) || stopHere || lastGranted) {
       break;
+    }
+    bool earlyLast = false;
+    if (interruptRequested()) {
+      // The step in flight is done. One more step with a checkpoint when the last one had none
+      // and the estimate fits the grace; else stop here.
+      _earlyStop = EarlyStop::Interrupt;
+      if (_lastCheckpointStep == _step ||
+          secondsSinceInterrupt() + std::max(stepEst, checkpointStepEst) > kInterruptGraceSeconds) {
+        break;
+      }
+      _log->warn("SIGINT/SIGTERM: finishing with a checkpoint after step {}", _step + 1);
+      earlyLast = true;
+    } else if (_o.walltimeSeconds &&
+               walltimeStopDue(
+                   std::chrono::duration<double>(SteadyClock::now() - _o.started).count(),
+                   *_o.walltimeSeconds, stepEst, checkpointStepEst)) {
+      _earlyStop = EarlyStop::Walltime;
+      earlyLast = true;
     }
     const auto t0 = SteadyClock::now();
     const std::int64_t step = _step + 1;
     const double tStart = _time.time();
     const double dt = _policy.next(_lastCourant, _time.remaining(_c.endTime));
+    _dtInFlight = dt;
     const SubcyclePlan plan = planFor(_c, dt, _dtDemMax);
     TimeHandler probe = _time;
     probe.advance(dt);
-    const bool last = probe.reached(_c.endTime) || (_o.stopAfterStep && step >= *_o.stopAfterStep);
+    const bool last =
+        probe.reached(_c.endTime) || (_o.stopAfterStep && step >= *_o.stopAfterStep) || earlyLast;
+    lastGranted = earlyLast;
     const bool checkpoint = checkpointDue(
         step, last, _c.checkpoint.everySteps, _c.checkpoint.everySeconds,
         std::chrono::duration<double>(SteadyClock::now() - lastCheckpointWall).count());
@@ -98,6 +126,7 @@ void Session::stepLoop(std::int64_t startStep) {
     if (checkpoint) {
       writeCheckpoint(step, ckDir, dd, cd);
       lastCheckpointWall = SteadyClock::now();
+      _lastCheckpointStep = step;
     }
     const auto tIo1 = SteadyClock::now();
     if (_c.output.snapshotEvery > 0 && (step % _c.output.snapshotEvery == 0 || last)) {
@@ -112,9 +141,13 @@ void Session::stepLoop(std::int64_t startStep) {
     progress.update(_step, _time.time());
     _pendingCfd = std::move(cfdDone);
     afterPrevious = SteadyClock::now();
+    const double wall = std::chrono::duration<double>(afterPrevious - t0).count();
+    double& estimate = checkpoint ? checkpointStepEst : stepEst;
+    estimate = std::max(estimate, wall);
     _overhead.overhead += std::chrono::duration<double>(afterPrevious - tDone).count() -
                           std::chrono::duration<double>(tIo2 - tIo0).count();
   }
+  _inStepLoop = false;
   progress.finish(_step, _time.time());
 }
 

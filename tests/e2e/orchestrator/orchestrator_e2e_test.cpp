@@ -1,6 +1,8 @@
 // End-to-end tests of `coredem run/resume` with the real DEM server and coredem-gas:
 // restart identity (200 straight == 100 + resume + 100, bitwise DEM state on the cpu
-// backend), kill -9 of the DEM server (with and without --auto-restart), bad case files.
+// backend), kill -9 of the DEM server (with and without --auto-restart), bad case files,
+// SIGTERM with a checkpoint and resume, resume without a checkpoint, --walltime, a CFD
+// participant dying of SIGFPE, pre-flight failures and warnings of `coredem check`.
 #include <algorithm>
 #include <chrono>
 #include <csignal>
@@ -425,4 +427,177 @@ TEST_F(CoredemE2E, CurveRemoteServer) {
   ::kill(server, SIGTERM);
   int status = 0;
   ::waitpid(server, &status, 0);
+}
+
+// SIGTERM mid-run (as a batch scheduler sends it): coredem finishes the CFD step in flight,
+// writes a checkpoint, stops both participants and exits 130; `coredem resume` continues and
+// ends in the same state as an uninterrupted run (bitwise DEM datasets), with one timeseries
+// row per step.
+TEST_F(CoredemE2E, SigtermCheckpointsAndResumeMatches) {
+  const fs::path a = dir / "straight", k = dir / "term";
+  ASSERT_EQ(
+      runCoredem({"run", restartCase.string(), "--out", a.string(), "--no-plots"}, dir / "a.log"),
+      0)
+      << readAll(dir / "a.log");
+  const pid_t o =
+      startCoredem({"run", restartCase.string(), "--out", k.string(), "--no-plots"}, dir / "k.log");
+  const auto end = std::chrono::steady_clock::now() + 40s;
+  std::vector<pid_t> children;
+  while (std::chrono::steady_clock::now() < end && children.empty()) {
+    if (fs::exists(k / "checkpoints/00000040/manifest.json")) {
+      children = childrenNamed(o, "coredem-dem");
+      const auto gases = childrenNamed(o, "coredem-gas");
+      children.insert(children.end(), gases.begin(), gases.end());
+      ASSERT_EQ(children.size(), 2u);
+      ::kill(o, SIGTERM);
+    }
+    std::this_thread::sleep_for(2ms);
+  }
+  ASSERT_FALSE(children.empty()) << "never saw checkpoint 40";
+  ASSERT_EQ(waitExit(o, 50s), 130) << readAll(dir / "k.log");
+  const std::string log = readAll(dir / "k.log");
+  std::smatch m;
+  const std::regex re("stopped after step ([0-9]+) with checkpoint");
+  ASSERT_TRUE(std::regex_search(log, m, re)) << log;
+  const int stopped = std::stoi(m[1].str());
+  EXPECT_GT(stopped, 40);
+  EXPECT_LT(stopped, 200);
+  char ck[64];
+  std::snprintf(ck, sizeof ck, "checkpoints/%08d/manifest.json", stopped);
+  EXPECT_TRUE(fs::exists(k / ck)) << log;
+  EXPECT_NE(log.find("coredem resume " + k.string()), std::string::npos) << log;
+  for (const pid_t c : children) {
+    EXPECT_NE(::kill(c, 0), 0) << "participant " << c << " still runs";
+  }
+  EXPECT_TRUE(leftovers(k).empty());
+
+  ASSERT_EQ(runCoredem({"resume", k.string(), "--no-plots"}, dir / "r.log"), 0)
+      << readAll(dir / "r.log");
+  expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(k / finalCheckpoint));
+  const std::string ts = readAll(k / "timeseries.csv");
+  EXPECT_EQ(std::count(ts.begin(), ts.end(), '\n'), 201);
+}
+
+// A run folder without a complete checkpoint (interrupted before the first one) is no dead
+// end: `coredem run --out` on it points to `coredem resume`, which starts it again from step 0
+// and ends in the same state as an uninterrupted run.
+TEST_F(CoredemE2E, ResumeWithoutCheckpointStartsFromStepZero) {
+  const fs::path a = dir / "straight", k = dir / "nock";
+  ASSERT_EQ(
+      runCoredem({"run", restartCase.string(), "--out", a.string(), "--no-plots"}, dir / "a.log"),
+      0)
+      << readAll(dir / "a.log");
+  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", k.string(), "--stop-after", "10",
+                        "--no-plots"},
+                       dir / "k1.log"),
+            0)
+      << readAll(dir / "k1.log");
+  fs::remove_all(k / "checkpoints"); // as after an interrupt before the first checkpoint
+  // `run` into the same folder: exit 2, naming resume and what it does without a checkpoint.
+  EXPECT_EQ(
+      runCoredem({"run", restartCase.string(), "--out", k.string(), "--no-plots"}, dir / "k2.log"),
+      2);
+  const std::string runLog = readAll(dir / "k2.log");
+  EXPECT_NE(runLog.find("coredem resume " + k.string()), std::string::npos) << runLog;
+  EXPECT_NE(runLog.find("from step 0 when it has none"), std::string::npos) << runLog;
+  ASSERT_EQ(runCoredem({"resume", k.string(), "--no-plots"}, dir / "k3.log"), 0)
+      << readAll(dir / "k3.log");
+  const std::string resumeLog = readAll(dir / "k3.log");
+  EXPECT_NE(resumeLog.find("no complete checkpoint; starting the run again from step 0"),
+            std::string::npos)
+      << resumeLog;
+  expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(k / finalCheckpoint));
+  const std::string ts = readAll(k / "timeseries.csv");
+  EXPECT_EQ(std::count(ts.begin(), ts.end(), '\n'), 201);
+  EXPECT_TRUE(fs::exists(k / "snapshots/particles_00000000.h5"));
+}
+
+// --walltime: a limit shorter than the reserve stops after the first step with a checkpoint
+// (exit 0, the reason logged); resume finishes and matches an uninterrupted run. A generous
+// limit does not stop the run.
+TEST_F(CoredemE2E, WalltimeStopsWithCheckpoint) {
+  const fs::path a = dir / "straight", w = dir / "wall";
+  ASSERT_EQ(runCoredem({"run", restartCase.string(), "--out", a.string(), "--no-plots",
+                        "--walltime", "100000"},
+                       dir / "a.log"),
+            0)
+      << readAll(dir / "a.log");
+  EXPECT_EQ(readAll(dir / "a.log").find("wall-time limit"), std::string::npos);
+  EXPECT_TRUE(fs::exists(a / finalCheckpoint));
+  ASSERT_EQ(runCoredem(
+                {"run", restartCase.string(), "--out", w.string(), "--no-plots", "--walltime", "1"},
+                dir / "w1.log"),
+            0)
+      << readAll(dir / "w1.log");
+  const std::string log = readAll(dir / "w1.log");
+  EXPECT_NE(log.find("stopped after step 1 "), std::string::npos) << log;
+  EXPECT_NE(log.find("before the wall-time limit (--walltime 1 s)"), std::string::npos) << log;
+  EXPECT_TRUE(fs::exists(w / "checkpoints/00000001/manifest.json"));
+  EXPECT_FALSE(fs::exists(w / finalCheckpoint));
+  ASSERT_EQ(runCoredem({"resume", w.string(), "--no-plots"}, dir / "w2.log"), 0)
+      << readAll(dir / "w2.log");
+  expectSameDemState(demStateOf(a / finalCheckpoint), demStateOf(w / finalCheckpoint));
+}
+
+// A CFD participant killed by SIGFPE (a diverged solution) is reported with the step, its
+// Δt_CFD, the last Courant number coredem-gas reported (0.2 m/s · 0.5 ms / 5 mm = 0.02) and a
+// Δt to try; exit 1, the DEM server is stopped.
+TEST_F(CoredemE2E, CfdSigfpeReportsCourantAndSuggestsDt) {
+  const fs::path k = dir / "fpe";
+  const pid_t o =
+      startCoredem({"run", restartCase.string(), "--out", k.string(), "--no-plots"}, dir / "k.log");
+  const auto end = std::chrono::steady_clock::now() + 40s;
+  pid_t dem = 0;
+  while (std::chrono::steady_clock::now() < end && !dem) {
+    if (fs::exists(k / "checkpoints/00000020/manifest.json")) {
+      const auto dems = childrenNamed(o, "coredem-dem");
+      const auto gases = childrenNamed(o, "coredem-gas");
+      ASSERT_EQ(dems.size(), 1u);
+      ASSERT_EQ(gases.size(), 1u);
+      dem = dems[0];
+      ::kill(gases[0], SIGFPE);
+    }
+    std::this_thread::sleep_for(2ms);
+  }
+  ASSERT_NE(dem, 0) << "never saw checkpoint 20";
+  EXPECT_EQ(waitExit(o, 50s), 1);
+  const std::string log = readAll(dir / "k.log");
+  EXPECT_NE(log.find("killed by signal 8 (SIGFPE); floating-point exception: the CFD solution "
+                     "probably diverged in step"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("(dt_CFD = 0.0005 s; last reported Courant number 0.02). Try time.dt <= "
+                     "0.00025 s"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(::kill(dem, 0), 0) << "coredem-dem (pid " << dem << ") still runs";
+}
+
+// `coredem check` on the command line: a pre-flight failure exits 2 with file:line:col and
+// both values; a temperature in °C is a warning (exit 0).
+TEST(CoredemCli, CheckPreflightFailsAndWarns) {
+  const fs::path d = tempDir("check-preflight");
+  const std::string text = readAll(kCases / "restart" / "case.yaml");
+  auto write = [&](const std::string& from, const std::string& to) {
+    std::string t = text;
+    const auto pos = t.find(from);
+    EXPECT_NE(pos, std::string::npos) << from;
+    t.replace(pos, from.size(), to);
+    fs::create_directories(d / "case");
+    std::ofstream(d / "case" / "case.yaml") << t;
+  };
+  write("max: [0.0095, 0.0095, 0.014]", "max: [0.0095, 0.0095, 0.025]");
+  EXPECT_EQ(runCoredem({"check", (d / "case").string()}, d / "log1", 30s), 2);
+  const std::string l1 = readAll(d / "log1");
+  EXPECT_NE(l1.find("case.yaml:24:13: particles[0].region: particles[0] (beads): the particle "
+                    "region is"),
+            std::string::npos)
+      << l1;
+  EXPECT_NE(l1.find("(z = 0.025 m > 0.02 m)"), std::string::npos) << l1;
+  write("temperature: 300.0", "temperature: 27.0");
+  EXPECT_EQ(runCoredem({"check", (d / "case").string()}, d / "log2", 30s), 0);
+  const std::string l2 = readAll(d / "log2");
+  EXPECT_NE(l2.find("particles[0].temperature: 27 K is below 200 K: °C given?"), std::string::npos)
+      << l2;
+  fs::remove_all(d);
 }

@@ -5,6 +5,7 @@
 /// sub-cycling plan, coordinated checkpoints, snapshots, timeseries and progress. Faults of a
 /// participant (death, missed deadline, Error reply) are reported by name and reason.
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -38,7 +39,30 @@ struct RunOptions {
   /// it for the DEM server only): coredem-dem --timers writes RUN/timers-dem.json, coredemFoam
   /// -timers RUN/timers-cfd.json (docs/performance.md "Timers").
   bool timers = false;
+  /// `--walltime SECONDS`: stop with a checkpoint before this much wall time has passed since
+  /// `started` (docs/orchestrator.md "Stopping a run").
+  std::optional<double> walltimeSeconds;
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
 };
+
+/// Grace after SIGINT/SIGTERM: the run finishes the CFD step in flight and, when the estimate
+/// fits, one more step with a checkpoint; past this (or at a second signal) it stops at once.
+inline constexpr double kInterruptGraceSeconds = 10.0;
+
+/// Wall time kept free before `--walltime`: shutdown of the participants and the last records.
+inline double walltimeReserve(double walltime) {
+  return 5.0 + 0.02 * walltime;
+}
+
+/// True when step `s`, about to be granted, must be the last one (with a checkpoint) so that
+/// the run ends before `walltime`: `elapsed` since the start, `stepEst` and `checkpointStepEst`
+/// the largest wall time of a step without and with a checkpoint so far. If s ran without a
+/// checkpoint, the next possible stop would be after s+1 with one.
+bool walltimeStopDue(double elapsed, double walltime, double stepEst, double checkpointStepEst);
+
+/// The hint of a CFD participant killed by SIGFPE: the solution probably diverged at `step`
+/// with `dt` and the last reported Courant number (< 0: none yet), and a Δt to try.
+std::string divergenceHint(std::int64_t step, double dt, double courant);
 
 /// Exit codes of `coredem`.
 enum ExitCode : int {

@@ -1,0 +1,491 @@
+// Pre-flight consistency of a case (preflight.h): geometry, packing, temperatures, and the
+// OpenFOAM participant's gravity and gas properties against case.yaml.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <numeric>
+#include <regex>
+#include <sstream>
+
+#include <yaml-cpp/yaml.h>
+
+#include <coredem/common/yaml_section.h>
+#include <coredem/orchestrator/preflight.h>
+
+namespace fs = std::filesystem;
+
+namespace coredem::orchestrator {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Where in case.yaml a value comes from: the deepest node of `path` that exists.
+class Locator {
+public:
+  explicit Locator(const CaseConfig& c)
+      : _file(c.caseFile.string()) {
+    try {
+      _root = YAML::Load(c.text);
+    } catch (const std::exception&) {
+    }
+  }
+
+  YAML::Mark mark(const std::vector<std::string>& path) const {
+    YAML::Node n;
+    n.reset(_root);
+    YAML::Mark m;
+    for (const auto& key : path) {
+      if (!n || !(n.IsMap() || n.IsSequence())) {
+        break;
+      }
+      const YAML::Node& cn = n; // const access: a missing key is not added
+      YAML::Node next;
+      if (cn.IsSequence()) {
+        const std::size_t i = std::stoul(key);
+        if (i >= cn.size()) {
+          break;
+        }
+        next = cn[i];
+      } else {
+        next = cn[key];
+      }
+      if (!next) {
+        break;
+      }
+      n.reset(next); // rebind (assignment would overwrite the node's value)
+      m = n.Mark();
+    }
+    return m;
+  }
+
+  [[noreturn]] void fail(const std::vector<std::string>& path, const std::string& key,
+                         const std::string& what) const {
+    yaml::fail(_file, mark(path), key, what);
+  }
+
+  std::string warning(const std::vector<std::string>& path, const std::string& key,
+                      const std::string& what) const {
+    const YAML::Mark m = mark(path);
+    if (m.line >= 0) {
+      return fmt::format("{}:{}:{}: {}: {}", _file, m.line + 1, m.column + 1, key, what);
+    }
+    return fmt::format("{}: {}: {}", _file, key, what);
+  }
+
+  const YAML::Node& root() const { return _root; }
+
+private:
+  std::string _file;
+  YAML::Node _root;
+};
+
+struct Box {
+  Vec3 lo{}, hi{};
+};
+
+std::string fmtVec(const Vec3& v) {
+  return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v[0], v[1], v[2]);
+}
+
+std::string fmtBox(const Box& b) {
+  return fmtVec(b.lo) + " to " + fmtVec(b.hi);
+}
+
+const char* axisName(int d) {
+  static const char* names[] = {"x", "y", "z"};
+  return names[d];
+}
+
+/// The first axis on which `inner` sticks out of `outer` by more than `tol`, with a message
+/// naming both values; empty when inside.
+std::string outside(const Box& inner, const Box& outer, double tol) {
+  for (int d = 0; d < 3; ++d) {
+    if (inner.lo[d] < outer.lo[d] - tol) {
+      return fmt::format("{} = {:.6g} m < {:.6g} m", axisName(d), inner.lo[d], outer.lo[d]);
+    }
+    if (inner.hi[d] > outer.hi[d] + tol) {
+      return fmt::format("{} = {:.6g} m > {:.6g} m", axisName(d), inner.hi[d], outer.hi[d]);
+    }
+  }
+  return {};
+}
+
+double dot(const Vec3& a, const Vec3& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/// The space the particles of a set occupy initially (whole particles): the region for lattice
+/// and random packing (the DEM places them inside it), else the bounding box of the spheres.
+Box occupied(const ParticleSetConfig& p) {
+  if (p.positions.empty()) {
+    return {p.regionMin, p.regionMax};
+  }
+  const double r = 0.5 * p.diameter;
+  Box b{p.positions.front(), p.positions.front()};
+  for (const auto& x : p.positions) {
+    for (int d = 0; d < 3; ++d) {
+      b.lo[d] = std::min(b.lo[d], x[d]);
+      b.hi[d] = std::max(b.hi[d], x[d]);
+    }
+  }
+  for (int d = 0; d < 3; ++d) {
+    b.lo[d] -= r;
+    b.hi[d] += r;
+  }
+  return b;
+}
+
+/// Centres a set's particles can have: explicit positions, or the corners of the region shrunk
+/// by the radius (lattice and random centres lie in that box, so a plane that keeps its corners
+/// keeps them all).
+std::vector<Vec3> extremeCentres(const ParticleSetConfig& p) {
+  if (!p.positions.empty()) {
+    return p.positions;
+  }
+  const double r = 0.5 * p.diameter;
+  std::vector<Vec3> out;
+  for (int k = 0; k < 8; ++k) {
+    Vec3 x{};
+    for (int d = 0; d < 3; ++d) {
+      x[d] = (k >> d) & 1 ? std::max(p.regionMax[d] - r, p.regionMin[d] + r)
+                          : std::min(p.regionMin[d] + r, p.regionMax[d] - r);
+    }
+    out.push_back(x);
+  }
+  return out;
+}
+
+std::string setName(const ParticleSetConfig& p, std::size_t i) {
+  return p.name.empty() ? fmt::format("particles[{}]", i)
+                        : fmt::format("particles[{}] ({})", i, p.name);
+}
+
+void warnTemperature(const Locator& at, std::vector<std::string>& warnings,
+                     const std::vector<std::string>& path, const std::string& key, double value) {
+  if (value > 0.0 && value < kImplausibleTemperatureK) {
+    warnings.push_back(
+        at.warning(path, key,
+                   fmt::format("{:.6g} K is below {:.0f} K: °C given? (temperatures "
+                               "are in kelvin: {:.6g} °C = {:.6g} K)",
+                               value, kImplausibleTemperatureK, value, value + 273.15)));
+  }
+}
+
+/// Explicit positions of all sets: no pair overlaps by more than kMaxInitialOverlapFraction of
+/// the smaller diameter (sweep along x).
+void checkExplicitOverlaps(const CaseConfig& c, const Locator& at) {
+  struct P {
+    Vec3 x;
+    double d;
+    std::size_t set, index;
+  };
+  std::vector<P> all;
+  double dMax = 0.0;
+  for (std::size_t i = 0; i < c.particles.size(); ++i) {
+    const auto& s = c.particles[i];
+    for (std::size_t k = 0; k < s.positions.size(); ++k) {
+      all.push_back({s.positions[k], s.diameter, i, k});
+      dMax = std::max(dMax, s.diameter);
+    }
+  }
+  std::sort(all.begin(), all.end(), [](const P& a, const P& b) { return a.x[0] < b.x[0]; });
+  for (std::size_t a = 0; a < all.size(); ++a) {
+    for (std::size_t b = a + 1; b < all.size() && all[b].x[0] - all[a].x[0] < dMax; ++b) {
+      const Vec3 dx{all[b].x[0] - all[a].x[0], all[b].x[1] - all[a].x[1],
+                    all[b].x[2] - all[a].x[2]};
+      const double overlap = 0.5 * (all[a].d + all[b].d) - std::sqrt(dot(dx, dx));
+      const double dMin = std::min(all[a].d, all[b].d);
+      if (overlap > kMaxInitialOverlapFraction * dMin) {
+        const P& p =
+            all[a].set < all[b].set || (all[a].set == all[b].set && all[a].index < all[b].index)
+                ? all[b]
+                : all[a];
+        const P& q = &p == &all[a] ? all[b] : all[a];
+        at.fail({"particles", std::to_string(p.set), "positions", std::to_string(p.index)},
+                fmt::format("particles[{}].positions[{}]", p.set, p.index),
+                fmt::format("overlaps particles[{}].positions[{}] by {:.4g} m = {:.3g} of the "
+                            "smaller diameter (at most {:.3g} allowed): centres {} and {}",
+                            q.set, q.index, overlap, overlap / dMin, kMaxInitialOverlapFraction,
+                            fmtVec(p.x), fmtVec(q.x)));
+      }
+    }
+  }
+}
+
+// ------------------------------------------------------------------------- OpenFOAM files
+
+/// A keyword entry "key value;" of an OpenFOAM dictionary file: the value text and its line.
+struct FoamEntry {
+  std::string value;
+  int line = 0;
+};
+
+std::optional<FoamEntry> foamEntry(const fs::path& file, const std::string& key) {
+  std::ifstream in(file);
+  if (!in) {
+    return std::nullopt;
+  }
+  std::string line;
+  int n = 0;
+  const std::regex re("^\\s*" + key + "\\s+([^;]*);");
+  while (std::getline(in, line)) {
+    ++n;
+    std::smatch m;
+    if (std::regex_search(line, m, re)) {
+      return FoamEntry{m[1].str(), n};
+    }
+  }
+  return std::nullopt;
+}
+
+/// The last number of an entry's value ("[0 2 -1 0 0 0 0] 1.5e-05" or "1.5e-05").
+std::optional<double> foamScalar(const std::string& value) {
+  std::istringstream in(
+      value.substr(value.find(']') == std::string::npos ? 0 : value.find(']') + 1));
+  double v = 0.0;
+  std::optional<double> last;
+  while (in >> v) {
+    last = v;
+  }
+  return last;
+}
+
+bool close(double a, double b) {
+  return std::abs(a - b) <= kFoamEqualityRelTol * std::max(std::abs(a), std::abs(b));
+}
+
+} // namespace
+
+std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
+  const Locator at(c);
+  std::vector<std::string> warnings;
+  Box grid;
+  double extent = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    grid.lo[d] = c.grid.origin[d];
+    grid.hi[d] = c.grid.origin[d] + c.grid.spacing[d] * double(c.grid.cells[d]);
+    extent = std::max(extent, grid.hi[d] - grid.lo[d]);
+  }
+  const double tol = 1e-9 * extent;
+
+  // The walls inside the coupling grid: particles can reach every point within them.
+  if (c.walls.box) {
+    const Box walls{c.walls.box->first, c.walls.box->second};
+    const std::string why = outside(walls, grid, tol);
+    if (!why.empty()) {
+      at.fail({"walls", "box"}, "walls.box",
+              fmt::format("the walls {} extend beyond the coupling grid {} ({}); particles "
+                          "outside the grid get no gas forces: enlarge grid.cells or "
+                          "grid.origin, or shrink walls.box",
+                          fmtBox(walls), fmtBox(grid), why));
+    }
+  }
+
+  for (std::size_t i = 0; i < c.particles.size(); ++i) {
+    const auto& p = c.particles[i];
+    const std::string idx = std::to_string(i);
+    const std::vector<std::string> where =
+        p.positions.empty() ? std::vector<std::string>{"particles", idx, "region"}
+                            : std::vector<std::string>{"particles", idx, "positions"};
+    const std::string key = fmt::format("particles[{}].{}", i, where.back());
+    const Box b = occupied(p);
+    // The grid holds the region (lattice, random) or every centre (positions: particles are
+    // coupled to the cell of their centre).
+    const double r = 0.5 * p.diameter;
+    Box coupled = b;
+    if (!p.positions.empty()) {
+      for (int d = 0; d < 3; ++d) {
+        coupled.lo[d] += r;
+        coupled.hi[d] -= r;
+      }
+    }
+    std::string why = outside(coupled, grid, tol);
+    if (!why.empty()) {
+      at.fail(where, key,
+              fmt::format("{}: the particle {} {}, beyond the coupling grid {} ({}); "
+                          "enlarge grid.cells or grid.origin, or move the particles",
+                          setName(p, i), p.positions.empty() ? "region is" : "centres span",
+                          fmtBox(coupled), fmtBox(grid), why));
+    }
+    if (c.walls.box) {
+      const Box walls{c.walls.box->first, c.walls.box->second};
+      why = outside(b, walls, tol + (p.positions.empty() ? 0.0 : kMaxInitialOverlapFraction * r));
+      if (!why.empty()) {
+        at.fail(where, key,
+                fmt::format("{}: the particles occupy {}, outside the walls {} ({}); place "
+                            "them inside walls.box",
+                            setName(p, i), fmtBox(b), fmtBox(walls), why));
+      }
+    }
+    for (std::size_t k = 0; k < c.walls.planes.size(); ++k) {
+      const auto& pl = c.walls.planes[k];
+      const double len = std::sqrt(dot(pl.normal, pl.normal));
+      if (len <= 0.0) {
+        continue;
+      }
+      for (const auto& x : extremeCentres(p)) {
+        const Vec3 rel{x[0] - pl.point[0], x[1] - pl.point[1], x[2] - pl.point[2]};
+        const double dist = dot(rel, pl.normal) / len;
+        if (dist < r * (1.0 - kMaxInitialOverlapFraction) - tol) {
+          at.fail(where, key,
+                  fmt::format("{}: a particle centre at {} is {:.6g} m from the wall "
+                              "walls.planes[{}] (point {}, normal {}) on its inner side, less "
+                              "than the radius {:.6g} m: the particle is behind or inside the "
+                              "wall; move the region to the side the normal points to",
+                              setName(p, i), fmtVec(x), dist, k, fmtVec(pl.point),
+                              fmtVec(pl.normal), r));
+        }
+      }
+    }
+    // Room for the particles.
+    if (p.positions.empty()) {
+      double volume = 1.0;
+      long long sites = 1;
+      for (int d = 0; d < 3; ++d) {
+        const double len = p.regionMax[d] - p.regionMin[d];
+        volume *= len;
+        sites *= static_cast<long long>(std::floor(len / p.diameter + 1e-9));
+      }
+      const double solid = double(p.count) * kPi * p.diameter * p.diameter * p.diameter / 6.0;
+      if (p.packing == "lattice" && sites < static_cast<long long>(p.count)) {
+        at.fail({"particles", idx, "count"}, fmt::format("particles[{}].count", i),
+                fmt::format("{}: the region holds {} lattice sites of diameter {:.6g} m, but "
+                            "count = {}; enlarge the region or reduce the count",
+                            setName(p, i), sites, p.diameter, p.count));
+      }
+      if (p.packing == "random") {
+        const double phi = volume > 0.0 ? solid / volume : 1.0;
+        if (phi > kMaxRandomSolidFraction) {
+          at.fail({"particles", idx, "count"}, fmt::format("particles[{}].count", i),
+                  fmt::format("{}: {} particles of diameter {:.6g} m fill {:.3g} of the region's "
+                              "volume, more than a random packing reaches ({:.2g}); enlarge the "
+                              "region or reduce the count",
+                              setName(p, i), p.count, p.diameter, phi, kMaxRandomSolidFraction));
+        }
+        if (phi > kWarnRandomSolidFraction) {
+          warnings.push_back(at.warning(
+              {"particles", idx, "count"}, fmt::format("particles[{}].count", i),
+              fmt::format("{}: solid fraction {:.3g} of the region (above {:.2g}): random "
+                          "placement without overlap may not find room; use packing: lattice or "
+                          "a larger region",
+                          setName(p, i), phi, kWarnRandomSolidFraction)));
+        }
+      }
+    }
+    if (at.root()["particles"] && at.root()["particles"][i] &&
+        at.root()["particles"][i]["temperature"]) {
+      warnTemperature(at, warnings, {"particles", idx, "temperature"},
+                      fmt::format("particles[{}].temperature", i), p.temperature);
+    }
+  }
+  checkExplicitOverlaps(c, at);
+  // Placed sets whose regions intersect: the DEM places each set on its own.
+  for (std::size_t i = 0; i < c.particles.size(); ++i) {
+    for (std::size_t j = i + 1; j < c.particles.size(); ++j) {
+      if (c.particles[i].positions.empty() || c.particles[j].positions.empty()) {
+        const Box a = occupied(c.particles[i]), b = occupied(c.particles[j]);
+        bool meet = true;
+        for (int d = 0; d < 3; ++d) {
+          meet = meet && std::min(a.hi[d], b.hi[d]) - std::max(a.lo[d], b.lo[d]) > tol;
+        }
+        if (meet) {
+          warnings.push_back(
+              at.warning({"particles", std::to_string(j)}, fmt::format("particles[{}]", j),
+                         fmt::format("{} occupies {}, which intersects {} of {}: sets are placed "
+                                     "independently, so their particles may overlap",
+                                     setName(c.particles[j], j), fmtBox(b), fmtBox(a),
+                                     setName(c.particles[i], i))));
+        }
+      }
+    }
+  }
+
+  if (at.root()["gas_properties"] && at.root()["gas_properties"]["temperature"]) {
+    warnTemperature(at, warnings, {"gas_properties", "temperature"}, "gas_properties.temperature",
+                    c.gasProperties.temperature);
+  }
+  if (c.walls.temperature > 0.0) {
+    warnTemperature(at, warnings, {"walls", "temperature"}, "walls.temperature",
+                    c.walls.temperature);
+  }
+  // The prescribed gas temperature (coredem-gas's section), when it is a number.
+  const YAML::Node gas = at.root()[c.cfd.gasKey];
+  if (gas && gas.IsMap() && gas["T_g"] && gas["T_g"].IsScalar()) {
+    try {
+      warnTemperature(at, warnings, {c.cfd.gasKey, "T_g"}, c.cfd.gasKey + ".T_g",
+                      gas["T_g"].as<double>());
+    } catch (const YAML::Exception&) {
+    }
+  }
+  return warnings;
+}
+
+void checkOpenFoamCase(const CaseConfig& c) {
+  const Locator at(c);
+  const fs::path dir = c.caseDir / c.cfd.caseFolder;
+  const fs::path gFile = dir / "constant" / "g";
+  if (const auto g = foamEntry(gFile, "value")) {
+    const auto open = g->value.find('('), shut = g->value.find(')');
+    std::istringstream in(open != std::string::npos && shut != std::string::npos
+                              ? g->value.substr(open + 1, shut - open - 1)
+                              : std::string());
+    Vec3 foam{};
+    if (in >> foam[0] >> foam[1] >> foam[2]) {
+      const double norm =
+          std::max(std::sqrt(dot(foam, foam)), std::sqrt(dot(c.gravity, c.gravity)));
+      bool same = true;
+      for (int d = 0; d < 3; ++d) {
+        same = same && std::abs(foam[d] - c.gravity[d]) <= kFoamEqualityRelTol * norm;
+      }
+      if (!same) {
+        at.fail({"gravity"}, "gravity",
+                fmt::format("{} m/s2 (the DEM), but {}:{} gives ({:.6g} {:.6g} {:.6g}) (the "
+                            "gas); give the same vector in both",
+                            fmtVec(c.gravity), gFile.string(), g->line, foam[0], foam[1], foam[2]));
+      }
+    }
+  }
+  const fs::path tFile = dir / "constant" / "transportProperties";
+  auto scalar = [&](const std::string& key) -> std::optional<std::pair<double, int>> {
+    const auto e = foamEntry(tFile, key);
+    if (!e) {
+      return std::nullopt;
+    }
+    const auto v = foamScalar(e->value);
+    if (!v) {
+      return std::nullopt;
+    }
+    return std::make_pair(*v, e->line);
+  };
+  const auto rho = scalar("rho"), nu = scalar("nu"), cp = scalar("cp"), kappa = scalar("kappa");
+  const auto& gp = c.gasProperties;
+  const bool given = bool(at.root()["gas_properties"]);
+  auto compare = [&](const char* key, double yamlValue, double foamValue, const std::string& what,
+                     int line, const char* unit) {
+    if (close(yamlValue, foamValue)) {
+      return;
+    }
+    const bool has = given && at.root()["gas_properties"][key];
+    at.fail({"gas_properties", key}, fmt::format("gas_properties.{}", key),
+            fmt::format("{:.6g} {}{} (the DEM's drag and heat transfer), but {}:{} gives {} = "
+                        "{:.6g} {} (the gas); give the same value in both (relative tolerance "
+                        "{:.0e})",
+                        yamlValue, unit, has ? "" : " (the default; no value in case.yaml)",
+                        tFile.string(), line, what, foamValue, unit, kFoamEqualityRelTol));
+  };
+  if (rho) {
+    compare("density", gp.density, rho->first, "rho", rho->second, "kg/m3");
+  }
+  if (nu && rho) {
+    compare("viscosity", gp.viscosity, nu->first * rho->first,
+            fmt::format("nu·rho = {:.6g}·{:.6g}", nu->first, rho->first), nu->second, "Pa s");
+  }
+  if (cp) {
+    compare("cp", gp.cp, cp->first, "cp", cp->second, "J/kg/K");
+  }
+  if (kappa) {
+    compare("conductivity", gp.conductivity, kappa->first, "kappa", kappa->second, "W/m/K");
+  }
+}
+
+} // namespace coredem::orchestrator

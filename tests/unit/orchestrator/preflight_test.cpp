@@ -1,0 +1,315 @@
+// Pre-flight consistency (preflight.h): each check fails (CaseError with file:line:col and both
+// values) or warns as documented; the OpenFOAM participant's gravity and gas properties are
+// compared with the fluidized-bed-cooling case's OpenFOAM folder; every case under cases/
+// passes; the --walltime decision and the divergence hint (session.h).
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <coredem/orchestrator/case_config.h>
+#include <coredem/orchestrator/participants.h>
+#include <coredem/orchestrator/preflight.h>
+#include <coredem/orchestrator/session.h>
+
+#include "case_text.h"
+
+using namespace coredem::orchestrator;
+using coredem::orchestrator::test::replace;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kSource = COREDEM_SOURCE_DIR;
+
+// Line numbers matter: the tests check file:line:col.
+const char* kCase = R"(name: preflight
+time: {end: 0.01, dt: 1.0e-4}
+grid: {spacing: [0.01, 0.01, 0.01], cells: [2, 2, 4]}
+materials:
+  - {name: glass, density: 2500, k_n: 1000, e_n: 0.9}
+particles:
+  - material: glass
+    count: 10
+    diameter: 2.0e-3
+    temperature: 300.0
+    packing: random
+    region: {min: [0, 0, 0.01], max: [0.02, 0.02, 0.02]}
+walls:
+  box: {min: [0, 0, 0], max: [0.02, 0.02, 0.04]}
+  planes:
+    - {point: [0, 0, 0.005], normal: [0, 0, 1]}
+gas:
+  T_g: 500.0
+  u_g: [0, 0, 0.1]
+)";
+
+CaseConfig parse(const std::string& text, const fs::path& caseDir = fs::temp_directory_path()) {
+  return parseCase(text, caseDir / "case.yaml", caseDir);
+}
+
+/// The CaseError of checkCaseConsistency ("" when it passes).
+std::string failureOf(const std::string& text) {
+  try {
+    checkCaseConsistency(parse(text));
+  } catch (const CaseError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+} // namespace
+
+TEST(Preflight, ConsistentCasePassesWithoutWarnings) {
+  EXPECT_EQ(failureOf(kCase), "");
+  EXPECT_TRUE(checkCaseConsistency(parse(kCase)).empty());
+}
+
+TEST(Preflight, ParticlesBeyondTheGridFail) {
+  const std::string e = failureOf(
+      replace(kCase, "max: [0.02, 0.02, 0.02]}\nwalls", "max: [0.02, 0.03, 0.02]}\nwalls"));
+  EXPECT_TRUE(contains(e, "case.yaml:12:13: particles[0].region:")) << e;
+  EXPECT_TRUE(contains(e, "beyond the coupling grid")) << e;
+  EXPECT_TRUE(contains(e, "y = 0.03 m > 0.02 m")) << e;
+}
+
+TEST(Preflight, WallsBeyondTheGridFail) {
+  const std::string e =
+      failureOf(replace(kCase, "max: [0.02, 0.02, 0.04]}", "max: [0.02, 0.02, 0.05]}"));
+  EXPECT_TRUE(contains(e, "case.yaml:14:8: walls.box:")) << e;
+  EXPECT_TRUE(contains(e, "z = 0.05 m > 0.04 m")) << e;
+}
+
+TEST(Preflight, ParticlesOutsideTheWallBoxFail) {
+  // Grid and walls both shrunk in x, the region not.
+  std::string t = replace(kCase, "cells: [2, 2, 4]", "cells: [4, 2, 4]");
+  t = replace(t, "spacing: [0.01, 0.01, 0.01]", "spacing: [0.01, 0.01, 0.01]");
+  t = replace(t, "max: [0.02, 0.02, 0.02]}\nwalls", "max: [0.03, 0.02, 0.02]}\nwalls");
+  const std::string e = failureOf(t);
+  EXPECT_TRUE(contains(e, "particles[0].region:")) << e;
+  EXPECT_TRUE(contains(e, "outside the walls")) << e;
+  EXPECT_TRUE(contains(e, "x = 0.03 m > 0.02 m")) << e;
+}
+
+TEST(Preflight, ParticlesBehindAPlaneFail) {
+  // The region starts at z = 0.004, the plane keeps z >= 0.005 + r.
+  const std::string e =
+      failureOf(replace(kCase, "min: [0, 0, 0.01], max", "min: [0, 0, 0.004], max"));
+  EXPECT_TRUE(contains(e, "case.yaml:12:13: particles[0].region:")) << e;
+  EXPECT_TRUE(contains(e, "walls.planes[0]")) << e;
+  EXPECT_TRUE(contains(e, "less than the radius 0.001 m")) << e;
+  // A particle resting on the plane (centre at r above it) passes.
+  EXPECT_EQ(failureOf(replace(kCase, "min: [0, 0, 0.01], max", "min: [0, 0, 0.005], max")), "");
+}
+
+TEST(Preflight, LatticeRegionTooSmallFails) {
+  std::string t = replace(kCase, "packing: random", "packing: lattice");
+  t = replace(t, "count: 10", "count: 1001"); // 10 x 10 x 5 = 500 sites of 2 mm
+  const std::string e = failureOf(t);
+  EXPECT_TRUE(contains(e, "case.yaml:8:12: particles[0].count:")) << e;
+  EXPECT_TRUE(contains(e, "500 lattice sites")) << e;
+  EXPECT_TRUE(contains(e, "count = 1001")) << e;
+}
+
+TEST(Preflight, RandomPackingTooDenseFailsAndDenseWarns) {
+  // Region 4e-6 m3; a 2 mm sphere is 4.19e-9 m3: 640 spheres = 0.67 > 0.64.
+  const std::string e = failureOf(replace(kCase, "count: 10", "count: 640"));
+  EXPECT_TRUE(contains(e, "particles[0].count:")) << e;
+  EXPECT_TRUE(contains(e, "fill 0.67 of the region")) << e;
+  // 420 spheres = 0.44: a warning.
+  const auto w = checkCaseConsistency(parse(replace(kCase, "count: 10", "count: 420")));
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_TRUE(contains(w[0], "case.yaml:8:12: particles[0].count:")) << w[0];
+  EXPECT_TRUE(contains(w[0], "solid fraction 0.44")) << w[0];
+}
+
+TEST(Preflight, ExplicitOverlapBeyondTheFractionFails) {
+  const std::string base = R"(name: explicit
+time: {end: 0.01, dt: 1.0e-4}
+grid: {spacing: [0.01, 0.01, 0.01], cells: [2, 2, 2]}
+materials:
+  - {name: glass, density: 2500, k_n: 1000, e_n: 0.9}
+particles:
+  - material: glass
+    diameter: 2.0e-3
+    positions:
+      - [0.010, 0.01, 0.01]
+      - [0.0115, 0.01, 0.01]
+gas: {T_g: 300.0}
+)";
+  // 0.5 mm overlap = 0.25 of the diameter.
+  const std::string e = failureOf(base);
+  EXPECT_TRUE(contains(e, "case.yaml:11:9: particles[0].positions[1]:")) << e;
+  EXPECT_TRUE(contains(e, "overlaps particles[0].positions[0]")) << e;
+  EXPECT_TRUE(contains(e, "0.25 of the smaller diameter (at most 0.05 allowed)")) << e;
+  // A centre outside the grid (the particle is coupled to the cell of its centre).
+  const std::string g = failureOf(replace(base, "[0.010, 0.01, 0.01]", "[0.010, 0.01, 0.021]"));
+  EXPECT_TRUE(contains(g, "case.yaml:10:7: particles[0].positions:")) << g;
+  EXPECT_TRUE(contains(g, "centres span")) << g;
+  EXPECT_TRUE(contains(g, "z = 0.021 m > 0.02 m")) << g;
+  // 0.05 mm = 0.025 of the diameter (as the contact verification cases): accepted.
+  EXPECT_EQ(failureOf(replace(base, "[0.0115, 0.01, 0.01]", "[0.01195, 0.01, 0.01]")), "");
+}
+
+TEST(Preflight, IntersectingRegionsWarn) {
+  const std::string t = replace(kCase, "walls:", R"(  - material: glass
+    count: 5
+    diameter: 2.0e-3
+    region: {min: [0, 0, 0.015], max: [0.01, 0.01, 0.03]}
+walls:)");
+  const auto w = checkCaseConsistency(parse(t));
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_TRUE(contains(w[0], "particles[1]:")) << w[0];
+  EXPECT_TRUE(contains(w[0], "intersects")) << w[0];
+}
+
+TEST(Preflight, CelsiusTemperaturesWarn) {
+  std::string t = replace(kCase, "temperature: 300.0", "temperature: 90.0");
+  t = replace(t, "T_g: 500.0", "T_g: 20.0");
+  t = replace(t, "walls:\n", "gas_properties: {temperature: 20}\nwalls:\n");
+  const auto w = checkCaseConsistency(parse(t));
+  ASSERT_EQ(w.size(), 3u);
+  EXPECT_TRUE(contains(w[0], "case.yaml:10:18: particles[0].temperature: 90 K is below 200 K: "
+                             "°C given?"))
+      << w[0];
+  EXPECT_TRUE(contains(w[1], "gas_properties.temperature: 20 K")) << w[1];
+  EXPECT_TRUE(contains(w[2], "gas.T_g: 20 K")) << w[2];
+  // Warnings, not failures.
+  EXPECT_EQ(failureOf(t), "");
+}
+
+// ------------------------------------------------------------------ the OpenFOAM participant
+
+namespace {
+
+/// cases/fluidized-bed-cooling with its OpenFOAM folder copied to a temp folder.
+fs::path foamCaseCopy(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("coredem-preflight-" + name);
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const fs::path src = kSource / "cases" / "fluidized-bed-cooling";
+  fs::copy(src / "openfoam", d / "openfoam", fs::copy_options::recursive);
+  fs::copy_file(src / "case.yaml", d / "case.yaml");
+  return d;
+}
+
+std::string readText(const fs::path& p) {
+  std::ifstream in(p);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+void writeText(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
+
+/// The pre-flight of the coredemFoam row of the participant table ("" when it passes).
+std::string foamFailureOf(const fs::path& dir) {
+  const CaseConfig c = parse(readText(dir / "case.yaml"), dir);
+  const ParticipantDescriptor& p = participant(c.cfd.participant);
+  EXPECT_NE(p.preflight, nullptr);
+  try {
+    p.preflight(c);
+  } catch (const CaseError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+} // namespace
+
+TEST(PreflightOpenFoam, FluidizedBedCoolingIsConsistent) {
+  const fs::path d = foamCaseCopy("ok");
+  EXPECT_EQ(foamFailureOf(d), "");
+  fs::remove_all(d);
+}
+
+TEST(PreflightOpenFoam, GravityMismatchNamesBothValues) {
+  const fs::path d = foamCaseCopy("gravity");
+  writeText(d / "case.yaml", replace(readText(d / "case.yaml"), "gravity: [0.0, -9.81, 0.0]",
+                                     "gravity: [0.0, 0.0, -9.81]"));
+  const std::string e = foamFailureOf(d);
+  EXPECT_TRUE(contains(e, "case.yaml:19:10: gravity: [0, 0, -9.81] m/s2")) << e;
+  EXPECT_TRUE(contains(e, "openfoam/constant/g:16 gives (0 -9.81 0)")) << e;
+  fs::remove_all(d);
+}
+
+TEST(PreflightOpenFoam, GasPropertyMismatchNamesBothValues) {
+  const fs::path d = foamCaseCopy("gas");
+  writeText(d / "case.yaml",
+            replace(readText(d / "case.yaml"), "viscosity: 1.81e-5", "viscosity: 1.85e-5"));
+  std::string e = foamFailureOf(d);
+  EXPECT_TRUE(contains(e, "case.yaml:23:14: gas_properties.viscosity: 1.85e-05 Pa s")) << e;
+  EXPECT_TRUE(contains(e, "constant/transportProperties:17 gives nu·rho = 1.5033e-05·1.204 = "
+                          "1.80997e-05 Pa s"))
+      << e;
+  // The OpenFOAM side changed instead: cp.
+  writeText(d / "case.yaml",
+            replace(readText(d / "case.yaml"), "viscosity: 1.85e-5", "viscosity: 1.81e-5"));
+  writeText(d / "openfoam/constant/transportProperties",
+            replace(readText(d / "openfoam/constant/transportProperties"), "cp              1006;",
+                    "cp              1000;"));
+  e = foamFailureOf(d);
+  EXPECT_TRUE(contains(e, "case.yaml:25:7: gas_properties.cp: 1006 J/kg/K")) << e;
+  EXPECT_TRUE(contains(e, "gives cp = 1000 J/kg/K")) << e;
+  fs::remove_all(d);
+}
+
+// Every case under cases/ passes the consistency checks (and its participant's pre-flight).
+TEST(Preflight, EveryShippedCasePasses) {
+  std::size_t checked = 0;
+  for (const auto& e : fs::recursive_directory_iterator(kSource / "cases")) {
+    if (e.path().extension() != ".yaml" || e.path().filename() == "sweep.yaml" ||
+        e.path().filename() == "verify.yaml") {
+      continue;
+    }
+    SCOPED_TRACE(e.path().string());
+    CaseConfig c;
+    try {
+      c = loadCase(e.path());
+    } catch (const CaseError& err) {
+      ADD_FAILURE() << err.what();
+      continue;
+    }
+    EXPECT_NO_THROW({
+      const ParticipantDescriptor& p = participant(c.cfd.participant);
+      if (p.preflight != nullptr) {
+        p.preflight(c);
+      }
+      for (const auto& w : checkCaseConsistency(c)) {
+        ADD_FAILURE() << "warning: " << w;
+      }
+    });
+    ++checked;
+  }
+  EXPECT_GE(checked, 30u);
+}
+
+// ------------------------------------------------------------------ stopping early
+
+TEST(Stopping, WalltimeStopsWhenTheNextCheckpointWouldNotFit) {
+  // Reserve for 1000 s: 5 + 20 = 25 s.
+  EXPECT_DOUBLE_EQ(walltimeReserve(1000.0), 25.0);
+  // 900 s elapsed, steps of 10 s, checkpoint steps of 30 s: 900 + 10 + 30 + 25 = 965 < 1000.
+  EXPECT_FALSE(walltimeStopDue(900.0, 1000.0, 10.0, 30.0));
+  // 940 s: 1005 > 1000: this step is the last, with a checkpoint.
+  EXPECT_TRUE(walltimeStopDue(940.0, 1000.0, 10.0, 30.0));
+  // No estimate yet (first step): only the reserve counts.
+  EXPECT_FALSE(walltimeStopDue(0.5, 1000.0, 0.0, 0.0));
+  EXPECT_TRUE(walltimeStopDue(0.5, 1.0, 0.0, 0.0));
+}
+
+TEST(Stopping, DivergenceHintNamesCourantAndSuggestsDt) {
+  const std::string h = divergenceHint(42, 1e-3, 2.5);
+  EXPECT_TRUE(contains(h, "diverged in step 42")) << h;
+  EXPECT_TRUE(contains(h, "Courant number 2.5")) << h;
+  EXPECT_TRUE(contains(h, "time.dt <= 0.0002 s")) << h; // 1e-3 * 0.5/2.5
+  const std::string none = divergenceHint(1, 1e-3, -1.0);
+  EXPECT_TRUE(contains(none, "no Courant number reported yet")) << none;
+  EXPECT_TRUE(contains(none, "time.dt <= 0.0005 s")) << none;
+}
