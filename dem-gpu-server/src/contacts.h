@@ -1,10 +1,24 @@
 #pragma once
 /// @file
 /// Particle–particle and particle–wall contact forces in the DEM sub-step (PHYSICS §2.1, LSD with
-/// tangential history), written once for every backend like engine_impl.h. Every particle
-/// gathers its own contacts over its full neighbour list (no atomics), keeps its tangential
-/// history in K slots (partner gid, −(w+2) for wall w) and adds the contact forces to the gas
-/// force the drag module wrote (coupled runs).
+/// tangential history), written once for every backend like engine_impl.h.
+///
+/// Each pair is evaluated once, by its owner: the particle with the smaller global id (gid), a
+/// choice that survives re-sorting. At every neighbour rebuild the full neighbour lists give
+/// the half lists in CSR form (`_halfStart`, `_half`: each particle's owned candidates, gid of
+/// the partner larger, in ascending index order). Per sub-step, no atomics:
+///   pass 1 (per owner i): every owned candidate in contact is evaluated with the LSD law; the
+///     owner adds f and L_ij n × f_t to its own force and torque, keeps δ_t in its history
+///     slots, and writes the partner's share (−f is implied; L_ji n × f_t) to the per-candidate
+///     buffers `_pf`, `_ptq`; then its walls;
+///   pass 2 (per particle j): adds the partner shares of the contacts it does not own, in the
+///     ascending index order of its neighbour list (a fixed order).
+/// Both passes write only their own index, so the result does not depend on the thread count.
+/// The LSD law is mirror-exact (lsd_contact.h): j's share is bitwise what evaluating the pair
+/// from j's side gives. History slots (partner gid, −(w+2) for wall w) hold the owned contacts
+/// and the walls only; slots of a state file written when both sides kept their history are
+/// read as they are (the owner's slot is the one used; the other is dropped at the next sub-step).
+/// Forces add the gas force of the drag module in coupled runs.
 
 #include <array>
 #include <cstddef>
@@ -29,6 +43,8 @@ class ContactModule {
 public:
   template <class T>
   using Dual = backend::DualArray<T, Exec>;
+  template <class T>
+  using Dev = backend::DeviceArray<T, Exec>;
 
   void setup(const EngineSetup& s) {
     _pairs.allocate(s.pairs.size());
@@ -44,7 +60,10 @@ public:
   }
 
   bool enabled() const { return true; }
-  std::size_t bytes() const { return _pairs.bytes() + _walls.bytes(); }
+  std::size_t bytes() const {
+    return _pairs.bytes() + _walls.bytes() + _count.bytes() + _halfStart.bytes() + _half.bytes() +
+           _pf.bytes() + _ptq.bytes();
+  }
   ContactTotals totals() const { return {}; }
 
   /// History slots in use in some row (slots at or beyond it are empty everywhere); the
@@ -52,16 +71,58 @@ public:
   int usedSlots() const { return _maxUsedSlots; }
   /// After new particles: every slot may be in use.
   void resetUsedSlots(int slots) { _maxUsedSlots = slots; }
+  /// The neighbour lists or the particle order changed: the half lists are rebuilt before the
+  /// next sources().
+  void neighboursChanged() { _halfValid = false; }
 
   void beginWindow(StepContext<Exec>&) {}
   void update(StepContext<Exec>&) {}
   void endWindow(WindowContext<Exec>&) {}
+
+  /// Half lists (CSR) from the full neighbour lists: reads gid, nbCount, nbList.
+  void buildHalfLists(Exec& exec, ParticleStore<Exec>& p) {
+    const std::size_t n = p.n;
+    const int M = p.M;
+    const std::int64_t* gid = p.gid.d();
+    const std::int32_t* cnt = p.nbCount.d();
+    const std::int32_t* list = p.nbList.d();
+    _count.reserve(n + 1);
+    _halfStart.reserve(n + 1);
+    std::uint32_t* c = _count.d();
+    exec.parallelFor(n + 1, [=] DEM_LAMBDA(std::size_t i) {
+      std::uint32_t owned = 0;
+      if (i < n) {
+        for (int a = 0; a < cnt[i]; ++a)
+          owned += gid[list[i * M + a]] > gid[i] ? 1u : 0u;
+      }
+      c[i] = owned;
+    });
+    std::uint32_t* hs = _halfStart.d();
+    exec.exclusiveScan(c, hs, n + 1);
+    std::uint32_t total = 0;
+    Exec::copyToHost(&total, hs + n, sizeof(total));
+    _half.reserve(total);
+    _pf.reserve(3 * static_cast<std::size_t>(total));
+    _ptq.reserve(3 * static_cast<std::size_t>(total));
+    std::int32_t* half = _half.d();
+    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+      std::uint32_t k = hs[i];
+      for (int a = 0; a < cnt[i]; ++a) {
+        const std::int32_t j = list[i * M + a];
+        if (gid[j] > gid[i])
+          half[k++] = j;
+      }
+    });
+    _halfValid = true;
+  }
 
   /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, nbCount, nbList
   /// (+ the gas force of the drag module in coupled runs); writes force, torque, fwall, histKey,
   /// histDisp, contacts, wallContacts.
   void sources(StepContext<Exec>& ctx) {
     ParticleStore<Exec>& p = ctx.particles;
+    if (!_halfValid)
+      buildHalfLists(ctx.exec, p);
     const double dt = ctx.dt;
     const std::size_t n = p.n;
     const double* x = p.pos.d();
@@ -80,6 +141,10 @@ public:
     double* fw = p.fwall.d();
     std::int32_t* nc = p.contacts.d();
     std::int32_t* nwc = p.wallContacts.d();
+    const std::uint32_t* hs = _halfStart.d();
+    const std::int32_t* half = _half.d();
+    double* pf = _pf.d();
+    double* ptq = _ptq.d();
     const PairProps* pairs = _pairs.d();
     const kernels::PlaneWall* walls = _walls.d();
     const int nWalls = static_cast<int>(ctx.setup.walls.size());
@@ -88,103 +153,139 @@ public:
     const int M = p.M;
     const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
 
-    // reduceMax runs the kernel body once per index (side effects on index i only) and
-    // returns the largest number of contacts of a particle, in the same pass.
-    const double maxSlots = ctx.exec.reduceMax(
+    // Pass 1: the owned pairs and the walls of every particle.
+    ctx.exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+      using namespace kernels;
+      const long long ii = static_cast<long long>(i);
+      const Vec3 xi = load3(x, ii);
+      const Vec3 vi = load3(v, ii);
+      const Vec3 wi = load3(w, ii);
+      const double ri = r[i];
+      const double mi = m[i];
+      const int ai = mat[i];
+      // Slots in use are compacted at the front; nc + nwc of the last sub-step bounds them.
+      const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
+      std::int64_t oldKey[kMaxHistorySlots];
+      Vec3 oldD[kMaxHistorySlots];
+      for (int s = 0; s < used; ++s) {
+        oldKey[s] = hk[i * K + s];
+        oldD[s] = load3(hd, ii * K + s);
+      }
+      int slot = 0;
+      auto history = [&](std::int64_t key) {
+        for (int s = 0; s < used; ++s)
+          if (oldKey[s] == key)
+            return oldD[s];
+        return Vec3{0.0, 0.0, 0.0};
+      };
+      auto remember = [&](std::int64_t key, Vec3 d) {
+        if (slot < K) {
+          hk[i * K + slot] = key;
+          store3(hd, ii * K + slot, d);
+        }
+        ++slot;
+      };
+      Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
+      Vec3 T{0.0, 0.0, 0.0};
+      // Particle–particle LSD (Eqs. 7–13) over the owned candidates.
+      const std::uint32_t qEnd = hs[i + 1];
+      for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
+        const std::int32_t j = half[q];
+        const Vec3 d = load3(x, j) - xi;
+        const double l2 = dot(d, d);
+        const double rj = r[j];
+        const double rsum = ri + rj;
+        if (l2 >= rsum * rsum)
+          continue;
+        const double l = ::sqrt(l2);
+        const Vec3 nrm = (1.0 / l) * d;
+        const double deltaN = rsum - l;
+        const PairProps pp = pairs[ai * nMat + mat[j]];
+        const double meff = effectiveMass(mi, m[j]);
+        const double etan = pp.dampFactor * ::sqrt(pp.kn * meff);
+        const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+        const double lij = leverArm(l, ri, rj);
+        const double lji = leverArm(l, rj, ri);
+        const Vec3 vij = relativeVelocity(vi, load3(v, j), wi, load3(w, j), lij, lji, nrm);
+        const std::int64_t key = gid[j];
+        const LsdResult res = lsdContact(lp, nrm, deltaN, vij, lij, history(key), dt);
+        F += res.force;
+        T += res.torque;
+        remember(key, res.deltaT);
+        // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
+        store3(pf, static_cast<long long>(q), res.force);
+        store3(ptq, static_cast<long long>(q), lji * res.nxft);
+      }
+      // Walls (m_eff = m_i, the particle's material).
+      Vec3 FW{0.0, 0.0, 0.0};
+      int wallCount = 0;
+      for (int k = 0; k < nWalls; ++k) {
+        const double deltaN = wallOverlap(walls[k], xi, ri);
+        if (deltaN <= 0.0)
+          continue;
+        const PairProps pp = pairs[ai * nMat + ai];
+        const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
+        const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+        const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
+        const LsdResult res = wallContact(lp, walls[k], deltaN, vi, wi, ri, history(key), dt);
+        FW += res.force;
+        T += res.torque;
+        remember(key, res.deltaT);
+        ++wallCount;
+      }
+      F += FW;
+      for (int s = slot; s < used; ++s)
+        hk[i * K + s] = -1;
+      store3(f, ii, F);
+      store3(tq, ii, T);
+      store3(fw, ii, FW);
+      nwc[i] = wallCount;
+    });
+
+    // Pass 2: the shares of the pairs owned by the partner, in neighbour-list order.
+    // reduceMax runs the body once per index (side effects on index i only) and returns the
+    // largest number of contacts of a particle, in the same pass.
+    const double maxContacts = ctx.exec.reduceMax(
         n,
         [=] DEM_LAMBDA(std::size_t i) {
           using namespace kernels;
           const long long ii = static_cast<long long>(i);
           const Vec3 xi = load3(x, ii);
-          const Vec3 vi = load3(v, ii);
-          const Vec3 wi = load3(w, ii);
           const double ri = r[i];
-          const double mi = m[i];
-          const int ai = mat[i];
-          // Slots in use are compacted at the front: the last sub-step used nc + nwc of them.
-          const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
-          std::int64_t oldKey[kMaxHistorySlots];
-          Vec3 oldD[kMaxHistorySlots];
-          for (int s = 0; s < used; ++s) {
-            oldKey[s] = hk[i * K + s];
-            oldD[s] = load3(hd, ii * K + s);
-          }
-          int slot = 0;
-          auto history = [&](std::int64_t key) {
-            for (int s = 0; s < used; ++s)
-              if (oldKey[s] == key)
-                return oldD[s];
-            return Vec3{0.0, 0.0, 0.0};
-          };
-          auto remember = [&](std::int64_t key, Vec3 d) {
-            if (slot < K) {
-              hk[i * K + slot] = key;
-              store3(hd, ii * K + slot, d);
-            }
-            ++slot;
-          };
-          Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
-          Vec3 T{0.0, 0.0, 0.0};
-          // Particle–particle LSD (Eqs. 7–13), gathered over the full neighbour list.
+          const std::int64_t gi = gid[i];
+          Vec3 F = load3(f, ii);
+          Vec3 T = load3(tq, ii);
           int pairCount = 0;
           const int nb = cnt[i];
           for (int a = 0; a < nb; ++a) {
             const std::int32_t j = list[i * M + a];
-            const Vec3 d = load3(x, j) - xi;
-            const double l2 = dot(d, d);
-            const double rj = r[j];
-            const double rsum = ri + rj;
-            if (l2 >= rsum * rsum)
+            // The owner's test (d from j to i): the same contact decision, bitwise.
+            const Vec3 d = xi - load3(x, j);
+            const double rsum = r[j] + ri;
+            if (dot(d, d) >= rsum * rsum)
               continue;
-            const double l = ::sqrt(l2);
-            const Vec3 nrm = (1.0 / l) * d;
-            const double deltaN = rsum - l;
-            const PairProps pp = pairs[ai * nMat + mat[j]];
-            const double meff = effectiveMass(mi, m[j]);
-            const double etan = pp.dampFactor * ::sqrt(pp.kn * meff);
-            const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-            const double lij = leverArm(l, ri, rj);
-            const double lji = leverArm(l, rj, ri);
-            const Vec3 vij = relativeVelocity(vi, load3(v, j), wi, load3(w, j), lij, lji, nrm);
-            const std::int64_t key = gid[j];
-            const LsdResult res = lsdContact(lp, nrm, deltaN, vij, lij, history(key), dt);
-            F += res.force;
-            T += res.torque;
-            remember(key, res.deltaT);
             ++pairCount;
+            if (gid[j] > gi)
+              continue; // owned by i: added in pass 1
+            const std::uint32_t qEnd = hs[j + 1];
+            for (std::uint32_t q = hs[j]; q < qEnd; ++q) {
+              if (half[q] == static_cast<std::int32_t>(i)) {
+                F += -load3(pf, static_cast<long long>(q));
+                T += load3(ptq, static_cast<long long>(q));
+                break;
+              }
+            }
           }
-          // Walls (m_eff = m_i, the particle's material).
-          Vec3 FW{0.0, 0.0, 0.0};
-          int wallCount = 0;
-          for (int k = 0; k < nWalls; ++k) {
-            const double deltaN = wallOverlap(walls[k], xi, ri);
-            if (deltaN <= 0.0)
-              continue;
-            const PairProps pp = pairs[ai * nMat + ai];
-            const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
-            const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-            const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-            const LsdResult res = wallContact(lp, walls[k], deltaN, vi, wi, ri, history(key), dt);
-            FW += res.force;
-            T += res.torque;
-            remember(key, res.deltaT);
-            ++wallCount;
-          }
-          F += FW;
-          for (int s = slot; s < used; ++s)
-            hk[i * K + s] = -1;
           store3(f, ii, F);
           store3(tq, ii, T);
-          store3(fw, ii, FW);
           nc[i] = pairCount;
-          nwc[i] = wallCount;
-          return static_cast<double>(pairCount + wallCount);
+          return static_cast<double>(pairCount + nwc[i]);
         },
         0.0);
     p.produced(kForce | kTorque | kFwall | kHistKey | kHistDisp | kContacts | kWallContacts);
-    _maxUsedSlots = maxSlots < K ? static_cast<int>(maxSlots) : K;
-    if (maxSlots > K) {
-      backend::raiseUserError("a particle has " + std::to_string(static_cast<int>(maxSlots)) +
+    _maxUsedSlots = maxContacts < K ? static_cast<int>(maxContacts) : K;
+    if (maxContacts > K) {
+      backend::raiseUserError("a particle has " + std::to_string(static_cast<int>(maxContacts)) +
                               " simultaneous contacts but only " + std::to_string(K) +
                               " tangential-history slots; raise NeighbourOptions::historySlots "
                               "(at most " +
@@ -221,6 +322,12 @@ public:
 private:
   Dual<PairProps> _pairs;
   Dual<kernels::PlaneWall> _walls;
+  Dev<std::uint32_t> _count;     ///< owned candidates per particle (scan input), n + 1
+  Dev<std::uint32_t> _halfStart; ///< CSR offsets of the half lists, n + 1
+  Dev<std::int32_t> _half;       ///< owned candidates (partner index), ascending per particle
+  Dev<double> _pf;               ///< per candidate: force on the owner f (N), 3 values
+  Dev<double> _ptq;              ///< per candidate: torque on the partner L_ji n × f_t (N m), 3
+  bool _halfValid = false;
   int _maxUsedSlots =
       kMaxHistorySlots; ///< max contacts of a particle in the last sub-step (≥ slots in use)
 };
