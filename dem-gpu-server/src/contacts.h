@@ -153,98 +153,107 @@ public:
     const int M = p.M;
     const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
 
-    // Pass 1: the owned pairs and the walls of every particle.
-    ctx.exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
-      using namespace kernels;
-      const long long ii = static_cast<long long>(i);
-      const Vec3 xi = load3(x, ii);
-      const Vec3 vi = load3(v, ii);
-      const Vec3 wi = load3(w, ii);
-      const double ri = r[i];
-      const double mi = m[i];
-      const int ai = mat[i];
-      // Slots in use are compacted at the front; nc + nwc of the last sub-step bounds them.
-      const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
-      std::int64_t oldKey[kMaxHistorySlots];
-      Vec3 oldD[kMaxHistorySlots];
-      for (int s = 0; s < used; ++s) {
-        oldKey[s] = hk[i * K + s];
-        oldD[s] = load3(hd, ii * K + s);
-      }
-      int slot = 0;
-      auto history = [&](std::int64_t key) {
-        for (int s = 0; s < used; ++s)
-          if (oldKey[s] == key)
-            return oldD[s];
-        return Vec3{0.0, 0.0, 0.0};
-      };
-      auto remember = [&](std::int64_t key, Vec3 d) {
-        if (slot < K) {
-          hk[i * K + slot] = key;
-          store3(hd, ii * K + slot, d);
-        }
-        ++slot;
-      };
-      Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
-      Vec3 T{0.0, 0.0, 0.0};
-      // Particle–particle LSD (Eqs. 7–13) over the owned candidates.
-      const std::uint32_t qEnd = hs[i + 1];
-      for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
-        const std::int32_t j = half[q];
-        const Vec3 d = load3(x, j) - xi;
-        const double l2 = dot(d, d);
-        const double rj = r[j];
-        const double rsum = ri + rj;
-        if (l2 >= rsum * rsum)
-          continue;
-        const double l = ::sqrt(l2);
-        const Vec3 nrm = (1.0 / l) * d;
-        const double deltaN = rsum - l;
-        const PairProps pp = pairs[ai * nMat + mat[j]];
-        const double meff = effectiveMass(mi, m[j]);
-        const double etan = pp.dampFactor * ::sqrt(pp.kn * meff);
-        const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-        const double lij = leverArm(l, ri, rj);
-        const double lji = leverArm(l, rj, ri);
-        const Vec3 vij = relativeVelocity(vi, load3(v, j), wi, load3(w, j), lij, lji, nrm);
-        const std::int64_t key = gid[j];
-        const LsdResult res = lsdContact(lp, nrm, deltaN, vij, lij, history(key), dt);
-        F += res.force;
-        T += res.torque;
-        remember(key, res.deltaT);
-        // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
-        store3(pf, static_cast<long long>(q), res.force);
-        store3(ptq, static_cast<long long>(q), lji * res.nxft);
-      }
-      // Walls (m_eff = m_i, the particle's material).
-      Vec3 FW{0.0, 0.0, 0.0};
-      int wallCount = 0;
-      for (int k = 0; k < nWalls; ++k) {
-        const double deltaN = wallOverlap(walls[k], xi, ri);
-        if (deltaN <= 0.0)
-          continue;
-        const PairProps pp = pairs[ai * nMat + ai];
-        const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
-        const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-        const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-        const LsdResult res = wallContact(lp, walls[k], deltaN, vi, wi, ri, history(key), dt);
-        FW += res.force;
-        T += res.torque;
-        remember(key, res.deltaT);
-        ++wallCount;
-      }
-      F += FW;
-      for (int s = slot; s < used; ++s)
-        hk[i * K + s] = -1;
-      store3(f, ii, F);
-      store3(tq, ii, T);
-      store3(fw, ii, FW);
-      nwc[i] = wallCount;
-    });
+    // Pass 1: the owned pairs and the walls of every particle. reduceMax runs the body once
+    // per index (side effects on index i only) and returns the most history slots a particle
+    // needs (owned contacts + walls), in the same pass.
+    const double maxSlots = ctx.exec.reduceMax(
+        n,
+        [=] DEM_LAMBDA(std::size_t i) {
+          using namespace kernels;
+          const long long ii = static_cast<long long>(i);
+          const Vec3 xi = load3(x, ii);
+          const Vec3 vi = load3(v, ii);
+          const Vec3 wi = load3(w, ii);
+          const double ri = r[i];
+          const double mi = m[i];
+          const int ai = mat[i];
+          // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
+          // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
+          const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
+          std::int64_t oldKey[kMaxHistorySlots];
+          Vec3 oldD[kMaxHistorySlots];
+          for (int s = 0; s < used; ++s) {
+            oldKey[s] = hk[i * K + s];
+            oldD[s] = load3(hd, ii * K + s);
+          }
+          int slot = 0;
+          auto history = [&](std::int64_t key) {
+            for (int s = 0; s < used; ++s)
+              if (oldKey[s] == key)
+                return oldD[s];
+            return Vec3{0.0, 0.0, 0.0};
+          };
+          auto remember = [&](std::int64_t key, Vec3 d) {
+            if (slot < K) {
+              hk[i * K + slot] = key;
+              store3(hd, ii * K + slot, d);
+            }
+            ++slot;
+          };
+          Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
+          Vec3 T{0.0, 0.0, 0.0};
+          // Particle–particle LSD (Eqs. 7–13) over the owned candidates.
+          int owned = 0;
+          const std::uint32_t qEnd = hs[i + 1];
+          for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
+            const std::int32_t j = half[q];
+            const Vec3 d = load3(x, j) - xi;
+            const double l2 = dot(d, d);
+            const double rj = r[j];
+            const double rsum = ri + rj;
+            if (l2 >= rsum * rsum)
+              continue;
+            const double l = ::sqrt(l2);
+            const Vec3 nrm = (1.0 / l) * d;
+            const double deltaN = rsum - l;
+            const PairProps pp = pairs[ai * nMat + mat[j]];
+            const double meff = effectiveMass(mi, m[j]);
+            const double etan = pp.dampFactor * ::sqrt(pp.kn * meff);
+            const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+            const double lij = leverArm(l, ri, rj);
+            const double lji = leverArm(l, rj, ri);
+            const Vec3 vij = relativeVelocity(vi, load3(v, j), wi, load3(w, j), lij, lji, nrm);
+            const std::int64_t key = gid[j];
+            const LsdResult res = lsdContact(lp, nrm, deltaN, vij, lij, history(key), dt);
+            F += res.force;
+            T += res.torque;
+            remember(key, res.deltaT);
+            // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
+            store3(pf, static_cast<long long>(q), res.force);
+            store3(ptq, static_cast<long long>(q), lji * res.nxft);
+            ++owned;
+          }
+          // Walls (m_eff = m_i, the particle's material).
+          Vec3 FW{0.0, 0.0, 0.0};
+          int wallCount = 0;
+          for (int k = 0; k < nWalls; ++k) {
+            const double deltaN = wallOverlap(walls[k], xi, ri);
+            if (deltaN <= 0.0)
+              continue;
+            const PairProps pp = pairs[ai * nMat + ai];
+            const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
+            const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+            const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
+            const LsdResult res = wallContact(lp, walls[k], deltaN, vi, wi, ri, history(key), dt);
+            FW += res.force;
+            T += res.torque;
+            remember(key, res.deltaT);
+            ++wallCount;
+          }
+          F += FW;
+          for (int s = slot; s < used; ++s)
+            hk[i * K + s] = -1;
+          store3(f, ii, F);
+          store3(tq, ii, T);
+          store3(fw, ii, FW);
+          nc[i] = owned;
+          nwc[i] = wallCount;
+          return static_cast<double>(slot);
+        },
+        0.0);
 
     // Pass 2: the shares of the pairs owned by the partner, in neighbour-list order.
-    // reduceMax runs the body once per index (side effects on index i only) and returns the
-    // largest number of contacts of a particle, in the same pass.
+    // Returns the largest number of contacts of a particle (pairs from both sides, walls).
     const double maxContacts = ctx.exec.reduceMax(
         n,
         [=] DEM_LAMBDA(std::size_t i) {
@@ -255,7 +264,7 @@ public:
           const std::int64_t gi = gid[i];
           Vec3 F = load3(f, ii);
           Vec3 T = load3(tq, ii);
-          int pairCount = 0;
+          int pairCount = 0; // contacts owned by i or by the partner
           const int nb = cnt[i];
           for (int a = 0; a < nb; ++a) {
             const std::int32_t j = list[i * M + a];
@@ -278,12 +287,11 @@ public:
           }
           store3(f, ii, F);
           store3(tq, ii, T);
-          nc[i] = pairCount;
           return static_cast<double>(pairCount + nwc[i]);
         },
         0.0);
     p.produced(kForce | kTorque | kFwall | kHistKey | kHistDisp | kContacts | kWallContacts);
-    _maxUsedSlots = maxContacts < K ? static_cast<int>(maxContacts) : K;
+    _maxUsedSlots = maxSlots < K ? static_cast<int>(maxSlots) : K;
     if (maxContacts > K) {
       backend::raiseUserError("a particle has " + std::to_string(static_cast<int>(maxContacts)) +
                               " simultaneous contacts but only " + std::to_string(K) +
@@ -298,8 +306,8 @@ public:
     p.toHost(kContacts);
     std::size_t s = 0;
     for (std::size_t i = 0; i < p.n; ++i)
-      s += static_cast<std::size_t>(p.contacts.h()[i]);
-    return s / 2;
+      s += static_cast<std::size_t>(p.contacts.h()[i]); // each pair counted by its owner
+    return s;
   }
   /// Particle–wall contacts of the last sub-step.
   std::size_t wallContacts(ParticleStore<Exec>& p) const {

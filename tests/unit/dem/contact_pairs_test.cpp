@@ -259,6 +259,7 @@ TEST(ContactPairs, StatesWithBothSidesOfTheHistoryContinueBitwise) {
       bothSided.histKey[qj] = oneSided.gid[i];
       for (int c = 0; c < 3; ++c)
         bothSided.histDisp[3 * qj + c] = -oneSided.histDisp[3 * q + c];
+      ++bothSided.contacts[j]; // format ≤ 2: contact_count counted both sides' contacts
       ++mirrored;
     }
   }

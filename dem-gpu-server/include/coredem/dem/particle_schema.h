@@ -53,7 +53,7 @@
   X(temperature,  Temperature,  double,       "temperature",          Particles, 1, Particle,  "K",      kResorted | kCompacted | kCheckpointed | kSnapshot, 1, Required, "temperature T_p") \
   X(species,      Species,      double,       "species",              Particles, 1, Species,   "-",      kResorted | kCompacted | kCheckpointed, 1, Required, "solid species mass fractions") \
   X(material,     Material,     std::int32_t, "material",             Particles, 1, Particle,  "",       kResorted | kCompacted | kCheckpointed | kSnapshot, 1, Required, "material index") \
-  X(contacts,     Contacts,     std::int32_t, "contact_count",        Contacts,  1, Particle,  "",       kResorted | kCompacted | kCheckpointed, 1, Zero, "particle contacts found in the last sub-step") \
+  X(contacts,     Contacts,     std::int32_t, "contact_count",        Contacts,  1, Particle,  "",       kResorted | kCompacted | kCheckpointed, 1, Zero, "particle contacts this particle owned (partner gid larger) in the last sub-step; format <= 2: all its particle contacts") \
   X(wallContacts, WallContacts, std::int32_t, "wall_contact_count",   Contacts,  1, Particle,  "",       kResorted | kCompacted | kCheckpointed, 1, Zero, "wall contacts found in the last sub-step") \
   X(gid,          Gid,          std::int64_t, "global_id",            Particles, 1, Particle,  "",       kResorted | kCompacted | kCheckpointed | kSnapshot, 1, Required, "global id, stable through re-sorting and removal") \
   X(histKey,      HistKey,      std::int64_t, "history_key",          Contacts,  1, History,   "",       kResorted | kCompacted | kCheckpointed, 1, MinusOne, "tangential-history key: partner gid (contacts this particle owns: partner gid larger), -(w+2) for wall w, -1 empty") \
