@@ -62,7 +62,7 @@ public:
   bool enabled() const { return true; }
   std::size_t bytes() const {
     return _pairs.bytes() + _walls.bytes() + _count.bytes() + _halfStart.bytes() + _half.bytes() +
-           _pf.bytes() + _ptq.bytes();
+           _lowStart.bytes() + _low.bytes() + _hit.bytes() + _pf.bytes() + _ptq.bytes();
   }
   ContactTotals totals() const { return {}; }
 
@@ -113,12 +113,48 @@ public:
           half[k++] = j;
       }
     });
+    // Low lists: for each particle, the position in its partner's half list of every
+    // candidate the partner owns, in neighbour-list order (the lists are symmetric).
+    exec.parallelFor(n + 1, [=] DEM_LAMBDA(std::size_t i) {
+      c[i] = i < n ? static_cast<std::uint32_t>(cnt[i]) - (hs[i + 1] - hs[i]) : 0u;
+    });
+    _lowStart.reserve(n + 1);
+    std::uint32_t* ls = _lowStart.d();
+    exec.exclusiveScan(c, ls, n + 1);
+    std::uint32_t lowTotal = 0;
+    Exec::copyToHost(&lowTotal, ls + n, sizeof(lowTotal));
+    _low.reserve(lowTotal);
+    _hit.reserve(total);
+    std::uint32_t* low = _low.d();
+    const double missing = exec.reduceMax(
+        n,
+        [=] DEM_LAMBDA(std::size_t i) {
+          std::uint32_t k = ls[i];
+          double miss = 0.0;
+          for (int a = 0; a < cnt[i]; ++a) {
+            const std::int32_t j = list[i * M + a];
+            if (gid[j] > gid[i])
+              continue;
+            std::uint32_t at = hs[j];
+            while (at < hs[j + 1] && half[at] != static_cast<std::int32_t>(i))
+              ++at;
+            if (at == hs[j + 1])
+              miss = 1.0;
+            low[k++] = at;
+          }
+          return miss;
+        },
+        0.0);
+    if (missing > 0.0 || lowTotal != total) {
+      backend::raiseUserError("the neighbour lists are not symmetric (a state file edited by "
+                              "hand?); set list_valid = 0 to rebuild them");
+    }
     _halfValid = true;
   }
 
-  /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, nbCount, nbList
-  /// (+ the gas force of the drag module in coupled runs); writes force, torque, fwall, histKey,
-  /// histDisp, contacts, wallContacts.
+  /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, the half and low
+  /// lists (built from nbCount, nbList after a rebuild) (+ the gas force of the drag module in
+  /// coupled runs); writes force, torque, fwall, histKey, histDisp, contacts, wallContacts.
   void sources(StepContext<Exec>& ctx) {
     ParticleStore<Exec>& p = ctx.particles;
     if (!_halfValid)
@@ -134,8 +170,6 @@ public:
     const std::int64_t* gid = p.gid.d();
     std::int64_t* hk = p.histKey.d();
     double* hd = p.histDisp.d();
-    const std::int32_t* cnt = p.nbCount.d();
-    const std::int32_t* list = p.nbList.d();
     double* f = p.force.d();
     double* tq = p.torque.d();
     double* fw = p.fwall.d();
@@ -143,6 +177,9 @@ public:
     std::int32_t* nwc = p.wallContacts.d();
     const std::uint32_t* hs = _halfStart.d();
     const std::int32_t* half = _half.d();
+    const std::uint32_t* ls = _lowStart.d();
+    const std::uint32_t* low = _low.d();
+    unsigned char* hit = _hit.d();
     double* pf = _pf.d();
     double* ptq = _ptq.d();
     const PairProps* pairs = _pairs.d();
@@ -150,7 +187,6 @@ public:
     const int nWalls = static_cast<int>(ctx.setup.walls.size());
     const int nMat = ctx.setup.nMaterials;
     const int K = p.K;
-    const int M = p.M;
     const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
 
     // Pass 1: the owned pairs and the walls of every particle. reduceMax runs the body once
@@ -201,7 +237,9 @@ public:
             const double l2 = dot(d, d);
             const double rj = r[j];
             const double rsum = ri + rj;
-            if (l2 >= rsum * rsum)
+            const bool touching = l2 < rsum * rsum;
+            hit[q] = touching ? 1 : 0;
+            if (!touching)
               continue;
             const double l = ::sqrt(l2);
             const Vec3 nrm = (1.0 / l) * d;
@@ -259,31 +297,17 @@ public:
         [=] DEM_LAMBDA(std::size_t i) {
           using namespace kernels;
           const long long ii = static_cast<long long>(i);
-          const Vec3 xi = load3(x, ii);
-          const double ri = r[i];
-          const std::int64_t gi = gid[i];
           Vec3 F = load3(f, ii);
           Vec3 T = load3(tq, ii);
-          int pairCount = 0; // contacts owned by i or by the partner
-          const int nb = cnt[i];
-          for (int a = 0; a < nb; ++a) {
-            const std::int32_t j = list[i * M + a];
-            // The owner's test (d from j to i): the same contact decision, bitwise.
-            const Vec3 d = xi - load3(x, j);
-            const double rsum = r[j] + ri;
-            if (dot(d, d) >= rsum * rsum)
+          int pairCount = nc[i]; // + the contacts the partners own
+          const std::uint32_t kEnd = ls[i + 1];
+          for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
+            const long long q = low[k];
+            if (!hit[q])
               continue;
+            F += -load3(pf, q);
+            T += load3(ptq, q);
             ++pairCount;
-            if (gid[j] > gi)
-              continue; // owned by i: added in pass 1
-            const std::uint32_t qEnd = hs[j + 1];
-            for (std::uint32_t q = hs[j]; q < qEnd; ++q) {
-              if (half[q] == static_cast<std::int32_t>(i)) {
-                F += -load3(pf, static_cast<long long>(q));
-                T += load3(ptq, static_cast<long long>(q));
-                break;
-              }
-            }
           }
           store3(f, ii, F);
           store3(tq, ii, T);
@@ -333,6 +357,9 @@ private:
   Dev<std::uint32_t> _count;     ///< owned candidates per particle (scan input), n + 1
   Dev<std::uint32_t> _halfStart; ///< CSR offsets of the half lists, n + 1
   Dev<std::int32_t> _half;       ///< owned candidates (partner index), ascending per particle
+  Dev<std::uint32_t> _lowStart;  ///< CSR offsets of the low lists, n + 1
+  Dev<std::uint32_t> _low;       ///< per candidate a partner owns: its index in the half lists
+  Dev<unsigned char> _hit;       ///< per candidate: in contact this sub-step (pass 1)
   Dev<double> _pf;               ///< per candidate: force on the owner f (N), 3 values
   Dev<double> _ptq;              ///< per candidate: torque on the partner L_ji n × f_t (N m), 3
   bool _halfValid = false;
