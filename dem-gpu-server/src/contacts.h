@@ -147,7 +147,7 @@ public:
         0.0);
     if (missing > 0.0 || lowTotal != total) {
       backend::raiseUserError("the neighbour lists are not symmetric (a state file edited by "
-                              "hand?); set list_valid = 0 to rebuild them");
+                              "hand?); set /meta@neighbour_list_valid = 0 to rebuild them");
     }
     _halfValid = true;
   }
