@@ -1,10 +1,24 @@
 #pragma once
 /// @file
 /// Particle–particle and particle–wall contact forces in the DEM sub-step (PHYSICS §2.1, LSD with
-/// tangential history), written once for every backend like engine_impl.h. Every particle
-/// gathers its own contacts over its full neighbour list (no atomics), keeps its tangential
-/// history in K slots (partner gid, −(w+2) for wall w) and adds the contact forces to the gas
-/// force the drag module wrote (coupled runs).
+/// tangential history), written once for every backend like engine_impl.h.
+///
+/// Each pair is evaluated once, by its owner: the particle with the smaller global id (gid), a
+/// choice that survives re-sorting. At every neighbour rebuild the full neighbour lists give
+/// the half lists in CSR form (`_halfStart`, `_half`: each particle's owned candidates, gid of
+/// the partner larger, in ascending index order). Per sub-step, no atomics:
+///   pass 1 (per owner i): every owned candidate in contact is evaluated with the LSD law; the
+///     owner adds f and L_ij n × f_t to its own force and torque, keeps δ_t in its history
+///     slots, and writes the partner's share (−f is implied; L_ji n × f_t) to the per-candidate
+///     buffers `_pf`, `_ptq`; then its walls;
+///   pass 2 (per particle j): adds the partner shares of the contacts it does not own, in the
+///     ascending index order of its neighbour list (a fixed order).
+/// Both passes write only their own index, so the result does not depend on the thread count.
+/// The LSD law is mirror-exact (lsd_contact.h): j's share is bitwise what evaluating the pair
+/// from j's side gives. History slots (partner gid, −(w+2) for wall w) hold the owned contacts
+/// and the walls only; slots of a state file written when both sides kept their history are
+/// read as they are (the owner's slot is the one used; the other is dropped at the next sub-step).
+/// Forces add the gas force of the drag module in coupled runs.
 
 #include <array>
 #include <cstddef>
@@ -29,6 +43,8 @@ class ContactModule {
 public:
   template <class T>
   using Dual = backend::DualArray<T, Exec>;
+  template <class T>
+  using Dev = backend::DeviceArray<T, Exec>;
 
   void setup(const EngineSetup& s) {
     _pairs.allocate(s.pairs.size());
@@ -44,7 +60,10 @@ public:
   }
 
   bool enabled() const { return true; }
-  std::size_t bytes() const { return _pairs.bytes() + _walls.bytes(); }
+  std::size_t bytes() const {
+    return _pairs.bytes() + _walls.bytes() + _count.bytes() + _halfStart.bytes() + _half.bytes() +
+           _lowStart.bytes() + _low.bytes() + _hit.bytes() + _pf.bytes() + _ptq.bytes();
+  }
   ContactTotals totals() const { return {}; }
 
   /// History slots in use in some row (slots at or beyond it are empty everywhere); the
@@ -52,16 +71,94 @@ public:
   int usedSlots() const { return _maxUsedSlots; }
   /// After new particles: every slot may be in use.
   void resetUsedSlots(int slots) { _maxUsedSlots = slots; }
+  /// The neighbour lists or the particle order changed: the half lists are rebuilt before the
+  /// next sources().
+  void neighboursChanged() { _halfValid = false; }
 
   void beginWindow(StepContext<Exec>&) {}
   void update(StepContext<Exec>&) {}
   void endWindow(WindowContext<Exec>&) {}
 
-  /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, nbCount, nbList
-  /// (+ the gas force of the drag module in coupled runs); writes force, torque, fwall, histKey,
-  /// histDisp, contacts, wallContacts.
+  /// Half lists (CSR) from the full neighbour lists: reads gid, nbCount, nbList.
+  void buildHalfLists(Exec& exec, ParticleStore<Exec>& p) {
+    const std::size_t n = p.n;
+    const int M = p.M;
+    const std::int64_t* gid = p.gid.d();
+    const std::int32_t* cnt = p.nbCount.d();
+    const std::int32_t* list = p.nbList.d();
+    _count.reserve(n + 1);
+    _halfStart.reserve(n + 1);
+    std::uint32_t* c = _count.d();
+    exec.parallelFor(n + 1, [=] DEM_LAMBDA(std::size_t i) {
+      std::uint32_t owned = 0;
+      if (i < n) {
+        for (int a = 0; a < cnt[i]; ++a)
+          owned += gid[list[i * M + a]] > gid[i] ? 1u : 0u;
+      }
+      c[i] = owned;
+    });
+    std::uint32_t* hs = _halfStart.d();
+    exec.exclusiveScan(c, hs, n + 1);
+    std::uint32_t total = 0;
+    Exec::copyToHost(&total, hs + n, sizeof(total));
+    _half.reserve(total);
+    _pf.reserve(3 * static_cast<std::size_t>(total));
+    _ptq.reserve(3 * static_cast<std::size_t>(total));
+    std::int32_t* half = _half.d();
+    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+      std::uint32_t k = hs[i];
+      for (int a = 0; a < cnt[i]; ++a) {
+        const std::int32_t j = list[i * M + a];
+        if (gid[j] > gid[i])
+          half[k++] = j;
+      }
+    });
+    // Low lists: for each particle, the position in its partner's half list of every
+    // candidate the partner owns, in neighbour-list order (the lists are symmetric).
+    exec.parallelFor(n + 1, [=] DEM_LAMBDA(std::size_t i) {
+      c[i] = i < n ? static_cast<std::uint32_t>(cnt[i]) - (hs[i + 1] - hs[i]) : 0u;
+    });
+    _lowStart.reserve(n + 1);
+    std::uint32_t* ls = _lowStart.d();
+    exec.exclusiveScan(c, ls, n + 1);
+    std::uint32_t lowTotal = 0;
+    Exec::copyToHost(&lowTotal, ls + n, sizeof(lowTotal));
+    _low.reserve(lowTotal);
+    _hit.reserve(total);
+    std::uint32_t* low = _low.d();
+    const double missing = exec.reduceMax(
+        n,
+        [=] DEM_LAMBDA(std::size_t i) {
+          std::uint32_t k = ls[i];
+          double miss = 0.0;
+          for (int a = 0; a < cnt[i]; ++a) {
+            const std::int32_t j = list[i * M + a];
+            if (gid[j] > gid[i])
+              continue;
+            std::uint32_t at = hs[j];
+            while (at < hs[j + 1] && half[at] != static_cast<std::int32_t>(i))
+              ++at;
+            if (at == hs[j + 1])
+              miss = 1.0;
+            low[k++] = at;
+          }
+          return miss;
+        },
+        0.0);
+    if (missing > 0.0 || lowTotal != total) {
+      backend::raiseUserError("the neighbour lists are not symmetric (a state file edited by "
+                              "hand?); set /meta@neighbour_list_valid = 0 to rebuild them");
+    }
+    _halfValid = true;
+  }
+
+  /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, the half and low
+  /// lists (built from nbCount, nbList after a rebuild) (+ the gas force of the drag module in
+  /// coupled runs); writes force, torque, fwall, histKey, histDisp, contacts, wallContacts.
   void sources(StepContext<Exec>& ctx) {
     ParticleStore<Exec>& p = ctx.particles;
+    if (!_halfValid)
+      buildHalfLists(ctx.exec, p);
     const double dt = ctx.dt;
     const std::size_t n = p.n;
     const double* x = p.pos.d();
@@ -73,23 +170,28 @@ public:
     const std::int64_t* gid = p.gid.d();
     std::int64_t* hk = p.histKey.d();
     double* hd = p.histDisp.d();
-    const std::int32_t* cnt = p.nbCount.d();
-    const std::int32_t* list = p.nbList.d();
     double* f = p.force.d();
     double* tq = p.torque.d();
     double* fw = p.fwall.d();
     std::int32_t* nc = p.contacts.d();
     std::int32_t* nwc = p.wallContacts.d();
+    const std::uint32_t* hs = _halfStart.d();
+    const std::int32_t* half = _half.d();
+    const std::uint32_t* ls = _lowStart.d();
+    const std::uint32_t* low = _low.d();
+    unsigned char* hit = _hit.d();
+    double* pf = _pf.d();
+    double* ptq = _ptq.d();
     const PairProps* pairs = _pairs.d();
     const kernels::PlaneWall* walls = _walls.d();
     const int nWalls = static_cast<int>(ctx.setup.walls.size());
     const int nMat = ctx.setup.nMaterials;
     const int K = p.K;
-    const int M = p.M;
     const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
 
-    // reduceMax runs the kernel body once per index (side effects on index i only) and
-    // returns the largest number of contacts of a particle, in the same pass.
+    // Pass 1: the owned pairs and the walls of every particle. reduceMax runs the body once
+    // per index (side effects on index i only) and returns the most history slots a particle
+    // needs (owned contacts + walls), in the same pass.
     const double maxSlots = ctx.exec.reduceMax(
         n,
         [=] DEM_LAMBDA(std::size_t i) {
@@ -101,7 +203,8 @@ public:
           const double ri = r[i];
           const double mi = m[i];
           const int ai = mat[i];
-          // Slots in use are compacted at the front: the last sub-step used nc + nwc of them.
+          // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
+          // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
           const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
           std::int64_t oldKey[kMaxHistorySlots];
           Vec3 oldD[kMaxHistorySlots];
@@ -125,16 +228,18 @@ public:
           };
           Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
           Vec3 T{0.0, 0.0, 0.0};
-          // Particle–particle LSD (Eqs. 7–13), gathered over the full neighbour list.
-          int pairCount = 0;
-          const int nb = cnt[i];
-          for (int a = 0; a < nb; ++a) {
-            const std::int32_t j = list[i * M + a];
+          // Particle–particle LSD (Eqs. 7–13) over the owned candidates.
+          int owned = 0;
+          const std::uint32_t qEnd = hs[i + 1];
+          for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
+            const std::int32_t j = half[q];
             const Vec3 d = load3(x, j) - xi;
             const double l2 = dot(d, d);
             const double rj = r[j];
             const double rsum = ri + rj;
-            if (l2 >= rsum * rsum)
+            const bool touching = l2 < rsum * rsum;
+            hit[q] = touching ? 1 : 0;
+            if (!touching)
               continue;
             const double l = ::sqrt(l2);
             const Vec3 nrm = (1.0 / l) * d;
@@ -151,7 +256,10 @@ public:
             F += res.force;
             T += res.torque;
             remember(key, res.deltaT);
-            ++pairCount;
+            // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
+            store3(pf, static_cast<long long>(q), res.force);
+            store3(ptq, static_cast<long long>(q), lji * res.nxft);
+            ++owned;
           }
           // Walls (m_eff = m_i, the particle's material).
           Vec3 FW{0.0, 0.0, 0.0};
@@ -176,15 +284,40 @@ public:
           store3(f, ii, F);
           store3(tq, ii, T);
           store3(fw, ii, FW);
-          nc[i] = pairCount;
+          nc[i] = owned;
           nwc[i] = wallCount;
-          return static_cast<double>(pairCount + wallCount);
+          return static_cast<double>(slot);
+        },
+        0.0);
+
+    // Pass 2: the shares of the pairs owned by the partner, in neighbour-list order.
+    // Returns the largest number of contacts of a particle (pairs from both sides, walls).
+    const double maxContacts = ctx.exec.reduceMax(
+        n,
+        [=] DEM_LAMBDA(std::size_t i) {
+          using namespace kernels;
+          const long long ii = static_cast<long long>(i);
+          Vec3 F = load3(f, ii);
+          Vec3 T = load3(tq, ii);
+          int pairCount = nc[i]; // + the contacts the partners own
+          const std::uint32_t kEnd = ls[i + 1];
+          for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
+            const long long q = low[k];
+            if (!hit[q])
+              continue;
+            F += -load3(pf, q);
+            T += load3(ptq, q);
+            ++pairCount;
+          }
+          store3(f, ii, F);
+          store3(tq, ii, T);
+          return static_cast<double>(pairCount + nwc[i]);
         },
         0.0);
     p.produced(kForce | kTorque | kFwall | kHistKey | kHistDisp | kContacts | kWallContacts);
     _maxUsedSlots = maxSlots < K ? static_cast<int>(maxSlots) : K;
-    if (maxSlots > K) {
-      backend::raiseUserError("a particle has " + std::to_string(static_cast<int>(maxSlots)) +
+    if (maxContacts > K) {
+      backend::raiseUserError("a particle has " + std::to_string(static_cast<int>(maxContacts)) +
                               " simultaneous contacts but only " + std::to_string(K) +
                               " tangential-history slots; raise NeighbourOptions::historySlots "
                               "(at most " +
@@ -197,8 +330,8 @@ public:
     p.toHost(kContacts);
     std::size_t s = 0;
     for (std::size_t i = 0; i < p.n; ++i)
-      s += static_cast<std::size_t>(p.contacts.h()[i]);
-    return s / 2;
+      s += static_cast<std::size_t>(p.contacts.h()[i]); // each pair counted by its owner
+    return s;
   }
   /// Particle–wall contacts of the last sub-step.
   std::size_t wallContacts(ParticleStore<Exec>& p) const {
@@ -221,6 +354,15 @@ public:
 private:
   Dual<PairProps> _pairs;
   Dual<kernels::PlaneWall> _walls;
+  Dev<std::uint32_t> _count;     ///< owned candidates per particle (scan input), n + 1
+  Dev<std::uint32_t> _halfStart; ///< CSR offsets of the half lists, n + 1
+  Dev<std::int32_t> _half;       ///< owned candidates (partner index), ascending per particle
+  Dev<std::uint32_t> _lowStart;  ///< CSR offsets of the low lists, n + 1
+  Dev<std::uint32_t> _low;       ///< per candidate a partner owns: its index in the half lists
+  Dev<unsigned char> _hit;       ///< per candidate: in contact this sub-step (pass 1)
+  Dev<double> _pf;               ///< per candidate: force on the owner f (N), 3 values
+  Dev<double> _ptq;              ///< per candidate: torque on the partner L_ji n × f_t (N m), 3
+  bool _halfValid = false;
   int _maxUsedSlots =
       kMaxHistorySlots; ///< max contacts of a particle in the last sub-step (≥ slots in use)
 };

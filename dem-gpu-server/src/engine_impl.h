@@ -2,8 +2,9 @@
 /// @file
 /// The DEM engine, written once and instantiated per backend (cpu: backend/cpu/cpu_engine.cpp,
 /// cuda: backend/cuda/cuda_engine.cu). All loops are Exec::parallelFor over particles or
-/// cells; each index writes only its own outputs (full neighbour lists, gather, no atomics),
-/// so results are deterministic and independent of the thread count.
+/// cells; each index writes only its own outputs (no atomics; contacts.h evaluates each pair
+/// once, by its owner, and gathers the partner's share in a fixed order), so results are
+/// deterministic and independent of the thread count.
 ///
 /// The engine owns the particles, the neighbour lists and the coupling-cell binning
 /// (coupling_cells.h) and drives the sub-step modules through one interface (step_module.h):
@@ -90,6 +91,7 @@ public:
     });
     _p.toDevice(kAllFields);
     _contacts.resetUsedSlots(_p.K);
+    _contacts.neighboursChanged();
     _listValid = s.listValid != 0;
     reserveScratch();
   }
@@ -346,6 +348,7 @@ public:
     const double* x = _p.pos.d();
     _exec.parallelFor(3 * n, [=] DEM_LAMBDA(std::size_t k) { xr[k] = x[k]; });
     _p.produced(kAllFields);
+    _contacts.neighboursChanged(); // half lists follow the new order and lists
     _listValid = true;
     ++_t.rebuilds;
   }

@@ -53,10 +53,10 @@
   X(temperature,  Temperature,  double,       "temperature",          Particles, 1, Particle,  "K",      kResorted | kCompacted | kCheckpointed | kSnapshot, 1, Required, "temperature T_p") \
   X(species,      Species,      double,       "species",              Particles, 1, Species,   "-",      kResorted | kCompacted | kCheckpointed, 1, Required, "solid species mass fractions") \
   X(material,     Material,     std::int32_t, "material",             Particles, 1, Particle,  "",       kResorted | kCompacted | kCheckpointed | kSnapshot, 1, Required, "material index") \
-  X(contacts,     Contacts,     std::int32_t, "contact_count",        Contacts,  1, Particle,  "",       kResorted | kCompacted | kCheckpointed, 1, Zero, "particle contacts found in the last sub-step") \
+  X(contacts,     Contacts,     std::int32_t, "contact_count",        Contacts,  1, Particle,  "",       kResorted | kCompacted | kCheckpointed, 1, Zero, "particle contacts this particle owned (partner gid larger) in the last sub-step; format <= 2: all its particle contacts") \
   X(wallContacts, WallContacts, std::int32_t, "wall_contact_count",   Contacts,  1, Particle,  "",       kResorted | kCompacted | kCheckpointed, 1, Zero, "wall contacts found in the last sub-step") \
   X(gid,          Gid,          std::int64_t, "global_id",            Particles, 1, Particle,  "",       kResorted | kCompacted | kCheckpointed | kSnapshot, 1, Required, "global id, stable through re-sorting and removal") \
-  X(histKey,      HistKey,      std::int64_t, "history_key",          Contacts,  1, History,   "",       kResorted | kCompacted | kCheckpointed, 1, MinusOne, "tangential-history partner: gid, -(w+2) for wall w, -1 empty") \
+  X(histKey,      HistKey,      std::int64_t, "history_key",          Contacts,  1, History,   "",       kResorted | kCompacted | kCheckpointed, 1, MinusOne, "tangential-history key: partner gid (contacts this particle owns: partner gid larger), -(w+2) for wall w, -1 empty") \
   X(histDisp,     HistDisp,     double,       "history_displacement", Contacts,  3, History,   "m",      kResorted | kCompacted | kCheckpointed, 1, Zero, "accumulated tangential displacement delta_t") \
   X(nbCount,      NbCount,      std::int32_t, "neighbour_count",      Contacts,  1, Particle,  "",       kCompacted | kCheckpointed, 1, Zero, "neighbour-list length; rebuilt after a re-sort") \
   X(nbList,       NbList,       std::int32_t, "neighbour_list",       Contacts,  1, Neighbour, "",       kCompacted | kCheckpointed, 1, Zero, "neighbour indices (internal order); rebuilt after a re-sort") \
@@ -69,7 +69,10 @@ namespace coredem::dem::schema {
 /// Version of the HDF5 state-file layout this build writes (/meta attribute `format_version`).
 /// Files without the attribute are version 1. A file with a larger version is refused.
 /// 2: `format_version` written; initial_diameter and chemistry_reference always present.
-inline constexpr int kFormatVersion = 2;
+/// 3: each contact's tangential history is kept once, by its owner (the particle with the
+///    smaller gid; src/contacts.h); versions 1–2 kept it on both sides, which reads as is (the
+///    owner's slot is used, the partner's dropped at the next sub-step, results unchanged).
+inline constexpr int kFormatVersion = 3;
 
 enum class Type { Float64, Int32, Int64 };
 enum class Group { Particles, Contacts };

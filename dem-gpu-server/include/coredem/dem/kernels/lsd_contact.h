@@ -12,8 +12,8 @@
 ///        if |k_t δ_t| > μ|f_n|:  f_t = −μ|f_n| t − η_t v_t,  δ_t ← (μ|f_n|/k_t) t,  t = δ_t/|δ_t|
 ///   (7)  torque on i: L_ij n × f_t                                        (N m)
 /// P_n projects on the current tangent plane. The expressions are mirror-exact: evaluating
-/// the pair from j's side (n → −n, v_ij → −v_ij, δ_t → −δ_t) gives exactly −f, so the
-/// gathered (full-list) forces conserve momentum to round-off.
+/// the pair from j's side (n → −n, v_ij → −v_ij, δ_t → −δ_t) gives exactly −f and the torque
+/// L_ji n × f_t, so one evaluation per pair (contacts.h) gives both sides bitwise.
 
 #include "coredem/dem/kernels/common.h"
 #include "coredem/dem/kernels/vec3.h"
@@ -33,6 +33,7 @@ struct LsdResult {
   Vec3 force;  ///< f_n + f_t on particle i (N)
   Vec3 torque; ///< torque on i (N m)
   Vec3 deltaT; ///< updated accumulated tangential displacement (m), to store
+  Vec3 nxft;   ///< n × f_t (N): torque on i = L_ij n × f_t, on j = L_ji n × f_t (mirror-exact)
 };
 
 /// Contact point velocity difference v_ij (m/s).
@@ -64,7 +65,8 @@ DEM_HD LsdResult lsdContact(const LsdParams& p, Vec3 n, double deltaN, Vec3 vij,
   const Vec3 ft = fs - p.etat * vt;
   LsdResult r;
   r.force = fn + ft;
-  r.torque = lij * cross(n, ft);
+  r.nxft = cross(n, ft);
+  r.torque = lij * r.nxft;
   r.deltaT = dT;
   return r;
 }

@@ -1,0 +1,276 @@
+// Contact pairs evaluated once (contacts.h): the owner (smaller global id) evaluates each pair,
+// the partner gathers its share. Checked against a reference that evaluates every pair from both
+// sides, for thread-count independence on a dense bed, and for state files whose history holds
+// both sides of a contact (the layout before format version 3).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "coredem/dem/kernels/damping.h"
+#include "coredem/dem/kernels/lsd_contact.h"
+#include "coredem/dem/kernels/wall_contact.h"
+#include "engine.h"
+
+using namespace coredem::dem;
+using kernels::Vec3;
+
+namespace {
+
+constexpr int kSlots = 12;
+constexpr double kDiameter = 1e-3;
+constexpr double kPi = 3.14159265358979323846;
+
+/// Two materials; pairs mix them as DemSystem does (symmetric table).
+EngineSetup denseSetup(int threads) {
+  EngineSetup s;
+  s.nMaterials = 2;
+  const PairProps a{200.0, 100.0, 0.3, 0.5, 0.3};
+  const PairProps b{300.0, 150.0, 0.2, 0.5, 0.5};
+  const PairProps ab{240.0, 120.0, 0.3, 0.5, 0.3};
+  s.pairs = {a, ab, ab, b};
+  s.walls = {kernels::PlaneWall{Vec3{0, 0, 0}, Vec3{0, 0, 1}}};
+  s.maxRadius = 0.55 * kDiameter;
+  s.skin = 0.1 * kDiameter;
+  s.historySlots = kSlots;
+  s.neighbourSlots = 32;
+  s.threads = threads;
+  return s;
+}
+
+/// side³ particles on a compressed, jittered lattice (spacing 0.95 d): every lattice neighbour
+/// overlaps, the bottom layer touches the floor; two radii and two materials; random motion.
+/// Given in shuffled order with shuffled global ids so that ownership differs from index order.
+HostState denseState(int side) {
+  HostState s;
+  const auto n = static_cast<std::size_t>(side * side * side);
+  s.n = n;
+  s.historySlots = kSlots;
+  s.neighbourSlots = 32;
+  std::mt19937_64 rng(42);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<std::int64_t> gids(n);
+  for (std::size_t i = 0; i < n; ++i)
+    gids[i] = static_cast<std::int64_t>(i);
+  std::shuffle(gids.begin(), gids.end(), rng);
+  const double h = 0.95 * kDiameter;
+  for (std::size_t i = 0; i < n; ++i) {
+    const int ix = static_cast<int>(i % side), iy = static_cast<int>((i / side) % side),
+              iz = static_cast<int>(i / (side * side));
+    const double c[3] = {h * ix, h * iy, 0.48 * kDiameter + h * iz};
+    for (int d = 0; d < 3; ++d) {
+      s.pos.push_back(c[d] + 0.01 * kDiameter * u(rng));
+      s.vel.push_back(0.05 * u(rng));
+      s.omega.push_back(50.0 * u(rng));
+    }
+    const bool big = (ix + iy + iz) % 2 == 0;
+    const double r = big ? 0.5 * kDiameter : 0.49 * kDiameter;
+    s.radius.push_back(r);
+    s.density.push_back(2500.0);
+    s.mass.push_back(2500.0 * 4.0 / 3.0 * kPi * r * r * r);
+    s.temperature.push_back(300.0);
+    s.material.push_back(big ? 0 : 1);
+    s.gid.push_back(gids[i]);
+  }
+  s.xref = s.pos;
+  fillDefaults(s);
+  checkShapes(s, "denseState");
+  return s;
+}
+
+std::map<std::int64_t, std::size_t> rowByGid(const HostState& s) {
+  std::map<std::int64_t, std::size_t> m;
+  for (std::size_t i = 0; i < s.n; ++i)
+    m[s.gid[i]] = i;
+  return m;
+}
+
+/// δ_t stored in particle i's slots under `key`, and whether there is one.
+bool slotOf(const HostState& s, std::size_t i, std::int64_t key, Vec3& d) {
+  for (int k = 0; k < s.historySlots; ++k) {
+    const std::size_t q = i * s.historySlots + static_cast<std::size_t>(k);
+    if (s.histKey[q] == key) {
+      d = Vec3{s.histDisp[3 * q], s.histDisp[3 * q + 1], s.histDisp[3 * q + 2]};
+      return true;
+    }
+  }
+  return false;
+}
+
+Vec3 at(const std::vector<double>& v, std::size_t i) {
+  return Vec3{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+}
+
+void expectBitwiseEqual(const HostState& a, const HostState& b) {
+  EXPECT_EQ(a.gid, b.gid);
+  EXPECT_EQ(a.pos, b.pos);
+  EXPECT_EQ(a.vel, b.vel);
+  EXPECT_EQ(a.omega, b.omega);
+  EXPECT_EQ(a.force, b.force);
+  EXPECT_EQ(a.torque, b.torque);
+  EXPECT_EQ(a.histKey, b.histKey);
+  EXPECT_EQ(a.contacts, b.contacts);
+  // δ_t of the slots in use (an emptied slot keeps a stale δ_t that is never read).
+  ASSERT_EQ(a.histDisp.size(), b.histDisp.size());
+  for (std::size_t q = 0; q < a.histKey.size(); ++q) {
+    if (a.histKey[q] == -1)
+      continue;
+    for (int c = 0; c < 3; ++c)
+      EXPECT_EQ(a.histDisp[3 * q + c], b.histDisp[3 * q + c]) << "slot " << q;
+  }
+}
+
+} // namespace
+
+TEST(ContactPairs, ForcesMatchAReferenceEvaluatingBothSides) {
+  const EngineSetup setup = denseSetup(2);
+  auto engine = makeCpuEngine(setup);
+  engine->setState(denseState(6));
+  const double dt = 2e-6;
+  for (int k = 0; k < 40; ++k) // tangential history builds up (some contacts slide)
+    engine->subStep(dt);
+  const HostState s0 = engine->state();
+  engine->subStep(dt);
+  const HostState s1 = engine->state(); // forces of this sub-step: at s0's positions
+  const auto row1 = rowByGid(s1);
+
+  // Reference: every pair evaluated from each side, the history of side i taken from the
+  // owner's slot (negated for the partner).
+  double fMax = 0.0, tMax = 0.0, fErr = 0.0, tErr = 0.0, dErr = 0.0, dMax = 0.0;
+  std::size_t pairContacts = 0, sliding = 0;
+  for (std::size_t i = 0; i < s0.n; ++i) {
+    using namespace kernels;
+    const Vec3 xi = at(s0.pos, i);
+    const double ri = s0.radius[i];
+    Vec3 F{0, 0, 0}, T{0, 0, 0};
+    for (std::size_t j = 0; j < s0.n; ++j) {
+      if (j == i)
+        continue;
+      const Vec3 d = at(s0.pos, j) - xi;
+      const double l = std::sqrt(dot(d, d));
+      const double rj = s0.radius[j];
+      if (l >= ri + rj)
+        continue;
+      ++pairContacts;
+      const Vec3 n = (1.0 / l) * d;
+      const PairProps pp = setup.pairs[s0.material[i] * setup.nMaterials + s0.material[j]];
+      const double etan = pp.dampFactor * std::sqrt(pp.kn * effectiveMass(s0.mass[i], s0.mass[j]));
+      const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+      const double lij = leverArm(l, ri, rj), lji = leverArm(l, rj, ri);
+      const Vec3 vij = relativeVelocity(at(s0.vel, i), at(s0.vel, j), at(s0.omega, i),
+                                        at(s0.omega, j), lij, lji, n);
+      const bool owner = s0.gid[i] < s0.gid[j];
+      Vec3 hist{0, 0, 0};
+      if (owner) {
+        slotOf(s0, i, s0.gid[j], hist);
+      } else if (slotOf(s0, j, s0.gid[i], hist)) {
+        hist = -hist;
+      }
+      const LsdResult res = lsdContact(lp, n, ri + rj - l, vij, lij, hist, dt);
+      F += res.force;
+      T += res.torque;
+      if (owner) { // the updated history is kept once, by the owner
+        Vec3 stored{0, 0, 0};
+        ASSERT_TRUE(slotOf(s1, row1.at(s0.gid[i]), s0.gid[j], stored));
+        const Vec3 e = stored - res.deltaT;
+        dErr = std::max(dErr, std::sqrt(dot(e, e)));
+        dMax = std::max(dMax, std::sqrt(dot(res.deltaT, res.deltaT)));
+        Vec3 none{0, 0, 0};
+        EXPECT_FALSE(slotOf(s1, row1.at(s0.gid[j]), s0.gid[i], none)) << "history kept twice";
+        // Sliding: |k_t δ_t| = μ|f_n| after the update (the Coulomb branch ran).
+        const Vec3 fn = (-pp.kn * (ri + rj - l)) * n - etan * (dot(vij, n) * n);
+        const double ktd = pp.kt * std::sqrt(dot(res.deltaT, res.deltaT));
+        const double limit = pp.mu * std::sqrt(dot(fn, fn));
+        if (std::abs(ktd - limit) <= 1e-9 * limit)
+          ++sliding;
+      }
+    }
+    for (const PlaneWall& w : setup.walls) {
+      const double dn = wallOverlap(w, xi, ri);
+      if (dn <= 0.0)
+        continue;
+      const PairProps pp = setup.pairs[s0.material[i] * setup.nMaterials + s0.material[i]];
+      const double etan = pp.dampFactor * std::sqrt(pp.kn * s0.mass[i]);
+      const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+      Vec3 hist{0, 0, 0};
+      slotOf(s0, i, -2, hist);
+      const LsdResult res = wallContact(lp, w, dn, at(s0.vel, i), at(s0.omega, i), ri, hist, dt);
+      F += res.force;
+      T += res.torque;
+    }
+    const std::size_t i1 = row1.at(s0.gid[i]);
+    const Vec3 ef = at(s1.force, i1) - F, et = at(s1.torque, i1) - T;
+    fErr = std::max(fErr, std::sqrt(dot(ef, ef)));
+    tErr = std::max(tErr, std::sqrt(dot(et, et)));
+    fMax = std::max(fMax, std::sqrt(dot(F, F)));
+    tMax = std::max(tMax, std::sqrt(dot(T, T)));
+  }
+  ASSERT_GT(pairContacts, 4 * s0.n) << "not a dense bed: the test proves little";
+  EXPECT_EQ(engine->pairContacts(), pairContacts / 2);
+  EXPECT_GT(sliding, 0u) << "no sliding contact: the Coulomb branch is not exercised";
+  // Only the summation order differs from the reference: round-off.
+  EXPECT_LE(fErr, 1e-12 * fMax);
+  EXPECT_LE(tErr, 1e-12 * tMax);
+  EXPECT_LE(dErr, 1e-12 * dMax);
+}
+
+TEST(ContactPairs, OneAndTwoThreadsAreBitwiseIdenticalOnADenseBed) {
+  // 512 particles: more than the 256 below which the cpu backend runs a loop serially.
+  HostState s[2];
+  for (int t = 0; t < 2; ++t) {
+    auto engine = makeCpuEngine(denseSetup(t + 1));
+    engine->setState(denseState(8));
+    for (int k = 0; k < 60; ++k)
+      engine->subStep(2e-6);
+    s[t] = engine->state();
+  }
+  expectBitwiseEqual(s[0], s[1]);
+}
+
+TEST(ContactPairs, StatesWithBothSidesOfTheHistoryContinueBitwise) {
+  // Before format version 3 both particles of a contact kept its history (δ_t and −δ_t).
+  // Such a state continues exactly as the one-sided state does: the owner's slot is used.
+  const EngineSetup setup = denseSetup(2);
+  auto engine = makeCpuEngine(setup);
+  engine->setState(denseState(6));
+  for (int k = 0; k < 30; ++k)
+    engine->subStep(2e-6);
+  const HostState oneSided = engine->state();
+  HostState bothSided = oneSided;
+  const auto row = rowByGid(oneSided);
+  std::vector<int> used(oneSided.n, 0);
+  for (std::size_t i = 0; i < oneSided.n; ++i)
+    for (int k = 0; k < kSlots && oneSided.histKey[i * kSlots + k] != -1; ++k)
+      used[i] = k + 1;
+  std::size_t mirrored = 0;
+  for (std::size_t i = 0; i < oneSided.n; ++i) {
+    for (int k = 0; k < used[i]; ++k) {
+      const std::size_t q = i * kSlots + static_cast<std::size_t>(k);
+      const std::int64_t key = oneSided.histKey[q];
+      if (key < 0)
+        continue; // a wall
+      const std::size_t j = row.at(key);
+      ASSERT_LT(used[j], kSlots);
+      const std::size_t qj = j * kSlots + static_cast<std::size_t>(used[j]++);
+      bothSided.histKey[qj] = oneSided.gid[i];
+      for (int c = 0; c < 3; ++c)
+        bothSided.histDisp[3 * qj + c] = -oneSided.histDisp[3 * q + c];
+      ++bothSided.contacts[j]; // format ≤ 2: contact_count counted both sides' contacts
+      ++mirrored;
+    }
+  }
+  ASSERT_GT(mirrored, oneSided.n) << "too few contacts with history: the test proves little";
+  HostState out[2];
+  for (int v = 0; v < 2; ++v) {
+    auto e = makeCpuEngine(setup);
+    e->setState(v == 0 ? oneSided : bothSided);
+    for (int k = 0; k < 30; ++k)
+      e->subStep(2e-6);
+    out[v] = e->state();
+  }
+  expectBitwiseEqual(out[0], out[1]);
+}
