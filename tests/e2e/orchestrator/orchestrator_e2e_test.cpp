@@ -460,7 +460,9 @@ TEST_F(CoredemE2E, SigtermCheckpointsAndResumeMatches) {
   const std::regex re("stopped after step ([0-9]+) with checkpoint");
   ASSERT_TRUE(std::regex_search(log, m, re)) << log;
   const int stopped = std::stoi(m[1].str());
-  EXPECT_GT(stopped, 40);
+  // The signal comes right after checkpoint 40: when coredem sees it before granting step 41
+  // it stops at 40 (already checkpointed), else after the step in flight with a new checkpoint.
+  EXPECT_GE(stopped, 40);
   EXPECT_LT(stopped, 200);
   char ck[64];
   std::snprintf(ck, sizeof ck, "checkpoints/%08d/manifest.json", stopped);
