@@ -1,7 +1,10 @@
 // ZeroMQ transport. The only translation unit that includes zmq.hpp: ZeroMQ stays private.
+#include <atomic>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <regex>
+#include <utility>
 
 #include <zmq.hpp>
 
@@ -32,6 +35,10 @@ void setCommonOptions(zmq::socket_t& socket, const TransportOptions& o) {
   socket.set(zmq::sockopt::heartbeat_ttl, static_cast<int>(o.heartbeatTimeout.count()));
   // A send never blocks forever: after 10 s it fails and is reported.
   socket.set(zmq::sockopt::sndtimeo, 10000);
+  // A frame larger than this drops the connection before it is allocated.
+  if (o.maxMessageBytes > 0) {
+    socket.set(zmq::sockopt::maxmsgsize, o.maxMessageBytes);
+  }
 }
 
 void setKey(zmq::socket_t& socket, int option, const std::string& key, const char* which) {
@@ -127,9 +134,22 @@ bool waitReadable(zmq::socket_t& socket, Clock::time_point deadline) {
   }
 }
 
-/// Receives all frames of one multipart message (after poll said readable).
-std::vector<zmq::message_t> receiveFrames(zmq::socket_t& socket, const std::string& what) {
+/// What receiveFrames dropped: a message over the limits keeps its first frames (routing id,
+/// envelope) so that it can be answered, the rest is read and released at once.
+struct Oversize {
+  std::size_t frames = 0;
+  std::uint64_t bytes = 0;
+  bool exceeded = false;
+};
+
+/// Receives all frames of one multipart message (after poll said readable). With limits
+/// (maxBytes > 0), frames beyond `keep` are released as soon as the message's frame count or
+/// total size exceeds them.
+std::vector<zmq::message_t> receiveFrames(zmq::socket_t& socket, const std::string& what,
+                                          std::int64_t maxBytes = 0, std::size_t keep = 1,
+                                          Oversize* over = nullptr, int* srcFd = nullptr) {
   std::vector<zmq::message_t> frames;
+  Oversize o;
   try {
     for (;;) {
       zmq::message_t frame;
@@ -137,13 +157,32 @@ std::vector<zmq::message_t> receiveFrames(zmq::socket_t& socket, const std::stri
         break; // parts of a multipart message arrive together; nothing more
       }
       bool more = frame.more();
-      frames.push_back(std::move(frame));
+      // The connection's fd (ZMQ_SRCFD). libzmq 4.3 leaves it off a ROUTER's routing-id frame
+      // when poll() prefetched the message, so the first frame that has it is used.
+      if (srcFd != nullptr && *srcFd < 0 && o.frames < 2) {
+        *srcFd = zmq_msg_get(frame.handle(), ZMQ_SRCFD);
+      }
+      ++o.frames;
+      o.bytes += frame.size();
+      if (maxBytes > 0 && (o.frames > kMaxFramesPerMessage + keep ||
+                           o.bytes > static_cast<std::uint64_t>(maxBytes) + 4096)) {
+        o.exceeded = true;
+      }
+      if (!o.exceeded || frames.size() < keep + 1) {
+        frames.push_back(std::move(frame));
+      }
       if (!more) {
         break;
       }
     }
   } catch (const zmq::error_t& e) {
     rethrowZmq(e, what);
+  }
+  if (o.exceeded) {
+    frames.resize(std::min(frames.size(), keep + 1)); // routing id(s) + envelope
+  }
+  if (over != nullptr) {
+    *over = o;
   }
   return frames;
 }
@@ -259,8 +298,67 @@ struct Server::Impl {
   TransportOptions options;
   std::shared_ptr<zmq::context_t> context = sharedContext(); // outlives the socket
   zmq::socket_t socket{*context, zmq::socket_type::router};
+  /// Connection events of `socket` (ZMQ_EVENT_DISCONNECTED carries the connection's fd).
+  zmq::socket_t monitor{*context, zmq::socket_type::pair};
+  /// The connection (fd, and how many connections that fd had carried) each known peer's last
+  /// message came on. The generation keeps a reused fd's new connection apart from the old.
+  std::map<PeerId, std::pair<int, std::uint64_t>> fdOf;
+  std::map<int, std::uint64_t> generation; ///< ZMQ_EVENT_ACCEPTED count per fd
+  std::vector<PeerId> disconnected;        ///< since the last takeDisconnected()
   std::string endpoint;
   std::shared_ptr<spdlog::logger> log = transportLog();
+
+  void startMonitor() {
+    static std::atomic<std::uint64_t> counter{0};
+    const std::string address = "inproc://coredem-server-monitor-" + std::to_string(++counter);
+    if (zmq_socket_monitor(socket.handle(), address.c_str(),
+                           ZMQ_EVENT_ACCEPTED | ZMQ_EVENT_DISCONNECTED) != 0) {
+      throw TransportError(std::string("starting the socket monitor failed: ") +
+                           zmq_strerror(zmq_errno()));
+    }
+    monitor.connect(address);
+  }
+
+  /// Reads the pending monitor events; a closed connection's peers move to `disconnected`.
+  void drainMonitor() {
+    try {
+      for (;;) {
+        zmq::message_t event;
+        if (!monitor.recv(event, zmq::recv_flags::dontwait)) {
+          return;
+        }
+        const bool more = event.more();
+        std::uint16_t id = 0;
+        std::uint32_t value = 0;
+        if (event.size() >= 6) {
+          std::memcpy(&id, event.data(), 2);
+          std::memcpy(&value, static_cast<const char*>(event.data()) + 2, 4);
+        }
+        if (more) {
+          zmq::message_t address; // second frame: the endpoint
+          (void)monitor.recv(address, zmq::recv_flags::dontwait);
+        }
+        const int fd = static_cast<int>(value);
+        if (id == ZMQ_EVENT_ACCEPTED) {
+          ++generation[fd];
+          continue;
+        }
+        if (id != ZMQ_EVENT_DISCONNECTED) {
+          continue;
+        }
+        for (auto it = fdOf.begin(); it != fdOf.end();) {
+          if (it->second == std::make_pair(fd, generation[fd])) {
+            disconnected.push_back(it->first);
+            it = fdOf.erase(it);
+          } else {
+            ++it;
+          }
+        }
+      }
+    } catch (const zmq::error_t& e) {
+      log->warn("socket monitor of {}: ZeroMQ error {} ({})", endpoint, e.num(), e.what());
+    }
+  }
 };
 
 Server::Server(TransportOptions options) {
@@ -269,6 +367,7 @@ Server::Server(TransportOptions options) {
     _impl->options = std::move(options);
     setCommonOptions(_impl->socket, _impl->options);
     _impl->socket.set(zmq::sockopt::router_mandatory, 1);
+    _impl->startMonitor();
     if (_impl->options.curve.serverConfigured()) {
       int one = 1;
       zmq_setsockopt(_impl->socket.handle(), ZMQ_CURVE_SERVER, &one, sizeof(one));
@@ -314,12 +413,32 @@ std::optional<Request> Server::receive(std::chrono::milliseconds timeout,
   if (!waitReadable(_impl->socket, deadline)) {
     return std::nullopt;
   }
-  auto frames = receiveFrames(_impl->socket, "receiving on " + _impl->endpoint);
+  _impl->drainMonitor(); // closed connections first: their routing ids may be reused next
+  Oversize over;
+  int fd = -1;
+  auto frames = receiveFrames(_impl->socket, "receiving on " + _impl->endpoint,
+                              _impl->options.maxMessageBytes, 1, &over, &fd);
   if (frames.empty()) {
     return std::nullopt;
   }
   Request request;
   request.peer = frames[0].to_string();
+  if (fd >= 0) { // the monitor was drained first: generation[fd] is this connection's
+    _impl->fdOf[request.peer] = {fd, _impl->generation[fd]};
+  }
+  if (over.exceeded) {
+    frames.resize(std::min<std::size_t>(frames.size(), 2));
+    (void)decodeFrames(frames, 1, request.message, {}); // the envelope, for sequence and type
+    request.status = Status::error(
+        v1::ERROR_CODE_BYTE_LENGTH,
+        "message of " + std::to_string(over.frames) + " frames and " + std::to_string(over.bytes) +
+            " bytes exceeds the limits of " + std::to_string(kMaxFramesPerMessage) +
+            " arrays and " + std::to_string(_impl->options.maxMessageBytes) +
+            " bytes (coredem-dem --max-message-mb); send smaller fields or raise the limit");
+    _impl->log->warn("refused an oversized message on {}: {}", _impl->endpoint,
+                     request.status.message);
+    return request;
+  }
   request.status = decodeFrames(frames, 1, request.message, options);
   if (!request.status.ok()) {
     _impl->log->debug("undecodable message on {}: {}", _impl->endpoint, request.status.toString());
@@ -337,6 +456,11 @@ void Server::reply(const PeerId& peer, Message message) {
     // EHOSTUNREACH: the peer has gone; its reply is dropped (it will time out and report).
     _impl->log->warn("reply dropped: {}", e.what());
   }
+}
+
+std::vector<PeerId> Server::takeDisconnected() {
+  _impl->drainMonitor();
+  return std::exchange(_impl->disconnected, {});
 }
 
 void Server::replyFrames(const PeerId& peer, const Frames& frames) {

@@ -13,6 +13,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "admission.h"
 #include "configure_map.h"
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
@@ -34,6 +35,13 @@ namespace {
 constexpr const char* kSoftware = "coredem-dem 0.1.0";
 /// Relative tolerance of dt comparisons (grant vs GasFields, dt_dem·n_sub vs dt_cfd).
 constexpr double kDtTolerance = 1e-12;
+/// Unknown Configure options named one by one in the log; the rest are counted.
+constexpr std::size_t kLoggedIgnoredOptions = 5;
+
+/// A peer-supplied string for a log line or a reply (escaped, length-capped).
+std::string safe(std::string_view text, std::size_t maxBytes = 120) {
+  return proto::printable(text, maxBytes);
+}
 
 std::string randomSessionId() {
   std::random_device rd;
@@ -78,6 +86,7 @@ proto::TransportOptions transportOptions(const ServerOptions& o) {
   proto::TransportOptions t;
   t.sender = kSoftware;
   t.allowInsecure = o.insecure;
+  t.maxMessageBytes = o.maxMessageBytes;
   if (!o.curveKeysDir.empty()) {
     t.curve.serverPublicKey = readKey(fs::path(o.curveKeysDir) / "server.public");
     t.curve.serverSecretKey = readKey(fs::path(o.curveKeysDir) / "server.secret");
@@ -113,6 +122,7 @@ struct Held {
 
 struct DemServer::Impl {
   ServerOptions opt;
+  Limits limits;
   proto::Server server;
   std::string endpoint;
   std::shared_ptr<spdlog::logger> log = coredem::logger("dem.server");
@@ -142,12 +152,21 @@ struct DemServer::Impl {
 
   explicit Impl(ServerOptions o)
       : opt(std::move(o))
+      , limits(limitsFor(opt.maxMemoryBytes > 0 ? opt.maxMemoryBytes : defaultMaxMemory(),
+                         opt.maxSubSteps))
       , server(transportOptions(opt)) {}
+
+  /// The session's orchestrator or CFD participant (the connections that said Hello).
+  bool isMember(const proto::PeerId& p) const {
+    return state != SessionState::Idle && !p.empty() && (p == oPeer || p == cPeer);
+  }
 
   // ---- replies ---------------------------------------------------------------------------
   void send(const proto::PeerId& peer, proto::Message m, std::uint64_t sequence,
             std::int64_t step) {
-    m.setSessionId(session);
+    // The session id goes to the session's members only (docs/security.md): a stranger's reply
+    // carries none, in the envelope or the text.
+    m.setSessionId(isMember(peer) ? session : std::string());
     m.setSequence(sequence);
     m.setStep(step);
     server.reply(peer, std::move(m));
@@ -167,15 +186,15 @@ struct DemServer::Impl {
     const auto& env = r.message.envelope();
     log->warn("session {}: refused {} from {}: {}: {}", session.empty() ? "-" : session,
               proto::messageTypeName(env.type()), peerName(r.peer), proto::errorCodeName(code),
-              message);
+              safe(message, 400));
     send(r.peer, proto::makeError(code, message, env.sequence(), env.type()), env.sequence(),
          env.step());
   }
 
   void reject(const proto::Request& r, v1::ErrorCode code, const std::string& reason) {
     const auto& env = r.message.envelope();
-    log->warn("rejected Hello from '{}' ({}): {}: {}", env.sender(), hexPeer(r.peer),
-              proto::errorCodeName(code), reason);
+    log->warn("rejected Hello from '{}' ({}): {}: {}", safe(env.sender()), hexPeer(r.peer),
+              proto::errorCodeName(code), safe(reason, 400));
     auto m = proto::makeReject(code, reason);
     m.envelope().mutable_reject()->set_server_protocol_major(proto::kProtocolVersion.major);
     m.envelope().mutable_reject()->set_server_protocol_minor(proto::kProtocolVersion.minor);
@@ -231,15 +250,38 @@ struct DemServer::Impl {
     sessionEnded = true;
   }
 
+  /// The peer's name for logs and replies (escaped, at most 64 bytes of the peer's text).
   static std::string nameOf(const proto::Request& r) {
     const auto& env = r.message.envelope();
     if (!env.sender().empty()) {
-      return env.sender();
+      return safe(env.sender(), 64);
     }
     if (!env.hello().software_version().empty()) {
-      return env.hello().software_version();
+      return safe(env.hello().software_version(), 64);
     }
     return hexPeer(r.peer);
+  }
+
+  /// A closed connection (the transport's socket monitor): the orchestrator's ends the
+  /// session; the CFD participant's frees its role for a new connection.
+  void onDisconnected(const proto::PeerId& p) {
+    lastSequence.erase(p);
+    if (state == SessionState::Idle) {
+      return;
+    }
+    if (p == oPeer) {
+      endSession(fmt::format("the connection of orchestrator '{}' closed", oName),
+                 v1::ERROR_CODE_TRANSPORT);
+    } else if (p == cPeer) {
+      log->warn("session {}: the connection of CFD participant '{}' closed; a new CFD "
+                "participant may join with the session id",
+                session, cName);
+      if (held && held->request.peer == p) {
+        held.reset();
+      }
+      cPeer.clear();
+      cName.clear();
+    }
   }
 
   void onHello(const proto::Request& r) {
@@ -257,11 +299,16 @@ struct DemServer::Impl {
     }
     if (h.role() == v1::ROLE_ORCHESTRATOR) {
       if (state != SessionState::Idle) {
+        // Never the session id: the caller is not a member (or, on the orchestrator's own
+        // connection, already knows it).
         const double secs = std::chrono::duration<double>(Clock::now() - started).count();
         reject(r, v1::ERROR_CODE_SESSION_BUSY,
-               fmt::format("coredem-dem at {} already serves session {} of orchestrator '{}' "
-                           "(for {:.0f} s); wait until it ends or start another coredem-dem",
-                           endpoint, session, oName, secs));
+               r.peer == oPeer
+                   ? std::string("this connection is already the orchestrator of the active "
+                                 "session; a second Hello is refused (send Shutdown to end it)")
+                   : fmt::format("coredem-dem at {} already serves another session (for {:.0f} "
+                                 "s); wait until it ends or start another coredem-dem",
+                                 endpoint, secs));
         return;
       }
       session = randomSessionId();
@@ -284,12 +331,23 @@ struct DemServer::Impl {
         reject(r, v1::ERROR_CODE_UNKNOWN_SESSION,
                fmt::format("session id '{}' is not the active session of coredem-dem at {}; use "
                            "the id the orchestrator passes in COREDEM_SESSION",
-                           env.session_id(), endpoint));
+                           safe(env.session_id(), 40), endpoint));
+        return;
+      }
+      if (r.peer == oPeer) {
+        reject(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+               "this connection is the session's orchestrator; the CFD participant says Hello "
+               "on its own connection");
         return;
       }
       if (!cPeer.empty() && cPeer != r.peer) {
-        log->warn("session {}: CFD participant '{}' replaced by a new connection '{}'", session,
-                  cName, env.sender());
+        // Each role is bound to the connection that said Hello first; the role is freed when
+        // that connection closes (onDisconnected).
+        reject(r, v1::ERROR_CODE_SESSION_BUSY,
+               fmt::format("the session already has a CFD participant ('{}') on another "
+                           "connection; a second one is refused",
+                           cName));
+        return;
       }
       cPeer = r.peer;
       cName = nameOf(r);
@@ -321,6 +379,11 @@ struct DemServer::Impl {
       refuse(r, s.code, s.message);
       return;
     }
+    // Admission control before anything is allocated: counts against the memory budget.
+    if (const std::string why = admitConfigure(c, limits); !why.empty()) {
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION, why);
+      return;
+    }
     std::unique_ptr<dem::DemSystem> next;
     std::uint32_t nSub = 0;
     ServerLedgers restored;
@@ -347,9 +410,13 @@ struct DemServer::Impl {
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION, e.what());
       return;
     }
-    for (const auto& k : ignored) {
+    for (std::size_t i = 0; i < ignored.size() && i < kLoggedIgnoredOptions; ++i) {
       log->warn("session {}: Configure option '{}' is not a DEM server option (ignored)", session,
-                k);
+                safe(ignored[i], 64));
+    }
+    if (ignored.size() > kLoggedIgnoredOptions) {
+      log->warn("session {}: {} more Configure options are not DEM server options (ignored)",
+                session, ignored.size() - kLoggedIgnoredOptions);
     }
     system = std::move(next);
     ledgers = restored;
@@ -370,7 +437,7 @@ struct DemServer::Impl {
     log->info("session {}: configured by '{}': {} particles{}, grid {} x {} x {}, {} gas species, "
               "backend {}, dt_dem_max {:.4g} s, start step {}",
               session, oName, system->particleCount(),
-              c.initial_state_file().empty() ? "" : " from " + c.initial_state_file(),
+              c.initial_state_file().empty() ? "" : " from " + safe(c.initial_state_file(), 200),
               g.counts().x(), g.counts().y(), g.counts().z(), species, system->backendName(), dtMax,
               lastStep);
     auto m = proto::makeConfigured(cells, system->particleCount(), species, nSub, dtMax);
@@ -401,6 +468,13 @@ struct DemServer::Impl {
       return;
     }
     const double dtMax = system->dtDemMax();
+    if (g.n_sub() > limits.subSteps) {
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+             fmt::format("StepGrant of step {}: n_sub = {} exceeds the limit {} (coredem-dem "
+                         "--max-sub-steps); use a smaller CFD step",
+                         env.step(), g.n_sub(), limits.subSteps));
+      return;
+    }
     if (!(g.dt_cfd() > 0.0) || !std::isfinite(g.dt_cfd()) || g.n_sub() < 1) {
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
              fmt::format("StepGrant of step {}: dt_cfd = {} s and n_sub = {} must be positive",
@@ -512,7 +586,12 @@ struct DemServer::Impl {
       auto m = proto::makeError(v1::ERROR_CODE_INTERNAL, e.what(), grant->sequence,
                                 v1::MESSAGE_TYPE_STEP_GRANT);
       send(grant->peer, std::move(m), grant->sequence, grant->step);
+      const auto failed = grant->step;
       grant.reset();
+      // The DEM state is unknown after a failed step: end the session rather than leave it
+      // half-alive (every later step would fail too).
+      endSession(fmt::format("step {} failed in the DEM core: {}", failed, e.what()),
+                 v1::ERROR_CODE_INTERNAL);
       return;
     }
     const double dt = grant->dtCfd;
@@ -727,8 +806,9 @@ struct DemServer::Impl {
       return;
     }
     send(r.peer, proto::makeAck("session " + session + " ended"), env.sequence(), env.step());
-    endSession("Shutdown from the orchestrator" +
-               (env.shutdown().reason().empty() ? std::string() : ": " + env.shutdown().reason()));
+    endSession("Shutdown from the orchestrator" + (env.shutdown().reason().empty()
+                                                       ? std::string()
+                                                       : ": " + safe(env.shutdown().reason())));
   }
 
   // ---- dispatch --------------------------------------------------------------------------
@@ -756,10 +836,8 @@ struct DemServer::Impl {
       return;
     }
     if (r.peer != oPeer && r.peer != cPeer) {
-      refuse(
-          r, v1::ERROR_CODE_UNKNOWN_SESSION,
-          fmt::format("this connection has not joined session {}: send Hello first",
-                      env.session_id().empty() ? std::string("(none given)") : env.session_id()));
+      refuse(r, v1::ERROR_CODE_UNKNOWN_SESSION,
+             "this connection has not joined the active session: send Hello first");
       return;
     }
     proto::Expectation e;
@@ -842,8 +920,14 @@ DemServer::DemServer(ServerOptions options)
                 m.opt.bind);
   }
   m.endpoint = m.server.bind(m.opt.bind);
-  m.log->info("coredem-dem listening on {} (backend {}, threads {}, session timeout {} s)",
-              m.endpoint, m.opt.backend, m.opt.threads, m.opt.sessionTimeoutSeconds);
+  m.log->info("coredem-dem listening on {} (backend {}, threads {}, session timeout {} s, memory "
+              "budget {}: up to {} particles and {} cells; messages up to {}; n_sub up to {})",
+              m.endpoint, m.opt.backend, m.opt.threads, m.opt.sessionTimeoutSeconds,
+              formatBytes(m.limits.memoryBytes), m.limits.particles, m.limits.cells,
+              m.opt.maxMessageBytes > 0
+                  ? formatBytes(static_cast<std::uint64_t>(m.opt.maxMessageBytes))
+                  : std::string("unlimited"),
+              m.limits.subSteps);
 }
 
 DemServer::~DemServer() = default;
@@ -862,17 +946,25 @@ bool DemServer::poll(std::chrono::milliseconds wait) {
   }
   auto req = m.server.receive(wait);
   m.lastReceived = Clock::now();
+  for (const auto& p : m.server.takeDisconnected()) {
+    m.onDisconnected(p);
+  }
   if (req) {
     try {
       m.handle(*req);
     } catch (const std::exception& e) {
-      // A bug or an unexpected failure while handling one message: answer and keep serving.
-      m.log->error("internal error while handling a {} message: {}",
-                   proto::messageTypeName(req->message.envelope().type()), e.what());
+      // A bug or an unexpected failure while handling one message: answer; a session member's
+      // message ends the session (its state is unknown), a stranger's changes nothing.
+      const auto type = proto::messageTypeName(req->message.envelope().type());
+      m.log->error("internal error while handling a {} message: {}", type, e.what());
       m.send(req->peer,
              proto::makeError(v1::ERROR_CODE_INTERNAL, std::string("internal error: ") + e.what(),
                               req->message.envelope().sequence(), req->message.envelope().type()),
              req->message.envelope().sequence(), req->message.envelope().step());
+      if (m.isMember(req->peer)) {
+        m.endSession(fmt::format("internal error while handling a {} message: {}", type, e.what()),
+                     v1::ERROR_CODE_INTERNAL);
+      }
     }
   }
   m.housekeeping();

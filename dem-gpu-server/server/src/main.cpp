@@ -8,6 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "admission.h"
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
 #include "coredem/server/dem_server.h"
@@ -59,6 +60,21 @@ int main(int argc, char** argv) {
   app.add_flag(
       "--exit-after-session", o.exitAfterSession,
       "exit when the first session ends (set by the orchestrator that started this server)");
+  std::string maxMemory;
+  app.add_option("--max-memory", maxMemory,
+                 "memory budget the count limits of a Configure derive from, e.g. 8G or 512M "
+                 "(default: half of the physical memory); a Configure estimated above it is "
+                 "refused before anything is allocated");
+  double maxMessageMb = static_cast<double>(o.maxMessageBytes) / (1024.0 * 1024.0);
+  app.add_option("--max-message-mb", maxMessageMb,
+                 "largest message part (frame) a peer may send, MiB; a larger one closes its "
+                 "connection (0: no limit)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--max-sub-steps", o.maxSubSteps,
+                 "most DEM sub-steps per CFD step (StepGrant n_sub) the server accepts")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--endpoint-file", endpointFile, "write the bound endpoint into this file");
   app.add_flag("--timers", o.timers,
                "per-stage timers (DEM stages and the exchange): a log line every --timers-every "
@@ -86,6 +102,15 @@ int main(int argc, char** argv) {
             : (std::filesystem::path(endpointFile).parent_path() / "dem-timers.json").string();
   }
   try {
+    o.maxMessageBytes = static_cast<std::int64_t>(maxMessageMb * 1024.0 * 1024.0);
+    if (!maxMemory.empty()) {
+      try {
+        o.maxMemoryBytes = coredem::server::parseBytes(maxMemory);
+      } catch (const coredem::UserError& e) {
+        log->error("--max-memory: {}", e.what());
+        return 2;
+      }
+    }
     if (!generateKeys.empty()) {
       coredem::server::generateCurveKeys(generateKeys);
       std::cout << "CURVE key pair written to " << generateKeys << "/server.{public,secret}\n";

@@ -45,6 +45,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <coredem/protocol/message.h>
 #include <coredem/protocol/status.h>
@@ -68,6 +69,13 @@ struct CurveKeys {
 /// libzmq was built without CURVE.
 std::pair<std::string, std::string> generateCurveKeyPair();
 
+/// Default largest message part (frame) any socket accepts: 256 MiB, e.g. one float64 array of
+/// 11 million cells x 3 components. A peer that announces a larger frame is disconnected by
+/// ZeroMQ before anything is allocated (ZMQ_MAXMSGSIZE).
+inline constexpr std::int64_t kDefaultMaxMessageBytes = std::int64_t{256} << 20;
+/// Most frames one message may have (envelope + arrays); more: the message is refused.
+inline constexpr std::size_t kMaxFramesPerMessage = 1024;
+
 struct TransportOptions {
   /// ZMQ_HEARTBEAT_IVL: ping the peer after this much silence.
   std::chrono::milliseconds heartbeatInterval{1000};
@@ -80,6 +88,10 @@ struct TransportOptions {
   /// Server only: allow a non-loopback bind without CURVE (an explicit user opt-out, e.g.
   /// `coredem-dem --insecure` on a trusted network). Default: refuse.
   bool allowInsecure = false;
+  /// ZMQ_MAXMSGSIZE on every socket: the largest frame accepted (a larger one drops the
+  /// connection before it is read). A server also refuses a message whose frames together
+  /// exceed it (BYTE_LENGTH) or that has more than kMaxFramesPerMessage frames. <= 0: no limit.
+  std::int64_t maxMessageBytes = kDefaultMaxMessageBytes;
   /// Free text put into Envelope.sender of outgoing messages when empty.
   std::string sender;
 };
@@ -129,6 +141,10 @@ public:
   /// input: undecodable messages come back with a non-ok Request::status.
   std::optional<Request> receive(std::chrono::milliseconds timeout,
                                  const ReceiveOptions& options = {});
+  /// Peers whose connection closed since the last call (socket monitor; a peer is known once
+  /// it has sent a message). A routing id is never reused while its connection is open, so
+  /// a session bound to a routing id ends here when that connection closes.
+  std::vector<PeerId> takeDisconnected();
   /// Sends `message` to `peer`. Non-blocking; a vanished peer's reply is dropped (logged).
   /// Fills in Envelope.sender when empty.
   void reply(const PeerId& peer, Message message);

@@ -49,13 +49,18 @@ struct Expectation {
 Status validate(const Message& message, const Expectation& expectation);
 
 /// Checks a Configure body for consistency (INVALID_CONFIGURATION): Cartesian mesh with
-/// positive counts/spacing, unique species with molar mass > 0, sub-cycling
-/// dt_dem*n_sub == dt_cfd (rel. 1e-12), particle sets referencing existing materials with
-/// positive diameter, count, region min < max and mass fractions summing to 1 (abs. 1e-9),
-/// material parameters in range (k_n > 0, 0 < e_n <= 1, friction >= 0, density > 0).
+/// positive counts/spacing and at most kMaxCells cells (an overflowing product is refused), unique
+/// species with molar mass > 0, sub-cycling dt_dem*n_sub == dt_cfd (rel. 1e-12), particle sets
+/// referencing existing materials with positive diameter, count, region min < max and mass
+/// fractions summing to 1 (abs. 1e-9), material parameters in range (k_n > 0, 0 < e_n <= 1,
+/// friction >= 0, density > 0).
 Status validateConfigure(const v1::Configure& configure);
 
-/// Number of cells of the coupling mesh (0 if unset).
+/// Most coupling cells of any Configure (cells are indexed by int in the DEM core); a server
+/// may set a lower limit from its memory budget.
+inline constexpr std::uint64_t kMaxCells = 2147483647;
+
+/// Number of cells of the coupling mesh (0 if unset; UINT64_MAX if x*y*z overflows 64 bits).
 std::uint64_t cellCount(const v1::CouplingMesh& mesh);
 
 } // namespace coredem::protocol

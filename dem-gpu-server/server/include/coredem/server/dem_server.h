@@ -15,6 +15,7 @@
 /// Any invalid message gets an Error reply (code + what to do) and changes nothing.
 
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -30,6 +31,12 @@ struct ServerOptions {
   std::string curveKeysDir;      ///< DIR/server.public + DIR/server.secret (Z85)
   bool insecure = false;         ///< allow a non-loopback bind without CURVE
   bool exitAfterSession = false; ///< run() returns when the first session ends
+  /// Admission control (docs/security.md): the memory budget the count limits of a Configure
+  /// derive from (0: half of the physical memory), the largest message part any peer may send
+  /// (ZMQ_MAXMSGSIZE; a larger one closes its connection) and the most sub-steps per grant.
+  std::uint64_t maxMemoryBytes = 0;
+  std::int64_t maxMessageBytes = std::int64_t{256} << 20;
+  std::uint64_t maxSubSteps = 100000;
   /// Per-stage timers (docs/performance.md "Timers"): a report in the log every `timersEvery`
   /// CFD steps (0: only at the end) and at the end of each session, written as JSON to
   /// `timersFile` (empty: coredem-dem-timers.json in the working directory).
