@@ -303,8 +303,9 @@ struct Server::Impl {
   /// The connection (fd, and how many connections that fd had carried) each known peer's last
   /// message came on. The generation keeps a reused fd's new connection apart from the old.
   std::map<PeerId, std::pair<int, std::uint64_t>> fdOf;
-  std::map<int, std::uint64_t> generation; ///< ZMQ_EVENT_ACCEPTED count per fd
-  std::vector<PeerId> disconnected;        ///< since the last takeDisconnected()
+  std::map<int, std::uint64_t> generation;              ///< ZMQ_EVENT_ACCEPTED count per fd
+  static constexpr std::size_t kMaxDisconnected = 4096; ///< oldest dropped beyond this
+  std::vector<PeerId> disconnected;                     ///< since the last takeDisconnected()
   std::string endpoint;
   std::shared_ptr<spdlog::logger> log = transportLog();
 
@@ -348,6 +349,9 @@ struct Server::Impl {
         }
         for (auto it = fdOf.begin(); it != fdOf.end();) {
           if (it->second == std::make_pair(fd, generation[fd])) {
+            if (disconnected.size() >= kMaxDisconnected) { // a server that never asks
+              disconnected.erase(disconnected.begin());
+            }
             disconnected.push_back(it->first);
             it = fdOf.erase(it);
           } else {

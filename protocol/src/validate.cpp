@@ -237,6 +237,90 @@ Status validate(const Message& message, const Expectation& e) {
 }
 
 namespace {
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+Status outOfRange(std::string_view array, std::size_t cell, const std::string& what, double value,
+                  double lo, double hi, std::string_view unit) {
+  return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION,
+                       "GasFields array '" + std::string(array) + "' cell " + std::to_string(cell) +
+                           ": " + what + " = " + num(value) + " " + std::string(unit) +
+                           " is outside the range [" + num(lo) + ", " + num(hi) + "] " +
+                           std::string(unit) +
+                           " (docs/protocol.md §3 'Ranges'); check the sender's units and "
+                           "solution");
+}
+
+} // namespace
+
+Status validateGasRanges(const Message& m, const GasRanges& r) {
+  namespace f = fields;
+  struct Scalar {
+    std::string_view name;
+    double lo, hi;
+    std::string_view unit;
+  };
+  const Scalar scalars[] = {
+      {f::kGasTemperature, r.temperatureMin, r.temperatureMax, "K"},
+      {f::kGasDensity, r.densityMin, r.densityMax, "kg/m3"},
+      {f::kGasViscosity, r.viscosityMin, r.viscosityMax, "Pa s"},
+      {f::kGasConductivity, r.conductivityMin, r.conductivityMax, "W/m/K"},
+      {f::kGasHeatCapacity, r.heatCapacityMin, r.heatCapacityMax, "J/kg/K"},
+  };
+  for (const Scalar& s : scalars) {
+    const auto v = m.values<double>(s.name);
+    for (std::size_t c = 0; c < v.size(); ++c) {
+      if (!(v[c] >= s.lo && v[c] <= s.hi)) {
+        return outOfRange(s.name, c, std::string(s.name), v[c], s.lo, s.hi, s.unit);
+      }
+    }
+  }
+  const auto magnitudes = [&](std::string_view name, double hi, std::string_view unit) -> Status {
+    const auto v = m.values<double>(name);
+    for (std::size_t c = 0; 3 * c + 2 < v.size(); ++c) {
+      const double mag = std::hypot(v[3 * c], v[3 * c + 1], v[3 * c + 2]);
+      if (!(mag <= hi)) {
+        return outOfRange(name, c, "|" + std::string(name) + "|", mag, 0.0, hi, unit);
+      }
+    }
+    return {};
+  };
+  if (Status s = magnitudes(f::kGasVelocity, r.speedMax, "m/s"); !s.ok()) {
+    return s;
+  }
+  if (Status s = magnitudes(f::kPressureGradient, r.pressureGradientMax, "Pa/m"); !s.ok()) {
+    return s;
+  }
+  const auto& body = m.envelope().gas_fields();
+  const std::size_t ns = body.species_count();
+  const auto y = m.values<double>(f::kGasMassFractions);
+  if (ns > 0 && y.size() == ns * body.cell_count()) {
+    const double t = r.massFractionTolerance;
+    for (std::size_t c = 0; c < body.cell_count(); ++c) {
+      double sum = 0.0;
+      for (std::size_t k = 0; k < ns; ++k) {
+        const double v = y[c * ns + k];
+        if (!(v >= -t && v <= 1.0 + t)) {
+          return outOfRange(f::kGasMassFractions, c, "Y of species " + std::to_string(k), v, -t,
+                            1.0 + t, "");
+        }
+        sum += v;
+      }
+      if (!(std::abs(sum - 1.0) <= r.massFractionSumTolerance)) {
+        return outOfRange(f::kGasMassFractions, c, "sum of Y", sum,
+                          1.0 - r.massFractionSumTolerance, 1.0 + r.massFractionSumTolerance, "");
+      }
+    }
+  }
+  return {};
+}
+
+namespace {
 bool positive(const v1::Vec3& v) {
   return v.x() > 0 && v.y() > 0 && v.z() > 0;
 }

@@ -855,7 +855,10 @@ struct DemServer::Impl {
     if (type == v1::MESSAGE_TYPE_GAS_FIELDS && stepEnd) { // the CFD's step and the transfer
       xt.waitPeer += std::chrono::duration<double>(lastReceived - *stepEnd).count();
     }
-    const auto s = proto::validate(r.message, e);
+    auto s = proto::validate(r.message, e);
+    if (s.ok() && type == v1::MESSAGE_TYPE_GAS_FIELDS) {
+      s = proto::validateGasRanges(r.message); // physical ranges (docs/protocol.md §3)
+    }
     if (type == v1::MESSAGE_TYPE_GAS_FIELDS) {
       xt.validate += std::chrono::duration<double>(Clock::now() - tValidate).count();
     }

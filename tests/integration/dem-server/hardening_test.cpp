@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -73,10 +74,19 @@ bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
-proto::Message gasFields(std::int64_t step, double time, double dt, const std::string& session) {
+/// Uniform gas fields; `poison` may change one array before the message is built.
+struct GasValues {
+  std::vector<double> u = std::vector<double>(3 * kN, 0.0),
+                      gradP = std::vector<double>(3 * kN, 0.0), T = std::vector<double>(kN, 300.0),
+                      rho = std::vector<double>(kN, 1.2), mu = std::vector<double>(kN, 1.8e-5),
+                      kappa = std::vector<double>(kN, 0.026), cp = std::vector<double>(kN, 1005.0),
+                      Y = std::vector<double>(kN, 1.0);
+};
+
+proto::Message gasFields(std::int64_t step, double time, double dt, const std::string& session,
+                         const GasValues& g = {}) {
   namespace f = proto::fields;
-  std::vector<double> u(3 * kN, 0.0), gradP(3 * kN, 0.0), T(kN, 300.0), rho(kN, 1.2),
-      mu(kN, 1.8e-5), kappa(kN, 0.026), cp(kN, 1005.0), Y(kN, 1.0);
+  const auto& [u, gradP, T, rho, mu, kappa, cp, Y] = g;
   auto m = proto::makeGasFields(step, time, dt, kN, 1);
   m.setSessionId(session);
   m.addArray(f::kGasVelocity, u, {kN, 3});
@@ -263,6 +273,54 @@ TEST(Admission, AbsurdSubStepCountsAreRefusedAndTheNextStepRuns) {
   o.dem().send(std::move(g));
   auto src = cfd.request(gasFields(1, 0.0, dt, o.session()), 20s);
   EXPECT_EQ(src.type(), v1::MESSAGE_TYPE_SOURCES);
+  auto done = o.dem().receive(20s);
+  ASSERT_TRUE(done.has_value());
+  EXPECT_EQ(done->type(), v1::MESSAGE_TYPE_STEP_DONE);
+  o.shutdown();
+}
+
+// ---- poisoning: physical ranges of the gas fields -----------------------------------------------
+
+TEST(GasRanges, AbsurdButFiniteGasFieldsAreRefusedAndTheStepRunsWithValidOnes) {
+  ServerThread srv(options());
+  MiniOrchestrator o(srv.endpoint(), smallCase(kParticles, kD, kBox, kCells));
+  proto::Client cfd;
+  cfd.connect(srv.endpoint());
+  proto::expectType(cfd.request(cfdHello(o.session()), 10s), v1::MESSAGE_TYPE_WELCOME);
+  const double dt = 2e-4;
+  const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
+  auto g = proto::makeStepGrant(1, 0.0, dt, nSub, dt / nSub);
+  g.setSessionId(o.session());
+  o.dem().send(std::move(g));
+  struct Poison {
+    const char* array;
+    std::function<void(GasValues&)> apply;
+  };
+  const Poison poisons[] = {
+      {"mu_g", [](GasValues& v) { v.mu[4] = 1e-310; }}, // denormal viscosity
+      {"kappa_g", [](GasValues& v) { v.kappa[0] = 1e30; }},
+      {"T_g", [](GasValues& v) { v.T[2] = 1e9; }},
+      {"T_g", [](GasValues& v) { v.T[2] = 20.0; }}, // degrees Celsius sent as K
+      {"u_g", [](GasValues& v) { v.u[3 * 5 + 2] = 1e8; }},
+      {"rho_g", [](GasValues& v) { v.rho[1] = 1e-300; }},
+      {"cp_g", [](GasValues& v) { v.cp[1] = 1e20; }},
+      {"grad_p", [](GasValues& v) { v.gradP[0] = 1e300; }},
+      {"Y_g", [](GasValues& v) { v.Y[7] = 0.5; }}, // sum 0.5
+  };
+  for (const Poison& p : poisons) {
+    GasValues v;
+    p.apply(v);
+    const auto msg = refusal(cfd.request(gasFields(1, 0.0, dt, o.session(), v), 10s),
+                             v1::ERROR_CODE_INVALID_CONFIGURATION);
+    EXPECT_TRUE(contains(msg, std::string("'") + p.array + "'")) << p.array << ": " << msg;
+    EXPECT_TRUE(contains(msg, "range")) << msg;
+  }
+  // The refused fields changed nothing: the valid ones run the step, with finite Sources.
+  auto src = cfd.request(gasFields(1, 0.0, dt, o.session()), 20s);
+  ASSERT_EQ(src.type(), v1::MESSAGE_TYPE_SOURCES);
+  for (const double k : src.values<double>(proto::fields::kDragCoefficient)) {
+    EXPECT_TRUE(std::isfinite(k));
+  }
   auto done = o.dem().receive(20s);
   ASSERT_TRUE(done.has_value());
   EXPECT_EQ(done->type(), v1::MESSAGE_TYPE_STEP_DONE);

@@ -143,7 +143,8 @@ public:
                                  const ReceiveOptions& options = {});
   /// Peers whose connection closed since the last call (socket monitor; a peer is known once
   /// it has sent a message). A routing id is never reused while its connection is open, so
-  /// a session bound to a routing id ends here when that connection closes.
+  /// a session bound to a routing id ends here when that connection closes. Keeps the last
+  /// 4096 until asked. inproc connections are not watched (they have no file descriptor).
   std::vector<PeerId> takeDisconnected();
   /// Sends `message` to `peer`. Non-blocking; a vanished peer's reply is dropped (logged).
   /// Fills in Envelope.sender when empty.
