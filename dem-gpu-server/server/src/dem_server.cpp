@@ -10,6 +10,7 @@
 #include <random>
 
 #include <fcntl.h>
+#include <malloc.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -35,6 +36,8 @@ namespace {
 constexpr const char* kSoftware = "coredem-dem 0.1.0";
 /// Relative tolerance of dt comparisons (grant vs GasFields, dt_dem·n_sub vs dt_cfd).
 constexpr double kDtTolerance = 1e-12;
+/// Longest error text sent back to a peer (longer ones are cut, "...(N bytes)").
+constexpr std::size_t kMaxReplyText = 4096;
 /// Unknown Configure options named one by one in the log; the rest are counted.
 constexpr std::size_t kLoggedIgnoredOptions = 5;
 
@@ -187,8 +190,12 @@ struct DemServer::Impl {
     log->warn("session {}: refused {} from {}: {}: {}", session.empty() ? "-" : session,
               proto::messageTypeName(env.type()), peerName(r.peer), proto::errorCodeName(code),
               safe(message, 400));
-    send(r.peer, proto::makeError(code, message, env.sequence(), env.type()), env.sequence(),
-         env.step());
+    // Our own text with escaped, capped peer strings; capped as a whole too.
+    send(r.peer,
+         proto::makeError(code,
+                          message.size() > kMaxReplyText ? safe(message, kMaxReplyText) : message,
+                          env.sequence(), env.type()),
+         env.sequence(), env.step());
   }
 
   void reject(const proto::Request& r, v1::ErrorCode code, const std::string& reason) {
@@ -243,6 +250,7 @@ struct DemServer::Impl {
     cName.clear();
     lastSequence.clear();
     system.reset();
+    ::malloc_trim(0); // the session's particles and grids go back to the system
     grant.reset();
     held.reset();
     ledgers = ServerLedgers();
@@ -407,7 +415,18 @@ struct DemServer::Impl {
             dem::TimeHandler::subStepsFor(c.sub_cycling().dt_cfd(), next->dtDemMax()));
       }
     } catch (const coredem::UserError& e) {
+      next.reset();
+      ::malloc_trim(0); // give a large failed build's memory back to the system
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION, e.what());
+      return;
+    } catch (const std::bad_alloc&) {
+      next.reset();
+      ::malloc_trim(0);
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+             fmt::format("Configure: out of memory while building the particles although the "
+                         "estimate fits the {} budget; lower coredem-dem --max-memory so that "
+                         "such a Configure is refused up front",
+                         formatBytes(limits.memoryBytes)));
       return;
     }
     for (std::size_t i = 0; i < ignored.size() && i < kLoggedIgnoredOptions; ++i) {
@@ -667,12 +686,12 @@ struct DemServer::Impl {
       xt.packSend += std::chrono::duration<double>(Clock::now() - tDone).count();
     } else {
       log->error("session {}: checkpoint of step {} into {} failed: {}", session, grant->step,
-                 grant->checkpointDir, checkpointError);
+                 safe(grant->checkpointDir, 200), safe(checkpointError, 400));
       send(grant->peer,
            proto::makeError(
                v1::ERROR_CODE_CHECKPOINT_FAILED,
                fmt::format("step {} done, but writing its checkpoint into {} failed: {}",
-                           grant->step, grant->checkpointDir, checkpointError),
+                           grant->step, safe(grant->checkpointDir, 200), checkpointError),
                grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT),
            grant->sequence, grant->step);
     }
@@ -761,7 +780,8 @@ struct DemServer::Impl {
     writeServerLedgers(tmp.string(), l, step, session);
     syncFile(tmp);
     fs::rename(tmp, final);
-    log->info("session {}: checkpoint of step {} written to {}", session, step, final.string());
+    log->info("session {}: checkpoint of step {} written to {}", session, step,
+              safe(final.string(), 200));
     return {"dem.h5"};
   }
 
