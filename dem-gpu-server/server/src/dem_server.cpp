@@ -94,6 +94,15 @@ proto::TransportOptions transportOptions(const ServerOptions& o) {
     t.curve.serverPublicKey = readKey(fs::path(o.curveKeysDir) / "server.public");
     t.curve.serverSecretKey = readKey(fs::path(o.curveKeysDir) / "server.secret");
   }
+  if (!o.clientKeysFile.empty()) {
+    COREDEM_CHECK(!o.curveKeysDir.empty(),
+                  "--client-keys {} needs --curve-keys DIR (the allow-list authenticates CURVE "
+                  "clients)",
+                  o.clientKeysFile);
+    t.curve.allowedClientKeys = proto::readAllowedClientKeys(o.clientKeysFile);
+    COREDEM_CHECK(!t.curve.allowedClientKeys.empty(),
+                  "--client-keys {} lists no key: nobody could connect", o.clientKeysFile);
+  }
   return t;
 }
 
@@ -270,6 +279,11 @@ struct DemServer::Impl {
     return hexPeer(r.peer);
   }
 
+  /// ", client key K" when the client's CURVE key was authenticated by the allow-list.
+  static std::string keyNote(const proto::Request& r) {
+    return r.clientKey.empty() ? std::string() : ", client key " + r.clientKey;
+  }
+
   /// A closed connection (the transport's socket monitor): the orchestrator's ends the
   /// session; the CFD participant's frees its role for a new connection.
   void onDisconnected(const proto::PeerId& p) {
@@ -326,8 +340,8 @@ struct DemServer::Impl {
       started = lastActivity = Clock::now();
       sessionEnded = false;
       lastSequence[r.peer] = env.sequence();
-      log->info("session {}: orchestrator '{}' connected (protocol {}.{}, peer {})", session, oName,
-                n.agreed.major, n.agreed.minor, hexPeer(r.peer));
+      log->info("session {}: orchestrator '{}' connected (protocol {}.{}, peer {}{})", session,
+                oName, n.agreed.major, n.agreed.minor, hexPeer(r.peer), keyNote(r));
     } else if (h.role() == v1::ROLE_CFD) {
       if (state == SessionState::Idle) {
         reject(r, v1::ERROR_CODE_NOT_CONFIGURED,
@@ -360,8 +374,8 @@ struct DemServer::Impl {
       cPeer = r.peer;
       cName = nameOf(r);
       lastSequence[r.peer] = env.sequence();
-      log->info("session {}: CFD participant '{}' connected (protocol {}.{}, peer {})", session,
-                cName, n.agreed.major, n.agreed.minor, hexPeer(r.peer));
+      log->info("session {}: CFD participant '{}' connected (protocol {}.{}, peer {}{})", session,
+                cName, n.agreed.major, n.agreed.minor, hexPeer(r.peer), keyNote(r));
     } else {
       reject(r, v1::ERROR_CODE_UNSUPPORTED,
              "coredem-dem takes sessions of an orchestrator (ROLE_ORCHESTRATOR) and its CFD "
@@ -1008,7 +1022,8 @@ void DemServer::stop() {
   _impl->stopFlag.store(true);
 }
 
-void generateCurveKeys(const std::string& dir) {
+namespace {
+void writeKeyPair(const std::string& dir, const std::string& stem) {
   fs::create_directories(dir);
   const auto pair = proto::generateCurveKeyPair();
   const auto write = [](const fs::path& p, const std::string& key, bool secret) {
@@ -1024,8 +1039,17 @@ void generateCurveKeys(const std::string& dir) {
     COREDEM_CHECK(ok, "cannot write {}", tmp);
     fs::rename(tmp, p);
   };
-  write(fs::path(dir) / "server.public", pair.first, false);
-  write(fs::path(dir) / "server.secret", pair.second, true);
+  write(fs::path(dir) / (stem + ".public"), pair.first, false);
+  write(fs::path(dir) / (stem + ".secret"), pair.second, true);
+}
+} // namespace
+
+void generateCurveKeys(const std::string& dir) {
+  writeKeyPair(dir, "server");
+}
+
+void generateClientKey(const std::string& dir) {
+  writeKeyPair(dir, "client");
 }
 
 } // namespace coredem::server

@@ -55,6 +55,12 @@ int main(int argc, char** argv) {
   app.add_option(
       "--curve-keys", o.curveKeysDir,
       "directory with server.public and server.secret (CURVE; needed for non-loopback binds)");
+  app.add_option("--client-keys", o.clientKeysFile,
+                 "allow-list of client public keys (one Z85 key per line, '#' comments; with "
+                 "--curve-keys): only these clients may connect");
+  std::string generateClientKeyDir;
+  app.add_option("--generate-client-key", generateClientKeyDir,
+                 "write a new client key pair into DIR/client.{public,secret} and exit");
   app.add_flag("--insecure", o.insecure,
                "allow a non-loopback bind without CURVE (trusted networks only)");
   app.add_flag(
@@ -110,6 +116,13 @@ int main(int argc, char** argv) {
         log->error("--max-memory: {}", e.what());
         return 2;
       }
+    }
+    if (!generateClientKeyDir.empty()) {
+      coredem::server::generateClientKey(generateClientKeyDir);
+      std::cout << "client key pair written to " << generateClientKeyDir
+                << "/client.{public,secret}; add client.public to the server's --client-keys "
+                   "file\n";
+      return 0;
     }
     if (!generateKeys.empty()) {
       coredem::server::generateCurveKeys(generateKeys);

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -13,6 +15,7 @@
 
 #include <gtest/gtest.h>
 #include <spdlog/sinks/ostream_sink.h>
+#include <unistd.h>
 
 #include "../client/mini_orchestrator.h"
 #include "admission.h"
@@ -518,4 +521,61 @@ TEST(Logs, PeerStringsAreEscapedAndCappedAndRepeatedWarningsSummarised) {
   EXPECT_EQ(optionWarnings, 5);
   EXPECT_EQ(summaries, 1);
   EXPECT_TRUE(contains(text, "evil\\n[2026")) << "the name is logged, escaped";
+}
+
+// ---- client authentication (CURVE + ZAP allow-list) --------------------------------------------
+
+TEST(ClientKeys, OnlyClientsOnTheAllowListAreAdmitted) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("coredem-dem-client-keys-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  server::generateCurveKeys(dir.string());
+  server::generateClientKey((dir / "alice").string());
+  std::string serverPub, alicePub, aliceSec;
+  std::ifstream(dir / "server.public") >> serverPub;
+  std::ifstream(dir / "alice" / "client.public") >> alicePub;
+  std::ifstream(dir / "alice" / "client.secret") >> aliceSec;
+  ASSERT_EQ(alicePub.size(), 40u);
+  {
+    std::ofstream allow(dir / "authorized_keys");
+    allow << "# CFD nodes allowed to drive this DEM server\n\n" << alicePub << " alice@node1\n";
+  }
+  auto o = options();
+  o.curveKeysDir = dir.string();
+  o.clientKeysFile = (dir / "authorized_keys").string();
+  ServerThread srv(o);
+  proto::TransportOptions alice;
+  alice.curve.serverPublicKey = serverPub;
+  alice.curve.clientPublicKey = alicePub;
+  alice.curve.clientSecretKey = aliceSec;
+  proto::Client allowed(alice);
+  allowed.connect(srv.endpoint());
+  EXPECT_EQ(allowed.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "alice"), 10s).type(),
+            v1::MESSAGE_TYPE_WELCOME);
+  // A client that knows the server's public key but made up its own key pair: the CURVE
+  // handshake is refused by the ZAP handler and no message reaches the server.
+  proto::TransportOptions mallory = alice;
+  const auto pair = proto::generateCurveKeyPair();
+  mallory.curve.clientPublicKey = pair.first;
+  mallory.curve.clientSecretKey = pair.second;
+  proto::Client refused(mallory);
+  refused.connect(srv.endpoint());
+  EXPECT_THROW(refused.request(proto::makeHeartbeat("mallory"), 1s), proto::TimeoutError);
+  // The allowed client is still served.
+  EXPECT_EQ(allowed.request(proto::makeHeartbeat("alice"), 10s).type(), v1::MESSAGE_TYPE_HEARTBEAT);
+  // A malformed allow-list is refused at start naming the line.
+  {
+    std::ofstream bad(dir / "bad_keys");
+    bad << alicePub << "\nnot-a-key\n";
+  }
+  auto b = options();
+  b.curveKeysDir = dir.string();
+  b.clientKeysFile = (dir / "bad_keys").string();
+  try {
+    server::DemServer s(b);
+    ADD_FAILURE() << "a malformed allow-list must be refused";
+  } catch (const coredem::UserError& e) {
+    EXPECT_TRUE(contains(e.what(), "line 2")) << e.what();
+  }
+  std::filesystem::remove_all(dir);
 }

@@ -59,6 +59,11 @@ struct CurveKeys {
   std::string serverSecretKey;
   std::string clientPublicKey;
   std::string clientSecretKey;
+  /// Server only: the client public keys (Z85) allowed to connect, like ssh
+  /// `authorized_keys`. Non-empty: a ZAP handler admits only these keys (any other client's
+  /// CURVE handshake fails, no message of it arrives) and each Request carries its client's
+  /// key. Empty: any client that knows the server's public key is admitted.
+  std::vector<std::string> allowedClientKeys;
   [[nodiscard]] bool serverConfigured() const { return !serverSecretKey.empty(); }
   [[nodiscard]] bool clientConfigured() const {
     return !serverPublicKey.empty() && !clientPublicKey.empty() && !clientSecretKey.empty();
@@ -68,6 +73,11 @@ struct CurveKeys {
 /// Generates a CURVE key pair {public, secret} (Z85); throws ProtocolError(UNSUPPORTED) if
 /// libzmq was built without CURVE.
 std::pair<std::string, std::string> generateCurveKeyPair();
+
+/// Reads an allow-list of client public keys: one Z85 key (40 characters) per line, then
+/// optional free text (a name); blank lines and lines starting with '#' are skipped. Throws
+/// ProtocolError(SECURITY) naming the file and line of a malformed key.
+std::vector<std::string> readAllowedClientKeys(const std::string& path);
 
 /// Default largest message part (frame) any socket accepts: 256 MiB, e.g. one float64 array of
 /// 11 million cells x 3 components. A peer that announces a larger frame is disconnected by
@@ -112,6 +122,9 @@ using PeerId = std::string;
 /// One request received by a Server.
 struct Request {
   PeerId peer;
+  /// The client's CURVE public key (Z85) as authenticated by the ZAP handler, when the server
+  /// has an allow-list (CurveKeys::allowedClientKeys); empty otherwise.
+  std::string clientKey;
   Message message;
   /// Structural decode result (Message::decode): if not ok, answer with makeError(status).
   Status status;

@@ -28,7 +28,11 @@ struct ServerOptions {
   double sessionTimeoutSeconds = 600; ///< a session whose peers are silent this long ends
   /// How long a GasFields may wait for the orchestrator's StepGrant of its step.
   double grantWaitSeconds = 60;
-  std::string curveKeysDir;      ///< DIR/server.public + DIR/server.secret (Z85)
+  std::string curveKeysDir; ///< DIR/server.public + DIR/server.secret (Z85)
+  /// Allow-list of client public keys (one Z85 key per line, like ssh `authorized_keys`; needs
+  /// curveKeysDir): only these clients complete the CURVE handshake. Empty: any client that
+  /// knows the server's public key.
+  std::string clientKeysFile;
   bool insecure = false;         ///< allow a non-loopback bind without CURVE
   bool exitAfterSession = false; ///< run() returns when the first session ends
   /// Admission control (docs/security.md): the memory budget the count limits of a Configure
@@ -78,5 +82,8 @@ private:
 
 /// Writes a new CURVE key pair into DIR/server.public and DIR/server.secret (mode 0600).
 void generateCurveKeys(const std::string& dir);
+/// Writes a new client key pair into DIR/client.public and DIR/client.secret (mode 0600); the
+/// public key goes into the server's --client-keys allow-list.
+void generateClientKey(const std::string& dir);
 
 } // namespace coredem::server
