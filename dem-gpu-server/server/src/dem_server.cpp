@@ -517,9 +517,9 @@ struct DemServer::Impl {
     if (g.dt_cfd() / g.n_sub() > dtMax * (1.0 + kDtTolerance)) {
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
              fmt::format("StepGrant of step {}: dt_cfd/n_sub = {:.6g} s exceeds this DEM's "
-                         "dt_dem_max = {:.6g} s; use n_sub >= {}",
+                         "dt_dem_max = {:.6g} s; use n_sub >= {:.0f}",
                          env.step(), g.dt_cfd() / g.n_sub(), dtMax,
-                         dem::TimeHandler::subStepsFor(g.dt_cfd(), dtMax)));
+                         std::ceil(g.dt_cfd() / dtMax))); // a double: never throws or wraps
       return;
     }
     if (g.dt_dem() > 0.0 &&

@@ -269,6 +269,13 @@ TEST(Admission, AbsurdSubStepCountsAreRefusedAndTheNextStepRuns) {
     EXPECT_TRUE(contains(msg, "n_sub = " + std::to_string(nSub))) << msg;
     EXPECT_TRUE(contains(msg, "1000")) << msg;
   }
+  { // a CFD step of 10^10 s: 6e15 sub-steps needed; refused, the session goes on
+    auto huge = proto::makeStepGrant(1, 0.0, 1e10, 1, 1e10);
+    huge.setSessionId(o.session());
+    const auto msg =
+        refusal(o.dem().request(std::move(huge), 10s), v1::ERROR_CODE_INVALID_CONFIGURATION);
+    EXPECT_TRUE(contains(msg, "dt_dem_max")) << msg;
+  }
   const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
   ASSERT_LE(nSub, 1000u);
   auto g = proto::makeStepGrant(1, 0.0, dt, nSub, dt / nSub);
