@@ -174,7 +174,7 @@ std::vector<zmq::message_t> receiveFrames(zmq::socket_t& socket, const std::stri
       }
       ++o.frames;
       o.bytes += frame.size();
-      if (maxBytes > 0 && (o.frames > kMaxFramesPerMessage + keep ||
+      if (maxBytes > 0 && (o.frames > kMaxFramesPerMessage + keep + 1 ||
                            o.bytes > static_cast<std::uint64_t>(maxBytes) + 4096)) {
         o.exceeded = true;
       }
