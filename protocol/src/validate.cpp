@@ -285,7 +285,7 @@ Status validateGasRanges(const Message& m, const GasRanges& r) {
     for (std::size_t c = 0; 3 * c + 2 < v.size(); ++c) {
       const double mag = std::hypot(v[3 * c], v[3 * c + 1], v[3 * c + 2]);
       if (!(mag <= hi)) {
-        return outOfRange(name, c, "|" + std::string(name) + "|", mag, 0.0, hi, unit);
+        return outOfRange(name, c, std::string("|").append(name).append("|"), mag, 0.0, hi, unit);
       }
     }
     return {};

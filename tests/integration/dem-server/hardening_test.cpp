@@ -182,7 +182,7 @@ TEST(Admission, HugeCountsAreRefusedNamingFieldValueAndLimitAndTheSessionStaysUs
   auto species = base; // 300 gas species
   for (int k = 0; k < 299; ++k) {
     auto* s = species.add_species();
-    s->set_name("S" + std::to_string(k));
+    s->set_name(std::string("S").append(std::to_string(k)));
     s->set_molar_mass(0.03);
   }
   msg = refusal(o.configure(species), v1::ERROR_CODE_INVALID_CONFIGURATION);
@@ -192,7 +192,7 @@ TEST(Admission, HugeCountsAreRefusedNamingFieldValueAndLimitAndTheSessionStaysUs
   auto opts = base; // 300 options
   for (int k = 0; k < 300; ++k) {
     auto* kv = opts.add_options();
-    kv->set_key("k" + std::to_string(k));
+    kv->set_key(std::string("k").append(std::to_string(k)));
     kv->set_value("v");
   }
   msg = refusal(o.configure(opts), v1::ERROR_CODE_INVALID_CONFIGURATION);
