@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include <CLI/CLI.hpp>
+#include <unistd.h>
 
 #include "admission.h"
 #include "coredem/common/check.h"
@@ -16,8 +17,16 @@
 namespace {
 
 std::atomic<coredem::server::DemServer*> gServer{nullptr};
+std::atomic<int> gSignals{0};
 
-extern "C" void onSignal(int) {
+/// SIGINT/SIGTERM: the first ends the session after the message being handled; a second one
+/// (a step of many sub-steps may take long) exits at once with 128 + signal.
+extern "C" void onSignal(int sig) {
+  if (gSignals.fetch_add(1) >= 1) {
+    static const char kMsg[] = "coredem-dem: second signal: exiting now\n";
+    (void)!::write(2, kMsg, sizeof kMsg - 1);
+    ::_exit(128 + sig);
+  }
   if (auto* s = gServer.load()) {
     s->stop();
   }
