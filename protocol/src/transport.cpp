@@ -678,6 +678,9 @@ Client::Client(TransportOptions options) {
     _impl = std::make_unique<Impl>();
     _impl->options = std::move(options);
     setCommonOptions(_impl->socket, _impl->options);
+    if (!_impl->options.routingId.empty()) {
+      _impl->socket.set(zmq::sockopt::routing_id, _impl->options.routingId);
+    }
     if (_impl->options.curve.clientConfigured()) {
       setKey(_impl->socket, ZMQ_CURVE_SERVERKEY, _impl->options.curve.serverPublicKey,
              "server public key");

@@ -469,6 +469,41 @@ TEST(SessionBinding, ALostOrchestratorEndsTheSession) {
   refusal(late.request(cfdHello(session), 10s), v1::ERROR_CODE_UNKNOWN_SESSION);
 }
 
+TEST(SessionBinding, ReusingTheOrchestratorsRoutingIdGainsNothing) {
+  ServerThread srv(options());
+  proto::TransportOptions same;
+  same.routingId = "orchestrator-1";
+  auto o = std::make_unique<proto::Client>(same);
+  o->connect(srv.endpoint());
+  auto w = o->request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "real"), 10s);
+  ASSERT_EQ(w.type(), v1::MESSAGE_TYPE_WELCOME);
+  const auto session = w.envelope().welcome().session_id();
+  // While the orchestrator is connected, ZeroMQ refuses a second connection with its routing
+  // id: nothing of it reaches the server.
+  {
+    proto::Client twin(same);
+    twin.connect(srv.endpoint());
+    auto s = proto::makeShutdown("take over");
+    s.setSessionId(session);
+    EXPECT_THROW(twin.request(std::move(s), 1s), proto::TimeoutError);
+  }
+  auto hb = proto::makeHeartbeat("still here");
+  hb.setSessionId(session);
+  EXPECT_EQ(o->request(std::move(hb), 10s).envelope().session_id(), session);
+  // Once its connection closed, the session is over: a peer reusing the routing id (and the
+  // session id it somehow learnt) meets no session.
+  o.reset();
+  proto::Client probe;
+  probe.connect(srv.endpoint());
+  auto free = helloUntilFree(probe, v1::ROLE_ORCHESTRATOR, "");
+  ASSERT_EQ(free.type(), v1::MESSAGE_TYPE_WELCOME); // the old session ended
+  proto::Client reuse(same);
+  reuse.connect(srv.endpoint());
+  auto cfg = proto::makeConfigure(smallCase(kParticles, kD, kBox, kCells));
+  cfg.setSessionId(session);
+  refusal(reuse.request(std::move(cfg), 10s), v1::ERROR_CODE_UNKNOWN_SESSION);
+}
+
 // ---- logs and replies --------------------------------------------------------------------------
 
 TEST(Logs, PeerStringsAreEscapedAndCappedAndRepeatedWarningsSummarised) {

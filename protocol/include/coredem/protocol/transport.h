@@ -102,6 +102,9 @@ struct TransportOptions {
   /// connection before it is read). A server also refuses a message whose frames together
   /// exceed it (BYTE_LENGTH) or that has more than kMaxFramesPerMessage frames. <= 0: no limit.
   std::int64_t maxMessageBytes = kDefaultMaxMessageBytes;
+  /// Client only: the ZeroMQ routing id this connection presents (ZMQ_ROUTING_ID, 1-255
+  /// bytes; empty: the server assigns one). For tests of routing-id reuse.
+  std::string routingId;
   /// Free text put into Envelope.sender of outgoing messages when empty.
   std::string sender;
 };
