@@ -37,7 +37,7 @@ struct LoopbackService::Impl {
 
   void sendError(const PeerId& peer, const Status& s, const Message& offending) {
     ++errors;
-    log->warn("refused {}: {}", messageTypeName(offending.type()), s.toString());
+    log->warn("refused {}: {}", messageTypeName(offending.type()), printable(s.toString(), 400));
     server.reply(peer, makeError(s, offending.envelope().sequence(), offending.type()));
   }
 
@@ -153,8 +153,8 @@ struct LoopbackService::Impl {
     if (sessionPeer && *sessionPeer != req.peer) {
       ++errors;
       Message r = makeReject(v1::ERROR_CODE_SESSION_BUSY,
-                             "this server already serves session " + sessionId +
-                                 "; start another server for a second session");
+                             "this server already serves another session; start another "
+                             "server for a second session"); // never the id to a non-member
       r.setSequence(seq);
       server.reply(req.peer, std::move(r));
       return;

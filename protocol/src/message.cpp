@@ -54,9 +54,9 @@ std::string dtypeName(v1::DType dtype) {
 
 void ArrayView::checkDtype(v1::DType wanted) const {
   if (descriptor->dtype() != wanted) {
-    throw ProtocolError(v1::ERROR_CODE_DTYPE, "array '" + descriptor->name() + "' has dtype " +
-                                                  dtypeName(descriptor->dtype()) + ", read as " +
-                                                  dtypeName(wanted));
+    throw ProtocolError(v1::ERROR_CODE_DTYPE, "array '" + printable(descriptor->name()) +
+                                                  "' has dtype " + dtypeName(descriptor->dtype()) +
+                                                  ", read as " + dtypeName(wanted));
   }
 }
 
@@ -145,15 +145,15 @@ Status decodeInto(Message& out, const std::byte* envelopeData, std::size_t envel
     std::size_t elem = dtypeSize(d.dtype());
     if (elem == 0) {
       return Status::error(v1::ERROR_CODE_DTYPE,
-                           "array '" + d.name() + "' (frame " + std::to_string(i + 1) +
+                           "array '" + printable(d.name()) + "' (frame " + std::to_string(i + 1) +
                                ") has dtype " + dtypeName(d.dtype()) +
                                ", which this protocol version does not know; use one of "
                                "float64, float32, int32, int64, uint8, uint32, uint64");
     }
     if (b.size != d.byte_length()) {
       return Status::error(v1::ERROR_CODE_BYTE_LENGTH,
-                           "array '" + d.name() + "' (frame " + std::to_string(i + 1) + ") has " +
-                               std::to_string(b.size) +
+                           "array '" + printable(d.name()) + "' (frame " + std::to_string(i + 1) +
+                               ") has " + std::to_string(b.size) +
                                " bytes but its descriptor declares byte_length " +
                                std::to_string(d.byte_length()) +
                                "; the frame was truncated or the descriptor is wrong");
@@ -163,7 +163,7 @@ Status decodeInto(Message& out, const std::byte* envelopeData, std::size_t envel
         elements * elem != d.byte_length()) {
       return Status::error(
           v1::ERROR_CODE_BYTE_LENGTH,
-          "array '" + d.name() + "': shape " + shapeString(d.shape()) + " of " +
+          "array '" + printable(d.name()) + "': shape " + shapeString(d.shape()) + " of " +
               dtypeName(d.dtype()) + " needs " +
               (elements > d.byte_length() ? std::string("more than ") : std::string()) +
               std::to_string(elements * elem) + " bytes but byte_length is " +

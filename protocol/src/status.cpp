@@ -1,3 +1,5 @@
+#include <algorithm>
+
 #include <coredem/protocol/status.h>
 
 namespace coredem::protocol {
@@ -23,6 +25,45 @@ std::string messageTypeName(v1::MessageType type) {
     return "UNKNOWN_TYPE_" + std::to_string(static_cast<int>(type));
   }
   return stripPrefix(v1::MessageType_Name(type), "MESSAGE_TYPE_");
+}
+
+std::string printable(std::string_view text, std::size_t maxBytes) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  const std::size_t n = std::min(text.size(), maxBytes);
+  out.reserve(n + 24);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    switch (c) {
+    case '\n':
+      out += "\\n";
+      break;
+    case '\r':
+      out += "\\r";
+      break;
+    case '\t':
+      out += "\\t";
+      break;
+    case '\\':
+      out += "\\\\";
+      break;
+    case '"':
+      out += "\\\"";
+      break;
+    default:
+      if (c >= 0x20 && c < 0x7f) {
+        out += static_cast<char>(c);
+      } else {
+        out += "\\x";
+        out += kHex[c >> 4];
+        out += kHex[c & 0xf];
+      }
+    }
+  }
+  if (text.size() > n) {
+    out += "...(" + std::to_string(text.size()) + " bytes)";
+  }
+  return out;
 }
 
 std::string Status::toString() const {

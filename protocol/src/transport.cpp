@@ -1,7 +1,14 @@
 // ZeroMQ transport. The only translation unit that includes zmq.hpp: ZeroMQ stays private.
+#include <atomic>
 #include <cstring>
+#include <fstream>
+#include <map>
 #include <mutex>
 #include <regex>
+#include <set>
+#include <sstream>
+#include <thread>
+#include <utility>
 
 #include <zmq.hpp>
 
@@ -32,6 +39,10 @@ void setCommonOptions(zmq::socket_t& socket, const TransportOptions& o) {
   socket.set(zmq::sockopt::heartbeat_ttl, static_cast<int>(o.heartbeatTimeout.count()));
   // A send never blocks forever: after 10 s it fails and is reported.
   socket.set(zmq::sockopt::sndtimeo, 10000);
+  // A frame larger than this drops the connection before it is allocated.
+  if (o.maxMessageBytes > 0) {
+    socket.set(zmq::sockopt::maxmsgsize, o.maxMessageBytes);
+  }
 }
 
 void setKey(zmq::socket_t& socket, int option, const std::string& key, const char* which) {
@@ -127,9 +138,23 @@ bool waitReadable(zmq::socket_t& socket, Clock::time_point deadline) {
   }
 }
 
-/// Receives all frames of one multipart message (after poll said readable).
-std::vector<zmq::message_t> receiveFrames(zmq::socket_t& socket, const std::string& what) {
+/// What receiveFrames dropped: a message over the limits keeps its first frames (routing id,
+/// envelope) so that it can be answered, the rest is read and released at once.
+struct Oversize {
+  std::size_t frames = 0;
+  std::uint64_t bytes = 0;
+  bool exceeded = false;
+};
+
+/// Receives all frames of one multipart message (after poll said readable). With limits
+/// (maxBytes > 0), frames beyond `keep` are released as soon as the message's frame count or
+/// total size exceeds them.
+std::vector<zmq::message_t> receiveFrames(zmq::socket_t& socket, const std::string& what,
+                                          std::int64_t maxBytes = 0, std::size_t keep = 1,
+                                          Oversize* over = nullptr, int* srcFd = nullptr,
+                                          std::string* userId = nullptr) {
   std::vector<zmq::message_t> frames;
+  Oversize o;
   try {
     for (;;) {
       zmq::message_t frame;
@@ -137,13 +162,37 @@ std::vector<zmq::message_t> receiveFrames(zmq::socket_t& socket, const std::stri
         break; // parts of a multipart message arrive together; nothing more
       }
       bool more = frame.more();
-      frames.push_back(std::move(frame));
+      // The connection's fd (ZMQ_SRCFD). libzmq 4.3 leaves it off a ROUTER's routing-id frame
+      // when poll() prefetched the message, so the first frame that has it is used.
+      if (srcFd != nullptr && *srcFd < 0 && o.frames < 2) {
+        *srcFd = zmq_msg_get(frame.handle(), ZMQ_SRCFD);
+        // The ZAP handler's user id: the client's authenticated key (an allow-list only).
+        const char* user = zmq_msg_gets(frame.handle(), "User-Id");
+        if (userId != nullptr && user != nullptr) {
+          *userId = user;
+        }
+      }
+      ++o.frames;
+      o.bytes += frame.size();
+      if (maxBytes > 0 && (o.frames > kMaxFramesPerMessage + keep + 1 ||
+                           o.bytes > static_cast<std::uint64_t>(maxBytes) + 4096)) {
+        o.exceeded = true;
+      }
+      if (!o.exceeded || frames.size() < keep + 1) {
+        frames.push_back(std::move(frame));
+      }
       if (!more) {
         break;
       }
     }
   } catch (const zmq::error_t& e) {
     rethrowZmq(e, what);
+  }
+  if (o.exceeded) {
+    frames.resize(std::min(frames.size(), keep + 1)); // routing id(s) + envelope
+  }
+  if (over != nullptr) {
+    *over = o;
   }
   return frames;
 }
@@ -215,7 +264,172 @@ std::shared_ptr<zmq::context_t> sharedContext() {
   return context;
 }
 
+/// ZAP handler (ZeroMQ RFC 27) on inproc://zeromq.zap.01 of the shared context: CURVE clients
+/// are admitted when their public key is in the allow-list of the ZAP domain of the socket
+/// they connect to (one domain per Server with an allow-list). One per process, alive while a
+/// Server uses it; its thread polls with a short timeout so that it stops promptly.
+class ZapHandler {
+public:
+  static std::shared_ptr<ZapHandler> instance() {
+    static std::mutex mutex;
+    static std::weak_ptr<ZapHandler> weak;
+    std::lock_guard lock(mutex);
+    auto h = weak.lock();
+    if (!h) {
+      h = std::shared_ptr<ZapHandler>(new ZapHandler());
+      weak = h;
+    }
+    return h;
+  }
+  ~ZapHandler() {
+    _stop = true;
+    _thread.join();
+  }
+  ZapHandler(const ZapHandler&) = delete;
+  ZapHandler& operator=(const ZapHandler&) = delete;
+
+  std::string addDomain(const std::vector<std::string>& keys) {
+    static std::atomic<std::uint64_t> counter{0};
+    const std::string domain = "coredem-" + std::to_string(++counter);
+    std::lock_guard lock(_mutex);
+    _domains[domain] = std::set<std::string>(keys.begin(), keys.end());
+    return domain;
+  }
+  void removeDomain(const std::string& domain) {
+    std::lock_guard lock(_mutex);
+    _domains.erase(domain);
+  }
+
+private:
+  ZapHandler() {
+    _socket.set(zmq::sockopt::linger, 0);
+    // Before any CURVE socket of ours accepts. A previous handler's endpoint may take a
+    // moment to be released after its socket closed.
+    for (int attempt = 0;; ++attempt) {
+      try {
+        _socket.bind("inproc://zeromq.zap.01");
+        break;
+      } catch (const zmq::error_t& e) {
+        if (e.num() != EADDRINUSE || attempt >= 50) {
+          rethrowZmq(e, "starting the ZAP handler (client key allow-list)");
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    }
+    _thread = std::thread([this] { run(); });
+  }
+
+  void run() {
+    while (!_stop) {
+      zmq::pollitem_t item{_socket.handle(), 0, ZMQ_POLLIN, 0};
+      try {
+        if (zmq::poll(&item, 1, std::chrono::milliseconds(100)) <= 0) {
+          continue;
+        }
+        std::vector<zmq::message_t> request;
+        for (;;) {
+          zmq::message_t f;
+          if (!_socket.recv(f, zmq::recv_flags::dontwait)) {
+            break;
+          }
+          const bool more = f.more();
+          request.push_back(std::move(f));
+          if (!more) {
+            break;
+          }
+        }
+        answer(request);
+      } catch (const zmq::error_t& e) {
+        transportLog()->warn("ZAP handler: ZeroMQ error {} ({})", e.num(), e.what());
+      }
+    }
+  }
+
+  /// Request: version, request id, domain, address, routing id, mechanism, credentials.
+  void answer(const std::vector<zmq::message_t>& r) {
+    std::string status = "400", text = "malformed ZAP request", user;
+    if (r.size() >= 6) {
+      const std::string domain = r[2].to_string(), address = r[3].to_string();
+      const std::string mechanism = r[5].to_string();
+      if (mechanism == "CURVE" && r.size() >= 7 && r[6].size() == 32) {
+        char z85[41] = {};
+        zmq_z85_encode(z85, static_cast<const std::uint8_t*>(r[6].data()), 32);
+        std::lock_guard lock(_mutex);
+        const auto d = _domains.find(domain);
+        if (d == _domains.end()) {
+          status = "200"; // a socket without an allow-list: CURVE alone decides
+          text = "OK";
+        } else if (d->second.count(z85) != 0) {
+          status = "200";
+          text = "OK";
+          user = z85;
+        } else {
+          text = "client key not allowed";
+          // A refused client reconnects every 100 ms: log its 1st, 2nd, 4th, 8th... refusal.
+          if (_refusals.size() > 1024) {
+            _refusals.clear();
+          }
+          const std::uint64_t n = ++_refusals[z85];
+          if ((n & (n - 1)) == 0) {
+            transportLog()->warn("refused CURVE client {} from {} ({} times): its key is not in "
+                                 "the allow-list",
+                                 z85, printable(address, 64), n);
+          }
+        }
+      } else {
+        std::lock_guard lock(_mutex);
+        const bool guarded = _domains.count(domain) != 0;
+        status = guarded ? "400" : "200";
+        text = guarded ? "CURVE with an allowed client key required" : "OK";
+      }
+    }
+    const std::string version = "1.0";
+    const std::string id = r.size() > 1 ? r[1].to_string() : std::string();
+    const std::string parts[] = {version, id, status, text, user, std::string()};
+    for (std::size_t i = 0; i < 6; ++i) {
+      _socket.send(zmq::buffer(parts[i]),
+                   i + 1 < 6 ? zmq::send_flags::sndmore : zmq::send_flags::none);
+    }
+  }
+
+  std::shared_ptr<zmq::context_t> _context = sharedContext(); // outlives the socket
+  zmq::socket_t _socket{*_context, zmq::socket_type::rep};
+  std::mutex _mutex;
+  std::map<std::string, std::set<std::string>> _domains;
+  std::map<std::string, std::uint64_t> _refusals; ///< per refused key (log rate limit)
+  std::atomic<bool> _stop{false};
+  std::thread _thread;
+};
+
 } // namespace
+
+std::vector<std::string> readAllowedClientKeys(const std::string& path) {
+  std::ifstream in(path);
+  if (!in.good()) {
+    throw ProtocolError(v1::ERROR_CODE_SECURITY,
+                        "cannot read the client key allow-list " + path +
+                            " (one Z85 public key per line; `coredem-dem --generate-client-key "
+                            "DIR` writes a key pair)");
+  }
+  std::vector<std::string> keys;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    std::istringstream words(line);
+    std::string key;
+    if (!(words >> key) || key.starts_with("#")) {
+      continue;
+    }
+    char binary[32];
+    if (key.size() != 40 ||
+        zmq_z85_decode(reinterpret_cast<std::uint8_t*>(binary), key.c_str()) == nullptr) {
+      throw ProtocolError(v1::ERROR_CODE_SECURITY,
+                          path + " line " + std::to_string(n) + ": '" + printable(key, 60) +
+                              "' is not a 40-character Z85 CURVE public key");
+    }
+    keys.push_back(key);
+  }
+  return keys;
+}
 
 bool isLoopbackEndpoint(std::string_view endpoint) {
   if (endpoint.starts_with("ipc://") || endpoint.starts_with("inproc://")) {
@@ -259,8 +473,74 @@ struct Server::Impl {
   TransportOptions options;
   std::shared_ptr<zmq::context_t> context = sharedContext(); // outlives the socket
   zmq::socket_t socket{*context, zmq::socket_type::router};
+  /// Connection events of `socket` (ZMQ_EVENT_DISCONNECTED carries the connection's fd).
+  zmq::socket_t monitor{*context, zmq::socket_type::pair};
+  /// With an allow-list of client keys: the ZAP handler and this socket's domain in it.
+  std::shared_ptr<ZapHandler> zap;
+  std::string zapDomain;
+  /// The connection (fd, and how many connections that fd had carried) each known peer's last
+  /// message came on. The generation keeps a reused fd's new connection apart from the old.
+  std::map<PeerId, std::pair<int, std::uint64_t>> fdOf;
+  std::map<int, std::uint64_t> generation;              ///< ZMQ_EVENT_ACCEPTED count per fd
+  static constexpr std::size_t kMaxDisconnected = 4096; ///< oldest dropped beyond this
+  std::vector<PeerId> disconnected;                     ///< since the last takeDisconnected()
   std::string endpoint;
   std::shared_ptr<spdlog::logger> log = transportLog();
+
+  void startMonitor() {
+    static std::atomic<std::uint64_t> counter{0};
+    const std::string address = "inproc://coredem-server-monitor-" + std::to_string(++counter);
+    if (zmq_socket_monitor(socket.handle(), address.c_str(),
+                           ZMQ_EVENT_ACCEPTED | ZMQ_EVENT_DISCONNECTED) != 0) {
+      throw TransportError(std::string("starting the socket monitor failed: ") +
+                           zmq_strerror(zmq_errno()));
+    }
+    monitor.connect(address);
+  }
+
+  /// Reads the pending monitor events; a closed connection's peers move to `disconnected`.
+  void drainMonitor() {
+    try {
+      for (;;) {
+        zmq::message_t event;
+        if (!monitor.recv(event, zmq::recv_flags::dontwait)) {
+          return;
+        }
+        const bool more = event.more();
+        std::uint16_t id = 0;
+        std::uint32_t value = 0;
+        if (event.size() >= 6) {
+          std::memcpy(&id, event.data(), 2);
+          std::memcpy(&value, static_cast<const char*>(event.data()) + 2, 4);
+        }
+        if (more) {
+          zmq::message_t address; // second frame: the endpoint
+          (void)monitor.recv(address, zmq::recv_flags::dontwait);
+        }
+        const int fd = static_cast<int>(value);
+        if (id == ZMQ_EVENT_ACCEPTED) {
+          ++generation[fd];
+          continue;
+        }
+        if (id != ZMQ_EVENT_DISCONNECTED) {
+          continue;
+        }
+        for (auto it = fdOf.begin(); it != fdOf.end();) {
+          if (it->second == std::make_pair(fd, generation[fd])) {
+            if (disconnected.size() >= kMaxDisconnected) { // a server that never asks
+              disconnected.erase(disconnected.begin());
+            }
+            disconnected.push_back(it->first);
+            it = fdOf.erase(it);
+          } else {
+            ++it;
+          }
+        }
+      }
+    } catch (const zmq::error_t& e) {
+      log->warn("socket monitor of {}: ZeroMQ error {} ({})", endpoint, e.num(), e.what());
+    }
+  }
 };
 
 Server::Server(TransportOptions options) {
@@ -269,18 +549,28 @@ Server::Server(TransportOptions options) {
     _impl->options = std::move(options);
     setCommonOptions(_impl->socket, _impl->options);
     _impl->socket.set(zmq::sockopt::router_mandatory, 1);
+    _impl->startMonitor();
     if (_impl->options.curve.serverConfigured()) {
       int one = 1;
       zmq_setsockopt(_impl->socket.handle(), ZMQ_CURVE_SERVER, &one, sizeof(one));
       setKey(_impl->socket, ZMQ_CURVE_SECRETKEY, _impl->options.curve.serverSecretKey,
              "server secret key");
+      if (!_impl->options.curve.allowedClientKeys.empty()) {
+        _impl->zap = ZapHandler::instance();
+        _impl->zapDomain = _impl->zap->addDomain(_impl->options.curve.allowedClientKeys);
+        _impl->socket.set(zmq::sockopt::zap_domain, _impl->zapDomain);
+      }
     }
   } catch (const zmq::error_t& e) {
     rethrowZmq(e, "creating the server socket");
   }
 }
 
-Server::~Server() = default;
+Server::~Server() {
+  if (_impl && _impl->zap) {
+    _impl->zap->removeDomain(_impl->zapDomain);
+  }
+}
 Server::Server(Server&&) noexcept = default;
 Server& Server::operator=(Server&&) noexcept = default;
 
@@ -314,12 +604,36 @@ std::optional<Request> Server::receive(std::chrono::milliseconds timeout,
   if (!waitReadable(_impl->socket, deadline)) {
     return std::nullopt;
   }
-  auto frames = receiveFrames(_impl->socket, "receiving on " + _impl->endpoint);
+  _impl->drainMonitor(); // closed connections first: their routing ids may be reused next
+  Oversize over;
+  int fd = -1;
+  std::string userId;
+  auto frames = receiveFrames(_impl->socket, "receiving on " + _impl->endpoint,
+                              _impl->options.maxMessageBytes, 1, &over, &fd, &userId);
   if (frames.empty()) {
     return std::nullopt;
   }
   Request request;
   request.peer = frames[0].to_string();
+  if (_impl->zap) {
+    request.clientKey = userId;
+  }
+  if (fd >= 0) { // the monitor was drained first: generation[fd] is this connection's
+    _impl->fdOf[request.peer] = {fd, _impl->generation[fd]};
+  }
+  if (over.exceeded) {
+    frames.resize(std::min<std::size_t>(frames.size(), 2));
+    (void)decodeFrames(frames, 1, request.message, {}); // the envelope, for sequence and type
+    request.status = Status::error(
+        v1::ERROR_CODE_BYTE_LENGTH,
+        "message of " + std::to_string(over.frames) + " frames and " + std::to_string(over.bytes) +
+            " bytes exceeds the limits of " + std::to_string(kMaxFramesPerMessage) +
+            " arrays and " + std::to_string(_impl->options.maxMessageBytes) +
+            " bytes (coredem-dem --max-message-mb); send smaller fields or raise the limit");
+    _impl->log->warn("refused an oversized message on {}: {}", _impl->endpoint,
+                     request.status.message);
+    return request;
+  }
   request.status = decodeFrames(frames, 1, request.message, options);
   if (!request.status.ok()) {
     _impl->log->debug("undecodable message on {}: {}", _impl->endpoint, request.status.toString());
@@ -337,6 +651,11 @@ void Server::reply(const PeerId& peer, Message message) {
     // EHOSTUNREACH: the peer has gone; its reply is dropped (it will time out and report).
     _impl->log->warn("reply dropped: {}", e.what());
   }
+}
+
+std::vector<PeerId> Server::takeDisconnected() {
+  _impl->drainMonitor();
+  return std::exchange(_impl->disconnected, {});
 }
 
 void Server::replyFrames(const PeerId& peer, const Frames& frames) {
@@ -359,6 +678,9 @@ Client::Client(TransportOptions options) {
     _impl = std::make_unique<Impl>();
     _impl->options = std::move(options);
     setCommonOptions(_impl->socket, _impl->options);
+    if (!_impl->options.routingId.empty()) {
+      _impl->socket.set(zmq::sockopt::routing_id, _impl->options.routingId);
+    }
     if (_impl->options.curve.clientConfigured()) {
       setKey(_impl->socket, ZMQ_CURVE_SERVERKEY, _impl->options.curve.serverPublicKey,
              "server public key");

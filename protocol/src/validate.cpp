@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -46,7 +47,8 @@ Status checkFinite(const ArrayView& view) {
                  std::to_string(i % shape[1]) + ")";
       }
       return Status::error(v1::ERROR_CODE_NON_FINITE,
-                           "array '" + view.name() + "' contains " + what + " at " + where +
+                           "array '" + printable(view.name()) + "' contains " + what + " at " +
+                               where +
                                "; every value must be finite - check the sender's solution "
                                "for divergence at that cell");
     }
@@ -61,7 +63,7 @@ Status checkArrays(const Message& message, std::span<const fields::FieldSpec> re
     ArrayView v = message.array(i);
     if (!seen.insert(v.name()).second) {
       return Status::error(v1::ERROR_CODE_DUPLICATE_FIELD,
-                           "array '" + v.name() + "' appears more than once in one " +
+                           "array '" + printable(v.name()) + "' appears more than once in one " +
                                messageTypeName(message.type()) + " message; send it once");
     }
   }
@@ -77,16 +79,17 @@ Status checkArrays(const Message& message, std::span<const fields::FieldSpec> re
     }
     if (v->dtype() != v1::DTYPE_FLOAT64) {
       return Status::error(v1::ERROR_CODE_DTYPE,
-                           "array '" + v->name() + "' has dtype " + dtypeName(v->dtype()) +
+                           "array '" + printable(v->name()) + "' has dtype " +
+                               dtypeName(v->dtype()) +
                                " but coupling fields are float64; convert before sending");
     }
     auto expected = fields::shapeOf(spec.extent, cells, species);
     if (v->shape() != expected) {
       return Status::error(v1::ERROR_CODE_SHAPE,
-                           "array '" + v->name() + "' has shape " + shapeString(v->shape()) +
-                               " but " + shapeString(expected) + " was expected for " +
-                               std::to_string(cells) + " configured cells and " +
-                               std::to_string(species) +
+                           "array '" + printable(v->name()) + "' has shape " +
+                               shapeString(v->shape()) + " but " + shapeString(expected) +
+                               " was expected for " + std::to_string(cells) +
+                               " configured cells and " + std::to_string(species) +
                                " species; send one row per coupling cell of Configure");
     }
   }
@@ -120,14 +123,14 @@ Status structure(const Message& message) {
     const auto& d = env.arrays(i);
     std::size_t elem = dtypeSize(d.dtype());
     if (elem == 0) {
-      return Status::error(v1::ERROR_CODE_DTYPE,
-                           "array '" + d.name() + "' has unknown dtype " + dtypeName(d.dtype()));
+      return Status::error(v1::ERROR_CODE_DTYPE, "array '" + printable(d.name()) +
+                                                     "' has unknown dtype " + dtypeName(d.dtype()));
     }
     std::uint64_t elements = 0;
     if (impl.arrays[static_cast<std::size_t>(i)].size != d.byte_length() ||
         !shapeElements(d.shape(), &elements) || elements * elem != d.byte_length()) {
       return Status::error(v1::ERROR_CODE_BYTE_LENGTH,
-                           "array '" + d.name() +
+                           "array '" + printable(d.name()) +
                                "': frame size, byte_length and prod(shape)*sizeof(dtype) "
                                "disagree");
     }
@@ -142,7 +145,12 @@ std::uint64_t cellCount(const v1::CouplingMesh& mesh) {
     return 0;
   }
   const auto& c = mesh.cartesian().counts();
-  return c.x() * c.y() * c.z();
+  std::uint64_t xy = 0, xyz = 0;
+  if (__builtin_mul_overflow(static_cast<std::uint64_t>(c.x()), c.y(), &xy) ||
+      __builtin_mul_overflow(xy, static_cast<std::uint64_t>(c.z()), &xyz)) {
+    return std::numeric_limits<std::uint64_t>::max();
+  }
+  return xyz;
 }
 
 Status validate(const Message& message, const Expectation& e) {
@@ -180,8 +188,9 @@ Status validate(const Message& message, const Expectation& e) {
   }
   if (e.sessionId && env.session_id() != *e.sessionId) {
     return Status::error(v1::ERROR_CODE_UNKNOWN_SESSION,
-                         "session id '" + env.session_id() + "' does not match this session ('" +
-                             *e.sessionId + "'); use the session_id of the Welcome reply");
+                         "session id '" + printable(env.session_id()) +
+                             "' does not match this session ('" + *e.sessionId +
+                             "'); use the session_id of the Welcome reply");
   }
   if (e.sequence && env.sequence() != *e.sequence) {
     return Status::error(v1::ERROR_CODE_OUT_OF_ORDER,
@@ -228,6 +237,90 @@ Status validate(const Message& message, const Expectation& e) {
 }
 
 namespace {
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(6);
+  os << v;
+  return os.str();
+}
+
+Status outOfRange(std::string_view array, std::size_t cell, const std::string& what, double value,
+                  double lo, double hi, std::string_view unit) {
+  return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION,
+                       "GasFields array '" + std::string(array) + "' cell " + std::to_string(cell) +
+                           ": " + what + " = " + num(value) + " " + std::string(unit) +
+                           " is outside the range [" + num(lo) + ", " + num(hi) + "] " +
+                           std::string(unit) +
+                           " (docs/protocol.md §3 'Ranges'); check the sender's units and "
+                           "solution");
+}
+
+} // namespace
+
+Status validateGasRanges(const Message& m, const GasRanges& r) {
+  namespace f = fields;
+  struct Scalar {
+    std::string_view name;
+    double lo, hi;
+    std::string_view unit;
+  };
+  const Scalar scalars[] = {
+      {f::kGasTemperature, r.temperatureMin, r.temperatureMax, "K"},
+      {f::kGasDensity, r.densityMin, r.densityMax, "kg/m3"},
+      {f::kGasViscosity, r.viscosityMin, r.viscosityMax, "Pa s"},
+      {f::kGasConductivity, r.conductivityMin, r.conductivityMax, "W/m/K"},
+      {f::kGasHeatCapacity, r.heatCapacityMin, r.heatCapacityMax, "J/kg/K"},
+  };
+  for (const Scalar& s : scalars) {
+    const auto v = m.values<double>(s.name);
+    for (std::size_t c = 0; c < v.size(); ++c) {
+      if (!(v[c] >= s.lo && v[c] <= s.hi)) {
+        return outOfRange(s.name, c, std::string(s.name), v[c], s.lo, s.hi, s.unit);
+      }
+    }
+  }
+  const auto magnitudes = [&](std::string_view name, double hi, std::string_view unit) -> Status {
+    const auto v = m.values<double>(name);
+    for (std::size_t c = 0; 3 * c + 2 < v.size(); ++c) {
+      const double mag = std::hypot(v[3 * c], v[3 * c + 1], v[3 * c + 2]);
+      if (!(mag <= hi)) {
+        return outOfRange(name, c, std::string("|").append(name).append("|"), mag, 0.0, hi, unit);
+      }
+    }
+    return {};
+  };
+  if (Status s = magnitudes(f::kGasVelocity, r.speedMax, "m/s"); !s.ok()) {
+    return s;
+  }
+  if (Status s = magnitudes(f::kPressureGradient, r.pressureGradientMax, "Pa/m"); !s.ok()) {
+    return s;
+  }
+  const auto& body = m.envelope().gas_fields();
+  const std::size_t ns = body.species_count();
+  const auto y = m.values<double>(f::kGasMassFractions);
+  if (ns > 0 && y.size() == ns * body.cell_count()) {
+    const double t = r.massFractionTolerance;
+    for (std::size_t c = 0; c < body.cell_count(); ++c) {
+      double sum = 0.0;
+      for (std::size_t k = 0; k < ns; ++k) {
+        const double v = y[c * ns + k];
+        if (!(v >= -t && v <= 1.0 + t)) {
+          return outOfRange(f::kGasMassFractions, c, "Y of species " + std::to_string(k), v, -t,
+                            1.0 + t, "");
+        }
+        sum += v;
+      }
+      if (!(std::abs(sum - 1.0) <= r.massFractionSumTolerance)) {
+        return outOfRange(f::kGasMassFractions, c, "sum of Y", sum,
+                          1.0 - r.massFractionSumTolerance, 1.0 + r.massFractionSumTolerance, "");
+      }
+    }
+  }
+  return {};
+}
+
+namespace {
 bool positive(const v1::Vec3& v) {
   return v.x() > 0 && v.y() > 0 && v.z() > 0;
 }
@@ -247,55 +340,63 @@ Status validateConfigure(const v1::Configure& c) {
   if (g.counts().x() == 0 || g.counts().y() == 0 || g.counts().z() == 0) {
     return bad("coupling_mesh.cartesian.counts must be >= 1 on every axis");
   }
+  if (const std::uint64_t cells = cellCount(c.coupling_mesh()); cells > kMaxCells) {
+    return bad("coupling_mesh.cartesian.counts " + std::to_string(g.counts().x()) + " x " +
+               std::to_string(g.counts().y()) + " x " + std::to_string(g.counts().z()) + " = " +
+               (cells == std::numeric_limits<std::uint64_t>::max() ? std::string("(overflow)")
+                                                                   : std::to_string(cells)) +
+               " cells exceeds the protocol limit of " + std::to_string(kMaxCells) + " cells");
+  }
   if (!positive(g.spacing()) || !finite3(g.spacing()) || !finite3(g.origin())) {
     return bad("coupling_mesh.cartesian.spacing must be finite and > 0 on every axis");
   }
   std::set<std::string> names;
   for (const auto& s : c.species()) {
     if (s.name().empty() || !names.insert(s.name()).second) {
-      return bad("species name '" + s.name() + "' is empty or repeated; names must be unique");
+      return bad("species name '" + printable(s.name()) +
+                 "' is empty or repeated; names must be unique");
     }
     if (!(s.molar_mass() > 0) || !std::isfinite(s.molar_mass())) {
-      return bad("species '" + s.name() + "' has molar_mass " + std::to_string(s.molar_mass()) +
-                 " kg/mol; it must be > 0 (e.g. 0.044 for CO2)");
+      return bad("species '" + printable(s.name()) + "' has molar_mass " +
+                 std::to_string(s.molar_mass()) + " kg/mol; it must be > 0 (e.g. 0.044 for CO2)");
     }
   }
   // v1.1 chemistry: solid species, reactions, switches (the DEM server checks the species
   // references and the models' needs when it builds the system).
   for (const auto& s : c.solid_species()) {
     if (s.name().empty() || !names.insert(s.name()).second) {
-      return bad("solid_species name '" + s.name() +
+      return bad("solid_species name '" + printable(s.name()) +
                  "' is empty or repeated (also among the gas "
                  "species); names must be unique");
     }
     if (!(s.molar_mass() > 0) || !std::isfinite(s.molar_mass())) {
-      return bad("solid_species '" + s.name() + "' has molar_mass " +
+      return bad("solid_species '" + printable(s.name()) + "' has molar_mass " +
                  std::to_string(s.molar_mass()) + " kg/mol; it must be > 0");
     }
   }
   for (const auto& r : c.reactions()) {
     if (r.terms_size() < 1 || r.terms_size() > 6) {
-      return bad("reaction '" + r.name() + "' has " + std::to_string(r.terms_size()) +
+      return bad("reaction '" + printable(r.name()) + "' has " + std::to_string(r.terms_size()) +
                  " terms; give 1 to 6");
     }
     for (const auto& t : r.terms()) {
       if (!(t.nu() != 0.0) || !std::isfinite(t.nu())) {
-        return bad("reaction '" + r.name() + "': term '" + t.species() +
+        return bad("reaction '" + printable(r.name()) + "': term '" + printable(t.species()) +
                    "' needs a finite nonzero nu");
       }
     }
     if (r.rate().law() != v1::RATE_LAW_CONSTANT && r.rate().law() != v1::RATE_LAW_ARRHENIUS) {
-      return bad("reaction '" + r.name() +
+      return bad("reaction '" + printable(r.name()) +
                  "': rate.law must be RATE_LAW_CONSTANT or RATE_LAW_ARRHENIUS");
     }
     if (!(r.rate().a() >= 0.0) || !std::isfinite(r.rate().a()) || !std::isfinite(r.rate().beta()) ||
         !(r.rate().activation_energy() >= 0.0) || !std::isfinite(r.rate().activation_energy()) ||
         !std::isfinite(r.rate().order())) {
-      return bad("reaction '" + r.name() +
+      return bad("reaction '" + printable(r.name()) +
                  "': rate needs finite a >= 0, beta, activation_energy >= 0, order");
     }
     if (r.heat_case() == v1::Reaction::kHeatOfReaction && !std::isfinite(r.heat_of_reaction())) {
-      return bad("reaction '" + r.name() + "': heat_of_reaction is not finite");
+      return bad("reaction '" + printable(r.name()) + "': heat_of_reaction is not finite");
     }
   }
   if (c.has_chemistry() && c.chemistry().has_removal_fraction() &&
@@ -323,7 +424,7 @@ Status validateConfigure(const v1::Configure& c) {
     if (!(m.density() > 0) || !(m.k_n() > 0) || !(m.e_n() > 0 && m.e_n() <= 1) ||
         !(m.friction() >= 0) || (m.has_kt_factor() && !(m.kt_factor() > 0)) ||
         (m.has_etat_factor() && !(m.etat_factor() >= 0))) {
-      return bad("material " + std::to_string(m.id()) + " ('" + m.name() +
+      return bad("material " + std::to_string(m.id()) + " ('" + printable(m.name()) +
                  "') needs density > 0, k_n > 0, 0 < e_n <= 1, friction >= 0, kt_factor > 0, "
                  "etat_factor >= 0");
     }
@@ -358,7 +459,7 @@ Status validateConfigure(const v1::Configure& c) {
         double sum = 0;
         for (const auto& nv : p.composition()) {
           if (!(nv.value() >= 0)) {
-            return bad(which + " composition '" + nv.name() + "' is negative");
+            return bad(which + " composition '" + printable(nv.name()) + "' is negative");
           }
           sum += nv.value();
         }

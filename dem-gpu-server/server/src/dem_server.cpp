@@ -10,9 +10,11 @@
 #include <random>
 
 #include <fcntl.h>
+#include <malloc.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "admission.h"
 #include "configure_map.h"
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
@@ -34,6 +36,15 @@ namespace {
 constexpr const char* kSoftware = "coredem-dem 0.1.0";
 /// Relative tolerance of dt comparisons (grant vs GasFields, dt_dem·n_sub vs dt_cfd).
 constexpr double kDtTolerance = 1e-12;
+/// Longest error text sent back to a peer (longer ones are cut, "...(N bytes)").
+constexpr std::size_t kMaxReplyText = 4096;
+/// Unknown Configure options named one by one in the log; the rest are counted.
+constexpr std::size_t kLoggedIgnoredOptions = 5;
+
+/// A peer-supplied string for a log line or a reply (escaped, length-capped).
+std::string safe(std::string_view text, std::size_t maxBytes = 120) {
+  return proto::printable(text, maxBytes);
+}
 
 std::string randomSessionId() {
   std::random_device rd;
@@ -78,9 +89,19 @@ proto::TransportOptions transportOptions(const ServerOptions& o) {
   proto::TransportOptions t;
   t.sender = kSoftware;
   t.allowInsecure = o.insecure;
+  t.maxMessageBytes = o.maxMessageBytes;
   if (!o.curveKeysDir.empty()) {
     t.curve.serverPublicKey = readKey(fs::path(o.curveKeysDir) / "server.public");
     t.curve.serverSecretKey = readKey(fs::path(o.curveKeysDir) / "server.secret");
+  }
+  if (!o.clientKeysFile.empty()) {
+    COREDEM_CHECK(!o.curveKeysDir.empty(),
+                  "--client-keys {} needs --curve-keys DIR (the allow-list authenticates CURVE "
+                  "clients)",
+                  o.clientKeysFile);
+    t.curve.allowedClientKeys = proto::readAllowedClientKeys(o.clientKeysFile);
+    COREDEM_CHECK(!t.curve.allowedClientKeys.empty(),
+                  "--client-keys {} lists no key: nobody could connect", o.clientKeysFile);
   }
   return t;
 }
@@ -113,6 +134,7 @@ struct Held {
 
 struct DemServer::Impl {
   ServerOptions opt;
+  Limits limits;
   proto::Server server;
   std::string endpoint;
   std::shared_ptr<spdlog::logger> log = coredem::logger("dem.server");
@@ -142,12 +164,21 @@ struct DemServer::Impl {
 
   explicit Impl(ServerOptions o)
       : opt(std::move(o))
+      , limits(limitsFor(opt.maxMemoryBytes > 0 ? opt.maxMemoryBytes : defaultMaxMemory(),
+                         opt.maxSubSteps))
       , server(transportOptions(opt)) {}
+
+  /// The session's orchestrator or CFD participant (the connections that said Hello).
+  bool isMember(const proto::PeerId& p) const {
+    return state != SessionState::Idle && !p.empty() && (p == oPeer || p == cPeer);
+  }
 
   // ---- replies ---------------------------------------------------------------------------
   void send(const proto::PeerId& peer, proto::Message m, std::uint64_t sequence,
             std::int64_t step) {
-    m.setSessionId(session);
+    // The session id goes to the session's members only (docs/security.md): a stranger's reply
+    // carries none, in the envelope or the text.
+    m.setSessionId(isMember(peer) ? session : std::string());
     m.setSequence(sequence);
     m.setStep(step);
     server.reply(peer, std::move(m));
@@ -167,15 +198,19 @@ struct DemServer::Impl {
     const auto& env = r.message.envelope();
     log->warn("session {}: refused {} from {}: {}: {}", session.empty() ? "-" : session,
               proto::messageTypeName(env.type()), peerName(r.peer), proto::errorCodeName(code),
-              message);
-    send(r.peer, proto::makeError(code, message, env.sequence(), env.type()), env.sequence(),
-         env.step());
+              safe(message, 400));
+    // Our own text with escaped, capped peer strings; capped as a whole too.
+    send(r.peer,
+         proto::makeError(code,
+                          message.size() > kMaxReplyText ? safe(message, kMaxReplyText) : message,
+                          env.sequence(), env.type()),
+         env.sequence(), env.step());
   }
 
   void reject(const proto::Request& r, v1::ErrorCode code, const std::string& reason) {
     const auto& env = r.message.envelope();
-    log->warn("rejected Hello from '{}' ({}): {}: {}", env.sender(), hexPeer(r.peer),
-              proto::errorCodeName(code), reason);
+    log->warn("rejected Hello from '{}' ({}): {}: {}", safe(env.sender()), hexPeer(r.peer),
+              proto::errorCodeName(code), safe(reason, 400));
     auto m = proto::makeReject(code, reason);
     m.envelope().mutable_reject()->set_server_protocol_major(proto::kProtocolVersion.major);
     m.envelope().mutable_reject()->set_server_protocol_minor(proto::kProtocolVersion.minor);
@@ -224,6 +259,7 @@ struct DemServer::Impl {
     cName.clear();
     lastSequence.clear();
     system.reset();
+    ::malloc_trim(0); // the session's particles and grids go back to the system
     grant.reset();
     held.reset();
     ledgers = ServerLedgers();
@@ -231,15 +267,43 @@ struct DemServer::Impl {
     sessionEnded = true;
   }
 
+  /// The peer's name for logs and replies (escaped, at most 64 bytes of the peer's text).
   static std::string nameOf(const proto::Request& r) {
     const auto& env = r.message.envelope();
     if (!env.sender().empty()) {
-      return env.sender();
+      return safe(env.sender(), 64);
     }
     if (!env.hello().software_version().empty()) {
-      return env.hello().software_version();
+      return safe(env.hello().software_version(), 64);
     }
     return hexPeer(r.peer);
+  }
+
+  /// ", client key K" when the client's CURVE key was authenticated by the allow-list.
+  static std::string keyNote(const proto::Request& r) {
+    return r.clientKey.empty() ? std::string() : ", client key " + r.clientKey;
+  }
+
+  /// A closed connection (the transport's socket monitor): the orchestrator's ends the
+  /// session; the CFD participant's frees its role for a new connection.
+  void onDisconnected(const proto::PeerId& p) {
+    lastSequence.erase(p);
+    if (state == SessionState::Idle) {
+      return;
+    }
+    if (p == oPeer) {
+      endSession(fmt::format("the connection of orchestrator '{}' closed", oName),
+                 v1::ERROR_CODE_TRANSPORT);
+    } else if (p == cPeer) {
+      log->warn("session {}: the connection of CFD participant '{}' closed; a new CFD "
+                "participant may join with the session id",
+                session, cName);
+      if (held && held->request.peer == p) {
+        held.reset();
+      }
+      cPeer.clear();
+      cName.clear();
+    }
   }
 
   void onHello(const proto::Request& r) {
@@ -257,11 +321,16 @@ struct DemServer::Impl {
     }
     if (h.role() == v1::ROLE_ORCHESTRATOR) {
       if (state != SessionState::Idle) {
+        // Never the session id: the caller is not a member (or, on the orchestrator's own
+        // connection, already knows it).
         const double secs = std::chrono::duration<double>(Clock::now() - started).count();
         reject(r, v1::ERROR_CODE_SESSION_BUSY,
-               fmt::format("coredem-dem at {} already serves session {} of orchestrator '{}' "
-                           "(for {:.0f} s); wait until it ends or start another coredem-dem",
-                           endpoint, session, oName, secs));
+               r.peer == oPeer
+                   ? std::string("this connection is already the orchestrator of the active "
+                                 "session; a second Hello is refused (send Shutdown to end it)")
+                   : fmt::format("coredem-dem at {} already serves another session (for {:.0f} "
+                                 "s); wait until it ends or start another coredem-dem",
+                                 endpoint, secs));
         return;
       }
       session = randomSessionId();
@@ -271,8 +340,8 @@ struct DemServer::Impl {
       started = lastActivity = Clock::now();
       sessionEnded = false;
       lastSequence[r.peer] = env.sequence();
-      log->info("session {}: orchestrator '{}' connected (protocol {}.{}, peer {})", session, oName,
-                n.agreed.major, n.agreed.minor, hexPeer(r.peer));
+      log->info("session {}: orchestrator '{}' connected (protocol {}.{}, peer {}{})", session,
+                oName, n.agreed.major, n.agreed.minor, hexPeer(r.peer), keyNote(r));
     } else if (h.role() == v1::ROLE_CFD) {
       if (state == SessionState::Idle) {
         reject(r, v1::ERROR_CODE_NOT_CONFIGURED,
@@ -284,18 +353,29 @@ struct DemServer::Impl {
         reject(r, v1::ERROR_CODE_UNKNOWN_SESSION,
                fmt::format("session id '{}' is not the active session of coredem-dem at {}; use "
                            "the id the orchestrator passes in COREDEM_SESSION",
-                           env.session_id(), endpoint));
+                           safe(env.session_id(), 40), endpoint));
+        return;
+      }
+      if (r.peer == oPeer) {
+        reject(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+               "this connection is the session's orchestrator; the CFD participant says Hello "
+               "on its own connection");
         return;
       }
       if (!cPeer.empty() && cPeer != r.peer) {
-        log->warn("session {}: CFD participant '{}' replaced by a new connection '{}'", session,
-                  cName, env.sender());
+        // Each role is bound to the connection that said Hello first; the role is freed when
+        // that connection closes (onDisconnected).
+        reject(r, v1::ERROR_CODE_SESSION_BUSY,
+               fmt::format("the session already has a CFD participant ('{}') on another "
+                           "connection; a second one is refused",
+                           cName));
+        return;
       }
       cPeer = r.peer;
       cName = nameOf(r);
       lastSequence[r.peer] = env.sequence();
-      log->info("session {}: CFD participant '{}' connected (protocol {}.{}, peer {})", session,
-                cName, n.agreed.major, n.agreed.minor, hexPeer(r.peer));
+      log->info("session {}: CFD participant '{}' connected (protocol {}.{}, peer {}{})", session,
+                cName, n.agreed.major, n.agreed.minor, hexPeer(r.peer), keyNote(r));
     } else {
       reject(r, v1::ERROR_CODE_UNSUPPORTED,
              "coredem-dem takes sessions of an orchestrator (ROLE_ORCHESTRATOR) and its CFD "
@@ -321,6 +401,11 @@ struct DemServer::Impl {
       refuse(r, s.code, s.message);
       return;
     }
+    // Admission control before anything is allocated: counts against the memory budget.
+    if (const std::string why = admitConfigure(c, limits); !why.empty()) {
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION, why);
+      return;
+    }
     std::unique_ptr<dem::DemSystem> next;
     std::uint32_t nSub = 0;
     ServerLedgers restored;
@@ -344,12 +429,27 @@ struct DemServer::Impl {
             dem::TimeHandler::subStepsFor(c.sub_cycling().dt_cfd(), next->dtDemMax()));
       }
     } catch (const coredem::UserError& e) {
+      next.reset();
+      ::malloc_trim(0); // give a large failed build's memory back to the system
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION, e.what());
       return;
+    } catch (const std::bad_alloc&) {
+      next.reset();
+      ::malloc_trim(0);
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+             fmt::format("Configure: out of memory while building the particles although the "
+                         "estimate fits the {} budget; lower coredem-dem --max-memory so that "
+                         "such a Configure is refused up front",
+                         formatBytes(limits.memoryBytes)));
+      return;
     }
-    for (const auto& k : ignored) {
+    for (std::size_t i = 0; i < ignored.size() && i < kLoggedIgnoredOptions; ++i) {
       log->warn("session {}: Configure option '{}' is not a DEM server option (ignored)", session,
-                k);
+                safe(ignored[i], 64));
+    }
+    if (ignored.size() > kLoggedIgnoredOptions) {
+      log->warn("session {}: {} more Configure options are not DEM server options (ignored)",
+                session, ignored.size() - kLoggedIgnoredOptions);
     }
     system = std::move(next);
     ledgers = restored;
@@ -370,7 +470,7 @@ struct DemServer::Impl {
     log->info("session {}: configured by '{}': {} particles{}, grid {} x {} x {}, {} gas species, "
               "backend {}, dt_dem_max {:.4g} s, start step {}",
               session, oName, system->particleCount(),
-              c.initial_state_file().empty() ? "" : " from " + c.initial_state_file(),
+              c.initial_state_file().empty() ? "" : " from " + safe(c.initial_state_file(), 200),
               g.counts().x(), g.counts().y(), g.counts().z(), species, system->backendName(), dtMax,
               lastStep);
     auto m = proto::makeConfigured(cells, system->particleCount(), species, nSub, dtMax);
@@ -401,6 +501,13 @@ struct DemServer::Impl {
       return;
     }
     const double dtMax = system->dtDemMax();
+    if (g.n_sub() > limits.subSteps) {
+      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+             fmt::format("StepGrant of step {}: n_sub = {} exceeds the limit {} (coredem-dem "
+                         "--max-sub-steps); use a smaller CFD step",
+                         env.step(), g.n_sub(), limits.subSteps));
+      return;
+    }
     if (!(g.dt_cfd() > 0.0) || !std::isfinite(g.dt_cfd()) || g.n_sub() < 1) {
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
              fmt::format("StepGrant of step {}: dt_cfd = {} s and n_sub = {} must be positive",
@@ -410,9 +517,9 @@ struct DemServer::Impl {
     if (g.dt_cfd() / g.n_sub() > dtMax * (1.0 + kDtTolerance)) {
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
              fmt::format("StepGrant of step {}: dt_cfd/n_sub = {:.6g} s exceeds this DEM's "
-                         "dt_dem_max = {:.6g} s; use n_sub >= {}",
+                         "dt_dem_max = {:.6g} s; use n_sub >= {:.0f}",
                          env.step(), g.dt_cfd() / g.n_sub(), dtMax,
-                         dem::TimeHandler::subStepsFor(g.dt_cfd(), dtMax)));
+                         std::ceil(g.dt_cfd() / dtMax))); // a double: never throws or wraps
       return;
     }
     if (g.dt_dem() > 0.0 &&
@@ -512,7 +619,12 @@ struct DemServer::Impl {
       auto m = proto::makeError(v1::ERROR_CODE_INTERNAL, e.what(), grant->sequence,
                                 v1::MESSAGE_TYPE_STEP_GRANT);
       send(grant->peer, std::move(m), grant->sequence, grant->step);
+      const auto failed = grant->step;
       grant.reset();
+      // The DEM state is unknown after a failed step: end the session rather than leave it
+      // half-alive (every later step would fail too).
+      endSession(fmt::format("step {} failed in the DEM core: {}", failed, e.what()),
+                 v1::ERROR_CODE_INTERNAL);
       return;
     }
     const double dt = grant->dtCfd;
@@ -588,12 +700,12 @@ struct DemServer::Impl {
       xt.packSend += std::chrono::duration<double>(Clock::now() - tDone).count();
     } else {
       log->error("session {}: checkpoint of step {} into {} failed: {}", session, grant->step,
-                 grant->checkpointDir, checkpointError);
+                 safe(grant->checkpointDir, 200), safe(checkpointError, 400));
       send(grant->peer,
            proto::makeError(
                v1::ERROR_CODE_CHECKPOINT_FAILED,
                fmt::format("step {} done, but writing its checkpoint into {} failed: {}",
-                           grant->step, grant->checkpointDir, checkpointError),
+                           grant->step, safe(grant->checkpointDir, 200), checkpointError),
                grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT),
            grant->sequence, grant->step);
     }
@@ -682,7 +794,8 @@ struct DemServer::Impl {
     writeServerLedgers(tmp.string(), l, step, session);
     syncFile(tmp);
     fs::rename(tmp, final);
-    log->info("session {}: checkpoint of step {} written to {}", session, step, final.string());
+    log->info("session {}: checkpoint of step {} written to {}", session, step,
+              safe(final.string(), 200));
     return {"dem.h5"};
   }
 
@@ -727,8 +840,9 @@ struct DemServer::Impl {
       return;
     }
     send(r.peer, proto::makeAck("session " + session + " ended"), env.sequence(), env.step());
-    endSession("Shutdown from the orchestrator" +
-               (env.shutdown().reason().empty() ? std::string() : ": " + env.shutdown().reason()));
+    endSession("Shutdown from the orchestrator" + (env.shutdown().reason().empty()
+                                                       ? std::string()
+                                                       : ": " + safe(env.shutdown().reason())));
   }
 
   // ---- dispatch --------------------------------------------------------------------------
@@ -756,10 +870,8 @@ struct DemServer::Impl {
       return;
     }
     if (r.peer != oPeer && r.peer != cPeer) {
-      refuse(
-          r, v1::ERROR_CODE_UNKNOWN_SESSION,
-          fmt::format("this connection has not joined session {}: send Hello first",
-                      env.session_id().empty() ? std::string("(none given)") : env.session_id()));
+      refuse(r, v1::ERROR_CODE_UNKNOWN_SESSION,
+             "this connection has not joined the active session: send Hello first");
       return;
     }
     proto::Expectation e;
@@ -777,7 +889,10 @@ struct DemServer::Impl {
     if (type == v1::MESSAGE_TYPE_GAS_FIELDS && stepEnd) { // the CFD's step and the transfer
       xt.waitPeer += std::chrono::duration<double>(lastReceived - *stepEnd).count();
     }
-    const auto s = proto::validate(r.message, e);
+    auto s = proto::validate(r.message, e);
+    if (s.ok() && type == v1::MESSAGE_TYPE_GAS_FIELDS) {
+      s = proto::validateGasRanges(r.message); // physical ranges (docs/protocol.md §3)
+    }
     if (type == v1::MESSAGE_TYPE_GAS_FIELDS) {
       xt.validate += std::chrono::duration<double>(Clock::now() - tValidate).count();
     }
@@ -842,8 +957,14 @@ DemServer::DemServer(ServerOptions options)
                 m.opt.bind);
   }
   m.endpoint = m.server.bind(m.opt.bind);
-  m.log->info("coredem-dem listening on {} (backend {}, threads {}, session timeout {} s)",
-              m.endpoint, m.opt.backend, m.opt.threads, m.opt.sessionTimeoutSeconds);
+  m.log->info("coredem-dem listening on {} (backend {}, threads {}, session timeout {} s, memory "
+              "budget {}: up to {} particles and {} cells; messages up to {}; n_sub up to {})",
+              m.endpoint, m.opt.backend, m.opt.threads, m.opt.sessionTimeoutSeconds,
+              formatBytes(m.limits.memoryBytes), m.limits.particles, m.limits.cells,
+              m.opt.maxMessageBytes > 0
+                  ? formatBytes(static_cast<std::uint64_t>(m.opt.maxMessageBytes))
+                  : std::string("unlimited"),
+              m.limits.subSteps);
 }
 
 DemServer::~DemServer() = default;
@@ -862,17 +983,25 @@ bool DemServer::poll(std::chrono::milliseconds wait) {
   }
   auto req = m.server.receive(wait);
   m.lastReceived = Clock::now();
+  for (const auto& p : m.server.takeDisconnected()) {
+    m.onDisconnected(p);
+  }
   if (req) {
     try {
       m.handle(*req);
     } catch (const std::exception& e) {
-      // A bug or an unexpected failure while handling one message: answer and keep serving.
-      m.log->error("internal error while handling a {} message: {}",
-                   proto::messageTypeName(req->message.envelope().type()), e.what());
+      // A bug or an unexpected failure while handling one message: answer; a session member's
+      // message ends the session (its state is unknown), a stranger's changes nothing.
+      const auto type = proto::messageTypeName(req->message.envelope().type());
+      m.log->error("internal error while handling a {} message: {}", type, e.what());
       m.send(req->peer,
              proto::makeError(v1::ERROR_CODE_INTERNAL, std::string("internal error: ") + e.what(),
                               req->message.envelope().sequence(), req->message.envelope().type()),
              req->message.envelope().sequence(), req->message.envelope().step());
+      if (m.isMember(req->peer)) {
+        m.endSession(fmt::format("internal error while handling a {} message: {}", type, e.what()),
+                     v1::ERROR_CODE_INTERNAL);
+      }
     }
   }
   m.housekeeping();
@@ -893,7 +1022,8 @@ void DemServer::stop() {
   _impl->stopFlag.store(true);
 }
 
-void generateCurveKeys(const std::string& dir) {
+namespace {
+void writeKeyPair(const std::string& dir, const std::string& stem) {
   fs::create_directories(dir);
   const auto pair = proto::generateCurveKeyPair();
   const auto write = [](const fs::path& p, const std::string& key, bool secret) {
@@ -909,8 +1039,17 @@ void generateCurveKeys(const std::string& dir) {
     COREDEM_CHECK(ok, "cannot write {}", tmp);
     fs::rename(tmp, p);
   };
-  write(fs::path(dir) / "server.public", pair.first, false);
-  write(fs::path(dir) / "server.secret", pair.second, true);
+  write(fs::path(dir) / (stem + ".public"), pair.first, false);
+  write(fs::path(dir) / (stem + ".secret"), pair.second, true);
+}
+} // namespace
+
+void generateCurveKeys(const std::string& dir) {
+  writeKeyPair(dir, "server");
+}
+
+void generateClientKey(const std::string& dir) {
+  writeKeyPair(dir, "client");
 }
 
 } // namespace coredem::server

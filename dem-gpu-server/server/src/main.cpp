@@ -7,7 +7,9 @@
 #include <iostream>
 
 #include <CLI/CLI.hpp>
+#include <unistd.h>
 
+#include "admission.h"
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
 #include "coredem/server/dem_server.h"
@@ -15,8 +17,16 @@
 namespace {
 
 std::atomic<coredem::server::DemServer*> gServer{nullptr};
+std::atomic<int> gSignals{0};
 
-extern "C" void onSignal(int) {
+/// SIGINT/SIGTERM: the first ends the session after the message being handled; a second one
+/// (a step of many sub-steps may take long) exits at once with 128 + signal.
+extern "C" void onSignal(int sig) {
+  if (gSignals.fetch_add(1) >= 1) {
+    static const char kMsg[] = "coredem-dem: second signal: exiting now\n";
+    (void)!::write(2, kMsg, sizeof kMsg - 1);
+    ::_exit(128 + sig);
+  }
   if (auto* s = gServer.load()) {
     s->stop();
   }
@@ -54,11 +64,32 @@ int main(int argc, char** argv) {
   app.add_option(
       "--curve-keys", o.curveKeysDir,
       "directory with server.public and server.secret (CURVE; needed for non-loopback binds)");
+  app.add_option("--client-keys", o.clientKeysFile,
+                 "allow-list of client public keys (one Z85 key per line, '#' comments; with "
+                 "--curve-keys): only these clients may connect");
+  std::string generateClientKeyDir;
+  app.add_option("--generate-client-key", generateClientKeyDir,
+                 "write a new client key pair into DIR/client.{public,secret} and exit");
   app.add_flag("--insecure", o.insecure,
                "allow a non-loopback bind without CURVE (trusted networks only)");
   app.add_flag(
       "--exit-after-session", o.exitAfterSession,
       "exit when the first session ends (set by the orchestrator that started this server)");
+  std::string maxMemory;
+  app.add_option("--max-memory", maxMemory,
+                 "memory budget the count limits of a Configure derive from, e.g. 8G or 512M "
+                 "(default: half of the physical memory); a Configure estimated above it is "
+                 "refused before anything is allocated");
+  double maxMessageMb = static_cast<double>(o.maxMessageBytes) / (1024.0 * 1024.0);
+  app.add_option("--max-message-mb", maxMessageMb,
+                 "largest message part (frame) a peer may send, MiB; a larger one closes its "
+                 "connection (0: no limit)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--max-sub-steps", o.maxSubSteps,
+                 "most DEM sub-steps per CFD step (StepGrant n_sub) the server accepts")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--endpoint-file", endpointFile, "write the bound endpoint into this file");
   app.add_flag("--timers", o.timers,
                "per-stage timers (DEM stages and the exchange): a log line every --timers-every "
@@ -86,6 +117,22 @@ int main(int argc, char** argv) {
             : (std::filesystem::path(endpointFile).parent_path() / "dem-timers.json").string();
   }
   try {
+    o.maxMessageBytes = static_cast<std::int64_t>(maxMessageMb * 1024.0 * 1024.0);
+    if (!maxMemory.empty()) {
+      try {
+        o.maxMemoryBytes = coredem::server::parseBytes(maxMemory);
+      } catch (const coredem::UserError& e) {
+        log->error("--max-memory: {}", e.what());
+        return 2;
+      }
+    }
+    if (!generateClientKeyDir.empty()) {
+      coredem::server::generateClientKey(generateClientKeyDir);
+      std::cout << "client key pair written to " << generateClientKeyDir
+                << "/client.{public,secret}; add client.public to the server's --client-keys "
+                   "file\n";
+      return 0;
+    }
     if (!generateKeys.empty()) {
       coredem::server::generateCurveKeys(generateKeys);
       std::cout << "CURVE key pair written to " << generateKeys << "/server.{public,secret}\n";

@@ -174,14 +174,16 @@ TEST(DemServer, ServesConfigureAndGasFieldsWithSourcesOfTheRightShape) {
 TEST(DemServer, OneSessionAtATime) {
   ServerThread server;
   MiniOrchestrator o(server.endpoint(), smallCase(kParticles, kD, kBox, kCells));
-  // A second orchestrator gets Reject SESSION_BUSY naming the active session.
+  // A second orchestrator gets Reject SESSION_BUSY; the session id is never sent to a
+  // non-member (docs/security.md), neither in the text nor in the envelope.
   proto::Client second;
   second.connect(server.endpoint());
   auto r = second.request(proto::makeHello(v1::ROLE_ORCHESTRATOR, "second orchestrator"), 10s);
   ASSERT_EQ(r.type(), v1::MESSAGE_TYPE_REJECT);
   EXPECT_EQ(r.envelope().reject().code(), v1::ERROR_CODE_SESSION_BUSY);
-  EXPECT_NE(r.envelope().reject().reason().find(o.session()), std::string::npos)
+  EXPECT_EQ(r.envelope().reject().reason().find(o.session()), std::string::npos)
       << r.envelope().reject().reason();
+  EXPECT_EQ(r.envelope().session_id(), "");
   // A CFD participant with a wrong session id is rejected.
   proto::Client cfd;
   cfd.connect(server.endpoint());

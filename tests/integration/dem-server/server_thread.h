@@ -19,6 +19,14 @@ public:
     _server = std::make_unique<coredem::server::DemServer>(o);
     _thread = std::thread([this] { _server->run(); });
   }
+  /// A server with these options (bind, backend and threads as above unless set).
+  explicit ServerThread(coredem::server::ServerOptions o) {
+    o.bind = "tcp://127.0.0.1:*";
+    o.backend = "cpu";
+    o.threads = 1;
+    _server = std::make_unique<coredem::server::DemServer>(o);
+    _thread = std::thread([this] { _server->run(); });
+  }
   ~ServerThread() {
     _server->stop();
     _thread.join();

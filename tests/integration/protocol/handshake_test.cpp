@@ -58,6 +58,9 @@ TEST(Handshake, SecondSessionIsRejectedAsBusy) {
   Message reply = second.request(makeHello(v1::ROLE_CFD, "intruder"), kTimeout);
   ASSERT_EQ(reply.type(), v1::MESSAGE_TYPE_REJECT);
   EXPECT_EQ(reply.envelope().reject().code(), v1::ERROR_CODE_SESSION_BUSY);
+  // The session id is sent to the session's peer only (docs/security.md).
+  EXPECT_EQ(reply.envelope().reject().reason().find(first.id), std::string::npos);
+  EXPECT_EQ(reply.envelope().session_id(), "");
   // The second client cannot send data either; the first one goes on.
   Message data = gasFields(0, first.id);
   Message err = second.request(std::move(data), kTimeout);

@@ -317,3 +317,102 @@ TEST(ValidateConfigure, ChecksTheChemistryFieldsOfV11) {
   c.mutable_chemistry()->set_removal_fraction(1.5);
   expectBad(c, "removal_fraction");
 }
+
+TEST(ValidateConfigure, RefusesGridsWhoseCellCountOverflowsOrExceedsTheLimit) {
+  auto c = validConfigure();
+  auto* counts = c.mutable_coupling_mesh()->mutable_cartesian()->mutable_counts();
+  counts->set_x(4294967295u); // (2^32-1)^2 * 4 wraps around 2^64 (a wrapped product was 0 cells)
+  counts->set_y(4294967295u);
+  counts->set_z(4);
+  EXPECT_EQ(cellCount(c.coupling_mesh()), std::numeric_limits<std::uint64_t>::max());
+  Status s = validateConfigure(c);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_INVALID_CONFIGURATION);
+  EXPECT_NE(s.message.find("overflow"), std::string::npos) << s.message;
+  counts->set_x(65536); // 2^32 cells: no overflow, but past kMaxCells
+  counts->set_y(65536);
+  counts->set_z(1);
+  EXPECT_EQ(cellCount(c.coupling_mesh()), std::uint64_t{1} << 32);
+  s = validateConfigure(c);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_INVALID_CONFIGURATION);
+  EXPECT_NE(s.message.find("4294967296"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find(std::to_string(kMaxCells)), std::string::npos) << s.message;
+}
+
+TEST(Printable, EscapesControlCharactersAndCapsTheLength) {
+  EXPECT_EQ(printable("plain name 1.0"), "plain name 1.0");
+  EXPECT_EQ(printable("a\nb\rc\td\\e\"f"), "a\\nb\\rc\\td\\\\e\\\"f");
+  EXPECT_EQ(printable(std::string("x\0y\x1b[31m\xff", 9)), "x\\x00y\\x1b[31m\\xff");
+  const std::string longText(100000, 'z');
+  const std::string cut = printable(longText, 10);
+  EXPECT_EQ(cut, "zzzzzzzzzz...(100000 bytes)");
+  EXPECT_EQ(printable(longText).size(), 160u + std::string("...(100000 bytes)").size());
+}
+
+TEST(Validate, PeerStringsInRefusalsAreEscaped) {
+  // An array name with a newline (a forged log line) comes back escaped.
+  auto m = makeHeartbeat("probe");
+  std::vector<double> v(4, std::nan(""));
+  m.addArray("evil\n[info] forged", v, {4});
+  Expectation e;
+  Status s = validate(m, e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_NON_FINITE);
+  EXPECT_EQ(s.message.find('\n'), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("evil\\n[info] forged"), std::string::npos) << s.message;
+}
+
+namespace {
+/// A GasFields message of air at 300 K in `cells` cells with one species (Y = 1), with `edit`
+/// applied to the named array first.
+template <class Edit>
+Message physicalGas(std::uint64_t cells, std::string_view edited, Edit edit) {
+  namespace f = fields;
+  Message m = makeGasFields(1, 0.0, 1e-3, cells, 1);
+  const std::pair<std::string_view, double> values[] = {
+      {f::kGasVelocity, 0.5},      {f::kPressureGradient, -1e4}, {f::kGasTemperature, 300.0},
+      {f::kGasDensity, 1.2},       {f::kGasViscosity, 1.8e-5},   {f::kGasConductivity, 0.026},
+      {f::kGasHeatCapacity, 1005}, {f::kGasMassFractions, 1.0}};
+  for (const auto& [name, value] : values) {
+    const auto shape = f::shapeOf(name, cells, 1);
+    std::vector<double> v(cells * (shape.size() > 1 ? shape[1] : 1), value);
+    if (name == edited) {
+      edit(v);
+    }
+    m.addArray<double>(name, v, shape);
+  }
+  return m;
+}
+} // namespace
+
+TEST(ValidateGasRanges, AcceptsPhysicalFieldsAndNamesTheFirstValueOutsideItsRange) {
+  const auto none = [](std::vector<double>&) {};
+  EXPECT_TRUE(validateGasRanges(physicalGas(4, "", none)).ok());
+  struct Case {
+    std::string_view array;
+    std::size_t index;
+    double value;
+    const char* needle;
+  };
+  const Case cases[] = {
+      {fields::kGasTemperature, 2, 20.0, "cell 2: T_g = 20 K"},
+      {fields::kGasTemperature, 0, 1e7, "T_g = 1e+07 K"},
+      {fields::kGasViscosity, 3, 1e-310, "mu_g"},
+      {fields::kGasDensity, 1, 0.0, "rho_g"},
+      {fields::kGasConductivity, 1, 1e30, "kappa_g"},
+      {fields::kGasHeatCapacity, 1, 1.0, "cp_g"},
+      {fields::kGasVelocity, 3 * 2 + 1, 2e4, "cell 2: |u_g|"},
+      {fields::kPressureGradient, 0, 1e13, "|grad_p|"},
+      {fields::kGasMassFractions, 3, 0.9, "cell 3: sum of Y = 0.9"},
+      {fields::kGasMassFractions, 0, 1.5, "Y of species 0 = 1.5"},
+  };
+  for (const Case& c : cases) {
+    const Status s = validateGasRanges(
+        physicalGas(4, c.array, [&](std::vector<double>& v) { v[c.index] = c.value; }));
+    EXPECT_EQ(s.code, v1::ERROR_CODE_INVALID_CONFIGURATION) << c.needle;
+    EXPECT_NE(s.message.find(c.needle), std::string::npos) << s.message;
+  }
+  // A sum off by less than the tolerance passes (OpenFOAM's species rarely sum to 1 exactly).
+  EXPECT_TRUE(
+      validateGasRanges(physicalGas(4, fields::kGasMassFractions, [](std::vector<double>& v) {
+        v[0] = 0.99;
+      })).ok());
+}

@@ -38,6 +38,13 @@ std::string errorCodeName(v1::ErrorCode code);
 /// Short name of a message type without the "MESSAGE_TYPE_" prefix, e.g. "GAS_FIELDS".
 std::string messageTypeName(v1::MessageType type);
 
+/// A peer-supplied string made safe for a log line or a reply: control characters, quotes
+/// and backslashes are escaped (\n, \t, \xNN, \", \\), bytes outside printable ASCII are
+/// written as \xNN, and the result is cut after `maxBytes` input bytes with "...(N bytes)"
+/// appended. A newline in a peer's name can therefore never forge a log line, and a 1 MB name
+/// is echoed as a 160-byte prefix.
+std::string printable(std::string_view peerText, std::size_t maxBytes = 160);
+
 /// A protocol failure with its error code.
 class ProtocolError : public UserError {
 public:

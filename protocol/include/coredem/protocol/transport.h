@@ -45,6 +45,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <coredem/protocol/message.h>
 #include <coredem/protocol/status.h>
@@ -58,6 +59,11 @@ struct CurveKeys {
   std::string serverSecretKey;
   std::string clientPublicKey;
   std::string clientSecretKey;
+  /// Server only: the client public keys (Z85) allowed to connect, like ssh
+  /// `authorized_keys`. Non-empty: a ZAP handler admits only these keys (any other client's
+  /// CURVE handshake fails, no message of it arrives) and each Request carries its client's
+  /// key. Empty: any client that knows the server's public key is admitted.
+  std::vector<std::string> allowedClientKeys;
   [[nodiscard]] bool serverConfigured() const { return !serverSecretKey.empty(); }
   [[nodiscard]] bool clientConfigured() const {
     return !serverPublicKey.empty() && !clientPublicKey.empty() && !clientSecretKey.empty();
@@ -67,6 +73,18 @@ struct CurveKeys {
 /// Generates a CURVE key pair {public, secret} (Z85); throws ProtocolError(UNSUPPORTED) if
 /// libzmq was built without CURVE.
 std::pair<std::string, std::string> generateCurveKeyPair();
+
+/// Reads an allow-list of client public keys: one Z85 key (40 characters) per line, then
+/// optional free text (a name); blank lines and lines starting with '#' are skipped. Throws
+/// ProtocolError(SECURITY) naming the file and line of a malformed key.
+std::vector<std::string> readAllowedClientKeys(const std::string& path);
+
+/// Default largest message part (frame) any socket accepts: 256 MiB, e.g. one float64 array of
+/// 11 million cells x 3 components. A peer that announces a larger frame is disconnected by
+/// ZeroMQ before anything is allocated (ZMQ_MAXMSGSIZE).
+inline constexpr std::int64_t kDefaultMaxMessageBytes = std::int64_t{256} << 20;
+/// Most frames one message may have (envelope + arrays); more: the message is refused.
+inline constexpr std::size_t kMaxFramesPerMessage = 1024;
 
 struct TransportOptions {
   /// ZMQ_HEARTBEAT_IVL: ping the peer after this much silence.
@@ -80,6 +98,13 @@ struct TransportOptions {
   /// Server only: allow a non-loopback bind without CURVE (an explicit user opt-out, e.g.
   /// `coredem-dem --insecure` on a trusted network). Default: refuse.
   bool allowInsecure = false;
+  /// ZMQ_MAXMSGSIZE on every socket: the largest frame accepted (a larger one drops the
+  /// connection before it is read). A server also refuses a message whose frames together
+  /// exceed it (BYTE_LENGTH) or that has more than kMaxFramesPerMessage frames. <= 0: no limit.
+  std::int64_t maxMessageBytes = kDefaultMaxMessageBytes;
+  /// Client only: the ZeroMQ routing id this connection presents (ZMQ_ROUTING_ID, 1-255
+  /// bytes; empty: the server assigns one). For tests of routing-id reuse.
+  std::string routingId;
   /// Free text put into Envelope.sender of outgoing messages when empty.
   std::string sender;
 };
@@ -100,6 +125,9 @@ using PeerId = std::string;
 /// One request received by a Server.
 struct Request {
   PeerId peer;
+  /// The client's CURVE public key (Z85) as authenticated by the ZAP handler, when the server
+  /// has an allow-list (CurveKeys::allowedClientKeys); empty otherwise.
+  std::string clientKey;
   Message message;
   /// Structural decode result (Message::decode): if not ok, answer with makeError(status).
   Status status;
@@ -129,6 +157,11 @@ public:
   /// input: undecodable messages come back with a non-ok Request::status.
   std::optional<Request> receive(std::chrono::milliseconds timeout,
                                  const ReceiveOptions& options = {});
+  /// Peers whose connection closed since the last call (socket monitor; a peer is known once
+  /// it has sent a message). A routing id is never reused while its connection is open, so
+  /// a session bound to a routing id ends here when that connection closes. Keeps the last
+  /// 4096 until asked. inproc connections are not watched (they have no file descriptor).
+  std::vector<PeerId> takeDisconnected();
   /// Sends `message` to `peer`. Non-blocking; a vanished peer's reply is dropped (logged).
   /// Fills in Envelope.sender when empty.
   void reply(const PeerId& peer, Message message);

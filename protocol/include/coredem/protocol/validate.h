@@ -49,13 +49,38 @@ struct Expectation {
 Status validate(const Message& message, const Expectation& expectation);
 
 /// Checks a Configure body for consistency (INVALID_CONFIGURATION): Cartesian mesh with
-/// positive counts/spacing, unique species with molar mass > 0, sub-cycling
-/// dt_dem*n_sub == dt_cfd (rel. 1e-12), particle sets referencing existing materials with
-/// positive diameter, count, region min < max and mass fractions summing to 1 (abs. 1e-9),
-/// material parameters in range (k_n > 0, 0 < e_n <= 1, friction >= 0, density > 0).
+/// positive counts/spacing and at most kMaxCells cells (an overflowing product is refused), unique
+/// species with molar mass > 0, sub-cycling dt_dem*n_sub == dt_cfd (rel. 1e-12), particle sets
+/// referencing existing materials with positive diameter, count, region min < max and mass
+/// fractions summing to 1 (abs. 1e-9), material parameters in range (k_n > 0, 0 < e_n <= 1,
+/// friction >= 0, density > 0).
 Status validateConfigure(const v1::Configure& configure);
 
-/// Number of cells of the coupling mesh (0 if unset).
+/// Physically plausible ranges of the received gas fields (docs/protocol.md §3, "Ranges").
+/// Wide enough for any gas (and most liquids) a CFD-DEM run couples; a value outside is a
+/// sender bug (wrong units, divergence, uninitialised memory), refused before it reaches the
+/// DEM core, where it would turn every later Sources into NaN.
+struct GasRanges {
+  double temperatureMin = 100.0, temperatureMax = 6000.0; ///< T_g, K
+  double densityMin = 1e-4, densityMax = 2e4;             ///< rho_g, kg/m3
+  double viscosityMin = 1e-7, viscosityMax = 1.0;         ///< mu_g, Pa s
+  double conductivityMin = 1e-4, conductivityMax = 1e3;   ///< kappa_g, W/m/K
+  double heatCapacityMin = 100.0, heatCapacityMax = 1e5;  ///< cp_g, J/kg/K
+  double speedMax = 1e4;                                  ///< |u_g|, m/s
+  double pressureGradientMax = 1e12;                      ///< |grad_p|, Pa/m
+  double massFractionTolerance = 1e-3;                    ///< Y_k in [-tol, 1 + tol]
+  double massFractionSumTolerance = 0.05;                 ///< |sum_k Y_k - 1| (n_species >= 1)
+};
+
+/// Checks a (validated) GasFields message's values against `ranges`: the first value outside
+/// is refused (INVALID_CONFIGURATION) naming the array, the cell, the value and the range.
+Status validateGasRanges(const Message& gasFields, const GasRanges& ranges = {});
+
+/// Most coupling cells of any Configure (cells are indexed by int in the DEM core); a server
+/// may set a lower limit from its memory budget.
+inline constexpr std::uint64_t kMaxCells = 2147483647;
+
+/// Number of cells of the coupling mesh (0 if unset; UINT64_MAX if x*y*z overflows 64 bits).
 std::uint64_t cellCount(const v1::CouplingMesh& mesh);
 
 } // namespace coredem::protocol

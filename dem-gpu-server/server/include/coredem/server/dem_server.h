@@ -15,6 +15,7 @@
 /// Any invalid message gets an Error reply (code + what to do) and changes nothing.
 
 #include <chrono>
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -27,9 +28,19 @@ struct ServerOptions {
   double sessionTimeoutSeconds = 600; ///< a session whose peers are silent this long ends
   /// How long a GasFields may wait for the orchestrator's StepGrant of its step.
   double grantWaitSeconds = 60;
-  std::string curveKeysDir;      ///< DIR/server.public + DIR/server.secret (Z85)
+  std::string curveKeysDir; ///< DIR/server.public + DIR/server.secret (Z85)
+  /// Allow-list of client public keys (one Z85 key per line, like ssh `authorized_keys`; needs
+  /// curveKeysDir): only these clients complete the CURVE handshake. Empty: any client that
+  /// knows the server's public key.
+  std::string clientKeysFile;
   bool insecure = false;         ///< allow a non-loopback bind without CURVE
   bool exitAfterSession = false; ///< run() returns when the first session ends
+  /// Admission control (docs/security.md): the memory budget the count limits of a Configure
+  /// derive from (0: half of the physical memory), the largest message part any peer may send
+  /// (ZMQ_MAXMSGSIZE; a larger one closes its connection) and the most sub-steps per grant.
+  std::uint64_t maxMemoryBytes = 0;
+  std::int64_t maxMessageBytes = std::int64_t{256} << 20;
+  std::uint64_t maxSubSteps = 100000;
   /// Per-stage timers (docs/performance.md "Timers"): a report in the log every `timersEvery`
   /// CFD steps (0: only at the end) and at the end of each session, written as JSON to
   /// `timersFile` (empty: coredem-dem-timers.json in the working directory).
@@ -71,5 +82,8 @@ private:
 
 /// Writes a new CURVE key pair into DIR/server.public and DIR/server.secret (mode 0600).
 void generateCurveKeys(const std::string& dir);
+/// Writes a new client key pair into DIR/client.public and DIR/client.secret (mode 0600); the
+/// public key goes into the server's --client-keys allow-list.
+void generateClientKey(const std::string& dir);
 
 } // namespace coredem::server
