@@ -1,4 +1,4 @@
-# Third-party dependencies, all from Debian packages (scripts/install-deps.sh, DESIGN §7).
+# Third-party dependencies, all from Debian packages (scripts/install-deps.sh, README.md).
 find_package(PkgConfig REQUIRED)
 find_package(Threads REQUIRED)
 find_package(OpenMP REQUIRED COMPONENTS CXX)
@@ -30,7 +30,7 @@ if(NOT TARGET coredem::hdf5)
 endif()
 
 # ZeroMQ (C library + cppzmq header-only binding) as one target. PRIVATE link only:
-# ZeroMQ never appears in a public header (pimpl, STYLE §13).
+# ZeroMQ never appears in a public header (pimpl).
 if(NOT TARGET coredem::zmq)
   add_library(coredem::zmq INTERFACE IMPORTED)
   target_link_libraries(coredem::zmq INTERFACE PkgConfig::ZMQ)

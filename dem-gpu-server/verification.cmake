@@ -1,4 +1,4 @@
-# Analytic and reference solutions of the thermochemistry verification suite (PHYSICS.md §8):
+# Analytic and reference solutions of the thermochemistry verification suite (docs/physics.md §8):
 # header-only, include/coredem/dem/verification/analytic.h. Link coredem::dem_verification to
 # compare a simulation against them (e.g. `coredem verify`). Included from
 # dem-gpu-server/CMakeLists.txt after coredem_dem_kernels is defined:

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Installs the Debian packages CoReDEM builds and runs with (DESIGN §7).
+# Installs the Debian packages CoReDEM builds and runs with (README.md).
 # Idempotent: packages already present are left alone, and `apt-get update` runs
 # at most once, only when something has to be installed.
 #

@@ -13,7 +13,7 @@
 
 namespace coredem::bench {
 
-/// The decks of bench/decks.md (material: Patil glass, PHYSICS §7).
+/// The decks of bench/decks.md (material: Patil glass, docs/physics.md §7).
 inline coredem::dem::DemConfig deck(const std::string& name, std::size_t n) {
   using namespace coredem::dem;
   DemConfig c;
@@ -49,7 +49,7 @@ inline coredem::dem::DemConfig deck(const std::string& name, std::size_t n) {
   return c;
 }
 
-/// A PCM coupling grid over the deck's box with cells of about `cell` metres (PHYSICS §1.1:
+/// A PCM coupling grid over the deck's box with cells of about `cell` metres (docs/physics.md §1.1:
 /// Δx ≈ 3–5 d_p). addBox order of the walls: x lo/hi, y lo/hi, z lo/hi.
 inline void addCouplingGrid(coredem::dem::DemConfig& cfg, double cell) {
   const std::array<double, 3> hi{cfg.walls[1].point[0], cfg.walls[3].point[1],

@@ -92,7 +92,7 @@ DemConfig makeConfig(const Options& o, const Variant& v) {
   h.contactConduction = v.contact;
   h.lensConduction = v.lens;
   h.radiation = v.radiation;
-  // Species for the chemistry variants: a CLG bed (PHYSICS §6) of char + oxygen carrier.
+  // Species for the chemistry variants: a CLG bed (docs/physics.md §6) of char + oxygen carrier.
   if (v.chemistry > 0) {
     cfg.gasSpecies = {{"CO", 28.0101e-3},
                       {"CO2", 44.0095e-3},

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Chemistry in the DEM sub-step (PHYSICS §3.5, §4, §6; docs/thermochemistry.md), written once
-/// for every backend like engine_impl.h and heat.h. Per sub-step, after the forces, the drag
+/// Chemistry in the DEM sub-step (docs/physics.md §3.5, §4, §6; docs/thermochemistry.md), written
+/// once for every backend like engine_impl.h and heat.h. Per sub-step, after the forces, the drag
 /// deposition (particles sorted by PCM cell) and the heat sources, before the motion update:
 ///   1. rates, per particle, with the gas of its PCM cell frozen for the CFD step (ρ_g, Y_g and
 ///      the constant pressure): the data-defined reactions (reaction_generic.h), R1 + R2
@@ -310,8 +310,9 @@ public:
             mGas += gdot[i * nG + k];
           }
           q[i] = cp.reactionHeat ? sc * heat : 0.0;
-          // Sensible enthalpy carried by the moved mass (PHYSICS §3.5): the gas gets ṁ_gas at T_p
-          // instead of T_g; the particle's Σ m c_p T changes by Δm c_p T_p without a heat flow.
+          // Sensible enthalpy carried by the moved mass (docs/physics.md §3.5): the gas gets ṁ_gas
+          // at T_p instead of T_g; the particle's Σ m c_p T changes by Δm c_p T_p without a heat
+          // flow.
           const std::uint32_t pc = coupled ? pcell[i] : nCells;
           sens[2 * i] =
               (sensGas && pc < nCells && mGas != 0.0) ? mGas * cpgC[pc] * (T[i] - tgC[pc]) : 0.0;

@@ -61,7 +61,7 @@ ChemistrySetup makeChemistrySetup(const DemConfig& c) {
     return s;
 
   COREDEM_CHECK(o.removalFraction > 0.0 && o.removalFraction < 1.0,
-                "chemistry: removal_fraction = {} must be in (0, 1) (PHYSICS §1.1: 0.1)",
+                "chemistry: removal_fraction = {} must be in (0, 1) (docs/physics.md §1.1: 0.1)",
                 o.removalFraction);
   COREDEM_CHECK(o.pressure > 0.0 && std::isfinite(o.pressure),
                 "chemistry: gas pressure {} Pa must be > 0", o.pressure);

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Particle–particle and particle–wall contact forces in the DEM sub-step (PHYSICS §2.1, LSD with
-/// tangential history), written once for every backend like engine_impl.h.
+/// Particle–particle and particle–wall contact forces in the DEM sub-step (docs/physics.md §2.1,
+/// LSD with tangential history), written once for every backend like engine_impl.h.
 ///
 /// Each pair is evaluated once, by its owner: the particle with the smaller global id (gid), a
 /// choice that survives re-sorting. At every neighbour rebuild the full neighbour lists give

@@ -1,9 +1,9 @@
 #pragma once
 /// @file
-/// The coupling-cell binning the drag, heat and chemistry modules share (PCM, PHYSICS §1.1): the
-/// coupling cell of every particle (sentinel nCells outside the grid), the particles sorted by
-/// cell (perm, cStart/cEnd ranges) and ε_g frozen at the start of the CFD step. Owned by the
-/// engine; the modules read it through StepContext::cells.
+/// The coupling-cell binning the drag, heat and chemistry modules share (PCM, docs/physics.md
+/// §1.1): the coupling cell of every particle (sentinel nCells outside the grid), the particles
+/// sorted by cell (perm, cStart/cEnd ranges) and ε_g frozen at the start of the CFD step. Owned by
+/// the engine; the modules read it through StepContext::cells.
 ///
 /// Cost O(particles), independent of the grid size: only the ranges of OCCUPIED cells (and of the
 /// sentinel) are written; those of the other cells are stale and must not be read. Per-cell work

@@ -174,7 +174,8 @@ void validate(const DemConfig& c) {
                 c.neighbour.skinFactor);
   COREDEM_CHECK(c.neighbour.initialNeighbourSlots >= 1,
                 "neighbour.initialNeighbourSlots must be >= 1");
-  COREDEM_CHECK(c.dtFactor >= 1, "dtFactor {} must be >= 1 (PHYSICS: 50)", c.dtFactor);
+  COREDEM_CHECK(c.dtFactor >= 1, "dtFactor {} must be >= 1 (default 50, docs/physics.md §2.1)",
+                c.dtFactor);
   COREDEM_CHECK(c.epsMinDrag > 0 && c.epsMinDrag < 1, "epsMinDrag {} must be in (0, 1)",
                 c.epsMinDrag);
   COREDEM_CHECK(c.heat.minSeparation > 0, "heat: s_min = {} m must be > 0", c.heat.minSeparation);

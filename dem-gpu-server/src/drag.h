@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// The gas forces of coupled runs in the DEM sub-step (PHYSICS §1.1, §2.2) and their cell
+/// The gas forces of coupled runs in the DEM sub-step (docs/physics.md §1.1, §2.2) and their cell
 /// sources, written once for every backend like engine_impl.h:
 ///   sources:    per particle the PCM cell, the drag coefficient β V_p/(1−ε) of the law chosen
 ///               by `models: {drag: ...}` (kernels/drag.h) with ε_g frozen at the window start,

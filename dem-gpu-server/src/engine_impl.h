@@ -8,7 +8,8 @@
 ///
 /// The engine owns the particles, the neighbour lists and the coupling-cell binning
 /// (coupling_cells.h) and drives the sub-step modules through one interface (step_module.h):
-/// drag.h, contacts.h, heat.h, chemistry.h. Sub-step (DESIGN §4 step order, symplectic Euler):
+/// drag.h, contacts.h, heat.h, chemistry.h. Sub-step (docs/architecture.md step order, symplectic
+/// Euler):
 ///   1. neighbour lists rebuilt if a particle moved more than skin/2 since the last build
 ///      (cell keys → stable sort → particles reordered → 27-cell search)
 ///   2. sources of every module, in this order, on the same configuration:

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
-/// Particle heat transfer in the DEM sub-step (PHYSICS §3, Eq. 18; DESIGN §4), written once
-/// for every backend like engine_impl.h. Per sub-step, after the contact forces and the drag
-/// deposition (which leaves the particles sorted by PCM cell):
+/// Particle heat transfer in the DEM sub-step (docs/physics.md §3, Eq. 18; docs/architecture.md),
+/// written once for every backend like engine_impl.h. Per sub-step, after the contact forces and
+/// the drag deposition (which leaves the particles sorted by PCM cell):
 ///   1. cell means of T_p for the radiation environment (§3.4 (a), including the particle)
 ///   2. per particle (full neighbour list, gather, no atomics): contact conduction (Eqs. 22–23)
 ///      and gas-lens conduction (Eqs. 24–26) over the neighbours, convection with the gas of

@@ -1,10 +1,10 @@
 #pragma once
 /// @file
-/// ParticleStore: the particle state as structure of arrays (DESIGN §4, STYLE §6), each array
-/// a host/device mirror. The arrays, their widths and the FieldMask bits are generated from
-/// the particle schema (coredem/dem/particle_schema.h): one row a field. Kernels name the
-/// fields they read and write with FieldMask bits; the engine syncs exactly those (`require`)
-/// and marks the written ones (`produced`).
+/// ParticleStore: the particle state as structure of arrays (docs/architecture.md, LAMMPS AtomVec
+/// style), each array a host/device mirror. The arrays, their widths and the FieldMask bits are
+/// generated from the particle schema (coredem/dem/particle_schema.h): one row a field. Kernels
+/// name the fields they read and write with FieldMask bits; the engine syncs exactly those
+/// (`require`) and marks the written ones (`produced`).
 
 #include <cstddef>
 #include <cstdint>

@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
   VerifyOptions verifyOpts;
   std::vector<std::string> only;
   auto* verify = app.add_subcommand(
-      "verify", "run the verification cases (PHYSICS §8) against the analytic solutions");
+      "verify", "run the verification cases (docs/physics.md §8) against the analytic solutions");
   verify->add_option("--out", verifyOpts.outDir, "output folder (default runs/verify)");
   verify->add_option("--only", only, "only these cases (comma-separated names)")->delimiter(',');
   verify->add_flag("--list", verifyOpts.list, "list the cases and exit");

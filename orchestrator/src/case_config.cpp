@@ -206,7 +206,7 @@ void parseChemistry(const Section& top, CaseConfig& c) {
         g.fail(
             g.markOf("char_stoichiometry"), g.full("char_stoichiometry"),
             "seed is not implemented: the seed's pseudo-char lines of R1 and R2 are not mutually "
-            "consistent (PHYSICS §6.1); use carbon");
+            "consistent (docs/physics.md §6.1); use carbon");
       }
       ch.ocReduction = g.onOff("oc_reduction", false);
       ch.wgs = g.onOff("wgs", false);

@@ -9,8 +9,8 @@
 
 namespace coredem::orchestrator {
 
-/// Smallest collision time over the particle sets / 50 (PHYSICS Eq. 12, m_eff = m/2 for equal
-/// particles): t_col = sqrt(π² + ln² e_n) / sqrt(k_n / m_eff). Only used for the provisional
+/// Smallest collision time over the particle sets / 50 (docs/physics.md Eq. 12, m_eff = m/2 for
+/// equal particles): t_col = sqrt(π² + ln² e_n) / sqrt(k_n / m_eff). Only used for the provisional
 /// plan in Configure; the DEM server's reply is authoritative.
 double estimateDtDemMax(const CaseConfig& c);
 

@@ -1,5 +1,5 @@
-// `coredem verify` (docs/verification.md): the PHYSICS §8 verification cases through the real
-// processes, compared with the analytic solutions of dem/verification/analytic.h.
+// `coredem verify` (docs/verification.md): the docs/physics.md §8 verification cases through the
+// real processes, compared with the analytic solutions of dem/verification/analytic.h.
 #include <algorithm>
 #include <charconv>
 #include <chrono>
@@ -42,7 +42,7 @@ struct CaseSpec {
   std::string name;
   fs::path dir;
   std::string family;
-  std::string reference;        ///< PHYSICS section and reference values (free text)
+  std::string reference;        ///< docs/physics.md section and reference values (free text)
   double tolerance = 0.0;       ///< primary metric (relative unless the metric says)
   double secondTolerance = 0.0; ///< energy drift (conduction) or mass fractions (reaction)
   std::string skip;             ///< non-empty: not run, reported as skipped (the reason)
@@ -243,7 +243,7 @@ std::int64_t cellOf(const CaseConfig& c, const Vec3& x) {
   return idx[0] + std::int64_t(c.grid.cells[0]) * (idx[1] + std::int64_t(c.grid.cells[1]) * idx[2]);
 }
 
-/// PCM gas fraction of the cell holding particle i (PHYSICS §1.1).
+/// PCM gas fraction of the cell holding particle i (docs/physics.md §1.1).
 double cellVoidage(const CaseConfig& c, const std::vector<Particle>& ps, std::size_t i) {
   const std::int64_t cell = cellOf(c, ps[i].x);
   if (cell < 0) {
@@ -489,11 +489,13 @@ std::vector<Metric> checkReaction(const CaseSpec& spec, const CaseConfig& c,
       r.molarD = solidM.at(sp);
       nameD = sp;
     } else {
-      bad(c.caseFile, "family reaction knows A(g) + 2 B(s) -> C(g) + D(s) only (PHYSICS §8.5)");
+      bad(c.caseFile,
+          "family reaction knows A(g) + 2 B(s) -> C(g) + D(s) only (docs/physics.md §8.5)");
     }
   }
   if (nameB.empty() || nameD.empty() || !(r.molarA > 0) || !(r.molarC > 0)) {
-    bad(c.caseFile, "family reaction knows A(g) + 2 B(s) -> C(g) + D(s) only (PHYSICS §8.5)");
+    bad(c.caseFile,
+        "family reaction knows A(g) + 2 B(s) -> C(g) + D(s) only (docs/physics.md §8.5)");
   }
   const YAML::Node rate = rx[0]["rate"];
   if (!rate || rate["law"].Scalar() != "constant") {

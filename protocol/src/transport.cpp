@@ -577,11 +577,12 @@ Server& Server::operator=(Server&&) noexcept = default;
 std::string Server::bind(const std::string& endpoint) {
   if (!isLoopbackEndpoint(endpoint) && !_impl->options.curve.serverConfigured() &&
       !_impl->options.allowInsecure) {
-    throw ProtocolError(v1::ERROR_CODE_SECURITY,
-                        "refusing to bind " + endpoint +
-                            ": a non-loopback endpoint requires CURVE keys (DESIGN §1). Bind "
-                            "tcp://127.0.0.1:PORT or ipc://PATH, or set "
-                            "TransportOptions::curve (serverSecretKey/serverPublicKey)");
+    throw ProtocolError(
+        v1::ERROR_CODE_SECURITY,
+        "refusing to bind " + endpoint +
+            ": a non-loopback endpoint requires CURVE keys (docs/architecture.md). Bind "
+            "tcp://127.0.0.1:PORT or ipc://PATH, or set "
+            "TransportOptions::curve (serverSecretKey/serverPublicKey)");
   }
   try {
     _impl->socket.bind(endpoint);

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""CLG gasifier plots (docs/validation.md, PHYSICS §9.2): outlet gas and solid conversion.
+"""CLG gasifier plots (docs/validation.md, docs/physics.md §9.2): outlet gas and solid conversion.
 
 Usage: validation_clg.py RUN_DIR [--out DIR] [--summary FILE]
 
@@ -12,7 +12,7 @@ and writes to DIR (default RUN_DIR/plots):
                       exceeds 1e-6 of the N2 flow), and the outlet
                       molar flows of CO, CO2, H2 (dry) vs time
   clg_conversion.png  carbon conversion X_C = 1 − m_C(t)/m_C(0) and carrier conversion
-                      ξ = 1 − m_Fe2O3 / m_Fe2O3,eq (PHYSICS §6.3, m_eq = m_Fe2O3 + (3 M_Fe2O3 /
+                      ξ = 1 − m_Fe2O3 / m_Fe2O3,eq (docs/physics.md §6.3, m_eq = m_Fe2O3 + (3 M_Fe2O3 /
                       (2 M_Fe3O4)) m_Fe3O4) summed over all particles, vs time
 --summary writes a Markdown table (end values). Interpreter: COREDEM_PYTHON (numpy,
 matplotlib, h5py, yaml).

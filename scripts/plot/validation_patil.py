@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Patil bed-cooling validation plots (docs/validation.md, PHYSICS §9.1).
+"""Patil bed-cooling validation plots (docs/validation.md, docs/physics.md §9.1).
 
 Usage: validation_patil.py --run LABEL=RUN_DIR [--run ...] [--out DIR] [--summary FILE]
 
@@ -30,9 +30,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from plot_run import read_timeseries  # noqa: E402  (same folder)
 
-CP_P = 840.0  # J/kg/K, glass (PHYSICS §7), = the case files' materials[0].cp
+CP_P = 840.0  # J/kg/K, glass (docs/physics.md §7), = the case files' materials[0].cp
 T0_C = 90.0
-SEED = {"75g": 3.0, "125g": 2.5}  # °C/s, PHYSICS §9.1 fits
+SEED = {"75g": 3.0, "125g": 2.5}  # °C/s, docs/physics.md §9.1 fits
 
 
 def case_numbers(run_dir):

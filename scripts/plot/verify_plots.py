@@ -20,11 +20,11 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 TITLES = {
-    "contact-conduction": "Particle-particle contact conduction (PHYSICS 8.1)",
-    "gas-lens": "Particle-fluid-particle conduction through the gas lens (PHYSICS 8.2)",
-    "convection": "Particle-gas convection (PHYSICS 8.3)",
-    "radiation": "Radiation, RK4 reference (PHYSICS 8.4)",
-    "reaction": "Heterogeneous reaction A(g) + 2B(s) -> C(g) + D(s) (PHYSICS 8.5)",
+    "contact-conduction": "Particle-particle contact conduction (docs/physics.md §8.1)",
+    "gas-lens": "Particle-fluid-particle conduction through the gas lens (docs/physics.md §8.2)",
+    "convection": "Particle-gas convection (docs/physics.md §8.3)",
+    "radiation": "Radiation, RK4 reference (docs/physics.md §8.4)",
+    "reaction": "Heterogeneous reaction A(g) + 2B(s) -> C(g) + D(s) (docs/physics.md §8.5)",
 }
 
 

@@ -68,7 +68,7 @@ V_REF = 0.5                      # m/s, impact velocity at which the contact tim
 # as U^(1/5), so a factor 1.5 off U costs < 9 %. A bubbling bed needs about V_REF.
 # report.py checks every run's counts.
 U_SUB = 0.025
-DT_FACTOR = 50                   # CoReDEM: dt_DEM = t_col / 50 (PHYSICS Eq. 12)
+DT_FACTOR = 50                   # CoReDEM: dt_DEM = t_col / 50 (docs/physics.md Eq. 12)
 LATTICE_FAC = 1.05               # start lattice spacing / d_p
 JITTER_FAC = 0.02                # +- jitter of each start position / d_p (< (fac - 1)/2)
 ALPHAC_MIN = 0.3                 # smallest gas fraction in the gas equations (both codes)

@@ -10,8 +10,8 @@ Runs two tiny serial LIGGGHTS decks with exactly the contact settings of the pac
 2. particle-wall: one sphere touching the plane z = 0, approaching it at 0.5 m/s;
 
 each at the deck's dt = t_col/50 and at dt/4, and prints the measured rebound ratio
-|v_n,out / v_n,in| against e_n = 0.97 (PHYSICS Eq. 11/13) and, for the pair, the contact
-duration against t_col (PHYSICS Eq. 12). Exit status 1 if a rebound ratio is off by more than
+|v_n,out / v_n,in| against e_n = 0.97 (docs/physics.md Eq. 11/13) and, for the pair, the contact
+duration against t_col (docs/physics.md Eq. 12). Exit status 1 if a rebound ratio is off by more than
 TOL_E (dt) or TOL_E_FINE (dt/4), see below, or the duration by more than 2 time steps.
 """
 

@@ -7,7 +7,7 @@
 //                                                          + fvOptions
 //
 // with ac the gas volume fraction (field "alphac", read if present, otherwise 1), U the
-// interstitial gas velocity and p the kinematic pressure: the "Model A" split of PHYSICS §1,
+// interstitial gas velocity and p the kinematic pressure: the "Model A" split of docs/physics.md §1,
 // constant density. With alphac = 1 it is the plain incompressible Navier-Stokes equations
 // (what pisoFoam solves), and a uniform alphac cancels out of every term, which the
 // integration test uses as a consistency check.

@@ -51,7 +51,8 @@ void addChemistry(const v1::Configure& c, dem::DemConfig& cfg) {
     COREDEM_CHECK(
         clg.char_stoichiometry() != v1::CHAR_STOICHIOMETRY_SEED,
         "Configure: chemistry.clg.char_stoichiometry = seed is not implemented (the seed's "
-        "pseudo-char lines of R1 and R2 are not mutually consistent, PHYSICS §6.1); use carbon");
+        "pseudo-char lines of R1 and R2 are not mutually consistent, docs/physics.md §6.1); use "
+        "carbon");
     o.clg.ocReduction = clg.oc_reduction();
     o.clg.wgs = clg.wgs();
     switch (clg.wgs_equilibrium()) {

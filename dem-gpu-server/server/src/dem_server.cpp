@@ -758,8 +758,9 @@ struct DemServer::Impl {
       proto::addNamedValue(l.mutable_mass(), "dem.removed_mass_kg", c.removedMass());
       proto::addNamedValue(l.mutable_energy(), "dem.reaction_heat_J", c.reactionHeat);
       proto::addNamedValue(l.mutable_energy(), "dem.homogeneous_heat_J", c.homogeneousHeat);
-      // Sensible enthalpy of the transferred mass (PHYSICS §3.5): into the gas inside Q_hom, and
-      // the particles' Σ m c_p T change by mass leaving at T_p (closes the particle energy ledger).
+      // Sensible enthalpy of the transferred mass (docs/physics.md §3.5): into the gas inside
+      // Q_hom, and the particles' Σ m c_p T change by mass leaving at T_p (closes the particle
+      // energy ledger).
       proto::addNamedValue(l.mutable_energy(), "dem.gas_sensible_heat_J", c.gasSensibleHeat);
       proto::addNamedValue(l.mutable_energy(), "dem.sensible_mass_enthalpy_J",
                            c.sensibleMassEnthalpy);
@@ -948,10 +949,11 @@ DemServer::DemServer(ServerOptions options)
   auto& m = *_impl;
   dem::parseBackend(m.opt.backend); // fail early on a bad name
   if (!proto::isLoopbackEndpoint(m.opt.bind) && m.opt.curveKeysDir.empty()) {
-    COREDEM_CHECK(m.opt.insecure,
-                  "--bind {} is not a loopback address: give --curve-keys DIR (CURVE encryption "
-                  "and authentication, DESIGN §1) or, on a trusted network only, --insecure",
-                  m.opt.bind);
+    COREDEM_CHECK(
+        m.opt.insecure,
+        "--bind {} is not a loopback address: give --curve-keys DIR (CURVE encryption "
+        "and authentication, docs/architecture.md) or, on a trusted network only, --insecure",
+        m.opt.bind);
     m.log->warn("binding {} WITHOUT encryption (--insecure): anyone who reaches this port can "
                 "drive this server",
                 m.opt.bind);

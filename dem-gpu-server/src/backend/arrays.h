@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Device arrays and host/device mirrors over a backend's memory functions (STYLE §6).
+/// Device arrays and host/device mirrors over a backend's memory functions (LAMMPS AtomVec style).
 /// On the cpu backend (separateDevice = false) a DualArray's device pointer *is* its host
 /// pointer and toDevice()/toHost() do nothing; on cuda the host side is pinned memory.
 

@@ -1,6 +1,6 @@
-// Chemistry integrated in the DEM sub-step (PHYSICS §3.5, §4, §6, §8.5; docs/thermochemistry.md).
-// Every case runs a real DemSystem (cpu backend) and compares with the analytic solution, the
-// kernel values, or an independent RK4 integration of the conversion ODE.
+// Chemistry integrated in the DEM sub-step (docs/physics.md §3.5, §4, §6, §8.5;
+// docs/thermochemistry.md). Every case runs a real DemSystem (cpu backend) and compares with the
+// analytic solution, the kernel values, or an independent RK4 integration of the conversion ODE.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -109,7 +109,7 @@ double idealRho(double p, const std::vector<double>& x, double t) {
   return p * mmix / (k::kGasConstant * t);
 }
 
-// ---------------------------------------------------------------- PHYSICS §8.5 (MFiX-RC)
+// ---------------------------------------------------------------- docs/physics.md §8.5 (MFiX-RC)
 constexpr double kMA = 0.025, kMB = 0.015, kMC = 0.030, kMD = 0.025, kMI = 0.020, kOmega = 3.927e-4;
 
 DemConfig reactiveChemistryCase(double dH = 0.0) {

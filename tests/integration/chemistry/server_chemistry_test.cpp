@@ -108,8 +108,8 @@ TEST(DemServerChemistry, SourcesCarryTheParticlesSpeciesRatesAndTheLedgerTheConv
               1e-13 * m0);
   EXPECT_EQ(named(l.mass(), "dem.removed_mass_kg"), 0.0);
   EXPECT_EQ(named(l.energy(), "dem.reaction_heat_J"), 0.0);
-  // Sensible enthalpy of the moved mass (PHYSICS §3.5): the gas-side total is the transfer part of
-  // the Q_hom it was sent (no WGS here; 1e-12 rel), the particle side is Δm c_p T_p with
+  // Sensible enthalpy of the moved mass (docs/physics.md §3.5): the gas-side total is the transfer
+  // part of the Q_hom it was sent (no WGS here; 1e-12 rel), the particle side is Δm c_p T_p with
   // c_p T_p = E/m (identical particles; heat and reaction heat off, so T_p stays put). Δm is the
   // change of the stored masses (what Σ m c_p T sees): it matches the analytic Δm to the round-off
   // of the particle masses, hence the same 1e-13 m0 as the mass check above (times c_p T_p).

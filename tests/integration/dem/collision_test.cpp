@@ -1,4 +1,4 @@
-// Binary collisions (PHYSICS §2.1): restitution, contact duration, momentum.
+// Binary collisions (docs/physics.md §2.1): restitution, contact duration, momentum.
 #include <gtest/gtest.h>
 
 #include "dem_test_util.h"
@@ -15,7 +15,7 @@ struct CollisionResult {
   std::vector<double> p0, p1;
 };
 
-/// Head-on collision of two 1 mm glass spheres (PHYSICS §7) approaching at ±v; `phase`
+/// Head-on collision of two 1 mm glass spheres (docs/physics.md §7) approaching at ±v; `phase`
 /// places the first overlap at that fraction of a step.
 CollisionResult collide(double v, double phase, double d1 = 1e-3, double d2 = 1e-3) {
   DemConfig c;
@@ -63,7 +63,7 @@ CollisionResult collide(double v, double phase, double d1 = 1e-3, double d2 = 1e
 } // namespace
 
 TEST(BinaryCollision, RestitutionAndContactDuration) {
-  // e_n within 1e-3 (PHYSICS §2.1 analytic check) and t_col within 2 Δt_DEM, for contact
+  // e_n within 1e-3 (docs/physics.md §2.1 analytic check) and t_col within 2 Δt_DEM, for contact
   // onsets at several phases within a step.
   for (double phase : {0.25, 0.5, 0.75}) {
     for (double v : {0.05, 0.5, 1.0}) {

@@ -7,7 +7,7 @@ using namespace coredem::dem;
 using namespace coredem::dem::testing;
 
 TEST(Wall, SlidingSphereReachesRollingAtFiveSevenths) {
-  // PHYSICS §2.1 analytic check: a sphere launched sliding (ω = 0) on a frictional floor
+  // docs/physics.md §2.1 analytic check: a sphere launched sliding (ω = 0) on a frictional floor
   // ends rolling at v = 5/7 v0 (angular momentum about the contact point is conserved).
   DemConfig c;
   c.materials[0].mu = 0.3;
@@ -34,7 +34,7 @@ TEST(Wall, SlidingSphereReachesRollingAtFiveSevenths) {
 }
 
 namespace {
-/// Terminal velocity from Gidaspow/Wen–Yu (PHYSICS §2.2) by bisection, independent of the
+/// Terminal velocity from Gidaspow/Wen–Yu (docs/physics.md §2.2) by bisection, independent of the
 /// kernels: (ρ_p − ρ_g) g = ¾ C_D(Re) ε^−1.65 ρ_g v²/d with Re = ε ρ_g d v/μ_g
 /// (weight − buoyancy = β V_p v/(1−ε)).
 double terminalVelocity(double rhoP, double rhoG, double mu, double d, double eps, double g) {

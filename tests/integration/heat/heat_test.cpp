@@ -1,4 +1,4 @@
-// Heat transfer integrated in the DEM sub-step (PHYSICS §3, §8; docs/heat-coupling.md).
+// Heat transfer integrated in the DEM sub-step (docs/physics.md §3, §8; docs/heat-coupling.md).
 // Every case runs a real DemSystem (cpu backend) and compares with verification/analytic.h.
 #include <algorithm>
 #include <cmath>
@@ -96,8 +96,8 @@ std::string sci(double v) {
 
 } // namespace
 
-// PHYSICS §8.1 seed variant d2 = 3.6 mm, δ = 4e-5 m, in vacuum (no coupling: no gas, so only
-// contact conduction acts). Seed tolerance 6e-4 % = 6e-6 relative; Σ m c T to 1e-12.
+// docs/physics.md §8.1 seed variant d2 = 3.6 mm, δ = 4e-5 m, in vacuum (no coupling: no gas, so
+// only contact conduction acts). Seed tolerance 6e-4 % = 6e-6 relative; Σ m c T to 1e-12.
 TEST(HeatStep, TwoTouchingParticlesConserveEnergyAndFollowTheAnalyticSolution) {
   const va::TwoParticleCase c = va::seedContactConductionCase(3.6e-3, 4e-5);
   DemSystem sys(twoParticles(c), BackendKind::Cpu, 1);
@@ -126,8 +126,8 @@ TEST(HeatStep, TwoTouchingParticlesConserveEnergyAndFollowTheAnalyticSolution) {
   EXPECT_EQ(sys.heatTotals().convection, 0.0);
 }
 
-// PHYSICS §8.2 MFiX-PFP (gap 0.18 mm) through the gas lens, in a coupled cell with κ_g of §8.0
-// and convection off. Seed tolerance 1.5e-4 % = 1.5e-6 relative; energy to 1e-12.
+// docs/physics.md §8.2 MFiX-PFP (gap 0.18 mm) through the gas lens, in a coupled cell with κ_g of
+// §8.0 and convection off. Seed tolerance 1.5e-4 % = 1.5e-6 relative; energy to 1e-12.
 TEST(HeatStep, GasLensPairFollowsTheAnalyticSolution) {
   const va::TwoParticleCase c = va::mfixLensCase();
   DemConfig cfg = twoParticles(c);
@@ -190,15 +190,15 @@ struct ConvectionCase {
 
 } // namespace
 
-// PHYSICS §8.3 with the seed's Li–Mason correlation (Re with ε, ε = 0.995759): T_p(t) within
-// 1e-4 relative over 2 s (the Euler error at Δt = 1e-4 s is ~1e-6 of T_g − T_p).
+// docs/physics.md §8.3 with the seed's Li–Mason correlation (Re with ε, ε = 0.995759): T_p(t)
+// within 1e-4 relative over 2 s (the Euler error at Δt = 1e-4 s is ~1e-6 of T_g − T_p).
 TEST(HeatStep, SingleParticleInHotGasFollowsTheConvectiveHeatingCurve) {
   ConvectionCase cc;
   DemSystem sys(cc.cfg, BackendKind::Cpu, 1);
   cc.gas().apply(sys);
   const kernels::GasState g = va::musserConvectionGas(cc.tg, va::mfixConvectionCellVoidage());
   const double coef = va::convectionCoefficient(kernels::ConvectionParams{}, g, cc.d, cc.m, cc.u);
-  EXPECT_NEAR(coef, 0.960850, 2e-6); // PHYSICS §8.3 table, Li–Mason with ε
+  EXPECT_NEAR(coef, 0.960850, 2e-6); // docs/physics.md §8.3 table, Li–Mason with ε
   double worst = 0.0, worstDiff = 0.0;
   for (int w = 1; w <= 20; ++w) {
     sys.advance(0.1, 1000);
@@ -267,7 +267,7 @@ TEST(HeatStep, CellHeatSourcesEqualTheParticlesConvectiveGain) {
   EXPECT_EQ(sys.heatTotals().radiation, 0.0); // emissivity 0
 }
 
-// PHYSICS §8.4 MFiX-RAD: A and B in one 1.5 × 1.0 × 0.36 cm cell, gas held at 400 K,
+// docs/physics.md §8.4 MFiX-RAD: A and B in one 1.5 × 1.0 × 0.36 cm cell, gas held at 400 K,
 // k_p = 0 and no convection: radiation only, T_env of variant (a). vs RK4 within 2e-7 relative.
 TEST(HeatStep, RadiationOfTwoParticlesFollowsTheRk4Reference) {
   const va::RadiationCase rc = va::mfixRadiationCase();

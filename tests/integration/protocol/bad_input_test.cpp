@@ -1,4 +1,4 @@
-// Bad input over real tcp loopback sockets (DESIGN §3): every malformed or inconsistent
+// Bad input over real tcp loopback sockets (docs/protocol.md): every malformed or inconsistent
 // message gets an Error reply with its specific code, and the server then serves the next
 // valid request correctly.
 #include <limits>

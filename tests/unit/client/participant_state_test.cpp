@@ -1,4 +1,4 @@
-// The client's state checks (STYLE §2), without any peer: every call out of order throws
+// The client's state checks, without any peer: every call out of order throws
 // StateError naming the call and the state; missing peers in the environment are Argument
 // errors naming the variable. This file is compiled as C++14 (CMake CXX_STANDARD 14) to prove
 // that the public header works in OpenFOAM translation units.

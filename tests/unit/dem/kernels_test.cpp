@@ -1,4 +1,4 @@
-// Kernel unit tests on the CPU against PHYSICS.md §1.1 and §2 (Eqs. 9–17).
+// Kernel unit tests on the CPU against docs/physics.md §1.1 and §2 (Eqs. 9–17).
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -17,7 +17,7 @@ using namespace coredem::dem::kernels;
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-// Patil glass (PHYSICS §7): d = 1 mm, ρ = 2500, k_n = 1000, e_n = 0.97.
+// Patil glass (docs/physics.md §7): d = 1 mm, ρ = 2500, k_n = 1000, e_n = 0.97.
 const double kMass = 2500.0 * kPi / 6.0 * 1e-9;
 } // namespace
 
@@ -43,7 +43,7 @@ TEST(Damping, Eq11RestitutionRecoveredFromEq12And13) {
 }
 
 TEST(CollisionTime, Eq12PatilValue) {
-  // PHYSICS §7 [V]: t_col = 8.04e-5 s, Δt_DEM = 1.61e-6 s for the glass pair.
+  // docs/physics.md §7 [V]: t_col = 8.04e-5 s, Δt_DEM = 1.61e-6 s for the glass pair.
   const double t = collisionTimeFromRestitution(1000.0, kMass / 2, 0.97);
   EXPECT_NEAR(t, std::sqrt(kMass / 2 / 1000.0) * std::sqrt(kPi * kPi + std::pow(std::log(0.97), 2)),
               1e-18);
@@ -165,7 +165,7 @@ TEST(Drag, WenYuDragCoefficientNearlyContinuousAtRe1000) {
 TEST(Drag, EpsClipAndStokesLimit) {
   const double rho = 1.2, mu = 1.8e-5, d = 1e-3, vol = kPi / 6e9;
   const GidaspowParams p{};
-  // ε below ε_min = 0.35 is clipped (PHYSICS §1.1 [C]).
+  // ε below ε_min = 0.35 is clipped (docs/physics.md §1.1 [C]).
   EXPECT_DOUBLE_EQ(gidaspowParticleCoefficient(p, 0.2, rho, mu, d, vol, 0.5),
                    gidaspowParticleCoefficient(p, 0.35, rho, mu, d, vol, 0.5));
   // Zero slip in the dilute branch: finite, equal to the Re → 0 limit.

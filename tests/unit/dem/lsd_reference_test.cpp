@@ -1,6 +1,6 @@
-// LSD pair contact against reference data (STYLE §8): data/lsd_contact.yaml holds inputs and
-// expected force/torque/δ_t computed by an independent Python implementation of PHYSICS §2.1
-// (data/make_lsd_reference.py).
+// LSD pair contact against reference data: data/lsd_contact.yaml holds inputs and
+// expected force/torque/δ_t computed by an independent Python implementation of docs/physics.md
+// §2.1 (data/make_lsd_reference.py).
 #include <cmath>
 #include <string>
 

@@ -1,4 +1,4 @@
-// TimeHandler: sub-step count and drift-free accumulation (STYLE §9, preCICE ManyTinyTimesteps).
+// TimeHandler: sub-step count and drift-free accumulation (preCICE ManyTinyTimesteps).
 #include <cmath>
 #include <limits>
 

@@ -211,7 +211,7 @@ TEST(CaseChemistry, RoundTripThroughConfigureReactsAsConfigured) {
   coredem::dem::DemSystem sys(d, coredem::dem::BackendKind::Cpu, 1);
   const double m0 = sys.particles().mass[0];
   sys.advance(0.1, 1);
-  // dm/dt = −(2 M_B − M_D) ω (PHYSICS §8.5).
+  // dm/dt = −(2 M_B − M_D) ω (docs/physics.md §8.5).
   const double expected = m0 - (2 * 0.015 - 0.025) * 3.927e-4 * 0.1;
   EXPECT_NEAR(sys.particles().mass[0], expected, 1e-15);
 }

@@ -1,4 +1,4 @@
-// TimeHandler (Kahan summation), dt policy and sub-cycling plan (STYLE §9, §10).
+// TimeHandler (Kahan summation), dt policy and sub-cycling plan.
 #include <cmath>
 
 #include <gtest/gtest.h>

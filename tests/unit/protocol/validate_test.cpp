@@ -1,4 +1,4 @@
-// Validation of received messages (DESIGN §3): each violation yields its own code and a
+// Validation of received messages (docs/protocol.md): each violation yields its own code and a
 // message naming the field.
 #include <cmath>
 #include <limits>

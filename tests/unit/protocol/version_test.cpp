@@ -1,4 +1,4 @@
-// Version negotiation rule (DESIGN §3).
+// Version negotiation rule (docs/protocol.md).
 #include <gtest/gtest.h>
 
 #include <coredem/protocol/version.h>

@@ -1,6 +1,6 @@
-// Contact conduction (PHYSICS §3.2) and gas-lens conduction (§3.3) vs the MFiX reference
-// constants (§8.1, §8.2), reference/refvalues.py, closed forms and an independent fine
-// long-double quadrature.
+// Contact conduction (docs/physics.md §3.2) and gas-lens conduction (§3.3) vs the MFiX reference
+// constants (§8.1, §8.2), reference values computed independently in Python (docs/physics.md §8),
+// closed forms and an independent fine long-double quadrature.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -131,8 +131,9 @@ TEST(Quadrature, GaussKronrodExactnessAndAdaptivity) {
 
 // ---- contact conduction -------------------------------------------------------------------
 
-// MFiX-CC (§8.1): r_c = 1.475235004121685e-05 m (refvalues.py, acos form, ~1e-12 accurate);
-// a = A_C = 0.01027998273952850 s⁻¹ (MFiX file) and b = 0.004106681767591312 (refvalues.py).
+// MFiX-CC (§8.1): r_c = 1.475235004121685e-05 m (the independent Python reference values, acos
+// form, ~1e-12 accurate); a = A_C = 0.01027998273952850 s⁻¹ (MFiX file) and b =
+// 0.004106681767591312 (the independent Python reference values).
 TEST(ContactConduction, MfixReferenceConstants) {
   const double rc = k::intersectionCircleRadius(1.5e-3, 1.8e-3, kMfixCcDistance);
   EXPECT_NEAR(rc, 1.475235004121685e-05, 1e-10 * rc);
@@ -160,8 +161,9 @@ TEST(ContactConduction, IntersectionRadiusIsAccurateForTinyOverlaps) {
   EXPECT_EQ(k::contactConductance(1.0, 2.0, 1e-3, 2e-3, 3e-3), 0.0);
 }
 
-// Seed variants (§8.1 table; refvalues.py): particle 1 = A (3.0 mm, 373.15 K), particle 2 =
-// material B (278.15 K). Printed digits: r_c 6 significant, a/b 7, T 1e-4 K.
+// Seed variants (§8.1 table; the independent Python reference values): particle 1 = A (3.0 mm,
+// 373.15 K), particle 2 = material B (278.15 K). Printed digits: r_c 6 significant, a/b 7, T 1e-4
+// K.
 TEST(ContactConduction, SeedVariantTable) {
   struct Row {
     double d2, ov, rc, a, b, tInf, t1, t2;
@@ -215,8 +217,9 @@ TEST(Conduction, PairTermsAreExactlyAntisymmetric) {
 // ---- gas lens ------------------------------------------------------------------------------
 
 // MFiX-PFP (§8.2): R_out = 5.565457e-4 m, R_in = 0, exact I = 3.675223767717116e-3 m
-// (refvalues.py, tolerance 1e-12 absolute per piece → ~3e-10 relative), a, b from it.
-// MFiX's own a = 0.0401067383 comes from its loose EPS = 1e-2 Simpson (6.7e-5 relative).
+// (the independent Python reference values, tolerance 1e-12 absolute per piece → ~3e-10 relative),
+// a, b from it. MFiX's own a = 0.0401067383 comes from its loose EPS = 1e-2 Simpson (6.7e-5
+// relative).
 TEST(GasLens, MfixReferenceConstants) {
   const k::GasLensParams p;
   const auto geo = k::gasLensGeometry(p, 1.5e-3, 1.8e-3, kMfixPfpDistance);
@@ -235,7 +238,8 @@ TEST(GasLens, MfixReferenceConstants) {
   EXPECT_NEAR(c.b, 0.0160219735, 1e-4 * c.b);
 }
 
-// Seed gap / overlap variants (§8.2 table, refvalues.py full digits) → 1e-9 relative.
+// Seed gap / overlap variants (§8.2 table, the independent Python reference values full digits) →
+// 1e-9 relative.
 TEST(GasLens, SeedVariantsMatchReferenceScript) {
   struct Row {
     double gap, sMin, integral;
@@ -262,7 +266,7 @@ TEST(GasLens, SeedVariantsMatchReferenceScript) {
   EXPECT_NEAR(c.b, 0.1530239, 5e-7 * 0.1530239);
 }
 
-// Accuracy target 1e-8 relative (PHYSICS §3.3): compare against the closed form for equal
+// Accuracy target 1e-8 relative (docs/physics.md §3.3): compare against the closed form for equal
 // spheres and the independent long-double quadrature for unequal spheres, in and out of
 // contact, with s_min from 4e-10 to 1e-6 m. Observed agreement is ~1e-13; assert 1e-10 for
 // the closed form gasLensIntegral() and the adaptive gasLensIntegralReference() alike.

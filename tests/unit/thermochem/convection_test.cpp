@@ -1,4 +1,4 @@
-// Li–Mason / Ranz–Marshall convection (PHYSICS §3.1) vs the MFiX convection case (§8.3)
+// Li–Mason / Ranz–Marshall convection (docs/physics.md §3.1) vs the MFiX convection case (§8.3)
 // and the Li–Mason table of §8.3.
 #include <cmath>
 #include <iterator>
@@ -38,7 +38,7 @@ TEST(Convection, MfixRanzMarshallCoefficient) {
   EXPECT_NEAR(v::convectionTemperature(298.15, 373.15, c, 5.0), 299.0771, 5e-5);
 }
 
-// PHYSICS §8.3 Li–Mason table (Nu to 1e-4, coefficient to 1e-6, T(1 s) to 1e-4 K).
+// docs/physics.md §8.3 Li–Mason table (Nu to 1e-4, coefficient to 1e-6, T(1 s) to 1e-4 K).
 TEST(Convection, LiMasonTableOfPhysics) {
   struct Row {
     double u;

@@ -1,5 +1,5 @@
-// NASA-7 data, reaction enthalpies and equilibrium constants vs PHYSICS.md §3.5 / Appendix A
-// and the numbers printed by physics/reference/nasa.py (same Burcat/MFiX coefficients).
+// NASA-7 data, reaction enthalpies and equilibrium constants vs docs/physics.md §3.5 / Appendix A
+// and reference numbers computed independently in Python from the same Burcat/MFiX coefficients.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -63,7 +63,7 @@ TEST(Nasa7, MatchesReferenceScript) {
   }
 }
 
-// PHYSICS §3.5 table, rounded to the printed digits (H 0.01 kJ/mol, C_p 0.01 J/mol/K; the
+// docs/physics.md §3.5 table, rounded to the printed digits (H 0.01 kJ/mol, C_p 0.01 J/mol/K; the
 // oxide C_p at 0.1 J/mol/K).
 TEST(Nasa7, FormationEnthalpiesAndHeatCapacitiesOfPhysicsTable) {
   struct Row {
@@ -141,7 +141,7 @@ TEST(ReactionEnthalpy, MatchesReferenceScript) {
       EXPECT_NEAR(dh, r.dh[i], 1e-9 * std::fabs(r.dh[i]));
     }
   }
-  // PHYSICS §3.5 table (kJ/mol, rounded): R1 +172.45 and R4 −47.0 at 298.15 K.
+  // docs/physics.md §3.5 table (kJ/mol, rounded): R1 +172.45 and R4 −47.0 at 298.15 K.
   EXPECT_NEAR(k::reactionEnthalpy(k::ClgReaction::R1, 298.15) / 1e3, 172.45, 0.005);
   EXPECT_NEAR(k::reactionEnthalpy(k::ClgReaction::R4, 298.15) / 1e3, -47.0, 0.05);
 }
@@ -154,7 +154,7 @@ TEST(ReactionEnthalpy, WgsEquilibriumConstantFromGibbs) {
 }
 
 // Molar masses from atomic masses: every CLG reaction balances to round-off (a few ulp of
-// the largest term, 3 M_Fe2O3 ≈ 0.48 kg/mol → 2e-16), and they match PHYSICS §6 to 2e-6.
+// the largest term, 3 M_Fe2O3 ≈ 0.48 kg/mol → 2e-16), and they match docs/physics.md §6 to 2e-6.
 TEST(ReactionEnthalpy, ReactionsBalanceMassToRoundOff) {
   for (int i = 0; i < static_cast<int>(k::ClgReaction::Count); ++i) {
     SCOPED_TRACE(i);

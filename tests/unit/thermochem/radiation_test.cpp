@@ -1,4 +1,4 @@
-// Radiation kernel (PHYSICS §3.4) and the RK4 reference of the MFiX radiation case (§8.4).
+// Radiation kernel (docs/physics.md §3.4) and the RK4 reference of the MFiX radiation case (§8.4).
 #include <cmath>
 #include <iterator>
 #include <vector>
@@ -38,8 +38,9 @@ TEST(Radiation, EnvironmentTemperature) {
   EXPECT_EQ(k::radiationEnvironmentTemperature(eps, tg, 0.0, 0), tg);
 }
 
-// Constants of §8.4 vs refvalues.py: C_A = 2.700186611336668e-10, C_B = 1.553298547852017e-10,
-// ε_g = 0.928581127008392 (1e-12 relative: only the order of multiplications differs).
+// Constants of §8.4 vs the independent Python reference values: C_A = 2.700186611336668e-10, C_B
+// = 1.553298547852017e-10, ε_g = 0.928581127008392 (1e-12 relative: only the order of
+// multiplications differs).
 TEST(Radiation, MfixCaseConstants) {
   const v::RadiationCase c = v::mfixRadiationCase();
   EXPECT_NEAR(c.epsG, 9.285811270083920e-01, 1e-13);
@@ -50,8 +51,8 @@ TEST(Radiation, MfixCaseConstants) {
   EXPECT_NEAR(v::radiationConstant(c.m1, c.d1) / 2.70024635866355e-10, 1.0, 3e-5);
 }
 
-// RK4, Δt = 1e-3 s, vs refvalues.py (printed to 1e-6 K → tolerance 1e-6 K) for both T_env
-// variants; and the step is converged (Δt = 1e-3 vs 2e-3 differ by < 1e-8 K).
+// RK4, Δt = 1e-3 s, vs the independent Python reference values (printed to 1e-6 K → tolerance 1e-6
+// K) for both T_env variants; and the step is converged (Δt = 1e-3 vs 2e-3 differ by < 1e-8 K).
 TEST(Radiation, Rk4ReferenceMatchesScript) {
   const std::vector<double> times = {10.0, 50.0, 100.0, 200.0, 300.0};
   const double refA[5][2] = {{338.063746, 432.9536},

@@ -1,4 +1,4 @@
-// Heterogeneous reactions: the generic data-defined reaction (PHYSICS §8.5), char
+// Heterogeneous reactions: the generic data-defined reaction (docs/physics.md §8.5), char
 // gasification R1/R2 (§6.1) and oxygen-carrier reduction R4/R5 (§6.3).
 #include <cmath>
 
@@ -102,7 +102,7 @@ TEST(GenericReaction, ArrheniusRate) {
 
 // ---- char gasification ----------------------------------------------------------------------
 
-// PHYSICS §6.1 sanity value: 1223 K, P_H2O = 0.5 bar, P_H2 = 0.05 bar → r_H2O ≈ 2.7e-3 s⁻¹
+// docs/physics.md §6.1 sanity value: 1223 K, P_H2O = 0.5 bar, P_H2 = 0.05 bar → r_H2O ≈ 2.7e-3 s⁻¹
 // (stated to 2 digits; the exact value of the formula is checked to 1e-14).
 TEST(CharGasification, LangmuirHinshelwoodRates) {
   const k::CharGasificationParams p;
@@ -159,8 +159,8 @@ TEST(CharGasification, ParticleRatesConserveMass) {
 
 // ---- oxygen-carrier reduction ---------------------------------------------------------------
 
-// Conversion and rates; full-conversion times τ = ρ_m r_g/(b k_s Cⁿ) of PHYSICS §6.3 ("≈ 200 s
-// for CO and ≈ 35 s for H2" at 1223 K, C = 1 mol/m³, stated to ~2 digits → ±10 %).
+// Conversion and rates; full-conversion times τ = ρ_m r_g/(b k_s Cⁿ) of docs/physics.md §6.3 ("≈
+// 200 s for CO and ≈ 35 s for H2" at 1223 K, C = 1 mol/m³, stated to ~2 digits → ±10 %).
 TEST(OcReduction, RatesAndConversionTimes) {
   const k::OcReductionParams p;
   const double t = 1223.0;

@@ -1,4 +1,4 @@
-// Particle species/mass/diameter update (PHYSICS §4, Eqs. 31–32, removal §1.1) and the
+// Particle species/mass/diameter update (docs/physics.md §4, Eqs. 31–32, removal §1.1) and the
 // particle energy equation (Eq. 18, §3.5).
 #include <cmath>
 
@@ -48,7 +48,7 @@ TEST(ParticleSpecies, ShrinkingDiameterAndRemoval) {
 }
 
 // Mass → mole fractions and ideal-gas density: steam/N2 1:1 molar at 1173 K, 1 atm gives
-// ρ ≈ 0.239 kg/m³ (PHYSICS §7).
+// ρ ≈ 0.239 kg/m³ (docs/physics.md §7).
 TEST(ParticleSpecies, GasCompositionHelpers) {
   const double mH2O = k::molarMass(k::Species::H2O);
   const double mN2 = k::molarMass(k::Species::N2);

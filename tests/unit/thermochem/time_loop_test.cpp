@@ -1,6 +1,6 @@
 // Explicit time loops built from the kernels (the way the DEM server integrates Eq. 18 and
 // Eq. 31), compared with the analytic solutions: energy conservation of the pair terms and
-// the seed's accuracy targets (PHYSICS §8.1: relative error < 6e-4 %).
+// the seed's accuracy targets (docs/physics.md §8.1: relative error < 6e-4 %).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -86,7 +86,7 @@ TEST(TimeLoop, MfixContactConductionEulerMatchesAnalytic) {
 }
 
 // Seed variant d2 = 3.6 mm, δ = 4e-5 m (fastest exchange of the table), Δt = 1e-4 s, 50 s:
-// PHYSICS §8.1 acceptance relative error < 1e-4 %.
+// docs/physics.md §8.1 acceptance relative error < 1e-4 %.
 TEST(TimeLoop, SeedContactVariantEulerMatchesAnalytic) {
   const v::Material ma = v::musserMaterialA();
   const v::Material mb = v::musserMaterialB();

@@ -1,5 +1,5 @@
 // The analytic solutions of the verification suite (dem-gpu-server/.../verification/analytic.h)
-// vs the numbers of PHYSICS.md §8 and the MFiX reference files quoted there.
+// vs the numbers of docs/physics.md §8 and the MFiX reference files quoted there.
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -25,9 +25,9 @@ TEST(Verification, MusserPropertySet) {
 // MFiX-CC analytic column (§8.1): T_A(9.901 s) = 312.85412739, T_A(49.901) = 354.88198678,
 // T_B(49.901) = 430.48651583 K. The file's analytic column was evaluated with MFiX's own
 // rounded constants/times: our exact constants (A_C to 1e-10) reproduce it to 1.7e-6 K, not
-// the 1e-8 K PHYSICS §8.1 claims (refvalues.py gives the same 354.8819885 K) → tolerance
-// 2e-6 K. T_∞ = 408.9050 K in PHYSICS is computed from the rounded m C of §8.0 (408.90516 K
-// exactly) → tolerance 2e-4 K.
+// the 1e-8 K docs/physics.md §8.1 claims (the independent Python reference values gives the same
+// 354.8819885 K) → tolerance 2e-6 K. T_∞ = 408.9050 K in docs/physics.md is computed from the
+// rounded m C of §8.0 (408.90516 K exactly) → tolerance 2e-4 K.
 TEST(Verification, MfixContactConductionAnalytic) {
   const auto c = v::contactConductionCoefficients(
       3.0e-3, v::musserMaterialA(), 3.6e-3, v::musserMaterialB(), (0.4799731 - 0.1499864) * 1e-2);
@@ -35,7 +35,8 @@ TEST(Verification, MfixContactConductionAnalytic) {
   const auto t50 = v::twoParticleExchange(c.a, c.b, 298.15, 453.15, 49.901);
   EXPECT_NEAR(t50.t1, 354.88198678, 2e-6);
   EXPECT_NEAR(t50.t2, 430.48651583, 2e-6);
-  // refvalues.py at 49.901 s (same formula, exact constants): 354.8819884768602 K.
+  // the independent Python reference values at 49.901 s (same formula, exact constants):
+  // 354.8819884768602 K.
   EXPECT_NEAR(t50.t1, 354.8819884768602, 1e-10);
   EXPECT_NEAR(v::twoParticleEquilibrium(c.a, c.b, 298.15, 453.15), 408.9050, 2e-4);
   // t = 0 returns the initial state; t → ∞ the equilibrium; energy m C T is conserved.
@@ -61,7 +62,7 @@ TEST(Verification, MfixLensAnalytic) {
 }
 
 // §8.5 reaction: t_end = 1.499996 s, m(0.5) = 3.4361167353e-5, m(1.0) = 3.3379417353e-5,
-// m(≥1.5) = 3.2397674240e-5 kg, fractions (refvalues.py, 8 decimals).
+// m(≥1.5) = 3.2397674240e-5 kg, fractions (the independent Python reference values, 8 decimals).
 TEST(Verification, ReactionAnalytic) {
   const v::ReactionCase c = v::mfixReactionCase();
   EXPECT_NEAR(c.m0, 3.5342917353e-05, 5e-16);

@@ -1,7 +1,7 @@
 // Particle–wall conduction (kernels/wall_conduction.h): contact conductance against
 // Batchelor–O'Brien with r_c = √(R² − h²), the closed-form lens integral against an independent
 // long-double quadrature of its definition, and the wall as the limit of a very large sphere
-// in the particle–particle kernels (PHYSICS §3.2–3.3).
+// in the particle–particle kernels (docs/physics.md §3.2–3.3).
 #include <cmath>
 
 #include <gtest/gtest.h>

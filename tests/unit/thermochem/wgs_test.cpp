@@ -1,4 +1,4 @@
-// Homogeneous water–gas shift (PHYSICS §6.2): equilibrium consistency, sources, limiter.
+// Homogeneous water–gas shift (docs/physics.md §6.2): equilibrium consistency, sources, limiter.
 #include <cmath>
 #include <iterator>
 

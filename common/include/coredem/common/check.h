@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// User errors vs internal bugs (STYLE §2).
+/// User errors vs internal bugs.
 ///
 /// COREDEM_CHECK(cond, fmt, args...) is for anything a user, a case file or a peer can get
 /// wrong: it throws coredem::UserError with a formatted message that says what was wrong and

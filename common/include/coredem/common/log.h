@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// One named logger per component (STYLE §3): `auto log = coredem::logger("dem.server");`
+/// One named logger per component: `auto log = coredem::logger("dem.server");`
 /// Loggers print "[time] [name] [level] message" to stderr; the level comes from the
 /// COREDEM_LOG_LEVEL environment variable (trace|debug|info|warn|error|off, default info).
 

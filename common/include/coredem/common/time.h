@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Time arithmetic shared by the orchestrator and the DEM server (STYLE §9, PHYSICS §5), so
+/// Time arithmetic shared by the orchestrator and the DEM server (docs/physics.md §5), so
 /// both compute the same sub-cycling plan: n_sub = ceil(Δt_CFD/Δt_DEM,max) with a ratio
 /// within 1e-12 of an integer counted as that integer, and tolerant time comparisons.
 

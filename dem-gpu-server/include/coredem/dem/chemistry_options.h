@@ -1,11 +1,11 @@
 #pragma once
 /// @file
-/// Chemistry integrated in the DEM step (PHYSICS §3.5, §4, §6, §8.5; docs/thermochemistry.md):
-/// data-defined heterogeneous reactions, the built-in CLG set (R1, R2 char gasification; R4, R5
-/// oxygen-carrier reduction; R3 homogeneous water–gas shift per cell), shrinking particles and
-/// their removal. Plain data; filled from `Configure.reactions` / `Configure.chemistry`
-/// (case.yaml `reactions:` / `chemistry:`) by the server. Species are named by the gas and solid
-/// species lists of DemConfig.
+/// Chemistry integrated in the DEM step (docs/physics.md §3.5, §4, §6, §8.5;
+/// docs/thermochemistry.md): data-defined heterogeneous reactions, the built-in CLG set (R1, R2
+/// char gasification; R4, R5 oxygen-carrier reduction; R3 homogeneous water–gas shift per cell),
+/// shrinking particles and their removal. Plain data; filled from `Configure.reactions` /
+/// `Configure.chemistry` (case.yaml `reactions:` / `chemistry:`) by the server. Species are named
+/// by the gas and solid species lists of DemConfig.
 
 #include <cstdint>
 #include <string>
@@ -40,7 +40,7 @@ struct ReactionConfig {
   bool heatFromNasa7 = false;  ///< ΔH_r(T_p) from NASA-7 data (every species must have data)
 };
 
-/// The built-in coal-fuelled chemical-looping set (PHYSICS §6).
+/// The built-in coal-fuelled chemical-looping set (docs/physics.md §6).
 struct ClgOptions {
   bool charGasification = false; ///< R1 + R2: solid C; gas CO, CO2, H2, H2O
   bool ocReduction = false;      ///< R4 + R5: solid Fe2O3, Fe3O4; gas CO, CO2, H2, H2O

@@ -2,7 +2,7 @@
 /// @file
 /// The DEM core's public API: `coredem::dem::DemSystem`, built from a plain `DemConfig`.
 ///
-/// Typical use by the server (one CFD step, DESIGN §1):
+/// Typical use by the server (one CFD step, docs/architecture.md):
 /// @code
 ///   coredem::dem::DemSystem dem(config, coredem::dem::BackendKind::Auto, threads);
 ///   int nSub = coredem::dem::TimeHandler::subStepsFor(dtCfd, dem.dtDemMax());
@@ -40,7 +40,7 @@ bool cudaBackendBuilt();
 /// Number of visible CUDA devices (0 when the CUDA backend is not built or no GPU/driver).
 int cudaDeviceCount();
 
-/// Contact properties of one solid material (PHYSICS §2.1, Eqs. 9–13).
+/// Contact properties of one solid material (docs/physics.md §2.1, Eqs. 9–13).
 /// Pairs of different materials use k_n = 2 k_a k_b/(k_a+k_b), e_n = min(e_a, e_b),
 /// μ = min(μ_a, μ_b) [C]; particle–wall contacts use the particle's material with
 /// m_eff = m_i (the wall is rigid, immobile, and has the particle's properties).
@@ -134,9 +134,9 @@ struct DemConfig {
   std::vector<Species> gasSpecies;   ///< Y_g and R_species entries
   NeighbourOptions neighbour;
   kernels::DragLaw drag = kernels::DragLaw::Gidaspow; ///< `models: {drag: ...}` (kernels/drag.h)
-  double epsMinDrag = 0.35;                           ///< ε_min clip in drag (PHYSICS §1.1 [C])
-  double dtFactor = 50.0; ///< Δt_DEM,max = t_col,min / dtFactor (PHYSICS Eq. 12)
-  HeatOptions heat;       ///< particle heat transfer (docs/heat-coupling.md)
+  double epsMinDrag = 0.35; ///< ε_min clip in drag (docs/physics.md §1.1 [C])
+  double dtFactor = 50.0;   ///< Δt_DEM,max = t_col,min / dtFactor (docs/physics.md Eq. 12)
+  HeatOptions heat;         ///< particle heat transfer (docs/heat-coupling.md)
   /// Hold every particle in place (`models: {motion: frozen}`, as MFiX's verification cases do):
   /// forces, torques and gravity do not move it, positions stay fixed, velocities are zeroed
   /// every sub-step. Contacts and heat transfer are evaluated as usual; the collision time then
@@ -165,10 +165,11 @@ struct GasFieldsView {
   std::span<const double> Yg;     ///< Y_g, N*ns (-), species fastest
 };
 
-/// Per-cell sources for the CFD, averaged over the sub-steps of one advance() (PHYSICS §1.1).
-/// Heat: gas energy source −(H T_g − H_Tp) (W/m³), H = Σ h_i A_i/V_c, H_Tp = Σ h_i A_i T_p,i/V_c
-/// (docs/heat-coupling.md). Species: R_species = (1/V_c) Σ ṁ_gas,i (heterogeneous, averaged over
-/// the sub-steps) + WGS per cell; Q_hom: WGS heat into the gas (docs/thermochemistry.md).
+/// Per-cell sources for the CFD, averaged over the sub-steps of one advance() (docs/physics.md
+/// §1.1). Heat: gas energy source −(H T_g − H_Tp) (W/m³), H = Σ h_i A_i/V_c, H_Tp = Σ h_i A_i
+/// T_p,i/V_c (docs/heat-coupling.md). Species: R_species = (1/V_c) Σ ṁ_gas,i (heterogeneous,
+/// averaged over the sub-steps) + WGS per cell; Q_hom: WGS heat into the gas
+/// (docs/thermochemistry.md).
 struct CellSources {
   std::vector<double> epsG;     ///< ε_g (-), N
   std::vector<double> kSl;      ///< K_sl = (1/V_c) Σ β V_p/(1-ε) (kg/m³/s), N
@@ -221,7 +222,7 @@ public:
   DemSystem& operator=(const DemSystem&) = delete;
 
   /// Largest stable DEM step: min over present material pairs and walls of t_col / dtFactor
-  /// (PHYSICS Eq. 12 with Eq. 13 damping), using the lightest particle of each material.
+  /// (docs/physics.md Eq. 12 with Eq. 13 damping), using the lightest particle of each material.
   double dtDemMax() const;
 
   /// Copies the gas fields used (frozen) during the next advance() calls.

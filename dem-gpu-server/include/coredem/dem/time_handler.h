@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Sub-cycling time arithmetic (STYLE §9, PHYSICS §5): Δt_DEM·n_sub = Δt_CFD exactly and
+/// Sub-cycling time arithmetic (docs/physics.md §5): Δt_DEM·n_sub = Δt_CFD exactly and
 /// simulated time accumulated with Kahan (compensated) summation, so 10^6 tiny steps do
 /// not drift.
 

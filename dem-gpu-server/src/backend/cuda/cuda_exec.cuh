@@ -14,7 +14,7 @@
 #include <cstdint>
 #include <string>
 
-/// Wraps every CUDA runtime call (STYLE §7): throws with file:line and a hint.
+/// Wraps every CUDA runtime call: throws with file:line and a hint.
 #define DEM_CUDA_CHECK(expr)                                                                   \
   do {                                                                                         \
     const cudaError_t demCudaErr_ = (expr);                                                    \

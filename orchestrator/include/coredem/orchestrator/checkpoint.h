@@ -1,8 +1,8 @@
 #pragma once
 /// @file
-/// Coordinated checkpoints (DESIGN §6, docs/session.md): layout of `checkpoints/<step>/`,
-/// the manifest written last (temp file + fsync + rename) with the SHA-256 of every file,
-/// verification, resume selection and pruning to the last K.
+/// Coordinated checkpoints (docs/orchestrator.md, docs/session.md): layout of
+/// `checkpoints/<step>/`, the manifest written last (temp file + fsync + rename) with the SHA-256
+/// of every file, verification, resume selection and pruning to the last K.
 
 #include <cstdint>
 #include <filesystem>

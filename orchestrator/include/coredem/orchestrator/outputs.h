@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Run outputs (DESIGN §6): timeseries.csv, particle snapshots indexed by an XDMF file that
-/// ParaView opens, and the summary printed by `coredem inspect`.
+/// Run outputs (docs/orchestrator.md): timeseries.csv, particle snapshots indexed by an XDMF file
+/// that ParaView opens, and the summary printed by `coredem inspect`.
 
 #include <cstdint>
 #include <filesystem>

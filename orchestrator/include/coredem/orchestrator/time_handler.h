@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Simulated time of a coupled run (STYLE §9, §10): compensated (Kahan) summation of the
+/// Simulated time of a coupled run: compensated (Kahan) summation of the
 /// granted Δt_CFD, window-end comparison with a tolerance, the Δt_CFD policy (fixed or
 /// CFL-adaptive within [dt_min, dt_max]) and the DEM sub-cycling plan.
 

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// `coredem verify` (docs/verification.md): runs the verification cases of
-/// cases/verification (PHYSICS §8) through the real processes, compares the particle histories
-/// of their snapshots with the analytic solutions (dem/verification/analytic.h, RK4 for
+/// cases/verification (docs/physics.md §8) through the real processes, compares the particle
+/// histories of their snapshots with the analytic solutions (dem/verification/analytic.h, RK4 for
 /// radiation), writes DIR/summary.json, one CSV per case and the plots, and prints a table.
 
 #include <filesystem>

@@ -249,7 +249,7 @@ void addNamedValue(google::protobuf::RepeatedPtrField<v1::NamedValue>* list, std
 std::optional<double> findNamedValue(const google::protobuf::RepeatedPtrField<v1::NamedValue>& list,
                                      std::string_view name);
 
-/// Material defaults of PHYSICS §2: k_t/k_n = 2/7 and eta_t/eta_n = 1/2 when unset.
+/// Material defaults of docs/physics.md §2: k_t/k_n = 2/7 and eta_t/eta_n = 1/2 when unset.
 double ktFactor(const v1::Material& material);
 double etatFactor(const v1::Material& material);
 

@@ -30,7 +30,7 @@
 /// Rules:
 /// * `Server::bind` refuses (ProtocolError SECURITY) a non-loopback endpoint (anything other
 ///   than tcp://127.x.x.x, tcp://localhost, tcp://[::1], ipc://, inproc://) unless CURVE keys
-///   are given in the options (DESIGN §1).
+///   are given in the options (docs/architecture.md).
 /// * Every wait has a deadline. ZeroMQ heartbeats (ZMQ_HEARTBEAT_IVL/TIMEOUT/TTL) detect dead
 ///   peers at the socket level; `Client::request` throws TimeoutError naming the endpoint and
 ///   the awaited reply when the deadline passes.

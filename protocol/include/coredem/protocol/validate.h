@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Validation of received messages (DESIGN §3). Call it on every message before using it;
+/// Validation of received messages (docs/protocol.md). Call it on every message before using it;
 /// on failure answer `makeError(status, seq, type)` and keep serving (state unchanged).
 ///
 /// @code

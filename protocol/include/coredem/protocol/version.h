@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Protocol version and the negotiation rule (DESIGN §3):
+/// Protocol version and the negotiation rule (docs/protocol.md):
 /// same major -> accept and use min(minor); different major -> reject naming both versions.
 
 #include <cstdint>

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Gravity body force — PHYSICS §2, Eq. 6: f_g = m_i g (N).
+/// Gravity body force — docs/physics.md §2, Eq. 6: f_g = m_i g (N).
 
 #include "coredem/dem/kernels/common.h"
 #include "coredem/dem/kernels/vec3.h"

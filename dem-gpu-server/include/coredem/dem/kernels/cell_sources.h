@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Cell sources for the CFD, accumulated over the DEM sub-steps and averaged — PHYSICS §1.1
+/// Cell sources for the CFD, accumulated over the DEM sub-steps and averaged — docs/physics.md §1.1
 /// and §5 [C] (MFiX explicit coupling): per sub-step s and cell c
 ///   V_s,c = Σ_{i∈c} V_p,i,   K_c = Σ_{i∈c} β_i V_p,i/(1−ε),   (K U)_c = Σ_{i∈c} β_i V_p,i/(1−ε)
 ///   v_i

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Char gasification R1 (C + CO2 → 2 CO) and R2 (C + H2O → CO + H2) for coal-fuelled
-/// chemical-looping gasification (PHYSICS §6.1; Langmuir–Hinshelwood, shrinking core).
+/// chemical-looping gasification (docs/physics.md §6.1; Langmuir–Hinshelwood, shrinking core).
 ///
 ///   r_CO2 = k_CO2 K_CO2 P_CO2 / (1 + K_CO2 P_CO2 + K_CO P_CO)      s⁻¹
 ///   r_H2O = k_H2O K_H2O P_H2O / (1 + K_H2O P_H2O + K_H2 P_H2)      s⁻¹
@@ -13,7 +13,7 @@
 ///   heat into the particle: Q = −ΔH_R1(T_p) ṅ_R1 − ΔH_R2(T_p) ṅ_R2  (NASA-7, §3.5)
 ///
 /// [C] pure-carbon char (the seed's pseudo-char stoichiometry is inconsistent, §6.1).
-/// Kinetic defaults are the [C]/[K] values of PHYSICS §6.1 (Yu et al.'s own values were not
+/// Kinetic defaults are the [C]/[K] values of docs/physics.md §6.1 (Yu et al.'s own values were not
 /// found): A = 1e7 s⁻¹, E_H2O = 210 kJ/mol, E_CO2 = 230 kJ/mol, K_H2O = K_CO2 = 1 bar⁻¹,
 /// K_H2 = K_CO = 10 bar⁻¹ (temperature independent).
 

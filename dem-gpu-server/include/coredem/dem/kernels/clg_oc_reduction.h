@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// Oxygen-carrier reduction R4 (3 Fe2O3 + CO → 2 Fe3O4 + CO2) and R5 (3 Fe2O3 + H2 →
-/// 2 Fe3O4 + H2O) (PHYSICS §6.3; grain / shrinking-core model, reaction control, Abad et al.
-/// 2007 form).
+/// 2 Fe3O4 + H2O) (docs/physics.md §6.3; grain / shrinking-core model, reaction control, Abad et
+/// al. 2007 form).
 ///
 ///   m_eq = m (X_Fe2O3 + X_Fe3O4 · 3 M_Fe2O3/(2 M_Fe3O4))    Fe2O3-equivalent mass (conserved)
 ///   ξ    = 1 − m X_Fe2O3 / m_eq                               conversion
@@ -13,9 +13,9 @@
 ///   gas:    ṁ_CO = −M_CO ṅ_R4, ṁ_CO2 = M_CO2 ṅ_R4, ṁ_H2 = −M_H2 ṅ_R5, ṁ_H2O = M_H2O ṅ_R5
 ///   heat into the particle: Q = −ΔH_R4(T_p) ṅ_R4 − ΔH_R5(T_p) ṅ_R5
 ///
-/// The seed's prefactor R0/(2 M_O2) is replaced by the mass-balance form above (PHYSICS §0.3).
-/// Defaults: ρ_m = 32811 mol/m³, r_g = 2.6e-7 m (IDAES, citing Abad 2007); CO: k0 = 1e-4 m/s,
-/// E = 20 kJ/mol, n = 1; H2: k0 = 9e-4 mol^(1−n) m^(3n−2)/s, E = 24 kJ/mol, n = 0.8 ([K], to
+/// The seed's prefactor R0/(2 M_O2) is replaced by the mass-balance form above (docs/physics.md
+/// §0.3). Defaults: ρ_m = 32811 mol/m³, r_g = 2.6e-7 m (IDAES, citing Abad 2007); CO: k0 = 1e-4
+/// m/s, E = 20 kJ/mol, n = 1; H2: k0 = 9e-4 mol^(1−n) m^(3n−2)/s, E = 24 kJ/mol, n = 0.8 ([K], to
 /// verify).
 
 #include <cmath>

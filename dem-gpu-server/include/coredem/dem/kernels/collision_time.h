@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// LSD collision time — PHYSICS §2.1, seed Eq. 12 (MFiX check_solids_dem.f):
+/// LSD collision time — docs/physics.md §2.1, seed Eq. 12 (MFiX check_solids_dem.f):
 ///   t_col = π / √( k_n/m_eff − η_n²/(4 m_eff²) )        (s)
 /// With η_n from Eq. 13 this equals √(m_eff/k_n)·√(π² + ln² e_n); Δt_DEM = t_col,min / 50.
 

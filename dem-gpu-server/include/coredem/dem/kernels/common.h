@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// The one qualifier macro for physics kernels shared by the CPU and CUDA backends
-/// (STYLE §4–5): `DEM_HD` is `__host__ __device__` under nvcc and `inline` otherwise, so
+///: `DEM_HD` is `__host__ __device__` under nvcc and `inline` otherwise, so
 /// the CPU backend and the GPU backend run the exact same expressions.
 
 #if defined(__CUDACC__)

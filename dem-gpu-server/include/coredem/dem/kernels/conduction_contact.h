@@ -1,13 +1,13 @@
 #pragma once
 /// @file
-/// Particle–particle contact conduction (PHYSICS §3.2, seed Eqs. 22–23; Batchelor & O'Brien
+/// Particle–particle contact conduction (docs/physics.md §3.2, seed Eqs. 22–23; Batchelor & O'Brien
 /// 1977 as modified in MFiX `des_thermo_cond.f`).
 ///
 ///   (22) Q_pp,ij = 4 k_i k_j/(k_i + k_j) · r_c,ij · (T_j − T_i)     W, heat into i, if l < R_i+R_j
 ///   (23) r_c,ij  = √( R_L² − ((R_L² − R_S² + l²)/(2 l))² )          m, radius of the circle in
 ///                  which the two sphere surfaces intersect (symmetric in i, j)
 ///
-/// The errata of PHYSICS §0.3 apply: the factor is 4 (not 2), and the sign is (T_j − T_i).
+/// The errata of docs/physics.md §0.3 apply: the factor is 4 (not 2), and the sign is (T_j − T_i).
 ///
 /// Exact antisymmetry: the conductance G_ij is computed from expressions that are bitwise
 /// symmetric in (i, j) (products/sums of the two k's, sorted radii), so

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Particle–fluid–particle conduction through a gas "lens" (PHYSICS §3.3, seed Eqs. 24–26;
+/// Particle–fluid–particle conduction through a gas "lens" (docs/physics.md §3.3, seed Eqs. 24–26;
 /// Rong & Horio 1999 as modified in MFiX `des_thermo_cond.f`).
 ///
 ///   (24) Q_pfp,ij = κ_g (T_j − T_i) I,   I = ∫_{R_in}^{R_out} 2π r dr / max(gap(r), s_min)

@@ -2,7 +2,7 @@
 /// @file
 /// Globally adaptive Gauss–Kronrod (G7/K15) quadrature usable in DEM_HD code: no recursion,
 /// no heap, a fixed-capacity interval list on the stack. Used by the gas-lens conduction
-/// integral (PHYSICS §3.3 [C]: "adaptive Simpson or Gauss–Kronrod with a relative tolerance
+/// integral (docs/physics.md §3.3 [C]: "adaptive Simpson or Gauss–Kronrod with a relative tolerance
 /// ≤ 1e-8").
 ///
 /// Algorithm (QUADPACK QAG style): keep a list of sub-intervals with their K15 estimate and

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Particle–gas convective heat transfer (PHYSICS §3.1, seed Eqs. 19–21).
+/// Particle–gas convective heat transfer (docs/physics.md §3.1, seed Eqs. 19–21).
 ///
 ///   (19) Q_gp,i = h_i A_p,i (T_g − T_p,i),   A_p,i = π d_p,i²      W, gas → particle
 ///   (20) h_i    = Nu_i κ_g / d_p,i                                   W/(m² K)
@@ -10,12 +10,13 @@
 ///        Nu = 2 + 4.5e-5 εⁿ Re^1.8                                 Re ≥ 1500
 ///   Ranz–Marshall (MFiX `des_thermo_conv.f`, option): Nu = 2 + 0.6 Re^0.5 Pr^(1/3)
 ///   Pr = μ_g C_p,g / κ_g.
-///   Re_p = ε ρ_g d_p |u_g − v_p| / μ_g (default, same Re as the Gidaspow drag, PHYSICS §3.1 [C])
+///   Re_p = ε ρ_g d_p |u_g − v_p| / μ_g (default, same Re as the Gidaspow drag, docs/physics.md
+///   §3.1 [C])
 ///        or ρ_g d_p |u_g − v_p| / μ_g (reynoldsWithVoidage = false, Kratos form).
-///   ε is clipped below at epsMin (PHYSICS §1.1 [C], 0.35) in the Nusselt evaluation.
+///   ε is clipped below at epsMin (docs/physics.md §1.1 [C], 0.35) in the Nusselt evaluation.
 ///
-/// Coupling split (DESIGN §1): per particle the conductance G_i = h_i A_p,i (W/K). The gas
-/// energy equation receives −Q_gp,c = −(H_c T_g − (H T_p)_c) with
+/// Coupling split (docs/architecture.md): per particle the conductance G_i = h_i A_p,i (W/K). The
+/// gas energy equation receives −Q_gp,c = −(H_c T_g − (H T_p)_c) with
 ///   H_c = Σ_{i∈c} G_i / V_c  (W/(m³ K), implicit coefficient on T_g)
 ///   (H T_p)_c = Σ_{i∈c} G_i T_p,i / V_c  (W/m³, explicit part),
 /// which equals (1/V_c) Σ Q_gp,i exactly when T_g is the cell value (PCM).

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Normal damping coefficient from the restitution coefficient — PHYSICS §2.1, seed Eq. 13
+/// Normal damping coefficient from the restitution coefficient — docs/physics.md §2.1, seed Eq. 13
 /// (MFiX check_solids_dem.f):
 ///   η_n = 2 √(k_n m_eff) |ln e_n| / √(π² + ln² e_n)      (e_n = 0 → η_n = 2 √(k_n m_eff))
 /// Units: k_n N/m, m_eff kg → η_n kg/s. m_eff = m_i m_j/(m_i+m_j), wall: m_eff = m_i.

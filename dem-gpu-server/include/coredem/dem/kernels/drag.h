@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Drag-law dispatch (PHYSICS §2.2): the engine calls particleDragCoefficient() with the law
-/// chosen by `models: {drag: ...}` (registry: coredem/dem/models.h). Adding a drag law: its
+/// Drag-law dispatch (docs/physics.md §2.2): the engine calls particleDragCoefficient() with the
+/// law chosen by `models: {drag: ...}` (registry: coredem/dem/models.h). Adding a drag law: its
 /// kernel header (one function returning β V_p/(1−ε) in kg/s), an enumerator and a case here,
 /// one registry row in models.cpp, its test (docs/architecture.md).
 

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Gidaspow drag (Ergun for ε ≤ 0.8, Wen–Yu above) — PHYSICS §2.2, seed Eqs. 14–17
+/// Gidaspow drag (Ergun for ε ≤ 0.8, Wen–Yu above) — docs/physics.md §2.2, seed Eqs. 14–17
 /// (MFiX drag_gs.f, des/drag_gp_des.f):
 ///   Re_p = ε ρ_g d_p |u_g − v| / μ_g
 ///   ε ≤ 0.8:  β = 150 (1−ε)² μ_g/(ε d_p²) + 1.75 (1−ε) ρ_g |Δu|/d_p
@@ -17,7 +17,7 @@
 namespace coredem::dem::kernels {
 
 struct GidaspowParams {
-  double epsMin = 0.35;   ///< ε clip (PHYSICS §1.1 [C])
+  double epsMin = 0.35;   ///< ε clip (docs/physics.md §1.1 [C])
   double epsSwitch = 0.8; ///< Ergun / Wen–Yu switch
 };
 

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Linear spring–dashpot (LSD) contact, normal + tangential with accumulated tangential
-/// displacement and the Coulomb limit in the MFiX form — PHYSICS §2.1, seed Eqs. 7–10
+/// displacement and the Coulomb limit in the MFiX form — docs/physics.md §2.1, seed Eqs. 7–10
 /// (MFiX calc_force_dem.f).
 ///
 /// Conventions: n = (x_j − x_i)/|x_j − x_i| points from i to j; δ_n = R_i + R_j − |x_j − x_i|

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// NASA 7-coefficient thermodynamic polynomials (PHYSICS.md §3.5, Appendix A) for the
+/// NASA 7-coefficient thermodynamic polynomials (docs/physics.md §3.5, Appendix A) for the
 /// species of the CLG model, plus consistent molar masses.
 ///
 ///   C_p/R  = a1 + a2 T + a3 T² + a4 T³ + a5 T⁴
@@ -8,7 +8,7 @@
 ///   S/R    = a1 ln T + a2 T + a3 T²/2 + a4 T³/3 + a5 T⁴/4 + a7       (p° = 1 bar)
 ///
 /// Coefficients: Burcat's database as shipped with MFiX (`model/thermochemical/BURCAT.THR`),
-/// transcribed in PHYSICS.md Appendix A. Units: T in K, molar quantities per mol, SI.
+/// transcribed in docs/physics.md Appendix A. Units: T in K, molar quantities per mol, SI.
 ///
 /// Interval choice: the interval [tMin, tMax) that contains T; at a break point the upper
 /// interval is used (same as reference/nasa.py for the two-range species). Outside the data
@@ -55,8 +55,8 @@ struct Nasa7Data {
 };
 
 /// Atomic masses (kg/mol, IUPAC conventional values). [C] Molar masses are built from these
-/// so that every reaction balances to round-off; they agree with PHYSICS §6 to ≤ 2e-6 kg/mol
-/// (Fe2O3 159.687 vs 159.688, Fe3O4 231.531 vs 231.533 g/mol; the rounded table values do
+/// so that every reaction balances to round-off; they agree with docs/physics.md §6 to ≤ 2e-6
+/// kg/mol (Fe2O3 159.687 vs 159.688, Fe3O4 231.531 vs 231.533 g/mol; the rounded table values do
 /// not balance R4/R5 by 1e-3 g/mol).
 inline constexpr double kAtomC = 12.011e-3;
 inline constexpr double kAtomH = 1.008e-3;
@@ -94,7 +94,7 @@ DEM_HD constexpr double molarMass(GasSpecies g) {
   return molarMass(toSpecies(g));
 }
 
-/// Coefficient table (PHYSICS Appendix A; Burcat/MFiX).
+/// Coefficient table (docs/physics.md Appendix A; Burcat/MFiX).
 // clang-format off
 DEM_HD constexpr Nasa7Data nasa7Data(Species s) {
   switch (s) {

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Particle energy equation (PHYSICS §3, seed Eq. 18) and the heat of heterogeneous
+/// Particle energy equation (docs/physics.md §3, seed Eq. 18) and the heat of heterogeneous
 /// reactions (§3.5). Particles are isothermal (lumped, Bi ≪ 1).
 ///
 ///   (18) m_i C_p,i dT_p,i/dt = Σ_j Q_pp,ij + Σ_j Q_pfp,ij + Q_gp,i + Q_rad,i + Q_rxn,i

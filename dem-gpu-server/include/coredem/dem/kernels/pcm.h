@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Particle centroid method (PCM) on a uniform Cartesian coupling grid — PHYSICS §1.1, seed
+/// Particle centroid method (PCM) on a uniform Cartesian coupling grid — docs/physics.md §1.1, seed
 /// Eq. 5: a particle belongs entirely to the cell that holds its centre;
 ///   ε_g,c = 1 − (1/V_c) Σ_{i∈c} V_p,i.
 /// Cells are numbered c = i + nx (j + ny k); O(1) lookup.

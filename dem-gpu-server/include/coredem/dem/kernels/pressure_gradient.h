@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Pressure-gradient force — PHYSICS §2, Eq. 6 ("Model A", §1): f_∇p = −V_p ∇p (N), with
+/// Pressure-gradient force — docs/physics.md §2, Eq. 6 ("Model A", §1): f_∇p = −V_p ∇p (N), with
 /// ∇p the value of the particle's coupling cell (PCM) and V_p = π d_p³/6.
 
 #include "coredem/dem/kernels/common.h"

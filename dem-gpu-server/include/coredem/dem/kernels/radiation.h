@@ -1,12 +1,12 @@
 #pragma once
 /// @file
-/// Particle radiation with a continuum environment temperature (PHYSICS §3.4, seed Eqs. 27–28;
-/// Zhou, Yu & Zulli 2009).
+/// Particle radiation with a continuum environment temperature (docs/physics.md §3.4, seed Eqs.
+/// 27–28; Zhou, Yu & Zulli 2009).
 ///
 ///   (27) Q_rad,i = e_p,i σ A_p,i (T_env,i⁴ − T_p,i⁴),   A_p,i = π d_p,i²       W, into i
 ///   (28) T_env,i = ε_g,Ω T_g,Ω + (1 − ε_g,Ω) T̄_p,Ω
 ///
-/// Two definitions of T̄_p,Ω (PHYSICS §3.4):
+/// Two definitions of T̄_p,Ω (docs/physics.md §3.4):
 ///  (a) CellMeanIncludingSelf (MFiX `des_thermo_rad.f`): arithmetic mean of all particles whose
 ///      centroid is in the CFD cell of i, including i. The DEM step uses this one (heat.h).
 ///  (b) NeighbourMeanExcludingSelf (Zhou/Kratos, literal seed Eq. 28): mean over the neighbours

@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Reaction stoichiometry over the NASA-7 species, heats of reaction (PHYSICS §3.5,
+/// Reaction stoichiometry over the NASA-7 species, heats of reaction (docs/physics.md §3.5,
 /// Eqs. 29–30) and equilibrium constants, and the CLG reaction set R1–R5 (§6).
 ///
 ///   ΔH_r(T) = Σ_products ν_n H_n(T) − Σ_reactants ν_n H_n(T)    J per mol of reaction (29)
@@ -24,7 +24,7 @@ struct Stoichiometry {
   double nu[kMaxStoichTerms];
 };
 
-/// The CLG reactions (PHYSICS §6, seed Table 1). [C] R1/R2 use pure-carbon char.
+/// The CLG reactions (docs/physics.md §6, seed Table 1). [C] R1/R2 use pure-carbon char.
 enum class ClgReaction : int {
   R1 = 0, ///< C + CO2 → 2 CO                (char–CO2 gasification)
   R2,     ///< C + H2O → CO + H2             (char–steam gasification)

@@ -2,7 +2,7 @@
 /// @file
 /// A heterogeneous (gas–particle) reaction defined by data: stoichiometry, molar masses and a
 /// constant or Arrhenius rate. Used by the reactive-chemistry verification case
-/// (PHYSICS §8.5: A(g) + 2B(s) → C(g) + D(s), ω = 3.927e-4 mol/s while X_B > 0) and by any
+/// (docs/physics.md §8.5: A(g) + 2B(s) → C(g) + D(s), ω = 3.927e-4 mol/s while X_B > 0) and by any
 /// case that declares its own reactions.
 ///
 ///   extent rate (mol of reaction per s, per particle):

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Particle mass, species mass fractions and size (PHYSICS §4, seed Eqs. 31–32), the removal
-/// criterion (§1.1), and gas-composition helpers used by the reaction kernels.
+/// Particle mass, species mass fractions and size (docs/physics.md §4, seed Eqs. 31–32), the
+/// removal criterion (§1.1), and gas-composition helpers used by the reaction kernels.
 ///
 ///   (31) dm_i/dt = Σ_{n∈solids} ṁ_sn,i,   d(X_sn,i m_i)/dt = ṁ_sn,i     (kg/s)
 ///   (32) d_p,i = (6 m_i / (π ρ_p,i))^(1/3),  ρ_p,i constant (shrinking particle)

@@ -1,7 +1,7 @@
 #pragma once
 /// @file
-/// Particle–wall conduction with a flat wall held at a fixed temperature T_w: PHYSICS §3.2–3.3
-/// in the wall limit (the partner sphere becomes a half-space of the wall material) [C].
+/// Particle–wall conduction with a flat wall held at a fixed temperature T_w: docs/physics.md
+/// §3.2–3.3 in the wall limit (the partner sphere becomes a half-space of the wall material) [C].
 ///
 /// Geometry: particle radius R, centre at distance h from the wall plane (overlap δ = R − h).
 ///

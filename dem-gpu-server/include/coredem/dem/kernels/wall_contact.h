@@ -1,6 +1,6 @@
 #pragma once
 /// @file
-/// Particle–wall contact with an infinite rigid plane (PHYSICS §2, Eq. 8 with j → wall,
+/// Particle–wall contact with an infinite rigid plane (docs/physics.md §2, Eq. 8 with j → wall,
 /// m_eff = m_i): the same LSD law as lsd_contact.h with the wall immobile. An axis-aligned
 /// box is its six planes (normals pointing inwards).
 ///   overlap δ_n = R − (x − p)·n̂_w,  contact normal (i → wall) n = −n̂_w,

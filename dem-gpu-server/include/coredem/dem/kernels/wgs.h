@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Homogeneous water–gas shift R3, CO + H2O ⇌ CO2 + H2, evaluated per CFD cell by the DEM
-/// server (PHYSICS §6.2, §1) and returned as species and heat sources.
+/// server (docs/physics.md §6.2, §1) and returned as species and heat sources.
 ///
 ///   ω = ε_g k_f(T) [C_CO C_H2O − C_CO2 C_H2 / K_eq(T)]     mol/(m³ of cell · s), C_j = ρ_g Y_j/M_j
 ///   k_f = 2.78e-3 exp(−1510/T) m³/(mol s)   (Yoon, Wei & Denn 1978 / Gururajan 1992 [K])
@@ -9,7 +9,7 @@
 ///                 Thermodynamic exp(−ΔG°/(RT)) from the NASA-7 data (exactly consistent).
 ///   R_n = M_n ν_n ω  (kg/(m³ s));  S_h,rxn,g = −ΔH_R3(T_g) ω  (W/m³)
 ///
-/// The seed's extracted rate is not equilibrium-consistent (PHYSICS §0.3); this form is.
+/// The seed's extracted rate is not equilibrium-consistent (docs/physics.md §0.3); this form is.
 /// ω already contains ε_g: do not multiply by ε_g again (§1).
 
 #include <cmath>

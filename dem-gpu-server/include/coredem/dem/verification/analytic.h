@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Analytic and reference solutions for the thermochemistry verification suite
-/// (PHYSICS.md §8; seed Section 3; MFiX `legacy_tests/dem-tests`, Musser 2011 property set).
+/// (docs/physics.md §8; seed Section 3; MFiX `legacy_tests/dem-tests`, Musser 2011 property set).
 /// Host-only helpers (they use std::vector); the physics comes from the DEM_HD kernels, so the
 /// reference and the simulation share the sub-model formulas but not the time integration.
 ///
@@ -28,7 +28,7 @@
 
 namespace coredem::dem::verification {
 
-/// Unit conversions of the CGS MFiX inputs (PHYSICS §8.0).
+/// Unit conversions of the CGS MFiX inputs (docs/physics.md §8.0).
 inline constexpr double kCalPerSCmKToWPerMK = 418.4; ///< cal/(s cm K) → W/(m K)
 inline constexpr double kCalPerGKToJPerKgK = 4184.0; ///< cal/(g K) → J/(kg K)
 
@@ -296,8 +296,8 @@ inline ReactionState reactionAnalytic(const ReactionCase& c, double t) {
 }
 
 /// Shrinking core with a constant rate coefficient k (s⁻¹): dξ/dt = k (1 − ξ)^(2/3) gives
-/// 1 − ξ(t) = (1 − k t/3)³ for t < 3/k and 0 afterwards (PHYSICS §6.1 char with constant gas,
-/// §6.3 grain model with constant gas). For pure-carbon char, 1 − ξ = m_C/m_C0 and the
+/// 1 − ξ(t) = (1 − k t/3)³ for t < 3/k and 0 afterwards (docs/physics.md §6.1 char with constant
+/// gas, §6.3 grain model with constant gas). For pure-carbon char, 1 − ξ = m_C/m_C0 and the
 /// diameter of a constant-density particle is d0 (1 − k t/3).
 inline double shrinkingCoreUnreacted(double k, double t) {
   const double s = 1.0 - k * t / 3.0;
