@@ -20,6 +20,15 @@ void fsyncPath(const fs::path& p, bool directory) {
   ::close(fd);
 }
 
+void syncFile(const fs::path& p) {
+  const int fd = ::open(p.c_str(), O_RDONLY);
+  COREDEM_CHECK(fd >= 0, "cannot open {} to flush it: {}", p.string(), std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int err = errno;
+  ::close(fd);
+  COREDEM_CHECK(rc == 0, "fsync of {} failed: {}", p.string(), std::strerror(err));
+}
+
 void writeFileAtomic(const fs::path& path, const std::string& content) {
   const fs::path tmp =
       path.parent_path() / (path.filename().string() + ".tmp." + std::to_string(::getpid()));

@@ -84,8 +84,8 @@ public:
   bool enabled() const { return _h.enabled; }
 
   std::size_t bytes() const {
-    return _mat.bytes() + _q.bytes() + _g.bytes() + _qrad.bytes() + _cellT.bytes() +
-           _lensI.bytes() + _acc.bytes() + _walls.bytes() + _qw.bytes() + _wallAcc.bytes();
+    return _mat.bytes() + _q.bytes() + _g.bytes() + _qrad.bytes() + _cellT.bytes() + _acc.bytes() +
+           _walls.bytes() + _qw.bytes() + _wallAcc.bytes();
   }
 
   /// Heat the particles received since construction (or the restored totals).
@@ -182,34 +182,11 @@ public:
       _qw.reserve(n);
     double* qwOut = nWalls > 0 ? _qw.d() : nullptr;
 
-    // 2. Lens integrals, once per pair: the particle with the smaller global id evaluates the
-    //    pair (canonical order) and stores I in its neighbour slot; the partner reads it there.
-    double* li = nullptr;
-    if (lens) {
-      _lensI.reserve(n * static_cast<std::size_t>(M));
-      li = _lensI.d();
-      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
-        using namespace kernels;
-        const long long ii = static_cast<long long>(i);
-        const int nb = cnt[i];
-        for (int a = 0; a < nb; ++a) {
-          const std::int32_t j = list[i * M + a];
-          double value = 0.0;
-          if (gid[i] < gid[j]) {
-            const Vec3 d = load3(x, j) - load3(x, ii);
-            const double l2 = dot(d, d);
-            const double big = r[i] > r[j] ? r[i] : r[j];
-            const double small = r[i] > r[j] ? r[j] : r[i];
-            const double reach = lensFactor * big + small;
-            if (l2 < reach * reach)
-              value = gasLensIntegral(lp, r[i], r[j], ::sqrt(l2)).value;
-          }
-          li[i * M + a] = value;
-        }
-      });
-    }
-
-    // 3. Per-particle heat rate.
+    // 2. Per-particle heat rate. Pair terms are evaluated in the canonical order (lo, hi) by
+    //    global id, so both sides compute bitwise the same conductance: Q_ij = −Q_ji exactly.
+    //    The gas-lens integral (closed form) is evaluated on both sides instead of being stored
+    //    per neighbour slot: +10 % instructions in the coupled heat step, but 8·M bytes less per
+    //    particle (1,090 → 962 B on the packed deck: within 1 KiB) and no partner-slot search.
     exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
       const long long ii = static_cast<long long>(i);
@@ -256,18 +233,7 @@ public:
             else if (chi < nCells)
               kg = kap[chi];
             if (kg > 0.0) {
-              double lensIntegral = 0.0;
-              if (iFirst) {
-                lensIntegral = li[i * M + a];
-              } else { // the partner's slot that holds i (the lists are symmetric)
-                const int nbj = cnt[j];
-                for (int b = 0; b < nbj; ++b) {
-                  if (list[static_cast<std::size_t>(j) * M + b] == static_cast<std::int32_t>(i)) {
-                    lensIntegral = li[static_cast<std::size_t>(j) * M + b];
-                    break;
-                  }
-                }
-              }
+              const double lensIntegral = gasLensIntegral(lp, rlo, rhi, l).value;
               const double qab = kg * lensIntegral * dT;
               ql += iFirst ? qab : -qab;
             }
@@ -408,7 +374,6 @@ private:
   Dual<HeatMaterial> _mat;
   Dev<double> _q, _g, _qrad; ///< per particle: Q_i (W), G_i (W/K), Q_rad,i (W)
   Dev<double> _cellT;        ///< per cell: Σ T_p (radiation environment)
-  Dev<double> _lensI;        ///< per neighbour slot: lens integral I (m), owner = smaller gid
   Dual<double> _acc;         ///< per cell: Σ_sub H, Σ_sub H_Tp, Σ_sub Q_rad/V_c
   Dual<ThermalWall> _walls;  ///< fixed-temperature walls
   Dev<double> _qw;           ///< per particle: Q_wall,i (W)

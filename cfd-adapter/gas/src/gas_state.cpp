@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "coredem/common/check.h"
+#include "coredem/common/files.h"
 #include "coredem/common/hdf5.h"
 #include "coredem/common/version.h"
 
@@ -36,9 +37,7 @@ void writeGasState(const std::string& path, const GasState& s) {
     h5::writeStrings(led, "names", s.names);
     H5Fflush(file, H5F_SCOPE_GLOBAL);
   }
-  const int fd = ::open(tmp.c_str(), O_RDONLY);
-  COREDEM_CHECK(fd >= 0 && ::fsync(fd) == 0, "cannot flush {} to disk", tmp);
-  ::close(fd);
+  coredem::syncFile(tmp);
   std::filesystem::rename(tmp, path);
 }
 

@@ -17,6 +17,7 @@
 #include "admission.h"
 #include "configure_map.h"
 #include "coredem/common/check.h"
+#include "coredem/common/files.h"
 #include "coredem/common/log.h"
 #include "coredem/dem/dem_system.h"
 #include "coredem/dem/time_handler.h"
@@ -107,14 +108,6 @@ proto::TransportOptions transportOptions(const ServerOptions& o) {
 }
 
 /// Flushes a written file to disk before it is renamed into place.
-void syncFile(const fs::path& p) {
-  const int fd = ::open(p.c_str(), O_RDONLY);
-  COREDEM_CHECK(fd >= 0, "cannot open {} to flush it", p.string());
-  const int rc = ::fsync(fd);
-  ::close(fd);
-  COREDEM_CHECK(rc == 0, "fsync of {} failed", p.string());
-}
-
 struct Grant {
   proto::PeerId peer;
   std::uint64_t sequence = 0;

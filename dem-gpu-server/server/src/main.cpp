@@ -11,6 +11,7 @@
 
 #include "admission.h"
 #include "coredem/common/check.h"
+#include "coredem/common/files.h"
 #include "coredem/common/log.h"
 #include "coredem/server/dem_server.h"
 
@@ -33,13 +34,7 @@ extern "C" void onSignal(int sig) {
 }
 
 void writeEndpointFile(const std::string& path, const std::string& endpoint) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    COREDEM_CHECK(out.good(), "cannot write the endpoint file {}", tmp);
-    out << endpoint << "\n";
-  }
-  std::filesystem::rename(tmp, path);
+  coredem::writeFileAtomic(path, endpoint + "\n");
 }
 
 } // namespace

@@ -2,13 +2,13 @@
 #include "timers.h"
 
 #include <filesystem>
-#include <fstream>
 #include <utility>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "coredem/common/check.h"
+#include "coredem/common/files.h"
 #include "coredem/common/json.h"
 
 namespace coredem::server {
@@ -124,21 +124,12 @@ std::string timersJson(const ExchangeTimes& x, const dem::StageTimes& st, double
 }
 
 void writeTextFile(const std::string& path, const std::string& text) {
-  namespace fs = std::filesystem;
-  const fs::path p(path);
+  const std::filesystem::path p(path);
   if (p.has_parent_path()) {
     std::error_code ec;
-    fs::create_directories(p.parent_path(), ec);
+    std::filesystem::create_directories(p.parent_path(), ec);
   }
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    COREDEM_CHECK(out.good(), "cannot write the timers file {}: check --timers-file and its folder",
-                  tmp);
-    out << text;
-    COREDEM_CHECK(out.good(), "writing {} failed (disk full?)", tmp);
-  }
-  fs::rename(tmp, p);
+  coredem::writeFileAtomic(p, text);
 }
 
 } // namespace coredem::server

@@ -33,7 +33,8 @@ std::string timersReport(const ExchangeTimes& x, const dem::StageTimes& st, doub
 /// The same figures as one JSON object.
 std::string timersJson(const ExchangeTimes& x, const dem::StageTimes& st, double sessionSeconds,
                        const std::string& session, const std::string& backend, int threads);
-/// Writes `text` to `path` (temporary file + rename). Throws coredem::UserError on failure.
+/// Writes `text` to `path` atomically (coredem::writeFileAtomic), creating its folder.
+/// Throws coredem::UserError on failure.
 void writeTextFile(const std::string& path, const std::string& text);
 
 } // namespace coredem::server

@@ -15,4 +15,8 @@ void writeFileAtomic(const std::filesystem::path& path, const std::string& conte
 /// fsync of a file or (directory = true) a folder; best effort (some file systems refuse it).
 void fsyncPath(const std::filesystem::path& p, bool directory);
 
+/// fsync of a file written by another library (e.g. HDF5) before it is renamed into place;
+/// throws UserError naming the file when it cannot be flushed.
+void syncFile(const std::filesystem::path& p);
+
 } // namespace coredem
