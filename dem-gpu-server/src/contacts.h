@@ -4,13 +4,12 @@
 /// LSD with tangential history), written once for every backend like engine_impl.h.
 ///
 /// Each pair is evaluated once, by its owner: the particle with the smaller global id (gid), a
-/// choice that survives re-sorting. At every neighbour rebuild the full neighbour lists give
-/// the half lists in CSR form (`_halfStart`, `_half`: each particle's owned candidates, gid of
-/// the partner larger, in ascending index order). Per sub-step, no atomics:
+/// choice that survives re-sorting, over the engine's half and low lists (pair_lists.h). Per
+/// sub-step, no atomics:
 ///   pass 1 (per owner i): every owned candidate in contact is evaluated with the LSD law; the
 ///     owner adds f and L_ij n × f_t to its own force and torque, keeps δ_t in its history
-///     slots, and writes the partner's share (−f is implied; L_ji n × f_t) to the per-candidate
-///     buffers `_pf`, `_ptq`; then its walls;
+///     slots, and writes the partner's share (−f is implied; L_ji n × f_t) to the pair lists'
+///     per-candidate scratch; then its walls;
 ///   pass 2 (per particle j): adds the partner shares of the contacts it does not own, in the
 ///     ascending index order of its neighbour list (a fixed order).
 /// Both passes write only their own index, so the result does not depend on the thread count.
@@ -31,6 +30,7 @@
 #include "coredem/dem/kernels/lsd_contact.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_contact.h"
+#include "pair_lists.h"
 #include "step_module.h"
 
 namespace coredem::dem {
@@ -60,10 +60,7 @@ public:
   }
 
   bool enabled() const { return true; }
-  std::size_t bytes() const {
-    return _pairs.bytes() + _walls.bytes() + _count.bytes() + _halfStart.bytes() + _half.bytes() +
-           _lowStart.bytes() + _low.bytes() + _hit.bytes() + _pf.bytes() + _ptq.bytes();
-  }
+  std::size_t bytes() const { return _pairs.bytes() + _walls.bytes() + _hit.bytes(); }
   ContactTotals totals() const { return {}; }
 
   /// History slots in use in some row (slots at or beyond it are empty everywhere); the
@@ -71,94 +68,17 @@ public:
   int usedSlots() const { return _maxUsedSlots; }
   /// After new particles: every slot may be in use.
   void resetUsedSlots(int slots) { _maxUsedSlots = slots; }
-  /// The neighbour lists or the particle order changed: the half lists are rebuilt before the
-  /// next sources().
-  void neighboursChanged() { _halfValid = false; }
 
   void beginWindow(StepContext<Exec>&) {}
   void update(StepContext<Exec>&) {}
   void endWindow(WindowContext<Exec>&) {}
 
-  /// Half lists (CSR) from the full neighbour lists: reads gid, nbCount, nbList.
-  void buildHalfLists(Exec& exec, ParticleStore<Exec>& p) {
-    const std::size_t n = p.n;
-    const int M = p.M;
-    const std::int64_t* gid = p.gid.d();
-    const std::int32_t* cnt = p.nbCount.d();
-    const std::int32_t* list = p.nbList.d();
-    _count.reserve(n + 1);
-    _halfStart.reserve(n + 1);
-    std::uint32_t* c = _count.d();
-    exec.parallelFor(n + 1, [=] DEM_LAMBDA(std::size_t i) {
-      std::uint32_t owned = 0;
-      if (i < n) {
-        for (int a = 0; a < cnt[i]; ++a)
-          owned += gid[list[i * M + a]] > gid[i] ? 1u : 0u;
-      }
-      c[i] = owned;
-    });
-    std::uint32_t* hs = _halfStart.d();
-    exec.exclusiveScan(c, hs, n + 1);
-    std::uint32_t total = 0;
-    Exec::copyToHost(&total, hs + n, sizeof(total));
-    _half.reserve(total);
-    _pf.reserve(3 * static_cast<std::size_t>(total));
-    _ptq.reserve(3 * static_cast<std::size_t>(total));
-    std::int32_t* half = _half.d();
-    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
-      std::uint32_t k = hs[i];
-      for (int a = 0; a < cnt[i]; ++a) {
-        const std::int32_t j = list[i * M + a];
-        if (gid[j] > gid[i])
-          half[k++] = j;
-      }
-    });
-    // Low lists: for each particle, the position in its partner's half list of every
-    // candidate the partner owns, in neighbour-list order (the lists are symmetric).
-    exec.parallelFor(n + 1, [=] DEM_LAMBDA(std::size_t i) {
-      c[i] = i < n ? static_cast<std::uint32_t>(cnt[i]) - (hs[i + 1] - hs[i]) : 0u;
-    });
-    _lowStart.reserve(n + 1);
-    std::uint32_t* ls = _lowStart.d();
-    exec.exclusiveScan(c, ls, n + 1);
-    std::uint32_t lowTotal = 0;
-    Exec::copyToHost(&lowTotal, ls + n, sizeof(lowTotal));
-    _low.reserve(lowTotal);
-    _hit.reserve(total);
-    std::uint32_t* low = _low.d();
-    const double missing = exec.reduceMax(
-        n,
-        [=] DEM_LAMBDA(std::size_t i) {
-          std::uint32_t k = ls[i];
-          double miss = 0.0;
-          for (int a = 0; a < cnt[i]; ++a) {
-            const std::int32_t j = list[i * M + a];
-            if (gid[j] > gid[i])
-              continue;
-            std::uint32_t at = hs[j];
-            while (at < hs[j + 1] && half[at] != static_cast<std::int32_t>(i))
-              ++at;
-            if (at == hs[j + 1])
-              miss = 1.0;
-            low[k++] = at;
-          }
-          return miss;
-        },
-        0.0);
-    if (missing > 0.0 || lowTotal != total) {
-      backend::raiseUserError("the neighbour lists are not symmetric (a state file edited by "
-                              "hand?); set /meta@neighbour_list_valid = 0 to rebuild them");
-    }
-    _halfValid = true;
-  }
-
-  /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, the half and low
-  /// lists (built from nbCount, nbList after a rebuild) (+ the gas force of the drag module in
-  /// coupled runs); writes force, torque, fwall, histKey, histDisp, contacts, wallContacts.
+  /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, the pair lists
+  /// (+ the gas force of the drag module in coupled runs); writes force, torque, fwall, histKey,
+  /// histDisp, contacts, wallContacts.
   void sources(StepContext<Exec>& ctx) {
     ParticleStore<Exec>& p = ctx.particles;
-    if (!_halfValid)
-      buildHalfLists(ctx.exec, p);
+    PairLists<Exec>& pl = ctx.pairs;
     const double dt = ctx.dt;
     const std::size_t n = p.n;
     const double* x = p.pos.d();
@@ -175,13 +95,15 @@ public:
     double* fw = p.fwall.d();
     std::int32_t* nc = p.contacts.d();
     std::int32_t* nwc = p.wallContacts.d();
-    const std::uint32_t* hs = _halfStart.d();
-    const std::int32_t* half = _half.d();
-    const std::uint32_t* ls = _lowStart.d();
-    const std::uint32_t* low = _low.d();
+    const std::uint32_t* hs = pl.halfStart();
+    const std::int32_t* half = pl.half();
+    const std::uint32_t* ls = pl.lowStart();
+    const std::uint32_t* low = pl.low();
+    _hit.reserve(pl.candidates());
     unsigned char* hit = _hit.d();
-    double* pf = _pf.d();
-    double* ptq = _ptq.d();
+    // Partner shares in the shared scratch: force (3 values), then torque (3), per candidate.
+    static_assert(PairLists<Exec>::kScratchWidth >= 6);
+    double* share = pl.scratch();
     const PairProps* pairs = _pairs.d();
     const kernels::PlaneWall* walls = _walls.d();
     const int nWalls = static_cast<int>(ctx.setup.walls.size());
@@ -257,8 +179,8 @@ public:
             T += res.torque;
             remember(key, res.deltaT);
             // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
-            store3(pf, static_cast<long long>(q), res.force);
-            store3(ptq, static_cast<long long>(q), lji * res.nxft);
+            store3(share, 2 * static_cast<long long>(q), res.force);
+            store3(share, 2 * static_cast<long long>(q) + 1, lji * res.nxft);
             ++owned;
           }
           // Walls (m_eff = m_i, the particle's material).
@@ -305,8 +227,8 @@ public:
             const long long q = low[k];
             if (!hit[q])
               continue;
-            F += -load3(pf, q);
-            T += load3(ptq, q);
+            F += -load3(share, 2 * q);
+            T += load3(share, 2 * q + 1);
             ++pairCount;
           }
           store3(f, ii, F);
@@ -354,15 +276,7 @@ public:
 private:
   Dual<PairProps> _pairs;
   Dual<kernels::PlaneWall> _walls;
-  Dev<std::uint32_t> _count;     ///< owned candidates per particle (scan input), n + 1
-  Dev<std::uint32_t> _halfStart; ///< CSR offsets of the half lists, n + 1
-  Dev<std::int32_t> _half;       ///< owned candidates (partner index), ascending per particle
-  Dev<std::uint32_t> _lowStart;  ///< CSR offsets of the low lists, n + 1
-  Dev<std::uint32_t> _low;       ///< per candidate a partner owns: its index in the half lists
-  Dev<unsigned char> _hit;       ///< per candidate: in contact this sub-step (pass 1)
-  Dev<double> _pf;               ///< per candidate: force on the owner f (N), 3 values
-  Dev<double> _ptq;              ///< per candidate: torque on the partner L_ji n × f_t (N m), 3
-  bool _halfValid = false;
+  Dev<unsigned char> _hit; ///< per candidate: in contact this sub-step (pass 1)
   int _maxUsedSlots =
       kMaxHistorySlots; ///< max contacts of a particle in the last sub-step (≥ slots in use)
 };

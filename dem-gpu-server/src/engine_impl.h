@@ -2,9 +2,9 @@
 /// @file
 /// The DEM engine, written once and instantiated per backend (cpu: backend/cpu/cpu_engine.cpp,
 /// cuda: backend/cuda/cuda_engine.cu). All loops are Exec::parallelFor over particles or
-/// cells; each index writes only its own outputs (no atomics; contacts.h evaluates each pair
-/// once, by its owner, and gathers the partner's share in a fixed order), so results are
-/// deterministic and independent of the thread count.
+/// cells; each index writes only its own outputs (no atomics; contacts.h and heat.h evaluate each
+/// pair once, by its owner, and gather the partner's share in a fixed order: pair_lists.h), so
+/// results are deterministic and independent of the thread count.
 ///
 /// The engine owns the particles, the neighbour lists and the coupling-cell binning
 /// (coupling_cells.h) and drives the sub-step modules through one interface (step_module.h):
@@ -41,6 +41,7 @@
 #include "engine.h"
 #include "gas_fields.h"
 #include "heat.h"
+#include "pair_lists.h"
 #include "particle_store.h"
 #include "step_module.h"
 
@@ -92,7 +93,7 @@ public:
     });
     _p.toDevice(kAllFields);
     _contacts.resetUsedSlots(_p.K);
-    _contacts.neighboursChanged();
+    _pairLists.invalidate();
     _listValid = s.listValid != 0;
     reserveScratch();
   }
@@ -148,8 +149,8 @@ public:
   std::size_t memoryBytes() const override {
     auto& self = const_cast<EngineImpl&>(*this);
     return self._p.bytes() + _keys.bytes() + _perm.bytes() + _cellStart.bytes() + _cellEnd.bytes() +
-           _scratch.bytes() + _cells.bytes() + _drag.bytes() + _contacts.bytes() + _heat.bytes() +
-           _chem.bytes() + _gas.bytes();
+           _scratch.bytes() + _cells.bytes() + _pairLists.bytes() + _drag.bytes() +
+           _contacts.bytes() + _heat.bytes() + _chem.bytes() + _gas.bytes();
   }
 
   // ---------------------------------------------------------------- neighbour search
@@ -349,7 +350,7 @@ public:
     const double* x = _p.pos.d();
     _exec.parallelFor(3 * n, [=] DEM_LAMBDA(std::size_t k) { xr[k] = x[k]; });
     _p.produced(kAllFields);
-    _contacts.neighboursChanged(); // half lists follow the new order and lists
+    _pairLists.invalidate(); // half and low lists follow the new order and lists
     _listValid = true;
     ++_t.rebuilds;
   }
@@ -357,7 +358,7 @@ public:
   // ---------------------------------------------------------------- window and sub-step
   /// What the modules see this sub-step (dt = 0 at the window boundaries).
   StepContext<Exec> stepContext(double dt) {
-    return StepContext<Exec>{_exec, _p, _s, gasOrNull(), _cells, dt};
+    return StepContext<Exec>{_exec, _p, _s, gasOrNull(), _cells, _pairLists, dt};
   }
   const GasFields<Exec>* gasOrNull() const { return _hasGas && _s.coupled ? &_gas : nullptr; }
 
@@ -466,8 +467,10 @@ public:
     if (_p.n == 0)
       return;
     auto t0 = Clock::now();
-    if (!_listValid) {
-      rebuild();
+    if (!_listValid || !_pairLists.valid()) {
+      if (!_listValid)
+        rebuild();
+      _pairLists.ensure(_exec, _p);
       Exec::synchronize();
       auto t1 = Clock::now();
       _t.neighbour += std::chrono::duration<double>(t1 - t0).count();
@@ -509,6 +512,7 @@ private:
   GasFields<Exec> _gas; ///< per-cell gas fields of the CFD step, read by the modules
   bool _hasGas = false;
   CouplingCells<Exec> _cells; ///< PCM cell binning and frozen ε_g, read by the modules
+  PairLists<Exec> _pairLists; ///< half and low lists of the neighbour lists (pair_lists.h)
   Dev<std::uint32_t> _keys, _perm, _cellStart, _cellEnd; ///< neighbour search
   Dev<unsigned char> _scratch;
   bool _listValid = false;

@@ -4,9 +4,10 @@
 /// written once for every backend like engine_impl.h. Per sub-step, after the contact forces and
 /// the drag deposition (which leaves the particles sorted by PCM cell):
 ///   1. cell means of T_p for the radiation environment (§3.4 (a), including the particle)
-///   2. per particle (full neighbour list, gather, no atomics): contact conduction (Eqs. 22–23)
-///      and gas-lens conduction (Eqs. 24–26) over the neighbours, convection with the gas of
-///      its PCM cell (Eqs. 19–21), radiation (Eqs. 27–28); the sum Q_i (W) is stored
+///   2. pair terms once per pair by its owner over the half lists, the partner's share gathered
+///      in a fixed order (pair_lists.h, no atomics): contact conduction (Eqs. 22–23) and gas-lens
+///      conduction (Eqs. 24–26); then per particle convection with the gas of its PCM cell
+///      (Eqs. 19–21) and radiation (Eqs. 27–28); the sum Q_i (W) is stored
 ///   3. per cell: H = Σ G_i/V_c, H_Tp = Σ G_i T_i/V_c (G_i = h_i A_i) and Σ Q_rad,i, added to
 ///      the window accumulators (averaged over the sub-steps at the window end)
 ///   4. after the motion update: T_i += Δt Q_i/(m_i c_p,i) (explicit Euler, Eq. 18)
@@ -17,10 +18,9 @@
 /// (start of the sub-step), as MFiX does (CALC_THERMO_DES before CFNEWVALUES), so that the
 /// neighbour list is exact for them and they share the PCM cells of the drag deposition.
 ///
-/// Pair terms: each particle evaluates each of its pairs with the arguments in canonical
-/// order (smaller global id first), so both particles of a pair compute bitwise the same
-/// conductance G_ab and temperature difference T_b − T_a and add ±G_ab (T_b − T_a):
-/// Q_ab = −Q_ba exactly on every backend, whatever the evaluation order or FMA contraction.
+/// Pair terms: the owner (smaller global id, the canonical first argument of the pair kernels)
+/// evaluates G_ab (T_b − T_a) once and its partner subtracts the stored value: Q_ab = −Q_ba
+/// exactly on every backend, whatever the evaluation order or FMA contraction.
 
 #include <cstdint>
 #include <vector>
@@ -36,6 +36,7 @@
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_conduction.h"
 #include "heat_setup.h"
+#include "pair_lists.h"
 #include "step_module.h"
 
 namespace coredem::dem {
@@ -104,7 +105,7 @@ public:
 
   /// Heat sources of one sub-step. When coupled, the particles are sorted by PCM cell
   /// (ctx.cells) as the drag module leaves them.
-  /// Reads pos, vel, radius, temperature, material, gid, nbCount, nbList; writes _q, _g, _qrad,
+  /// Reads pos, vel, radius, temperature, material, the pair lists; writes _q, _g, _qrad,
   /// _acc.
   void sources(StepContext<Exec>& ctx) {
     if (!_h.enabled)
@@ -156,10 +157,6 @@ public:
     const double* v = p.vel.d();
     const double* r = p.radius.d();
     const std::int32_t* mat = p.material.d();
-    const std::int64_t* gid = p.gid.d();
-    const std::int32_t* cnt = p.nbCount.d();
-    const std::int32_t* list = p.nbList.d();
-    const int M = p.M;
     const HeatMaterial* hm = _mat.d();
     const double* tg = hasTg ? gasFields->Tg.d() : nullptr;
     const double* kap = hasKappa ? gasFields->kappaG.d() : nullptr;
@@ -182,62 +179,88 @@ public:
       _qw.reserve(n);
     double* qwOut = nWalls > 0 ? _qw.d() : nullptr;
 
-    // 2. Per-particle heat rate. Pair terms are evaluated in the canonical order (lo, hi) by
-    //    global id, so both sides compute bitwise the same conductance: Q_ij = −Q_ji exactly.
-    //    The gas-lens integral (closed form) is evaluated on both sides instead of being stored
-    //    per neighbour slot: +10 % instructions in the coupled heat step, but 8·M bytes less per
-    //    particle (1,090 → 962 B on the packed deck: within 1 KiB) and no partner-slot search.
+    // 2a. Pair terms, each pair once by its owner (the smaller global id, which is also the
+    //     canonical "lo" of the pair kernels) over the half lists (pair_lists.h): the owner
+    //     keeps +Q_ab (heat into lo = G (T_hi − T_lo)) and writes it to the per-candidate
+    //     scratch (contact, lens), 0 when the pair is out of reach. Q_ab = −Q_ba exactly.
+    PairLists<Exec>& pl = ctx.pairs;
+    const std::uint32_t* hs = pl.halfStart();
+    const std::int32_t* half = pl.half();
+    const std::uint32_t* ls = pl.lowStart();
+    const std::uint32_t* low = pl.low();
+    static_assert(PairLists<Exec>::kScratchWidth >= 2);
+    double* share = pl.scratch(); // per candidate: Q_ab contact, Q_ab lens (W)
+    double* qOwn = _q.d();        // owner's pair sums, contact and lens: _q and _g until 2b
+    double* lOwn = _g.d();
+    if (contact || lens) {
+      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+        using namespace kernels;
+        const long long lo = static_cast<long long>(i);
+        const Vec3 xlo = load3(x, lo);
+        const double rlo = r[lo];
+        const double tlo = T[lo];
+        const double klo = hm[mat[lo]].k;
+        const std::uint32_t clo = lens ? pcell[lo] : nCells;
+        double qc = 0.0, ql = 0.0;
+        const std::uint32_t qEnd = hs[i + 1];
+        for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
+          const long long hi = half[q];
+          double qcab = 0.0, qlab = 0.0;
+          const Vec3 d = load3(x, hi) - xlo;
+          const double l2 = dot(d, d);
+          const double rhi = r[hi];
+          const double big = rlo > rhi ? rlo : rhi;
+          const double small = rlo > rhi ? rhi : rlo;
+          const double reach = lens ? lensFactor * big + small : rlo + rhi;
+          if (l2 < reach * reach) {
+            const double l = ::sqrt(l2);
+            const double dT = T[hi] - tlo; // heat into lo = G (T_hi − T_lo)
+            if (contact && l < rlo + rhi) {
+              const double khi = hm[mat[hi]].k;
+              if (klo + khi > 0.0)
+                qcab = contactConductance(klo, khi, rlo, rhi, l) * dT;
+            }
+            if (lens) {
+              // κ_g of the pair: mean of the two PCM cells (a particle outside the grid uses
+              // the other's; both outside: no lens) [C].
+              const std::uint32_t chi = pcell[hi];
+              double kg = 0.0;
+              if (clo < nCells && chi < nCells)
+                kg = 0.5 * (kap[clo] + kap[chi]);
+              else if (clo < nCells)
+                kg = kap[clo];
+              else if (chi < nCells)
+                kg = kap[chi];
+              if (kg > 0.0)
+                qlab = kg * gasLensIntegral(lp, rlo, rhi, l).value * dT;
+            }
+          }
+          qc += qcab;
+          ql += qlab;
+          share[2 * q] = qcab;
+          share[2 * q + 1] = qlab;
+        }
+        qOwn[i] = qc;
+        lOwn[i] = ql;
+      });
+    }
+
+    // 2b. Per-particle heat rate: the pair sums of 2a plus −Q_ab of the pairs the partners own
+    //     (low lists, fixed order), convection with the gas of the PCM cell, radiation, walls.
     exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
       const long long ii = static_cast<long long>(i);
       const double ti = T[i];
       const HeatMaterial mi = hm[mat[i]];
-      const std::int64_t gi = gid[i];
       const std::uint32_t celli = coupled ? pcell[i] : nCells;
       ParticleHeatSources src;
       if (contact || lens) {
-        double qc = 0.0, ql = 0.0;
-        const int nb = cnt[i];
-        for (int a = 0; a < nb; ++a) {
-          const std::int32_t j = list[i * M + a];
-          // Canonical order: (lo, hi) by global id.
-          const bool iFirst = gi < gid[j];
-          const long long lo = iFirst ? ii : static_cast<long long>(j);
-          const long long hi = iFirst ? static_cast<long long>(j) : ii;
-          const Vec3 d = load3(x, hi) - load3(x, lo);
-          const double l2 = dot(d, d);
-          const double rlo = r[lo], rhi = r[hi];
-          const double big = rlo > rhi ? rlo : rhi;
-          const double small = rlo > rhi ? rhi : rlo;
-          const double reach = lens ? lensFactor * big + small : rlo + rhi;
-          if (!(l2 < reach * reach))
-            continue;
-          const double l = ::sqrt(l2);
-          const double dT = T[hi] - T[lo]; // heat into lo = G (T_hi − T_lo)
-          if (contact && l < rlo + rhi) {
-            const double klo = hm[mat[lo]].k, khi = hm[mat[hi]].k;
-            if (klo + khi > 0.0) {
-              const double qab = contactConductance(klo, khi, rlo, rhi, l) * dT;
-              qc += iFirst ? qab : -qab;
-            }
-          }
-          if (lens) {
-            // κ_g of the pair: mean of the two PCM cells (a particle outside the grid uses
-            // the other's; both outside: no lens) [C].
-            const std::uint32_t clo = pcell[lo], chi = pcell[hi];
-            double kg = 0.0;
-            if (clo < nCells && chi < nCells)
-              kg = 0.5 * (kap[clo] + kap[chi]);
-            else if (clo < nCells)
-              kg = kap[clo];
-            else if (chi < nCells)
-              kg = kap[chi];
-            if (kg > 0.0) {
-              const double lensIntegral = gasLensIntegral(lp, rlo, rhi, l).value;
-              const double qab = kg * lensIntegral * dT;
-              ql += iFirst ? qab : -qab;
-            }
-          }
+        double qc = qOwn[i], ql = lOwn[i];
+        const std::uint32_t kEnd = ls[i + 1];
+        for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
+          const std::uint32_t q = low[k];
+          qc -= share[2 * q];
+          ql -= share[2 * q + 1];
         }
         src.contactConduction = qc;
         src.lensConduction = ql;

@@ -19,6 +19,7 @@
 #include "coupling_cells.h"
 #include "engine.h"
 #include "gas_fields.h"
+#include "pair_lists.h"
 #include "particle_store.h"
 
 namespace coredem::dem {
@@ -34,6 +35,8 @@ struct StepContext {
   /// PCM cell of every particle, the particles sorted by cell and ε_g frozen at the window
   /// start (coupling_cells.h); unused without a coupling grid.
   CouplingCells<Exec>& cells;
+  /// Half and low pair lists of the current neighbour lists (pair_lists.h); valid in sources().
+  PairLists<Exec>& pairs;
   double dt; ///< sub-step length Δt_DEM (s)
 };
 
