@@ -35,6 +35,9 @@
 
 namespace coredem::dem {
 
+/// Particles ahead whose history rows pass 1 prefetches (CPU; a hint only).
+constexpr std::size_t kPrefetchAhead = 8;
+
 /// The contact module has no ledger (counts and wall forces are read from the particles).
 struct ContactTotals {};
 
@@ -73,12 +76,45 @@ public:
   void update(StepContext<Exec>&) {}
   void endWindow(WindowContext<Exec>&) {}
 
+  /// Wall candidates per particle, a bit per wall (all bits beyond 32 walls), from the positions
+  /// of the last neighbour build (xref): a particle moves at most skin/2 from xref before the
+  /// next build, so one whose gap to a wall at xref is at least skin/2 cannot touch it until
+  /// then (radii only shrink). Rebuilt with the pair lists; reads xref, radius.
+  void buildWallCandidates(StepContext<Exec>& ctx) {
+    ParticleStore<Exec>& p = ctx.particles;
+    _wallNear.reserve(p.n);
+    std::uint32_t* near = _wallNear.d();
+    const double* xr = p.xref.d();
+    const double* r = p.radius.d();
+    const kernels::PlaneWall* walls = _walls.d();
+    const int nWalls = static_cast<int>(ctx.setup.walls.size());
+    const double halfSkin = 0.5 * ctx.setup.skin;
+    ctx.exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
+      std::uint32_t bits = 0;
+      if (nWalls > 32) {
+        bits = 0xffffffffu;
+      } else {
+        const kernels::Vec3 xi = kernels::load3(xr, static_cast<long long>(i));
+        for (int k = 0; k < nWalls; ++k) {
+          // Not "≥ skin/2 away" (also catches NaN): a candidate.
+          if (!(-kernels::wallOverlap(walls[k], xi, r[i]) >= halfSkin))
+            bits |= 1u << k;
+        }
+      }
+      near[i] = bits;
+    });
+    _wallGeneration = ctx.pairs.generation();
+  }
+
   /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, the pair lists
   /// (+ the gas force of the drag module in coupled runs); writes force, torque, fwall, histKey,
   /// histDisp, contacts, wallContacts.
   void sources(StepContext<Exec>& ctx) {
     ParticleStore<Exec>& p = ctx.particles;
     PairLists<Exec>& pl = ctx.pairs;
+    if (_wallGeneration != pl.generation())
+      buildWallCandidates(ctx);
+    const std::uint32_t* wallNear = _wallNear.d();
     const double dt = ctx.dt;
     const std::size_t n = p.n;
     const double* x = p.pos.d();
@@ -125,6 +161,14 @@ public:
           const double ri = r[i];
           const double mi = m[i];
           const int ai = mat[i];
+          // The history rows of the few particles in contact are scattered through memory:
+          // ask for those of a particle kPrefetchAhead further on while this one computes.
+          if (i + kPrefetchAhead < n && nc[i + kPrefetchAhead] + nwc[i + kPrefetchAhead] > 0) {
+            const std::size_t a = (i + kPrefetchAhead) * static_cast<std::size_t>(K);
+            backend::prefetch(hk + a);
+            backend::prefetch(hd + 3 * a);
+            backend::prefetch(hd + 3 * a + 8);
+          }
           // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
           // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
           const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
@@ -164,14 +208,15 @@ public:
             if (!touching)
               continue;
             const double l = ::sqrt(l2);
-            const Vec3 nrm = (1.0 / l) * d;
+            const double invL = 1.0 / l;
+            const Vec3 nrm = invL * d;
             const double deltaN = rsum - l;
             const PairProps pp = pairs[ai * nMat + mat[j]];
             const double meff = effectiveMass(mi, m[j]);
             const double etan = pp.dampFactor * ::sqrt(pp.kn * meff);
             const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-            const double lij = leverArm(l, ri, rj);
-            const double lji = leverArm(l, rj, ri);
+            const double lij = leverArmInv(l, invL, ri, rj);
+            const double lji = leverArmInv(l, invL, rj, ri);
             const Vec3 vij = relativeVelocity(vi, load3(v, j), wi, load3(w, j), lij, lji, nrm);
             const std::int64_t key = gid[j];
             const LsdResult res = lsdContact(lp, nrm, deltaN, vij, lij, history(key), dt);
@@ -186,7 +231,10 @@ public:
           // Walls (m_eff = m_i, the particle's material).
           Vec3 FW{0.0, 0.0, 0.0};
           int wallCount = 0;
+          const std::uint32_t nearBits = wallNear[i];
           for (int k = 0; k < nWalls; ++k) {
+            if (k < 32 && !(nearBits & (1u << k)))
+              continue;
             const double deltaN = wallOverlap(walls[k], xi, ri);
             if (deltaN <= 0.0)
               continue;
@@ -276,7 +324,9 @@ public:
 private:
   Dual<PairProps> _pairs;
   Dual<kernels::PlaneWall> _walls;
-  Dev<unsigned char> _hit; ///< per candidate: in contact this sub-step (pass 1)
+  Dev<unsigned char> _hit;      ///< per candidate: in contact this sub-step (pass 1)
+  Dev<std::uint32_t> _wallNear; ///< per particle: wall candidates (buildWallCandidates)
+  std::uint64_t _wallGeneration = ~std::uint64_t{0}; ///< pair-list build of _wallNear
   int _maxUsedSlots =
       kMaxHistorySlots; ///< max contacts of a particle in the last sub-step (≥ slots in use)
 };

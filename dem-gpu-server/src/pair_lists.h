@@ -51,6 +51,9 @@ public:
            _scratch.bytes();
   }
 
+  /// Counts the builds: a module that derives data from the lists rebuilds it when this changes.
+  std::uint64_t generation() const { return _generation; }
+
   /// Owned candidates in all half lists.
   std::uint32_t candidates() const { return _total; }
 
@@ -129,6 +132,7 @@ public:
     }
     _total = total;
     _valid = true;
+    ++_generation;
   }
 
 private:
@@ -139,6 +143,7 @@ private:
   Dev<std::uint32_t> _low;       ///< per candidate a partner owns: its index in the half lists
   Dev<double> _scratch;          ///< kScratchWidth doubles per candidate, shared (see above)
   std::uint32_t _total = 0;
+  std::uint64_t _generation = 0;
   bool _valid = false;
 };
 

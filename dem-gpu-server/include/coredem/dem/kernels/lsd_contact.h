@@ -46,6 +46,12 @@ DEM_HD double leverArm(double l, double ri, double rj) {
   return 0.5 * l + (ri * ri - rj * rj) / (2.0 * l);
 }
 
+/// leverArm with 1/l already known (no division); mirror-exact as leverArm is:
+/// leverArmInv(l, 1/l, rj, ri) uses the negated difference of the same squares.
+DEM_HD double leverArmInv(double l, double invL, double ri, double rj) {
+  return 0.5 * l + (ri * ri - rj * rj) * (0.5 * invL);
+}
+
 /// Eqs. 9–10 and 7. @pre deltaN > 0, |n| = 1, p.kt > 0.
 DEM_HD LsdResult lsdContact(const LsdParams& p, Vec3 n, double deltaN, Vec3 vij, double lij,
                             Vec3 deltaTOld, double dt) {
