@@ -274,3 +274,84 @@ TEST(ContactPairs, StatesWithBothSidesOfTheHistoryContinueBitwise) {
   }
   expectBitwiseEqual(out[0], out[1]);
 }
+
+// Wall candidates are taken from the last neighbour build (contacts.h, buildWallCandidates):
+// particles flying at walls from every side, from gaps just below and just above skin/2, with
+// stale neighbour lists from a state file, must feel each wall in exactly the sub-steps in which
+// a brute-force check over every wall finds an overlap.
+TEST(ContactPairs, WallCandidatesMissNoContact) {
+  EngineSetup s = denseSetup(1);
+  const double L = 10.0 * kDiameter;
+  s.walls = {kernels::PlaneWall{Vec3{0, 0, 0}, Vec3{1, 0, 0}},
+             kernels::PlaneWall{Vec3{L, 0, 0}, Vec3{-1, 0, 0}},
+             kernels::PlaneWall{Vec3{0, 0, 0}, Vec3{0, 1, 0}},
+             kernels::PlaneWall{Vec3{0, L, 0}, Vec3{0, -1, 0}},
+             kernels::PlaneWall{Vec3{0, 0, 0}, Vec3{0, 0, 1}},
+             kernels::PlaneWall{Vec3{0, 0, L}, Vec3{0, 0, -1}}};
+  HostState st;
+  st.historySlots = kSlots;
+  st.neighbourSlots = 32;
+  const double r = 0.5 * kDiameter;
+  const double halfSkin = 0.5 * s.skin;
+  // One particle per wall and per starting gap, spread along the wall, heading at it at 0.3 m/s.
+  int k = 0;
+  for (int w = 0; w < 6; ++w) {
+    for (const double gap : {0.3 * halfSkin, 0.54 * halfSkin, 0.9 * halfSkin, 0.999 * halfSkin,
+                             1.001 * halfSkin, 1.5 * halfSkin, 3.0 * halfSkin}) {
+      const int axis = w / 2;
+      const bool low = w % 2 == 0;
+      double x[3] = {0.5 * L, 0.5 * L, 0.5 * L};
+      x[(axis + 1) % 3] = (1.5 + 1.2 * (k % 7)) * kDiameter; // apart from each other
+      x[(axis + 2) % 3] = (1.5 + 1.1 * (k / 7)) * kDiameter;
+      x[axis] = low ? r + gap : L - r - gap;
+      double v[3] = {0.0, 0.0, 0.0};
+      v[axis] = low ? -0.3 : 0.3;
+      for (int d = 0; d < 3; ++d) {
+        st.pos.push_back(x[d]);
+        st.vel.push_back(v[d]);
+        st.omega.push_back(0.0);
+      }
+      st.radius.push_back(r);
+      st.density.push_back(2500.0);
+      st.mass.push_back(2500.0 * 4.0 / 3.0 * kPi * r * r * r);
+      st.temperature.push_back(300.0);
+      st.material.push_back(0);
+      st.gid.push_back(k);
+      ++k;
+    }
+  }
+  st.n = static_cast<std::size_t>(k);
+  fillDefaults(st);
+  // xref half a skin behind the positions: as if the particles had moved since the last build.
+  st.xref = st.pos;
+  for (std::size_t i = 0; i < st.n; ++i)
+    for (int d = 0; d < 3; ++d)
+      st.xref[3 * i + d] -= 0.45 * halfSkin *
+                            (st.vel[3 * i + d] > 0   ? 1
+                             : st.vel[3 * i + d] < 0 ? -1
+                                                     : 0);
+  checkShapes(st, "wall approach");
+
+  for (const bool staleList : {false, true}) {
+    auto engine = makeCpuEngine(s);
+    HostState start = st;
+    start.listValid = staleList ? 1 : 0;
+    if (staleList) { // every list empty (no particle within reach of another): valid as such
+      start.nbCount.assign(start.n, 0);
+    }
+    engine->setState(start);
+    const double dt = 1e-6;
+    std::size_t touched = 0;
+    for (int step = 0; step < 400; ++step) {
+      const HostState before = engine->state();
+      std::size_t expected = 0;
+      for (std::size_t i = 0; i < before.n; ++i)
+        for (const auto& w : s.walls)
+          expected += kernels::wallOverlap(w, at(before.pos, i), before.radius[i]) > 0.0 ? 1 : 0;
+      engine->subStep(dt);
+      ASSERT_EQ(engine->wallContacts(), expected) << "sub-step " << step << " stale=" << staleList;
+      touched += expected;
+    }
+    EXPECT_GT(touched, 0u); // the particles did reach the walls
+  }
+}
