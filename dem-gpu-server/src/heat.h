@@ -86,7 +86,7 @@ public:
 
   std::size_t bytes() const {
     return _mat.bytes() + _q.bytes() + _g.bytes() + _qrad.bytes() + _cellT.bytes() + _acc.bytes() +
-           _walls.bytes() + _qw.bytes() + _wallAcc.bytes();
+           _walls.bytes() + _qw.bytes() + _wallAcc.bytes() + _convFactors.bytes();
   }
 
   /// Heat the particles received since construction (or the restored totals).
@@ -101,6 +101,25 @@ public:
     double* acc = _acc.d();
     ctx.exec.parallelFor(3 * nCells, [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
     _acc.markDeviceModified();
+    // The Nusselt factors of every cell (ε frozen, gas fixed for the window): once per window.
+    const GasFields<Exec>* gf = ctx.gas;
+    _convFactorsValid = gf != nullptr && _h.convection && gf->has(gf->Tg) && gf->has(gf->kappaG) &&
+                        gf->has(gf->cpG);
+    if (_convFactorsValid) {
+      _convFactors.reserve(nCells);
+      kernels::NusseltFactors* nf = _convFactors.d();
+      const kernels::ConvectionParams cp = _h.convectionParams;
+      const double* eps = ctx.cells.epsFrozen();
+      const double* rhoG = gf->rhoG.d();
+      const double* muG = gf->muG.d();
+      const double* kap = gf->kappaG.d();
+      const double* cpg = gf->cpG.d();
+      const double* tg = gf->Tg.d();
+      ctx.exec.parallelFor(nCells, [=] DEM_LAMBDA(std::size_t c) {
+        const kernels::GasState gs{rhoG[c], muG[c], kap[c], cpg[c], tg[c], eps[c]};
+        nf[c] = kernels::nusseltFactors(cp, gs);
+      });
+    }
   }
 
   /// Heat sources of one sub-step. When coupled, the particles are sorted by PCM cell
@@ -124,6 +143,11 @@ public:
     const bool hasKappa = coupled && gasFields->has(gasFields->kappaG);
     const bool hasCp = coupled && gasFields->has(gasFields->cpG);
     const bool conv = coupled && _h.convection && hasTg && hasKappa && hasCp;
+    if (conv && !_convFactorsValid) {
+      backend::raiseUserError("internal: heat sources without the window's Nusselt factors "
+                              "(beginWindow was not called after the gas fields were set)");
+    }
+    const kernels::NusseltFactors* convFactors = conv ? _convFactors.d() : nullptr;
     const bool rad = coupled && _h.radiation && hasTg;
     const bool lens = coupled && _h.lensConduction && hasKappa;
     const bool contact = _h.contactConduction;
@@ -271,7 +295,8 @@ public:
         if (conv) {
           const double slip = norm(load3(ug, celli) - load3(v, ii));
           const GasState gs{rhoG[celli], muG[celli], kap[celli], cpg[celli], tg[celli], eps};
-          const ConvectionResult cr = convection(cp, gs, 2.0 * r[i], slip, ti);
+          const ConvectionResult cr =
+              convectionFromFactors(cp, convFactors[celli], gs, 2.0 * r[i], slip, ti);
           g = cr.conductance;
           src.convection = cr.heat;
         }
@@ -401,6 +426,8 @@ private:
   Dual<ThermalWall> _walls;  ///< fixed-temperature walls
   Dev<double> _qw;           ///< per particle: Q_wall,i (W)
   Dual<double> _wallAcc;     ///< kWallSlots partial sums of Σ_sub Σ_i Q_wall,i Δt (J)
+  Dev<kernels::NusseltFactors> _convFactors; ///< per cell: Nusselt factors of the window
+  bool _convFactorsValid = false;
   HeatTotals _totals;
 };
 

@@ -139,3 +139,30 @@ TEST(Convection, CellSourceSplitReproducesParticleSum) {
   // Tolerance: the split form subtracts two sums of ~20 terms of size ~G·T/V; 1e-12 of those.
   EXPECT_NEAR(k::cellConvectionHeat(cell, g.T), sumQ / vCell, 1e-12 * cell.H * g.T);
 }
+
+// The heat module evaluates convection from per-cell Nusselt factors computed once per CFD step
+// (convectionFromFactors): bitwise the per-particle kernel for both models, with and without ε
+// in Re, below the ε clip, and in all three Li–Mason Reynolds ranges (Re ≈ 0 to ≈ 5000).
+TEST(Convection, CellFactorsGiveBitwiseTheParticleKernel) {
+  int checked = 0;
+  for (const k::NusseltModel model : {k::NusseltModel::LiMason, k::NusseltModel::RanzMarshall}) {
+    for (const bool withEps : {true, false}) {
+      for (const double eps : {0.2, 0.35, 0.41, 0.7, 1.0}) {
+        for (const double slip : {0.0, 1e-4, 0.05, 0.9, 4.0, 13.0, 60.0}) {
+          k::ConvectionParams p;
+          p.model = model;
+          p.reynoldsWithVoidage = withEps;
+          p.voidageExponent = 4.75;
+          k::GasState g = v::musserConvectionGas(340.0, eps);
+          const k::ConvectionResult a = k::convection(p, g, 1.3e-3, slip, 415.0);
+          const k::ConvectionResult b =
+              k::convectionFromFactors(p, k::nusseltFactors(p, g), g, 1.3e-3, slip, 415.0);
+          EXPECT_EQ(a.conductance, b.conductance) << "eps " << eps << " slip " << slip;
+          EXPECT_EQ(a.heat, b.heat);
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(checked, 140);
+}
