@@ -206,12 +206,13 @@ public:
     // 2a. Pair terms, each pair once by its owner (the smaller global id, which is also the
     //     canonical "lo" of the pair kernels) over the half lists (pair_lists.h): the owner
     //     keeps +Q_ab (heat into lo = G (T_hi − T_lo)) and writes it to the per-candidate
-    //     scratch (contact, lens), 0 when the pair is out of reach. Q_ab = −Q_ba exactly.
+    //     scratch at the partner's low-list position (contact, lens), 0 when the pair is out of
+    //     reach. Q_ab = −Q_ba exactly.
     PairLists<Exec>& pl = ctx.pairs;
     const std::uint32_t* hs = pl.halfStart();
     const std::int32_t* half = pl.half();
     const std::uint32_t* ls = pl.lowStart();
-    const std::uint32_t* low = pl.low();
+    const std::uint32_t* lowPos = pl.lowPos();
     static_assert(PairLists<Exec>::kScratchWidth >= 2);
     double* share = pl.scratch(); // per candidate: Q_ab contact, Q_ab lens (W)
     double* qOwn = _q.d();        // owner's pair sums, contact and lens: _q and _g until 2b
@@ -261,8 +262,9 @@ public:
           }
           qc += qcab;
           ql += qlab;
-          share[2 * q] = qcab;
-          share[2 * q + 1] = qlab;
+          const std::size_t kq = lowPos[q]; // the partner's slot for its share
+          share[2 * kq] = qcab;
+          share[2 * kq + 1] = qlab;
         }
         qOwn[i] = qc;
         lOwn[i] = ql;
@@ -282,9 +284,8 @@ public:
         double qc = qOwn[i], ql = lOwn[i];
         const std::uint32_t kEnd = ls[i + 1];
         for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
-          const std::uint32_t q = low[k];
-          qc -= share[2 * q];
-          ql -= share[2 * q + 1];
+          qc -= share[2 * static_cast<std::size_t>(k)];
+          ql -= share[2 * static_cast<std::size_t>(k) + 1];
         }
         src.contactConduction = qc;
         src.lensConduction = ql;

@@ -8,11 +8,14 @@
 /// choice that survives re-sorting, and the canonical order of the pair kernels (the owner is
 /// "lo"). After every neighbour rebuild (or a new state) the full neighbour lists give
 ///   half lists: each particle's owned candidates (partner gid larger), ascending index order;
-///   low lists:  for each particle, the position q in its partner's half list of every
-///               candidate the partner owns, in neighbour-list order (the lists are symmetric).
-/// A module evaluates candidate q in a pass over owners, writes the partner's share to a buffer
-/// indexed by q, and gathers the shares in a second pass over particles along the low lists: a
-/// fixed order, no atomics, results independent of the thread count.
+///   low lists:  for each particle, the candidates its partners own, in neighbour-list order
+///               (the lists are symmetric), numbered k in CSR form (`lowStart`); `lowPos[q]` is
+///               the k of half-list candidate q in its partner's low list.
+/// A module evaluates candidate q in a pass over owners and writes the partner's share at
+/// k = lowPos[q] of a per-candidate buffer; a second pass over particles reads its shares at
+/// k = lowStart[i] … lowStart[i+1] − 1, contiguous in memory (the scattered accesses are the
+/// owners' stores, which do not stall as scattered loads would): a fixed order, no atomics,
+/// results independent of the thread count.
 ///
 /// `scratch()` is one such per-candidate buffer of kScratchWidth doubles, shared: a module may
 /// use it only inside its own sources() call (written in its first pass, read in its second),
@@ -47,8 +50,8 @@ public:
   }
 
   std::size_t bytes() const {
-    return _count.bytes() + _halfStart.bytes() + _half.bytes() + _lowStart.bytes() + _low.bytes() +
-           _scratch.bytes();
+    return _count.bytes() + _halfStart.bytes() + _half.bytes() + _lowStart.bytes() +
+           _lowPos.bytes() + _scratch.bytes();
   }
 
   /// Counts the builds: a module that derives data from the lists rebuilds it when this changes.
@@ -60,7 +63,7 @@ public:
   const std::uint32_t* halfStart() const { return _halfStart.d(); }
   const std::int32_t* half() const { return _half.d(); }
   const std::uint32_t* lowStart() const { return _lowStart.d(); }
-  const std::uint32_t* low() const { return _low.d(); }
+  const std::uint32_t* lowPos() const { return _lowPos.d(); }
   double* scratch() { return _scratch.d(); }
 
   /// Builds the lists from the neighbour lists (public only because nvcc requires it of a
@@ -105,8 +108,8 @@ public:
     exec.exclusiveScan(c, ls, n + 1);
     std::uint32_t lowTotal = 0;
     Exec::copyToHost(&lowTotal, ls + n, sizeof(lowTotal));
-    _low.reserve(lowTotal);
-    std::uint32_t* low = _low.d();
+    _lowPos.reserve(total > lowTotal ? total : lowTotal);
+    std::uint32_t* lowPos = _lowPos.d();
     const double missing = exec.reduceMax(
         n,
         [=] DEM_LAMBDA(std::size_t i) {
@@ -119,9 +122,12 @@ public:
             std::uint32_t at = hs[j];
             while (at < hs[j + 1] && half[at] != static_cast<std::int32_t>(i))
               ++at;
-            if (at == hs[j + 1])
+            if (at == hs[j + 1]) {
               miss = 1.0;
-            low[k++] = at;
+            } else {
+              lowPos[at] = k;
+            }
+            ++k;
           }
           return miss;
         },
@@ -140,7 +146,7 @@ private:
   Dev<std::uint32_t> _halfStart; ///< CSR offsets of the half lists, n + 1
   Dev<std::int32_t> _half;       ///< owned candidates (partner index), ascending per particle
   Dev<std::uint32_t> _lowStart;  ///< CSR offsets of the low lists, n + 1
-  Dev<std::uint32_t> _low;       ///< per candidate a partner owns: its index in the half lists
+  Dev<std::uint32_t> _lowPos;    ///< per half-list candidate q: its k in the partner's low list
   Dev<double> _scratch;          ///< kScratchWidth doubles per candidate, shared (see above)
   std::uint32_t _total = 0;
   std::uint64_t _generation = 0;
