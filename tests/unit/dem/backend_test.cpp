@@ -71,6 +71,34 @@ TEST(CpuBackend, SortByKeyIsStableAndSorted) {
   }
 }
 
+// The radix sort runs its passes on several threads (blocks counted and scattered in (digit,
+// block) order): the permutation must equal the serial stable sort for any thread count, key
+// range (1 to 4 digit passes) and size (below and above the parallel threshold, odd sizes).
+TEST(CpuBackend, RadixSortEqualsStableSortOnAnyThreadCount) {
+  std::uint64_t s = 7;
+  for (const std::size_t n : {std::size_t{1}, std::size_t{1000}, std::size_t{16383},
+                              std::size_t{40001}, std::size_t{250000}}) {
+    for (const std::uint32_t numKeys : {1u, 200u, 4961u, 70000u, 3000000000u}) {
+      std::vector<std::uint32_t> keys(n);
+      for (auto& k : keys) {
+        s = s * 6364136223846793005ull + 1442695040888963407ull;
+        k = static_cast<std::uint32_t>((s >> 20) % numKeys);
+      }
+      std::vector<std::uint32_t> expected(n);
+      std::iota(expected.begin(), expected.end(), 0u);
+      std::stable_sort(expected.begin(), expected.end(),
+                       [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });
+      for (const int threads : {1, 2, 3, 8}) {
+        backend::CpuExec exec;
+        exec.threads = threads;
+        std::vector<std::uint32_t> perm(n, 0xdeadbeefu);
+        exec.sortByKeyRadix(keys.data(), n, numKeys, perm.data());
+        ASSERT_EQ(perm, expected) << "n " << n << " keys " << numKeys << " threads " << threads;
+      }
+    }
+  }
+}
+
 // ---------------------------------------------------------------- conformance, per backend
 template <BackendKind K>
 struct BackendTag {

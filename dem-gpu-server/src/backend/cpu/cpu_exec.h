@@ -73,6 +73,8 @@ struct CpuExec {
   /// Stable LSD radix sort (8-bit digits over the bits numKeys needs): the same permutation as
   /// sortByKey, at a cost O(n · bits/8) that does not depend on numKeys (no histogram of
   /// numKeys buckets). For sparse keys, e.g. a few particles on a large coupling grid.
+  /// Parallel: each thread counts the digits of its own contiguous block, and scatters it to
+  /// offsets ordered by (digit, block): the same stable permutation for any thread count.
   /// @pre keys[i] < numKeys.
   void sortByKeyRadix(const std::uint32_t* keys, std::size_t n, std::uint32_t numKeys,
                       std::uint32_t* perm) const {
@@ -82,16 +84,40 @@ struct CpuExec {
     _radixTmp.resize(n);
     std::uint32_t* src = perm;
     std::uint32_t* dst = _radixTmp.data();
-    for (std::size_t i = 0; i < n; ++i)
-      src[i] = static_cast<std::uint32_t>(i);
+    const int blocks =
+        n < kParallelSortMin ? 1 : std::min<int>(threadCount(), static_cast<int>(n / 4096) + 1);
+    _radixCount.assign(static_cast<std::size_t>(blocks) * 256, 0);
+    std::size_t* count = _radixCount.data();
     for (int shift = 0; shift < bits; shift += 8) {
-      std::size_t count[257] = {};
-      for (std::size_t i = 0; i < n; ++i)
-        ++count[((keys[src[i]] >> shift) & 255u) + 1];
-      for (int d = 0; d < 256; ++d)
-        count[d + 1] += count[d];
-      for (std::size_t i = 0; i < n; ++i)
-        dst[count[(keys[src[i]] >> shift) & 255u]++] = src[i];
+      const bool first = shift == 0;
+#pragma omp parallel num_threads(blocks) if (blocks > 1)
+      {
+        const int b = blocks > 1 ? omp_get_thread_num() : 0;
+        const std::size_t lo = n * b / blocks, hi = n * (b + 1) / blocks;
+        std::size_t* c = count + 256 * static_cast<std::size_t>(b);
+        for (int d = 0; d < 256; ++d)
+          c[d] = 0;
+        for (std::size_t i = lo; i < hi; ++i) {
+          const std::uint32_t idx = first ? static_cast<std::uint32_t>(i) : src[i];
+          ++c[(keys[idx] >> shift) & 255u];
+        }
+#pragma omp barrier
+#pragma omp single
+        {
+          std::size_t sum = 0; // exclusive offsets in (digit, block) order
+          for (int d = 0; d < 256; ++d) {
+            for (int t = 0; t < blocks; ++t) {
+              const std::size_t v = count[256 * static_cast<std::size_t>(t) + d];
+              count[256 * static_cast<std::size_t>(t) + d] = sum;
+              sum += v;
+            }
+          }
+        }
+        for (std::size_t i = lo; i < hi; ++i) {
+          const std::uint32_t idx = first ? static_cast<std::uint32_t>(i) : src[i];
+          dst[c[(keys[idx] >> shift) & 255u]++] = idx;
+        }
+      }
       std::swap(src, dst);
     }
     if (src != perm && n)
@@ -126,7 +152,10 @@ struct CpuExec {
   static void synchronize() {}
 
 private:
+  /// Below this many keys the radix sort runs on one thread.
+  static constexpr std::size_t kParallelSortMin = 16384;
   mutable std::vector<std::uint32_t> _hist, _offsets, _radixTmp;
+  mutable std::vector<std::size_t> _radixCount;
 };
 
 } // namespace coredem::dem::backend
