@@ -382,6 +382,7 @@ struct DemSystem::Impl {
   std::string hash;
   CellSources sources;
   std::size_t nParticles = 0;
+  const std::atomic<bool>* interrupt = nullptr; ///< setInterruptFlag
   BackendKind kind = BackendKind::Cpu;
   std::unique_ptr<Engine> makeEngine() const {
 #if defined(COREDEM_CUDA_ENABLED)
@@ -592,6 +593,9 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
       dt, m.dtMax, m.config.dtFactor, TimeHandler::subStepsFor(dtCfd, m.dtMax));
   m.engine->beginWindow();
   for (int s = 0; s < nSub; ++s) {
+    if (m.interrupt != nullptr && m.interrupt->load(std::memory_order_relaxed)) {
+      throw Interrupted(fmt::format("interrupted after {} of {} sub-steps", s, nSub));
+    }
     m.engine->subStep(dt);
     m.time.add(dt);
     ++m.step;
@@ -618,6 +622,10 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   return m.sources;
+}
+
+void DemSystem::setInterruptFlag(const std::atomic<bool>* flag) {
+  _impl->interrupt = flag;
 }
 
 void DemSystem::writeState(const std::string& path, const std::string& protocolVersion) const {

@@ -445,6 +445,7 @@ struct DemServer::Impl {
                 session, ignored.size() - kLoggedIgnoredOptions);
     }
     system = std::move(next);
+    system->setInterruptFlag(&stopFlag); // SIGINT/SIGTERM stop a long step within a sub-step
     ledgers = restored;
     if (ledgers.speciesToGas.size() != static_cast<std::size_t>(c.species_size())) {
       ledgers.speciesToGas.assign(static_cast<std::size_t>(c.species_size()), 0.0);
@@ -605,6 +606,16 @@ struct DemServer::Impl {
     const dem::CellSources* s = nullptr;
     try {
       s = &system->advance(grant->dtCfd, static_cast<int>(grant->nSub));
+    } catch (const dem::Interrupted& e) {
+      // A signal (or DemServer::stop) during a long step: answer both members and end the
+      // session at once; run() then returns.
+      log->warn("session {}: step {} stopped by a signal ({}): ending the session", session,
+                grant->step, e.what());
+      const std::string reason = fmt::format("the server is stopping: step {} was interrupted ({})",
+                                             grant->step, e.what());
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, reason);
+      endSession(reason); // answers the StepGrant too
+      return;
     } catch (const std::exception& e) {
       log->error("session {}: step {} failed in the DEM core: {}", session, grant->step, e.what());
       refuse(r, v1::ERROR_CODE_INTERNAL,
