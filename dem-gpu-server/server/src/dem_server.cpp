@@ -858,6 +858,13 @@ struct DemServer::Impl {
       return;
     }
     const auto type = env.type();
+    if (type == v1::MESSAGE_TYPE_UNSPECIFIED || !v1::MessageType_IsValid(type)) {
+      // Checked first, from anyone in any state (docs/protocol.md §5): an empty message (one
+      // zero-byte frame parses as an Envelope with nothing set) or a type of a newer version.
+      const auto s = proto::validate(r.message, proto::Expectation{});
+      refuse(r, v1::ERROR_CODE_UNKNOWN_TYPE, s.message);
+      return;
+    }
     if (type == v1::MESSAGE_TYPE_HELLO) {
       onHello(r);
       return;
@@ -878,6 +885,23 @@ struct DemServer::Impl {
       refuse(r, v1::ERROR_CODE_UNKNOWN_SESSION,
              "this connection has not joined the active session: send Hello first");
       return;
+    }
+    switch (type) { // what D sends, or C sends to O: never D's to receive
+    case v1::MESSAGE_TYPE_WELCOME:
+    case v1::MESSAGE_TYPE_REJECT:
+    case v1::MESSAGE_TYPE_CONFIGURED:
+    case v1::MESSAGE_TYPE_SOURCES:
+    case v1::MESSAGE_TYPE_STEP_DONE:
+    case v1::MESSAGE_TYPE_CHECKPOINT_DONE:
+    case v1::MESSAGE_TYPE_ERROR:
+    case v1::MESSAGE_TYPE_ACK:
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             fmt::format("{} is a reply, never sent to the DEM server; it takes Hello, Configure, "
+                         "StepGrant, GasFields, CheckpointRequest, Heartbeat and Shutdown",
+                         proto::messageTypeName(type)));
+      return;
+    default:
+      break;
     }
     proto::Expectation e;
     if (type == v1::MESSAGE_TYPE_GAS_FIELDS) {
