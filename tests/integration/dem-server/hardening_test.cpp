@@ -799,3 +799,48 @@ TEST(Stoppable, SigtermDuringALongStepEndsTheSessionWithinASubStep) {
   EXPECT_TRUE(contains(log, "interrupted after")) << log;
   fs::remove_all(dir);
 }
+
+// ---- failures inside D: a failed step ends the session -----------------------------------------
+
+// A particle set launched at 1e300 m/s (finite, so the Configure passes) flies off in the
+// first sub-step: the DEM core fails the step. Both members get an Error naming the failure,
+// the session ends (no "step failed" to every later request), and the server serves the next
+// orchestrator.
+TEST(InternalFailure, AFailedStepEndsTheSessionAndTheServerServesTheNext) {
+  ServerThread srv(options());
+  auto c = smallCase(kParticles, kD, kBox, kCells);
+  c.mutable_particle_sets(0)->mutable_initial_velocity()->set_x(1e300);
+  MiniOrchestrator o(srv.endpoint(), c);
+  proto::Client cfd;
+  cfd.connect(srv.endpoint());
+  proto::expectType(cfd.request(cfdHello(o.session()), 10s), v1::MESSAGE_TYPE_WELCOME);
+  const double dt = 2e-4;
+  const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
+  ASSERT_LE(nSub, 1000u);
+  for (std::int64_t step = 1; step <= 3; ++step) { // the failure may need a rebuild to show
+    auto g = proto::makeStepGrant(step, dt * double(step - 1), dt, nSub, dt / nSub);
+    g.setSessionId(o.session());
+    o.dem().send(std::move(g));
+    auto reply = cfd.request(gasFields(step, dt * double(step - 1), dt, o.session()), 20s);
+    if (reply.type() == v1::MESSAGE_TYPE_SOURCES) {
+      auto done = o.dem().receive(20s);
+      ASSERT_TRUE(done.has_value());
+      ASSERT_EQ(done->type(), v1::MESSAGE_TYPE_STEP_DONE);
+      continue;
+    }
+    const auto msg = refusal(reply, v1::ERROR_CODE_INTERNAL);
+    EXPECT_TRUE(contains(msg, "failed in the DEM core")) << msg;
+    EXPECT_TRUE(contains(msg, "unstable")) << msg;
+    auto oReply = o.dem().receive(20s);
+    ASSERT_TRUE(oReply.has_value());
+    EXPECT_EQ(oReply->type(), v1::MESSAGE_TYPE_ERROR);
+    // The session is over: the next grant meets no session, a new orchestrator is welcomed.
+    auto next = proto::makeStepGrant(step + 1, dt * double(step), dt, nSub, dt / nSub);
+    next.setSessionId(o.session());
+    refusal(o.dem().request(std::move(next), 10s), v1::ERROR_CODE_NOT_CONFIGURED);
+    Orchestrator fresh(srv.endpoint());
+    EXPECT_NE(fresh.session, o.session());
+    return;
+  }
+  FAIL() << "a particle at 1e300 m/s did not fail the step";
+}
