@@ -405,7 +405,8 @@ struct DemServer::Impl {
     std::vector<std::string> ignored;
     try {
       COREDEM_CHECK(c.coupling_mesh().has_cartesian(), "Configure has no Cartesian coupling grid");
-      const auto cfg = toDemConfig(c, &ignored);
+      auto cfg = toDemConfig(c, &ignored);
+      cfg.interrupt = &stopFlag; // SIGINT/SIGTERM stop a long placement
       next = std::make_unique<dem::DemSystem>(cfg, dem::parseBackend(opt.backend), opt.threads);
       if (!c.initial_state_file().empty()) {
         COREDEM_CHECK(fs::exists(c.initial_state_file()), "initial state file '{}' does not exist",
@@ -421,6 +422,12 @@ struct DemServer::Impl {
         nSub = static_cast<std::uint32_t>(
             dem::TimeHandler::subStepsFor(c.sub_cycling().dt_cfd(), next->dtDemMax()));
       }
+    } catch (const dem::Interrupted& e) {
+      next.reset();
+      log->warn("session {}: Configure stopped by a signal ({})", session, e.what());
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             fmt::format("the server is stopping: Configure was {}", e.what()));
+      return;
     } catch (const coredem::UserError& e) {
       next.reset();
       ::malloc_trim(0); // give a large failed build's memory back to the system

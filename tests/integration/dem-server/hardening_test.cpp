@@ -844,3 +844,22 @@ TEST(InternalFailure, AFailedStepEndsTheSessionAndTheServerServesTheNext) {
   }
   FAIL() << "a particle at 1e300 m/s did not fail the step";
 }
+
+// A Configure whose random packing cannot succeed (500000 particles of 1 mm in a 6 mm box:
+// about 10^9 placement attempts before it gives up): stopping the server interrupts the
+// placement; the orchestrator is answered and the server thread ends.
+TEST(Stoppable, StoppingDuringAParticlePlacementInterruptsIt) {
+  auto srv = std::make_unique<ServerThread>(options(std::uint64_t{4} << 30));
+  Orchestrator o(srv->endpoint());
+  auto c = smallCase(kParticles, kD, kBox, kCells);
+  c.mutable_particle_sets(0)->set_count(500000);
+  auto m = proto::makeConfigure(c);
+  m.setSessionId(o.session);
+  o.client.send(std::move(m));
+  std::this_thread::sleep_for(500ms); // placing
+  srv.reset(); // stop() and join: returns only once the placement has stopped
+  auto reply = o.client.receive(10s);
+  ASSERT_TRUE(reply.has_value());
+  const auto msg = refusal(*reply, v1::ERROR_CODE_UNEXPECTED_MESSAGE);
+  EXPECT_TRUE(contains(msg, "interrupted while placing particle set 'beads'")) << msg;
+}

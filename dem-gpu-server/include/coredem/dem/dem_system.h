@@ -149,6 +149,10 @@ struct DemConfig {
   /// temperature (K) with particle–wall conduction (kernels/wall_conduction.h); 0 = adiabatic.
   double wallTemperature = 0.0;
   int wallMaterial = 0; ///< material of the walls (its conductivity is k_w)
+  /// A stop flag (e.g. set from a signal handler), read while particles are placed: once set,
+  /// the constructor throws Interrupted. It also becomes the system's interrupt flag
+  /// (setInterruptFlag). Not part of the configuration hash. nullptr: none.
+  const std::atomic<bool>* interrupt = nullptr;
 
   /// Adds the six planes of the axis-aligned box [lo, hi] (normals pointing inwards).
   void addBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi);
