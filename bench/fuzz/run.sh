@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer target for envelope decoding + validation (bench/fuzz/envelope_fuzz.cpp)
 # with clang, ASan and coverage on the protocol library, in its own build folder, and runs
-# EXECS executions (default 10^7) in one process, seeded with protocol/golden/.
+# EXECS executions (default 10^7) in one process, seeded with protocol/golden/ (a second run
+# goes on from the corpus the first one grew).
 #
 #   bench/fuzz/run.sh [EXECS] [MAX_SECONDS]
 #
@@ -38,7 +39,7 @@ cd "$build"
 start=$(date +%s)
 set +e
 ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}" "$build/bin/coredem-fuzz-envelope" \
-  -runs="$execs" -max_total_time="$maxSeconds" -jobs=1 -workers=1 -rss_limit_mb=2048 \
+  -runs="$execs" -max_total_time="$maxSeconds" -rss_limit_mb=2048 \
   -max_len=65536 -print_final_stats=1 "$corpus" 2>&1 | tee "$build/fuzz.log" | grep -v "^#[0-9]*.*\(NEW\|REDUCE\|pulse\)"
 rc=${PIPESTATUS[0]}
 set -e

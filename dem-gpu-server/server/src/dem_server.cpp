@@ -10,6 +10,7 @@
 #include <random>
 
 #include <fcntl.h>
+#include <google/protobuf/stubs/logging.h>
 #include <malloc.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -72,6 +73,15 @@ const char* stateName(SessionState s) {
     return "configured";
   }
   return "?";
+}
+
+/// libprotobuf's own messages (e.g. one ERROR line per refused string field with invalid UTF-8,
+/// which any peer can trigger per message): to the log at debug level, not to stderr.
+void protobufLog(google::protobuf::LogLevel level, const char* file, int line,
+                 const std::string& message) {
+  static auto log = coredem::logger("protocol.protobuf");
+  log->debug("libprotobuf {} {}:{}: {}", static_cast<int>(level), file, line,
+             proto::printable(message, 200));
 }
 
 std::string readKey(const fs::path& p) {
@@ -982,6 +992,7 @@ struct DemServer::Impl {
 DemServer::DemServer(ServerOptions options)
     : _impl(std::make_unique<Impl>(std::move(options))) {
   auto& m = *_impl;
+  google::protobuf::SetLogHandler(&protobufLog);
   dem::parseBackend(m.opt.backend); // fail early on a bad name
   if (!proto::isLoopbackEndpoint(m.opt.bind) && m.opt.curveKeysDir.empty()) {
     COREDEM_CHECK(

@@ -863,3 +863,24 @@ TEST(Stoppable, StoppingDuringAParticlePlacementInterruptsIt) {
   const auto msg = refusal(*reply, v1::ERROR_CODE_UNEXPECTED_MESSAGE);
   EXPECT_TRUE(contains(msg, "interrupted while placing particle set 'beads'")) << msg;
 }
+
+// A string field with invalid UTF-8 (any peer can send one per message): refused
+// MALFORMED_ENVELOPE, and libprotobuf's complaint goes to the log at debug level, not as an
+// unescaped line on stderr per message.
+TEST(Logs, InvalidUtf8IsRefusedWithoutALineOnStderrPerMessage) {
+  ServerThread srv(options());
+  proto::Client raw;
+  raw.connect(srv.endpoint());
+  auto hb = proto::makeHeartbeat("x");
+  hb.envelope().set_sender(std::string("bad \xff\xfe utf-8"));
+  auto frames = hb.encode();
+  ::testing::internal::CaptureStderr();
+  for (int i = 0; i < 3; ++i) {
+    raw.sendFrames(frames);
+    auto reply = raw.receive(10s);
+    ASSERT_TRUE(reply.has_value());
+    refusal(*reply, v1::ERROR_CODE_MALFORMED_ENVELOPE);
+  }
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_FALSE(contains(err, "libprotobuf")) << err;
+}
