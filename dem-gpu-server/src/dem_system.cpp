@@ -188,7 +188,7 @@ void validate(const DemConfig& c) {
 }
 
 /// Positions of one set (x,y,z triples).
-std::vector<double> placeParticles(const ParticleSet& s) {
+std::vector<double> placeParticles(const ParticleSet& s, const std::atomic<bool>* interrupt) {
   std::vector<double> p;
   if (s.packing == Packing::Explicit)
     return s.positions;
@@ -237,6 +237,11 @@ std::vector<double> placeParticles(const ParticleSet& s) {
   const std::size_t maxAttempts = 2000 * s.count + 10000;
   std::size_t attempts = 0;
   while (p.size() < 3 * s.count) {
+    if (interrupt != nullptr && (attempts & 4095) == 0 &&
+        interrupt->load(std::memory_order_relaxed)) {
+      throw Interrupted(fmt::format("interrupted while placing particle set '{}' ({} of {} placed)",
+                                    s.name, p.size() / 3, s.count));
+    }
     COREDEM_CHECK(
         ++attempts < maxAttempts,
         "particle set '{}': could not place {} non-overlapping particles of diameter {} m in the "
@@ -382,6 +387,7 @@ struct DemSystem::Impl {
   std::string hash;
   CellSources sources;
   std::size_t nParticles = 0;
+  const std::atomic<bool>* interrupt = nullptr; ///< setInterruptFlag
   BackendKind kind = BackendKind::Cpu;
   std::unique_ptr<Engine> makeEngine() const {
 #if defined(COREDEM_CUDA_ENABLED)
@@ -399,6 +405,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   validate(config);
   COREDEM_CHECK(threads >= 0, "threads = {} must be >= 0 (0 = OpenMP default)", threads);
   m.config = config;
+  m.interrupt = config.interrupt;
   m.hash = hashConfig(config);
 
   // Particles.
@@ -411,7 +418,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   std::vector<double> minMass(config.materials.size(), std::numeric_limits<double>::infinity());
   std::int64_t nextId = 0;
   for (const ParticleSet& s : config.particleSets) {
-    const std::vector<double> p = placeParticles(s);
+    const std::vector<double> p = placeParticles(s, config.interrupt);
     const std::size_t n = p.size() / 3;
     Rng rng{s.seed ^ 0x5bd1e995a5a5a5a5ull};
     const double r = 0.5 * s.diameter;
@@ -592,6 +599,9 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
       dt, m.dtMax, m.config.dtFactor, TimeHandler::subStepsFor(dtCfd, m.dtMax));
   m.engine->beginWindow();
   for (int s = 0; s < nSub; ++s) {
+    if (m.interrupt != nullptr && m.interrupt->load(std::memory_order_relaxed)) {
+      throw Interrupted(fmt::format("interrupted after {} of {} sub-steps", s, nSub));
+    }
     m.engine->subStep(dt);
     m.time.add(dt);
     ++m.step;
@@ -618,6 +628,10 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
   return m.sources;
+}
+
+void DemSystem::setInterruptFlag(const std::atomic<bool>* flag) {
+  _impl->interrupt = flag;
 }
 
 void DemSystem::writeState(const std::string& path, const std::string& protocolVersion) const {

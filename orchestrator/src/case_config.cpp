@@ -577,8 +577,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   }
 
   if (top.has("dem")) {
-    const Section d =
-        top.section("dem", {"endpoint", "backend", "threads", "timeout_s", "server_key", "timers"});
+    const Section d = top.section("dem", {"endpoint", "backend", "threads", "timeout_s",
+                                          "server_key", "client_key", "timers"});
     c.dem.endpoint = d.string("endpoint", std::string(),
                               "endpoint of a running coredem-dem, e.g. tcp://127.0.0.1:5555");
     if (!c.dem.endpoint.empty() && c.dem.endpoint.rfind("tcp://", 0) != 0 &&
@@ -603,6 +603,24 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
       if (c.dem.endpoint.empty()) {
         d.fail(d.markOf("server_key"), "dem.server_key",
                "only used with dem.endpoint (a server started elsewhere with --curve-keys)");
+      }
+    }
+    if (d.has("client_key")) {
+      const std::string rel = d.string(
+          "client_key", std::nullopt,
+          "this client's secret key file (client.secret) or the folder holding it, written by "
+          "'coredem-dem --generate-client-key DIR'");
+      c.dem.clientKey = fs::absolute(caseDir / rel);
+      if (!fs::exists(c.dem.clientKey)) {
+        d.fail(d.markOf("client_key"), "dem.client_key",
+               fmt::format("'{}' not found (looked for {}); give the client.secret file (or its "
+                           "folder) that 'coredem-dem --generate-client-key DIR' wrote",
+                           rel, c.dem.clientKey.string()));
+      }
+      if (!d.has("server_key")) {
+        d.fail(d.markOf("client_key"), "dem.client_key",
+               "only used with dem.server_key (a server started with --curve-keys and "
+               "--client-keys)");
       }
     }
   }

@@ -28,7 +28,8 @@ std::vector<ParticipantDescriptor> makeTable() {
               "--control", "{control_endpoint}", "--dem",       "{dem_endpoint}",
               "--session", "{session}",          "--timeout-s", "{timeout_s}"};
     p.restartArgs = {"--restart", "{restart_file}"};
-    p.env = {{"COREDEM_DEM_SERVER_KEY", "{dem_server_key}"}};
+    p.env = {{"COREDEM_DEM_SERVER_KEY", "{dem_server_key}"},
+             {"COREDEM_DEM_CLIENT_KEY_FILE", "{dem_client_key_file}"}};
     p.restartFile = "*.h5";
     p.preflight = &checkGasSection;
     t.push_back(std::move(p));
@@ -47,7 +48,8 @@ std::vector<ParticipantDescriptor> makeTable() {
              {"COREDEM_DEM_ENDPOINT", "{dem_endpoint}"},
              {"COREDEM_SESSION", "{session}"},
              {"COREDEM_TIMEOUT_S", "{timeout_s}"},
-             {"COREDEM_DEM_SERVER_KEY", "{dem_server_key}"}}; // remote DEM behind CURVE
+             {"COREDEM_DEM_SERVER_KEY", "{dem_server_key}"},            // remote DEM behind CURVE
+             {"COREDEM_DEM_CLIENT_KEY_FILE", "{dem_client_key_file}"}}; // a path, not the key
     // OpenFOAM reads its etc tree while its libraries load: Debian's unless set.
     p.envDefaults = {{"WM_PROJECT_DIR", "/usr/share/openfoam"}};
     p.restartFile = "coredemFoam.restart";
@@ -130,6 +132,7 @@ LaunchCommand launchCommand(const ParticipantDescriptor& p, const CaseConfig& co
       {"session", in.session},
       {"timeout_s", fmt::format("{}", config.cfd.timeoutSeconds)},
       {"dem_server_key", in.demServerKey},
+      {"dem_client_key_file", in.demClientKeyFile},
       {"restart_file", in.restartFile.string()}};
   LaunchCommand cmd;
   cmd.argv.push_back(in.program.string());

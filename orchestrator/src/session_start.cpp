@@ -26,7 +26,14 @@ void Session::startDem() {
     COREDEM_CHECK(key.size() == 40, "{}: not a Z85 CURVE public key (40 characters)",
                   _c.dem.serverKey.string());
     _serverKey = key;
-    const auto pair = protocol::generateCurveKeyPair();
+    // A persistent client key (dem.client_key) for a server with an allow-list; otherwise a
+    // throw-away pair (the server then admits any client that knows its public key).
+    const auto pair = _c.dem.clientKey.empty()
+                          ? protocol::generateCurveKeyPair()
+                          : protocol::readClientKeyPair(_c.dem.clientKey.string());
+    if (!_c.dem.clientKey.empty()) {
+      _log->info("CURVE client key {} ({})", pair.first, _c.dem.clientKey.string());
+    }
     transport.curve.serverPublicKey = key;
     transport.curve.clientPublicKey = pair.first;
     transport.curve.clientSecretKey = pair.second;
@@ -239,6 +246,7 @@ void Session::startCfd(const fs::path& cfdRestart) {
   in.demEndpoint = _demEndpoint;
   in.session = _session;
   in.demServerKey = _serverKey;
+  in.demClientKeyFile = _serverKey.empty() ? std::string() : _c.dem.clientKey.string();
   in.restartFile = cfdRestart;
   in.timers = _o.timers;
   prepareWorkDir(_cfd, _c, _o.runDir);

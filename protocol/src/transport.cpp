@@ -1,6 +1,7 @@
 // ZeroMQ transport. The only translation unit that includes zmq.hpp: ZeroMQ stays private.
 #include <atomic>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -10,6 +11,7 @@
 #include <thread>
 #include <utility>
 
+#include <sys/stat.h>
 #include <zmq.hpp>
 
 #include <coredem/common/log.h>
@@ -457,6 +459,59 @@ bool isLoopbackEndpoint(std::string_view endpoint) {
   return std::regex_match(host.begin(), host.end(), ipv4Loopback);
 }
 
+std::pair<std::string, std::string> readClientKeyPair(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path secretFile = path;
+  if (fs::is_directory(secretFile, ec)) {
+    secretFile /= "client.secret";
+  }
+  const std::string hint = " (a client key pair is written by `coredem-dem --generate-client-key "
+                           "DIR`; give DIR/client.secret or DIR)";
+  struct stat st {};
+  if (::stat(secretFile.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
+    throw ProtocolError(v1::ERROR_CODE_SECURITY,
+                        "cannot read the client secret key " + secretFile.string() + hint);
+  }
+  if ((st.st_mode & 077) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
+    throw ProtocolError(v1::ERROR_CODE_SECURITY,
+                        "the client secret key " + secretFile.string() + " has mode " + mode +
+                            ": others may read it; make it private with `chmod 600 " +
+                            secretFile.string() + "`");
+  }
+  std::ifstream in(secretFile);
+  std::string secret;
+  in >> secret;
+  char binary[32];
+  if (!in.good() && !in.eof()) {
+    throw ProtocolError(v1::ERROR_CODE_SECURITY,
+                        "cannot read the client secret key " + secretFile.string() + hint);
+  }
+  if (secret.size() != 40 ||
+      zmq_z85_decode(reinterpret_cast<std::uint8_t*>(binary), secret.c_str()) == nullptr) {
+    throw ProtocolError(v1::ERROR_CODE_SECURITY,
+                        secretFile.string() + " does not hold a 40-character Z85 CURVE key" + hint);
+  }
+  char pub[41] = {};
+  if (!zmq_has("curve") || zmq_curve_public(pub, secret.c_str()) != 0) {
+    throw ProtocolError(v1::ERROR_CODE_UNSUPPORTED,
+                        "this libzmq has no CURVE support; install libzmq built with libsodium");
+  }
+  const fs::path publicFile = secretFile.parent_path() / "client.public";
+  if (secretFile.filename() == "client.secret" && fs::exists(publicFile, ec)) {
+    std::string listed;
+    std::ifstream(publicFile) >> listed;
+    if (listed != pub) {
+      throw ProtocolError(v1::ERROR_CODE_SECURITY,
+                          publicFile.string() + " is not the public key of " + secretFile.string() +
+                              " (the pair was mixed up)");
+    }
+  }
+  return {pub, secret};
+}
+
 std::pair<std::string, std::string> generateCurveKeyPair() {
   char pub[41] = {};
   char sec[41] = {};
@@ -669,9 +724,86 @@ struct Client::Impl {
   TransportOptions options;
   std::shared_ptr<zmq::context_t> context = sharedContext(); // outlives the socket
   zmq::socket_t socket{*context, zmq::socket_type::dealer};
+  /// With CURVE: handshake failures of `socket` (a server whose allow-list lacks this
+  /// client's key answers the handshake with an ERROR: ZMQ_EVENT_HANDSHAKE_FAILED_AUTH).
+  std::optional<zmq::socket_t> monitor;
   std::string endpoint;
   std::uint64_t nextSequence = 1;
   std::shared_ptr<spdlog::logger> log = transportLog();
+
+  void startMonitor() {
+    static std::atomic<std::uint64_t> counter{0};
+    const std::string address = "inproc://coredem-client-monitor-" + std::to_string(++counter);
+    if (zmq_socket_monitor(socket.handle(), address.c_str(), ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) !=
+        0) {
+      throw TransportError(std::string("starting the socket monitor failed: ") +
+                           zmq_strerror(zmq_errno()));
+    }
+    monitor.emplace(*context, zmq::socket_type::pair);
+    monitor->connect(address);
+  }
+
+  /// Throws ProtocolError(SECURITY) when the server refused this client's key.
+  void checkHandshake() {
+    if (!monitor) {
+      return;
+    }
+    for (;;) {
+      zmq::message_t event;
+      if (!monitor->recv(event, zmq::recv_flags::dontwait)) {
+        return;
+      }
+      std::uint16_t id = 0;
+      std::uint32_t value = 0;
+      if (event.size() >= 6) {
+        std::memcpy(&id, event.data(), 2);
+        std::memcpy(&value, static_cast<const char*>(event.data()) + 2, 4);
+      }
+      if (event.more()) {
+        zmq::message_t address;
+        (void)monitor->recv(address, zmq::recv_flags::dontwait);
+      }
+      if (id == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH) {
+        throw ProtocolError(
+            v1::ERROR_CODE_SECURITY,
+            "the server at " + endpoint + " refused this client's CURVE key " +
+                options.curve.clientPublicKey + " (ZAP status " + std::to_string(value) +
+                "): the key is not on its allow-list (coredem-dem --client-keys FILE); add the "
+                "line of client.public to that file, or give the client key that is listed");
+      }
+    }
+  }
+
+  /// Waits until `socket` is readable (true) or the deadline passes (false); with CURVE,
+  /// throws as soon as the server refuses the handshake.
+  bool waitReadable(Clock::time_point deadline) {
+    if (!monitor) {
+      return coredem::protocol::waitReadable(socket, deadline);
+    }
+    for (;;) {
+      checkHandshake();
+      auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+      if (left.count() < 0) {
+        left = std::chrono::milliseconds(0);
+      }
+      zmq::pollitem_t items[2] = {{socket.handle(), 0, ZMQ_POLLIN, 0},
+                                  {monitor->handle(), 0, ZMQ_POLLIN, 0}};
+      try {
+        zmq::poll(items, 2, left);
+        if ((items[0].revents & ZMQ_POLLIN) != 0) {
+          return true;
+        }
+      } catch (const zmq::error_t& e) {
+        if (e.num() != EINTR) {
+          rethrowZmq(e, "poll");
+        }
+      }
+      if ((items[1].revents & ZMQ_POLLIN) == 0 && Clock::now() >= deadline) {
+        checkHandshake();
+        return false;
+      }
+    }
+  }
 };
 
 Client::Client(TransportOptions options) {
@@ -689,6 +821,7 @@ Client::Client(TransportOptions options) {
              "client public key");
       setKey(_impl->socket, ZMQ_CURVE_SECRETKEY, _impl->options.curve.clientSecretKey,
              "client secret key");
+      _impl->startMonitor();
     }
   } catch (const zmq::error_t& e) {
     rethrowZmq(e, "creating the client socket");
@@ -739,7 +872,7 @@ void Client::sendFrames(const Frames& frames) {
 std::optional<Message> Client::receive(std::chrono::milliseconds timeout,
                                        const ReceiveOptions& options, Status* status) {
   auto deadline = Clock::now() + timeout;
-  if (!waitReadable(_impl->socket, deadline)) {
+  if (!_impl->waitReadable(deadline)) {
     return std::nullopt;
   }
   auto frames = receiveFrames(_impl->socket, "receiving from " + _impl->endpoint);

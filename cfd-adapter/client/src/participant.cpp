@@ -118,8 +118,14 @@ struct Participant::Impl {
                (opt.softwareVersion.empty() ? kLibraryVersion : opt.softwareVersion) + ")";
     if (forDem) {
       const auto key = fromEnv(opt.demServerPublicKey, "COREDEM_DEM_SERVER_KEY");
+      const auto keyFile = fromEnv(opt.demClientKeyFile, "COREDEM_DEM_CLIENT_KEY_FILE");
+      COREDEM_CHECK(!key.empty() || keyFile.empty(),
+                    "{}: a client key ({}) is given but no DEM server public key "
+                    "(COREDEM_DEM_SERVER_KEY): client keys are only used with CURVE",
+                    opt.name, keyFile);
       if (!key.empty()) {
-        const auto pair = proto::generateCurveKeyPair();
+        const auto pair =
+            keyFile.empty() ? proto::generateCurveKeyPair() : proto::readClientKeyPair(keyFile);
         t.curve.serverPublicKey = key;
         t.curve.clientPublicKey = pair.first;
         t.curve.clientSecretKey = pair.second;

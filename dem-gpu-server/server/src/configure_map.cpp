@@ -5,11 +5,24 @@
 #include <map>
 
 #include "coredem/common/check.h"
+#include "coredem/dem/kernels/nasa7.h"
 #include "coredem/dem/models.h"
 
 namespace coredem::server {
 
 namespace {
+
+/// Molar mass (kg/mol) of a species of the DEM core's thermodynamic table by name; 0 if the
+/// name is not there.
+double builtinMolarMass(const std::string& name) {
+  namespace k = coredem::dem::kernels;
+  static const std::map<std::string, k::Species> table = {
+      {"CO", k::Species::CO},       {"CO2", k::Species::CO2},     {"H2", k::Species::H2},
+      {"H2O", k::Species::H2O},     {"N2", k::Species::N2},       {"C", k::Species::C},
+      {"Fe2O3", k::Species::Fe2O3}, {"Fe3O4", k::Species::Fe3O4}, {"Al2O3", k::Species::Al2O3}};
+  const auto it = table.find(name);
+  return it == table.end() ? 0.0 : k::molarMass(it->second);
+}
 
 std::array<double, 3> vec(const v1::Vec3& v) {
   return {v.x(), v.y(), v.z()};
@@ -146,6 +159,16 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
         molar = s.molar_mass();
       }
     }
+    if (c.solid_species_size() == 0 && molar <= 0.0) {
+      // Protocol v1.0 names composition species without molar masses (v1.1 adds
+      // Configure.solid_species): the DEM core's species table gives them.
+      molar = builtinMolarMass(name);
+      COREDEM_CHECK(molar > 0.0,
+                    "Configure: composition species '{}' has no molar mass: it is neither a gas "
+                    "species nor one of CoReDEM's solid species (C, Fe2O3, Fe3O4, Al2O3); declare "
+                    "it in Configure.solid_species (protocol v1.1)",
+                    name);
+    }
     cfg.solidSpecies.push_back({name, molar});
   }
 
@@ -194,7 +217,9 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
       d.diameter = ps.diameter();
       d.density = ps.density() > 0.0 ? ps.density() : materialDensity[ps.material_id()];
       d.temperature = ps.temperature() > 0.0 ? ps.temperature() : d.temperature;
-      d.composition.assign(solid.size(), 0.0);
+      // No composition: left empty, the DEM core puts all of the mass in the first solid
+      // species (docs/protocol.md §3).
+      d.composition.assign(ps.composition().empty() ? 0 : solid.size(), 0.0);
       for (const auto& nv : ps.composition()) {
         const auto k = std::find(solid.begin(), solid.end(), nv.name()) - solid.begin();
         d.composition[static_cast<std::size_t>(k)] = nv.value();

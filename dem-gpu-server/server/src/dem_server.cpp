@@ -10,6 +10,7 @@
 #include <random>
 
 #include <fcntl.h>
+#include <google/protobuf/stubs/logging.h>
 #include <malloc.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -72,6 +73,15 @@ const char* stateName(SessionState s) {
     return "configured";
   }
   return "?";
+}
+
+/// libprotobuf's own messages (e.g. one ERROR line per refused string field with invalid UTF-8,
+/// which any peer can trigger per message): to the log at debug level, not to stderr.
+void protobufLog(google::protobuf::LogLevel level, const char* file, int line,
+                 const std::string& message) {
+  static auto log = coredem::logger("protocol.protobuf");
+  log->debug("libprotobuf {} {}:{}: {}", static_cast<int>(level), file, line,
+             proto::printable(message, 200));
 }
 
 std::string readKey(const fs::path& p) {
@@ -405,7 +415,8 @@ struct DemServer::Impl {
     std::vector<std::string> ignored;
     try {
       COREDEM_CHECK(c.coupling_mesh().has_cartesian(), "Configure has no Cartesian coupling grid");
-      const auto cfg = toDemConfig(c, &ignored);
+      auto cfg = toDemConfig(c, &ignored);
+      cfg.interrupt = &stopFlag; // SIGINT/SIGTERM stop a long placement
       next = std::make_unique<dem::DemSystem>(cfg, dem::parseBackend(opt.backend), opt.threads);
       if (!c.initial_state_file().empty()) {
         COREDEM_CHECK(fs::exists(c.initial_state_file()), "initial state file '{}' does not exist",
@@ -421,6 +432,12 @@ struct DemServer::Impl {
         nSub = static_cast<std::uint32_t>(
             dem::TimeHandler::subStepsFor(c.sub_cycling().dt_cfd(), next->dtDemMax()));
       }
+    } catch (const dem::Interrupted& e) {
+      next.reset();
+      log->warn("session {}: Configure stopped by a signal ({})", session, e.what());
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             fmt::format("the server is stopping: Configure was {}", e.what()));
+      return;
     } catch (const coredem::UserError& e) {
       next.reset();
       ::malloc_trim(0); // give a large failed build's memory back to the system
@@ -445,6 +462,7 @@ struct DemServer::Impl {
                 session, ignored.size() - kLoggedIgnoredOptions);
     }
     system = std::move(next);
+    system->setInterruptFlag(&stopFlag); // SIGINT/SIGTERM stop a long step within a sub-step
     ledgers = restored;
     if (ledgers.speciesToGas.size() != static_cast<std::size_t>(c.species_size())) {
       ledgers.speciesToGas.assign(static_cast<std::size_t>(c.species_size()), 0.0);
@@ -605,6 +623,16 @@ struct DemServer::Impl {
     const dem::CellSources* s = nullptr;
     try {
       s = &system->advance(grant->dtCfd, static_cast<int>(grant->nSub));
+    } catch (const dem::Interrupted& e) {
+      // A signal (or DemServer::stop) during a long step: answer both members and end the
+      // session at once; run() then returns.
+      log->warn("session {}: step {} stopped by a signal ({}): ending the session", session,
+                grant->step, e.what());
+      const std::string reason = fmt::format("the server is stopping: step {} was interrupted ({})",
+                                             grant->step, e.what());
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, reason);
+      endSession(reason); // answers the StepGrant too
+      return;
     } catch (const std::exception& e) {
       log->error("session {}: step {} failed in the DEM core: {}", session, grant->step, e.what());
       refuse(r, v1::ERROR_CODE_INTERNAL,
@@ -847,6 +875,13 @@ struct DemServer::Impl {
       return;
     }
     const auto type = env.type();
+    if (type == v1::MESSAGE_TYPE_UNSPECIFIED || !v1::MessageType_IsValid(type)) {
+      // Checked first, from anyone in any state (docs/protocol.md §5): an empty message (one
+      // zero-byte frame parses as an Envelope with nothing set) or a type of a newer version.
+      const auto s = proto::validate(r.message, proto::Expectation{});
+      refuse(r, v1::ERROR_CODE_UNKNOWN_TYPE, s.message);
+      return;
+    }
     if (type == v1::MESSAGE_TYPE_HELLO) {
       onHello(r);
       return;
@@ -867,6 +902,23 @@ struct DemServer::Impl {
       refuse(r, v1::ERROR_CODE_UNKNOWN_SESSION,
              "this connection has not joined the active session: send Hello first");
       return;
+    }
+    switch (type) { // what D sends, or C sends to O: never D's to receive
+    case v1::MESSAGE_TYPE_WELCOME:
+    case v1::MESSAGE_TYPE_REJECT:
+    case v1::MESSAGE_TYPE_CONFIGURED:
+    case v1::MESSAGE_TYPE_SOURCES:
+    case v1::MESSAGE_TYPE_STEP_DONE:
+    case v1::MESSAGE_TYPE_CHECKPOINT_DONE:
+    case v1::MESSAGE_TYPE_ERROR:
+    case v1::MESSAGE_TYPE_ACK:
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             fmt::format("{} is a reply, never sent to the DEM server; it takes Hello, Configure, "
+                         "StepGrant, GasFields, CheckpointRequest, Heartbeat and Shutdown",
+                         proto::messageTypeName(type)));
+      return;
+    default:
+      break;
     }
     proto::Expectation e;
     if (type == v1::MESSAGE_TYPE_GAS_FIELDS) {
@@ -940,6 +992,7 @@ struct DemServer::Impl {
 DemServer::DemServer(ServerOptions options)
     : _impl(std::make_unique<Impl>(std::move(options))) {
   auto& m = *_impl;
+  google::protobuf::SetLogHandler(&protobufLog);
   dem::parseBackend(m.opt.backend); // fail early on a bad name
   if (!proto::isLoopbackEndpoint(m.opt.bind) && m.opt.curveKeysDir.empty()) {
     COREDEM_CHECK(

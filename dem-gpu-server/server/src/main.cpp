@@ -20,8 +20,9 @@ namespace {
 std::atomic<coredem::server::DemServer*> gServer{nullptr};
 std::atomic<int> gSignals{0};
 
-/// SIGINT/SIGTERM: the first ends the session after the message being handled; a second one
-/// (a step of many sub-steps may take long) exits at once with 128 + signal.
+/// SIGINT/SIGTERM: the first ends the session within a sub-step (a step in progress is
+/// interrupted, both members are answered) and the server exits; a second one exits at once
+/// with 128 + signal.
 extern "C" void onSignal(int sig) {
   if (gSignals.fetch_add(1) >= 1) {
     static const char kMsg[] = "coredem-dem: second signal: exiting now\n";

@@ -3,7 +3,9 @@
 // size, overflow, sessions bound to peers, log hygiene. In each, the server answers at once
 // with a specific error and keeps serving, or ends the session cleanly.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -13,8 +15,10 @@
 #include <sstream>
 #include <thread>
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <spdlog/sinks/ostream_sink.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "../client/mini_orchestrator.h"
@@ -602,7 +606,18 @@ TEST(ClientKeys, OnlyClientsOnTheAllowListAreAdmitted) {
   mallory.curve.clientSecretKey = pair.second;
   proto::Client refused(mallory);
   refused.connect(srv.endpoint());
-  EXPECT_THROW(refused.request(proto::makeHeartbeat("mallory"), 1s), proto::TimeoutError);
+  // The server answers the handshake with an ERROR (ZAP 400): the client says so at once,
+  // naming its key, instead of waiting out its deadline.
+  try {
+    (void)refused.request(proto::makeHeartbeat("mallory"), 10s);
+    ADD_FAILURE() << "a client key that is not on the allow-list must be refused";
+  } catch (const proto::TimeoutError& e) {
+    ADD_FAILURE() << "the refusal must be reported, not waited out: " << e.what();
+  } catch (const proto::ProtocolError& e) {
+    EXPECT_EQ(e.code(), v1::ERROR_CODE_SECURITY);
+    EXPECT_TRUE(contains(e.what(), pair.first)) << e.what();
+    EXPECT_TRUE(contains(e.what(), "allow-list")) << e.what();
+  }
   // The allowed client is still served.
   EXPECT_EQ(allowed.request(proto::makeHeartbeat("alice"), 10s).type(), v1::MESSAGE_TYPE_HEARTBEAT);
   // A malformed allow-list is refused at start naming the line.
@@ -620,4 +635,252 @@ TEST(ClientKeys, OnlyClientsOnTheAllowListAreAdmitted) {
     EXPECT_TRUE(contains(e.what(), "line 2")) << e.what();
   }
   std::filesystem::remove_all(dir);
+}
+
+// The persistent client pair of a user (`coredem-dem --generate-client-key DIR`), read back
+// by the clients (readClientKeyPair: DIR or DIR/client.secret): admitted by a server that
+// lists it; a secret readable by others, a mixed-up pair and a missing file are refused naming
+// the file; a server without an allow-list (and loopback without keys) admits anyone as before.
+TEST(ClientKeys, PersistentClientPairsAreReadAndChecked) {
+  namespace fs = std::filesystem;
+  const auto dir =
+      fs::temp_directory_path() / ("coredem-dem-client-pair-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  server::generateCurveKeys(dir.string());
+  server::generateClientKey((dir / "bob").string());
+  server::generateClientKey((dir / "eve").string());
+  std::string serverPub, bobPub;
+  std::ifstream(dir / "server.public") >> serverPub;
+  std::ifstream(dir / "bob" / "client.public") >> bobPub;
+  std::ofstream(dir / "authorized_keys") << bobPub << " bob\n";
+
+  const auto fromDir = proto::readClientKeyPair((dir / "bob").string());
+  const auto fromFile = proto::readClientKeyPair((dir / "bob" / "client.secret").string());
+  EXPECT_EQ(fromDir.first, bobPub);
+  EXPECT_EQ(fromDir, fromFile);
+
+  auto o = options();
+  o.curveKeysDir = dir.string();
+  o.clientKeysFile = (dir / "authorized_keys").string();
+  ServerThread srv(o);
+  auto clientOptions = [&](const std::pair<std::string, std::string>& pair) {
+    proto::TransportOptions t;
+    t.curve.serverPublicKey = serverPub;
+    t.curve.clientPublicKey = pair.first;
+    t.curve.clientSecretKey = pair.second;
+    return t;
+  };
+  proto::Client bob(clientOptions(fromFile));
+  bob.connect(srv.endpoint());
+  EXPECT_EQ(bob.request(proto::makeHeartbeat("bob"), 10s).type(), v1::MESSAGE_TYPE_HEARTBEAT);
+  proto::Client eve(clientOptions(proto::readClientKeyPair((dir / "eve").string())));
+  eve.connect(srv.endpoint());
+  try {
+    (void)eve.request(proto::makeHeartbeat("eve"), 10s);
+    ADD_FAILURE() << "eve's key is not on the allow-list";
+  } catch (const proto::TimeoutError& e) {
+    ADD_FAILURE() << "the refusal must be reported, not waited out: " << e.what();
+  } catch (const proto::ProtocolError& e) {
+    EXPECT_EQ(e.code(), v1::ERROR_CODE_SECURITY) << e.what();
+  }
+
+  // Checks of the files.
+  auto refusedWith = [&](const fs::path& path, const std::string& part) {
+    try {
+      (void)proto::readClientKeyPair(path.string());
+      ADD_FAILURE() << path << " must be refused";
+    } catch (const proto::ProtocolError& e) {
+      EXPECT_EQ(e.code(), v1::ERROR_CODE_SECURITY);
+      EXPECT_TRUE(contains(e.what(), part)) << e.what();
+      EXPECT_TRUE(contains(e.what(), path.string())) << e.what();
+    }
+  };
+  fs::permissions(dir / "eve" / "client.secret", fs::perms::group_read | fs::perms::others_read,
+                  fs::perm_options::add);
+  refusedWith(dir / "eve" / "client.secret", "chmod 600");
+  fs::copy_file(dir / "bob" / "client.public", dir / "eve" / "client.public",
+                fs::copy_options::overwrite_existing);
+  fs::permissions(dir / "eve" / "client.secret", fs::perms::owner_read | fs::perms::owner_write,
+                  fs::perm_options::replace);
+  refusedWith(dir / "eve" / "client.secret", "mixed up");
+  refusedWith(dir / "nobody", "cannot read");
+
+  // Without an allow-list any CURVE client is admitted; on loopback without keys, anyone.
+  auto open = options();
+  open.curveKeysDir = dir.string();
+  ServerThread openSrv(open);
+  proto::Client any(clientOptions(proto::generateCurveKeyPair()));
+  any.connect(openSrv.endpoint());
+  EXPECT_EQ(any.request(proto::makeHeartbeat("any"), 10s).type(), v1::MESSAGE_TYPE_HEARTBEAT);
+  ServerThread plain(options());
+  proto::Client plainClient;
+  plainClient.connect(plain.endpoint());
+  EXPECT_EQ(plainClient.request(proto::makeHeartbeat("plain"), 10s).type(),
+            v1::MESSAGE_TYPE_HEARTBEAT);
+  fs::remove_all(dir);
+}
+
+// ---- stoppable: a signal during a long step ---------------------------------------------------
+
+// coredem-dem (the program) granted a step of 10^8 sub-steps (legal under its
+// --max-sub-steps): SIGTERM during the step interrupts it within a sub-step, both members get
+// an answer naming the interruption, and the program exits 0 well before the step could end.
+TEST(Stoppable, SigtermDuringALongStepEndsTheSessionWithinASubStep) {
+  namespace fs = std::filesystem;
+  const auto dir =
+      fs::temp_directory_path() / ("coredem-dem-sigterm-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string epFile = (dir / "endpoint").string(), logFile = (dir / "dem.log").string();
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const int fd = ::open(logFile.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    ::execl(COREDEM_DEM_EXE, COREDEM_DEM_EXE, "--bind", "tcp://127.0.0.1:*", "--threads", "1",
+            "--max-sub-steps", "1000000000", "--endpoint-file", epFile.c_str(),
+            static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  auto readAll = [](const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  for (int i = 0; i < 2000 && !fs::exists(epFile); ++i) {
+    std::this_thread::sleep_for(10ms);
+  }
+  std::string ep = readAll(epFile);
+  while (!ep.empty() && std::isspace(static_cast<unsigned char>(ep.back()))) {
+    ep.pop_back();
+  }
+  ASSERT_FALSE(ep.empty()) << readAll(logFile);
+  int status = 0;
+  bool exited = false;
+  {
+    MiniOrchestrator o(ep, smallCase(kParticles, kD, kBox, kCells));
+    proto::Client cfd;
+    cfd.connect(ep);
+    proto::expectType(cfd.request(cfdHello(o.session()), 10s), v1::MESSAGE_TYPE_WELCOME);
+    const std::uint32_t nSub = 100000000;
+    const double dtDem = 0.5 * o.dtDemMax(), dt = dtDem * nSub;
+    auto g = proto::makeStepGrant(1, 0.0, dt, nSub, dtDem);
+    g.setSessionId(o.session());
+    o.dem().send(std::move(g));
+    cfd.send(gasFields(1, 0.0, dt, o.session()));
+    std::this_thread::sleep_for(500ms); // the step is running
+    ASSERT_EQ(::kill(pid, SIGTERM), 0);
+    // Liveness bound, not a timing measurement: the step itself would take minutes.
+    for (int i = 0; i < 1000 && !exited; ++i) {
+      exited = ::waitpid(pid, &status, WNOHANG) == pid;
+      if (!exited) {
+        std::this_thread::sleep_for(10ms);
+      }
+    }
+    if (exited) {
+      auto cfdReply = cfd.receive(5s);
+      ASSERT_TRUE(cfdReply.has_value());
+      EXPECT_TRUE(contains(refusal(*cfdReply, v1::ERROR_CODE_UNEXPECTED_MESSAGE), "interrupted"));
+      auto oReply = o.dem().receive(5s);
+      ASSERT_TRUE(oReply.has_value());
+      EXPECT_TRUE(contains(refusal(*oReply, v1::ERROR_CODE_UNEXPECTED_MESSAGE), "interrupted"));
+    }
+  }
+  if (!exited) {
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+    FAIL() << "coredem-dem did not exit within 10 s of SIGTERM\n" << readAll(logFile);
+  }
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+  const std::string log = readAll(logFile);
+  EXPECT_TRUE(contains(log, "stopped by a signal")) << log;
+  EXPECT_TRUE(contains(log, "interrupted after")) << log;
+  fs::remove_all(dir);
+}
+
+// ---- failures inside D: a failed step ends the session -----------------------------------------
+
+// A particle set launched at 1e300 m/s (finite, so the Configure passes) flies off in the
+// first sub-step: the DEM core fails the step. Both members get an Error naming the failure,
+// the session ends (no "step failed" to every later request), and the server serves the next
+// orchestrator.
+TEST(InternalFailure, AFailedStepEndsTheSessionAndTheServerServesTheNext) {
+  ServerThread srv(options());
+  auto c = smallCase(kParticles, kD, kBox, kCells);
+  c.mutable_particle_sets(0)->mutable_initial_velocity()->set_x(1e300);
+  MiniOrchestrator o(srv.endpoint(), c);
+  proto::Client cfd;
+  cfd.connect(srv.endpoint());
+  proto::expectType(cfd.request(cfdHello(o.session()), 10s), v1::MESSAGE_TYPE_WELCOME);
+  const double dt = 2e-4;
+  const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
+  ASSERT_LE(nSub, 1000u);
+  for (std::int64_t step = 1; step <= 3; ++step) { // the failure may need a rebuild to show
+    auto g = proto::makeStepGrant(step, dt * double(step - 1), dt, nSub, dt / nSub);
+    g.setSessionId(o.session());
+    o.dem().send(std::move(g));
+    auto reply = cfd.request(gasFields(step, dt * double(step - 1), dt, o.session()), 20s);
+    if (reply.type() == v1::MESSAGE_TYPE_SOURCES) {
+      auto done = o.dem().receive(20s);
+      ASSERT_TRUE(done.has_value());
+      ASSERT_EQ(done->type(), v1::MESSAGE_TYPE_STEP_DONE);
+      continue;
+    }
+    const auto msg = refusal(reply, v1::ERROR_CODE_INTERNAL);
+    EXPECT_TRUE(contains(msg, "failed in the DEM core")) << msg;
+    EXPECT_TRUE(contains(msg, "unstable")) << msg;
+    auto oReply = o.dem().receive(20s);
+    ASSERT_TRUE(oReply.has_value());
+    EXPECT_EQ(oReply->type(), v1::MESSAGE_TYPE_ERROR);
+    // The session is over: the next grant meets no session, a new orchestrator is welcomed.
+    auto next = proto::makeStepGrant(step + 1, dt * double(step), dt, nSub, dt / nSub);
+    next.setSessionId(o.session());
+    refusal(o.dem().request(std::move(next), 10s), v1::ERROR_CODE_NOT_CONFIGURED);
+    Orchestrator fresh(srv.endpoint());
+    EXPECT_NE(fresh.session, o.session());
+    return;
+  }
+  FAIL() << "a particle at 1e300 m/s did not fail the step";
+}
+
+// A Configure whose random packing cannot succeed (500000 particles of 1 mm in a 6 mm box:
+// about 10^9 placement attempts before it gives up): stopping the server interrupts the
+// placement; the orchestrator is answered and the server thread ends.
+TEST(Stoppable, StoppingDuringAParticlePlacementInterruptsIt) {
+  auto srv = std::make_unique<ServerThread>(options(std::uint64_t{4} << 30));
+  Orchestrator o(srv->endpoint());
+  auto c = smallCase(kParticles, kD, kBox, kCells);
+  c.mutable_particle_sets(0)->set_count(500000);
+  auto m = proto::makeConfigure(c);
+  m.setSessionId(o.session);
+  o.client.send(std::move(m));
+  std::this_thread::sleep_for(500ms); // placing
+  srv.reset(); // stop() and join: returns only once the placement has stopped
+  auto reply = o.client.receive(10s);
+  ASSERT_TRUE(reply.has_value());
+  const auto msg = refusal(*reply, v1::ERROR_CODE_UNEXPECTED_MESSAGE);
+  EXPECT_TRUE(contains(msg, "interrupted while placing particle set 'beads'")) << msg;
+}
+
+// A string field with invalid UTF-8 (any peer can send one per message): refused
+// MALFORMED_ENVELOPE, and libprotobuf's complaint goes to the log at debug level, not as an
+// unescaped line on stderr per message.
+TEST(Logs, InvalidUtf8IsRefusedWithoutALineOnStderrPerMessage) {
+  ServerThread srv(options());
+  proto::Client raw;
+  raw.connect(srv.endpoint());
+  auto hb = proto::makeHeartbeat("x");
+  hb.envelope().set_sender(std::string("bad \xff\xfe utf-8"));
+  auto frames = hb.encode();
+  ::testing::internal::CaptureStderr();
+  for (int i = 0; i < 3; ++i) {
+    raw.sendFrames(frames);
+    auto reply = raw.receive(10s);
+    ASSERT_TRUE(reply.has_value());
+    refusal(*reply, v1::ERROR_CODE_MALFORMED_ENVELOPE);
+  }
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_FALSE(contains(err, "libprotobuf")) << err;
 }

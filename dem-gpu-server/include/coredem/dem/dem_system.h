@@ -15,10 +15,12 @@
 /// All methods throw coredem::UserError on bad input, with a message that says what to fix.
 
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -147,6 +149,10 @@ struct DemConfig {
   /// temperature (K) with particle–wall conduction (kernels/wall_conduction.h); 0 = adiabatic.
   double wallTemperature = 0.0;
   int wallMaterial = 0; ///< material of the walls (its conductivity is k_w)
+  /// A stop flag (e.g. set from a signal handler), read while particles are placed: once set,
+  /// the constructor throws Interrupted. It also becomes the system's interrupt flag
+  /// (setInterruptFlag). Not part of the configuration hash. nullptr: none.
+  const std::atomic<bool>* interrupt = nullptr;
 
   /// Adds the six planes of the axis-aligned box [lo, hi] (normals pointing inwards).
   void addBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi);
@@ -206,6 +212,13 @@ struct StageTimes {
   std::uint64_t rebuilds = 0;
 };
 
+/// Thrown by DemSystem::advance() when its interrupt flag was set during the step (a signal to
+/// the server): the state is that of a partial CFD step, fit only for ending the run.
+class Interrupted : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
 /// The DEM system: particles, contacts and the sub-cycled integrator on one backend.
 /// Not thread-safe: call from one thread. On the cpu backend results are bitwise
 /// reproducible run to run and independent of the thread count (every particle gathers its
@@ -234,6 +247,11 @@ public:
   /// sub-step-averaged cell sources (empty vectors when no coupling grid).
   /// @pre dtCfd > 0, nSub >= 1, dtCfd/nSub <= dtDemMax()·(1 + 1e-12).
   const CellSources& advance(double dtCfd, int nSub);
+
+  /// A flag read before every sub-step of advance() (e.g. set from a signal handler): once it
+  /// is set, advance() stops within a sub-step and throws Interrupted. nullptr: none. The flag
+  /// must outlive the system.
+  void setInterruptFlag(const std::atomic<bool>* flag);
 
   /// Writes the full state (particles, contact history, neighbour lists, time) to HDF5.
   /// `protocolVersion` is the coupling protocol of the server that writes it ("1.1"), recorded

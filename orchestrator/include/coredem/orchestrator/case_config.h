@@ -80,7 +80,10 @@ struct DemConfig {
   int threads = 0;                 ///< 0: let the server choose
   double timeoutSeconds = 60;      ///< deadline of every request to D
   std::filesystem::path serverKey; ///< file with D's CURVE public key (Z85); empty: no CURVE
-  bool timers = false;             ///< dem.timers: coredem-dem --timers (RUN/timers-dem.json)
+  /// With serverKey: this user's client key (client.secret, or the folder holding it) for a D
+  /// with an allow-list (coredem-dem --client-keys); empty: a throw-away pair per run.
+  std::filesystem::path clientKey;
+  bool timers = false; ///< dem.timers: coredem-dem --timers (RUN/timers-dem.json)
 };
 
 struct CfdConfig {

@@ -92,6 +92,7 @@ struct LaunchInputs {
   std::filesystem::path runDir;  ///< absolute run folder
   std::string controlEndpoint, demEndpoint, session;
   std::string demServerKey;          ///< Z85 CURVE public key, empty without CURVE
+  std::string demClientKeyFile;      ///< path of the client secret key, empty: none given
   std::filesystem::path restartFile; ///< empty: a fresh start
   bool timers = false;               ///< `coredem run --timers`
 };

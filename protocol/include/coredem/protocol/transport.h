@@ -74,6 +74,15 @@ struct CurveKeys {
 /// libzmq was built without CURVE.
 std::pair<std::string, std::string> generateCurveKeyPair();
 
+/// Reads a persistent client key pair {public, secret} (Z85) for a server with an allow-list
+/// (`coredem-dem --client-keys`): `path` is the secret key file `client.secret` that
+/// `coredem-dem --generate-client-key DIR` wrote, or that DIR. The public key is derived from
+/// the secret one (and checked against `client.public` next to it when that file exists).
+/// Throws ProtocolError(SECURITY) naming the file when it cannot be read, is not a Z85 key,
+/// does not match its public key, or can be read by group or others (like ssh, a secret key
+/// must be private: chmod 600).
+std::pair<std::string, std::string> readClientKeyPair(const std::string& path);
+
 /// Reads an allow-list of client public keys: one Z85 key (40 characters) per line, then
 /// optional free text (a name); blank lines and lines starting with '#' are skipped. Throws
 /// ProtocolError(SECURITY) naming the file and line of a malformed key.

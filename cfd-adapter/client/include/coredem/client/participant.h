@@ -127,9 +127,15 @@ struct Options {
   double timeoutSeconds = 0.0; ///< per-request deadline; 0 = environment or 60 s
   std::string name = "cfd";    ///< this participant's name in logs and messages
   std::string softwareVersion; ///< e.g. "coredemFoam 0.1.0"; empty = the library's version
-  /// CURVE keys (Z85) when D requires them (remote D): D's public key; the client key pair is
-  /// generated when empty. Environment: COREDEM_DEM_SERVER_KEY.
+  /// CURVE keys (Z85) when D requires them (remote D): D's public key. Environment:
+  /// COREDEM_DEM_SERVER_KEY.
   std::string demServerPublicKey;
+  /// With demServerPublicKey: this client's persistent key pair, for a D with an allow-list
+  /// (`coredem-dem --client-keys`): the path of `client.secret` (or of the folder holding
+  /// it) written by `coredem-dem --generate-client-key DIR`; a path, never the key itself.
+  /// Empty: a throw-away pair is generated (enough for a D without an allow-list).
+  /// Environment: COREDEM_DEM_CLIENT_KEY_FILE.
+  std::string demClientKeyFile;
 };
 
 /// The coupling grid and species from O's Configure.
