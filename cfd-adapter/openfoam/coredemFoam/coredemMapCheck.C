@@ -13,12 +13,19 @@
 // Each relative error is printed ("check <name>: <error>") and compared with -tol (default
 // 1e-12): exit 1 when one exceeds it. A mesh the grid does not cover exits 2 (couplingGrid.C).
 //
+// Decomposed (mpirun -np K coredemMapCheck -parallel ...): each processor maps its own cells;
+// the sums are over all processors and the gathered values are the processors' contributions
+// added up (as the DEM server would add them in an M:1 exchange). "figure ..." lines give
+// totals to compare with a serial run of the same mesh; each processor prints the grid cells its
+// cells touch.
+//
 // Command line: coredemMapCheck -case DIR -origin '(x y z)' -spacing '(dx dy dz)'
-//   -counts '(nx ny nz)' [-tol T]
+//   -counts '(nx ny nz)' [-tol T] [-parallel]
 
 #include "fvCFD.H"
 
 #include "couplingGrid.H"
+#include "IOmanip.H"
 
 #include <cmath>
 #include <vector>
@@ -39,7 +46,6 @@ double hash01(Foam::label i, Foam::label q)
 int main(int argc, char* argv[])
 {
     argList::addNote("checks coredemFoam's map between this mesh and a coupling grid");
-    argList::noParallel();
     argList::addOption("origin", "vector", "coupling grid origin, m");
     argList::addOption("spacing", "vector", "coupling grid spacing, m");
     argList::addOption("counts", "vector", "coupling grid cells per axis");
@@ -66,6 +72,11 @@ int main(int argc, char* argv[])
     const scalar vg = grid.cellVolume();
     const std::vector<double>& Vf = grid.fluidVolume();
 
+    if (Pstream::parRun())
+    {
+        Pout<< "touched: " << label(grid.touched().size()) << " of " << grid.gridCells()
+            << " grid cells, " << mesh.nCells() << " mesh cells" << endl;
+    }
     label nPoly = 0;
     forAll(mesh.cells(), c)
     {
@@ -77,10 +88,13 @@ int main(int argc, char* argv[])
         const boundBox bb(mesh.points(), mesh.cellPoints()[c], false);
         minWidth = min(minWidth, cmptMin(bb.span()));
     }
+    reduce(nPoly, sumOp<label>());
+    reduce(minWidth, minOp<scalar>());
     Info<< "mesh: " << nPoly << " cells not hexahedra, smallest cell width " << minWidth
         << " m" << endl;
-    Info<< "map: " << nCells << " mesh cells, " << nGrid << " grid cells, "
-        << (grid.exact() ? "exact" : "overlap") << ", " << grid.overlapEntries()
+    Info<< "map: " << returnReduce(nCells, sumOp<label>()) << " mesh cells, " << nGrid << " grid cells, "
+        << (grid.exact() ? "exact" : "overlap") << ", "
+        << returnReduce(grid.overlapEntries(), sumOp<label>())
         << " overlaps, " << grid.partialCells() << " partial, " << grid.emptyCells()
         << " empty, weights in " << seconds << " s" << endl;
 
@@ -92,8 +106,7 @@ int main(int argc, char* argv[])
     };
 
     // Volume.
-    double vMesh = 0, vFluid = 0;
-    forAll(V, c) vMesh += V[c];
+    double vMesh = gSum(V), vFluid = 0;
     for (const double v : Vf) vFluid += v;
     report("volume", mag(vFluid - vMesh)/vMesh);
 
@@ -119,6 +132,7 @@ int main(int argc, char* argv[])
                 }
             }
             for (label c = 0; c < nCells; ++c) cfd += cell[3*c + q]*V[c];
+            reduce(cfd, sumOp<scalar>());
             worst = max(worst, mag(cfd - dem)/abs);
         }
         report("sources", worst);
@@ -138,19 +152,30 @@ int main(int argc, char* argv[])
         grid.scatter(eps.data(), 1, e.data(), CoredemGrid::Quantity::GasFraction);
         double cfd = 0;
         forAll(e, c) cfd += (1 - e[c])*V[c];
+        reduce(cfd, sumOp<scalar>());
         report("fraction_solid_volume", mag(cfd - solid)/solid);
-        report("fraction_range", (min(e) > 0 && max(e) <= 1) ? 0 : 1);
+        report("fraction_range", (gMin(e) > 0 && gMax(e) <= 1) ? 0 : 1);
 
         const double phi = 0.4;
         for (label g = 0; g < nGrid; ++g) eps[g] = 1 - phi*Vf[g]/vg;
         grid.scatter(eps.data(), 1, e.data(), CoredemGrid::Quantity::GasFraction);
-        report("fraction_uniform", max(mag(e - (1 - phi))));
+        report("fraction_uniform", gMax(mag(e - (1 - phi))));
     }
 
-    // Gather.
+    // Gather (decomposed: the processors' contributions added up, as the DEM server would).
     {
+        auto combine = [&](std::vector<double>& out)
+        {
+            if (!Pstream::parRun()) return;
+            List<scalar> sum(label(out.size()));
+            forAll(sum, i) sum[i] = out[i];
+            Pstream::listCombineGather(sum, plusEqOp<scalar>());
+            Pstream::listCombineScatter(sum);
+            forAll(sum, i) out[i] = sum[i];
+        };
         std::vector<double> u(nCells, 3.5), out;
         grid.gather(u.data(), 1, out);
+        combine(out);
         double worst = 0;
         for (const double v : out) worst = max(worst, mag(v - 3.5)/3.5);
         report("gather_constant", worst);
@@ -162,10 +187,21 @@ int main(int argc, char* argv[])
             cfd += u[c]*V[c];
             abs += mag(u[c])*V[c];
         }
+        reduce(cfd, sumOp<scalar>());
+        reduce(abs, sumOp<scalar>());
         grid.gather(u.data(), 1, out);
-        double dem = 0;
-        for (label g = 0; g < nGrid; ++g) dem += out[g]*Vf[g];
+        combine(out);
+        double dem = 0, umax = 0;
+        for (label g = 0; g < nGrid; ++g)
+        {
+            dem += out[g]*Vf[g];
+            umax = max(umax, out[g]);
+        }
         report("gather_conservative", mag(dem - cfd)/abs);
+        // Figures to compare between a serial and a decomposed run of the same mesh.
+        Info<< "figure fluid_volume: " << setprecision(17) << vFluid << nl
+            << "figure gathered_total: " << dem << nl
+            << "figure gathered_max: " << umax << setprecision(6) << endl;
     }
 
     Info<< (ok ? "map checks passed" : "map checks FAILED") << nl << "End" << endl;

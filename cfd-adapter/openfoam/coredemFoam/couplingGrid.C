@@ -97,20 +97,13 @@ CoredemGrid::CoredemGrid
                 << ", counts (" << nx << ' ' << ny << ' ' << nz << ")" << exit(FatalError, 2);
         }
     }
-    if (Pstream::parRun())
-    {
-        FatalErrorInFunction
-            << "coredemFoam runs serially; the coupling map is written for decomposed cases "
-            << "(global grid indices per cell) but the exchange is not. Run without -parallel."
-            << exit(FatalError, 2);
-    }
-
     // Is the mesh the grid? Every cell a hexahedron whose bounding box is one grid cell
     // (tolerance 1e-6 of the smallest spacing), every grid cell covered once.
     const scalar tol = 1e-6*min(h_.x(), min(h_.y(), h_.z()));
     const pointField& pts = mesh.points();
     const cellList& cells = mesh.cells();
-    exact_ = mesh.nCells() == nGrid_;
+    // A processor's share of a decomposed mesh is never the whole grid: overlap map.
+    exact_ = mesh.nCells() == nGrid_ && !Pstream::parRun();
     std::vector<label> owner(exact_ ? nGrid_ : 0, -1);
     for (label celli = 0; exact_ && celli < mesh.nCells(); ++celli)
     {
@@ -266,6 +259,24 @@ void CoredemGrid::computeOverlaps(const fvMesh& mesh)
     {
         fluidVolume_[overlapGrid_[e]] += overlapVol_[e];
     }
+    // The grid cells this processor's cells touch, with its part of their fluid volume.
+    for (label g = 0; g < nGrid_; ++g)
+    {
+        if (fluidVolume_[g] > 0)
+        {
+            touched_.push_back(g);
+            partialVolume_.push_back(fluidVolume_[g]);
+        }
+    }
+    if (Pstream::parRun())
+    {
+        // Decomposed: the fluid volume is the sum of the processors' parts (once per mesh).
+        List<scalar> total(nGrid_);
+        for (label g = 0; g < nGrid_; ++g) total[g] = fluidVolume_[g];
+        Pstream::listCombineGather(total, plusEqOp<scalar>());
+        Pstream::listCombineScatter(total);
+        for (label g = 0; g < nGrid_; ++g) fluidVolume_[g] = total[g];
+    }
     for (label g = 0; g < nGrid_; ++g)
     {
         const double vf = fluidVolume_[g];
@@ -327,7 +338,9 @@ void CoredemGrid::gather
         }
         return;
     }
-    // Overlap-weighted averages; grid cells without fluid get the domain's average.
+    // Overlap-weighted averages; grid cells without fluid get the domain's average. Decomposed,
+    // each processor's values are its contributions sum_{c here} A u_c / V_f,g, which add up
+    // over the processors to the average (the domain average of empty cells is the master's).
     std::vector<double> total(std::size_t(nComp), 0.0);
     double volume = 0;
     const label nCells = label(rowStart_.size()) - 1;
@@ -343,13 +356,37 @@ void CoredemGrid::gather
         for (label q = 0; q < nComp; ++q) total[q] += cellVol_[celli]*v[q];
         volume += cellVol_[celli];
     }
+    if (Pstream::parRun())
+    {
+        for (label q = 0; q < nComp; ++q) reduce(total[q], sumOp<scalar>());
+        reduce(volume, sumOp<scalar>());
+        if (!Pstream::master()) volume = -1;
+    }
     for (label g = 0; g < nGrid_; ++g)
     {
         double* o = out.data() + std::size_t(g)*nComp;
         const double vf = fluidVolume_[g];
         for (label q = 0; q < nComp; ++q)
         {
-            o[q] = vf > 0 ? o[q]/vf : total[q]/volume;
+            o[q] = vf > 0 ? o[q]/vf : (volume > 0 ? total[q]/volume : 0.0);
+        }
+    }
+}
+
+
+void CoredemGrid::gatherTouched
+(
+    const scalar* cellValues, label nComp, std::vector<double>& out
+) const
+{
+    std::vector<double> full;
+    gather(cellValues, nComp, full);
+    out.resize(touched_.size()*std::size_t(nComp));
+    for (std::size_t t = 0; t < touched_.size(); ++t)
+    {
+        for (label q = 0; q < nComp; ++q)
+        {
+            out[t*nComp + q] = full[std::size_t(touched_[t])*nComp + q];
         }
     }
 }
