@@ -60,7 +60,11 @@ void CouplingExchange::exchange(label step, scalar dt)
         CouplingOutput& out = *outputs_[i];
         out.update();
         ConstView v = out.cellValues();
-        if (!direct_ && !out.uniform())
+        if (out.onGrid())
+        {
+            // Per grid cell already.
+        }
+        else if (!direct_ && !out.uniform())
         {
             grid_.gather(v.data, out.nComponents(), gathered_[i]);
             v = gathered_[i];

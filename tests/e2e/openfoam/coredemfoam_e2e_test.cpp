@@ -481,6 +481,68 @@ particles:
   EXPECT_NEAR(measured["graded"] / measured["uniform"], 1.0, 0.01);
 }
 
+// Coupling cells partly outside the fluid: the column is 9 mm wide in the 10 mm coupling grid,
+// so the last column of coupling cells is half fluid (the DEM is told their fluid fraction).
+// A lattice bed of 9 x 16 x 10 beads has the voidage 1 - pi/6 of the fluid volume everywhere,
+// the half cells included, so the pressure drop is the full-width bed's (10 x 16 x 10 beads on
+// the uniform mesh, run here too): Ergun within 5% and the full-width run within 1%; the solid
+// volume the gas sees is the particles' (1e-9).
+TEST_F(CoredemFoamE2E, PartlyFilledCouplingCellsGiveTheErgunPressureDrop) {
+  const double u = 0.3;
+  std::map<std::string, double> measured;
+  for (const std::string width : {"full", "partial"}) {
+    const bool partial = width == "partial";
+    const int count = partial ? 1440 : 1600;
+    const fs::path d = dir / width;
+    fs::path c = makeCase(d, u, 293.15,
+                          std::string("time: {end: 0.012, dt: 1.0e-3}\n"
+                                      "materials:\n"
+                                      "  - {name: glass, density: 2500.0, k_n: 100.0, e_n: 0.5, "
+                                      "friction: 0.3}\n"
+                                      "particles:\n"
+                                      "  - {name: bed, material: glass, count: ") +
+                              std::to_string(count) +
+                              ", diameter: 1.0e-3, packing: lattice,\n"
+                              "     region: {min: [0.0, 0.004, 0.0], max: [" +
+                              (partial ? "0.009" : "0.01") + ", 0.020, 0.01]}}\n");
+    if (partial) {
+      const std::string yaml = readAll(c / "case.yaml");
+      ASSERT_NE(yaml.find("max: [0.01, 0.04, 0.01]"), std::string::npos);
+      writeAll(c / "case.yaml",
+               replaceAll(yaml, "max: [0.01, 0.04, 0.01]", "max: [0.009, 0.04, 0.01]"));
+      const fs::path dict = c / "openfoam" / "system" / "blockMeshDict";
+      std::string mesh = readAll(dict);
+      ASSERT_NE(mesh.find("(0.01 0    0)    (0.01 0.04 0)"), std::string::npos);
+      mesh = replaceAll(mesh, "(0.01 0    0)    (0.01 0.04 0)", "(0.009 0 0) (0.009 0.04 0)");
+      mesh =
+          replaceAll(mesh, "(0.01 0    0.01) (0.01 0.04 0.01)", "(0.009 0 0.01) (0.009 0.04 0.01)");
+      mesh = replaceAll(mesh, "(5 20 5) simpleGrading", "(9 20 5) simpleGrading");
+      writeAll(dict, mesh);
+    }
+    const fs::path run = d / "run";
+    ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, d / "coredem.log"), 0)
+        << readAll(d / "coredem.log") << logTail(run);
+    if (partial) {
+      EXPECT_NE(readAll(run / "logs" / "cfd.log").find("100 coupling cells partly and 0 not"),
+                std::string::npos)
+          << logTail(run);
+    }
+    auto ts = readTimeseries(run);
+    const auto& dp = ts["gas.pressure_drop_Pa"];
+    ASSERT_EQ(dp.size(), 12u);
+    const double vp = std::numbers::pi / 6.0 * kDp * kDp * kDp;
+    EXPECT_NEAR(ts["gas.solid_volume_m3"].back(), count * vp, 1e-9 * count * vp) << width;
+    measured[width] = (dp[9] + dp[10] + dp[11]) / 3.0;
+  }
+  const double eps = 1.0 - std::numbers::pi / 6.0, bed = 0.016;
+  const double expected = ergunGradient(eps, u) * bed + kRhoG * kG * kHeight;
+  std::cout << "partly filled coupling cells: pressure drop " << measured["partial"]
+            << " Pa, full width " << measured["full"] << " Pa, Ergun + gas column " << expected
+            << " Pa (" << 100.0 * (measured["partial"] / expected - 1.0) << " %)\n";
+  EXPECT_NEAR(measured["partial"] / expected, 1.0, 0.05);
+  EXPECT_NEAR(measured["partial"] / measured["full"], 1.0, 0.01);
+}
+
 // A coupling grid that does not cover the fluid domain (the mesh is 2 mm taller than the
 // grid) is refused before the first step with the first uncovered mesh cell named.
 TEST_F(CoredemFoamE2E, MeshOutsideTheCouplingGridIsRefusedNamingTheCell) {
