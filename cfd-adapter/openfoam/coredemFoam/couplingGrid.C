@@ -288,6 +288,8 @@ void CoredemGrid::computeOverlaps(const fvMesh& mesh)
         }
         else if (mag(vf - vg) <= 1e-12*vg)
         {
+            // All fluid (to round-off).
+            fluidVolume_[g] = vg;
             fluidScale_[g] = 1;
         }
         else
