@@ -432,6 +432,8 @@ public:
       const double* rhoH = gf->rhoG.h();
       const double* ygH = gf->Yg.h();
       const double* epsFrozen = w.cells.epsFrozenHost();
+      // Per coupling-cell volume: the gas fraction of the cell is φ_f ε_g (ε_g of the fluid).
+      const double* fluid = gf->has(gf->fluid) ? gf->fluid.h() : nullptr;
       std::vector<double> srcSum(static_cast<std::size_t>(nG), 0.0);
       double heat = 0.0;
       for (std::size_t c = 0; c < nc; ++c) {
@@ -440,8 +442,9 @@ public:
           const int k = cp.gasIndex[g];
           y[g] = k >= 0 ? ygH[c * nG + k] : 0.0;
         }
-        const kernels::WgsCellSources w =
-            kernels::wgsCellSources(cp.wgsParams, tgH[c], epsFrozen[c], rhoH[c], y, window);
+        const kernels::WgsCellSources w = kernels::wgsCellSources(
+            cp.wgsParams, tgH[c], fluid != nullptr ? fluid[c] * epsFrozen[c] : epsFrozen[c],
+            rhoH[c], y, window);
         for (int g = 0; g < kernels::kGasSpeciesCount; ++g) {
           const int k = cp.gasIndex[g];
           if (k < 0)

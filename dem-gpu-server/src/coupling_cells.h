@@ -97,9 +97,11 @@ public:
   }
 
   /// Window start: cells and sort from the current positions, then ε_g of every cell (PCM).
-  /// Reads pos, radius; writes pcell, perm, cStart, cEnd, epsFrozen.
+  /// `fluid` (device, nCells; nullptr: 1 everywhere) is the fluid fraction φ_f of each cell:
+  /// ε_g = 1 − V_s/(φ_f V_c); a cell without fluid keeps ε_g = 1 − V_s/V_c (a particle there is
+  /// refused by the engine). Reads pos, radius; writes pcell, perm, cStart, cEnd, epsFrozen.
   void freeze(Exec& exec, ParticleStore<Exec>& p, const kernels::GridParams& grid,
-              double cellVolume) {
+              double cellVolume, const double* fluid = nullptr) {
     computeCells(exec, p, grid);
     sort(exec, p.n);
     const std::uint32_t* cs = _cStart.d();
@@ -121,7 +123,8 @@ public:
       double vs = 0.0;
       for (std::uint32_t k = cs[c]; k < ce[c]; ++k)
         vs += kernels::sphereVolume(r[perm[k]]);
-      eps[c] = kernels::pcmGasFraction(vs, vc);
+      eps[c] = fluid != nullptr && fluid[c] > 0.0 ? kernels::pcmGasFraction(vs, vc * fluid[c])
+                                                  : kernels::pcmGasFraction(vs, vc);
     });
     _epsFrozen.markDeviceModified();
   }

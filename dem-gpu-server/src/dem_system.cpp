@@ -583,6 +583,12 @@ void DemSystem::setGasFields(const GasFieldsView& gas) {
   g.kappaG = check(gas.kappaG, nc, "kappa_g", true, true);
   g.cpG = check(gas.cpG, nc, "cp_g", true, true);
   g.Yg = check(gas.Yg, nc * ns, "Y_g", true, false);
+  g.fluidFraction = check(gas.fluidFraction, nc, "fluid_fraction", true, false);
+  for (std::size_t k = 0; k < g.fluidFraction.size(); ++k) {
+    COREDEM_CHECK(g.fluidFraction[k] >= 0.0 && g.fluidFraction[k] <= 1.0,
+                  "setGasFields: fluid_fraction[{}] = {} must lie in [0, 1]", k,
+                  g.fluidFraction[k]);
+  }
   m.engine->setGas(g);
 }
 

@@ -85,6 +85,7 @@ void compactParticles(HostState& s, const std::vector<std::size_t>& keep);
 /// Host copies of the gas fields (per cell).
 struct GasArrays {
   std::vector<double> ug, gradP, Tg, rhoG, muG, kappaG, cpG, Yg;
+  std::vector<double> fluidFraction; ///< empty: every cell all fluid
 };
 
 class Engine {

@@ -27,6 +27,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
 #include "backend/arrays.h"
@@ -362,6 +363,36 @@ public:
   }
   const GasFields<Exec>* gasOrNull() const { return _hasGas && _s.coupled ? &_gas : nullptr; }
 
+  /// A particle in a coupling cell without fluid (φ_f = 0: outside the CFD domain) is an error
+  /// naming it (host check of the frozen ε_g; particle positions copied only on error).
+  void refuseParticlesOutsideTheFluid(const GasFields<Exec>& gas) {
+    const double* f = gas.fluid.h();
+    const double* eps = _cells.epsFrozenHost();
+    for (std::size_t c = 0; c < _s.nCells; ++c) {
+      if (f[c] > 0.0 || eps[c] >= 1.0)
+        continue;
+      ParticleData pd;
+      particles(pd);
+      for (std::size_t i = 0; i < pd.count; ++i) {
+        const kernels::Vec3 x{pd.position[3 * i], pd.position[3 * i + 1], pd.position[3 * i + 2]};
+        if (kernels::pcmCell(_s.grid, x) == static_cast<long long>(c)) {
+          const auto num = [](double v) {
+            char b[32];
+            std::snprintf(b, sizeof b, "%.6g", v);
+            return std::string(b);
+          };
+          backend::raiseUserError(
+              "particle " + std::to_string(pd.globalId[i]) + " at (" + num(x.x) + ", " + num(x.y) +
+              ", " + num(x.z) + ") m lies in coupling cell " + std::to_string(c) +
+              ", which holds no fluid (fluid_fraction 0: outside the CFD domain); check the "
+              "walls against the CFD mesh");
+        }
+      }
+      backend::raiseUserError("coupling cell " + std::to_string(c) +
+                              " holds solid but no fluid (fluid_fraction 0)");
+    }
+  }
+
   /// Freezes ε_g (PCM at the current positions) and clears every module's window accumulators.
   void beginWindow() override {
     StepContext<Exec> ctx = stepContext(0.0);
@@ -370,7 +401,12 @@ public:
       return;
     const auto t0 = Clock::now();
     _p.require(kPos | kRadius);
-    _cells.freeze(_exec, _p, _s.grid, _s.cellVolume);
+    const GasFields<Exec>* gas = gasOrNull();
+    const bool fluid = gas != nullptr && gas->has(gas->fluid);
+    _cells.freeze(_exec, _p, _s.grid, _s.cellVolume, fluid ? gas->fluid.d() : nullptr);
+    if (fluid) {
+      refuseParticlesOutsideTheFluid(*gas);
+    }
     _drag.beginWindow(ctx);
     _heat.beginWindow(ctx);
     Exec::synchronize();

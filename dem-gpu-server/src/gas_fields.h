@@ -17,6 +17,7 @@ struct GasFields {
   using Arr = backend::DualArray<double, Exec>;
 
   Arr ug, gradP, Tg, rhoG, muG, kappaG, cpG, Yg;
+  Arr fluid; ///< φ_f per cell (empty: 1 everywhere)
 
   static bool has(const Arr& a) { return a.size() > 0; }
 
@@ -30,11 +31,12 @@ struct GasFields {
     upload(kappaG, g.kappaG);
     upload(cpG, g.cpG);
     upload(Yg, g.Yg);
+    upload(fluid, g.fluidFraction);
   }
 
   std::size_t bytes() const {
     std::size_t b = 0;
-    for (const Arr* a : {&ug, &gradP, &Tg, &rhoG, &muG, &kappaG, &cpG, &Yg})
+    for (const Arr* a : {&ug, &gradP, &Tg, &rhoG, &muG, &kappaG, &cpG, &Yg, &fluid})
       b += a->bytes();
     return b;
   }

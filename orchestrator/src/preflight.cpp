@@ -254,6 +254,80 @@ bool close(double a, double b) {
   return std::abs(a - b) <= kFoamEqualityRelTol * std::max(std::abs(a), std::abs(b));
 }
 
+/// The bounding box of an OpenFOAM case's mesh points, from constant/polyMesh/points (ASCII) or,
+/// before meshing, from the vertices of system/blockMeshDict (times its scale); the file it came
+/// from. nullopt when neither can be read simply (binary or compressed points, macros, ...).
+struct MeshBounds {
+  Vec3 lo, hi;
+  std::string from;
+};
+
+std::optional<MeshBounds> foamMeshBounds(const fs::path& dir) {
+  auto read = [](const fs::path& file) -> std::optional<std::string> {
+    std::ifstream in(file);
+    if (!in) {
+      return std::nullopt;
+    }
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  auto bounds = [](const std::string& list, double scale) -> std::optional<std::pair<Vec3, Vec3>> {
+    static const std::regex point("\\(\\s*([-+0-9.eE]+)\\s+([-+0-9.eE]+)\\s+([-+0-9.eE]+)\\s*\\)");
+    Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
+    std::size_t n = 0;
+    for (std::sregex_iterator it(list.begin(), list.end(), point), end; it != end; ++it, ++n) {
+      for (int d = 0; d < 3; ++d) {
+        const double v = std::strtod((*it)[d + 1].str().c_str(), nullptr) * scale;
+        lo[d] = std::min(lo[d], v);
+        hi[d] = std::max(hi[d], v);
+      }
+    }
+    if (n == 0) {
+      return std::nullopt;
+    }
+    return std::make_pair(lo, hi);
+  };
+  const fs::path pointsFile = dir / "constant" / "polyMesh" / "points";
+  if (const auto text = read(pointsFile)) {
+    if (text->find("binary") != std::string::npos) {
+      return std::nullopt;
+    }
+    const auto open = text->find('(', text->find('}') == std::string::npos ? 0 : text->find('}'));
+    if (open == std::string::npos) {
+      return std::nullopt;
+    }
+    if (const auto b = bounds(text->substr(open + 1), 1.0)) {
+      return MeshBounds{b->first, b->second, pointsFile.string()};
+    }
+    return std::nullopt;
+  }
+  const fs::path dictFile = dir / "system" / "blockMeshDict";
+  const auto text = read(dictFile);
+  if (!text || text->find('$') != std::string::npos ||
+      text->find("#include") != std::string::npos || text->find("#calc") != std::string::npos) {
+    return std::nullopt;
+  }
+  double scale = 1.0;
+  for (const char* key : {"scale", "convertToMeters"}) {
+    if (const auto e = foamEntry(dictFile, key)) {
+      if (const auto v = foamScalar(e->value)) {
+        scale = *v;
+      }
+    }
+  }
+  const auto v = text->find("vertices");
+  const auto open = v == std::string::npos ? v : text->find('(', v);
+  const auto shut = open == std::string::npos ? open : text->find(");", open);
+  if (shut == std::string::npos) {
+    return std::nullopt;
+  }
+  if (const auto b = bounds(text->substr(open + 1, shut - open - 1), scale)) {
+    return MeshBounds{b->first, b->second, dictFile.string()};
+  }
+  return std::nullopt;
+}
+
 } // namespace
 
 std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
@@ -485,6 +559,41 @@ void checkOpenFoamCase(const CaseConfig& c) {
   }
   if (kappa) {
     compare("conductivity", gp.conductivity, kappa->first, "kappa", kappa->second, "W/m/K");
+  }
+  // The coupling grid covers the fluid domain: the mesh's points lie in the grid's box (the grid
+  // is a box, so that is enough; coredemFoam checks every cell's volume again at start). Curved
+  // blockMesh edges can bulge beyond the vertices: coredemFoam catches those.
+  if (const auto mesh = foamMeshBounds(dir)) {
+    for (int d = 0; d < 3; ++d) {
+      const double lo = c.grid.origin[d];
+      const double hi = lo + c.grid.spacing[d] * double(c.grid.cells[d]);
+      const double tol = 1e-6 * c.grid.spacing[d];
+      if (mesh->lo[d] < lo - tol || mesh->hi[d] > hi + tol) {
+        const char* axis[] = {"x", "y", "z"};
+        at.fail({"grid"}, "grid",
+                fmt::format("the coupling grid spans {} = [{:.6g}, {:.6g}] m but the CFD mesh "
+                            "({}) spans [{:.6g}, {:.6g}] m: the coupling grid must cover the "
+                            "fluid domain; enlarge grid.cells or move grid.origin",
+                            axis[d], lo, hi, mesh->from, mesh->lo[d], mesh->hi[d]));
+      }
+    }
+    // The particles' walls inside the CFD domain: particles beyond the mesh would sit in coupling
+    // cells without fluid (the DEM server refuses them at the first step).
+    if (c.walls.box) {
+      for (int d = 0; d < 3; ++d) {
+        const double tol = 1e-6 * c.grid.spacing[d];
+        if (c.walls.box->first[d] < mesh->lo[d] - tol ||
+            c.walls.box->second[d] > mesh->hi[d] + tol) {
+          const char* axis[] = {"x", "y", "z"};
+          at.fail({"walls", "box"}, "walls.box",
+                  fmt::format("the particle walls span {} = [{:.6g}, {:.6g}] m but the CFD mesh "
+                              "({}) spans [{:.6g}, {:.6g}] m: particles beyond the mesh get no "
+                              "gas; shrink walls.box or enlarge the mesh",
+                              axis[d], c.walls.box->first[d], c.walls.box->second[d], mesh->from,
+                              mesh->lo[d], mesh->hi[d]));
+        }
+      }
+    }
   }
 }
 

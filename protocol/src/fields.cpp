@@ -17,6 +17,10 @@ constexpr std::array<FieldSpec, 8> kGasFields{{
     {kGasMassFractions, v1::EXTENT_SPECIES, "-", "gas species mass fractions"},
 }};
 
+constexpr std::array<FieldSpec, 1> kOptionalGasFields{{
+    {kFluidFraction, v1::EXTENT_SCALAR, "-", "fluid fraction of the coupling cell's volume"},
+}};
+
 constexpr std::array<FieldSpec, 7> kSourceFields{{
     {kVoidFraction, v1::EXTENT_SCALAR, "-", "gas volume fraction eps_g"},
     {kDragCoefficient, v1::EXTENT_SCALAR, "kg/m3/s", "implicit drag coefficient K_sl"},
@@ -31,12 +35,20 @@ constexpr std::array<FieldSpec, 7> kSourceFields{{
 std::span<const FieldSpec> gasFields() {
   return kGasFields;
 }
+std::span<const FieldSpec> optionalGasFields() {
+  return kOptionalGasFields;
+}
 std::span<const FieldSpec> sourceFields() {
   return kSourceFields;
 }
 
 const FieldSpec* findField(std::string_view name) {
   for (const auto& f : kGasFields) {
+    if (f.name == name) {
+      return &f;
+    }
+  }
+  for (const auto& f : kOptionalGasFields) {
     if (f.name == name) {
       return &f;
     }

@@ -231,7 +231,26 @@ Status validate(const Message& message, const Expectation& e) {
     }
     auto required =
         type == v1::MESSAGE_TYPE_GAS_FIELDS ? fields::gasFields() : fields::sourceFields();
-    return checkArrays(message, required, *e.cells, *e.species, e.requireFinite);
+    Status st = checkArrays(message, required, *e.cells, *e.species, e.requireFinite);
+    if (!st.ok() || type != v1::MESSAGE_TYPE_GAS_FIELDS) {
+      return st;
+    }
+    // Optional GasFields arrays: when present, the same dtype and shape rules.
+    for (const auto& spec : fields::optionalGasFields()) {
+      const auto v = message.findArray(spec.name);
+      if (!v) {
+        continue;
+      }
+      const auto expected = fields::shapeOf(spec.extent, *e.cells, *e.species);
+      if (v->dtype() != v1::DTYPE_FLOAT64 || v->shape() != expected) {
+        return Status::error(v1::ERROR_CODE_SHAPE,
+                             "array '" + std::string(spec.name) + "' has dtype " +
+                                 dtypeName(v->dtype()) + " and shape " + shapeString(v->shape()) +
+                                 " but float64 " + shapeString(expected) + " was expected for " +
+                                 std::to_string(*e.cells) + " configured cells");
+      }
+    }
+    return st;
   }
   return checkArrays(message, {}, 0, 0, e.requireFinite);
 }
@@ -295,6 +314,14 @@ Status validateGasRanges(const Message& m, const GasRanges& r) {
   }
   if (Status s = magnitudes(f::kPressureGradient, r.pressureGradientMax, "Pa/m"); !s.ok()) {
     return s;
+  }
+  if (const auto ff = m.findArray(f::kFluidFraction); ff && ff->dtype() == v1::DTYPE_FLOAT64) {
+    const auto v = ff->as<double>();
+    for (std::size_t c = 0; c < v.size(); ++c) {
+      if (!(v[c] >= 0.0 && v[c] <= 1.0)) {
+        return outOfRange(f::kFluidFraction, c, std::string(f::kFluidFraction), v[c], 0.0, 1.0, "");
+      }
+    }
   }
   const auto& body = m.envelope().gas_fields();
   const std::size_t ns = body.species_count();

@@ -276,12 +276,14 @@ struct Participant::Impl {
     const auto ns = static_cast<std::uint64_t>(grid.species.size());
     std::map<std::string, ConstView> given;
     for (const auto& f : fields) {
+      const auto named = [&](const auto& spec) { return spec.name == f.name; };
       COREDEM_CHECK(proto::fields::findField(f.name) != nullptr &&
-                        std::any_of(proto::fields::gasFields().begin(),
-                                    proto::fields::gasFields().end(),
-                                    [&](const auto& spec) { return spec.name == f.name; }),
+                        (std::any_of(proto::fields::gasFields().begin(),
+                                     proto::fields::gasFields().end(), named) ||
+                         std::any_of(proto::fields::optionalGasFields().begin(),
+                                     proto::fields::optionalGasFields().end(), named)),
                     "exchange: '{}' is not a GasFields array; the names are u_g, grad_p, T_g, "
-                    "rho_g, mu_g, kappa_g, cp_g, Y_g",
+                    "rho_g, mu_g, kappa_g, cp_g, Y_g (and optionally fluid_fraction)",
                     f.name);
       COREDEM_CHECK(given.emplace(f.name, f.values).second, "exchange: field '{}' given twice",
                     f.name);
@@ -322,6 +324,19 @@ struct Participant::Impl {
       // One copy into the message: zero-copy would leave ZeroMQ pointing into the caller's
       // arrays after a timed-out request, when the caller may already have freed them.
       msg.addArray<double>(name, std::span<const double>(it->second.data, it->second.size), shape);
+    }
+    for (const auto& spec : proto::fields::optionalGasFields()) {
+      const std::string name(spec.name);
+      const auto it = given.find(name);
+      if (it == given.end()) {
+        continue;
+      }
+      const std::uint64_t n = cells * proto::fields::componentsOf(spec.extent, ns);
+      COREDEM_CHECK(it->second.size == n && (n == 0 || it->second.data != nullptr),
+                    "exchange: '{}' has {} values; the coupling grid has {} cells, so it needs {}",
+                    name, it->second.size, cells, n);
+      msg.addArray<double>(name, std::span<const double>(it->second.data, it->second.size),
+                           proto::fields::shapeOf(spec.extent, cells, ns));
     }
     const auto t1 = Clock::now();
     const std::string what = "Sources for step " + std::to_string(step);

@@ -6,7 +6,8 @@
 //
 //   1. send the gas at the start of the step (U, grad p, T, properties, Y) to the DEM server,
 //      which sub-cycles its particles over dt and answers with sub-step-averaged sources:
-//      eps_g, K_sl, K_sl*U_s, H, H*T_p, R_k, Q_hom (PCM cells = this mesh's cells);
+//      eps_g, K_sl, K_sl*U_s, H, H*T_p, R_k, Q_hom on the coupling grid (PCM cells), mapped to
+//      and from this mesh by couplingGrid.H (any mesh the grid covers);
 //   2. advance the gas over the same dt with them: alphac (including d(alphac)/dt in
 //      continuity), implicit drag Sp(K_sl/rho) + explicit K_sl U_s/rho, particle heat implicit
 //      in T, species sources;

@@ -6,6 +6,19 @@
 namespace Foam
 {
 
+namespace
+{
+
+CoredemGrid::Quantity quantity(const CouplingInput& in)
+{
+    return in.gasFraction()
+        ? CoredemGrid::Quantity::GasFraction
+        : CoredemGrid::Quantity::Density;
+}
+
+} // namespace
+
+
 CouplingExchange::CouplingExchange
 (
     ::coredem::client::Participant& coupling,
@@ -26,7 +39,11 @@ CouplingExchange::CouplingExchange
     const char* mode = std::getenv("COREDEM_FOAM_EXCHANGE");
     direct_ = grid_.identity() && !(mode != nullptr && std::string(mode) == "copy");
     Info<< "Exchange: "
-        << (direct_ ? "in place (mesh cells in grid order)" : "gather/scatter copies")
+        << (
+               direct_ ? "in place (mesh cells in grid order)"
+             : grid_.exact() ? "gather/scatter copies"
+             : "overlap map (volume-weighted gather, conservative scatter)"
+           )
         << nl << endl;
 }
 
@@ -43,9 +60,23 @@ void CouplingExchange::exchange(label step, scalar dt)
         CouplingOutput& out = *outputs_[i];
         out.update();
         ConstView v = out.cellValues();
-        if (!direct_ && !out.uniform())
+        if (out.onGrid())
+        {
+            // Per grid cell already.
+        }
+        else if (!direct_ && !out.uniform())
         {
             grid_.gather(v.data, out.nComponents(), gathered_[i]);
+            v = gathered_[i];
+        }
+        else if (!grid_.exact() && out.uniform())
+        {
+            // The same value in every grid cell.
+            gathered_[i].assign
+            (
+                std::size_t(grid_.gridCells())*out.nComponents(),
+                out.nComponents() > 0 && v.size > 0 ? v.data[0] : 0.0
+            );
             v = gathered_[i];
         }
         fields.push_back({out.name(), v});
@@ -105,7 +136,7 @@ void CouplingExchange::exchange(label step, scalar dt)
         double* storage = in->cellStorage();
         if (storage != nullptr)
         {
-            if (v.data != storage) grid_.scatter(v.data, nComp, storage);
+            if (v.data != storage) grid_.scatter(v.data, nComp, storage, quantity(*in));
             in->read(storage);
         }
         else if (direct_)
@@ -115,7 +146,7 @@ void CouplingExchange::exchange(label step, scalar dt)
         else
         {
             scattered_.assign(nc*nComp, 0.0);
-            grid_.scatter(v.data, nComp, scattered_.data());
+            grid_.scatter(v.data, nComp, scattered_.data(), quantity(*in));
             in->read(scattered_.data());
         }
     }

@@ -611,6 +611,9 @@ struct DemServer::Impl {
     view.kappaG = r.message.values<double>(f::kGasConductivity);
     view.cpG = r.message.values<double>(f::kGasHeatCapacity);
     view.Yg = r.message.values<double>(f::kGasMassFractions);
+    if (const auto ff = r.message.findArray(f::kFluidFraction)) {
+      view.fluidFraction = ff->as<double>();
+    }
     try {
       system->setGasFields(view);
     } catch (const coredem::UserError& e) {

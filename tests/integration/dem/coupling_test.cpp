@@ -93,3 +93,64 @@ TEST(Coupling, RejectsBadGasFields) {
                coredem::UserError);
   EXPECT_THROW(sys.advance(10 * sys.dtDemMax(), 1), coredem::UserError); // Δt too large
 }
+
+// A coupling cell partly outside the CFD domain (fluid_fraction φ_f = 0.5): the drag law sees the
+// gas fraction of the fluid volume, ε = 1 − V_p/(φ_f V_c); the sources stay per coupling-cell
+// volume V_c (ε_g = 1 − V_p/V_c, K_sl V_c = β(ε) V_p/(1−ε)), the CFD side divides by φ_f.
+TEST(Coupling, FluidFractionGivesTheGasFractionOfTheFluidVolume) {
+  DemConfig c;
+  c.gravity = {0, 0, 0};
+  c.grid.origin = {0, 0, 0};
+  c.grid.spacing = {4e-3, 4e-3, 4e-3};
+  c.grid.counts = {2, 1, 1};
+  ParticleSet s;
+  s.packing = Packing::Explicit;
+  s.positions = {6e-3, 2e-3, 2e-3};
+  c.particleSets.push_back(s);
+  DemSystem sys(c, BackendKind::Cpu, 1);
+  const std::vector<double> ug{0, 0, 0, 0, 0, 1.0}, gp(6, 0.0), rho{1.2, 1.2}, mu{1.8e-5, 1.8e-5},
+      fluid{1.0, 0.5};
+  GasFieldsView view{ug, gp, {}, rho, mu, {}, {}, {}};
+  view.fluidFraction = fluid;
+  sys.setGasFields(view);
+  const CellSources& src = sys.advance(sys.dtDemMax(), 1);
+  const double vc = 64e-9, vp = kPi / 6 * 1e-9, eps = 1 - vp / (0.5 * vc);
+  const double re = eps * 1.2 * 1e-3 * 1.0 / 1.8e-5;
+  const double cd = 24 / re * (1 + 0.15 * std::pow(re, 0.687));
+  const double beta = 0.75 * cd * eps * (1 - eps) * 1.2 * 1.0 * std::pow(eps, -2.65) / 1e-3;
+  EXPECT_NEAR(src.epsG[1], 1 - vp / vc, 1e-15);
+  EXPECT_NEAR(src.kSl[1] * vc, beta * vp / (1 - eps), 1e-9 * beta * vp / (1 - eps));
+}
+
+// A particle in a coupling cell without fluid (fluid_fraction 0: outside the CFD domain) is an
+// error naming the particle and the cell; a fraction outside [0, 1] is refused.
+TEST(Coupling, ParticleInACellWithoutFluidIsRefusedNamingIt) {
+  DemConfig c;
+  c.gravity = {0, 0, 0};
+  c.grid.origin = {0, 0, 0};
+  c.grid.spacing = {4e-3, 4e-3, 4e-3};
+  c.grid.counts = {2, 1, 1};
+  ParticleSet s;
+  s.packing = Packing::Explicit;
+  s.positions = {6e-3, 2e-3, 2e-3};
+  c.particleSets.push_back(s);
+  DemSystem sys(c, BackendKind::Cpu, 1);
+  const std::vector<double> ug(6, 0.0), gp(6, 0.0), rho{1.2, 1.2}, mu{1.8e-5, 1.8e-5};
+  GasFieldsView view{ug, gp, {}, rho, mu, {}, {}, {}};
+  const std::vector<double> bad{1.0, 1.5};
+  view.fluidFraction = bad;
+  EXPECT_THROW(sys.setGasFields(view), coredem::UserError);
+  const std::vector<double> fluid{1.0, 0.0};
+  view.fluidFraction = fluid;
+  sys.setGasFields(view);
+  try {
+    sys.advance(sys.dtDemMax(), 1);
+    ADD_FAILURE() << "a particle in a cell without fluid was accepted";
+  } catch (const coredem::UserError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("particle 0 at (0.006, 0.002, 0.002) m lies in coupling cell 1"),
+              std::string::npos)
+        << m;
+    EXPECT_NE(m.find("no fluid"), std::string::npos) << m;
+  }
+}

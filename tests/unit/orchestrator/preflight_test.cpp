@@ -229,6 +229,31 @@ TEST(PreflightOpenFoam, FluidizedBedCoolingIsConsistent) {
   fs::remove_all(d);
 }
 
+// The coupling grid must cover the CFD mesh (points of constant/polyMesh, or the blockMeshDict's
+// vertices before meshing): a grid one cell short in y is refused naming the axis and both spans.
+TEST(PreflightOpenFoam, GridNotCoveringTheMeshNamesTheAxis) {
+  const fs::path d = foamCaseCopy("grid");
+  writeText(d / "case.yaml",
+            replace(readText(d / "case.yaml"), "cells: [10, 30, 2]", "cells: [10, 29, 2]"));
+  const std::string e = foamFailureOf(d);
+  EXPECT_TRUE(contains(e, "grid: the coupling grid spans y = [0, 0.058] m but the CFD mesh")) << e;
+  EXPECT_TRUE(contains(e, "blockMeshDict) spans [0, 0.06] m")) << e;
+  EXPECT_TRUE(contains(e, "must cover the fluid domain")) << e;
+  // A grid larger than the mesh is fine (coupling cells without fluid).
+  writeText(d / "case.yaml",
+            replace(readText(d / "case.yaml"), "cells: [10, 29, 2]", "cells: [10, 31, 3]"));
+  EXPECT_EQ(foamFailureOf(d), "");
+  // Particle walls beyond the mesh are not: particles there would get no gas.
+  const std::string yaml = readText(d / "case.yaml");
+  const auto box = yaml.find("max: [0.02, 0.06, 0.004]");
+  ASSERT_NE(box, std::string::npos) << yaml;
+  writeText(d / "case.yaml", replace(yaml, "max: [0.02, 0.06, 0.004]", "max: [0.02, 0.06, 0.005]"));
+  const std::string w = foamFailureOf(d);
+  EXPECT_TRUE(contains(w, "walls.box: the particle walls span z = [0, 0.005] m but the CFD mesh"))
+      << w;
+  fs::remove_all(d);
+}
+
 TEST(PreflightOpenFoam, GravityMismatchNamesBothValues) {
   const fs::path d = foamCaseCopy("gravity");
   writeText(d / "case.yaml", replace(readText(d / "case.yaml"), "gravity: [0.0, -9.81, 0.0]",

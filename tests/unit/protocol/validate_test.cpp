@@ -416,3 +416,28 @@ TEST(ValidateGasRanges, AcceptsPhysicalFieldsAndNamesTheFirstValueOutsideItsRang
         v[0] = 0.99;
       })).ok());
 }
+
+// The optional fluid_fraction array (a CFD mesh that leaves coupling cells partly outside the
+// fluid): accepted with one value per cell in [0, 1]; another shape or a value outside [0, 1] is
+// refused naming it.
+TEST(ValidateGasRanges, OptionalFluidFractionHasOneValuePerCellInZeroOne) {
+  const auto none = [](std::vector<double>&) {};
+  Expectation e;
+  e.types = {v1::MESSAGE_TYPE_GAS_FIELDS};
+  e.cells = 4;
+  e.species = 1;
+  Message ok = physicalGas(4, "", none);
+  ok.addArray<double>(fields::kFluidFraction, std::vector<double>{1.0, 0.5, 0.0, 1.0}, {4});
+  EXPECT_TRUE(validate(ok, e).ok()) << validate(ok, e).toString();
+  EXPECT_TRUE(validateGasRanges(ok).ok());
+  Message wide = physicalGas(4, "", none);
+  wide.addArray<double>(fields::kFluidFraction, std::vector<double>{1.0, 1.2, 0.0, 1.0}, {4});
+  const Status s = validateGasRanges(wide);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_INVALID_CONFIGURATION);
+  EXPECT_NE(s.message.find("cell 1: fluid_fraction = 1.2"), std::string::npos) << s.message;
+  Message shape = physicalGas(4, "", none);
+  shape.addArray<double>(fields::kFluidFraction, std::vector<double>{1.0, 1.0, 1.0}, {3});
+  const Status t = validate(shape, e);
+  EXPECT_EQ(t.code, v1::ERROR_CODE_SHAPE);
+  EXPECT_NE(t.message.find("fluid_fraction"), std::string::npos) << t.message;
+}

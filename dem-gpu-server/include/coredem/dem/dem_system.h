@@ -169,6 +169,10 @@ struct GasFieldsView {
   std::span<const double> kappaG; ///< κ_g, N (W/m/K)
   std::span<const double> cpG;    ///< c_p,g, N (J/kg/K)
   std::span<const double> Yg;     ///< Y_g, N*ns (-), species fastest
+  /// Optional fluid fraction φ_f of each cell's volume, N (-), in [0, 1]; empty: 1 everywhere.
+  /// PCM then takes ε_g = 1 − V_s/(φ_f V_c) for the closures (drag, heat, WGS) and a particle
+  /// in a cell with φ_f = 0 is an error naming it; the sources stay per V_c.
+  std::span<const double> fluidFraction;
 };
 
 /// Per-cell sources for the CFD, averaged over the sub-steps of one advance() (docs/physics.md

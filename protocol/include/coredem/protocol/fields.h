@@ -31,6 +31,12 @@ inline constexpr std::string_view kGasViscosity = "mu_g";       ///< [N] Pa s
 inline constexpr std::string_view kGasConductivity = "kappa_g"; ///< [N] W/m/K
 inline constexpr std::string_view kGasHeatCapacity = "cp_g";    ///< [N] J/kg/K
 inline constexpr std::string_view kGasMassFractions = "Y_g";    ///< [N,n_species] -
+/// Optional: the fraction of each coupling cell's volume that is fluid, in [0, 1] (absent: 1
+/// everywhere). Sent by a CFD participant whose mesh does not fill the coupling grid; the DEM
+/// server then takes the PCM gas fraction of the fluid volume, 1 − V_s/(φ_f V_c), in its
+/// closures (drag, heat, WGS) and refuses a particle in a cell without fluid. Its Sources stay
+/// per coupling-cell volume V_c (the CFD side divides by φ_f).
+inline constexpr std::string_view kFluidFraction = "fluid_fraction"; ///< [N] -
 
 // Sources (DEM -> CFD), averaged over the n_sub DEM sub-steps of the CFD step
 inline constexpr std::string_view kVoidFraction = "eps_g";             ///< [N] -
@@ -51,6 +57,8 @@ struct FieldSpec {
 
 /// The arrays a GasFields message must carry, in the canonical order.
 std::span<const FieldSpec> gasFields();
+/// The arrays a GasFields message may carry besides (fluid_fraction).
+std::span<const FieldSpec> optionalGasFields();
 /// The arrays a Sources message must carry, in the canonical order.
 std::span<const FieldSpec> sourceFields();
 /// The spec of a GasFields or Sources field by name; nullptr if the name is not one of them.

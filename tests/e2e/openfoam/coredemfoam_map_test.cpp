@@ -1,0 +1,247 @@
+// coredemFoam's map between an OpenFOAM mesh and the Cartesian coupling grid
+// (cfd-adapter/openfoam/coredemFoam/couplingGrid.H), checked by coredemMapCheck with synthetic
+// fields on meshes made by Debian's blockMesh and polyDualMesh from the column of the e2e tests
+// (1 x 4 x 1 cm; coupling grid 5 x 20 x 5 cells of 2 mm):
+//   * a mesh graded towards the walls (cells down to 0.37 mm, smaller than the 1 mm particles),
+//   * a polyhedral mesh (polyDualMesh of a block mesh),
+//   * a smaller box (9 x 39 x 6.5 mm): coupling cells partly filled and without fluid,
+// each conserve the sources (sum over mesh cells of s V = sum over coupling cells of s times the
+// fluid volume) and the solid volume to 1e-12 relative, give the gas fraction of the fluid
+// volume in partly filled cells (1 - phi everywhere for a solid volume phi V_f in every cell) and
+// keep it in (0, 1]; a mesh the grid does not cover is refused naming the cell (exit 2); the
+// uniform block equal to the grid keeps the exact map; decomposed meshes (2 and 4 processors)
+// give contributions that add up to the serial map.
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "coredem_e2e.h"
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace {
+
+const fs::path kBin = COREDEM_BIN_DIR;
+const fs::path kFoamBin = COREDEM_OPENFOAM_BIN_DIR;
+const fs::path kTemplate = COREDEM_FOAM_E2E_TEMPLATE;
+
+using coredem::e2e::readAll;
+using coredem::e2e::writeAll;
+
+std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
+  for (std::size_t i = s.find(from); i != std::string::npos; i = s.find(from, i + to.size())) {
+    s.replace(i, from.size(), to);
+  }
+  return s;
+}
+
+class CoredemFoamMap : public coredem::e2e::RunFolderTest {
+protected:
+  CoredemFoamMap()
+      : RunFolderTest(kBin, {"coredemMapCheck"}, "coredemfoam-map") {}
+
+  void SetUp() override {
+    RunFolderTest::SetUp();
+    // OpenFOAM's utilities need the etc tree (no bashrc).
+    ::setenv("WM_PROJECT_DIR", COREDEM_OPENFOAM_PROJECT_DIR, 1);
+  }
+
+  /// The column template with `blocks` (and `vertices` when given) as the blockMeshDict.
+  fs::path makeMesh(const std::string& blocks, const std::string& vertices = "") {
+    const fs::path c = dir / "case";
+    fs::copy(kTemplate, c, fs::copy_options::recursive);
+    for (const auto& e : fs::recursive_directory_iterator(c / "0")) {
+      writeAll(e.path(),
+               replaceAll(replaceAll(readAll(e.path()), "@U_IN@", "0.3"), "@T_IN@", "293.15"));
+    }
+    const fs::path dict = c / "system" / "blockMeshDict";
+    std::string s = readAll(dict);
+    const std::string uniform = "(5 20 5) simpleGrading (1 1 1)";
+    EXPECT_NE(s.find(uniform), std::string::npos);
+    s = replaceAll(s, uniform, blocks);
+    if (!vertices.empty()) {
+      const auto a = s.find("vertices"), b = s.find(");", a);
+      s = s.substr(0, a) + "vertices\n(\n" + vertices + "\n" + s.substr(b);
+    }
+    writeAll(dict, s);
+    run(kFoamBin / "blockMesh", {"-case", c.string()}, "blockMesh", 0);
+    return c;
+  }
+
+  /// Runs `program args` into dir/<name>.log; expects exit code `rc`; returns the log.
+  std::string run(const fs::path& program, std::vector<std::string> args, const std::string& name,
+                  int rc) {
+    const fs::path log = dir / (name + ".log");
+    fs::remove(log);
+    EXPECT_EQ(coredem::e2e::waitExit(coredem::e2e::startProgram(program, args, log), 60s), rc)
+        << readAll(log);
+    return readAll(log);
+  }
+
+  /// coredemMapCheck on case `c` against the tests' coupling grid (counts `counts`).
+  std::string check(const fs::path& c, int rc = 0, const std::string& counts = "(5 20 5)") {
+    return run(kBin / "coredemMapCheck",
+               {"-case", c.string(), "-origin", "(0 0 0)", "-spacing", "(0.002 0.002 0.002)",
+                "-counts", counts},
+               "mapcheck", rc);
+  }
+
+  /// "check NAME: VALUE" lines of coredemMapCheck.
+  static std::map<std::string, double> checks(const std::string& log) {
+    std::map<std::string, double> out;
+    const std::regex re("check ([a-z_]+): ([-0-9.eE+]+)");
+    for (std::sregex_iterator it(log.begin(), log.end(), re), end; it != end; ++it) {
+      out[(*it)[1].str()] = std::strtod((*it)[2].str().c_str(), nullptr);
+    }
+    return out;
+  }
+
+  /// Every check within 1e-12 relative (the conservation and gas-fraction checks included).
+  static void expectConservative(const std::string& log) {
+    const auto c = checks(log);
+    for (const char* name : {"volume", "sources", "fraction_solid_volume", "fraction_range",
+                             "fraction_uniform", "gather_constant", "gather_conservative"}) {
+      ASSERT_TRUE(c.count(name)) << name << " missing:\n" << log;
+      EXPECT_LE(c.at(name), 1e-12) << name << "\n" << log;
+    }
+    EXPECT_NE(log.find("map checks passed"), std::string::npos) << log;
+  }
+
+  /// A number after `key` in the log ("map: ... 12 partial").
+  static long count(const std::string& log, const std::string& what) {
+    std::smatch m;
+    EXPECT_TRUE(std::regex_search(log, m, std::regex("([0-9]+) " + what))) << what << "\n" << log;
+    return m.size() > 1 ? std::stol(m[1].str()) : -1;
+  }
+};
+
+// Graded towards every wall: 12 x 30 x 12 cells, the ones at the walls 0.37 mm wide (smaller
+// than a 1 mm particle), none aligned with the coupling grid.
+TEST_F(CoredemFoamMap, GradedMeshIsConservative) {
+  const fs::path c = makeMesh("(12 30 12) simpleGrading (((0.5 0.5 4) (0.5 0.5 0.25)) 1 "
+                              "((0.5 0.5 4) (0.5 0.5 0.25)))");
+  const std::string log = check(c);
+  EXPECT_NE(log.find("overlap,"), std::string::npos) << log;
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(log, m, std::regex("smallest cell width ([-0-9.eE+]+)")));
+  EXPECT_LT(std::strtod(m[1].str().c_str(), nullptr), 0.5e-3);
+  EXPECT_EQ(count(log, "partial"), 0);
+  EXPECT_EQ(count(log, "empty"), 0);
+  expectConservative(log);
+}
+
+// polyDualMesh of a 7 x 23 x 6 block: polyhedra along the walls, cells across the grid planes.
+TEST_F(CoredemFoamMap, PolyhedralMeshIsConservative) {
+  const fs::path c = makeMesh("(7 23 6) simpleGrading (1 1 1)");
+  run(kFoamBin / "polyDualMesh", {"-case", c.string(), "60", "-overwrite"}, "polyDualMesh", 0);
+  const std::string log = check(c);
+  EXPECT_GT(count(log, "cells not hexahedra"), 100);
+  EXPECT_NE(log.find("overlap,"), std::string::npos) << log;
+  expectConservative(log);
+}
+
+// A 9 x 39 x 6.5 mm box in the 10 x 40 x 10 mm grid: the coupling cells along x = 8-10 mm,
+// y = 38-40 mm and z = 6-8 mm are partly filled, those beyond z = 8 mm have no fluid. The gas
+// fraction of a partly filled cell is that of its fluid volume.
+TEST_F(CoredemFoamMap, PartlyFilledCouplingCellsUseTheirFluidVolume) {
+  const fs::path c = makeMesh("(9 26 7) simpleGrading (1 1 1)",
+                              "(0 0 0) (0.009 0 0) (0.009 0.039 0) (0 0.039 0)\n"
+                              "(0 0 0.0065) (0.009 0 0.0065) (0.009 0.039 0.0065) "
+                              "(0 0.039 0.0065)");
+  const std::string log = check(c);
+  // Partly filled: i = 4 or j = 19 or k = 3 (of k < 4): 5*20*4 - 4*19*3 = 172; empty: k = 4.
+  EXPECT_EQ(count(log, "partial"), 172);
+  EXPECT_EQ(count(log, "empty"), 100);
+  expectConservative(log);
+}
+
+// A coupling grid 2 mm short of the mesh (19 cells high for a 40 mm column) is refused naming
+// the first mesh cell it does not cover (exit 2).
+TEST_F(CoredemFoamMap, MeshNotCoveredByTheGridIsRefused) {
+  const fs::path c = makeMesh("(12 30 12) simpleGrading (1 1 1)");
+  const std::string log = check(c, 2, "(5 19 5)");
+  EXPECT_TRUE(
+      std::regex_search(log, std::regex("mesh cell [0-9]+ \\(centre .*outside the coupling grid")))
+      << log;
+  EXPECT_NE(log.find("must cover the fluid domain"), std::string::npos) << log;
+}
+
+// The uniform block equal to the grid keeps the exact map (coredemFoam's in-place exchange).
+TEST_F(CoredemFoamMap, MeshEqualToTheGridIsTheExactMap) {
+  const fs::path c = makeMesh("(5 20 5) simpleGrading (1 1 1)");
+  const std::string log = check(c);
+  EXPECT_NE(log.find("exact,"), std::string::npos) << log;
+  expectConservative(log);
+}
+
+// Decomposed (decomposePar, then mpirun -np K coredemMapCheck -parallel): each processor maps
+// its own cells and touches only part of the grid; the checks hold over all processors, and the
+// processors' contributions added up give the serial run's totals to 1e-12 relative (fluid
+// volume, sum of the gathered field times the fluid volume, its largest value). The graded mesh
+// on 2 processors, the polyhedral one on 4 (oversubscribed).
+TEST_F(CoredemFoamMap, DecomposedMapsAddUpToTheSerialMap) {
+  if (std::string(COREDEM_MPIRUN).empty()) {
+    GTEST_SKIP() << "no mpirun";
+  }
+  // Open MPI refuses root unless told (containers, CI).
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+  ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+  auto figures = [](const std::string& log) {
+    std::map<std::string, double> out;
+    const std::regex re("figure ([a-z_]+): ([-0-9.eE+]+)");
+    for (std::sregex_iterator it(log.begin(), log.end(), re), end; it != end; ++it) {
+      out[(*it)[1].str()] = std::strtod((*it)[2].str().c_str(), nullptr);
+    }
+    return out;
+  };
+  for (const auto& [kind, ranks] : {std::pair<std::string, int>{"graded", 2}, {"polyhedral", 4}}) {
+    SCOPED_TRACE(kind);
+    fs::remove_all(dir / "case");
+    const fs::path c = kind == "graded"
+                           ? makeMesh("(12 30 12) simpleGrading (((0.5 0.5 4) (0.5 0.5 0.25)) 1 "
+                                      "((0.5 0.5 4) (0.5 0.5 0.25)))")
+                           : makeMesh("(7 23 6) simpleGrading (1 1 1)");
+    if (kind == "polyhedral") {
+      run(kFoamBin / "polyDualMesh", {"-case", c.string(), "60", "-overwrite"}, "polyDualMesh", 0);
+    }
+    const std::string serial = check(c);
+    expectConservative(serial);
+    writeAll(c / "system" / "decomposeParDict",
+             "FoamFile { version 2.0; format ascii; class dictionary; object decomposeParDict; }\n"
+             "numberOfSubdomains " +
+                 std::to_string(ranks) + ";\nmethod simple;\nsimpleCoeffs { n (" +
+                 std::to_string(ranks / 2) + " 2 1); delta 0.001; }\n");
+    run(kFoamBin / "decomposePar", {"-case", c.string(), "-force"}, "decomposePar", 0);
+    const std::string par =
+        run(COREDEM_MPIRUN,
+            {"--oversubscribe", "-np", std::to_string(ranks), (kBin / "coredemMapCheck").string(),
+             "-parallel", "-case", c.string(), "-origin", "(0 0 0)", "-spacing",
+             "(0.002 0.002 0.002)", "-counts", "(5 20 5)"},
+            "mapcheck-parallel", 0);
+    EXPECT_NE(par.find("nProcs : " + std::to_string(ranks)), std::string::npos) << par;
+    expectConservative(par);
+    // Every processor touches part of the grid only.
+    const std::regex touched("\\[([0-9]+)\\] touched: ([0-9]+) of 500 grid cells");
+    int processors = 0;
+    for (std::sregex_iterator it(par.begin(), par.end(), touched), end; it != end; ++it) {
+      ++processors;
+      EXPECT_LT(std::stol((*it)[2].str()), 500) << (*it)[0].str();
+      EXPECT_GT(std::stol((*it)[2].str()), 0) << (*it)[0].str();
+    }
+    EXPECT_EQ(processors, ranks) << par;
+    const auto a = figures(serial), b = figures(par);
+    for (const char* name : {"fluid_volume", "gathered_total", "gathered_max"}) {
+      ASSERT_TRUE(a.count(name) && b.count(name)) << name << "\n" << par;
+      EXPECT_NEAR(b.at(name), a.at(name), 1e-12 * std::abs(a.at(name))) << name;
+    }
+  }
+}
+
+} // namespace
