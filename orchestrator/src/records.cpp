@@ -192,6 +192,18 @@ void Session::takeSnapshot(std::int64_t step, double time, double dt) {
   }
   const std::string rel = fmt::format("snapshots/particles_{:08d}.h5", step);
   fs::rename(tmp / done.envelope().checkpoint_done().files(0), _o.runDir / rel);
+  SnapshotLabels labels;
+  for (const auto& sp : _c.solidSpecies) {
+    labels.solidSpecies.push_back(sp.name);
+  }
+  for (const auto& set : _c.particles) {
+    labels.sets.push_back(set.name);
+    labels.setCounts.push_back(set.positions.empty() ? set.count : set.positions.size());
+  }
+  for (const auto& m : _c.materials) {
+    labels.materials.push_back(m.name);
+  }
+  describeSnapshot(_o.runDir / rel, labels);
   fs::remove_all(tmp);
   _snapshots.push_back({step, time, rel, gasOutputFolder(_o.runDir, _cfd.workDir, time, dt)});
   writeSnapshotIndex(_o.runDir, _snapshots);
