@@ -2,9 +2,12 @@
 //   coredem run CASE_DIR [--out RUN_DIR] [--auto-restart N] [--stop-after STEP] [--walltime S]
 //   coredem resume RUN_DIR [--auto-restart N] [--stop-after STEP] [--walltime S]
 //   coredem inspect FILE
+//   coredem render RUN_DIR [--times T,...] [--field F] [--gas-field G] [--out DIR]
 //   coredem check CASE_DIR
 //   coredem verify [--out DIR] [--only NAME[,NAME]] [--list] [--cases DIR] [--no-plots]
 #include <cstdio>
+#include <cstdlib>
+#include <fstream>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -46,6 +49,82 @@ void makePlots(const fs::path& runDir) {
     return;
   }
   std::printf("plots: %s\n", (runDir / "plots").string().c_str());
+}
+
+/// `coredem render`: scripts/render/render_run.py under ParaView's pvbatch (found at configure
+/// time or on PATH), under xvfb-run when there is no display.
+int renderRun(const fs::path& runDir, const std::vector<double>& times, const std::string& field,
+              const std::string& gasField, const std::string& outDir) {
+  auto log = coredem::logger("orchestrator");
+  fs::path pvbatch = COREDEM_PVBATCH;
+  if (pvbatch.empty() || !fs::exists(pvbatch)) {
+    pvbatch = coredem::findProgram("pvbatch");
+  }
+  if (pvbatch.empty()) {
+    log->error("coredem render needs ParaView's pvbatch, which was found neither at configure time "
+               "nor on PATH: install ParaView (Debian: apt-get install paraview xvfb, or "
+               "scripts/install-deps.sh) or put pvbatch on PATH");
+    return kExitBadInput;
+  }
+  const fs::path script = COREDEM_RENDER_SCRIPT;
+  if (!fs::exists(script)) {
+    log->error("the render script {} is missing (a build outside its source tree?)",
+               script.string());
+    return kExitBadInput;
+  }
+  if (!fs::exists(runDir / "outputs.csv")) {
+    log->error("{}: no outputs.csv: give a run folder whose case writes synchronized outputs "
+               "(output.every or output.every_seconds in case.yaml)",
+               runDir.string());
+    return kExitBadInput;
+  }
+  std::vector<std::string> args;
+  const char* display = std::getenv("DISPLAY");
+  if (display == nullptr || *display == '\0') {
+    fs::path xvfb = COREDEM_XVFB_RUN;
+    if (xvfb.empty() || !fs::exists(xvfb)) {
+      xvfb = coredem::findProgram("xvfb-run");
+    }
+    if (xvfb.empty()) {
+      log->error("no display (DISPLAY unset) and no xvfb-run: pvbatch needs one of them "
+                 "(Debian: apt-get install xvfb)");
+      return kExitBadInput;
+    }
+    args = {xvfb.string(), "-a"};
+  }
+  args.insert(args.end(), {pvbatch.string(), script.string(), runDir.string()});
+  if (!times.empty()) {
+    std::string t;
+    for (std::size_t i = 0; i < times.size(); ++i) {
+      t += (i ? "," : "") + fmt::format("{}", times[i]);
+    }
+    args.insert(args.end(), {"--times", t});
+  }
+  if (!field.empty()) {
+    args.insert(args.end(), {"--field", field});
+  }
+  if (!gasField.empty()) {
+    args.insert(args.end(), {"--gas-field", gasField});
+  }
+  const fs::path out = outDir.empty() ? runDir / "render" : fs::absolute(outDir);
+  args.insert(args.end(), {"--out", out.string()});
+  fs::create_directories(out);
+  const fs::path logFile = out / "render.log";
+  coredem::ChildProcess render("pvbatch", args, {}, logFile);
+  render.waitFor(std::chrono::hours(24));
+  if (render.exitCode() != 0) {
+    std::ifstream in(logFile);
+    std::string line, last;
+    while (std::getline(in, line)) {
+      if (!line.empty()) {
+        last = line;
+      }
+    }
+    log->error("render failed ({}): {}", logFile.string(), last);
+    return kExitFault;
+  }
+  std::printf("pictures: %s (log %s)\n", out.string().c_str(), logFile.string().c_str());
+  return kExitOk;
 }
 
 } // namespace
@@ -111,6 +190,24 @@ int main(int argc, char** argv) {
   verify->add_flag("--no-plots", noPlots, "do not make the PNG plots");
   verify->add_flag("--verbose", verifyOpts.verbose, "keep the runs' info log");
 
+  std::vector<double> renderTimes;
+  std::string renderField, renderGasField, renderOut;
+  auto* render = app.add_subcommand(
+      "render", "draw the particles (spheres at their radius, coloured by a field) over a slice "
+                "of a gas field at the same instants with ParaView: a PNG per output time and an "
+                "animation (docs/orchestrator.md \"Pictures\")");
+  render->add_option("RUN_DIR", runDir, "run folder with outputs.csv")->required();
+  render
+      ->add_option("--times", renderTimes,
+                   "times in s (comma-separated; the nearest output of "
+                   "each is drawn; default: every output)")
+      ->delimiter(',');
+  render->add_option("--field", renderField,
+                     "particle field to colour by (temperature, velocity, species_<name>, ...)");
+  render->add_option("--gas-field", renderGasField,
+                     "gas field of the slice (alphac, U, p, T, ...)");
+  render->add_option("--out", renderOut, "picture folder (default RUN_DIR/render)");
+
   auto* check = app.add_subcommand("check", "validate a case file and exit (0 valid, 2 invalid)");
   check->add_option("CASE_DIR", caseDir, "case folder with case.yaml (or a case file)")->required();
 
@@ -125,6 +222,9 @@ int main(int argc, char** argv) {
     if (*inspect) {
       std::cout << inspectSummary(file);
       return kExitOk;
+    }
+    if (*render) {
+      return renderRun(fs::absolute(runDir), renderTimes, renderField, renderGasField, renderOut);
     }
     if (*verify) {
       verifyOpts.only = only;
