@@ -30,7 +30,7 @@ namespace {
 
 /// Runs scripts/plot/plot_run.py with the Python that CMake found (COREDEM_PYTHON); a failure
 /// is a warning, never an error of the run.
-void makePlots(const fs::path& runDir) {
+void makePlots(const fs::path& runDir, bool interrupted) {
   auto log = coredem::logger("orchestrator");
   const fs::path python = COREDEM_PYTHON;
   const fs::path script = COREDEM_PLOT_SCRIPT;
@@ -39,8 +39,11 @@ void makePlots(const fs::path& runDir) {
               script.string());
     return;
   }
-  coredem::ChildProcess plot("plot script", {python.string(), script.string(), runDir.string()}, {},
-                             runDir / "logs" / "plot.log");
+  std::vector<std::string> args = {python.string(), script.string(), runDir.string()};
+  if (interrupted) {
+    args.push_back("--interrupted");
+  }
+  coredem::ChildProcess plot("plot script", args, {}, runDir / "logs" / "plot.log");
   if (!plot.waitFor(std::chrono::seconds(120))) {
     plot.stop();
   }
@@ -264,11 +267,12 @@ int main(int argc, char** argv) {
     }
     const int rc = runSession(config, opts);
     if (rc == kExitOk) {
-      std::printf("results: %s (timeseries.csv, particles.xdmf, checkpoints/)\n",
+      std::printf("results: %s (timeseries.csv, outputs.csv, particles.xdmf, checkpoints/)\n",
                   opts.runDir.string().c_str());
-      if (!noPlots) {
-        makePlots(opts.runDir);
-      }
+    }
+    // An interrupted run (SIGINT/SIGTERM) gets its plots too, up to its last step.
+    if ((rc == kExitOk || rc == kExitInterrupted) && !noPlots) {
+      makePlots(opts.runDir, rc == kExitInterrupted);
     }
     return rc;
   } catch (const CaseError& e) {

@@ -238,6 +238,23 @@ herr_t visit(hid_t group, const char* name, const H5L_info_t*, void* data) {
           sum += x;
         }
         d.mean = sum / double(n);
+        if (dims.size() == 2 && dims[1] > 1 && dims[0] > 0) {
+          const std::size_t rows = dims[0], w = dims[1];
+          d.columnMin.assign(w, std::numeric_limits<double>::infinity());
+          d.columnMax.assign(w, -std::numeric_limits<double>::infinity());
+          d.columnMean.assign(w, 0.0);
+          for (std::size_t i = 0; i < rows; ++i) {
+            for (std::size_t k = 0; k < w; ++k) {
+              const double x = v[i * w + k];
+              d.columnMin[k] = std::min(d.columnMin[k], x);
+              d.columnMax[k] = std::max(d.columnMax[k], x);
+              d.columnMean[k] += x;
+            }
+          }
+          for (auto& m : d.columnMean) {
+            m /= double(rows);
+          }
+        }
       }
     }
     st.datasets->push_back(d);
@@ -514,7 +531,19 @@ std::string inspectSummary(const fs::path& file) {
     for (std::size_t i = 0; i < d.dims.size(); ++i) {
       dims += (i ? "x" : "") + std::to_string(d.dims[i]);
     }
-    if (d.numeric) {
+    if (d.numeric && !d.columnMin.empty()) {
+      // Per component (x, y, z of a vector; species and other columns by name): statistics
+      // over all components together would mix quantities.
+      out << fmt::format("  {:<36} {:<8} [{}]  per column:\n", d.path, d.type, dims);
+      const std::size_t w = d.columnMin.size();
+      const auto names = w == 3 && columnNames(attrs, d.path, w)[0] == "0"
+                             ? std::vector<std::string>{"x", "y", "z"}
+                             : columnNames(attrs, d.path, w);
+      for (std::size_t k = 0; k < w; ++k) {
+        out << fmt::format("    {:<34} {:<8}      min {:.6g}  mean {:.6g}  max {:.6g}\n", names[k],
+                           "", d.columnMin[k], d.columnMean[k], d.columnMax[k]);
+      }
+    } else if (d.numeric) {
       out << fmt::format("  {:<36} {:<8} [{}]  min {:.6g}  mean {:.6g}  max {:.6g}\n", d.path,
                          d.type, dims, d.min, d.mean, d.max);
     } else {

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -20,6 +21,7 @@
 #include <set>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -208,6 +210,42 @@ output: {every_seconds: 0.004}
       EXPECT_TRUE(listed.count(name)) << "gas written at " << name << ", not an output time";
     }
   }
+}
+
+// An isothermal bed interrupted by SIGINT still gets its plots, with the panels it computes:
+// pressure drop and bed height (both in timeseries.csv), no temperature or heat panel.
+TEST_F(ResultsE2E, InterruptedIsothermalBedGetsItsPlots) {
+  const fs::path c = makeColumnCase(dir, R"(time: {end: 1.0, dt: 0.7e-3}
+)");
+  const fs::path run = dir / "run";
+  const pid_t pid = coredem::e2e::startProgram(
+      kBin / "coredem", {"run", c.string(), "--out", run.string()}, dir / "coredem.log");
+  ASSERT_GT(pid, 0);
+  // Wait for a few rows of timeseries.csv, then interrupt.
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    const std::string ts = readAll(run / "timeseries.csv");
+    if (std::count(ts.begin(), ts.end(), '\n') >= 4) {
+      break;
+    }
+    std::this_thread::sleep_for(20ms);
+  }
+  ::kill(pid, SIGINT);
+  ASSERT_EQ(coredem::e2e::waitExit(pid, 100s), 130) << tail(dir / "coredem.log");
+  const auto ts = coredem::e2e::readTimeseries(run);
+  ASSERT_TRUE(ts.count("gas.pressure_drop_Pa")) << "no pressure drop column";
+  ASSERT_TRUE(ts.count("bed_height_m")) << "no bed height column";
+  // 400 beads of 1 mm on a lattice filling the 6 mm high region from the distributor up (its
+  // layers are along z, each 10 x 6 beads): 6 mm, give or take the first steps' settling (10 %).
+  EXPECT_NEAR(ts.at("bed_height_m").back(), 6e-3, 0.6e-3);
+  EXPECT_GT(ts.at("gas.pressure_drop_Pa").back(), 0.0);
+  ASSERT_TRUE(fs::exists(run / "plots" / "timeseries.png")) << tail(run / "logs" / "plot.log");
+  EXPECT_GT(fs::file_size(run / "plots" / "timeseries.png"), 10000u);
+  const std::string plotLog = readAll(run / "logs" / "plot.log");
+  EXPECT_NE(plotLog.find("Pressure drop"), std::string::npos) << plotLog;
+  EXPECT_NE(plotLog.find("Bed height"), std::string::npos) << plotLog;
+  EXPECT_EQ(plotLog.find("Particle temperature"), std::string::npos) << plotLog;
+  EXPECT_EQ(plotLog.find("Heat exchange"), std::string::npos) << plotLog;
 }
 
 /// The reduced CLG case (4 solid species, 2 particle sets, 5291 particles) for 2 steps with an

@@ -1,6 +1,7 @@
 // Outputs: timeseries.csv (incl. truncation on resume), XDMF of particle snapshots, inspect.
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -169,6 +170,26 @@ TEST(Inspect, SummarisesHdf5) {
   EXPECT_NE(s.find("/particles/temperature"), std::string::npos) << s;
   EXPECT_NE(s.find("min 300  mean 301  max 302"), std::string::npos) << s;
   EXPECT_THROW(inspectSummary(d / "missing.h5"), coredem::UserError);
+  fs::remove_all(d);
+}
+
+// A vector's statistics are per component (x, y, z), a species array's per named column.
+TEST(Inspect, StatisticsPerComponent) {
+  const fs::path d = tempDir("inspect-columns");
+  writeSnapshot(d / "s.h5", 3); // position (i, 0, 0)
+  {
+    const coredem::h5::Handle f = coredem::h5::openFile(d / "s.h5", true);
+    coredem::h5::writeDataset(f, "particles/species", std::vector<double>{1, 0, 0.5, 0.5, 0, 1},
+                              {3, 2});
+    const coredem::h5::Handle ds(H5Dopen2(f, "particles/species", H5P_DEFAULT), H5Dclose);
+    coredem::h5::writeAttribute(ds, "columns", "C,Fe2O3");
+  }
+  const std::string s = inspectSummary(d / "s.h5");
+  EXPECT_NE(s.find("/particles/position"), std::string::npos) << s;
+  EXPECT_NE(s.find("per column"), std::string::npos) << s;
+  EXPECT_TRUE(std::regex_search(s, std::regex("\n    x +min 0  mean 1  max 2\n"))) << s;
+  EXPECT_TRUE(std::regex_search(s, std::regex("\n    y +min 0  mean 0  max 0\n"))) << s;
+  EXPECT_TRUE(std::regex_search(s, std::regex("\n    Fe2O3 +min 0  mean 0\\.5  max 1\n"))) << s;
   fs::remove_all(d);
 }
 

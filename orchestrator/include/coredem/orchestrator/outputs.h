@@ -38,6 +38,8 @@ struct DatasetInfo {
   std::string type; ///< "float64", "int64", "string", ...
   bool numeric = false;
   double min = 0, max = 0, mean = 0; ///< for numeric datasets
+  /// For numeric [N, W] datasets: min, mean and max of each column (x, y, z of a vector).
+  std::vector<double> columnMin, columnMean, columnMax;
 };
 
 struct AttributeInfo {
