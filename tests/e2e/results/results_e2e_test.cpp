@@ -337,4 +337,52 @@ TEST_F(ClgRun, RenderDrawsOneTime) {
   EXPECT_GT(std::stoi(readAll(count)), 50) << "the picture is (nearly) a single colour";
 }
 
+// docs/tutorial.md, as written: its ```bash blocks run in order, in one bash (set -euo pipefail),
+// in a folder that looks like the repository root (docs/, cases/, build/bin). Without ParaView
+// the render block is left out (and said so).
+TEST_F(ResultsE2E, TutorialRunsAsWritten) {
+  const std::string md = readAll(kSource / "docs" / "tutorial.md");
+  std::string script = "set -euo pipefail\n";
+  const Pvbatch pv = findPvbatch();
+  int blocks = 0;
+  bool renderSkipped = false;
+  for (std::size_t at = md.find("```bash\n"); at != std::string::npos;
+       at = md.find("```bash\n", at)) {
+    const std::size_t begin = at + 8, end = md.find("```", begin);
+    ASSERT_NE(end, std::string::npos) << "unterminated code block";
+    const std::string block = md.substr(begin, end - begin);
+    at = end + 3;
+    if (block.find("coredem render") != std::string::npos && !pv.missing.empty()) {
+      renderSkipped = true;
+      continue;
+    }
+    script += block;
+    ++blocks;
+  }
+  ASSERT_GE(blocks, 6) << "docs/tutorial.md lost its commands";
+  fs::create_directories(dir / "root" / "build");
+  fs::create_directory_symlink(kSource / "docs", dir / "root" / "docs");
+  fs::create_directory_symlink(kSource / "cases", dir / "root" / "cases");
+  fs::create_directory_symlink(kBin, dir / "root" / "build" / "bin");
+  writeAll(dir / "root" / "tutorial.sh", script);
+  const fs::path log = dir / "tutorial.log";
+  ASSERT_EQ(runProgram("/bin/bash",
+                       {"-c", "cd '" + (dir / "root").string() + "' && bash tutorial.sh"}, log),
+            0)
+      << tail(log);
+  const fs::path run = dir / "root" / "runs" / "mybed";
+  const auto rows = readCsv(run / "outputs.csv");
+  ASSERT_EQ(rows.size(), 5u) << readAll(run / "outputs.csv");
+  for (auto row : rows) {
+    EXPECT_TRUE(fs::exists(run / row["particles"])) << row["particles"];
+    EXPECT_TRUE(fs::is_directory(run / row["gas"])) << row["gas"];
+  }
+  EXPECT_TRUE(fs::exists(run / "plots" / "timeseries.png"));
+  EXPECT_NE(readAll(log).find("mybed/case.yaml: valid"), std::string::npos) << tail(log);
+  if (renderSkipped) {
+    GTEST_SKIP() << "the tutorial ran without its render step: " << pv.missing;
+  }
+  EXPECT_TRUE(fs::exists(run / "render" / "velocity_00000020.png")) << tail(log);
+}
+
 } // namespace
