@@ -61,6 +61,9 @@ void Session::stepLoop(std::int64_t startStep) {
     double tOutput = 0.0;
     if (_c.output.everySeconds > 0.0) {
       tOutput = nextOutputTime(tStart, _c.output.everySeconds);
+      while (_time.reached(tOutput)) { // within the time tolerance of a multiple already
+        tOutput += _c.output.everySeconds;
+      }
       toEnd = std::min(toEnd, _time.remaining(tOutput));
     }
     const double dt = _policy.next(_lastCourant, toEnd);
