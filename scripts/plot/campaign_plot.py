@@ -80,6 +80,7 @@ def main():
         ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(a.out, dpi=120)
+    print(f"x axis: {unit_label(a.x)}; y axis: {unit_label(a.y)}; title: {title}".replace("\n", " "))
     print(f"wrote {a.out}")
 
 
