@@ -202,6 +202,29 @@ output: {every_seconds: 0.004}
     H5Fclose(f);
     EXPECT_EQ(st, t) << row["particles"];
     listed.insert(fs::path(row["gas"]).filename().string());
+    // Self-describing: every /particles dataset has a unit and a description, names included.
+    const hid_t rf = H5Fopen((run / row["particles"]).c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    std::vector<std::string> names;
+    H5Literate_by_name(
+        rf, "particles", H5_INDEX_NAME, H5_ITER_INC, nullptr,
+        [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
+          static_cast<std::vector<std::string>*>(data)->push_back(name);
+          return 0;
+        },
+        &names, H5P_DEFAULT);
+    EXPECT_GE(names.size(), 15u);
+    for (const char* must : {"position", "velocity", "temperature", "diameter", "set_index"}) {
+      EXPECT_NE(std::find(names.begin(), names.end(), must), names.end()) << must;
+    }
+    for (const auto& n : names) {
+      const std::string path = "particles/" + n;
+      EXPECT_GT(H5Aexists_by_name(rf, path.c_str(), "unit", H5P_DEFAULT), 0) << n;
+      EXPECT_GT(H5Aexists_by_name(rf, path.c_str(), "description", H5P_DEFAULT), 0) << n;
+    }
+    for (const char* a : {"species_names", "set_names", "material_names", "step"}) {
+      EXPECT_GT(H5Aexists(rf, a), 0) << a;
+    }
+    H5Fclose(rf);
   }
   // No other gas time folder: controlDict's write interval no longer writes on its own.
   for (const auto& e : fs::directory_iterator(run / "openfoam")) {
