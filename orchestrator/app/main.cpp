@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 
 #include <CLI/CLI.hpp>
 #include <unistd.h>
@@ -93,7 +94,7 @@ int renderRun(const fs::path& runDir, const std::vector<double>& times, const st
                  "(Debian: apt-get install xvfb)");
       return kExitBadInput;
     }
-    args = {xvfb.string(), "-a"};
+    args = {xvfb.string(), "-a", "-s", "-screen 0 1920x1200x24"};
   }
   args.insert(args.end(), {pvbatch.string(), script.string(), runDir.string()});
   if (!times.empty()) {
@@ -113,9 +114,22 @@ int renderRun(const fs::path& runDir, const std::vector<double>& times, const st
   args.insert(args.end(), {"--out", out.string()});
   fs::create_directories(out);
   const fs::path logFile = out / "render.log";
-  coredem::ChildProcess render("pvbatch", args, {}, logFile);
-  render.waitFor(std::chrono::hours(24));
-  if (render.exitCode() != 0) {
+  // A virtual X server that is not ready in time (a loaded machine) makes pvbatch abort with
+  // "bad X server connection": one more try.
+  int exitCode = -1;
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    fs::remove(logFile);
+    coredem::ChildProcess render("pvbatch", args, {}, logFile);
+    render.waitFor(std::chrono::hours(24));
+    exitCode = render.exitCode();
+    std::ifstream in(logFile);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (exitCode == 0 || text.find("bad X server connection") == std::string::npos) {
+      break;
+    }
+    log->warn("pvbatch lost its X server; trying once more");
+  }
+  if (exitCode != 0) {
     std::ifstream in(logFile);
     std::string line, last;
     while (std::getline(in, line)) {

@@ -154,7 +154,7 @@ Pvbatch findPvbatch() {
       p.missing = "no display and no xvfb-run for pvbatch (Debian: apt-get install xvfb)";
       return p;
     }
-    p.command = {xvfb.string(), "-a"};
+    p.command = {xvfb.string(), "-a", "-s", "-screen 0 1920x1200x24"};
   }
   p.command.push_back(pv.string());
   return p;
@@ -314,7 +314,12 @@ TEST_F(ClgRun, ParaViewReadsSpeciesByName) {
                            "species_Fe3O4", "species_Al2O3", "velocity", "temperature", "diameter",
                            "set_index", "chemistry_reference_1", "contact_count"});
   const fs::path log = dir_ / "pvbatch.log";
-  ASSERT_EQ(runProgram(pv.command.front(), args, log), 0) << tail(log);
+  int rc = runProgram(pv.command.front(), args, log);
+  if (rc != 0 && readAll(log).find("bad X server connection") != std::string::npos) {
+    fs::remove(log); // the virtual X server was not ready (a loaded machine): once more
+    rc = runProgram(pv.command.front(), args, log);
+  }
+  ASSERT_EQ(rc, 0) << tail(log);
   const std::string out = readAll(log);
   EXPECT_NE(out.find("species_Fe2O3: 5291 values equal"), std::string::npos) << out;
   EXPECT_NE(out.find("velocity: 15873 values equal"), std::string::npos) << out;
