@@ -62,16 +62,13 @@ if(NOT COREDEM_PYTHON)
 endif()
 
 # ParaView's pvbatch for `coredem render` and the ParaView e2e test (optional: Debian's paraview;
-# without a display it runs under xvfb-run, Debian's xvfb). Looked up again on PATH at run time.
+# without a display it runs on a private Xvfb, Debian's xvfb, started by
+# scripts/render/with-xvfb.sh). Looked up again on PATH at run time.
 find_program(COREDEM_PVBATCH pvbatch DOC "ParaView's pvbatch (coredem render)")
-find_program(COREDEM_XVFB_RUN xvfb-run DOC "xvfb-run (pvbatch without a display)")
 if(NOT COREDEM_PVBATCH)
   message(STATUS "pvbatch not found: coredem render and the ParaView e2e tests need Debian's "
                  "paraview and xvfb (scripts/install-deps.sh)")
   set(COREDEM_PVBATCH "")
-endif()
-if(NOT COREDEM_XVFB_RUN)
-  set(COREDEM_XVFB_RUN "")
 endif()
 
 # Common compile flags for the project's own C++ (not for OpenFOAM translation units).

@@ -56,7 +56,7 @@ void makePlots(const fs::path& runDir, bool interrupted) {
 }
 
 /// `coredem render`: scripts/render/render_run.py under ParaView's pvbatch (found at configure
-/// time or on PATH), under xvfb-run when there is no display.
+/// time or on PATH), on a private Xvfb when there is no display.
 int renderRun(const fs::path& runDir, const std::vector<double>& times, const std::string& field,
               const std::string& gasField, const std::string& outDir) {
   auto log = coredem::logger("orchestrator");
@@ -82,19 +82,16 @@ int renderRun(const fs::path& runDir, const std::vector<double>& times, const st
                runDir.string());
     return kExitBadInput;
   }
+  // Without a display pvbatch runs on a private virtual X server (scripts/render/with-xvfb.sh).
   std::vector<std::string> args;
   const char* display = std::getenv("DISPLAY");
   if (display == nullptr || *display == '\0') {
-    fs::path xvfb = COREDEM_XVFB_RUN;
-    if (xvfb.empty() || !fs::exists(xvfb)) {
-      xvfb = coredem::findProgram("xvfb-run");
-    }
-    if (xvfb.empty()) {
-      log->error("no display (DISPLAY unset) and no xvfb-run: pvbatch needs one of them "
+    if (coredem::findProgram("Xvfb").empty()) {
+      log->error("no display (DISPLAY unset) and no Xvfb: pvbatch needs one of them "
                  "(Debian: apt-get install xvfb)");
       return kExitBadInput;
     }
-    args = {xvfb.string(), "-a", "-s", "-screen 0 1920x1200x24"};
+    args = {"/bin/sh", (script.parent_path() / "with-xvfb.sh").string()};
   }
   args.insert(args.end(), {pvbatch.string(), script.string(), runDir.string()});
   if (!times.empty()) {

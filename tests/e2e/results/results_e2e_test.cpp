@@ -2,12 +2,12 @@
 // coredemFoam):
 //   - particles and gas written at the same simulated times (output.every_seconds), listed in
 //     RUN/outputs.csv with decimal times, and no gas time written at controlDict's writeInterval;
-//   - a CLG snapshot (4 solid species) read by ParaView's XDMF reader (pvbatch under xvfb-run):
+//   - a CLG snapshot (4 solid species) read by ParaView's XDMF reader (pvbatch, private Xvfb):
 //     species columns by name, vectors and the added diameter/set_index equal the .h5's data;
 //   - `coredem render` draws one time as a PNG that is not a single colour;
 //   - the plots of an isothermal bed: pressure drop and bed height, no temperature panel;
 //   - docs/tutorial.md's commands, run as written on its tiny case.
-// The ParaView tests are skipped, with the reason, when pvbatch (or a display / xvfb-run) is
+// The ParaView tests are skipped, with the reason, when pvbatch (or a display / Xvfb) is
 // absent.
 #include <algorithm>
 #include <chrono>
@@ -127,7 +127,7 @@ particles:
   return c;
 }
 
-/// pvbatch and the way to run it here ({xvfb-run, -a, pvbatch} without a display), or the
+/// pvbatch and the way to run it here ({sh, with-xvfb.sh, pvbatch} without a display), or the
 /// reason it cannot run.
 struct Pvbatch {
   std::vector<std::string> command;
@@ -146,15 +146,11 @@ Pvbatch findPvbatch() {
   }
   const char* display = std::getenv("DISPLAY");
   if (display == nullptr || *display == '\0') {
-    fs::path xvfb = COREDEM_XVFB_RUN;
-    if (xvfb.empty() || !fs::exists(xvfb)) {
-      xvfb = coredem::findProgram("xvfb-run");
-    }
-    if (xvfb.empty()) {
-      p.missing = "no display and no xvfb-run for pvbatch (Debian: apt-get install xvfb)";
+    if (coredem::findProgram("Xvfb").empty()) {
+      p.missing = "no display and no Xvfb for pvbatch (Debian: apt-get install xvfb)";
       return p;
     }
-    p.command = {xvfb.string(), "-a", "-s", "-screen 0 1920x1200x24"};
+    p.command = {"/bin/sh", COREDEM_WITH_XVFB};
   }
   p.command.push_back(pv.string());
   return p;
