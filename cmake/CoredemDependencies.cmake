@@ -61,6 +61,16 @@ if(NOT COREDEM_PYTHON)
                   "tests are disabled. Run scripts/install-deps.sh.")
 endif()
 
+# ParaView's pvbatch for `coredem render` and the ParaView e2e test (optional: Debian's paraview;
+# without a display it runs on a private Xvfb, Debian's xvfb, started by
+# scripts/render/with-xvfb.sh). Looked up again on PATH at run time.
+find_program(COREDEM_PVBATCH pvbatch DOC "ParaView's pvbatch (coredem render)")
+if(NOT COREDEM_PVBATCH)
+  message(STATUS "pvbatch not found: coredem render and the ParaView e2e tests need Debian's "
+                 "paraview and xvfb (scripts/install-deps.sh)")
+  set(COREDEM_PVBATCH "")
+endif()
+
 # Common compile flags for the project's own C++ (not for OpenFOAM translation units).
 add_library(coredem_warnings INTERFACE)
 target_compile_options(coredem_warnings INTERFACE

@@ -3,11 +3,13 @@
 // `concurrency` at once, and records every transition in DIR/campaign.db.
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -619,6 +621,58 @@ std::string scalarOf(const fs::path& timeseries, const ScalarSpec& spec) {
   return fmt::format("{:.17g}", v);
 }
 
+/// First and last simulated time (column t) of a timeseries.csv; nullopt without rows.
+std::optional<std::pair<double, double>> timeRange(const fs::path& timeseries) {
+  std::ifstream in(timeseries);
+  std::string header, line;
+  if (!in || !std::getline(in, header)) {
+    return std::nullopt;
+  }
+  const auto cols = splitCsvLine(header);
+  const auto at = std::find(cols.begin(), cols.end(), "t");
+  if (at == cols.end()) {
+    return std::nullopt;
+  }
+  const std::size_t c = static_cast<std::size_t>(at - cols.begin());
+  std::optional<std::pair<double, double>> out;
+  while (std::getline(in, line)) {
+    const auto f = splitCsvLine(line);
+    if (f.size() <= c) {
+      continue;
+    }
+    const double t = std::strtod(f[c].c_str(), nullptr);
+    out = out ? std::pair{out->first, t} : std::pair{t, t};
+  }
+  return out;
+}
+
+/// What time the plotted value refers to, e.g. "final value at t = 0.05 s" or "mean over
+/// t = 0.001–0.05 s" (a range of members' times when they differ).
+std::string whenOf(const std::vector<MemberRecord>& members, const ScalarSpec& spec) {
+  double lo0 = HUGE_VAL, hi0 = -HUGE_VAL, lo1 = HUGE_VAL, hi1 = -HUGE_VAL;
+  for (const auto& m : members) {
+    if (m.status != "done") {
+      continue;
+    }
+    if (const auto r = timeRange(fs::path(m.runDir) / "timeseries.csv")) {
+      lo0 = std::min(lo0, r->first);
+      hi0 = std::max(hi0, r->first);
+      lo1 = std::min(lo1, r->second);
+      hi1 = std::max(hi1, r->second);
+    }
+  }
+  if (lo1 > hi1) {
+    return "";
+  }
+  auto span = [](double lo, double hi) {
+    return lo == hi ? fmt::format("{:.6g}", lo) : fmt::format("{:.6g}..{:.6g}", lo, hi);
+  };
+  if (spec.reduce == "final") {
+    return fmt::format("final value at t = {} s", span(lo1, hi1));
+  }
+  return fmt::format("{} over t = {} to {} s", spec.reduce, span(lo0, hi0), span(lo1, hi1));
+}
+
 int collect(const fs::path& dir, bool noPlot) {
   CampaignDb db(dir / "campaign.db", false);
   const auto members = db.members();
@@ -681,10 +735,17 @@ int collect(const fs::path& dir, bool noPlot) {
       }
     }
   }
+  std::string when;
+  for (const auto& sc : scalars) {
+    if (sc.label() == db.setting("plot_y")) {
+      when = whenOf(members, sc);
+    }
+  }
   const std::string cmd = fmt::format(
-      "'{}' '{}' '{}' --x '{}' --y '{}'{} --title '{}' --out '{}' > '{}' 2>&1", python.string(),
-      script.string(), (dir / "summary.csv").string(), db.setting("plot_x"), db.setting("plot_y"),
-      groups, db.setting("name"), png.string(), (dir / "plots" / "plot.log").string());
+      "'{}' '{}' '{}' --x '{}' --y '{}'{} --title '{}' --when '{}' --out '{}' > '{}' 2>&1",
+      python.string(), script.string(), (dir / "summary.csv").string(), db.setting("plot_x"),
+      db.setting("plot_y"), groups, db.setting("name"), when, png.string(),
+      (dir / "plots" / "plot.log").string());
   const int rc = std::system(cmd.c_str());
   if (rc != 0) {
     logger("campaign")->warn("plot script failed (see {})", (dir / "plots" / "plot.log").string());

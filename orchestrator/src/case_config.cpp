@@ -660,9 +660,13 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     c.checkpoint.keep = int(k.integer("keep", 3, 1, 1000000, "checkpoints to keep"));
   }
   if (top.has("output")) {
-    const Section o = top.section("output", {"every", "timeseries_every"});
-    c.output.snapshotEvery = o.integer("every", 0, 0, std::numeric_limits<std::int64_t>::max(),
-                                       "steps between particle snapshots, 0 = none");
+    const Section o = top.section("output", {"every", "every_seconds", "timeseries_every"});
+    c.output.snapshotEvery =
+        o.integer("every", 0, 0, std::numeric_limits<std::int64_t>::max(),
+                  "steps between outputs (particle snapshot and CFD fields), 0 = none");
+    c.output.everySeconds =
+        o.number("every_seconds", 0.0, 0.0, kBig,
+                 "simulated seconds between outputs (particle snapshot and CFD fields), 0 = none");
     c.output.timeseriesEvery =
         o.integer("timeseries_every", 1, 1, std::numeric_limits<std::int64_t>::max(),
                   "steps between timeseries.csv rows");

@@ -238,6 +238,23 @@ herr_t visit(hid_t group, const char* name, const H5L_info_t*, void* data) {
           sum += x;
         }
         d.mean = sum / double(n);
+        if (dims.size() == 2 && dims[1] > 1 && dims[0] > 0) {
+          const std::size_t rows = dims[0], w = dims[1];
+          d.columnMin.assign(w, std::numeric_limits<double>::infinity());
+          d.columnMax.assign(w, -std::numeric_limits<double>::infinity());
+          d.columnMean.assign(w, 0.0);
+          for (std::size_t i = 0; i < rows; ++i) {
+            for (std::size_t k = 0; k < w; ++k) {
+              const double x = v[i * w + k];
+              d.columnMin[k] = std::min(d.columnMin[k], x);
+              d.columnMax[k] = std::max(d.columnMax[k], x);
+              d.columnMean[k] += x;
+            }
+          }
+          for (auto& m : d.columnMean) {
+            m /= double(rows);
+          }
+        }
       }
     }
     st.datasets->push_back(d);
@@ -259,8 +276,131 @@ void scanHdf5(const fs::path& file, std::vector<DatasetInfo>& datasets,
   H5Lvisit(f, H5_INDEX_NAME, H5_ITER_INC, visit, &st);
 }
 
+namespace {
+
+std::string join(const std::vector<std::string>& v) {
+  std::string out;
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    out += (i ? "," : "") + v[i];
+  }
+  return out;
+}
+
+std::vector<std::string> splitNames(const std::string& s) {
+  std::vector<std::string> out;
+  std::string cur;
+  std::istringstream in(s);
+  while (std::getline(in, cur, ',')) {
+    out.push_back(cur);
+  }
+  return out;
+}
+
+/// The column names of a multi-column field: its `columns` attribute or 0..w-1.
+std::vector<std::string> columnNames(const std::vector<AttributeInfo>& attrs,
+                                     const std::string& path, std::uint64_t width) {
+  for (const auto& a : attrs) {
+    if (a.path == path + "@columns") {
+      auto names = splitNames(a.value);
+      if (names.size() == width) {
+        return names;
+      }
+    }
+  }
+  std::vector<std::string> out;
+  for (std::uint64_t k = 0; k < width; ++k) {
+    out.push_back(std::to_string(k));
+  }
+  return out;
+}
+
+} // namespace
+
+void describeSnapshot(const fs::path& file, const SnapshotLabels& labels) {
+  namespace sc = dem::schema;
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const h5::Handle f = h5::openFile(file, true);
+  for (const sc::FieldInfo& info : sc::kFields) {
+    const std::string path =
+        std::string("/") + sc::groupName(info.group) + "/" + std::string(info.name);
+    if (!h5::exists(f, std::string(sc::groupName(info.group))) || !h5::exists(f, path.substr(1))) {
+      continue;
+    }
+    const h5::Handle ds(H5Dopen2(f, path.c_str(), H5P_DEFAULT), H5Dclose);
+    if (!ds.valid() || h5::hasAttribute(ds, "unit")) {
+      continue;
+    }
+    h5::writeAttribute(ds, "unit",
+                       info.unit.empty() ? std::string("none") : std::string(info.unit));
+    h5::writeAttribute(ds, "description", std::string(info.doc));
+    if (info.per == sc::Per::Species && !labels.solidSpecies.empty()) {
+      h5::writeAttribute(ds, "columns", join(labels.solidSpecies));
+    } else if (info.per == sc::Per::Particle && info.components == 3) {
+      h5::writeAttribute(ds, "columns", std::string("x,y,z"));
+    } else if (info.per == sc::Per::Particle && info.components > 1) {
+      std::vector<std::string> k;
+      for (int c = 0; c < info.components; ++c) {
+        k.push_back(std::to_string(c));
+      }
+      h5::writeAttribute(ds, "columns", join(k));
+    }
+  }
+  const auto radius = h5::readDataset<double>(f, "particles/radius", file.string());
+  if (!h5::exists(f, "particles/diameter")) {
+    std::vector<double> d(radius.size());
+    for (std::size_t i = 0; i < d.size(); ++i) {
+      d[i] = 2.0 * radius[i];
+    }
+    h5::writeDataset(f, "particles/diameter", d);
+    const h5::Handle ds(H5Dopen2(f, "particles/diameter", H5P_DEFAULT), H5Dclose);
+    h5::writeAttribute(ds, "unit", "m");
+    h5::writeAttribute(ds, "description", "diameter d_p = 2 R");
+  }
+  // Global ids are given set by set in the order of particles[] (DemSystem's constructor).
+  if (!labels.sets.empty() && labels.sets.size() == labels.setCounts.size() &&
+      h5::exists(f, "particles/global_id") && !h5::exists(f, "particles/set_index")) {
+    const auto gid = h5::readDataset<std::int64_t>(f, "particles/global_id", file.string());
+    std::vector<std::int32_t> set(gid.size(), -1);
+    for (std::size_t i = 0; i < gid.size(); ++i) {
+      std::int64_t offset = 0;
+      for (std::size_t k = 0; k < labels.setCounts.size(); ++k) {
+        if (gid[i] >= offset && gid[i] < offset + std::int64_t(labels.setCounts[k])) {
+          set[i] = std::int32_t(k);
+          break;
+        }
+        offset += std::int64_t(labels.setCounts[k]);
+      }
+    }
+    h5::writeDataset(f, "particles/set_index", set);
+    const h5::Handle ds(H5Dopen2(f, "particles/set_index", H5P_DEFAULT), H5Dclose);
+    h5::writeAttribute(ds, "unit", "none");
+    h5::writeAttribute(ds, "description",
+                       "index of the particle set (case.yaml particles[]) the particle belongs to");
+    h5::writeAttribute(ds, "names", join(labels.sets));
+    h5::writeAttribute(ds, "columns", join(labels.sets));
+  }
+  if (!h5::hasAttribute(f, "title")) {
+    h5::writeAttribute(f, "title",
+                       "CoReDEM particle snapshot: /particles/<field> [N] or [N, columns], SI "
+                       "units; each dataset has the attributes unit and description");
+    if (h5::exists(f, "meta")) {
+      const h5::Handle meta = h5::openGroup(f, "meta", file.string());
+      if (h5::hasAttribute(meta, "time")) {
+        h5::writeAttribute(f, "time", h5::readAttribute<double>(meta, "time", file.string()));
+      }
+      if (h5::hasAttribute(meta, "step")) {
+        h5::writeAttribute(f, "step", h5::readAttribute<std::int64_t>(meta, "step", file.string()));
+      }
+    }
+    h5::writeAttribute(f, "species_names", join(labels.solidSpecies));
+    h5::writeAttribute(f, "set_names", join(labels.sets));
+    h5::writeAttribute(f, "material_names", join(labels.materials));
+  }
+}
+
 void writeParticleXdmf(const fs::path& xdmfPath,
                        const std::vector<std::pair<double, std::string>>& snapshots) {
+  namespace sc = dem::schema;
   std::ostringstream x;
   x << "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n";
   x << "<Xdmf Version=\"3.0\">\n <Domain>\n";
@@ -289,37 +429,59 @@ void writeParticleXdmf(const fs::path& xdmfPath,
                      "Format=\"HDF\">{}:/particles/position</DataItem>\n",
                      n, rel);
     x << "    </Geometry>\n";
-    // The node attributes are the DEM particle schema's snapshot fields present in the file.
-    for (const dem::schema::FieldInfo& f : dem::schema::snapshotFields()) {
-      if (f.name == dem::schema::kGeometryField) {
+    // The node attributes: every per-particle field of the DEM particle schema the file holds
+    // (per particle or per species), then the fields describeSnapshot adds.
+    std::vector<std::string> paths;
+    for (const sc::FieldInfo& f : sc::kFields) {
+      if (f.name == sc::kGeometryField ||
+          (f.per != sc::Per::Particle && f.per != sc::Per::Species)) {
         continue;
       }
-      const std::string name(f.name);
-      const auto it = std::find_if(ds.begin(), ds.end(), [&](const DatasetInfo& d) {
-        return d.path == "/particles/" + name;
-      });
+      paths.push_back(std::string("/") + sc::groupName(f.group) + "/" + std::string(f.name));
+    }
+    paths.push_back("/particles/diameter");
+    paths.push_back("/particles/set_index");
+    for (const std::string& path : paths) {
+      const auto it =
+          std::find_if(ds.begin(), ds.end(), [&](const DatasetInfo& d) { return d.path == path; });
       if (it == ds.end()) {
         continue;
       }
       const DatasetInfo& d = *it;
-      if (!d.numeric || d.dims.empty() || d.dims[0] != n) {
+      if (!d.numeric || d.dims.empty() || d.dims[0] != n || d.dims.size() > 2) {
         continue;
       }
-      const bool vec = d.dims.size() == 2 && d.dims[1] == 3;
-      const bool scalar = d.dims.size() == 1;
-      if (!vec && !scalar) {
-        continue;
-      }
+      const std::string name = path.substr(path.rfind('/') + 1);
       const bool isFloat = d.type.rfind("float", 0) == 0;
       const std::string numberType =
           isFloat ? "Float" : (d.type.rfind("u", 0) == 0 ? "UInt" : "Int");
       const std::string precision = d.type.find("64") != std::string::npos ? "8" : "4";
-      x << fmt::format("    <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"Node\">\n", name,
-                       vec ? "Vector" : "Scalar");
-      x << fmt::format("     <DataItem Dimensions=\"{}{}\" NumberType=\"{}\" Precision=\"{}\" "
-                       "Format=\"HDF\">{}:{}</DataItem>\n",
-                       n, vec ? " 3" : "", numberType, precision, rel, d.path);
-      x << "    </Attribute>\n";
+      const std::uint64_t width = d.dims.size() == 2 ? d.dims[1] : 1;
+      const std::string item =
+          fmt::format("DataItem Dimensions=\"{}{}\" NumberType=\"{}\" Precision=\"{}\" "
+                      "Format=\"HDF\">{}:{}</DataItem>",
+                      n, width > 1 ? fmt::format(" {}", width) : std::string(), numberType,
+                      precision, rel, d.path);
+      if (width == 1 || width == 3) {
+        x << fmt::format("    <Attribute Name=\"{}\" AttributeType=\"{}\" Center=\"Node\">\n", name,
+                         width == 3 ? "Vector" : "Scalar");
+        x << "     <" << item << "\n    </Attribute>\n";
+        continue;
+      }
+      // Any other width (species, ...): one named scalar per column, a hyperslab of the column.
+      const auto columns = columnNames(attrs, d.path, width);
+      for (std::uint64_t k = 0; k < width; ++k) {
+        x << fmt::format("    <Attribute Name=\"{}_{}\" AttributeType=\"Scalar\" "
+                         "Center=\"Node\">\n",
+                         name, columns[k]);
+        x << fmt::format("     <DataItem ItemType=\"HyperSlab\" Dimensions=\"{} 1\" "
+                         "Type=\"HyperSlab\">\n",
+                         n);
+        x << fmt::format("      <DataItem Dimensions=\"3 2\" Format=\"XML\">0 {} 1 1 {} 1"
+                         "</DataItem>\n",
+                         k, n);
+        x << "      <" << item << "\n     </DataItem>\n    </Attribute>\n";
+      }
     }
     x << "   </Grid>\n";
   }
@@ -369,7 +531,19 @@ std::string inspectSummary(const fs::path& file) {
     for (std::size_t i = 0; i < d.dims.size(); ++i) {
       dims += (i ? "x" : "") + std::to_string(d.dims[i]);
     }
-    if (d.numeric) {
+    if (d.numeric && !d.columnMin.empty()) {
+      // Per component (x, y, z of a vector; species and other columns by name): statistics
+      // over all components together would mix quantities.
+      out << fmt::format("  {:<36} {:<8} [{}]  per column:\n", d.path, d.type, dims);
+      const std::size_t w = d.columnMin.size();
+      const auto names = w == 3 && columnNames(attrs, d.path, w)[0] == "0"
+                             ? std::vector<std::string>{"x", "y", "z"}
+                             : columnNames(attrs, d.path, w);
+      for (std::size_t k = 0; k < w; ++k) {
+        out << fmt::format("    {:<34} {:<8}      min {:.6g}  mean {:.6g}  max {:.6g}\n", names[k],
+                           "", d.columnMin[k], d.columnMean[k], d.columnMax[k]);
+      }
+    } else if (d.numeric) {
       out << fmt::format("  {:<36} {:<8} [{}]  min {:.6g}  mean {:.6g}  max {:.6g}\n", d.path,
                          d.type, dims, d.min, d.mean, d.max);
     } else {

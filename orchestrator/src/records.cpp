@@ -1,5 +1,7 @@
 // The records of a run: timeseries rows, checkpoint manifests, particle snapshots and their
 // index, and the wall-time overhead record.
+#include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -35,7 +37,22 @@ std::vector<SnapshotEntry> readSnapshotIndex(const fs::path& runDir) {
     std::istringstream s(line);
     std::string step, time, file;
     if (std::getline(s, step, ',') && std::getline(s, time, ',') && std::getline(s, file)) {
-      out.push_back({std::stoll(step), doubleFromHex(time), file});
+      out.push_back({std::stoll(step), doubleFromHex(time), file, {}});
+    }
+  }
+  // The gas folders are in outputs.csv (step,time_s,particles,gas).
+  std::ifstream outputs(runDir / "outputs.csv");
+  std::getline(outputs, line);
+  while (std::getline(outputs, line)) {
+    std::istringstream s(line);
+    std::string step, time, file, gas;
+    if (std::getline(s, step, ',') && std::getline(s, time, ',') && std::getline(s, file, ',') &&
+        std::getline(s, gas)) {
+      for (auto& e : out) {
+        if (e.step == std::stoll(step)) {
+          e.gas = gas;
+        }
+      }
     }
   }
   return out;
@@ -43,13 +60,47 @@ std::vector<SnapshotEntry> readSnapshotIndex(const fs::path& runDir) {
 
 void writeSnapshotIndex(const fs::path& runDir, const std::vector<SnapshotEntry>& snaps) {
   std::string text = "step,time_hex,file\n";
+  std::string outputs = "step,time_s,particles,gas\n";
   std::vector<std::pair<double, std::string>> xdmf;
   for (const auto& s : snaps) {
     text += fmt::format("{},{},{}\n", s.step, doubleToHex(s.time), s.file);
+    outputs += fmt::format("{},{},{},{}\n", s.step, s.time, s.file, s.gas); // shortest round trip
     xdmf.emplace_back(s.time, s.file);
   }
   writeFileAtomic(runDir / "snapshots" / "index.csv", text);
+  writeFileAtomic(runDir / "outputs.csv", outputs);
   writeParticleXdmf(runDir / "particles.xdmf", xdmf);
+}
+
+double nextOutputTime(double time, double every) {
+  const double k = std::floor(time / every + 1e-9);
+  return (k + 1.0) * every;
+}
+
+std::string gasOutputFolder(const fs::path& runDir, const std::string& workDir, double time,
+                            double dt) {
+  if (workDir.empty() || !fs::is_directory(runDir / workDir)) {
+    return {};
+  }
+  std::string best;
+  double bestDiff = 0.5 * dt;
+  for (const auto& e : fs::directory_iterator(runDir / workDir)) {
+    if (!e.is_directory()) {
+      continue;
+    }
+    const std::string name = e.path().filename().string();
+    char* end = nullptr;
+    const double t = std::strtod(name.c_str(), &end);
+    if (name.empty() || end != name.c_str() + name.size()) {
+      continue; // not a time folder (constant, system, ...)
+    }
+    const double diff = std::abs(t - time);
+    if (diff <= bestDiff) {
+      bestDiff = diff;
+      best = (fs::path(workDir) / name).string();
+    }
+  }
+  return best;
 }
 
 void OverheadTotals::report(spdlog::logger& log, const fs::path& runDir) const {
@@ -126,7 +177,7 @@ void Session::writeCheckpoint(std::int64_t step, const fs::path& ckDir, const v1
   _log->debug("checkpoint {} written", ckDir.string());
 }
 
-void Session::takeSnapshot(std::int64_t step, double time) {
+void Session::takeSnapshot(std::int64_t step, double time, double dt) {
   const fs::path tmp = _o.runDir / "snapshots" / ".incoming";
   fs::remove_all(tmp);
   fs::create_directories(tmp);
@@ -141,8 +192,20 @@ void Session::takeSnapshot(std::int64_t step, double time) {
   }
   const std::string rel = fmt::format("snapshots/particles_{:08d}.h5", step);
   fs::rename(tmp / done.envelope().checkpoint_done().files(0), _o.runDir / rel);
+  SnapshotLabels labels;
+  for (const auto& sp : _c.solidSpecies) {
+    labels.solidSpecies.push_back(sp.name);
+  }
+  for (const auto& set : _c.particles) {
+    labels.sets.push_back(set.name);
+    labels.setCounts.push_back(set.positions.empty() ? set.count : set.positions.size());
+  }
+  for (const auto& m : _c.materials) {
+    labels.materials.push_back(m.name);
+  }
+  describeSnapshot(_o.runDir / rel, labels);
   fs::remove_all(tmp);
-  _snapshots.push_back({step, time, rel});
+  _snapshots.push_back({step, time, rel, gasOutputFolder(_o.runDir, _cfd.workDir, time, dt)});
   writeSnapshotIndex(_o.runDir, _snapshots);
 }
 

@@ -145,6 +145,7 @@ int Session::run() {
     fs::remove_all(_o.runDir / "snapshots");
     fs::create_directories(_o.runDir / "snapshots");
     fs::remove(_o.runDir / "particles.xdmf");
+    fs::remove(_o.runDir / "outputs.csv");
     if (!_cfd.workDir.empty()) {
       fs::remove_all(_o.runDir / _cfd.workDir); // a fresh copy of cfd.case (prepareWorkDir)
     }
@@ -183,8 +184,8 @@ int Session::run() {
     configureDem(startStep, _time.time(), initialState);
     startCfd(cfdRestart);
     handshakeCfd();
-    if (!fromCheckpoint && _c.output.snapshotEvery > 0) {
-      takeSnapshot(0, 0.0);
+    if (!fromCheckpoint && _c.output.any()) {
+      takeSnapshot(0, 0.0, _c.dt.dt);
     }
     stepLoop(startStep);
     clean = true;

@@ -73,12 +73,23 @@ struct SnapshotEntry {
   std::int64_t step;
   double time;
   std::string file; ///< relative to the run folder
+  std::string gas;  ///< the CFD participant's output folder of the same time ("" if none)
 };
 
-/// RUN/snapshots/index.csv (exact hex times) and RUN/particles.xdmf.
+/// RUN/snapshots/index.csv (exact hex times), RUN/outputs.csv (the index of synchronized
+/// outputs: step, decimal time, particle snapshot, gas time folder) and RUN/particles.xdmf.
 std::vector<SnapshotEntry> readSnapshotIndex(const std::filesystem::path& runDir);
 void writeSnapshotIndex(const std::filesystem::path& runDir,
                         const std::vector<SnapshotEntry>& snaps);
+
+/// The first multiple of `every` (s) after `time` (s), a multiple within 1e-9·every counting as
+/// reached.
+double nextOutputTime(double time, double every);
+
+/// The CFD participant's output folder of time `time` (s) under RUN/<workDir>: the numeric
+/// time folder nearest to it within half a step `dt` (relative to the run folder; "" if none).
+std::string gasOutputFolder(const std::filesystem::path& runDir, const std::string& workDir,
+                            double time, double dt);
 
 /// Ledger entries and diagnostics of a StepDone as (name, value) pairs, appended to `row`.
 void collect(const v1::StepDone& done, std::vector<std::pair<std::string, double>>& row);
@@ -126,7 +137,7 @@ private:
                           const v1::StepDone& dem, const v1::StepDone& cfd);
   void writeCheckpoint(std::int64_t step, const std::filesystem::path& dir, const v1::StepDone& dem,
                        const v1::StepDone& cfd);
-  void takeSnapshot(std::int64_t step, double time);
+  void takeSnapshot(std::int64_t step, double time, double dt);
 
   const CaseConfig& _c;
   RunOptions _o;

@@ -2,6 +2,7 @@
 // the sub-cycling plan, the checkpoint decision, the same StepGrant to both participants, their
 // StepDone, then the records of the step (records.cpp).
 #include <algorithm>
+#include <cmath>
 
 #include <coredem/orchestrator/progress.h>
 
@@ -54,7 +55,18 @@ void Session::stepLoop(std::int64_t startStep) {
     const auto t0 = SteadyClock::now();
     const std::int64_t step = _step + 1;
     const double tStart = _time.time();
-    const double dt = _policy.next(_lastCourant, _time.remaining(_c.endTime));
+    // Synchronized outputs every output.every_seconds land exactly on their multiples: the step
+    // is shortened to reach the next one as it is to reach time.end.
+    double toEnd = _time.remaining(_c.endTime);
+    double tOutput = 0.0;
+    if (_c.output.everySeconds > 0.0) {
+      tOutput = nextOutputTime(tStart, _c.output.everySeconds);
+      while (_time.reached(tOutput)) { // within the time tolerance of a multiple already
+        tOutput += _c.output.everySeconds;
+      }
+      toEnd = std::min(toEnd, _time.remaining(tOutput));
+    }
+    const double dt = _policy.next(_lastCourant, toEnd);
     _dtInFlight = dt;
     const SubcyclePlan plan = planFor(_c, dt, _dtDemMax);
     TimeHandler probe = _time;
@@ -62,6 +74,10 @@ void Session::stepLoop(std::int64_t startStep) {
     const bool last =
         probe.reached(_c.endTime) || (_o.stopAfterStep && step >= *_o.stopAfterStep) || earlyLast;
     lastGranted = earlyLast;
+    const bool output =
+        _c.output.any() &&
+        (last || (_c.output.snapshotEvery > 0 && step % _c.output.snapshotEvery == 0) ||
+         (_c.output.everySeconds > 0.0 && probe.reached(tOutput)));
     const bool checkpoint = checkpointDue(
         step, last, _c.checkpoint.everySteps, _c.checkpoint.everySeconds,
         std::chrono::duration<double>(SteadyClock::now() - lastCheckpointWall).count());
@@ -71,17 +87,20 @@ void Session::stepLoop(std::int64_t startStep) {
       fs::remove_all(ckDir); // a stale, incomplete one from an earlier attempt
       fs::create_directories(ckDir);
     }
-    auto makeGrant = [&] {
+    auto makeGrant = [&](bool cfd) {
       Message g = protocol::makeStepGrant(step, tStart, dt, std::uint32_t(plan.nSub), plan.dtDem);
       g.setSessionId(_session);
       if (checkpoint) {
         g.envelope().mutable_step_grant()->mutable_checkpoint()->set_directory(ckDir.string());
       }
+      if (cfd && output) { // the DEM server's part of an output is the snapshot request below
+        g.envelope().mutable_step_grant()->mutable_checkpoint()->set_tag(protocol::kOutputTag);
+      }
       return g;
     };
-    _dem->send(makeGrant());
+    _dem->send(makeGrant(false));
     {
-      Message g = makeGrant();
+      Message g = makeGrant(true);
       g.setSequence(_pendingCfd->message.envelope().sequence());
       _ctrl->reply(_pendingCfd->peer, std::move(g));
       _pendingCfd.reset();
@@ -129,8 +148,8 @@ void Session::stepLoop(std::int64_t startStep) {
       _lastCheckpointStep = step;
     }
     const auto tIo1 = SteadyClock::now();
-    if (_c.output.snapshotEvery > 0 && (step % _c.output.snapshotEvery == 0 || last)) {
-      takeSnapshot(step, _time.time());
+    if (output) {
+      takeSnapshot(step, _time.time(), dt);
     }
     const auto tIo2 = SteadyClock::now();
     _overhead.checkpoints += std::chrono::duration<double>(tIo1 - tIo0).count();

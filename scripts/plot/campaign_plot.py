@@ -1,20 +1,26 @@
 #!/usr/bin/env python3
 """Plot one result of a campaign against one swept key (docs/campaigns.md).
 
-    campaign_plot.py DIR/summary.csv --x gas.T_g --y mean_T_p --out DIR/plots/campaign.png
+    campaign_plot.py DIR/summary.csv --x gas.T_g --y mean_T_p --out DIR/plots/campaign.png \
+        [--when "final value at t = 0.05 s"]
 
 Reads summary.csv written by `coredem campaign collect`; members that are not done (empty
 result) are left out. When more than one key was swept, one line per combination of the
-other keys.
+other keys. Axes carry units (units.py: from the column or key name; [?] when unknown) and the
+title the time the plotted value refers to (--when, given by `coredem campaign collect`).
 """
 import argparse
 import csv
+import os
 import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from units import label as unit_label  # noqa: E402
 
 
 def number(text):
@@ -31,6 +37,7 @@ def main():
     ap.add_argument("--y", required=True, help="result (a column of summary.csv)")
     ap.add_argument("--out", required=True, help="PNG file")
     ap.add_argument("--title", default="campaign")
+    ap.add_argument("--when", default="", help="the time the y value refers to (title)")
     ap.add_argument("--group", action="append", default=[],
                     help="another swept key: one line per value (repeatable)")
     a = ap.parse_args()
@@ -62,14 +69,18 @@ def main():
         pts.sort(key=lambda p: p[0] if numeric else str(p[0]))  # noqa: E501
         xs = [p[0] for p in pts] if numeric else [str(p[0]) for p in pts]
         ax.plot(xs, [p[1] for p in pts], "o-", label=label or None)
-    ax.set_xlabel(a.x)
-    ax.set_ylabel(a.y)
-    ax.set_title(f"{a.title}: {a.y} vs {a.x}")
+    ax.set_xlabel(unit_label(a.x))
+    ax.set_ylabel(unit_label(a.y))
+    title = f"{a.title}: {a.y} vs {a.x}"
+    if a.when:
+        title += f"\n({a.when})"
+    ax.set_title(title, fontsize=10)
     ax.grid(True, alpha=0.3)
     if any(groups.keys()):
         ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(a.out, dpi=120)
+    print(f"x axis: {unit_label(a.x)}; y axis: {unit_label(a.y)}; title: {title}".replace("\n", " "))
     print(f"wrote {a.out}")
 
 

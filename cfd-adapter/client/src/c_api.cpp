@@ -135,6 +135,14 @@ coredem_status coredem_client_grant(const coredem_client* cc, coredem_grant* out
   });
 }
 
+coredem_status coredem_client_requires_output(const coredem_client* cc, int* out) {
+  auto* c = const_cast<coredem_client*>(cc);
+  return call(c, "coredem_client_requires_output", [&] {
+    argCheck(out != nullptr, "coredem_client_requires_output: out is NULL");
+    *out = participant(c).requiresOutput() ? 1 : 0;
+  });
+}
+
 coredem_status coredem_client_grid(const coredem_client* cc, coredem_grid* out) {
   auto* c = const_cast<coredem_client*>(cc);
   return call(c, "coredem_client_grid", [&] {

@@ -97,6 +97,7 @@ struct Participant::Impl {
   double time = 0.0, dt = 0.0, dtDem = 0.0;
   int nSub = 0;
   std::string checkpointDir;
+  bool outputRequested = false;
   std::string shutdownReason;
 
   Sources sources;
@@ -162,6 +163,7 @@ struct Participant::Impl {
     nSub = static_cast<int>(g.n_sub());
     dtDem = g.dt_dem() > 0.0 ? g.dt_dem() : dt / nSub;
     checkpointDir = g.has_checkpoint() ? g.checkpoint().directory() : std::string();
+    outputRequested = g.has_checkpoint() && g.checkpoint().tag() == proto::kOutputTag;
     state = State::Granted;
   }
 
@@ -526,6 +528,7 @@ COREDEM_GRANT_GETTER(double, dt, dt)
 COREDEM_GRANT_GETTER(int, nSub, nSub)
 COREDEM_GRANT_GETTER(double, dtDem, dtDem)
 COREDEM_GRANT_GETTER(std::string, checkpointDir, checkpointDir)
+COREDEM_GRANT_GETTER(bool, requiresOutput, outputRequested)
 #undef COREDEM_GRANT_GETTER
 
 bool Participant::requiresCheckpoint() const {

@@ -126,7 +126,13 @@ int main(int argc, char* argv[])
         }
         Info<< "Courant Number max: " << CoNum << endl;
 
-        // 4. checkpoint, StepDone and the wait for the next grant.
+        // 4. output, checkpoint, StepDone and the wait for the next grant. Output times are the
+        // orchestrator's (output in case.yaml): the gas fields are written on the steps whose
+        // particle snapshot it takes, never at controlDict's writeInterval.
+        if (coupling.requiresOutput())
+        {
+            runTime.writeNow();
+        }
         std::vector<std::string> files;
         if (coupling.requiresCheckpoint())
         {
@@ -144,7 +150,6 @@ int main(int argc, char* argv[])
                 << exit(FatalError);
         }
 
-        runTime.write();
         runTime.printExecutionTime(Info);
         ++steps;
         timers.endStep();

@@ -20,6 +20,7 @@
 #include "coredem/common/check.h"
 #include "coredem/common/files.h"
 #include "coredem/common/log.h"
+#include "coredem/dem/bed_height.h"
 #include "coredem/dem/dem_system.h"
 #include "coredem/dem/time_handler.h"
 #include "coredem/protocol/protocol.h"
@@ -806,6 +807,8 @@ struct DemServer::Impl {
     proto::addNamedValue(d, "min_T_p", lo);
     proto::addNamedValue(d, "max_T_p", hi);
     proto::addNamedValue(d, "dem_time_s", system->time());
+    proto::addNamedValue(d, "bed_height_m",
+                         dem::bedHeight(p.position, p.radius, p.count, system->config().gravity));
   }
 
   /// Writes DIR/dem.h5 (temp file + rename) and returns the file names relative to DIR.

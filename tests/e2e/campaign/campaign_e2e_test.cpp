@@ -305,6 +305,11 @@ TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
   EXPECT_NE(rows[0][5], rows[1][5]);
   EXPECT_TRUE(fs::is_regular_file(dir / "plots/campaign.png")) << readAll(dir / "plots/plot.log");
   EXPECT_GT(fs::file_size(dir / "plots/campaign.png"), 5000u);
+  // Axes with units, and the time the plotted (final) value refers to.
+  const std::string plotLog = readAll(dir / "plots/plot.log");
+  EXPECT_NE(plotLog.find("x axis: particles[0].diameter [m]"), std::string::npos) << plotLog;
+  EXPECT_NE(plotLog.find("y axis: dem.kinetic_energy_J [J]"), std::string::npos) << plotLog;
+  EXPECT_NE(plotLog.find("(final value at t = "), std::string::npos) << plotLog;
 
   // a member re-runs alone from its case folder with the same result
   ASSERT_EQ(runCoredem({"run", (dir / "members/m001/case").string(), "--out",

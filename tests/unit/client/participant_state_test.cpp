@@ -53,6 +53,7 @@ TEST(ParticipantState, CallsBeforeInitializeAreRefused) {
   EXPECT_NE(stateErrorOf([&] { p.sources(); }).find("sources()"), std::string::npos);
   EXPECT_NE(stateErrorOf([&] { p.requiresCheckpoint(); }).find("checkpointDir()"),
             std::string::npos);
+  EXPECT_NE(stateErrorOf([&] { p.requiresOutput(); }).find("requiresOutput()"), std::string::npos);
 }
 
 TEST(ParticipantState, MissingEnvironmentNamesTheVariable) {
@@ -94,6 +95,9 @@ TEST(ParticipantState, CApiReportsStateErrorsWithAMessage) {
   coredem_grant g;
   EXPECT_EQ(coredem_client_grant(c, &g), COREDEM_ERROR_STATE);
   EXPECT_NE(std::string(coredem_client_last_error(c)).find("state Created"), std::string::npos);
+  int output = -1;
+  EXPECT_EQ(coredem_client_requires_output(c, &output), COREDEM_ERROR_STATE);
+  EXPECT_EQ(coredem_client_requires_output(c, nullptr), COREDEM_ERROR_ARGUMENT);
   const double* v = nullptr;
   size_t n = 0;
   EXPECT_EQ(coredem_client_source(c, "eps_g", &v, &n), COREDEM_ERROR_STATE);

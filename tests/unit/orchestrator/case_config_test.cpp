@@ -57,6 +57,22 @@ TEST(CaseConfig, GoodCaseParses) {
   EXPECT_EQ(c.configHash.size(), 64u);
 }
 
+// Synchronized outputs every N steps and/or every S simulated seconds.
+TEST(CaseConfig, OutputEverySeconds) {
+  const CaseConfig c =
+      parseCase(replace(kGood, "output: {every: 5}", "output: {every: 0, every_seconds: 0.002}"),
+                "case.yaml", fs::temp_directory_path());
+  EXPECT_EQ(c.output.snapshotEvery, 0);
+  EXPECT_DOUBLE_EQ(c.output.everySeconds, 0.002);
+  EXPECT_TRUE(c.output.any());
+  const CaseConfig none = parseCase(replace(kGood, "output: {every: 5}", "output: {every: 0}"),
+                                    "case.yaml", fs::temp_directory_path());
+  EXPECT_FALSE(none.output.any());
+  const std::string e =
+      errorOf(replace(kGood, "output: {every: 5}", "output: {every_seconds: -1}"));
+  EXPECT_NE(e.find("output.every_seconds"), std::string::npos) << e;
+}
+
 TEST(CaseConfig, UnknownKeyNamesLineKeyAndAllowed) {
   const std::string e = errorOf(replace(kGood, "  dt: 1.0e-4", "  dtt: 1.0e-4"));
   EXPECT_NE(e.find("cases/x/case.yaml:4:3: time.dtt: unknown key"), std::string::npos) << e;

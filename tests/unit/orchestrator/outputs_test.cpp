@@ -1,6 +1,7 @@
 // Outputs: timeseries.csv (incl. truncation on resume), XDMF of particle snapshots, inspect.
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include <unistd.h>
 
 #include <coredem/common/check.h>
+#include <coredem/common/hdf5.h>
 #include <coredem/orchestrator/outputs.h>
 #include <coredem/orchestrator/progress.h>
 
@@ -104,6 +106,62 @@ TEST(Xdmf, DescribesSnapshots) {
   fs::remove_all(d);
 }
 
+// A CLG-like snapshot: 4 solid species and two sets. describeSnapshot names and documents
+// every schema dataset, adds diameter and set_index, and the XDMF shows each species column as a
+// named scalar (a hyperslab of /particles/species), whatever the species count.
+TEST(Xdmf, NamesEverySpeciesColumnAndDescribesTheSnapshot) {
+  const fs::path d = tempDir("xdmf-species");
+  fs::create_directories(d / "snapshots");
+  const fs::path file = d / "snapshots" / "s.h5";
+  writeSnapshot(file, 4);
+  {
+    const coredem::h5::Handle f = coredem::h5::openFile(file, true);
+    coredem::h5::writeDataset(f, "particles/radius", std::vector<double>{1e-4, 1e-4, 2e-4, 2e-4});
+    coredem::h5::writeDataset(f, "particles/global_id", std::vector<std::int64_t>{3, 0, 2, 1});
+    std::vector<double> y(16);
+    for (std::size_t i = 0; i < y.size(); ++i) {
+      y[i] = 0.01 * double(i);
+    }
+    coredem::h5::writeDataset(f, "particles/species", y, {4, 4});
+  }
+  SnapshotLabels labels;
+  labels.solidSpecies = {"C", "Fe2O3", "Fe3O4", "Al2O3"};
+  labels.sets = {"carrier", "char"};
+  labels.setCounts = {3, 1};
+  labels.materials = {"carrier", "char"};
+  describeSnapshot(file, labels);
+  {
+    const coredem::h5::Handle f = coredem::h5::openFile(file);
+    const coredem::h5::Handle sp(H5Dopen2(f, "particles/species", H5P_DEFAULT), H5Dclose);
+    EXPECT_EQ(coredem::h5::readStringAttribute(sp, "columns", "t"), "C,Fe2O3,Fe3O4,Al2O3");
+    EXPECT_EQ(coredem::h5::readStringAttribute(sp, "unit", "t"), "-");
+    const coredem::h5::Handle t(H5Dopen2(f, "particles/temperature", H5P_DEFAULT), H5Dclose);
+    EXPECT_EQ(coredem::h5::readStringAttribute(t, "unit", "t"), "K");
+    EXPECT_FALSE(coredem::h5::readStringAttribute(t, "description", "t").empty());
+    EXPECT_EQ(coredem::h5::readDataset<double>(f, "particles/diameter", "t"),
+              (std::vector<double>{2e-4, 2e-4, 4e-4, 4e-4}));
+    // gids 0..2: carrier, 3: char
+    EXPECT_EQ(coredem::h5::readDataset<std::int32_t>(f, "particles/set_index", "t"),
+              (std::vector<std::int32_t>{1, 0, 0, 0}));
+    EXPECT_EQ(coredem::h5::readStringAttribute(f, "species_names", "t"), "C,Fe2O3,Fe3O4,Al2O3");
+    EXPECT_EQ(coredem::h5::readStringAttribute(f, "set_names", "t"), "carrier,char");
+  }
+  writeParticleXdmf(d / "particles.xdmf", {{0.25, "snapshots/s.h5"}});
+  const std::string x = readAll(d / "particles.xdmf");
+  for (const char* name : {"species_C", "species_Fe2O3", "species_Fe3O4", "species_Al2O3"}) {
+    EXPECT_NE(x.find(std::string("<Attribute Name=\"") + name + "\" AttributeType=\"Scalar\""),
+              std::string::npos)
+        << name << "\n"
+        << x;
+  }
+  EXPECT_NE(x.find("<DataItem Dimensions=\"3 2\" Format=\"XML\">0 3 1 1 4 1</DataItem>"),
+            std::string::npos)
+      << x;
+  EXPECT_NE(x.find("<Attribute Name=\"diameter\" AttributeType=\"Scalar\""), std::string::npos);
+  EXPECT_NE(x.find("<Attribute Name=\"set_index\" AttributeType=\"Scalar\""), std::string::npos);
+  fs::remove_all(d);
+}
+
 TEST(Inspect, SummarisesHdf5) {
   const fs::path d = tempDir("inspect");
   writeSnapshot(d / "s.h5", 3);
@@ -112,6 +170,26 @@ TEST(Inspect, SummarisesHdf5) {
   EXPECT_NE(s.find("/particles/temperature"), std::string::npos) << s;
   EXPECT_NE(s.find("min 300  mean 301  max 302"), std::string::npos) << s;
   EXPECT_THROW(inspectSummary(d / "missing.h5"), coredem::UserError);
+  fs::remove_all(d);
+}
+
+// A vector's statistics are per component (x, y, z), a species array's per named column.
+TEST(Inspect, StatisticsPerComponent) {
+  const fs::path d = tempDir("inspect-columns");
+  writeSnapshot(d / "s.h5", 3); // position (i, 0, 0)
+  {
+    const coredem::h5::Handle f = coredem::h5::openFile(d / "s.h5", true);
+    coredem::h5::writeDataset(f, "particles/species", std::vector<double>{1, 0, 0.5, 0.5, 0, 1},
+                              {3, 2});
+    const coredem::h5::Handle ds(H5Dopen2(f, "particles/species", H5P_DEFAULT), H5Dclose);
+    coredem::h5::writeAttribute(ds, "columns", "C,Fe2O3");
+  }
+  const std::string s = inspectSummary(d / "s.h5");
+  EXPECT_NE(s.find("/particles/position"), std::string::npos) << s;
+  EXPECT_NE(s.find("per column"), std::string::npos) << s;
+  EXPECT_TRUE(std::regex_search(s, std::regex("\n    x +min 0  mean 1  max 2\n"))) << s;
+  EXPECT_TRUE(std::regex_search(s, std::regex("\n    y +min 0  mean 0  max 0\n"))) << s;
+  EXPECT_TRUE(std::regex_search(s, std::regex("\n    Fe2O3 +min 0  mean 0\\.5  max 1\n"))) << s;
   fs::remove_all(d);
 }
 

@@ -102,7 +102,13 @@ struct CheckpointConfig {
 };
 
 struct OutputConfig {
-  std::int64_t snapshotEvery = 0;   ///< steps between particle snapshots, 0 = none
+  /// True when any synchronized output (particles and gas at the same step) is configured.
+  bool any() const { return snapshotEvery > 0 || everySeconds > 0.0; }
+  /// Steps between synchronized outputs (particle snapshot + CFD fields), 0 = none.
+  std::int64_t snapshotEvery = 0;
+  /// Simulated seconds between synchronized outputs (at multiples of it; Δt_CFD is shortened to
+  /// land on them), 0 = none.
+  double everySeconds = 0.0;
   std::int64_t timeseriesEvery = 1; ///< steps between timeseries rows
 };
 

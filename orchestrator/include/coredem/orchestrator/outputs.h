@@ -38,6 +38,8 @@ struct DatasetInfo {
   std::string type; ///< "float64", "int64", "string", ...
   bool numeric = false;
   double min = 0, max = 0, mean = 0; ///< for numeric datasets
+  /// For numeric [N, W] datasets: min, mean and max of each column (x, y, z of a vector).
+  std::vector<double> columnMin, columnMean, columnMax;
 };
 
 struct AttributeInfo {
@@ -53,10 +55,29 @@ void scanHdf5(const std::filesystem::path& file, std::vector<DatasetInfo>& datas
 /// Writes `xdmfPath` (atomically) describing the particle snapshots `snapshots` (paths
 /// relative to the XDMF's folder, with their times) as a temporal collection of
 /// poly-vertex grids: geometry from /particles/position (N×3), and each snapshot field of the
-/// DEM particle schema (coredem/dem/particle_schema.h, snapshotFields()) that the file holds
-/// with N rows as a node attribute (Scalar for [N], Vector for [N,3]).
+/// DEM particle schema (coredem/dem/particle_schema.h) that the file holds with N rows as node
+/// attributes: Scalar for [N], Vector for [N,3], and one Scalar per column for other widths
+/// (named `<field>_<column>`, the columns from the dataset's `columns` attribute, e.g.
+/// species_Fe2O3), plus diameter and set_index (describeSnapshot). The per-contact-slot and
+/// per-neighbour-slot bookkeeping of /contacts is not exposed.
 void writeParticleXdmf(const std::filesystem::path& xdmfPath,
                        const std::vector<std::pair<double, std::string>>& snapshots);
+
+/// The names a snapshot cannot know by itself (from the case file), in the order of the DEM
+/// server's indices.
+struct SnapshotLabels {
+  std::vector<std::string> solidSpecies; ///< columns of /particles/species
+  std::vector<std::string> sets;         ///< particles[] names (global ids in set order)
+  std::vector<std::uint64_t> setCounts;  ///< particles[] counts
+  std::vector<std::string> materials;    ///< values of /particles/material
+};
+
+/// Makes a particle snapshot (or state file) self-describing, in place: every dataset of the
+/// DEM particle schema gets the attributes `unit` and `description` (and `columns`: the species
+/// names of /particles/species, the components of other multi-column fields); adds
+/// /particles/diameter (2R, m) and /particles/set_index (attribute `names`); and the root gets
+/// `title`, `time`, `step`, `species_names`, `set_names`, `material_names` (comma-separated).
+void describeSnapshot(const std::filesystem::path& file, const SnapshotLabels& labels);
 
 /// `coredem inspect FILE`: a readable summary of an HDF5 state/snapshot, a manifest.json
 /// or a checkpoint folder (with hash verification).

@@ -227,6 +227,11 @@ Message makeStepGrant(std::int64_t step, double time, double dtCfd, std::uint32_
                       double dtDem);
 Message makeStepDone(std::int64_t step, double time, const v1::StepDone& body);
 Message makeCheckpointRequest(std::int64_t step, std::string directory, std::string tag = {});
+/// StepGrant.checkpoint.tag asking the CFD participant to write its output fields after the
+/// step (a synchronized output, docs/protocol.md): with an empty directory the grant asks for
+/// the output alone, with a directory for a checkpoint as well. A participant that does not
+/// know the tag sees no checkpoint request (empty directory) and writes nothing.
+inline constexpr const char* kOutputTag = "output";
 Message makeCheckpointDone(std::int64_t step, std::string directory,
                            std::vector<std::string> files);
 Message makeHeartbeat(std::string state = {});

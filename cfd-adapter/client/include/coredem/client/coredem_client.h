@@ -82,6 +82,9 @@ coredem_state coredem_client_state(const coredem_client* c);
 /* 1 while O keeps granting steps, else 0. */
 int coredem_client_is_running(const coredem_client* c);
 coredem_status coredem_client_grant(const coredem_client* c, coredem_grant* out);
+/* *out = 1 when the current grant asks for the participant's output fields after this step
+ * (synchronized outputs, docs/client.md), else 0. */
+coredem_status coredem_client_requires_output(const coredem_client* c, int* out);
 coredem_status coredem_client_grid(const coredem_client* c, coredem_grid* out);
 /* Name of species k (0 <= k < species_count). */
 coredem_status coredem_client_species_name(const coredem_client* c, int32_t k, const char** name);

@@ -200,6 +200,9 @@ public:
   double dtDem() const;              ///< s, Δt_DEM = dt()/nSub()
   bool requiresCheckpoint() const;   ///< write your state after this step
   std::string checkpointDir() const; ///< where to write it ("" if not requested)
+  /// Write your output fields (for users: the gas at this instant) after this step: the
+  /// orchestrator writes the particle snapshot of the same step (`output` in case.yaml).
+  bool requiresOutput() const;
   /// Why O ended the run (valid in Finished).
   std::string shutdownReason() const;
 
