@@ -29,6 +29,8 @@ BackendKind parseBackend(const std::string& name) {
     return BackendKind::Cuda;
   if (name == "auto")
     return BackendKind::Auto;
+  if (name == "cuda-sim")
+    return BackendKind::CudaSim;
   throw UserError("unknown DEM backend '" + name + "'; use cpu, cuda or auto");
 }
 
@@ -40,6 +42,8 @@ std::string backendName(BackendKind kind) {
     return "cuda";
   case BackendKind::Auto:
     return "auto";
+  case BackendKind::CudaSim:
+    return "cuda-sim";
   }
   return "?";
 }
@@ -388,6 +392,8 @@ struct DemSystem::Impl {
     if (kind == BackendKind::Cuda)
       return makeCudaEngine(setup);
 #endif
+    if (kind == BackendKind::CudaSim)
+      return makeCudaSimEngine(setup);
     return makeCpuEngine(setup);
   }
   std::shared_ptr<spdlog::logger> log = coredem::logger("dem.system");

@@ -92,7 +92,8 @@ protected:
   }
 };
 
-using Backends = ::testing::Types<BackendTag<BackendKind::Cpu>, BackendTag<BackendKind::Cuda>>;
+using Backends = ::testing::Types<BackendTag<BackendKind::Cpu>, BackendTag<BackendKind::CudaSim>,
+                                  BackendTag<BackendKind::Cuda>>;
 TYPED_TEST_SUITE(BackendConformance, Backends);
 
 namespace {

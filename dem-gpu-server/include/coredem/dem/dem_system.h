@@ -29,9 +29,12 @@
 namespace coredem::dem {
 
 /// Which backend runs the kernels. `Auto` = Cuda if a CUDA device is present, else Cpu.
-enum class BackendKind { Cpu, Cuda, Auto };
+/// `CudaSim` ("cuda-sim", for tests and debugging): the cpu kernels under the cuda backend's
+/// memory model (separate device memory filled with garbage, explicit copies), so that a
+/// missing host↔device synchronisation shows without a GPU; never chosen by `Auto`.
+enum class BackendKind { Cpu, Cuda, Auto, CudaSim };
 
-/// Parses "cpu" | "cuda" | "auto" (UserError otherwise).
+/// Parses "cpu" | "cuda" | "auto" | "cuda-sim" (UserError otherwise).
 BackendKind parseBackend(const std::string& name);
 /// "cpu" or "cuda".
 std::string backendName(BackendKind kind);
