@@ -26,14 +26,25 @@ void fillGarbage(void* p, std::size_t bytes) {
     q[k] = static_cast<unsigned char>(kGarbage >> (8 * (k % 8)));
 }
 
+/// Device allocations: bump-allocated from one reserved range (the arena), so that opening and
+/// closing a DeviceScope is one mprotect call; the arena restarts when nothing in it is live.
+/// Allocations that do not fit get their own mapping (`regions`).
 struct Registry {
   std::mutex mutex;
-  std::unordered_map<void*, std::size_t> regions; ///< device allocations → mapped length
+  char* base = nullptr; ///< arena, kArenaBytes of address space (no memory until touched)
+  std::size_t top = 0;  ///< bytes handed out since the arena was last empty
+  std::size_t live = 0; ///< live allocations in the arena
+  std::unordered_map<void*, std::size_t> regions; ///< every live allocation → mapped length
   int depth = 0;                                  ///< open DeviceScopes
 };
+constexpr std::size_t kArenaBytes = std::size_t{1} << 36; // 64 GiB of address space
 Registry& registry() {
   static Registry* r = new Registry; // never destroyed: frees may run at static destruction
   return *r;
+}
+bool inArena(const Registry& r, const void* p) {
+  const char* c = static_cast<const char*>(p);
+  return r.base != nullptr && c >= r.base && c < r.base + kArenaBytes;
 }
 std::atomic<std::uint64_t> gLaunches{0}, gRoundTrips{0};
 
@@ -45,6 +56,17 @@ std::size_t pageSize() {
 void protect(void* p, std::size_t len, bool accessible) {
   if (::mprotect(p, len, accessible ? PROT_READ | PROT_WRITE : PROT_NONE) != 0)
     raiseUserError(std::string("cuda-sim: mprotect failed: ") + std::strerror(errno));
+}
+
+/// Device memory accessible or not: the arena's used part in one call, then the others.
+void setAccess(Registry& r, bool accessible) {
+  const int prot = accessible ? PROT_READ | PROT_WRITE : PROT_NONE;
+  // mprotect failures only weaken the check (and DeviceScope's destructor may not throw).
+  if (r.top > 0)
+    ::mprotect(r.base, r.top, prot);
+  for (const auto& [p, len] : r.regions)
+    if (!inArena(r, p))
+      ::mprotect(p, len, prot);
 }
 
 // SIGSEGV: say what the likely cause is, then let the default action run (core dump).
@@ -77,12 +99,25 @@ void* allocDevice(std::size_t bytes) {
     return nullptr;
   installHandler();
   const std::size_t len = (bytes + pageSize() - 1) / pageSize() * pageSize();
-  void* p = ::mmap(nullptr, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-  if (p == MAP_FAILED)
-    throw std::bad_alloc();
-  fillGarbage(p, len);
   Registry& r = registry();
   std::lock_guard<std::mutex> lock(r.mutex);
+  if (r.base == nullptr) {
+    void* a =
+        ::mmap(nullptr, kArenaBytes, PROT_NONE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+    r.base = a == MAP_FAILED ? nullptr : static_cast<char*>(a);
+  }
+  void* p = nullptr;
+  if (r.base != nullptr && r.top + len <= kArenaBytes) {
+    p = r.base + r.top;
+    r.top += len;
+    ++r.live;
+    protect(p, len, true);
+  } else {
+    p = ::mmap(nullptr, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p == MAP_FAILED)
+      throw std::bad_alloc();
+  }
+  fillGarbage(p, len);
   if (r.depth == 0)
     protect(p, len, false);
   r.regions.emplace(p, len);
@@ -97,7 +132,13 @@ void freeDevice(void* p) {
   auto it = r.regions.find(p);
   if (it == r.regions.end())
     raiseUserError("cuda-sim: freeDevice of a pointer that allocDevice did not return");
-  ::munmap(p, it->second);
+  if (inArena(r, p)) {
+    ::madvise(p, it->second, MADV_DONTNEED); // give the pages back; the range is not reused
+    if (--r.live == 0)
+      r.top = 0; // ... until the arena is empty
+  } else {
+    ::munmap(p, it->second);
+  }
   r.regions.erase(it);
 }
 
@@ -118,16 +159,14 @@ DeviceScope::DeviceScope() {
   Registry& r = registry();
   std::lock_guard<std::mutex> lock(r.mutex);
   if (r.depth++ == 0)
-    for (const auto& [p, len] : r.regions)
-      protect(p, len, true);
+    setAccess(r, true);
 }
 
 DeviceScope::~DeviceScope() {
   Registry& r = registry();
   std::lock_guard<std::mutex> lock(r.mutex);
   if (--r.depth == 0)
-    for (const auto& [p, len] : r.regions)
-      ::mprotect(p, len, PROT_NONE); // no throw from a destructor; failure only weakens a check
+    setAccess(r, false);
 }
 
 std::uint64_t launches() {
