@@ -166,6 +166,7 @@ struct Gas {
 /// One run of a deck: the sources of every window and the final state.
 struct Run {
   std::vector<CellSources> windows;
+  std::vector<ParticleData> states; ///< after every window (each read clears the dirty flags)
   ParticleData p;
   HeatTotals heat;
   ChemistryTotals chem;
@@ -195,6 +196,7 @@ Run run(const DemConfig& cfg, BackendKind kind, int windows, int nSub, double dt
     r.contacts.push_back(sys.contactCount());
     r.pairContacts.push_back(sys.pairContactCount());
     r.wallForce.push_back(sys.wallForce());
+    r.states.push_back(sys.particles());
     if (w + 1 == writeAfter)
       sys.writeState(writeTo);
   }
@@ -218,6 +220,7 @@ void expectSameRun(const Run& ref, const Run& r, const Tolerances& t, bool count
     expectCloseRel({ref.wallForce[w][0], ref.wallForce[w][1], ref.wallForce[w][2]},
                    {r.wallForce[w][0], r.wallForce[w][1], r.wallForce[w][2]}, t.force,
                    "wall force");
+    expectSameParticles(ref.states[w], r.states[w], t);
   }
   expectSameParticles(ref.p, r.p, t);
   expectSameTotals(ref.heat, r.heat, ref.chem, r.chem, t);
@@ -429,5 +432,6 @@ TYPED_TEST(StageConformance, RestartContinuesTheStraightRun) {
   tail.contacts.erase(tail.contacts.begin(), tail.contacts.begin() + 4);
   tail.pairContacts.erase(tail.pairContacts.begin(), tail.pairContacts.begin() + 4);
   tail.wallForce.erase(tail.wallForce.begin(), tail.wallForce.begin() + 4);
+  tail.states.erase(tail.states.begin(), tail.states.begin() + 4);
   expectSameRun(tail, resumed, this->tol, this->kind != BackendKind::Cuda);
 }
