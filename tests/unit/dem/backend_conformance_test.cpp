@@ -332,8 +332,11 @@ protected:
     if constexpr (B::kind == BackendKind::Cuda) {
       if (!cudaBackendBuilt())
         GTEST_SKIP() << "CUDA backend not built";
-      if (cudaDeviceCount() == 0)
-        GTEST_SKIP() << "no CUDA device";
+      const CudaProbe cuda = probeCuda();
+      if (!cuda.error.empty())
+        FAIL() << cuda.error; // a broken GPU setup is a failure, not a skip
+      if (cuda.devices == 0)
+        GTEST_SKIP() << "no CUDA device: " << cuda.note;
     }
   }
   static constexpr BackendKind kind = B::kind;
@@ -384,10 +387,12 @@ TYPED_TEST(StageConformance, DragPcmAndEveryHeatModelWithWallHeat) {
     v.apply(cfg);
     const Run ref = run(cfg, BackendKind::Cpu, 3, 10, 1e-4);
     const Run r = run(cfg, this->kind, 3, 10, 1e-4);
-    if (cfg.heat.enabled && cfg.heat.convection)
+    if (cfg.heat.enabled && cfg.heat.convection) {
       EXPECT_NE(ref.heat.convection, 0.0);
-    if (cfg.heat.enabled && cfg.wallTemperature > 0)
+    }
+    if (cfg.heat.enabled && cfg.wallTemperature > 0) {
       EXPECT_GT(ref.heat.wall, 0.0);
+    }
     EXPECT_GT(maxAbs(ref.windows.back().kSl), 0.0);
     expectSameRun(ref, r, this->tol, this->kind != BackendKind::Cuda);
   }

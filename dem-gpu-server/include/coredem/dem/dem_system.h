@@ -40,8 +40,22 @@ BackendKind parseBackend(const std::string& name);
 std::string backendName(BackendKind kind);
 /// True when this build contains the CUDA backend (COREDEM_CUDA_ENABLED).
 bool cudaBackendBuilt();
-/// Number of visible CUDA devices (0 when the CUDA backend is not built or no GPU/driver).
+/// Number of visible CUDA devices (0 when the CUDA backend is not built, when there is no GPU
+/// or driver, and when the CUDA runtime fails: probeCuda() tells these apart).
 int cudaDeviceCount();
+
+/// What the CUDA runtime says about this machine.
+struct CudaProbe {
+  bool built = false; ///< this build contains the CUDA backend
+  int devices = 0;    ///< usable devices (0 when none, and on error)
+  /// Empty, or a CUDA runtime failure (e.g. a driver too old for this build's runtime) with
+  /// CUDA's own message and what to do: a broken GPU setup, never reported as "no device".
+  std::string error;
+  /// When devices == 0 without error: why (not built, no driver, no device, CUDA_VISIBLE_DEVICES).
+  std::string note;
+};
+/// Asks the CUDA runtime (cudaGetDeviceCount, driver and runtime versions) each call.
+CudaProbe probeCuda();
 
 /// Contact properties of one solid material (docs/physics.md §2.1, Eqs. 9–13).
 /// Pairs of different materials use k_n = 2 k_a k_b/(k_a+k_b), e_n = min(e_a, e_b),

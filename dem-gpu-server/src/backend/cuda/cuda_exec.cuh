@@ -21,8 +21,10 @@
     if (demCudaErr_ != cudaSuccess) {                                                          \
       ::coredem::dem::backend::raiseUserError(                                                 \
           std::string("CUDA call '") + #expr + "' failed at " + __FILE__ + ":" +               \
-          std::to_string(__LINE__) + ": " + cudaGetErrorString(demCudaErr_) +                  \
-          " (check the driver and the GPU with nvidia-smi, or run with --backend cpu)");       \
+          std::to_string(__LINE__) + ": " + cudaGetErrorName(demCudaErr_) + ": " +             \
+          cudaGetErrorString(demCudaErr_) +                                                    \
+          " (check the GPU and its driver with nvidia-smi, and CUDA_VISIBLE_DEVICES; "         \
+          "--backend cpu runs without it)");                                                   \
     }                                                                                          \
   } while (false)
 
