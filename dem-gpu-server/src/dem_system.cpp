@@ -9,6 +9,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "backend/sync_counters.h"
 #include "chemistry_config.h"
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
@@ -68,6 +69,11 @@ CudaProbe probeCuda() {
 
 int cudaDeviceCount() {
   return probeCuda().devices;
+}
+
+BackendSyncCounts backendSyncCounts() {
+  const backend::SyncCounters& c = backend::syncCounters();
+  return {c.hostRoundTrips.load(), c.deviceSyncs.load(), c.launches.load()};
 }
 
 void DemConfig::addBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi) {

@@ -2,12 +2,15 @@
 // host↔device synchronisation visible without a GPU.
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "backend/arrays.h"
 #include "backend/cuda_sim/cuda_sim_exec.h"
+#include "coredem/dem/dem_system.h"
 
 using namespace coredem::dem::backend;
 
@@ -102,4 +105,62 @@ TEST(CudaSimDeathTest, HostCodeDereferencingADevicePointerStops) {
   double* dd = a.d();
   exec.parallelFor(16, [=](std::size_t i) { dd[i] = 1.0; });
   EXPECT_EQ(fromDevice(a.d(), 16)[3], 1.0);
+}
+
+namespace {
+coredem::dem::DemConfig fourParticles(bool chemistry) {
+  using namespace coredem::dem;
+  DemConfig c;
+  c.gravity = {0, 0, 0};
+  ParticleSet s;
+  s.packing = Packing::Explicit;
+  s.positions = {0, 0, 0, 2e-3, 0, 0, 0, 2e-3, 0, 0, 0, 2e-3};
+  if (chemistry) {
+    c.gasSpecies = {{"G", 0.015}};
+    c.solidSpecies = {{"B", 0.015}, {"I", 0.020}};
+    s.composition = {0.5, 0.5};
+    ReactionConfig r;
+    r.name = "burn";
+    r.terms = {{"B", -1}, {"G", 1}};
+    r.A = 1e-9;
+    c.chemistry.reactions.push_back(r);
+  }
+  c.particleSets.push_back(s);
+  return c;
+}
+} // namespace
+
+// Host round trips and device synchronisations per sub-step (what coredem-bench dem reports):
+// counted by the device backends only; the figures are recorded in the test's XML output.
+TEST(CudaSim, HostRoundTripsAndSynchronisationsPerSubStepAreCounted) {
+  using namespace coredem::dem;
+  for (bool chemistry : {false, true}) {
+    SCOPED_TRACE(chemistry ? "with chemistry" : "mechanics");
+    DemSystem cpu(fourParticles(chemistry), BackendKind::Cpu, 1);
+    DemSystem sim(fourParticles(chemistry), BackendKind::CudaSim, 1);
+    const double dt = sim.dtDemMax();
+    cpu.advance(dt, 1); // first sub-step: neighbour lists built
+    sim.advance(dt, 1);
+    const BackendSyncCounts c0 = backendSyncCounts();
+    cpu.advance(100 * dt, 100);
+    const BackendSyncCounts c1 = backendSyncCounts();
+    EXPECT_EQ(c1.hostRoundTrips, c0.hostRoundTrips); // the cpu backend counts nothing
+    EXPECT_EQ(c1.deviceSyncs, c0.deviceSyncs);
+    sim.advance(100 * dt, 100);
+    const BackendSyncCounts c2 = backendSyncCounts();
+    EXPECT_EQ(sim.stageTimes().rebuilds, 1u); // no rebuild in the counted steps
+    const double trips = static_cast<double>(c2.hostRoundTrips - c1.hostRoundTrips) / 100.0;
+    const double syncs = static_cast<double>(c2.deviceSyncs - c1.deviceSyncs) / 100.0;
+    const double launches = static_cast<double>(c2.launches - c1.launches) / 100.0;
+    RecordProperty(chemistry ? "round_trips_per_substep_chemistry" : "round_trips_per_substep",
+                   std::to_string(trips));
+    std::printf("per sub-step (%s): %.2f host round trips, %.2f device syncs, %.2f launches\n",
+                chemistry ? "chemistry" : "mechanics", trips, syncs, launches);
+    // The window's reads happen once per window (0.01 per sub-step here).
+    // Today: the motion update's displacement maximum (the rebuild decision) and the contact
+    // module's two slot-overflow checks, + chemistry's removal check: a regression guard.
+    EXPECT_GE(trips, 1.0);
+    EXPECT_LE(trips, chemistry ? 4.01 : 3.0);
+    EXPECT_GT(launches, 1.0);
+  }
 }

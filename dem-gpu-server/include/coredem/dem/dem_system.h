@@ -57,6 +57,16 @@ struct CudaProbe {
 /// Asks the CUDA runtime (cudaGetDeviceCount, driver and runtime versions) each call.
 CudaProbe probeCuda();
 
+/// What made the backends with a separate device (cuda, cuda-sim) wait, counted since the
+/// process started, all systems together (the cpu backend counts nothing). Differences over a
+/// run divided by its sub-steps give the per-sub-step figures coredem-bench dem reports.
+struct BackendSyncCounts {
+  std::uint64_t hostRoundTrips = 0; ///< device → host copies the host waits for (incl. reductions)
+  std::uint64_t deviceSyncs = 0;    ///< explicit device-wide synchronisations
+  std::uint64_t launches = 0;       ///< kernel launches (CUB calls count as their kernels)
+};
+BackendSyncCounts backendSyncCounts();
+
 /// Contact properties of one solid material (docs/physics.md §2.1, Eqs. 9–13).
 /// Pairs of different materials use k_n = 2 k_a k_b/(k_a+k_b), e_n = min(e_a, e_b),
 /// μ = min(μ_a, μ_b) [C]; particle–wall contacts use the particle's material with

@@ -46,7 +46,6 @@ bool inArena(const Registry& r, const void* p) {
   const char* c = static_cast<const char*>(p);
   return r.base != nullptr && c >= r.base && c < r.base + kArenaBytes;
 }
-std::atomic<std::uint64_t> gLaunches{0}, gRoundTrips{0};
 
 std::size_t pageSize() {
   static const std::size_t page = static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
@@ -167,19 +166,6 @@ DeviceScope::~DeviceScope() {
   std::lock_guard<std::mutex> lock(r.mutex);
   if (--r.depth == 0)
     setAccess(r, false);
-}
-
-std::uint64_t launches() {
-  return gLaunches.load();
-}
-void countLaunch() {
-  ++gLaunches;
-}
-std::uint64_t hostRoundTrips() {
-  return gRoundTrips.load();
-}
-void countRoundTrip() {
-  ++gRoundTrips;
 }
 
 } // namespace backend::sim

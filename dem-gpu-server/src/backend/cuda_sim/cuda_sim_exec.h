@@ -27,6 +27,7 @@
 
 #include "../cpu/cpu_exec.h"
 #include "../exec_common.h"
+#include "../sync_counters.h"
 
 namespace coredem::dem::backend {
 
@@ -45,14 +46,12 @@ struct DeviceScope {
   DeviceScope(const DeviceScope&) = delete;
   DeviceScope& operator=(const DeviceScope&) = delete;
 };
-/// Kernel-like calls (parallelFor, exclusiveScan, sorts; reduceMax counts its evaluation loop)
-/// since the process started, all threads together.
-std::uint64_t launches();
-void countLaunch();
-/// Device → host transfers the host waits for (copyToHost, the result of reduceMax): each is a
-/// host round trip and a device-wide synchronisation on the cuda backend.
-std::uint64_t hostRoundTrips();
-void countRoundTrip();
+inline void countLaunch() {
+  ++syncCounters().launches;
+}
+inline void countRoundTrip() {
+  ++syncCounters().hostRoundTrips;
+}
 } // namespace sim
 
 struct CudaSimExec {
@@ -131,7 +130,9 @@ struct CudaSimExec {
   static void copyDeviceToDevice(void* dst, const void* src, std::size_t bytes) {
     copy(dst, src, bytes);
   }
-  static void synchronize() {}
+  static void synchronize() {
+    ++syncCounters().deviceSyncs;
+  }
 
 private:
   static void copy(void* dst, const void* src, std::size_t bytes) {
