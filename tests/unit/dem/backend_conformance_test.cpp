@@ -399,14 +399,20 @@ TYPED_TEST(StageConformance, DragPcmAndEveryHeatModelWithWallHeat) {
 }
 
 TYPED_TEST(StageConformance, ChemistryWithRemoval) {
-  const DemConfig cfg = burningBed();
-  const Run ref = run(cfg, BackendKind::Cpu, 12, 0, 1e-3);
-  const Run r = run(cfg, this->kind, 12, 0, 1e-3);
-  EXPECT_GT(ref.chem.removedCount, 0u);
-  EXPECT_LT(ref.p.count, 48u);
-  EXPECT_GE(ref.p.count, 16u); // the inert particles stay
-  EXPECT_NE(ref.chem.reactionHeat, 0.0);
-  expectSameRun(ref, r, this->tol, this->kind != BackendKind::Cuda);
+  for (bool coupled : {true, false}) {
+    SCOPED_TRACE(coupled ? "on a coupling grid" : "uncoupled (no grid: window totals only)");
+    DemConfig cfg = burningBed();
+    if (!coupled)
+      cfg.grid = CouplingGrid{};
+    const Run ref = run(cfg, BackendKind::Cpu, 12, 0, 1e-3);
+    const Run r = run(cfg, this->kind, 12, 0, 1e-3);
+    EXPECT_GT(ref.chem.removedCount, 0u);
+    EXPECT_LT(ref.p.count, 48u);
+    EXPECT_GE(ref.p.count, 16u); // the inert particles stay
+    EXPECT_NE(ref.chem.reactionHeat, 0.0);
+    EXPECT_LT(ref.chem.solidChange[0], 0.0);
+    expectSameRun(ref, r, this->tol, this->kind != BackendKind::Cuda);
+  }
 }
 
 TYPED_TEST(StageConformance, FrozenMode) {
