@@ -239,9 +239,9 @@ DemConfig denseBox() {
   ParticleSet s;
   s.packing = Packing::Lattice;
   s.regionMin = {0, 0, 0};
-  s.regionMax = {8 * 1.05e-3, 8 * 1.05e-3, 8 * 1.05e-3};
+  s.regionMax = {7 * 1.05e-3, 7 * 1.05e-3, 7 * 1.05e-3};
   s.spacing = 1.05e-3;
-  s.count = 512;
+  s.count = 343;
   s.velocityJitter = 0.3;
   s.seed = 5;
   c.particleSets.push_back(s);
@@ -350,8 +350,8 @@ TYPED_TEST_SUITE(StageConformance, AllBackends);
 TYPED_TEST(StageConformance, NeighbourSearchWithListGrowthContactsAndWalls) {
   const DemConfig cfg = denseBox();
   const double dt = DemSystem(cfg, BackendKind::Cpu, 1).dtDemMax();
-  const Run ref = run(cfg, BackendKind::Cpu, 8, 40, 40 * dt);
-  const Run r = run(cfg, this->kind, 8, 40, 40 * dt);
+  const Run ref = run(cfg, BackendKind::Cpu, 6, 25, 25 * dt);
+  const Run r = run(cfg, this->kind, 6, 25, 25 * dt);
   EXPECT_GT(ref.rebuilds, 1u);
   EXPECT_GT(ref.memoryAfter, ref.memoryBefore);            // the neighbour lists grew
   EXPECT_GT(ref.contacts.back(), ref.pairContacts.back()); // wall contacts present

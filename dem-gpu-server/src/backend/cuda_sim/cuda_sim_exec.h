@@ -57,19 +57,18 @@ inline void countRoundTrip() {
 struct CudaSimExec {
   static constexpr bool separateDevice = true;
   static constexpr const char* name = "cuda-sim";
-  int threads = 0; ///< 0: OpenMP default
-
-  int threadCount() const { return threads > 0 ? threads : omp_get_max_threads(); }
+  /// Ignored: cuda-sim runs on one thread. Changing page protections (DeviceScope) in a
+  /// process whose OpenMP threads spin between loops costs a TLB shootdown on every core
+  /// (20× slower on a loaded machine), and thread-count independence is the cpu backend's test.
+  int threads = 0;
 
   /// f(i) for every i, in reverse index order (any order is allowed; cpu runs ascending).
   template <class F>
   void parallelFor(std::size_t n, F f) const {
     sim::DeviceScope scope;
     sim::countLaunch();
-    const std::int64_t m = static_cast<std::int64_t>(n);
-#pragma omp parallel for schedule(dynamic, 512) num_threads(threadCount()) if (m > 256)
-    for (std::int64_t k = 0; k < m; ++k)
-      f(static_cast<std::size_t>(m - 1 - k));
+    for (std::size_t k = 0; k < n; ++k)
+      f(n - 1 - k);
   }
 
   /// Evaluates f into a buffer (as evalKernel does), then reduces it by a pairwise tree (the
@@ -107,21 +106,11 @@ struct CudaSimExec {
     sortByKey(keys, n, numKeys, perm);
   }
 
-  static void* allocHost(std::size_t bytes) {
-    return sim::allocHost(bytes);
-  }
-  static void freeHost(void* p) {
-    sim::freeHost(p);
-  }
-  static void* allocDevice(std::size_t bytes) {
-    return sim::allocDevice(bytes);
-  }
-  static void freeDevice(void* p) {
-    sim::freeDevice(p);
-  }
-  static void copyToDevice(void* d, const void* h, std::size_t bytes) {
-    copy(d, h, bytes);
-  }
+  static void* allocHost(std::size_t bytes) { return sim::allocHost(bytes); }
+  static void freeHost(void* p) { sim::freeHost(p); }
+  static void* allocDevice(std::size_t bytes) { return sim::allocDevice(bytes); }
+  static void freeDevice(void* p) { sim::freeDevice(p); }
+  static void copyToDevice(void* d, const void* h, std::size_t bytes) { copy(d, h, bytes); }
   static void copyToHost(void* h, const void* d, std::size_t bytes) {
     if (bytes)
       sim::countRoundTrip();
@@ -130,9 +119,7 @@ struct CudaSimExec {
   static void copyDeviceToDevice(void* dst, const void* src, std::size_t bytes) {
     copy(dst, src, bytes);
   }
-  static void synchronize() {
-    ++syncCounters().deviceSyncs;
-  }
+  static void synchronize() { ++syncCounters().deviceSyncs; }
 
 private:
   static void copy(void* dst, const void* src, std::size_t bytes) {
