@@ -36,7 +36,7 @@ enum class BackendKind { Cpu, Cuda, Auto, CudaSim };
 
 /// Parses "cpu" | "cuda" | "auto" | "cuda-sim" (UserError otherwise).
 BackendKind parseBackend(const std::string& name);
-/// "cpu" or "cuda".
+/// "cpu", "cuda", "auto" or "cuda-sim".
 std::string backendName(BackendKind kind);
 /// True when this build contains the CUDA backend (COREDEM_CUDA_ENABLED).
 bool cudaBackendBuilt();
@@ -276,7 +276,7 @@ public:
   std::uint64_t step() const; ///< DEM sub-steps taken
   std::size_t particleCount() const;
   std::size_t cellCount() const;   ///< coupling cells (0 without a grid)
-  std::string backendName() const; ///< "cpu" or "cuda"
+  std::string backendName() const; ///< "cpu", "cuda" or "cuda-sim"
   std::string
   configHash() const; ///< 16 hex digits over materials, walls, gravity, grid, species, options
   const DemConfig& config() const;
