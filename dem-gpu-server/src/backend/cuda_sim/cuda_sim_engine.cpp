@@ -71,13 +71,16 @@ void setAccess(Registry& r, bool accessible) {
 // SIGSEGV: say what the likely cause is, then let the default action run (core dump).
 void onSegv(int, siginfo_t* info, void*) {
   static const char msg[] =
-      "\ncuda-sim: SIGSEGV: host code touched memory it may not (most likely a device pointer, "
-      "d(), dereferenced outside a kernel or copy: on the cuda backend this reads garbage or "
-      "crashes; use the host mirror h() after toHost(), or Exec::copyToHost)\n";
-  (void)info;
-  ssize_t ignored = ::write(2, msg, sizeof msg - 1);
-  (void)ignored;
-  std::signal(SIGSEGV, SIG_DFL);
+      "\ncuda-sim: SIGSEGV in cuda-sim device memory: host code dereferenced a device pointer "
+      "(d()) outside a kernel or copy; on the cuda backend this reads garbage or crashes. Use the "
+      "host mirror h() after toHost(), or Exec::copyToHost\n";
+  // Only the arena is recognised (a plain pointer read: async-signal-safe enough here).
+  const Registry& r = registry();
+  if (inArena(r, info->si_addr)) {
+    ssize_t ignored = ::write(2, msg, sizeof msg - 1);
+    (void)ignored;
+  }
+  std::signal(SIGSEGV, SIG_DFL); // the default action runs when the access repeats
 }
 
 void installHandler() {
