@@ -84,7 +84,7 @@ int runDem(int argc, char** argv) {
   app.add_option("--warmup", warmup, "unmeasured steps first")->check(CLI::NonNegativeNumber);
   app.add_option("--backend", backend,
                  "cpu | cuda | auto | cuda-sim (cpu kernels, cuda memory model)")
-      ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
+      ->check(CLI::IsMember({"cpu", "cuda", "auto", "cuda-sim"}));
   app.add_option("--threads", threads, "OpenMP threads (cpu backend)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--skin", skin, "Verlet skin as a fraction of d_max (default: the library's)");
