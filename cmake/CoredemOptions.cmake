@@ -5,6 +5,8 @@ set(COREDEM_CUDA AUTO CACHE STRING "Build the CUDA DEM backend (AUTO|ON|OFF)")
 set_property(CACHE COREDEM_CUDA PROPERTY STRINGS AUTO ON OFF)
 set(COREDEM_OPENFOAM AUTO CACHE STRING "Build the OpenFOAM participant (AUTO|ON|OFF)")
 set_property(CACHE COREDEM_OPENFOAM PROPERTY STRINGS AUTO ON OFF)
+set(COREDEM_CUDA_ARCHITECTURES "75-real;80-real;90" CACHE STRING
+    "CUDA architectures of the CUDA backend (CMAKE_CUDA_ARCHITECTURES syntax; `native` = this machine's GPUs)")
 option(COREDEM_ENABLE_ASSERTS "Keep internal COREDEM_ASSERT checks in release builds" OFF)
 
 foreach(opt COREDEM_CUDA COREDEM_OPENFOAM)
@@ -27,16 +29,20 @@ if(NOT COREDEM_CUDA STREQUAL "OFF")
   endif()
   check_language(CUDA)
   if(CMAKE_CUDA_COMPILER)
+    # The GPUs the CUDA backend is compiled for: machine code (SASS) for Turing (75), Ampere
+    # (80, also runs on 86/87/89) and Hopper (90), plus PTX of 90 that the driver compiles for
+    # anything newer (Blackwell). `native`: only the GPUs of the build machine. A value given
+    # as CMAKE_CUDA_ARCHITECTURES on the command line takes precedence.
     if(NOT DEFINED CMAKE_CUDA_ARCHITECTURES)
-      # One real architecture keeps CI compile time low; set CMAKE_CUDA_ARCHITECTURES=native
-      # (or a list) on a GPU machine. PTX for 75 JIT-compiles on any newer device.
-      set(CMAKE_CUDA_ARCHITECTURES 75)
+      set(CMAKE_CUDA_ARCHITECTURES ${COREDEM_CUDA_ARCHITECTURES})
     endif()
     enable_language(CUDA)
     set(CMAKE_CUDA_STANDARD 20)
     set(CMAKE_CUDA_STANDARD_REQUIRED ON)
     find_package(CUDAToolkit REQUIRED)
     set(COREDEM_CUDA_ENABLED ON)
+    message(STATUS "CoReDEM: CUDA architectures ${CMAKE_CUDA_ARCHITECTURES} "
+                   "(COREDEM_CUDA_ARCHITECTURES)")
   elseif(COREDEM_CUDA STREQUAL "ON")
     message(FATAL_ERROR "COREDEM_CUDA=ON but no CUDA compiler (nvcc) was found. Put nvcc on "
                         "PATH or set CUDAToolkit_ROOT, or configure with -DCOREDEM_CUDA=OFF.")

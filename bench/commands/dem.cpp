@@ -82,8 +82,9 @@ int runDem(int argc, char** argv) {
   app.add_option("--particles", n, "number of particles")->check(CLI::Range(1.0, 2.0e9));
   app.add_option("--steps", steps, "measured DEM steps")->check(CLI::PositiveNumber);
   app.add_option("--warmup", warmup, "unmeasured steps first")->check(CLI::NonNegativeNumber);
-  app.add_option("--backend", backend, "cpu | cuda | auto")
-      ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
+  app.add_option("--backend", backend,
+                 "cpu | cuda | auto | cuda-sim (cpu kernels, cuda memory model)")
+      ->check(CLI::IsMember({"cpu", "cuda", "auto", "cuda-sim"}));
   app.add_option("--threads", threads, "OpenMP threads (cpu backend)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--skin", skin, "Verlet skin as a fraction of d_max (default: the library's)");
@@ -136,6 +137,7 @@ int runDem(int argc, char** argv) {
     if (warmup > 0)
       runSteps(warmup);
     sys.resetStageTimes();
+    const BackendSyncCounts sync0 = backendSyncCounts();
     const auto t1 = std::chrono::steady_clock::now();
     const std::clock_t c1 = std::clock();
     runSteps(steps);
@@ -143,6 +145,13 @@ int runDem(int argc, char** argv) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     // Process CPU time (all threads): cpu / (wall·threads) < 1 shows a shared/loaded machine.
     const double cpu = static_cast<double>(std::clock() - c1) / CLOCKS_PER_SEC;
+    // Per sub-step: what made the device backends wait (0 on the cpu backend).
+    const BackendSyncCounts sync1 = backendSyncCounts();
+    const double perStep = steps > 0 ? 1.0 / steps : 0.0;
+    const double roundTrips =
+        static_cast<double>(sync1.hostRoundTrips - sync0.hostRoundTrips) * perStep;
+    const double deviceSyncs = static_cast<double>(sync1.deviceSyncs - sync0.deviceSyncs) * perStep;
+    const double launches = static_cast<double>(sync1.launches - sync0.launches) * perStep;
     const int usedThreads = threads > 0 ? threads : 1;
     const StageTimes st = sys.stageTimes();
     const double keFinal = kineticEnergy(sys);
@@ -164,13 +173,14 @@ int runDem(int argc, char** argv) {
           "\"heat\":%.6f,\"drag\":%.6f},"
           "\"rebuilds\":%llu,\"cpu_s\":%.6f,\"cpu_utilisation\":%.3f,"
           "\"particle_steps_per_cpu_s\":%.6e,\"warmup\":%d,\"ke_initial\":%.17g,"
-          "\"ke_final\":%.17g,\"velocities\":\"%s\"}\n",
+          "\"ke_final\":%.17g,\"velocities\":\"%s\",\"host_round_trips_per_step\":%.3f,"
+          "\"device_syncs_per_step\":%.3f,\"launches_per_step\":%.3f}\n",
           deckName.c_str(), sys.backendName().c_str(), threads, n, steps, dt,
           cfg.neighbour.skinFactor, wall, setup, rate, pairsPer, wallPer, bytesPer,
           heat ? "true" : "false", st.neighbour, st.contact, st.integrate, st.coupling, st.heat,
           st.drag, static_cast<unsigned long long>(st.rebuilds), cpu, cpu / (wall * usedThreads),
           static_cast<double>(n) * steps / cpu, warmup, keInitial, keFinal,
-          velocityFile.empty() ? "deck" : "file");
+          velocityFile.empty() ? "deck" : "file", roundTrips, deviceSyncs, launches);
     } else {
       std::printf(
           "case %s, backend %s, threads %d, N = %zu, %d steps of dt_DEM = %.4e s (skin %.3g d)\n",
@@ -186,6 +196,9 @@ int runDem(int argc, char** argv) {
                   "particle steps per cpu s)\n",
                   cpu, 100.0 * cpu / (wall * usedThreads), usedThreads,
                   static_cast<double>(n) * steps / cpu);
+      std::printf("per sub-step             %.2f host round trips, %.2f device syncs, %.1f "
+                  "launches (device backends)\n",
+                  roundTrips, deviceSyncs, launches);
       std::printf("stage neighbour search   %.3f s  (%llu rebuilds)\n", st.neighbour,
                   static_cast<unsigned long long>(st.rebuilds));
       std::printf("stage contact forces     %.3f s\n", st.contact);

@@ -268,8 +268,14 @@ int runThermochem(int argc, char** argv) {
   }
   try {
     const BackendKind kind = parseBackend(o.backend);
-    const bool cuda =
-        kind == BackendKind::Cuda || (kind == BackendKind::Auto && cudaDeviceCount() > 0);
+    const CudaProbe probe = probeCuda();
+    if (kind == BackendKind::Cuda && (!probe.error.empty() || probe.devices == 0))
+      throw coredem::UserError("--backend cuda: " +
+                               (probe.error.empty() ? probe.note : probe.error));
+    if (kind == BackendKind::Auto && probe.devices == 0)
+      std::fprintf(stderr, "coredem-bench thermochem: backend auto runs on the cpu: %s\n",
+                   (probe.error.empty() ? probe.note : probe.error).c_str());
+    const bool cuda = kind == BackendKind::Cuda || (kind == BackendKind::Auto && probe.devices > 0);
     Measured m[kVariantCount];
     ParticleData particles;
     CouplingGrid grid;

@@ -349,16 +349,24 @@ public:
         }
       });
     } else {
-      exec.parallelFor(1, [=] DEM_LAMBDA(std::size_t) {
+      // One thread per column (W of them, not one for all), each over the particles in index
+      // order: the same additions in the same order as a single loop, so the same sums.
+      exec.parallelFor(static_cast<std::size_t>(W), [=] DEM_LAMBDA(std::size_t col) {
+        const int k = static_cast<int>(col);
+        double sum = acc[k];
         for (std::size_t i = 0; i < n; ++i) {
-          for (int g = 0; g < nG; ++g)
-            acc[g] += gdot[i * nG + g] * dt;
-          for (int a = 0; a < nS; ++a)
-            acc[nG + a] += dsol[i * nS + a];
-          acc[nG + nS] += q[i] * dt;
-          acc[nG + nS + 1] += sens[2 * i] * dt;
-          acc[nG + nS + 2] += sens[2 * i + 1];
+          if (k < nG)
+            sum += gdot[i * nG + k] * dt;
+          else if (k < nG + nS)
+            sum += dsol[i * nS + (k - nG)];
+          else if (k == nG + nS)
+            sum += q[i] * dt;
+          else if (k == nG + nS + 1)
+            sum += sens[2 * i] * dt;
+          else
+            sum += sens[2 * i + 1];
         }
+        acc[k] = sum;
       });
     }
     _acc.markDeviceModified();

@@ -9,6 +9,7 @@
 #include <limits>
 #include <unordered_map>
 
+#include "backend/sync_counters.h"
 #include "chemistry_config.h"
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
@@ -29,6 +30,8 @@ BackendKind parseBackend(const std::string& name) {
     return BackendKind::Cuda;
   if (name == "auto")
     return BackendKind::Auto;
+  if (name == "cuda-sim")
+    return BackendKind::CudaSim;
   throw UserError("unknown DEM backend '" + name + "'; use cpu, cuda or auto");
 }
 
@@ -40,6 +43,8 @@ std::string backendName(BackendKind kind) {
     return "cuda";
   case BackendKind::Auto:
     return "auto";
+  case BackendKind::CudaSim:
+    return "cuda-sim";
   }
   return "?";
 }
@@ -52,12 +57,23 @@ bool cudaBackendBuilt() {
 #endif
 }
 
-int cudaDeviceCount() {
+CudaProbe probeCuda() {
 #if defined(COREDEM_CUDA_ENABLED)
-  return cudaDevices();
+  return cudaProbe();
 #else
-  return 0;
+  CudaProbe p;
+  p.note = "this build has no CUDA backend (configure with -DCOREDEM_CUDA=ON)";
+  return p;
 #endif
+}
+
+int cudaDeviceCount() {
+  return probeCuda().devices;
+}
+
+BackendSyncCounts backendSyncCounts() {
+  const backend::SyncCounters& c = backend::syncCounters();
+  return {c.hostRoundTrips.load(), c.deviceSyncs.load(), c.launches.load()};
 }
 
 void DemConfig::addBox(const std::array<double, 3>& lo, const std::array<double, 3>& hi) {
@@ -394,6 +410,8 @@ struct DemSystem::Impl {
     if (kind == BackendKind::Cuda)
       return makeCudaEngine(setup);
 #endif
+    if (kind == BackendKind::CudaSim)
+      return makeCudaSimEngine(setup);
     return makeCpuEngine(setup);
   }
   std::shared_ptr<spdlog::logger> log = coredem::logger("dem.system");
@@ -534,14 +552,25 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   es.chem = makeChemistrySetup(config); // chemistry (chemistry.h); validates the options
 
   BackendKind kind = backend;
-  if (kind == BackendKind::Auto)
-    kind = cudaDeviceCount() > 0 ? BackendKind::Cuda : BackendKind::Cpu;
+  if (kind == BackendKind::Auto) {
+    const CudaProbe cuda = probeCuda();
+    kind = cuda.devices > 0 ? BackendKind::Cuda : BackendKind::Cpu;
+    if (!cuda.error.empty()) // a broken GPU setup is not "no GPU": say so loudly
+      m.log->warn("backend auto: running on the cpu because the CUDA backend cannot run: {}",
+                  cuda.error);
+    else if (cuda.devices == 0)
+      m.log->info("backend auto: running on the cpu ({})", cuda.note);
+  }
   if (kind == BackendKind::Cuda) {
     COREDEM_CHECK(cudaBackendBuilt(),
                   "backend 'cuda' requested but this build has no CUDA backend; "
                   "rebuild with -DCOREDEM_CUDA=ON or use --backend cpu");
-    COREDEM_CHECK(cudaDeviceCount() > 0, "backend 'cuda' requested but no CUDA device is visible; "
-                                         "use --backend cpu (or auto)");
+    const CudaProbe cuda = probeCuda();
+    COREDEM_CHECK(cuda.error.empty(), "backend 'cuda' requested but {}", cuda.error);
+    COREDEM_CHECK(cuda.devices > 0,
+                  "backend 'cuda' requested but there is no CUDA device: {}; use --backend cpu "
+                  "(or auto)",
+                  cuda.note);
   }
   m.kind = kind;
   m.engine = m.makeEngine();

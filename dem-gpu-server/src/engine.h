@@ -121,8 +121,11 @@ public:
 };
 
 std::unique_ptr<Engine> makeCpuEngine(const EngineSetup& setup);
+/// The cpu kernels under the cuda memory model (backend/cuda_sim/cuda_sim_exec.h).
+std::unique_ptr<Engine> makeCudaSimEngine(const EngineSetup& setup);
 /// Defined only when the CUDA backend is built (COREDEM_CUDA_ENABLED).
 std::unique_ptr<Engine> makeCudaEngine(const EngineSetup& setup);
-int cudaDevices();
+/// The CUDA runtime's answer (backend/cuda_probe.h); defined with the CUDA backend.
+CudaProbe cudaProbe();
 
 } // namespace coredem::dem

@@ -113,14 +113,19 @@ protected:
       if (!cudaBackendBuilt()) {
         GTEST_SKIP() << "CUDA backend not built";
       }
-      if (cudaDeviceCount() == 0) {
-        GTEST_SKIP() << "no CUDA device";
+      const CudaProbe cuda = probeCuda();
+      if (!cuda.error.empty()) {
+        FAIL() << cuda.error; // a broken GPU setup is a failure, not a skip
+      }
+      if (cuda.devices == 0) {
+        GTEST_SKIP() << "no CUDA device: " << cuda.note;
       }
     }
   }
 };
 
-using Backends = ::testing::Types<BackendTag<BackendKind::Cpu>, BackendTag<BackendKind::Cuda>>;
+using Backends = ::testing::Types<BackendTag<BackendKind::Cpu>, BackendTag<BackendKind::CudaSim>,
+                                  BackendTag<BackendKind::Cuda>>;
 TYPED_TEST_SUITE(BackendConformance, Backends);
 
 namespace {

@@ -31,16 +31,43 @@
 namespace coredem::dem {
 
 /// Which backend runs the kernels. `Auto` = Cuda if a CUDA device is present, else Cpu.
-enum class BackendKind { Cpu, Cuda, Auto };
+/// `CudaSim` ("cuda-sim", for tests and debugging): the cpu kernels under the cuda backend's
+/// memory model (separate device memory filled with garbage, explicit copies), so that a
+/// missing host↔device synchronisation shows without a GPU; never chosen by `Auto`.
+enum class BackendKind { Cpu, Cuda, Auto, CudaSim };
 
-/// Parses "cpu" | "cuda" | "auto" (UserError otherwise).
+/// Parses "cpu" | "cuda" | "auto" | "cuda-sim" (UserError otherwise).
 BackendKind parseBackend(const std::string& name);
-/// "cpu" or "cuda".
+/// "cpu", "cuda", "auto" or "cuda-sim".
 std::string backendName(BackendKind kind);
 /// True when this build contains the CUDA backend (COREDEM_CUDA_ENABLED).
 bool cudaBackendBuilt();
-/// Number of visible CUDA devices (0 when the CUDA backend is not built or no GPU/driver).
+/// Number of visible CUDA devices (0 when the CUDA backend is not built, when there is no GPU
+/// or driver, and when the CUDA runtime fails: probeCuda() tells these apart).
 int cudaDeviceCount();
+
+/// What the CUDA runtime says about this machine.
+struct CudaProbe {
+  bool built = false; ///< this build contains the CUDA backend
+  int devices = 0;    ///< usable devices (0 when none, and on error)
+  /// Empty, or a CUDA runtime failure (e.g. a driver too old for this build's runtime) with
+  /// CUDA's own message and what to do: a broken GPU setup, never reported as "no device".
+  std::string error;
+  /// When devices == 0 without error: why (not built, no driver, no device, CUDA_VISIBLE_DEVICES).
+  std::string note;
+};
+/// Asks the CUDA runtime (cudaGetDeviceCount, driver and runtime versions) each call.
+CudaProbe probeCuda();
+
+/// What made the backends with a separate device (cuda, cuda-sim) wait, counted since the
+/// process started, all systems together (the cpu backend counts nothing). Differences over a
+/// run divided by its sub-steps give the per-sub-step figures coredem-bench dem reports.
+struct BackendSyncCounts {
+  std::uint64_t hostRoundTrips = 0; ///< device → host copies the host waits for (incl. reductions)
+  std::uint64_t deviceSyncs = 0;    ///< explicit device-wide synchronisations
+  std::uint64_t launches = 0;       ///< kernel launches (CUB calls count as their kernels)
+};
+BackendSyncCounts backendSyncCounts();
 
 /// Contact properties of one solid material (docs/physics.md §2.1, Eqs. 9–13).
 /// Pairs of different materials use k_n = 2 k_a k_b/(k_a+k_b), e_n = min(e_a, e_b),
@@ -271,7 +298,7 @@ public:
   std::uint64_t step() const; ///< DEM sub-steps taken
   std::size_t particleCount() const;
   std::size_t cellCount() const;   ///< coupling cells (0 without a grid)
-  std::string backendName() const; ///< "cpu" or "cuda"
+  std::string backendName() const; ///< "cpu", "cuda" or "cuda-sim"
   std::string
   configHash() const; ///< 16 hex digits over materials, walls, gravity, grid, species, options
   const DemConfig& config() const;

@@ -4,6 +4,7 @@
 /// pinned host memory. Thin on purpose: the physics is the shared engine_impl.h.
 
 #include "../exec_common.h"
+#include "../sync_counters.h"
 
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
@@ -21,8 +22,10 @@
     if (demCudaErr_ != cudaSuccess) {                                                          \
       ::coredem::dem::backend::raiseUserError(                                                 \
           std::string("CUDA call '") + #expr + "' failed at " + __FILE__ + ":" +               \
-          std::to_string(__LINE__) + ": " + cudaGetErrorString(demCudaErr_) +                  \
-          " (check the driver and the GPU with nvidia-smi, or run with --backend cpu)");       \
+          std::to_string(__LINE__) + ": " + cudaGetErrorName(demCudaErr_) + ": " +             \
+          cudaGetErrorString(demCudaErr_) +                                                    \
+          " (check the GPU and its driver with nvidia-smi, and CUDA_VISIBLE_DEVICES; "         \
+          "--backend cpu runs without it)");                                                   \
     }                                                                                          \
   } while (false)
 
@@ -65,6 +68,7 @@ struct CudaExec {
   template <class F>
   void parallelFor(std::size_t n, F f) const {
     if (n == 0) return;
+    ++syncCounters().launches;
     forEachKernel<<<blocks(n), kBlock>>>(n, f);
     checkLaunch();
   }
@@ -73,6 +77,8 @@ struct CudaExec {
   double reduceMax(std::size_t n, F f, double init) const {
     if (n == 0) return init;
     double* vals = scratch<double>(_vals, _valsCap, n + 1);
+    syncCounters().launches += 2;
+    ++syncCounters().hostRoundTrips;
     evalKernel<<<blocks(n), kBlock>>>(n, f, vals);
     checkLaunch();
     std::size_t tmpBytes = 0;
@@ -85,6 +91,7 @@ struct CudaExec {
   }
 
   void exclusiveScan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {
+    ++syncCounters().launches;
     std::size_t tmpBytes = 0;
     DEM_CUDA_CHECK(cub::DeviceScan::ExclusiveSum(nullptr, tmpBytes, in, out, static_cast<int>(n)));
     void* tmp = scratch<unsigned char>(_tmp, _tmpCap, tmpBytes);
@@ -94,6 +101,7 @@ struct CudaExec {
   /// Stable LSD radix sort of (key, index) pairs; perm receives the indices.
   void sortByKey(const std::uint32_t* keys, std::size_t n, std::uint32_t numKeys, std::uint32_t* perm) const {
     if (n == 0) return;
+    syncCounters().launches += 2;
     int bits = 1;
     while (bits < 32 && (1ull << bits) < numKeys) ++bits;
     std::uint32_t* buf = scratch<std::uint32_t>(_sortBuf, _sortCap, 2 * n);
@@ -131,12 +139,16 @@ struct CudaExec {
     if (bytes) DEM_CUDA_CHECK(cudaMemcpy(d, h, bytes, cudaMemcpyHostToDevice));
   }
   static void copyToHost(void* h, const void* d, std::size_t bytes) {
+    if (bytes) ++syncCounters().hostRoundTrips;
     if (bytes) DEM_CUDA_CHECK(cudaMemcpy(h, d, bytes, cudaMemcpyDeviceToHost));
   }
   static void copyDeviceToDevice(void* dst, const void* src, std::size_t bytes) {
     if (bytes) DEM_CUDA_CHECK(cudaMemcpy(dst, src, bytes, cudaMemcpyDeviceToDevice));
   }
-  static void synchronize() { DEM_CUDA_CHECK(cudaDeviceSynchronize()); }
+  static void synchronize() {
+    ++syncCounters().deviceSyncs;
+    DEM_CUDA_CHECK(cudaDeviceSynchronize());
+  }
 
   CudaExec() = default;
   CudaExec(const CudaExec&) = delete;
