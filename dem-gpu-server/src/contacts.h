@@ -9,9 +9,9 @@
 ///   pass 1 (per owner i): every owned candidate in contact is evaluated with the LSD law; the
 ///     owner adds f and L_ij n × f_t to its own force and torque, keeps δ_t in its history
 ///     slots, and writes the partner's share (−f is implied; L_ji n × f_t) to the pair lists'
-///     per-candidate scratch at the partner's low-list position; then its walls;
-///   pass 2 (per particle j): adds the partner shares of the contacts it does not own, read
-///     contiguously in the order of its neighbour list (a fixed order).
+///     per-candidate scratch; then its walls;
+///   pass 2 (per particle j): adds the partner shares of the contacts it does not own, in the
+///     ascending index order of its neighbour list (a fixed order).
 /// Both passes write only their own index, so the result does not depend on the thread count.
 /// The LSD law is mirror-exact (lsd_contact.h): j's share is bitwise what evaluating the pair
 /// from j's side gives. History slots (partner gid, −(w+2) for wall w) hold the owned contacts
@@ -134,7 +134,7 @@ public:
     const std::uint32_t* hs = pl.halfStart();
     const std::int32_t* half = pl.half();
     const std::uint32_t* ls = pl.lowStart();
-    const std::uint32_t* lowPos = pl.lowPos();
+    const std::uint32_t* low = pl.low();
     _hit.reserve(pl.candidates());
     unsigned char* hit = _hit.d();
     // Partner shares in the shared scratch: force (3 values), then torque (3), per candidate.
@@ -204,8 +204,7 @@ public:
             const double rj = r[j];
             const double rsum = ri + rj;
             const bool touching = l2 < rsum * rsum;
-            const long long kq = lowPos[q]; // the partner's slot for its share
-            hit[kq] = touching ? 1 : 0;
+            hit[q] = touching ? 1 : 0;
             if (!touching)
               continue;
             const double l = ::sqrt(l2);
@@ -225,8 +224,8 @@ public:
             T += res.torque;
             remember(key, res.deltaT);
             // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
-            store3(share, 2 * kq, res.force);
-            store3(share, 2 * kq + 1, lji * res.nxft);
+            store3(share, 2 * static_cast<long long>(q), res.force);
+            store3(share, 2 * static_cast<long long>(q) + 1, lji * res.nxft);
             ++owned;
           }
           // Walls (m_eff = m_i, the particle's material).
@@ -273,10 +272,11 @@ public:
           int pairCount = nc[i]; // + the contacts the partners own
           const std::uint32_t kEnd = ls[i + 1];
           for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
-            if (!hit[k])
+            const long long q = low[k];
+            if (!hit[q])
               continue;
-            F += -load3(share, 2 * static_cast<long long>(k));
-            T += load3(share, 2 * static_cast<long long>(k) + 1);
+            F += -load3(share, 2 * q);
+            T += load3(share, 2 * q + 1);
             ++pairCount;
           }
           store3(f, ii, F);

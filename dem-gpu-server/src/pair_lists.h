@@ -9,13 +9,15 @@
 /// "lo"). After every neighbour rebuild (or a new state) the full neighbour lists give
 ///   half lists: each particle's owned candidates (partner gid larger), ascending index order;
 ///   low lists:  for each particle, the candidates its partners own, in neighbour-list order
-///               (the lists are symmetric), numbered k in CSR form (`lowStart`); `lowPos[q]` is
-///               the k of half-list candidate q in its partner's low list.
-/// A module evaluates candidate q in a pass over owners and writes the partner's share at
-/// k = lowPos[q] of a per-candidate buffer; a second pass over particles reads its shares at
-/// k = lowStart[i] … lowStart[i+1] − 1, contiguous in memory (the scattered accesses are the
-/// owners' stores, which do not stall as scattered loads would): a fixed order, no atomics,
-/// results independent of the thread count.
+///               (the lists are symmetric), numbered k in CSR form (`lowStart`): `low[k]` is
+///               the candidate's q in its owner's half list, and `lowPos[q]` the inverse.
+/// A module evaluates candidate q in a pass over owners, writes the partner's share to a
+/// per-candidate buffer, and gathers its own shares in a second pass over particles, in k
+/// order: a fixed order, no atomics, results independent of the thread count. The buffer may
+/// be indexed by q (owner writes contiguous, partner reads at low[k]: the contact module, whose
+/// few touching pairs make the scattered reads cheap, and whose two threads would otherwise
+/// write into each other's cache lines) or by k = lowPos[q] (owner writes scattered, partner
+/// reads contiguously: the heat module, which gathers every candidate in reach).
 ///
 /// `scratch()` is one such per-candidate buffer of kScratchWidth doubles, shared: a module may
 /// use it only inside its own sources() call (written in its first pass, read in its second),
@@ -50,7 +52,7 @@ public:
   }
 
   std::size_t bytes() const {
-    return _count.bytes() + _halfStart.bytes() + _half.bytes() + _lowStart.bytes() +
+    return _count.bytes() + _halfStart.bytes() + _half.bytes() + _lowStart.bytes() + _low.bytes() +
            _lowPos.bytes() + _scratch.bytes();
   }
 
@@ -63,6 +65,7 @@ public:
   const std::uint32_t* halfStart() const { return _halfStart.d(); }
   const std::int32_t* half() const { return _half.d(); }
   const std::uint32_t* lowStart() const { return _lowStart.d(); }
+  const std::uint32_t* low() const { return _low.d(); }
   const std::uint32_t* lowPos() const { return _lowPos.d(); }
   double* scratch() { return _scratch.d(); }
 
@@ -108,7 +111,9 @@ public:
     exec.exclusiveScan(c, ls, n + 1);
     std::uint32_t lowTotal = 0;
     Exec::copyToHost(&lowTotal, ls + n, sizeof(lowTotal));
+    _low.reserve(lowTotal);
     _lowPos.reserve(total > lowTotal ? total : lowTotal);
+    std::uint32_t* low = _low.d();
     std::uint32_t* lowPos = _lowPos.d();
     const double missing = exec.reduceMax(
         n,
@@ -127,7 +132,7 @@ public:
             } else {
               lowPos[at] = k;
             }
-            ++k;
+            low[k++] = at;
           }
           return miss;
         },
@@ -146,6 +151,7 @@ private:
   Dev<std::uint32_t> _halfStart; ///< CSR offsets of the half lists, n + 1
   Dev<std::int32_t> _half;       ///< owned candidates (partner index), ascending per particle
   Dev<std::uint32_t> _lowStart;  ///< CSR offsets of the low lists, n + 1
+  Dev<std::uint32_t> _low;       ///< per low-list entry k: the candidate's q in the half lists
   Dev<std::uint32_t> _lowPos;    ///< per half-list candidate q: its k in the partner's low list
   Dev<double> _scratch;          ///< kScratchWidth doubles per candidate, shared (see above)
   std::uint32_t _total = 0;
