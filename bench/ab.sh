@@ -25,12 +25,16 @@ python3 "$here/peers/liggghts/make_deck.py" 100000 300 "$out/deck" --deck agitat
   --contacts --skin 1e-4 >/dev/null
 vel="$out/deck/agitated.vel"
 
-load_ok() { python3 -c "import sys; sys.exit(0 if float(open('/proc/loadavg').read().split()[0]) < float('$LOAD_MAX') else 1)"; }
-wait_quiet() {
-  local w=0
-  while ! load_ok && [[ $w -lt 240 ]]; do sleep 5; w=$((w + 5)); done
-  local l; l="$(cut -d' ' -f1 /proc/loadavg)"
-  if load_ok; then echo "load $l"; else echo "load $l LOADED"; fi
+below_max() { python3 -c "import sys; sys.exit(0 if float('$1') < float('$LOAD_MAX') else 1)"; }
+wait_quiet() { # one reading decides both the wait and the label
+  local w=0 l
+  l="$(cut -d' ' -f1 /proc/loadavg)"
+  while ! below_max "$l" && [[ $w -lt 240 ]]; do
+    sleep 5
+    w=$((w + 5))
+    l="$(cut -d' ' -f1 /proc/loadavg)"
+  done
+  if below_max "$l"; then echo "load $l"; else echo "load $l LOADED"; fi
 }
 run() { # tag binary args...
   local tag="$1" bin="$2"; shift 2
