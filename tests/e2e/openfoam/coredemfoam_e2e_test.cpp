@@ -53,12 +53,7 @@ constexpr double kRhoG = 1.204, kMuG = 1.81e-5, kG = 9.81;
 constexpr double kRhoP = 2500.0, kDp = 1.0e-3;
 constexpr double kArea = 0.01 * 0.01, kHeight = 0.04;
 
-std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
-  for (std::size_t i = s.find(from); i != std::string::npos; i = s.find(from, i + to.size())) {
-    s.replace(i, from.size(), to);
-  }
-  return s;
-}
+using coredem::e2e::replaceAll;
 
 /// A case folder in `dir`: the column template with the inlet velocity/temperature filled in
 /// and a case.yaml made of the common part plus `body` (time, materials, particles, ...).

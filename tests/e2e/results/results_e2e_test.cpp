@@ -41,12 +41,7 @@ const fs::path kTemplate = COREDEM_FOAM_E2E_TEMPLATE;
 using coredem::e2e::readAll;
 using coredem::e2e::writeAll;
 
-std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
-  for (std::size_t i = s.find(from); i != std::string::npos; i = s.find(from, i + to.size())) {
-    s.replace(i, from.size(), to);
-  }
-  return s;
-}
+using coredem::e2e::replaceAll;
 
 /// Runs `program args...` (output into `log`) and returns its exit code.
 int runProgram(const fs::path& program, const std::vector<std::string>& args, const fs::path& log,

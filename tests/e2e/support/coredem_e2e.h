@@ -70,6 +70,14 @@ inline void writeAll(const fs::path& p, const std::string& text) {
   out << text;
 }
 
+/// `s` with every occurrence of `from` replaced by `to` (case-text edits of the e2e tests).
+inline std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
+  for (std::size_t i = s.find(from); i != std::string::npos; i = s.find(from, i + to.size())) {
+    s.replace(i, from.size(), to);
+  }
+  return s;
+}
+
 /// Starts `program args...` with stdout and stderr appended to `log`; returns the pid (-1 and
 /// a test failure when it cannot be started).
 inline pid_t startProgram(const fs::path& program, const std::vector<std::string>& args,
