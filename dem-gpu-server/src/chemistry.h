@@ -95,6 +95,12 @@ public:
 
   bool enabled() const { return _c.enabled; }
 
+  /// After the sub-step (host): notes a particle below the removal diameter (status array).
+  void readStatus(const double* status) {
+    if (_c.enabled && status[kStatusBelowRemoval] > 0.0)
+      _pending = true;
+  }
+
   /// True when a particle fell below the removal diameter since the last call (clears it).
   bool takeRemovalRequest() {
     const bool p = _pending;
@@ -104,7 +110,7 @@ public:
 
   std::size_t bytes() const {
     return _reactions.bytes() + _dh.bytes() + _gasM.bytes() + _cp.bytes() + _gdot.bytes() +
-           _dsolid.bytes() + _q.bytes() + _sens.bytes() + _acc.bytes();
+           _dsolid.bytes() + _q.bytes() + _sens.bytes() + _acc.bytes() + _blockSums.bytes();
   }
 
   /// Chemistry ledgers since construction (or the restored ones).
@@ -177,7 +183,7 @@ public:
     const double* rhoG = gas ? gasFields->rhoG.d() : nullptr;
     const double* yg = gas ? gasFields->Yg.d() : nullptr;
 
-    const double below = exec.reduceMax(
+    exec.reduceMaxInto(
         n,
         [=] DEM_LAMBDA(std::size_t i) {
           using namespace kernels;
@@ -319,10 +325,8 @@ public:
           sens[2 * i + 1] = dmStored * cpm[mat[i]] * T[i];
           return 2.0 * r[i] < frac * d0[i] ? 1.0 : 0.0;
         },
-        0.0);
+        0.0, ctx.status + kStatusBelowRemoval);
     p.produced(kMass | kSpecies | kRadius);
-    if (below > 0.0)
-      _pending = true;
 
     // Window accumulators per cell (+ one row for particles outside the grid).
     double* acc = _acc.d();
@@ -349,12 +353,20 @@ public:
         }
       });
     } else {
-      // One thread per column (W of them, not one for all), each over the particles in index
-      // order: the same additions in the same order as a single loop, so the same sums.
-      exec.parallelFor(static_cast<std::size_t>(W), [=] DEM_LAMBDA(std::size_t col) {
-        const int k = static_cast<int>(col);
-        double sum = acc[k];
-        for (std::size_t i = 0; i < n; ++i) {
+      // Two levels in a fixed order, so the sums do not depend on the backend or the thread
+      // count: per block of kTotalsBlock particles and column, the block's particles in index
+      // order; then per column, the blocks in order, added to the window total. n/kTotalsBlock·W
+      // threads, then W (the GPU no longer sums all particles in W threads).
+      const std::size_t nb = (n + kTotalsBlock - 1) / kTotalsBlock;
+      _blockSums.reserve(nb * static_cast<std::size_t>(W));
+      double* part = _blockSums.d();
+      exec.parallelFor(nb * static_cast<std::size_t>(W), [=] DEM_LAMBDA(std::size_t t) {
+        const std::size_t b = t / static_cast<std::size_t>(W);
+        const int k = static_cast<int>(t % static_cast<std::size_t>(W));
+        const std::size_t lo = b * kTotalsBlock;
+        const std::size_t hi = lo + kTotalsBlock < n ? lo + kTotalsBlock : n;
+        double sum = 0.0;
+        for (std::size_t i = lo; i < hi; ++i) {
           if (k < nG)
             sum += gdot[i * nG + k] * dt;
           else if (k < nG + nS)
@@ -366,7 +378,13 @@ public:
           else
             sum += sens[2 * i + 1];
         }
-        acc[k] = sum;
+        part[t] = sum;
+      });
+      exec.parallelFor(static_cast<std::size_t>(W), [=] DEM_LAMBDA(std::size_t col) {
+        double sum = 0.0;
+        for (std::size_t b = 0; b < nb; ++b)
+          sum += part[b * static_cast<std::size_t>(W) + col];
+        acc[col] += sum;
       });
     }
     _acc.markDeviceModified();
@@ -476,10 +494,12 @@ private:
   /// dH), then R1, R2, R4, R5 at kClgHeat.
   Dual<kernels::ReactionEnthalpyPoly> _dh;
   Dual<double> _gasM, _cp;
-  Dev<double> _gdot;   ///< per particle: gas mass rates (kg/s), N*nGas
-  Dev<double> _dsolid; ///< per particle: solid mass change in this sub-step (kg), N*nSolid
-  Dev<double> _q;      ///< per particle: Q_rxn (W)
-  Dev<double> _sens;   ///< per particle: ṁ_gas c_p,g (T_p − T_g) (W), Δm c_p T_p (J); N*2
+  Dev<double> _gdot;      ///< per particle: gas mass rates (kg/s), N*nGas
+  Dev<double> _dsolid;    ///< per particle: solid mass change in this sub-step (kg), N*nSolid
+  Dev<double> _q;         ///< per particle: Q_rxn (W)
+  Dev<double> _blockSums; ///< uncoupled totals: per block of kTotalsBlock particles and column
+  static constexpr std::size_t kTotalsBlock = 256;
+  Dev<double> _sens; ///< per particle: ṁ_gas c_p,g (T_p − T_g) (W), Δm c_p T_p (J); N*2
   Dual<double>
       _acc; ///< (nCells+1)*W: Σ gas kg, Σ solid kg, Σ Q_rxn J, Σ gas sensible J, Σ Δm c T J
   int _width = 0;        ///< W = nGas + nSolid + 3

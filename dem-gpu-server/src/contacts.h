@@ -150,7 +150,7 @@ public:
     // Pass 1: the owned pairs and the walls of every particle. reduceMax runs the body once
     // per index (side effects on index i only) and returns the most history slots a particle
     // needs (owned contacts + walls), in the same pass.
-    const double maxSlots = ctx.exec.reduceMax(
+    ctx.exec.reduceMaxInto(
         n,
         [=] DEM_LAMBDA(std::size_t i) {
           using namespace kernels;
@@ -258,11 +258,11 @@ public:
           nwc[i] = wallCount;
           return static_cast<double>(slot);
         },
-        0.0);
+        0.0, ctx.status + kStatusHistorySlots);
 
     // Pass 2: the shares of the pairs owned by the partner, in neighbour-list order.
     // Returns the largest number of contacts of a particle (pairs from both sides, walls).
-    const double maxContacts = ctx.exec.reduceMax(
+    ctx.exec.reduceMaxInto(
         n,
         [=] DEM_LAMBDA(std::size_t i) {
           using namespace kernels;
@@ -283,8 +283,16 @@ public:
           store3(tq, ii, T);
           return static_cast<double>(pairCount + nwc[i]);
         },
-        0.0);
+        0.0, ctx.status + kStatusContactsPerParticle);
     p.produced(kForce | kTorque | kFwall | kHistKey | kHistDisp | kContacts | kWallContacts);
+  }
+
+  /// After the sub-step (host): the history slots in use and the contact-count check of the
+  /// values sources() left in the status array. More contacts than slots is an error (the
+  /// sub-step's forces lost some contacts' history).
+  void readStatus(const double* status, int K) {
+    const double maxSlots = status[kStatusHistorySlots];
+    const double maxContacts = status[kStatusContactsPerParticle];
     _maxUsedSlots = maxSlots < K ? static_cast<int>(maxSlots) : K;
     if (maxContacts > K) {
       backend::raiseUserError("a particle has " + std::to_string(static_cast<int>(maxContacts)) +

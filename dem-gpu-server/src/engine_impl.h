@@ -74,6 +74,11 @@ public:
     _contacts.setup(_s);
     _heat.setup(_s.heat, _s.coupled ? _s.nCells : 0);
     _chem.setup(_s.chem, _s.coupled ? _s.nCells : 0);
+    _status.allocate(kStatusSlotCount);
+    for (int k = 0; k < kStatusSlotCount; ++k)
+      _status.h()[k] = 0.0;
+    _status.markHostModified();
+    _status.toDevice();
   }
 
   const char* name() const override { return Exec::name; }
@@ -359,7 +364,7 @@ public:
   // ---------------------------------------------------------------- window and sub-step
   /// What the modules see this sub-step (dt = 0 at the window boundaries).
   StepContext<Exec> stepContext(double dt) {
-    return StepContext<Exec>{_exec, _p, _s, gasOrNull(), _cells, _pairLists, dt};
+    return StepContext<Exec>{_exec, _p, _s, gasOrNull(), _cells, _pairLists, dt, _status.d()};
   }
   const GasFields<Exec>* gasOrNull() const { return _hasGas && _s.coupled ? &_gas : nullptr; }
 
@@ -438,9 +443,9 @@ public:
     }
   }
 
-  /// Symplectic Euler. Reads force, torque, mass, radius; writes pos, vel, omega.
-  /// Returns the largest displacement² since the last neighbour-list build.
-  double integrate(double dt) {
+  /// Symplectic Euler. Reads force, torque, mass, radius; writes pos, vel, omega, and the
+  /// largest displacement² since the last neighbour-list build (kStatusMaxDisplacement2).
+  void integrate(double dt) {
     const double* f = _p.force.d();
     const double* tq = _p.torque.d();
     const double* m = _p.mass.d();
@@ -457,9 +462,9 @@ public:
         store3(w, ii, kernels::Vec3{0.0, 0.0, 0.0});
       });
       _p.produced(kVel | kOmega);
-      return 0.0;
+      return;
     }
-    const double maxDisp2 = _exec.reduceMax(
+    _exec.reduceMaxInto(
         _p.n,
         [=] DEM_LAMBDA(std::size_t i) {
           using namespace kernels;
@@ -476,15 +481,13 @@ public:
           const double d2 = dot(d, d);
           return d2 == d2 ? d2 : HUGE_VAL; // NaN forces a rebuild, which reports it
         },
-        0.0);
+        0.0, _status.d() + kStatusMaxDisplacement2);
     _p.produced(kPos | kVel | kOmega);
-    return maxDisp2;
   }
 
-  /// Runs one module's sources (or update) and books its wall time in `stage`.
+  /// Runs one module's sources (or update) and marks the end of its stage.
   template <class Module>
-  void run(Module& stepModule, StepContext<Exec>& ctx, double& stage, Clock::time_point& t0,
-           bool update = false) {
+  void run(Module& stepModule, StepContext<Exec>& ctx, double& stage, bool update = false) {
     static_assert(StepModule<Module, Exec>);
     if (!stepModule.enabled())
       return;
@@ -493,48 +496,65 @@ public:
     } else {
       stepModule.sources(ctx);
     }
-    Exec::synchronize();
-    const auto t1 = Clock::now();
-    stage += std::chrono::duration<double>(t1 - t0).count();
-    t0 = t1;
+    markStage(stage);
   }
 
+  /// Stage timing that does not make the host wait for the device: a mark (Exec::Mark: a CUDA
+  /// event on the cuda backend, the host clock otherwise) at the end of each stage, their
+  /// differences booked after the sub-step's status read, when the device has passed them all.
+  void beginMarks() {
+    Exec::mark(_marks[0]);
+    _nMarks = 1;
+  }
+  void markStage(double& stage) {
+    Exec::mark(_marks[_nMarks]);
+    _markStage[_nMarks] = &stage;
+    ++_nMarks;
+  }
+  void bookMarks() {
+    for (int k = 1; k < _nMarks; ++k)
+      *_markStage[k] += Exec::seconds(_marks[k - 1], _marks[k]);
+    _nMarks = 0;
+  }
+
+  /// One sub-step. Without a neighbour rebuild the host waits for the device once: the status
+  /// read at the end (the values the kernels left in _status; step_module.h StatusSlot).
   void subStep(double dt) override {
     if (_p.n == 0)
       return;
-    auto t0 = Clock::now();
+    beginMarks();
     if (!_listValid || !_pairLists.valid()) {
       if (!_listValid)
         rebuild();
       _pairLists.ensure(_exec, _p);
-      Exec::synchronize();
-      auto t1 = Clock::now();
-      _t.neighbour += std::chrono::duration<double>(t1 - t0).count();
-      t0 = t1;
+      markStage(_t.neighbour);
     }
     _p.require(kAllFields);
     StepContext<Exec> ctx = stepContext(dt);
     if (_drag.enabled()) {  // drag.sources() in its two passes, timed apart (stages drag, coupling)
       _drag.gasForces(ctx); // gas force and PCM cell per particle
-      Exec::synchronize();
-      auto t1 = Clock::now();
-      _t.drag += std::chrono::duration<double>(t1 - t0).count();
+      markStage(_t.drag);
       _drag.sortAndDeposit(ctx); // particles sorted by cell, K_sl sums
-      Exec::synchronize();
-      t0 = Clock::now();
-      _t.coupling += std::chrono::duration<double>(t0 - t1).count();
+      markStage(_t.coupling);
     }
-    run(_contacts, ctx, _t.contact, t0); // + contact forces
-    run(_heat, ctx, _t.heat, t0);        // heat sources on the same configuration
-    run(_chem, ctx, _t.chemistry, t0);   // rates -> mass/diameter, before the motion
+    run(_contacts, ctx, _t.contact); // + contact forces
+    run(_heat, ctx, _t.heat);        // heat sources on the same configuration
+    run(_chem, ctx, _t.chemistry);   // rates -> mass/diameter, before the motion
+    integrate(dt);
+    if (_heat.enabled())
+      _heat.update(ctx); // T += Δt Q/(m c_p)
+    if (_chem.enabled())
+      _chem.update(ctx); // + Δt Q_rxn/(m c_p)
+    markStage(_t.integrate);
+    _status.markDeviceModified();
+    _status.toHost(); // the sub-step's one host round trip
+    bookMarks();
+    const double* status = _status.h();
+    _contacts.readStatus(status, _p.K);
+    _chem.readStatus(status);
     const double half = 0.5 * _s.skin;
-    if (integrate(dt) > half * half)
+    if (!_s.frozen && status[kStatusMaxDisplacement2] > half * half)
       _listValid = false;
-    double integrateTime = 0.0;
-    run(_heat, ctx, integrateTime, t0, true); // T += Δt Q/(m c_p)
-    run(_chem, ctx, integrateTime, t0, true); // + Δt Q_rxn/(m c_p)
-    Exec::synchronize();
-    _t.integrate += integrateTime + std::chrono::duration<double>(Clock::now() - t0).count();
   }
 
   std::size_t pairContacts() override { return _contacts.pairContacts(_p); }
@@ -553,6 +573,11 @@ private:
   Dev<unsigned char> _scratch;
   bool _listValid = false;
   StageTimes _t;
+  Dual<double> _status; ///< kStatusSlotCount values per sub-step (step_module.h StatusSlot)
+  static constexpr int kMaxMarks = 10;
+  typename Exec::Mark _marks[kMaxMarks]; ///< stage marks of the sub-step in flight
+  double* _markStage[kMaxMarks] = {};    ///< the StageTimes entry each mark ends
+  int _nMarks = 0;
   DragModule<Exec> _drag;        ///< gas forces and K_sl (drag.h)
   ContactModule<Exec> _contacts; ///< contact forces (contacts.h)
   HeatModule<Exec> _heat;        ///< particle heat transfer (heat.h)

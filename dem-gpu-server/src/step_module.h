@@ -24,6 +24,18 @@
 
 namespace coredem::dem {
 
+/// Values a sub-step's kernels leave in device memory (Exec::reduceMaxInto into
+/// StepContext::status) for the host's decisions after the sub-step: the engine reads them all
+/// back in one transfer at the end of the sub-step, its only host round trip without a neighbour
+/// rebuild. Each slot has one writer; a slot nobody wrote this sub-step keeps 0.
+enum StatusSlot : int {
+  kStatusMaxDisplacement2 = 0, ///< motion: largest displacement² since the list build (m²)
+  kStatusHistorySlots,         ///< contacts: most history slots a particle uses
+  kStatusContactsPerParticle,  ///< contacts: most contacts (pairs + walls) of a particle
+  kStatusBelowRemoval,         ///< chemistry: 1 when a particle fell below the removal size
+  kStatusSlotCount
+};
+
 /// What a module sees in a sub-step (or at the start of a window, with dt = 0).
 template <class Exec>
 struct StepContext {
@@ -38,6 +50,8 @@ struct StepContext {
   /// Half and low pair lists of the current neighbour lists (pair_lists.h); valid in sources().
   PairLists<Exec>& pairs;
   double dt; ///< sub-step length Δt_DEM (s)
+  /// Device array of kStatusSlotCount values (StatusSlot), read by the engine after the sub-step.
+  double* status;
 };
 
 /// What a module sees at the end of a window of nSub sub-steps (host side).

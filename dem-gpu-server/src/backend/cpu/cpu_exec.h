@@ -6,6 +6,7 @@
 /// over the work of a descheduled one (shared/oversubscribed machines).
 
 #include <algorithm>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -45,6 +46,14 @@ struct CpuExec {
     for (std::int64_t i = 0; i < m; ++i)
       r = std::max(r, f(static_cast<std::size_t>(i)));
     return r;
+  }
+
+  /// reduceMax whose result stays in device memory (*out; here host and device are one): the
+  /// device backends leave it there, and the engine reads every such result of a sub-step back
+  /// in one transfer at its end (engine_impl.h, SubStepStatus).
+  template <class F>
+  void reduceMaxInto(std::size_t n, F f, double init, double* out) const {
+    *out = reduceMax(n, f, init);
   }
 
   /// out[i] = Σ_{k<i} in[k] (serial: it is O(n) and runs on small histograms).
@@ -150,6 +159,19 @@ struct CpuExec {
       std::memcpy(dst, src, bytes);
   }
   static void synchronize() {}
+
+  /// Stage timing (engine_impl.h): a mark is the host clock (every loop has finished when the
+  /// call that ran it returns).
+  struct Mark {
+    std::chrono::steady_clock::time_point t;
+  };
+  static void mark(Mark& m) {
+    m.t = std::chrono::steady_clock::now();
+  }
+  /// Seconds from mark a to mark b.
+  static double seconds(const Mark& a, const Mark& b) {
+    return std::chrono::duration<double>(b.t - a.t).count();
+  }
 
 private:
   /// Below this many keys the radix sort runs on one thread.

@@ -9,6 +9,7 @@
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
 #include <cub/device/device_scan.cuh>
+#include <cuda/functional>
 #include <cuda_runtime.h>
 
 #include <cstddef>
@@ -41,6 +42,12 @@ template <class F>
 __global__ void evalKernel(std::size_t n, F f, double* out) {
   const std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
   if (i < n) out[i] = f(i);
+}
+
+/// *out = max(*v, init) (v == nullptr: init): the last step of reduceMaxInto, on the device.
+inline __global__ void maxWithInitKernel(const double* v, double init, double* out) {
+  const double r = v != nullptr ? *v : init;
+  *out = r > init ? r : init;
 }
 
 template <class T>
@@ -88,6 +95,28 @@ struct CudaExec {
     double r = init;
     DEM_CUDA_CHECK(cudaMemcpy(&r, vals + n, sizeof(double), cudaMemcpyDeviceToHost));
     return r > init ? r : init;
+  }
+
+  /// reduceMax whose result stays in device memory (*out, a device pointer): the launches are
+  /// queued and the host does not wait (the engine reads the sub-step's results in one copy).
+  template <class F>
+  void reduceMaxInto(std::size_t n, F f, double init, double* out) const {
+    if (n == 0) {
+      ++syncCounters().launches;
+      maxWithInitKernel<<<1, 1>>>(nullptr, init, out);
+      checkLaunch();
+      return;
+    }
+    double* vals = scratch<double>(_vals, _valsCap, n + 1);
+    syncCounters().launches += 2;
+    evalKernel<<<blocks(n), kBlock>>>(n, f, vals);  // f once per index (it may write)
+    checkLaunch();
+    std::size_t tmpBytes = 0;
+    DEM_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, tmpBytes, vals, out, static_cast<int>(n),
+                                             ::cuda::maximum<>{}, init));
+    void* tmp = scratch<unsigned char>(_tmp, _tmpCap, tmpBytes);
+    DEM_CUDA_CHECK(cub::DeviceReduce::Reduce(tmp, tmpBytes, vals, out, static_cast<int>(n),
+                                             ::cuda::maximum<>{}, init));
   }
 
   void exclusiveScan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {
@@ -148,6 +177,25 @@ struct CudaExec {
   static void synchronize() {
     ++syncCounters().deviceSyncs;
     DEM_CUDA_CHECK(cudaDeviceSynchronize());
+  }
+
+  /// Stage timing without waiting: a mark is a CUDA event recorded in the stream; the engine
+  /// reads the differences after the sub-step's status copy, when every mark has completed.
+  struct Mark {
+    cudaEvent_t e = nullptr;
+    Mark() = default;
+    Mark(const Mark&) = delete;
+    Mark& operator=(const Mark&) = delete;
+    ~Mark() { if (e) cudaEventDestroy(e); }
+  };
+  static void mark(Mark& m) {
+    if (!m.e) DEM_CUDA_CHECK(cudaEventCreate(&m.e));
+    DEM_CUDA_CHECK(cudaEventRecord(m.e));
+  }
+  static double seconds(const Mark& a, const Mark& b) {
+    float ms = 0.0f;
+    DEM_CUDA_CHECK(cudaEventElapsedTime(&ms, a.e, b.e));
+    return 1e-3 * static_cast<double>(ms);
   }
 
   CudaExec() = default;

@@ -72,20 +72,23 @@ struct CudaSimExec {
   }
 
   /// Evaluates f into a buffer (as evalKernel does), then reduces it by a pairwise tree (the
-  /// order of a CUB block reduction rather than the cpu's chunked loop).
+  /// order of a CUB block reduction rather than the cpu's chunked loop); the result is read
+  /// back to the host (a round trip).
   template <class F>
   double reduceMax(std::size_t n, F f, double init) const {
     if (n == 0)
       return init;
     sim::DeviceScope scope;
     sim::countRoundTrip();
-    _vals.resize(n);
-    double* vals = _vals.data();
-    parallelFor(n, [=](std::size_t i) { vals[i] = f(i); });
-    for (std::size_t stride = 1; stride < n; stride *= 2)
-      for (std::size_t i = 0; i + stride < n; i += 2 * stride)
-        vals[i] = std::max(vals[i], vals[i + stride]);
-    return std::max(vals[0], init);
+    return std::max(treeMax(n, f), init);
+  }
+
+  /// reduceMax whose result stays in device memory (*out, a device pointer): no round trip.
+  template <class F>
+  void reduceMaxInto(std::size_t n, F f, double init, double* out) const {
+    sim::DeviceScope scope;
+    sim::countLaunch();
+    *out = n == 0 ? init : std::max(treeMax(n, f), init);
   }
 
   void exclusiveScan(const std::uint32_t* in, std::uint32_t* out, std::size_t n) const {
@@ -121,7 +124,23 @@ struct CudaSimExec {
   }
   static void synchronize() { ++syncCounters().deviceSyncs; }
 
+  /// Stage timing: the host clock, as on the cpu (cuda uses events that do not wait).
+  using Mark = CpuExec::Mark;
+  static void mark(Mark& m) { CpuExec::mark(m); }
+  static double seconds(const Mark& a, const Mark& b) { return CpuExec::seconds(a, b); }
+
 private:
+  template <class F>
+  double treeMax(std::size_t n, F f) const {
+    _vals.resize(n);
+    double* vals = _vals.data();
+    parallelFor(n, [=](std::size_t i) { vals[i] = f(i); });
+    for (std::size_t stride = 1; stride < n; stride *= 2)
+      for (std::size_t i = 0; i + stride < n; i += 2 * stride)
+        vals[i] = std::max(vals[i], vals[i + stride]);
+    return vals[0];
+  }
+
   static void copy(void* dst, const void* src, std::size_t bytes) {
     if (!bytes)
       return;
