@@ -202,3 +202,52 @@ TEST_F(RemoteDemE2E, AKeyNotOnTheAllowListIsRefusedOverTheLink) {
       << text;
   EXPECT_EQ(NetnsLink::stop(server), 0) << readAll(dir / "server.log");
 }
+
+// bench/remote/link.sh, the same set-up for benchmarks: `up` gives a `dem:` section that a case
+// can use as it is, `down` leaves no namespace, veth or process behind.
+class LinkScriptE2E : public coredem::e2e::RunFolderTest {
+protected:
+  LinkScriptE2E()
+      : RunFolderTest(kBin, {"coredem", "coredem-dem", "coredem-gas", "coredem-relay"},
+                      "coredem-e2e-link") {}
+};
+
+TEST_F(LinkScriptE2E, UpGivesAWorkingDemSectionAndDownRemovesEverything) {
+  const std::string why = NetnsLink::unavailableReason();
+  if (!why.empty()) {
+    GTEST_SKIP() << "no emulated remote node: " << why;
+  }
+  const std::string name = "e2e" + std::to_string(::getpid());
+  const std::string env = "BUILD_DIR=" + kBin.parent_path().string() +
+                          " LINK_DIR=" + (dir / "links").string() + " DEM_ARGS='--threads 1' ";
+  const std::string script = (fs::path(COREDEM_SOURCE_DIR) / "bench/remote/link.sh").string();
+  struct Down { // the link goes, also when an assertion below fails
+    std::string command;
+    ~Down() { coredem::e2e::shell(command); }
+  } down{env + script + " down " + name};
+  std::string out;
+  ASSERT_EQ(coredem::e2e::shell(env + script + " up " + name + " 2", &out), 0) << out;
+  EXPECT_NE(out.find("round trip 2 ms"), std::string::npos) << out;
+  const std::string dem = readAll(dir / "links" / name / "dem.yaml");
+  ASSERT_NE(dem.find("endpoint: tcp://10.214."), std::string::npos) << dem;
+
+  std::string text = readAll(kCases / "restart" / "case.yaml");
+  text.replace(text.find("  end: 0.1"), 10, "  end: 0.01"); // 20 steps
+  text.replace(text.find("dem:\n"), 5, dem);
+  fs::create_directories(dir / "case");
+  coredem::e2e::writeAll(dir / "case" / "case.yaml", text);
+  const int rc =
+      coredem::e2e::waitExit(coredem::e2e::startProgram(kBin / "coredem",
+                                                        {"run", (dir / "case").string(), "--out",
+                                                         (dir / "run").string(), "--no-plots"},
+                                                        dir / "run.log"),
+                             120s);
+  EXPECT_EQ(rc, 0) << readAll(dir / "run.log") << readAll(dir / "links" / name / "dem.log");
+  EXPECT_GE(jsonNumber(readAll(dir / "run" / "logs" / "overhead.json"), "step_wall_s"), 2e-3);
+
+  ASSERT_EQ(coredem::e2e::shell(env + script + " down " + name, &out), 0) << out;
+  std::string list;
+  coredem::e2e::shell("ip netns list", &list);
+  EXPECT_EQ(list.find("coredem-link-" + name), std::string::npos) << list;
+  EXPECT_FALSE(fs::exists(dir / "links" / name));
+}
