@@ -33,6 +33,7 @@
 #include <poll.h>
 #include <sys/prctl.h>
 #include <sys/socket.h>
+#include <sys/time.h>
 #include <unistd.h>
 
 namespace {
@@ -227,8 +228,12 @@ int run(const std::string& listenAt, const std::string& targetAt, double delayMs
     std::rename(tmp.c_str(), portFile.c_str());
   }
   char settings[160];
-  std::snprintf(settings, sizeof settings, "one-way delay %g ms, bandwidth %s", delayMs,
-                mbit > 0 ? (std::to_string(mbit) + " Mbit/s").c_str() : "unlimited");
+  if (mbit > 0) {
+    std::snprintf(settings, sizeof settings, "one-way delay %g ms, %g Mbit/s each way", delayMs,
+                  mbit);
+  } else {
+    std::snprintf(settings, sizeof settings, "one-way delay %g ms, bandwidth unlimited", delayMs);
+  }
   logLine("listening on " + describe(bound) + ", forwarding to " + describe(targetAddr) + " (" +
           settings + ")");
 
@@ -283,6 +288,12 @@ int run(const std::string& listenAt, const std::string& targetAt, double delayMs
       const int cfd = ::accept4(lfd, reinterpret_cast<sockaddr*>(&peer), &peerLen, SOCK_CLOEXEC);
       if (cfd >= 0) {
         const int tfd = ::socket(targetAddr.ss_family, SOCK_STREAM | SOCK_CLOEXEC, 0);
+        // A blocking connect (the target is meant to be near: the same host or namespace),
+        // bounded so that a target that does not answer cannot stall the other connections.
+        const timeval connectTimeout{5, 0};
+        if (tfd >= 0) {
+          ::setsockopt(tfd, SOL_SOCKET, SO_SNDTIMEO, &connectTimeout, sizeof connectTimeout);
+        }
         if (tfd < 0 || ::connect(tfd, reinterpret_cast<sockaddr*>(&targetAddr), targetLen) != 0) {
           logLine("connection from " + describe(peer) + ": cannot connect to " +
                   describe(targetAddr) + ": " + std::strerror(errno) + "; closed");
@@ -291,6 +302,8 @@ int run(const std::string& listenAt, const std::string& targetAt, double delayMs
           }
           ::close(cfd);
         } else {
+          const timeval none{0, 0};
+          ::setsockopt(tfd, SOL_SOCKET, SO_SNDTIMEO, &none, sizeof none);
           setNonBlocking(cfd);
           setNonBlocking(tfd);
           setNoDelay(cfd);
