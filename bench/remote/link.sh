@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# bench/remote/link.sh up NAME RTT_MS [MBIT] | down NAME | status NAME
+# bench/remote/link.sh up NAME RTT_MS [MBIT] | down NAME | status NAME | clean
 #
 # An emulated remote DEM node for benchmarks (bench/remote/README.md). `up` creates a network
 # namespace `coredem-link-NAME` joined to the host by a veth pair with private addresses
@@ -18,7 +18,8 @@
 # and $LINK_DIR/NAME/env (LINK_ENDPOINT, LINK_SERVER_KEY, LINK_CLIENT_KEY, LINK_TIMERS_FILE,
 # LINK_RTT_MS, LINK_MODE) for scripts: `source "$LINK_DIR/NAME/env"`. The server serves one
 # session after the other until `down NAME`, which stops every process in the namespace and
-# removes the veth pair, the namespace and $LINK_DIR/NAME.
+# removes the veth pair, the namespace and $LINK_DIR/NAME. `clean` does that for every link
+# (namespaces coredem-link-*), e.g. after a benchmark was killed.
 #
 # Environment: BUILD_DIR (default <project>/build: coredem-dem, coredem-relay),
 #   LINK_DIR (default /tmp/coredem-link), DEM_ARGS (more coredem-dem options, e.g.
@@ -27,8 +28,14 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
-usage() { sed -n '2,25p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '2,27p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 die() { echo "link.sh: error: $*" >&2; exit 2; }
+if [[ "${1:-}" == clean ]]; then
+  for n in $(ip netns list 2>/dev/null | sed -n 's/^coredem-link-\([^ ]*\).*/\1/p'); do
+    "${BASH_SOURCE[0]}" down "$n"
+  done
+  exit 0
+fi
 [[ $# -ge 2 ]] || usage
 cmd="$1"
 name="$2"
