@@ -20,6 +20,8 @@ packages=(
   dpkg-dev bzip2 ca-certificates
   # the committed .clang-format is enforced by scripts/check-format.sh (CI)
   clang-format
+  # ip netns / veth of the remote-DEM e2e test and bench/remote/link.sh
+  iproute2
 )
 if [[ "${1:-}" == "--with-peers" ]]; then
   packages+=(liggghts openmpi-bin)

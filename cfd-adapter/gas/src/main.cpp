@@ -149,6 +149,7 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
   // D's n_sub sub-steps), the ledgers, and advance (StepDone -> next grant from O).
   using Clock = std::chrono::steady_clock;
   double tEval = 0.0, tExchange = 0.0, tLedger = 0.0, tAdvance = 0.0;
+  client::ExchangeTimes tSplit; // the exchange's split (client library), summed
   auto since = [](Clock::time_point a) {
     return std::chrono::duration<double>(Clock::now() - a).count();
   };
@@ -169,6 +170,11 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
                                 {"cp_g", f.cp_g},
                                 {"Y_g", f.Y_g}});
     tExchange += since(t0);
+    const auto x = p.lastExchangeTimes();
+    tSplit.serialise += x.serialise;
+    tSplit.send += x.send;
+    tSplit.wait += x.wait;
+    tSplit.receive += x.receive;
     t0 = Clock::now();
     const auto eps = s.field("eps_g"), k = s.field("K_sl"), kus = s.field("K_sl_Us"),
                h = s.field("H"), htp = s.field("H_Tp"), r = s.field("R_species"),
@@ -226,6 +232,9 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
         "per step ({} cells): gas evaluation {:.3f} ms, exchange with D {:.3f} ms (incl. "
         "D's sub-steps), ledgers+checkpoints {:.3f} ms, advance (StepDone -> grant) {:.3f} ms",
         n, tEval * k, tExchange * k, tLedger * k, tAdvance * k);
+    log->info("exchange per step: serialise {:.3f} ms, send {:.3f} ms, wait for D {:.3f} ms "
+              "(transfer both ways + D's work), receive {:.3f} ms",
+              tSplit.serialise * k, tSplit.send * k, tSplit.wait * k, tSplit.receive * k);
   }
   p.finalize();
   return 0;
