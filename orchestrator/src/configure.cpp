@@ -5,6 +5,8 @@
 #include <limits>
 #include <numbers>
 
+#include <coredem/protocol/coupling_scheme.h>
+
 namespace fs = std::filesystem;
 namespace v1 = coredem::v1;
 
@@ -134,6 +136,11 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
     auto* kv = cfg.add_options();
     kv->set_key(k);
     kv->set_value(v);
+  }
+  if (c.coupling.staggered()) { // sequential sends nothing: its Configure stays as before
+    auto* kv = cfg.add_options();
+    kv->set_key(std::string(protocol::fields::kCouplingSchemeOption));
+    kv->set_value("staggered");
   }
   cfg.set_output_directory(fs::absolute(runDir).string());
   addChemistryToConfigure(c, cfg); // v1.1: solid species, reactions, chemistry
