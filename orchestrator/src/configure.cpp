@@ -147,4 +147,24 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
   return cfg;
 }
 
+std::string couplingSchemeMismatch(const CaseConfig& c, const v1::StepDone& demDone,
+                                   std::int64_t step) {
+  const auto lag =
+      protocol::findNamedValue(demDone.diagnostics(), protocol::fields::kCouplingLagDiagnostic);
+  const bool demStaggered = lag && *lag == 1.0;
+  if (demStaggered == c.coupling.staggered()) {
+    return {};
+  }
+  if (c.coupling.staggered()) {
+    return fmt::format("does not run the staggered coupling scheme (coupling: {{scheme: "
+                       "staggered}}): its StepDone of step {} reports no {} = 1, as a server "
+                       "that ignores the Configure option {} (older than this coredem) would; use "
+                       "a coredem-dem of this version or the sequential scheme",
+                       step, protocol::fields::kCouplingLagDiagnostic,
+                       protocol::fields::kCouplingSchemeOption);
+  }
+  return fmt::format("reports {} in step {} of a sequential run",
+                     protocol::fields::kCouplingLagDiagnostic, step);
+}
+
 } // namespace coredem::orchestrator

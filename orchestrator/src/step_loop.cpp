@@ -5,7 +5,6 @@
 #include <cmath>
 
 #include <coredem/orchestrator/progress.h>
-#include <coredem/protocol/coupling_scheme.h>
 
 #include "configure.h"
 #include "session_impl.h"
@@ -117,24 +116,9 @@ void Session::stepLoop(std::int64_t startStep) {
     }
     // The scheme the DEM server runs is the one asked for: a server that ignored the Configure
     // option (an older coredem-dem logs unknown options and runs sequential) reports no lag.
-    {
-      const auto lag = protocol::findNamedValue(demDone.envelope().step_done().diagnostics(),
-                                                protocol::fields::kCouplingLagDiagnostic);
-      const bool demStaggered = lag && *lag == 1.0;
-      if (demStaggered != _c.coupling.staggered()) {
-        throw ParticipantFault(
-            kDemName,
-            _c.coupling.staggered()
-                ? fmt::format("does not run the staggered coupling scheme (coupling: {{scheme: "
-                              "staggered}}): its StepDone of step {} reports no {} = 1, as a "
-                              "server that ignores the Configure option {} (older than this "
-                              "coredem) would; use a coredem-dem of this version or the "
-                              "sequential scheme",
-                              step, protocol::fields::kCouplingLagDiagnostic,
-                              protocol::fields::kCouplingSchemeOption)
-                : fmt::format("reports {} in step {} of a sequential run", step,
-                              protocol::fields::kCouplingLagDiagnostic));
-      }
+    if (const std::string why = couplingSchemeMismatch(_c, demDone.envelope().step_done(), step);
+        !why.empty()) {
+      throw ParticipantFault(kDemName, why);
     }
     protocol::Request cfdDone;
     while (true) {
