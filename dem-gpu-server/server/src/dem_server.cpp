@@ -663,6 +663,7 @@ struct DemServer::Impl {
     if (!lag.hasPending) {
       try {
         lag.pending = system->evaluateSources(grant->dtCfd / grant->nSub);
+        lag.pendingDt = 0.0; // S^0: rates of the initial state, applied as they are
         lag.hasPending = true;
       } catch (const std::exception& e) {
         log->error("session {}: step {}: the initial sources failed in the DEM core: {}", session,
@@ -681,9 +682,22 @@ struct DemServer::Impl {
     if (lastLedger.ByteSizeLong() == 0) { // the first step of a session
       lastLedger = ledgerMessage(system->particles());
     }
-    const dem::CellSources& p = lag.pending;
+    dem::CellSources& p = lag.pending;
     const double dt = grant->dtCfd;
     const auto n = static_cast<std::size_t>(cells);
+    // The released mass and its heat (R_species, Q_hom) are amounts over the step that computed
+    // them: with a different Δt now (adaptive Δt_CFD) the rates are rescaled so that the gas gets
+    // exactly what the particles released. The coefficients (ε_g, K_sl, K_sl U_s, H, H T_p)
+    // describe the particles and are sent as they are.
+    if (lag.pendingDt > 0.0 && lag.pendingDt != dt) {
+      const double scale = lag.pendingDt / dt;
+      for (double& v : p.rSpecies) {
+        v *= scale;
+      }
+      for (double& v : p.qHom) {
+        v *= scale;
+      }
+    }
     double heat = 0.0;
     for (std::size_t c = 0; c < n; ++c) {
       heat += p.heatHTp[c] - p.heatH[c] * gas.Tg[c];
@@ -794,6 +808,7 @@ struct DemServer::Impl {
     }
     if (staggered) {
       lag.pending = *s;
+      lag.pendingDt = dt;
       lag.hasPending = true;
     }
     const auto particles = system->particles();

@@ -53,6 +53,7 @@ void writeStaggeredState(const std::string& path, const StaggeredState& s) {
   const h5::Handle group = h5::createGroup(file, "/server/staggered");
   h5::writeAttribute(group, "has_pending", s.hasPending ? 1 : 0);
   h5::writeAttribute(group, "heat_applied_J", s.heatApplied);
+  h5::writeAttribute(group, "pending_dt_s", s.pendingDt);
   h5::writeDataset(group, "species_computed_kg", s.speciesComputed);
   if (s.hasPending) {
     dem::CellSources p = s.pending;
@@ -72,6 +73,7 @@ StaggeredState readStaggeredState(const std::string& path, std::uint64_t cells, 
   const h5::Handle group = h5::openGroup(file, "/server/staggered", path);
   s.hasPending = h5::readAttribute<int>(group, "has_pending", path) != 0;
   s.heatApplied = h5::readAttribute<double>(group, "heat_applied_J", path);
+  s.pendingDt = h5::readAttribute<double>(group, "pending_dt_s", path);
   s.speciesComputed = h5::readDataset<double>(group, "species_computed_kg", path,
                                               static_cast<std::int64_t>(species));
   if (s.hasPending) {

@@ -22,6 +22,9 @@ struct ServerLedgers {
 struct StaggeredState {
   bool hasPending = false;
   dem::CellSources pending; ///< computed in the last step, sent with the next GasFields
+  /// Δt_CFD of the step that computed `pending` (0: evaluated without advancing, S^0): the
+  /// amount rates R_species and Q_hom are rescaled to the Δt of the step that applies them.
+  double pendingDt = 0.0;
   /// kg per gas species, ∫ Σ V_c R_k dt of the windows the DEM computed (at their own Δt); the
   /// applied side is ServerLedgers::speciesToGas.
   std::vector<double> speciesComputed;

@@ -166,14 +166,16 @@ TEST_F(StaggeredE2E, RestartIdentity) {
 }
 
 // Mass transfer with the lag (case staggered-chemistry: 27 held beads convert solid B into gas C
-// at a constant rate until B runs out at about step 22). Per step and species C:
+// at a constant rate until B runs out at t ~ 22 ms; Δt_CFD grows from 0.5 to 2 ms). Per step and
+// species C:
 // (1) dem.species_to_gas (booked by D when it sends the sources) = gas.species (booked by the gas
 //     when it applies them);
 // (2) dem.solid_to_gas (released by the particles, booked in the step that computes it) −
 //     dem.species_to_gas = dem.species_in_flight;
 // (3) after B is gone the last step released nothing, so what stays in flight is minus the
-//     step-1 initial sources' transfer: −gas.species(1).
-// Tolerance 1e-12 of the mass released (sums of a few tens of equal terms).
+//     step-1 initial sources' transfer: −gas.species(1). With a growing Δt this holds only
+//     because D rescales the lagged R_species to the Δt that applies them.
+// Tolerance 1e-12 of the mass released (sums of a few tens of terms).
 TEST_F(StaggeredE2E, SpeciesLedgersCloseWithTheLagBooked) {
   const fs::path a = dir / "run";
   ASSERT_EQ(runCoredem({"run", (kCases / "staggered-chemistry").string(), "--out", a.string(),
@@ -182,15 +184,18 @@ TEST_F(StaggeredE2E, SpeciesLedgersCloseWithTheLagBooked) {
             0)
       << readAll(dir / "a.log");
   auto ts = readTimeseries(a);
+  const auto& dt = ts["dt"];
   const auto& toGas = ts["dem.species_to_gas.C_kg"];
   const auto& gas = ts["gas.species.C_kg"];
   const auto& solid = ts["dem.solid_to_gas.C_kg"];
   const auto& inFlight = ts["dem.species_in_flight.C_kg"];
-  ASSERT_EQ(toGas.size(), 40u);
-  ASSERT_EQ(inFlight.size(), 40u);
+  const std::size_t n = toGas.size();
+  ASSERT_GE(n, 20u);
+  ASSERT_EQ(inFlight.size(), n);
+  ASSERT_GT(dt[5], 1.5 * dt[0]) << "the test needs a varying Δt";
   ASSERT_GT(gas.front(), 0.0);
-  ASSERT_EQ(solid[39], solid[30]) << "B must run out during the run (the test needs it)";
-  for (std::size_t i = 0; i < toGas.size(); ++i) {
+  ASSERT_EQ(solid[n - 1], solid[n - 3]) << "B must run out during the run (the test needs it)";
+  for (std::size_t i = 0; i < n; ++i) {
     const double tol = 1e-12 * solid[i];
     EXPECT_NEAR(toGas[i], gas[i], tol) << "row " << i;
     EXPECT_NEAR(solid[i] - toGas[i], inFlight[i], tol) << "row " << i;
