@@ -665,6 +665,28 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
   return m.sources;
 }
 
+const CellSources& DemSystem::evaluateSources(double dtDem) {
+  Impl& m = *_impl;
+  COREDEM_CHECK(dtDem > 0 && std::isfinite(dtDem) && dtDem <= m.dtMax * (1.0 + 1e-12),
+                "evaluateSources: dtDem = {:.6g} s must be > 0 and <= the stable DEM step {:.6g} s",
+                dtDem, m.dtMax);
+  // Everything one sub-step changes is put back afterwards: particles and contact history (the
+  // host state, as a restart would), the ledgers, the stage timers. Time and step are untouched.
+  const HostState saved = m.engine->state();
+  const HeatTotals heat = m.engine->heatTotals();
+  const ChemistryTotals chemistry = m.engine->chemistryTotals();
+  const StageTimes times = m.engine->times();
+  m.engine->beginWindow();
+  m.engine->subStep(dtDem);
+  m.engine->endWindow(dtDem, 1, m.sources);
+  (void)m.engine->takeRemovalRequest(); // no removal: the state is put back
+  m.engine->setState(saved);
+  m.engine->restoreHeatTotals(heat);
+  m.engine->restoreChemistryTotals(chemistry);
+  m.engine->times() = times;
+  return m.sources;
+}
+
 void DemSystem::setInterruptFlag(const std::atomic<bool>* flag) {
   _impl->interrupt = flag;
 }

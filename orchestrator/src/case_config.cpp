@@ -281,7 +281,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
                     {"name",       "description",    "time",          "grid",      "gravity",
                      "species",    "gas_properties", "materials",     "particles", "initial_state",
                      "walls",      "models",         "dem",           "cfd",       "gas",
-                     "checkpoint", "output",         "solid_species", "reactions", "chemistry"},
+                     "checkpoint", "output",         "solid_species", "reactions", "chemistry",
+                     "coupling"},
                     YAML::Mark());
   c.name = top.string("name", std::nullopt, "the case name, used for the run folder");
   if (c.name.empty() || c.name.find('/') != std::string::npos) {
@@ -649,6 +650,10 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     }
   }
   c.hasGasSection = top.has("gas");
+  if (top.has("coupling")) {
+    const Section k = top.section("coupling", {"scheme"});
+    c.coupling.scheme = k.choice("scheme", c.coupling.scheme, {"sequential", "staggered"});
+  }
 
   if (top.has("checkpoint")) {
     const Section k = top.section("checkpoint", {"every_steps", "every_seconds", "keep"});

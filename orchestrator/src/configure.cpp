@@ -5,6 +5,8 @@
 #include <limits>
 #include <numbers>
 
+#include <coredem/protocol/coupling_scheme.h>
+
 namespace fs = std::filesystem;
 namespace v1 = coredem::v1;
 
@@ -135,9 +137,34 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
     kv->set_key(k);
     kv->set_value(v);
   }
+  if (c.coupling.staggered()) { // sequential sends nothing: its Configure stays as before
+    auto* kv = cfg.add_options();
+    kv->set_key(std::string(protocol::fields::kCouplingSchemeOption));
+    kv->set_value("staggered");
+  }
   cfg.set_output_directory(fs::absolute(runDir).string());
   addChemistryToConfigure(c, cfg); // v1.1: solid species, reactions, chemistry
   return cfg;
+}
+
+std::string couplingSchemeMismatch(const CaseConfig& c, const v1::StepDone& demDone,
+                                   std::int64_t step) {
+  const auto lag =
+      protocol::findNamedValue(demDone.diagnostics(), protocol::fields::kCouplingLagDiagnostic);
+  const bool demStaggered = lag && *lag == 1.0;
+  if (demStaggered == c.coupling.staggered()) {
+    return {};
+  }
+  if (c.coupling.staggered()) {
+    return fmt::format("does not run the staggered coupling scheme (coupling: {{scheme: "
+                       "staggered}}): its StepDone of step {} reports no {} = 1, as a server "
+                       "that ignores the Configure option {} (older than this coredem) would; use "
+                       "a coredem-dem of this version or the sequential scheme",
+                       step, protocol::fields::kCouplingLagDiagnostic,
+                       protocol::fields::kCouplingSchemeOption);
+  }
+  return fmt::format("reports {} in step {} of a sequential run",
+                     protocol::fields::kCouplingLagDiagnostic, step);
 }
 
 } // namespace coredem::orchestrator

@@ -23,4 +23,10 @@ SubcyclePlan planFor(const CaseConfig& c, double dt, double dtDemMax);
 v1::Configure buildConfigure(const CaseConfig& c, const std::filesystem::path& runDir, double dtCfd,
                              const SubcyclePlan& plan);
 
+/// Why the DEM server's StepDone of `step` does not match the case's coupling scheme
+/// (docs/coupling-schemes.md "How the scheme is negotiated"), or "" when it does: a staggered
+/// server reports the diagnostic coupling_lag_steps = 1, a sequential one none.
+std::string couplingSchemeMismatch(const CaseConfig& c, const v1::StepDone& demDone,
+                                   std::int64_t step);
+
 } // namespace coredem::orchestrator

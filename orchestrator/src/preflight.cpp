@@ -482,6 +482,48 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
     warnTemperature(at, warnings, {"walls", "temperature"}, "walls.temperature",
                     c.walls.temperature);
   }
+  // Staggered coupling: the drag and heat sources the gas applies are one step old, so the
+  // particles must not relax to the gas within one step (docs/coupling-schemes.md "Stability").
+  // τ_p,min = ρ_p d_p²/(225 μ_g): the response time of the Ergun/Gidaspow viscous drag at
+  // ε_g = 0.4 (K_sl = 150 ε_s² μ_g/(ε_g d_p²), τ_p = ε_s ρ_p/K_sl), the shortest of a dense bed.
+  if (c.coupling.staggered()) {
+    const bool adaptive = c.dt.kind == DtPolicyConfig::Kind::Courant;
+    const double dtMax = adaptive ? c.dt.dtMax : c.dt.dt;
+    const std::vector<std::string> dtPath =
+        adaptive ? std::vector<std::string>{"time", "adaptive", "dt_max"}
+                 : std::vector<std::string>{"time", "dt"};
+    const std::string dtKey = adaptive ? "time.adaptive.dt_max" : "time.dt";
+    for (std::size_t i = 0; i < c.particles.size(); ++i) {
+      const ParticleSetConfig& p = c.particles[i];
+      double rho = p.density;
+      if (!(rho > 0.0)) {
+        const int m = materialIndex(c, p.material);
+        rho = m >= 0 ? c.materials[std::size_t(m)].density : 0.0;
+      }
+      const double tau = rho * p.diameter * p.diameter / (225.0 * c.gasProperties.viscosity);
+      if (!(tau > 0.0)) {
+        continue;
+      }
+      const std::string what = fmt::format(
+          "Δt_CFD = {:.4g} s with coupling.scheme staggered and particle set {} (d_p = {:.4g} m, "
+          "ρ_p = {:.4g} kg/m³, μ_g = {:.4g} Pa s): the particle response time τ_p = ρ_p d_p²/(225 "
+          "μ_g) = {:.4g} s",
+          dtMax, setName(p, i), p.diameter, rho, c.gasProperties.viscosity, tau);
+      if (dtMax > tau) {
+        at.fail(dtPath, dtKey,
+                what + " is shorter than one step: the gas would apply drag and heat sources of "
+                       "particles that have since relaxed (lagged sources oscillate). Use Δt_CFD "
+                       "<= τ_p (better <= 0.1 τ_p) or coupling.scheme sequential");
+      }
+      if (dtMax > 0.1 * tau) {
+        warnings.push_back(at.warning(
+            dtPath, dtKey,
+            what + fmt::format(": Δt_CFD/τ_p = {:.2g} > 0.1, the one-step lag of the drag and "
+                               "heat sources is more than 10 % of a particle relaxation",
+                               dtMax / tau)));
+      }
+    }
+  }
   // The prescribed gas temperature (coredem-gas's section), when it is a number.
   const YAML::Node gas = at.root()[c.cfd.gasKey];
   if (gas && gas.IsMap() && gas["T_g"] && gas["T_g"].IsScalar()) {

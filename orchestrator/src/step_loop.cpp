@@ -114,6 +114,12 @@ void Session::stepLoop(std::int64_t startStep) {
                                          protocol::messageTypeName(demDone.type()),
                                          demDone.envelope().step()));
     }
+    // The scheme the DEM server runs is the one asked for: a server that ignored the Configure
+    // option (an older coredem-dem logs unknown options and runs sequential) reports no lag.
+    if (const std::string why = couplingSchemeMismatch(_c, demDone.envelope().step_done(), step);
+        !why.empty()) {
+      throw ParticipantFault(kDemName, why);
+    }
     protocol::Request cfdDone;
     while (true) {
       cfdDone = receiveFromCfd(cfdTimeout, fmt::format("StepDone of step {}", step));

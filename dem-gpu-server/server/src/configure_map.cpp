@@ -7,6 +7,7 @@
 #include "coredem/common/check.h"
 #include "coredem/dem/kernels/nasa7.h"
 #include "coredem/dem/models.h"
+#include "coredem/protocol/coupling_scheme.h"
 
 namespace coredem::server {
 
@@ -269,6 +270,9 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
 
   // Model options by name (`models:` in case.yaml), through the model registry (models.h).
   for (const auto& kv : c.options()) {
+    if (kv.key() == protocol::fields::kCouplingSchemeOption) {
+      continue; // the server's own option (dem_server.cpp), not a DEM model
+    }
     if (!dem::applyModelOption(cfg, kv.key(), kv.value()) && warnings != nullptr) {
       warnings->push_back(kv.key());
     }

@@ -23,6 +23,7 @@
 #include "coredem/dem/bed_height.h"
 #include "coredem/dem/dem_system.h"
 #include "coredem/dem/time_handler.h"
+#include "coredem/protocol/coupling_scheme.h"
 #include "coredem/protocol/protocol.h"
 #include "state_meta.h"
 #include "timers.h"
@@ -162,7 +163,12 @@ struct DemServer::Impl {
   std::optional<Grant> grant;
   std::optional<Held> held;
   ServerLedgers ledgers;
-  ExchangeTimes xt;                         ///< --timers: exchange and advance seconds this session
+  /// Staggered coupling (Configure option coupling_scheme = staggered, docs/coupling-schemes.md):
+  /// GasFields of step n are answered at once with the sources computed in step n-1.
+  bool staggered = false;
+  StaggeredState lag;    ///< pending sources and the lag ledgers (staggered only)
+  v1::Ledger lastLedger; ///< the ledger of the last StepDone (sent with the lagged Sources)
+  ExchangeTimes xt;      ///< --timers: exchange and advance seconds this session
   std::optional<Clock::time_point> stepEnd; ///< when the last StepDone left (wait_for_peer starts)
   Clock::time_point lastReceived{};         ///< when receive() returned the message being handled
 
@@ -267,6 +273,9 @@ struct DemServer::Impl {
     grant.reset();
     held.reset();
     ledgers = ServerLedgers();
+    staggered = false;
+    lag = StaggeredState();
+    lastLedger.Clear();
     stepsDone = 0;
     sessionEnded = true;
   }
@@ -410,9 +419,27 @@ struct DemServer::Impl {
       refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION, why);
       return;
     }
+    // The coupling scheme is the server's own option (not a DEM model): an unknown value is
+    // refused, never taken for the default.
+    bool nextStaggered = false;
+    for (const auto& kv : c.options()) {
+      if (kv.key() == proto::fields::kCouplingSchemeOption) {
+        if (kv.value() == "staggered") {
+          nextStaggered = true;
+        } else if (kv.value() != "sequential") {
+          refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+                 fmt::format("Configure option {} = '{}': this server runs 'sequential' or "
+                             "'staggered'",
+                             proto::fields::kCouplingSchemeOption, safe(kv.value(), 64)));
+          return;
+        }
+      }
+    }
     std::unique_ptr<dem::DemSystem> next;
     std::uint32_t nSub = 0;
     ServerLedgers restored;
+    StaggeredState restoredLag;
+    restoredLag.speciesComputed.assign(static_cast<std::size_t>(c.species_size()), 0.0);
     std::vector<std::string> ignored;
     try {
       COREDEM_CHECK(c.coupling_mesh().has_cartesian(), "Configure has no Cartesian coupling grid");
@@ -424,6 +451,10 @@ struct DemServer::Impl {
                       c.initial_state_file());
         next->readState(c.initial_state_file());
         restored = readServerLedgers(c.initial_state_file(), c.species_size());
+        if (nextStaggered) {
+          restoredLag = readStaggeredState(c.initial_state_file(),
+                                           proto::cellCount(c.coupling_mesh()), c.species_size());
+        }
       }
       COREDEM_CHECK(std::isfinite(next->dtDemMax()) && next->dtDemMax() > 0.0,
                     "no stable DEM time step can be derived (dt_dem_max = {}): give the particle "
@@ -465,6 +496,19 @@ struct DemServer::Impl {
     system = std::move(next);
     system->setInterruptFlag(&stopFlag); // SIGINT/SIGTERM stop a long step within a sub-step
     ledgers = restored;
+    staggered = nextStaggered;
+    lag = restoredLag;
+    lastLedger.Clear();
+    if (staggered) {
+      log->info("session {}: staggered coupling: GasFields of step n are answered with the sources "
+                "of step n-1{}",
+                session,
+                lag.hasPending ? " (pending sources of the restart step read from the state file)"
+                : c.initial_state_file().empty()
+                    ? "; step 1 gets the sources of the initial state"
+                    : "; the state file holds no pending sources: the first step gets the sources "
+                      "of the restart state");
+    }
     if (ledgers.speciesToGas.size() != static_cast<std::size_t>(c.species_size())) {
       ledgers.speciesToGas.assign(static_cast<std::size_t>(c.species_size()), 0.0);
     }
@@ -591,6 +635,86 @@ struct DemServer::Impl {
     runStep(r);
   }
 
+  /// The Sources message answering `r` with the cell sources `s`.
+  void sendSources(const proto::Request& r, const dem::CellSources& s, const v1::Ledger& ledger) {
+    namespace f = proto::fields;
+    const auto& env = r.message.envelope();
+    auto src =
+        proto::makeSources(env.step(), env.time(), grant->dtCfd, cells, species, grant->nSub);
+    auto add = [&](std::string_view name, const std::vector<double>& v) {
+      src.addArray<double>(name, std::span<const double>(v), f::shapeOf(name, cells, species));
+    };
+    add(f::kVoidFraction, s.epsG);
+    add(f::kDragCoefficient, s.kSl);
+    add(f::kDragCoefficientTimesUs, s.kSlUs);
+    add(f::kHeatCoefficient, s.heatH);
+    add(f::kHeatCoefficientTimesTp, s.heatHTp);
+    add(f::kSpeciesSources, s.rSpecies);
+    add(f::kHomogeneousHeat, s.qHom);
+    *src.envelope().mutable_sources()->mutable_ledger() = ledger;
+    send(r.peer, std::move(src), env.sequence(), env.step());
+  }
+
+  /// Staggered: answers the GasFields of step n at once with the pending sources of step n-1 (for
+  /// the first step of a session without pending sources: those of the current state, evaluated
+  /// without advancing) and books them as applied with this step's T_g and Δt, the values the gas
+  /// applies them with. False when the session ended.
+  bool sendLaggedSources(const proto::Request& r, const dem::GasFieldsView& gas) {
+    if (!lag.hasPending) {
+      try {
+        lag.pending = system->evaluateSources(grant->dtCfd / grant->nSub);
+        lag.pendingDt = 0.0; // S^0: rates of the initial state, applied as they are
+        lag.hasPending = true;
+      } catch (const std::exception& e) {
+        log->error("session {}: step {}: the initial sources failed in the DEM core: {}", session,
+                   grant->step, e.what());
+        refuse(r, v1::ERROR_CODE_INTERNAL,
+               fmt::format("step {}: evaluating the initial sources failed in the DEM core: {}",
+                           grant->step, e.what()));
+        endSession(fmt::format("step {}: the initial sources failed: {}", grant->step, e.what()),
+                   v1::ERROR_CODE_INTERNAL);
+        return false;
+      }
+      log->info("session {}: step {} gets the sources of the particles at t = {} s (staggered "
+                "coupling, no pending sources)",
+                session, grant->step, grant->time);
+    }
+    if (lastLedger.ByteSizeLong() == 0) { // the first step of a session
+      lastLedger = ledgerMessage(system->particles());
+    }
+    dem::CellSources& p = lag.pending;
+    const double dt = grant->dtCfd;
+    const auto n = static_cast<std::size_t>(cells);
+    // The released mass and its heat (R_species, Q_hom) are amounts over the step that computed
+    // them: with a different Δt now (adaptive Δt_CFD) the rates are rescaled so that the gas gets
+    // exactly what the particles released. The coefficients (ε_g, K_sl, K_sl U_s, H, H T_p)
+    // describe the particles and are sent as they are.
+    if (lag.pendingDt > 0.0 && lag.pendingDt != dt) {
+      const double scale = lag.pendingDt / dt;
+      for (double& v : p.rSpecies) {
+        v *= scale;
+      }
+      for (double& v : p.qHom) {
+        v *= scale;
+      }
+    }
+    double heat = 0.0;
+    for (std::size_t c = 0; c < n; ++c) {
+      heat += p.heatHTp[c] - p.heatH[c] * gas.Tg[c];
+    }
+    lag.heatApplied += heat * cellVolume * dt;
+    for (std::size_t k = 0; k < species; ++k) {
+      double sum = 0.0;
+      for (std::size_t c = 0; c < n; ++c) {
+        sum += p.rSpecies[c * species + k];
+      }
+      ledgers.speciesToGas[k] += sum * cellVolume * dt;
+    }
+    sendSources(r, p, lastLedger);
+    lag.hasPending = false; // applied by the gas in this step; the step computes the next ones
+    return true;
+  }
+
   void runStep(const proto::Request& r) {
     const auto& env = r.message.envelope();
     const auto& body = env.gas_fields();
@@ -622,8 +746,16 @@ struct DemServer::Impl {
              fmt::format("GasFields of step {}: {}", env.step(), e.what()));
       return;
     }
-    const auto tGas = Clock::now();
+    auto tGas = Clock::now();
     xt.unpack += std::chrono::duration<double>(tGas - t0).count();
+    if (staggered) { // the lagged Sources leave before the step is computed (timed as pack_send)
+      if (!sendLaggedSources(r, view)) {
+        return;
+      }
+      const auto tSent = Clock::now();
+      xt.packSend += std::chrono::duration<double>(tSent - tGas).count();
+      tGas = tSent;
+    }
     const dem::CellSources* s = nullptr;
     try {
       s = &system->advance(grant->dtCfd, static_cast<int>(grant->nSub));
@@ -634,13 +766,17 @@ struct DemServer::Impl {
                 grant->step, e.what());
       const std::string reason = fmt::format("the server is stopping: step {} was interrupted ({})",
                                              grant->step, e.what());
-      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, reason);
+      if (!staggered) { // staggered: the GasFields were answered with the lagged Sources
+        refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, reason);
+      }
       endSession(reason); // answers the StepGrant too
       return;
     } catch (const std::exception& e) {
       log->error("session {}: step {} failed in the DEM core: {}", session, grant->step, e.what());
-      refuse(r, v1::ERROR_CODE_INTERNAL,
-             fmt::format("step {} failed in the DEM core: {}", grant->step, e.what()));
+      if (!staggered) {
+        refuse(r, v1::ERROR_CODE_INTERNAL,
+               fmt::format("step {} failed in the DEM core: {}", grant->step, e.what()));
+      }
       auto m = proto::makeError(v1::ERROR_CODE_INTERNAL, e.what(), grant->sequence,
                                 v1::MESSAGE_TYPE_STEP_GRANT);
       send(grant->peer, std::move(m), grant->sequence, grant->step);
@@ -659,33 +795,32 @@ struct DemServer::Impl {
 
     // Ledgers: the species the particles gave to the gas during this step (the heat from the gas
     // is the DEM core's HeatTotals::convection, booked there once).
+    // Staggered: booked here as computed; the gas gets them with the next GasFields, where they
+    // are booked as applied (sendLaggedSources).
     const auto n = static_cast<std::size_t>(cells);
+    std::vector<double>& booked = staggered ? lag.speciesComputed : ledgers.speciesToGas;
     for (std::size_t k = 0; k < species; ++k) {
       double sum = 0.0;
       for (std::size_t c = 0; c < n; ++c) {
         sum += s->rSpecies[c * species + k];
       }
-      ledgers.speciesToGas[k] += sum * cellVolume * dt;
+      booked[k] += sum * cellVolume * dt;
+    }
+    if (staggered) {
+      lag.pending = *s;
+      lag.pendingDt = dt;
+      lag.hasPending = true;
     }
     const auto particles = system->particles();
     v1::Ledger ledger = ledgerMessage(particles);
     const auto tLedgers = Clock::now();
     xt.ledgers += std::chrono::duration<double>(tLedgers - tAdvanced).count();
 
-    // Sources to C.
-    auto src = proto::makeSources(env.step(), env.time(), dt, cells, species, grant->nSub);
-    auto add = [&](std::string_view name, const std::vector<double>& v) {
-      src.addArray<double>(name, std::span<const double>(v), f::shapeOf(name, cells, species));
-    };
-    add(f::kVoidFraction, s->epsG);
-    add(f::kDragCoefficient, s->kSl);
-    add(f::kDragCoefficientTimesUs, s->kSlUs);
-    add(f::kHeatCoefficient, s->heatH);
-    add(f::kHeatCoefficientTimesTp, s->heatHTp);
-    add(f::kSpeciesSources, s->rSpecies);
-    add(f::kHomogeneousHeat, s->qHom);
-    *src.envelope().mutable_sources()->mutable_ledger() = ledger;
-    send(r.peer, std::move(src), env.sequence(), env.step());
+    // Sources to C (sequential; staggered sent them before advancing).
+    if (!staggered) {
+      sendSources(r, *s, ledger);
+    }
+    lastLedger = ledger;
     xt.packSend += std::chrono::duration<double>(Clock::now() - tLedgers).count();
     {
       auto ms = [](Clock::time_point a, Clock::time_point b) {
@@ -718,6 +853,9 @@ struct DemServer::Impl {
     }
     const auto tDone = Clock::now();
     addDiagnostics(done, particles);
+    if (staggered) { // tells the orchestrator that this server runs the scheme it asked for
+      proto::addNamedValue(done.mutable_diagnostics(), std::string(f::kCouplingLagDiagnostic), 1.0);
+    }
     done.set_wall_seconds(std::chrono::duration<double>(Clock::now() - t0).count());
     if (checkpointOk) {
       send(grant->peer, proto::makeStepDone(grant->step, grant->time, done), grant->sequence,
@@ -771,6 +909,17 @@ struct DemServer::Impl {
       proto::addNamedValue(l.mutable_species(), "dem.species_to_gas." + speciesNames[k] + "_kg",
                            ledgers.speciesToGas[k]);
     }
+    if (staggered) {
+      // The lag (docs/coupling-schemes.md "Ledgers"): what the particles exchanged minus what the
+      // gas has been handed, i.e. the pending step's transfer minus the first step's initial one.
+      proto::addNamedValue(l.mutable_energy(), "dem.heat_in_flight_J",
+                           heat.convection + lag.heatApplied);
+      for (std::size_t k = 0; k < speciesNames.size(); ++k) {
+        proto::addNamedValue(l.mutable_species(),
+                             "dem.species_in_flight." + speciesNames[k] + "_kg",
+                             lag.speciesComputed[k] - ledgers.speciesToGas[k]);
+      }
+    }
     // Chemistry ledgers (docs/thermochemistry.md): solid converted to gas by the particles'
     // reactions per gas species, reaction heat into the particles, WGS heat into the gas, removed
     // particles.
@@ -820,6 +969,9 @@ struct DemServer::Impl {
     system->writeState(tmp.string(), proto::kProtocolVersion.toString());
     ServerLedgers l = ledgers;
     writeServerLedgers(tmp.string(), l, step, session);
+    if (staggered) {
+      writeStaggeredState(tmp.string(), lag);
+    }
     syncFile(tmp);
     fs::rename(tmp, final);
     log->info("session {}: checkpoint of step {} written to {}", session, step,

@@ -129,6 +129,24 @@ TEST(Preflight, RandomPackingTooDenseFailsAndDenseWarns) {
   EXPECT_TRUE(contains(w[0], "solid fraction 0.44")) << w[0];
 }
 
+TEST(Preflight, StaggeredSchemeChecksTheStepAgainstTheParticleResponseTime) {
+  // τ_p = ρ_p d_p²/(225 μ_g) with μ_g = 1.81e-5 Pa s (default gas_properties): 10 µm glass beads
+  // τ_p = 6.1e-5 s < Δt = 1e-4 s: refused; 20 µm beads τ_p = 2.5e-4 s, Δt/τ_p = 0.41: a warning;
+  // the 2 mm beads of the base case (τ_p = 2.5 s) pass; the sequential scheme is not checked.
+  const std::string staggered = std::string(kCase) + "coupling: {scheme: staggered}\n";
+  EXPECT_TRUE(checkCaseConsistency(parse(staggered)).empty());
+  const std::string e = failureOf(replace(staggered, "diameter: 2.0e-3", "diameter: 1.0e-5"));
+  EXPECT_TRUE(contains(e, "case.yaml:2:")) << e;
+  EXPECT_TRUE(contains(e, "time.dt:")) << e;
+  EXPECT_TRUE(contains(e, "τ_p = ρ_p d_p²/(225 μ_g) = 6.139e-05 s")) << e;
+  EXPECT_TRUE(contains(e, "coupling.scheme sequential")) << e;
+  const auto w =
+      checkCaseConsistency(parse(replace(staggered, "diameter: 2.0e-3", "diameter: 2.0e-5")));
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_TRUE(contains(w[0], "Δt_CFD/τ_p = 0.41 > 0.1")) << w[0];
+  EXPECT_EQ(failureOf(replace(kCase, "diameter: 2.0e-3", "diameter: 1.0e-5")), "");
+}
+
 TEST(Preflight, ExplicitOverlapBeyondTheFractionFails) {
   const std::string base = R"(name: explicit
 time: {end: 0.01, dt: 1.0e-4}

@@ -279,6 +279,15 @@ public:
   /// @pre dtCfd > 0, nSub >= 1, dtCfd/nSub <= dtDemMax()·(1 + 1e-12).
   const CellSources& advance(double dtCfd, int nSub);
 
+  /// The cell sources of the current state with the gas fields set last, without advancing:
+  /// one sub-step of `dtDem` is evaluated (window of one sub-step: the forces, heat and reaction
+  /// rates of the current configuration, ε_g of the current positions) and the particle state,
+  /// contact history and ledgers are put back as they were, so that the next advance() is
+  /// bitwise the one without this call. The staggered coupling scheme sends these as the sources
+  /// of its first step (docs/coupling-schemes.md).
+  /// @pre 0 < dtDem <= dtDemMax()·(1 + 1e-12).
+  const CellSources& evaluateSources(double dtDem);
+
   /// A flag read before every sub-step of advance() (e.g. set from a signal handler): once it
   /// is set, advance() stops within a sub-step and throws Interrupted. nullptr: none. The flag
   /// must outlive the system.

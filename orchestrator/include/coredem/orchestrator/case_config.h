@@ -95,6 +95,13 @@ struct CfdConfig {
   bool timers = false;        ///< cfd.timers: the participant's stage timers (RUN/timers-cfd.json)
 };
 
+/// coupling: how CFD and DEM steps follow each other (docs/coupling-schemes.md).
+struct CouplingConfig {
+  /// sequential: the CFD waits for the DEM's sources of the same step; staggered: the CFD advances
+  /// step n with the sources the DEM computed in step n-1 while the DEM computes step n.
+  std::string scheme = "sequential";
+  bool staggered() const { return scheme == "staggered"; }
+};
 struct CheckpointConfig {
   std::int64_t everySteps = 0; ///< 0 = off
   double everySeconds = 0.0;   ///< wall-clock seconds, 0 = off
@@ -166,6 +173,7 @@ struct CaseConfig {
   std::vector<std::pair<std::string, std::string>> models;
   DemConfig dem;
   CfdConfig cfd;
+  CouplingConfig coupling;
   CheckpointConfig checkpoint;
   OutputConfig output;
   bool hasGasSection = false;
