@@ -20,6 +20,8 @@ packages=(
   dpkg-dev bzip2 ca-certificates
   # the committed .clang-format is enforced by scripts/check-format.sh (CI)
   clang-format
+  # campaigns on Slurm: the e2e tests start their own single-node Slurm (tests/e2e/slurm)
+  slurm-wlm munge
 )
 if [[ "${1:-}" == "--with-peers" ]]; then
   packages+=(liggghts openmpi-bin)
