@@ -211,16 +211,17 @@ std::string submit(const fs::path& dir, CampaignDb& db, const std::vector<Member
     indices += (indices.empty() ? "" : ",") + std::to_string(m.index);
   }
   const int maxConcurrent = std::stoi(db.setting("slurm.max_concurrent", "1"));
-  std::vector<std::string> args{"sbatch",
-                                "--parsable",
-                                fmt::format("--array={}%{}", indices, maxConcurrent),
-                                "--job-name=coredem-" + db.setting("name"),
-                                "--output=" + (dir / "slurm" / "logs" / "%A_%a.out").string(),
-                                "--open-mode=append",
-                                "--chdir=" + dir.string(),
-                                "--requeue",
-                                "--signal=B:TERM@" + db.setting("slurm.stop_margin", "120"),
-                                "--ntasks=1"};
+  std::vector<std::string> args{
+      "sbatch", "--parsable", fmt::format("--array={}%{}", indices, maxConcurrent),
+      "--job-name=coredem-" + db.setting("name"),
+      "--output=" + (dir / "slurm" / "logs" / "%A_%a.out").string(), "--open-mode=append",
+      "--chdir=" + dir.string(), "--requeue",
+      // the last call: SIGTERM to member.sh's process half the stop margin before the limit,
+      // for when the member's own wall-time stop did not come first (Slurm sends it up to a
+      // minute early; its time limit may have been changed after the start)
+      fmt::format("--signal=B:TERM@{}",
+                  std::max(1, std::stoi(db.setting("slurm.stop_margin", "120")) / 2)),
+      "--ntasks=1"};
   auto opt = [&](const std::string& key, const std::string& flag) {
     const std::string v = db.setting(key);
     if (!v.empty() && v != "0") {
@@ -532,12 +533,21 @@ int slurmMemberMain(const fs::path& dir, int index) {
     after = finishMember(db, m->id, m->runDir, status, retries);
     return after == "done" ? kOk : kFault;
   }
+  // The scheduler's view of this task: still RUNNING after our own wall-time stop or the
+  // time-limit warning (sbatch --signal=B:TERM): requeue it. Anything else (COMPLETING after
+  // scancel, a hard time-limit kill or preemption) means the task is ending: the member stays
+  // pending and the submitting side (campaign run/resume) resubmits it; Slurm requeues a
+  // preempted task itself where PreemptMode=REQUEUE.
+  const std::string jobState = endedTaskState(task);
+  const bool ending = jobState.rfind("RUNNING", 0) != 0;
   if (stopped) {
     const std::string ckpt = newestCheckpointName(m->runDir);
     const std::string reason =
-        forwarded ? fmt::format("stopped by signal {} (time limit, preemption or scancel)",
-                                gSignal.load())
-                  : fmt::format("stopped {} s before its time limit", margin);
+        ending ? fmt::format("its Slurm task ended ({}: scancel, time limit or preemption)",
+                             jobState.empty() ? "state unknown" : jobState)
+        : forwarded
+            ? fmt::format("stopped by Slurm's time-limit warning (signal {})", gSignal.load())
+            : fmt::format("stopped {} s before its time limit", margin);
     db.transaction([&] {
       if (db.markInterrupted(m->id, reason)) {
         db.setLastCheckpoint(m->id, ckpt);
@@ -553,6 +563,10 @@ int slurmMemberMain(const fs::path& dir, int index) {
   }
   if (after != "pending") {
     return kFault;
+  }
+  if (ending) {
+    log->info("member {}: coredem campaign resume {} resubmits it", m->id, dir.string());
+    return kOk;
   }
   // continue in a new run of this task (Slurm starts it again after its requeue delay)
   const Captured rq = capture({"scontrol", "requeue", task});

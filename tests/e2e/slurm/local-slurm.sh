@@ -33,11 +33,17 @@ log_tail() { # file, title
 
 # PIDs of processes started for this cluster: the daemons and every job process (slurmstepd and
 # the jobs inherit SLURM_CONF=$conf from slurmd / sbatch).
+# This script and its callers (which may have SLURM_CONF set too) are left alone.
 cluster_pids() {
-  local p
+  local p a ancestors=" "
+  a=$$
+  while [[ -n "$a" && "$a" != "0" && "$a" != "1" ]]; do
+    ancestors+="$a "
+    a=$(awk '{print $4}' "/proc/$a/stat" 2>/dev/null)
+  done
   for p in /proc/[0-9]*; do
     p=${p#/proc/}
-    [[ "$p" == "$$" ]] && continue
+    [[ "$ancestors" == *" $p "* ]] && continue
     if { tr '\0' '\n' <"/proc/$p/environ"; } 2>/dev/null | grep -qxF "SLURM_CONF=$conf"; then
       echo "$p"
     fi
@@ -84,6 +90,13 @@ if [[ "$cmd" == "stop" ]]; then
 fi
 [[ "$cmd" == "start" ]] || { echo "local-slurm: unknown command $cmd" >&2; exit 2; }
 watch_pid=${3:-}
+
+# slurmstepd makes Unix sockets DIR/spool/<node>_<job>.<step> (at most 108 bytes)
+if [[ ${#dir} -gt 60 ]]; then
+  echo "local-slurm: $dir is too long for slurmstepd's socket names (spool/<node>_<job>.<step>" \
+    "must stay under 108 bytes); use a folder path of at most 60 characters" >&2
+  exit 2
+fi
 
 # --- can Slurm run here at all?
 if [[ $(id -u) -ne 0 ]]; then
