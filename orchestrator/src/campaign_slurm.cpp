@@ -11,6 +11,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -18,6 +19,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -182,6 +184,40 @@ std::optional<long> timeLeft(const std::string& job) {
   return parseSlurmTime(firstLine(c.out));
 }
 
+/// Starts the member's `coredem` in a process group of its own with stdout and stderr appended
+/// to `log`. It dies with this process (PR_SET_PDEATHSIG): where the task's processes are
+/// tracked by parent pid (proctrack/linuxproc), a killed `campaign member` must not leave a
+/// `coredem` behind that works on the run folder while the member is resubmitted.
+int spawnTied(const std::vector<std::string>& argv, const fs::path& log) {
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  COREDEM_CHECK(pid >= 0, "cannot start {}: {}", argv[0], std::strerror(errno));
+  if (pid == 0) {
+    ::setpgid(0, 0);
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) {
+      ::_exit(127);
+    }
+    const int in = ::open("/dev/null", O_RDONLY);
+    const int out = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    if (in < 0 || out < 0) {
+      ::_exit(127);
+    }
+    ::dup2(in, 0);
+    ::dup2(out, 1);
+    ::dup2(out, 2);
+    std::vector<char*> args;
+    for (const auto& a : argv) {
+      args.push_back(const_cast<char*>(a.c_str()));
+    }
+    args.push_back(nullptr);
+    ::execv(args[0], args.data());
+    std::fprintf(stderr, "cannot run %s: %s\n", args[0], std::strerror(errno));
+    ::_exit(127);
+  }
+  return pid;
+}
+
 fs::path memberScript(const fs::path& dir) {
   return dir / "slurm" / "member.sh";
 }
@@ -320,6 +356,12 @@ void checkSlurmCommands() {
                   "(Debian: apt-get install slurm-client; on a cluster: module load slurm)",
                   c);
   }
+  const Captured q = capture({"squeue", "-h", "--me", "-o", "%i"});
+  COREDEM_CHECK(q.rc == 0,
+                "executor slurm: Slurm does not answer here (squeue exit code {}: {}); run the "
+                "campaign on a machine of the cluster (a login node), with SLURM_CONF set where "
+                "slurm.conf is not in its default place",
+                q.rc, trim(q.err + q.out));
 }
 
 std::map<std::string, std::string> slurmQueue() {
@@ -479,7 +521,7 @@ int slurmMemberMain(const fs::path& dir, int index) {
   std::signal(SIGTERM, onCampaignSignal);
   int pid = -1;
   try {
-    pid = spawnProcess("campaign member " + m->id, args, logFile); // own process group
+    pid = spawnTied(args, logFile);
   } catch (const UserError& e) {
     const std::string reason = e.what();
     db.transaction([&] {

@@ -329,6 +329,48 @@ TEST_F(SlurmCampaignE2E, ScancelledMemberIsResubmittedByResumeAndCompletes) {
       << log;
 }
 
+TEST_F(SlurmCampaignE2E, MemberKilledWithItsTaskIsFoundLostAndResumed) {
+  // As when a node dies: the task's `campaign member` process is killed (SIGKILL) before it
+  // can record anything; Slurm then ends the task and its processes. The database still says
+  // running; campaign resume sees the task gone, puts the member back to pending and
+  // resubmits it, and it continues from its checkpoint.
+  const fs::path c = dir / "c";
+  ASSERT_EQ(runCoredem({"campaign", "run", (kCases / "cancel.yaml").string(), "--out", c.string(),
+                        "--no-wait"},
+                       dir / "log.txt"),
+            0)
+      << readAll(dir / "log.txt");
+  const Row running = waitRunningWithCheckpoint(c, "m000");
+  ASSERT_GT(running.pid, 0) << readAll(dir / "log.txt");
+  // the member's coredem was started by `coredem campaign member` (its parent)
+  const std::string stat = readAll("/proc/" + std::to_string(running.pid) + "/stat");
+  std::istringstream rest(stat.substr(stat.rfind(')') + 2));
+  char state = 0;
+  pid_t member = 0;
+  rest >> state >> member;
+  ASSERT_GT(member, 1);
+  ASSERT_NE(readAll("/proc/" + std::to_string(member) + "/cmdline").find("member"),
+            std::string::npos);
+  ::kill(member, SIGKILL);
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (std::chrono::steady_clock::now() < deadline) {
+    const auto [qrc, q] = shell("squeue -h -r -o %i", dir / "squeue.txt");
+    if (qrc == 0 && q.find(running.jobId + "\n") == std::string::npos) {
+      break;
+    }
+    std::this_thread::sleep_for(200ms);
+  }
+  EXPECT_EQ(readDb(c).at("m000").status, "running"); // nobody could record the end
+  ASSERT_EQ(runCoredem({"campaign", "resume", c.string()}, dir / "resume.txt", 120s), 0)
+      << readAll(dir / "resume.txt");
+  expectAllDoneOnce(c, 2, 2000);
+  const Row r = readDb(c).at("m000");
+  EXPECT_EQ(countEvents(r, "lost"), 1) << eventsOf(r);
+  EXPECT_EQ(countEvents(r, "submitted"), 2) << eventsOf(r);
+  EXPECT_EQ(r.failures, 0) << eventsOf(r);
+  EXPECT_NE(r.exitReason, "");
+}
+
 // --- input errors (no Slurm needed)
 
 TEST(SlurmCampaignInput, BadSlurmSectionsAreRefusedNamingTheKey) {
@@ -359,6 +401,32 @@ TEST(SlurmCampaignInput, BadSlurmSectionsAreRefusedNamingTheKey) {
     EXPECT_NE(log.find(sweep.string() + ":"), std::string::npos) << log; // file:line:col
     EXPECT_FALSE(fs::exists(out)) << cases[i].first;
   }
+  fs::remove_all(d);
+}
+
+TEST(SlurmCampaignInput, UnreachableSlurmIsNamedBeforeAnythingIsWritten) {
+  // sbatch and squeue on PATH, but no cluster: squeue's own error is shown
+  const fs::path d = coredem::e2e::tempDir("coredem-slurm", "no-cluster");
+  fs::create_directories(d / "bin");
+  for (const char* c : {"sbatch", "squeue", "scontrol", "scancel"}) {
+    coredem::e2e::writeAll(d / "bin" / c, "#!/bin/sh\necho 'slurm_load_jobs error: Unable to "
+                                          "contact slurm controller (connect failure)' >&2\n"
+                                          "exit 1\n");
+    fs::permissions(d / "bin" / c, fs::perms::owner_all);
+  }
+  coredem::SpawnOptions o;
+  o.ownProcessGroup = false;
+  o.env["PATH"] = (d / "bin").string();
+  const int pid =
+      coredem::spawnProcess("coredem",
+                            {(kBin / "coredem").string(), "campaign", "run",
+                             (kCases / "grid4.yaml").string(), "--out", (d / "c").string()},
+                            d / "log.txt", o);
+  EXPECT_EQ(waitExit(pid, 30s), 1);
+  const std::string log = readAll(d / "log.txt");
+  EXPECT_NE(log.find("Slurm does not answer here"), std::string::npos) << log;
+  EXPECT_NE(log.find("Unable to contact slurm controller"), std::string::npos) << log;
+  EXPECT_FALSE(fs::exists(d / "c"));
   fs::remove_all(d);
 }
 
