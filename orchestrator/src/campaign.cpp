@@ -617,7 +617,7 @@ int status(const fs::path& dir, bool json) {
     std::printf("executor slurm: one array task per member (job id_index); scheduler state from "
                 "squeue%s\n",
                 queue.empty() ? " (no task of this user in the queue)" : "");
-    std::printf("%-6s %-8s %8s %8s %-10s %-12s %-22s %-40s %s\n", "member", "status", "attempts",
+    std::printf("%-6s %-8s %8s %8s %-10s %-12s %-28s %-40s %s\n", "member", "status", "attempts",
                 "failures", "checkpoint", "job", "scheduler", "values", "exit reason");
   } else {
     std::printf("%-6s %-8s %8s %8s %-10s %-40s %s\n", "member", "status", "attempts", "failures",
@@ -626,7 +626,7 @@ int status(const fs::path& dir, bool json) {
   for (const auto& m : members) {
     ++counts[m.status];
     if (slurm) {
-      std::printf("%-6s %-8s %8d %8d %-10s %-12s %-22s %-40s %s\n", m.id.c_str(), m.status.c_str(),
+      std::printf("%-6s %-8s %8d %8d %-10s %-12s %-28s %-40s %s\n", m.id.c_str(), m.status.c_str(),
                   m.attempts, m.failures, m.lastCheckpoint.c_str(), m.jobId.c_str(),
                   schedOf(m).c_str(), valuesText(m).c_str(), m.exitReason.c_str());
       continue;

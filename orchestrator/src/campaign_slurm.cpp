@@ -30,6 +30,8 @@
 #include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/campaign_db.h>
 #include <coredem/orchestrator/checkpoint.h>
+#include <coredem/orchestrator/session.h>
+#include <coredem/orchestrator/time_handler.h>
 
 #include "campaign_impl.h"
 
@@ -216,6 +218,22 @@ int spawnTied(const std::vector<std::string>& argv, const fs::path& log) {
     ::_exit(127);
   }
   return pid;
+}
+
+/// True when the run folder's newest complete checkpoint is at the case's end time (a run
+/// always writes one at its last step). `coredem run --walltime` exits 0 also when it stopped
+/// early, so the exit code alone does not say that a member is done.
+bool runReachedEnd(const fs::path& runDir) {
+  try {
+    const ResumeChoice c = selectResumeCheckpoint(runDir);
+    if (!c.dir || !c.manifest) {
+      return false;
+    }
+    const double end = loadRunCase(runDir).endTime;
+    return c.manifest->time >= end || timeEquals(c.manifest->time, end);
+  } catch (const std::exception&) {
+    return false;
+  }
 }
 
 fs::path memberScript(const fs::path& dir) {
@@ -566,10 +584,12 @@ int slurmMemberMain(const fs::path& dir, int index) {
     std::this_thread::sleep_for(100ms);
   }
 
-  const bool ok = status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  const bool exitedOk = status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  const bool ok = exitedOk && runReachedEnd(m->runDir);
+  // exit 0 before the end: stopped by --walltime; 130: by the forwarded SIGTERM
   const bool stopped =
-      !ok &&
-      (forwarded || (status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == kInterrupted));
+      !ok && (forwarded || exitedOk ||
+              (status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == kInterrupted));
   std::string after;
   if (ok) {
     after = finishMember(db, m->id, m->runDir, status, retries);

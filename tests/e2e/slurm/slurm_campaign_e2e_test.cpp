@@ -290,6 +290,43 @@ TEST_F(SlurmCampaignE2E, MemberStoppedByTimeLimitCheckpointsRequeuesAndResumes) 
       << log;
 }
 
+TEST_F(SlurmCampaignE2E, MemberStoppedByItsWalltimeBeforeTheLimitRequeuesAndResumes) {
+  // The usual path: the member's own --walltime (time left - stop_margin, about 10 s here)
+  // stops it with a checkpoint and exit code 0 before Slurm has to signal anything; campaign
+  // member sees that the run did not reach its end, records it stopped (not done) and
+  // requeues the task. The test freezes the member's coredem for 8 s (less than the
+  // participants' 20 s timeout) to pass the wall time on any machine.
+  const fs::path c = dir / "c";
+  const pid_t campaign =
+      start({"campaign", "run", (kCases / "walltime.yaml").string(), "--out", c.string()},
+            dir / "log.txt");
+  const Row first = waitRunningWithCheckpoint(c, "m000");
+  ASSERT_GT(first.pid, 0) << readAll(dir / "log.txt");
+  ::kill(static_cast<pid_t>(first.pid), SIGSTOP);
+  std::this_thread::sleep_for(8s);
+  ::kill(static_cast<pid_t>(first.pid), SIGCONT);
+  ASSERT_EQ(waitExit(campaign, 150s), 0) << readAll(dir / "log.txt");
+  expectAllDoneOnce(c, 1, 2000);
+  const Row r = readDb(c).at("m000");
+  // each attempt runs about 5 s (the wall time less coredem's reserve), so a slow machine
+  // needs more than two; every stop is requeued
+  EXPECT_GE(r.attempts, 2) << eventsOf(r);
+  EXPECT_EQ(r.failures, 0) << eventsOf(r);
+  EXPECT_EQ(countEvents(r, "stopped"), r.attempts - 1) << eventsOf(r);
+  EXPECT_EQ(countEvents(r, "requeued"), r.attempts - 1) << eventsOf(r);
+  EXPECT_EQ(countEvents(r, "submitted"), 1) << eventsOf(r);
+  bool walltimeStop = false;
+  for (const auto& e : r.events) {
+    walltimeStop = walltimeStop || e.find("stopped: stopped 110 s before its time limit") == 0;
+  }
+  EXPECT_TRUE(walltimeStop) << eventsOf(r);
+  const std::string log = readAll(c / "members" / "m000" / "coredem.log");
+  EXPECT_NE(log.find("before the wall-time limit"), std::string::npos) << log;
+  EXPECT_NE(log.substr(log.find("=== campaign attempt 2")).find(": coredem resume"),
+            std::string::npos)
+      << log;
+}
+
 TEST_F(SlurmCampaignE2E, ScancelledMemberIsResubmittedByResumeAndCompletes) {
   const fs::path c = dir / "c";
   ASSERT_EQ(runCoredem({"campaign", "run", (kCases / "cancel.yaml").string(), "--out", c.string(),
