@@ -99,7 +99,23 @@ CampaignDb::CampaignDb(const std::filesystem::path& file, bool create)
     throw UserError(fmt::format("cannot open campaign database {}: {}", file.string(), msg));
   }
   sqlite3_busy_timeout(_impl->db, 10000);
-  _impl->exec("PRAGMA journal_mode=WAL");
+  // WAL needs shared memory between all its users, i.e. one machine: the local executor's
+  // campaigns use it; a Slurm campaign, written by tasks on many nodes over a shared file
+  // system, uses the rollback journal, which needs only working POSIX locks.
+  std::string journal = "WAL";
+  {
+    sqlite3_stmt* q = nullptr;
+    if (sqlite3_prepare_v2(_impl->db, "SELECT value FROM settings WHERE key = 'executor'", -1, &q,
+                           nullptr) == SQLITE_OK &&
+        sqlite3_step(q) == SQLITE_ROW) {
+      const auto* v = sqlite3_column_text(q, 0);
+      if (v && std::string(reinterpret_cast<const char*>(v)) == "slurm") {
+        journal = "DELETE";
+      }
+    }
+    sqlite3_finalize(q);
+  }
+  _impl->exec(("PRAGMA journal_mode=" + journal).c_str());
   _impl->exec("PRAGMA synchronous=FULL");
   _impl->exec("PRAGMA foreign_keys=ON");
   // databases of earlier versions lack the Slurm columns

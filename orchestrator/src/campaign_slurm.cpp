@@ -29,8 +29,8 @@
 #include <coredem/common/process.h>
 #include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/campaign_db.h>
+#include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/checkpoint.h>
-#include <coredem/orchestrator/session.h>
 #include <coredem/orchestrator/time_handler.h>
 
 #include "campaign_impl.h"
@@ -223,13 +223,13 @@ int spawnTied(const std::vector<std::string>& argv, const fs::path& log) {
 /// True when the run folder's newest complete checkpoint is at the case's end time (a run
 /// always writes one at its last step). `coredem run --walltime` exits 0 also when it stopped
 /// early, so the exit code alone does not say that a member is done.
-bool runReachedEnd(const fs::path& runDir) {
+bool runReachedEnd(const fs::path& runDir, const fs::path& caseDir) {
   try {
     const ResumeChoice c = selectResumeCheckpoint(runDir);
     if (!c.dir || !c.manifest) {
       return false;
     }
-    const double end = loadRunCase(runDir).endTime;
+    const double end = loadCase(caseDir).endTime; // the member case = the run's case
     return c.manifest->time >= end || timeEquals(c.manifest->time, end);
   } catch (const std::exception&) {
     return false;
@@ -585,7 +585,7 @@ int slurmMemberMain(const fs::path& dir, int index) {
   }
 
   const bool exitedOk = status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
-  const bool ok = exitedOk && runReachedEnd(m->runDir);
+  const bool ok = exitedOk && runReachedEnd(m->runDir, m->caseDir);
   // exit 0 before the end: stopped by --walltime; 130: by the forwarded SIGTERM
   const bool stopped =
       !ok && (forwarded || exitedOk ||
@@ -630,12 +630,14 @@ int slurmMemberMain(const fs::path& dir, int index) {
     log->info("member {}: coredem campaign resume {} resubmits it", m->id, dir.string());
     return kOk;
   }
-  // continue in a new run of this task (Slurm starts it again after its requeue delay)
+  // Continue in a new run of this task (Slurm starts it again after its requeue delay). The
+  // event comes first: the requeue ends this task, and Slurm may kill scontrol (and this
+  // process) before scontrol can report its success.
+  db.transaction([&] { db.addEvent(m->id, "requeued", "Slurm task " + task); });
+  log->info("member {}: requeuing Slurm task {}", m->id, task);
   const Captured rq = capture({"scontrol", "requeue", task});
-  if (rq.rc == 0) {
-    db.transaction([&] { db.addEvent(m->id, "requeued", "Slurm task " + task); });
-    log->info("member {}: Slurm task {} requeued", m->id, task);
-  } else {
+  if (rq.rc > 0) {
+    db.transaction([&] { db.addEvent(m->id, "requeue failed", trim(rq.err + rq.out)); });
     log->warn("member {}: cannot requeue Slurm task {} ({}); coredem campaign resume {} "
               "resubmits the member",
               m->id, task, trim(rq.err + rq.out), dir.string());
