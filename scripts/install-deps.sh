@@ -22,6 +22,8 @@ packages=(
   clang-format
   # ip netns / veth of the remote-DEM e2e test and bench/remote/link.sh
   iproute2
+  # campaigns on Slurm: the e2e tests start their own single-node Slurm (tests/e2e/slurm)
+  slurm-wlm munge
 )
 if [[ "${1:-}" == "--with-peers" ]]; then
   packages+=(liggghts openmpi-bin)

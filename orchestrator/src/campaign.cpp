@@ -30,14 +30,13 @@
 #include <coredem/orchestrator/checkpoint.h>
 #include <coredem/orchestrator/sha256.h>
 
+#include "campaign_impl.h"
+
 namespace coredem::orchestrator {
 
-namespace {
+namespace campaign_detail {
 
 namespace fs = std::filesystem;
-using namespace std::chrono_literals;
-
-constexpr int kOk = 0, kFault = 1, kBadInput = 2, kInterrupted = 130;
 
 std::atomic<int> gSignal{0};
 extern "C" void onCampaignSignal(int sig) {
@@ -57,25 +56,113 @@ fs::path selfDir() {
   return ec ? fs::current_path() : exe.parent_path();
 }
 
-/// Holds an exclusive flock on DIR/campaign.lock for the life of the process: two campaign
-/// processes never work on one folder. The kernel drops it when the process dies (kill -9).
-class FolderLock {
-public:
-  explicit FolderLock(const fs::path& dir) {
-    _fd = ::open((dir / "campaign.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-    COREDEM_CHECK(_fd >= 0, "cannot create {}/campaign.lock", dir.string());
-    COREDEM_CHECK(::flock(_fd, LOCK_EX | LOCK_NB) == 0,
-                  "another coredem campaign process is working on {} (wait for it, or stop it "
-                  "and run coredem campaign resume {})",
-                  dir.string(), dir.string());
-  }
-  ~FolderLock() { ::close(_fd); }
-  FolderLock(const FolderLock&) = delete;
-  FolderLock& operator=(const FolderLock&) = delete;
+// Held for the life of the process: two campaign processes never work on one folder. The
+// kernel drops it when the process dies (kill -9).
+FolderLock::FolderLock(const fs::path& dir) {
+  _fd = ::open((dir / "campaign.lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  COREDEM_CHECK(_fd >= 0, "cannot create {}/campaign.lock", dir.string());
+  COREDEM_CHECK(::flock(_fd, LOCK_EX | LOCK_NB) == 0,
+                "another coredem campaign process is working on {} (wait for it, or stop it "
+                "and run coredem campaign resume {})",
+                dir.string(), dir.string());
+}
+FolderLock::~FolderLock() {
+  ::close(_fd);
+}
 
-private:
-  int _fd = -1;
-};
+std::string newestCheckpointName(const fs::path& runDir) {
+  std::string best;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(runDir / "checkpoints", ec)) {
+    if (fs::exists(e.path() / "manifest.json") && e.path().filename().string() > best) {
+      best = e.path().filename().string();
+    }
+  }
+  return best;
+}
+
+std::string lastErrorLine(const fs::path& log) {
+  const std::string text = readFile(log);
+  const auto start = text.rfind("=== campaign attempt");
+  std::istringstream in(start == std::string::npos ? text : text.substr(start));
+  std::string line, err;
+  while (std::getline(in, line)) {
+    if (line.find("[error]") != std::string::npos) {
+      err = line;
+    }
+  }
+  const auto tag = err.find("[error] ");
+  return tag == std::string::npos ? err : err.substr(tag + 8);
+}
+
+std::vector<std::string> memberCommand(const MemberRecord& m, std::string& how) {
+  const fs::path runDir = m.runDir;
+  std::vector<std::string> args{(selfDir() / "coredem").string()};
+  if (selectResumeCheckpoint(runDir).dir) {
+    args.insert(args.end(), {"resume", runDir.string(), "--no-plots"});
+    how = "resume";
+  } else {
+    std::error_code ec;
+    fs::remove_all(runDir, ec);
+    args.insert(args.end(), {"run", m.caseDir, "--out", runDir.string(), "--no-plots"});
+    how = "run";
+  }
+  return args;
+}
+
+std::string finishMember(CampaignDb& db, const std::string& id, const std::string& runDir,
+                         int status, int retries) {
+  auto log = logger("campaign");
+  const auto m = db.member(id);
+  const bool ok = status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  if (ok) {
+    const ResumeChoice c = selectResumeCheckpoint(runDir);
+    std::string ckpt, sw, proto;
+    if (c.dir && c.manifest) {
+      ckpt = c.dir->filename().string();
+      sw = c.manifest->softwareVersion;
+      proto = c.manifest->protocolVersion;
+      if (m && c.manifest->configHash != m->caseHash) {
+        log->warn("member {}: config hash {} of the run differs from the campaign's {}", id,
+                  c.manifest->configHash, m->caseHash);
+      }
+    }
+    db.transaction([&] {
+      if (db.markDone(id, ckpt, sw, proto)) {
+        db.addEvent(id, "done", ckpt);
+      }
+    });
+    log->info("member {}: done", id);
+    return "done";
+  }
+  std::string reason = status < 0 ? "lost track of the process" : describeWaitStatus(status);
+  const std::string err =
+      lastErrorLine(fs::path(m ? m->caseDir : "").parent_path() / "coredem.log");
+  if (!err.empty()) {
+    reason += ": " + err;
+  }
+  bool final = false;
+  db.transaction([&] {
+    db.markFailed(id, reason, retries);
+    const auto after = db.member(id);
+    final = after && after->status == "failed";
+    db.addEvent(id, final ? "failed" : "retry", reason);
+  });
+  if (final) {
+    log->error("member {} failed for good ({} attempts): {}", id, m ? m->failures + 1 : 0, reason);
+  } else {
+    log->warn("member {} failed ({}); it will be retried", id, reason);
+  }
+  return final ? "failed" : "pending";
+}
+
+} // namespace campaign_detail
+
+namespace {
+
+using namespace campaign_detail;
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
 
 /// True when `pid` is a live (not zombie) process whose command line mentions `runDir`.
 bool memberProcessAlive(std::int64_t pid, const std::string& runDir) {
@@ -111,33 +198,6 @@ std::int64_t findMemberProcess(const std::string& runDir) {
     }
   }
   return 0;
-}
-
-/// Newest checkpoint folder with a manifest (no hash check; for the status display).
-std::string newestCheckpointName(const fs::path& runDir) {
-  std::string best;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator(runDir / "checkpoints", ec)) {
-    if (fs::exists(e.path() / "manifest.json") && e.path().filename().string() > best) {
-      best = e.path().filename().string();
-    }
-  }
-  return best;
-}
-
-/// The last "[error]" line of the member log after the latest attempt marker.
-std::string lastErrorLine(const fs::path& log) {
-  const std::string text = readFile(log);
-  const auto start = text.rfind("=== campaign attempt");
-  std::istringstream in(start == std::string::npos ? text : text.substr(start));
-  std::string line, err;
-  while (std::getline(in, line)) {
-    if (line.find("[error]") != std::string::npos) {
-      err = line;
-    }
-  }
-  const auto tag = err.find("[error] ");
-  return tag == std::string::npos ? err : err.substr(tag + 8);
 }
 
 std::string csvField(const std::string& v) {
@@ -180,7 +240,6 @@ public:
       , _log(logger("campaign")) {
     _concurrency = std::stoi(_db.setting("concurrency", "1"));
     _retries = std::stoi(_db.setting("retries", "0"));
-    _coredem = selfDir() / "coredem";
   }
 
   /// Runs until every member is done or failed (or a signal arrives). Returns the exit code.
@@ -271,17 +330,8 @@ private:
 
   void start(const MemberRecord& m) {
     const fs::path runDir = m.runDir;
-    std::vector<std::string> args{_coredem.string()};
     std::string how;
-    if (selectResumeCheckpoint(runDir).dir) {
-      args.insert(args.end(), {"resume", runDir.string(), "--no-plots"});
-      how = "resume";
-    } else {
-      std::error_code ec;
-      fs::remove_all(runDir, ec);
-      args.insert(args.end(), {"run", m.caseDir, "--out", runDir.string(), "--no-plots"});
-      how = "run";
-    }
+    const std::vector<std::string> args = memberCommand(m, how);
     bool claimed = false;
     _db.transaction([&] {
       claimed = _db.markRunning(m.id, "pending");
@@ -345,47 +395,7 @@ private:
   }
 
   void finish(const std::string& id, const Running& r, int status) {
-    const auto m = _db.member(id);
-    const bool ok = status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
-    if (ok) {
-      const ResumeChoice c = selectResumeCheckpoint(r.runDir);
-      std::string ckpt, sw, proto;
-      if (c.dir && c.manifest) {
-        ckpt = c.dir->filename().string();
-        sw = c.manifest->softwareVersion;
-        proto = c.manifest->protocolVersion;
-        if (m && c.manifest->configHash != m->caseHash) {
-          _log->warn("member {}: config hash {} of the run differs from the campaign's {}", id,
-                     c.manifest->configHash, m->caseHash);
-        }
-      }
-      _db.transaction([&] {
-        if (_db.markDone(id, ckpt, sw, proto)) {
-          _db.addEvent(id, "done", ckpt);
-        }
-      });
-      _log->info("member {}: done", id);
-      return;
-    }
-    std::string reason = status < 0 ? "lost track of the process" : describeWaitStatus(status);
-    const std::string err =
-        lastErrorLine(fs::path(m ? m->caseDir : "").parent_path() / "coredem.log");
-    if (!err.empty()) {
-      reason += ": " + err;
-    }
-    bool final = false;
-    _db.transaction([&] {
-      _db.markFailed(id, reason, _retries);
-      const auto after = _db.member(id);
-      final = after && after->status == "failed";
-      _db.addEvent(id, final ? "failed" : "retry", reason);
-    });
-    if (final) {
-      _log->error("member {} failed for good ({} attempts): {}", id, m ? m->failures + 1 : 0,
-                  reason);
-    } else {
-      _log->warn("member {} failed ({}); it will be retried", id, reason);
-    }
+    finishMember(_db, id, r.runDir.string(), status, _retries);
   }
 
   /// SIGINT/SIGTERM: stop our members (they stop at a step and stay resumable), record them
@@ -427,7 +437,6 @@ private:
   std::shared_ptr<spdlog::logger> _log;
   int _concurrency = 1;
   int _retries = 0;
-  fs::path _coredem;
   std::map<std::string, Running> _running;
 };
 
@@ -457,6 +466,19 @@ void createCampaign(const Sweep& sw, const fs::path& dir) {
       db.setSetting("executor", sw.executor);
       db.setSetting("concurrency", std::to_string(sw.concurrency));
       db.setSetting("retries", std::to_string(sw.retries));
+      if (sw.executor == "slurm") {
+        const SlurmOptions& o = sw.slurm;
+        db.setSetting("slurm.partition", o.partition);
+        db.setSetting("slurm.time", o.time);
+        db.setSetting("slurm.time_seconds", std::to_string(o.timeSeconds));
+        db.setSetting("slurm.cpus_per_task", std::to_string(o.cpusPerTask));
+        db.setSetting("slurm.gres", o.gres);
+        db.setSetting("slurm.mem", o.mem);
+        db.setSetting("slurm.max_concurrent",
+                      std::to_string(o.maxConcurrent > 0 ? o.maxConcurrent : sw.concurrency));
+        db.setSetting("slurm.stop_margin", std::to_string(o.stopMargin));
+        db.setSetting("slurm.extra", fmt::format("{}", fmt::join(o.extra, "\n")));
+      }
       db.setSetting("software_version", kVersion);
       db.setSetting("created", utcNow());
       std::string scalars;
@@ -508,7 +530,7 @@ void createCampaign(const Sweep& sw, const fs::path& dir) {
   }
 }
 
-int runCampaign(const fs::path& dir, bool retryFailed) {
+int runCampaign(const fs::path& dir, bool retryFailed, bool wait) {
   FolderLock lock(dir);
   CampaignDb db(dir / "campaign.db", false);
   if (retryFailed) {
@@ -524,6 +546,10 @@ int runCampaign(const fs::path& dir, bool retryFailed) {
   }
   std::signal(SIGINT, onCampaignSignal);
   std::signal(SIGTERM, onCampaignSignal);
+  if (db.setting("executor", "local") == "slurm") {
+    checkSlurmCommands();
+    return runSlurmCampaign(dir, db, wait);
+  }
   Runner runner(dir, db);
   return runner.run();
 }
@@ -539,9 +565,22 @@ std::string valuesText(const MemberRecord& m) {
 int status(const fs::path& dir, bool json) {
   CampaignDb db(dir / "campaign.db", false);
   const auto members = db.members();
+  const bool slurm = db.setting("executor", "local") == "slurm";
+  // the scheduler's view of every member's task (squeue; empty where it cannot be asked)
+  const std::map<std::string, std::string> queue =
+      slurm ? slurmQueue() : std::map<std::string, std::string>{};
+  auto schedOf = [&](const MemberRecord& m) -> std::string {
+    if (!slurm || m.jobId.empty()) {
+      return "";
+    }
+    const auto it = queue.find(m.jobId);
+    // a running member whose task squeue no longer lists is lost (resume resubmits it)
+    return it != queue.end() ? it->second : (m.status == "running" ? "gone" : "-");
+  };
   if (json) {
     std::ostringstream o;
     o << "{\"campaign\": " << jsonString(db.setting("name"))
+      << ", \"executor\": " << jsonString(db.setting("executor", "local"))
       << ", \"dir\": " << jsonString(dir.string())
       << ", \"concurrency\": " << db.setting("concurrency")
       << ", \"retries\": " << db.setting("retries") << ", \"members\": [";
@@ -550,7 +589,9 @@ int status(const fs::path& dir, bool json) {
       o << (i ? ", " : "") << "{\"id\": " << jsonString(m.id)
         << ", \"status\": " << jsonString(m.status) << ", \"attempts\": " << m.attempts
         << ", \"failures\": " << m.failures << ", \"done_count\": " << m.doneCount
-        << ", \"pid\": " << m.pid << ", \"started\": " << jsonString(m.started)
+        << ", \"pid\": " << m.pid << ", \"job_id\": " << jsonString(m.jobId)
+        << ", \"scheduler_state\": " << jsonString(schedOf(m))
+        << ", \"started\": " << jsonString(m.started)
         << ", \"finished\": " << jsonString(m.finished)
         << ", \"last_checkpoint\": " << jsonString(m.lastCheckpoint)
         << ", \"exit_reason\": " << jsonString(m.exitReason)
@@ -572,10 +613,24 @@ int status(const fs::path& dir, bool json) {
   std::printf("campaign %s (%s): concurrency %s, retries %s\n", db.setting("name").c_str(),
               dir.string().c_str(), db.setting("concurrency").c_str(),
               db.setting("retries").c_str());
-  std::printf("%-6s %-8s %8s %8s %-10s %-40s %s\n", "member", "status", "attempts", "failures",
-              "checkpoint", "values", "exit reason");
+  if (slurm) {
+    std::printf("executor slurm: one array task per member (job id_index); scheduler state from "
+                "squeue%s\n",
+                queue.empty() ? " (no task of this user in the queue)" : "");
+    std::printf("%-6s %-8s %8s %8s %-10s %-12s %-28s %-40s %s\n", "member", "status", "attempts",
+                "failures", "checkpoint", "job", "scheduler", "values", "exit reason");
+  } else {
+    std::printf("%-6s %-8s %8s %8s %-10s %-40s %s\n", "member", "status", "attempts", "failures",
+                "checkpoint", "values", "exit reason");
+  }
   for (const auto& m : members) {
     ++counts[m.status];
+    if (slurm) {
+      std::printf("%-6s %-8s %8d %8d %-10s %-12s %-28s %-40s %s\n", m.id.c_str(), m.status.c_str(),
+                  m.attempts, m.failures, m.lastCheckpoint.c_str(), m.jobId.c_str(),
+                  schedOf(m).c_str(), valuesText(m).c_str(), m.exitReason.c_str());
+      continue;
+    }
     std::printf("%-6s %-8s %8d %8d %-10s %-40s %s\n", m.id.c_str(), m.status.c_str(), m.attempts,
                 m.failures, m.lastCheckpoint.c_str(), valuesText(m).c_str(), m.exitReason.c_str());
   }
@@ -762,20 +817,30 @@ int campaignMain(int argc, char** argv) {
                "(docs/campaigns.md)"};
   app.require_subcommand(1);
   std::string sweep, out, dir;
-  bool json = false, retryFailed = false, noPlot = false;
+  bool json = false, retryFailed = false, noPlot = false, noWait = false;
+  int index = -1;
   auto* run = app.add_subcommand("run", "create a campaign from SWEEP.yaml in DIR and run it");
   run->add_option("SWEEP", sweep, "sweep file")->required();
   run->add_option("--out", out, "campaign folder (must not hold a campaign)")->required();
+  run->add_flag("--no-wait", noWait,
+                "executor slurm: submit and return (follow with status, continue with resume)");
   auto* resume = app.add_subcommand("resume", "continue a campaign after any crash");
   resume->add_option("DIR", dir, "campaign folder")->required();
   resume->add_flag("--retry-failed", retryFailed,
                    "give members that failed for good another round of attempts");
+  resume->add_flag("--no-wait", noWait, "executor slurm: (re)submit and return");
   auto* st = app.add_subcommand("status", "print the members' state");
   st->add_option("DIR", dir, "campaign folder")->required();
   st->add_flag("--json", json, "as JSON");
   auto* col = app.add_subcommand("collect", "write DIR/summary.csv and DIR/plots/campaign.png");
   col->add_option("DIR", dir, "campaign folder")->required();
   col->add_flag("--no-plot", noPlot, "summary.csv only");
+  auto* mem = app.add_subcommand(
+      "member", "run one member inside its Slurm array task (called by DIR/slurm/member.sh)");
+  mem->add_option("DIR", dir, "campaign folder")->required();
+  mem->add_option("--index", index, "member index (the array task id)")
+      ->required()
+      ->check(CLI::NonNegativeNumber);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -785,13 +850,19 @@ int campaignMain(int argc, char** argv) {
   try {
     if (*run) {
       const Sweep sw = loadSweep(sweep); // throws CaseError: nothing written
+      if (sw.executor == "slurm") {
+        checkSlurmCommands(); // before anything is written
+      }
       const fs::path d = fs::absolute(out);
       createCampaign(sw, d);
       log->info("campaign {}: {} members in {}", sw.name, sw.members.size(), d.string());
-      return runCampaign(d, false);
+      return runCampaign(d, false, !noWait);
     }
     if (*resume) {
-      return runCampaign(fs::absolute(dir), retryFailed);
+      return runCampaign(fs::absolute(dir), retryFailed, !noWait);
+    }
+    if (*mem) {
+      return slurmMemberMain(fs::absolute(dir), index);
     }
     if (*st) {
       return status(fs::absolute(dir), json);

@@ -58,7 +58,7 @@ private:
 constexpr const char* kMemberColumns =
     "id, idx, case_dir, run_dir, case_hash, status, attempts, failures, done_count, pid, "
     "created, started, finished, last_checkpoint, exit_reason, software_version, "
-    "protocol_version";
+    "protocol_version, job_id, sched_state";
 
 } // namespace
 
@@ -99,9 +99,37 @@ CampaignDb::CampaignDb(const std::filesystem::path& file, bool create)
     throw UserError(fmt::format("cannot open campaign database {}: {}", file.string(), msg));
   }
   sqlite3_busy_timeout(_impl->db, 10000);
-  _impl->exec("PRAGMA journal_mode=WAL");
+  // WAL needs shared memory between all its users, i.e. one machine: the local executor's
+  // campaigns use it; a Slurm campaign, written by tasks on many nodes over a shared file
+  // system, uses the rollback journal, which needs only working POSIX locks.
+  std::string journal = "WAL";
+  {
+    sqlite3_stmt* q = nullptr;
+    if (sqlite3_prepare_v2(_impl->db, "SELECT value FROM settings WHERE key = 'executor'", -1, &q,
+                           nullptr) == SQLITE_OK &&
+        sqlite3_step(q) == SQLITE_ROW) {
+      const auto* v = sqlite3_column_text(q, 0);
+      if (v && std::string(reinterpret_cast<const char*>(v)) == "slurm") {
+        journal = "DELETE";
+      }
+    }
+    sqlite3_finalize(q);
+  }
+  _impl->exec(("PRAGMA journal_mode=" + journal).c_str());
   _impl->exec("PRAGMA synchronous=FULL");
   _impl->exec("PRAGMA foreign_keys=ON");
+  // databases of earlier versions lack the Slurm columns
+  sqlite3_stmt* probe = nullptr;
+  const bool hasMembers = sqlite3_prepare_v2(_impl->db, "SELECT idx FROM members LIMIT 0", -1,
+                                             &probe, nullptr) == SQLITE_OK;
+  sqlite3_finalize(probe);
+  probe = nullptr;
+  if (hasMembers && sqlite3_prepare_v2(_impl->db, "SELECT job_id FROM members LIMIT 0", -1, &probe,
+                                       nullptr) != SQLITE_OK) {
+    _impl->exec("ALTER TABLE members ADD COLUMN job_id TEXT");
+    _impl->exec("ALTER TABLE members ADD COLUMN sched_state TEXT");
+  }
+  sqlite3_finalize(probe);
 }
 
 CampaignDb::~CampaignDb() {
@@ -121,7 +149,7 @@ CREATE TABLE IF NOT EXISTS members(
   done_count INTEGER NOT NULL DEFAULT 0 CHECK(done_count <= 1),
   pid INTEGER NOT NULL DEFAULT 0,
   created TEXT NOT NULL, started TEXT, finished TEXT, last_checkpoint TEXT, exit_reason TEXT,
-  software_version TEXT, protocol_version TEXT);
+  software_version TEXT, protocol_version TEXT, job_id TEXT, sched_state TEXT);
 CREATE TABLE IF NOT EXISTS member_values(
   member TEXT NOT NULL REFERENCES members(id), pos INTEGER NOT NULL, path TEXT NOT NULL,
   value TEXT NOT NULL, PRIMARY KEY(member, pos));
@@ -177,6 +205,8 @@ std::vector<MemberRecord> CampaignDb::members() const {
     m.exitReason = s.text(14);
     m.softwareVersion = s.text(15);
     m.protocolVersion = s.text(16);
+    m.jobId = s.text(17);
+    m.schedState = s.text(18);
     out.push_back(std::move(m));
   }
   std::map<std::string, std::size_t> index;
@@ -228,6 +258,23 @@ bool CampaignDb::markRunning(const std::string& id, const std::string& fromStatu
 void CampaignDb::setPid(const std::string& id, std::int64_t pid) {
   _impl->update("UPDATE members SET pid = ?2 WHERE id = ?1 AND status = 'running'",
                 {id, std::to_string(pid)});
+}
+
+void CampaignDb::setJob(const std::string& id, const std::string& jobId,
+                        const std::string& fromStatus) {
+  _impl->update("UPDATE members SET job_id = ?2 WHERE id = ?1 AND status = ?3",
+                {id, jobId, fromStatus});
+}
+
+void CampaignDb::setSchedState(const std::string& id, const std::string& state) {
+  _impl->update("UPDATE members SET sched_state = ?2 WHERE id = ?1", {id, state});
+}
+
+bool CampaignDb::markLost(const std::string& id, const std::string& jobId,
+                          const std::string& reason) {
+  return _impl->update("UPDATE members SET status = 'pending', pid = 0, finished = ?3, "
+                       "exit_reason = ?4 WHERE id = ?1 AND status = 'running' AND job_id = ?2",
+                       {id, jobId, utcNow(), reason});
 }
 
 bool CampaignDb::markDone(const std::string& id, const std::string& lastCheckpoint,

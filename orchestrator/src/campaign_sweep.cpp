@@ -6,6 +6,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <coredem/common/yaml_section.h>
 #include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/case_config.h>
 
@@ -87,12 +88,98 @@ struct SweepReader {
   }
 };
 
-const std::set<std::string> kTopKeys = {"name",     "description", "base_case",
-                                        "executor", "concurrency", "retries",
-                                        "grid",     "members",     "collect"};
+const std::set<std::string> kTopKeys = {"name",        "description", "base_case", "executor",
+                                        "concurrency", "retries",     "grid",      "members",
+                                        "collect",     "slurm"};
 const std::set<std::string> kReduces = {"final", "max", "min", "mean"};
 
+/// The `slurm:` section (optional: without it every sbatch default applies).
+SlurmOptions parseSlurmSection(const YAML::Node& root, const std::string& file) {
+  SlurmOptions o;
+  if (!root["slurm"]) {
+    return o;
+  }
+  const yaml::Section s(root["slurm"], file, "slurm",
+                        {"partition", "time", "cpus_per_task", "gres", "mem", "max_concurrent",
+                         "stop_margin", "extra"},
+                        root.Mark());
+  o.partition = s.string("partition", "", "the Slurm partition (sbatch --partition)");
+  o.time = s.string("time", "",
+                    "time limit per member task, as sbatch --time: \"30\" minutes, \"2:00:00\", "
+                    "\"1-00:00:00\"");
+  if (!o.time.empty()) {
+    const auto t = parseSlurmTime(o.time);
+    if (!t || *t <= 0) {
+      s.fail(s.markOf("time"), "slurm.time",
+             fmt::format("'{}' is not a Slurm time limit; write minutes (\"30\"), "
+                         "minutes:seconds, hours:minutes:seconds or days-hours[:minutes[:seconds]]",
+                         o.time));
+    }
+    o.timeSeconds = *t;
+  }
+  o.cpusPerTask = static_cast<int>(
+      s.integer("cpus_per_task", 0, 1, 100000, "CPUs per member, sbatch --cpus-per-task"));
+  o.gres = s.string("gres", "", "generic resources per member, e.g. gpu:1 (sbatch --gres)");
+  o.mem = s.string("mem", "", "memory per member, e.g. 4G (sbatch --mem)");
+  o.maxConcurrent = static_cast<int>(s.integer(
+      "max_concurrent", 0, 1, 100000, "array tasks running at once; default: concurrency"));
+  const long defMargin = o.timeSeconds > 0 ? std::min<long>(120, o.timeSeconds / 4) : 120;
+  o.stopMargin = static_cast<int>(
+      s.integer("stop_margin", defMargin, 1, 65535,
+                "seconds before the time limit at which a member writes a checkpoint and stops"));
+  if (o.timeSeconds > 0 && o.stopMargin >= o.timeSeconds) {
+    s.fail(s.markOf("stop_margin"), "slurm.stop_margin",
+           fmt::format("{} s is not less than the time limit ({} = {} s)", o.stopMargin, o.time,
+                       o.timeSeconds));
+  }
+  if (s.has("extra")) {
+    const YAML::Node e = s.raw("extra");
+    if (!e.IsSequence()) {
+      s.fail(e.Mark(), "slurm.extra",
+             fmt::format("expected a list of sbatch arguments, e.g. [--account=proj, "
+                         "--qos=normal], got {}",
+                         yaml::describe(e)));
+    }
+    for (const auto& a : e) {
+      if (!a.IsScalar() || a.Scalar().empty()) {
+        s.fail(a.Mark(), "slurm.extra", "each entry is one sbatch argument (a string)");
+      }
+      const std::string v = a.Scalar();
+      for (const char* own : {"--array", "--output", "--error", "--job-name", "--parsable",
+                              "--signal", "--wrap", "--chdir"}) {
+        if (v.rfind(own, 0) == 0) {
+          s.fail(a.Mark(), "slurm.extra",
+                 fmt::format("'{}': {} is set by coredem campaign itself", v, own));
+        }
+      }
+      o.extra.push_back(v);
+    }
+  }
+  return o;
+}
+
 } // namespace
+
+std::optional<long> parseSlurmTime(const std::string& text) {
+  static const std::regex plain(R"(([0-9]+)(:([0-9]+))?(:([0-9]+))?)");
+  static const std::regex days(R"(([0-9]+)-([0-9]+)(:([0-9]+))?(:([0-9]+))?)");
+  std::smatch m;
+  auto num = [&](int i) { return m[i].matched ? std::stol(m[i].str()) : 0L; };
+  try {
+    if (std::regex_match(text, m, days)) {
+      return num(1) * 86400 + num(2) * 3600 + num(4) * 60 + num(6);
+    }
+    if (std::regex_match(text, m, plain)) {
+      if (m[5].matched) { // h:m:s
+        return num(1) * 3600 + num(3) * 60 + num(5);
+      }
+      return num(1) * 60 + num(3); // minutes[:seconds]
+    }
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  return std::nullopt;
+}
 
 std::string setCaseKey(const std::string& caseText, const std::string& path,
                        const std::string& valueYaml) {
@@ -173,7 +260,7 @@ Sweep loadSweep(const fs::path& sweepFile) {
     if (!kTopKeys.count(k)) {
       r.fail(kv.first, k,
              "unknown key; allowed keys: name, description, base_case, executor, concurrency, "
-             "retries, grid, members, collect");
+             "retries, grid, members, collect, slurm");
     }
   }
   // base case
@@ -200,21 +287,22 @@ Sweep loadSweep(const fs::path& sweepFile) {
   }
   if (root["executor"]) {
     sw.executor = root["executor"].as<std::string>();
-    if (sw.executor == "slurm") {
+    if (sw.executor != "local" && sw.executor != "slurm") {
       r.fail(root["executor"], "executor",
-             "'slurm' is not implemented yet (docs/campaigns.md says how it would work); use "
-             "'local'");
+             fmt::format("unknown executor '{}'; allowed: local, slurm", sw.executor));
     }
-    if (sw.executor != "local") {
-      r.fail(root["executor"], "executor",
-             fmt::format("unknown executor '{}'; allowed: local", sw.executor));
-    }
+  }
+  if (root["slurm"] && sw.executor != "slurm") {
+    r.fail(root["slurm"], "slurm", "a slurm section needs 'executor: slurm'");
   }
   if (root["concurrency"]) {
     sw.concurrency = r.integer(root["concurrency"], "concurrency", 1, "members run at once");
   }
   if (root["retries"]) {
     sw.retries = r.integer(root["retries"], "retries", 0, "failed attempts retried per member");
+  }
+  if (sw.executor == "slurm") {
+    sw.slurm = parseSlurmSection(root, r.file);
   }
 
   // parameters: grid (cartesian product, first key varies slowest) or explicit members

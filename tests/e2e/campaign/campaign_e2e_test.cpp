@@ -468,7 +468,8 @@ TEST(CampaignE2E, MalformedSweepIsRefusedNamingTheKey) {
       {"base_case: tiny\ngrid: {gas.T_g: []}\n", "grid.gas.T_g: expected a non-empty list"},
       {"base_case: tiny\ngrids: {gas.T_g: [1]}\n", "grids: unknown key"},
       {"base_case: nowhere\ngrid: {gas.T_g: [1]}\n", "base_case: no case.yaml"},
-      {"base_case: tiny\ngrid: {gas.T_g: [1]}\nexecutor: slurm\n", "executor: 'slurm'"},
+      {"base_case: tiny\ngrid: {gas.T_g: [1]}\nexecutor: pbs\n",
+       "executor: unknown executor 'pbs'; allowed: local, slurm"},
       {"base_case: tiny\ngrid: {gas.T_g: [1]}\ncollect: {scalars: [median:mean_T_p]}\n",
        "collect.scalars"},
   };

@@ -144,3 +144,28 @@ TEST(CampaignDbTest, TransitionsAreCountedExactly) {
   EXPECT_EQ(db.doneEvents("m000"), 1);
   fs::remove_all(d);
 }
+
+TEST(CampaignSlurm, TimeLimitsParseAsSbatchReadsThem) {
+  EXPECT_EQ(parseSlurmTime("30"), 30 * 60);             // minutes
+  EXPECT_EQ(parseSlurmTime("1:30"), 90);                // minutes:seconds
+  EXPECT_EQ(parseSlurmTime("2:00:00"), 7200);           // hours:minutes:seconds
+  EXPECT_EQ(parseSlurmTime("1-00:00:00"), 86400);       // days-hours:minutes:seconds
+  EXPECT_EQ(parseSlurmTime("1-2"), 86400 + 2 * 3600);   // days-hours
+  EXPECT_EQ(parseSlurmTime("1-2:30"), 93600 + 30 * 60); // days-hours:minutes
+  EXPECT_FALSE(parseSlurmTime("abc"));
+  EXPECT_FALSE(parseSlurmTime("1:2:3:4"));
+  EXPECT_FALSE(parseSlurmTime(""));
+}
+
+TEST(CampaignSlurm, ShippedSlurmSweepLoads) {
+  const Sweep sw = loadSweep(fs::path(COREDEM_CAMPAIGN_CASES) /
+                             "../../../../cases/campaign-demo/sweep-slurm.yaml");
+  EXPECT_EQ(sw.executor, "slurm");
+  EXPECT_EQ(sw.members.size(), 6u);
+  EXPECT_EQ(sw.slurm.time, "10");
+  EXPECT_EQ(sw.slurm.timeSeconds, 600);
+  EXPECT_EQ(sw.slurm.cpusPerTask, 1);
+  EXPECT_EQ(sw.slurm.stopMargin, 60);
+  EXPECT_EQ(sw.slurm.maxConcurrent, 0); // the sweep's concurrency applies
+  EXPECT_TRUE(sw.slurm.extra.empty());
+}

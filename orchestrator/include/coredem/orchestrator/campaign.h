@@ -5,6 +5,7 @@
 /// SQLite (campaign_db.h) so that `coredem campaign resume` continues after any crash.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,13 +26,28 @@ struct SweepMember {
   std::vector<std::pair<std::string, std::string>> values; ///< key path -> YAML value text
 };
 
+/// The `slurm:` section of a sweep file (executor: slurm): what every member's array task
+/// asks the scheduler for. Empty strings and zeros are not passed to sbatch.
+struct SlurmOptions {
+  std::string partition;
+  std::string time;      ///< Slurm time limit per task ("30", "2:00:00", "1-00:00:00")
+  long timeSeconds = 0;  ///< the same in seconds (0: none given)
+  int cpusPerTask = 0;   ///< --cpus-per-task
+  std::string gres;      ///< --gres, e.g. gpu:1
+  std::string mem;       ///< --mem, e.g. 4G
+  int maxConcurrent = 0; ///< array tasks at once (%N); 0: the sweep's concurrency
+  int stopMargin = 0;    ///< s before the time limit at which a member checkpoints and stops
+  std::vector<std::string> extra; ///< further sbatch arguments, one list entry each
+};
+
 /// A validated sweep file.
 struct Sweep {
   std::filesystem::path file;     ///< absolute
   std::string text;               ///< its bytes
   std::string name;               ///< campaign name
   std::filesystem::path baseCase; ///< absolute case folder
-  std::string executor = "local";
+  std::string executor = "local"; ///< local or slurm
+  SlurmOptions slurm;             ///< executor: slurm only
   int concurrency = 1;
   int retries = 0;                     ///< failed attempts tolerated per member beyond the first
   std::vector<std::string> parameters; ///< key paths, in file order
@@ -51,7 +67,11 @@ Sweep loadSweep(const std::filesystem::path& sweepFile);
 std::string setCaseKey(const std::string& caseText, const std::string& path,
                        const std::string& valueYaml);
 
-/// `coredem campaign run|resume|status|collect ...` (argv[0] is "campaign"). Returns the
+/// Seconds of a Slurm time limit ("minutes", "minutes:seconds", "hours:minutes:seconds",
+/// "days-hours", "days-hours:minutes", "days-hours:minutes:seconds"); nullopt when malformed.
+std::optional<long> parseSlurmTime(const std::string& text);
+
+/// `coredem campaign run|resume|status|collect|member ...` (argv[0] is "campaign"). Returns the
 /// exit code: 0 all members done, 1 some failed or a run-time error, 2 bad input (nothing
 /// written), 130 interrupted (resumable).
 int campaignMain(int argc, char** argv);

@@ -26,6 +26,8 @@ struct MemberRecord {
   int failures = 0;   ///< launches that ended with an error
   int doneCount = 0;  ///< times the member reached done (1 when done, never more)
   std::int64_t pid = 0;
+  std::string jobId;      ///< Slurm array task ("1234_5") of the latest submission, "" locally
+  std::string schedState; ///< last scheduler state seen by campaign resume (informational)
   std::string created, started, finished, lastCheckpoint, exitReason;
   std::string softwareVersion, protocolVersion;
   std::vector<std::pair<std::string, std::string>> values; ///< key path -> YAML value
@@ -69,6 +71,11 @@ public:
   /// crashed campaign's member is relaunched.
   bool markRunning(const std::string& id, const std::string& fromStatus);
   void setPid(const std::string& id, std::int64_t pid);
+  /// The Slurm task that will run (pending) or runs (running) the member.
+  void setJob(const std::string& id, const std::string& jobId, const std::string& fromStatus);
+  void setSchedState(const std::string& id, const std::string& state);
+  /// running -> pending when the member's Slurm task `jobId` is gone (no failure counted).
+  bool markLost(const std::string& id, const std::string& jobId, const std::string& reason);
   bool markDone(const std::string& id, const std::string& lastCheckpoint,
                 const std::string& softwareVersion, const std::string& protocolVersion);
   /// running -> pending (failures + 1) while failures <= retries, else running -> failed.
