@@ -228,25 +228,30 @@ public:
             store3(share, 2 * static_cast<long long>(q) + 1, lji * res.nxft);
             ++owned;
           }
-          // Walls (m_eff = m_i, the particle's material).
+          // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate
+          // bits of the first 32 (most particles have none), then every wall beyond them.
           Vec3 FW{0.0, 0.0, 0.0};
           int wallCount = 0;
-          const std::uint32_t nearBits = wallNear[i];
-          for (int k = 0; k < nWalls; ++k) {
-            if (k < 32 && !(nearBits & (1u << k)))
-              continue;
+          std::uint32_t bits = wallNear[i];
+          for (int k = bits != 0 ? lowestBit(bits) : 32; k < nWalls;) {
             const double deltaN = wallOverlap(walls[k], xi, ri);
-            if (deltaN <= 0.0)
-              continue;
-            const PairProps pp = pairs[ai * nMat + ai];
-            const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
-            const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-            const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-            const LsdResult res = wallContact(lp, walls[k], deltaN, vi, wi, ri, history(key), dt);
-            FW += res.force;
-            T += res.torque;
-            remember(key, res.deltaT);
-            ++wallCount;
+            if (deltaN > 0.0) {
+              const PairProps pp = pairs[ai * nMat + ai];
+              const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
+              const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+              const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
+              const LsdResult res = wallContact(lp, walls[k], deltaN, vi, wi, ri, history(key), dt);
+              FW += res.force;
+              T += res.torque;
+              remember(key, res.deltaT);
+              ++wallCount;
+            }
+            if (k < 32) {
+              bits &= bits - 1;
+              k = bits != 0 ? lowestBit(bits) : 32;
+            } else {
+              ++k;
+            }
           }
           F += FW;
           for (int s = slot; s < used; ++s)

@@ -28,23 +28,33 @@ struct CpuExec {
 
   int threadCount() const { return threads > 0 ? threads : omp_get_max_threads(); }
 
+  // Each thread calls its own copy of the body: a local whose address does not escape, so the
+  // compiler may keep the captured pointers in registers instead of reloading them from the
+  // shared closure after every store the body makes (it cannot rule out that such a store
+  // changes the closure). Same calls, same order within a thread: the results are unchanged.
   template <class F>
   void parallelFor(std::size_t n, F f) const {
     const std::int64_t m = static_cast<std::int64_t>(n);
-#pragma omp parallel for schedule(dynamic, 512) num_threads(threadCount()) if (m > 256)
-    for (std::int64_t i = 0; i < m; ++i)
-      f(static_cast<std::size_t>(i));
+#pragma omp parallel num_threads(threadCount()) if (m > 256)
+    {
+      const F g = f;
+#pragma omp for schedule(dynamic, 512) nowait
+      for (std::int64_t i = 0; i < m; ++i)
+        g(static_cast<std::size_t>(i));
+    }
   }
 
   template <class F>
   double reduceMax(std::size_t n, F f, double init) const {
     const std::int64_t m = static_cast<std::int64_t>(n);
     double r = init;
-#pragma omp parallel for schedule(dynamic, 512) num_threads(threadCount())                         \
-    reduction(max                                                                                  \
-              : r) if (m > 256)
-    for (std::int64_t i = 0; i < m; ++i)
-      r = std::max(r, f(static_cast<std::size_t>(i)));
+#pragma omp parallel num_threads(threadCount()) reduction(max : r) if (m > 256)
+    {
+      const F g = f;
+#pragma omp for schedule(dynamic, 512) nowait
+      for (std::int64_t i = 0; i < m; ++i)
+        r = std::max(r, g(static_cast<std::size_t>(i)));
+    }
     return r;
   }
 

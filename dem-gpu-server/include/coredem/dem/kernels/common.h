@@ -9,3 +9,19 @@
 #else
 #define DEM_HD inline
 #endif
+
+#include <cstdint>
+
+namespace coredem::dem::kernels {
+
+/// Index of the lowest set bit of x (x ≠ 0): walks a bit set in ascending order with
+/// `for (b = bits; b; b &= b - 1) use(lowestBit(b));`.
+DEM_HD int lowestBit(std::uint32_t x) {
+#if defined(__CUDA_ARCH__)
+  return __ffs(static_cast<int>(x)) - 1;
+#else
+  return __builtin_ctz(x);
+#endif
+}
+
+} // namespace coredem::dem::kernels
