@@ -29,6 +29,7 @@
 #include "singlePhaseTransportModel.H"
 #include "PhaseIncompressibleTurbulenceModel.H"
 #include "pimpleControl.H"
+#include "processorFvPatch.H"
 #include "fvOptions.H"
 
 #include "checkpoint.H"
@@ -36,6 +37,7 @@
 #include "couplingFields.H"
 #include "couplingGrid.H"
 #include "gasLedgers.H"
+#include "rankControl.H"
 #include "stageTimers.H"
 
 #include "coredem/client/participant.h"
@@ -141,7 +143,10 @@ int main(int argc, char* argv[])
         try
         {
             timers.tic();
-            coupling.advance(CoNum, ledgers.report(), files);
+            // Decomposed: the master reports the step (CoNum and the ledgers are reduced over
+            // the processors) and the others follow its next grant (rankControl.H).
+            if (Pstream::master()) coupling.advance(CoNum, ledgers.report(), files);
+            followMaster(coupling);
             timers.toc(StageTimers::Advance);
         }
         catch (const ::coredem::client::ClientError& e)
