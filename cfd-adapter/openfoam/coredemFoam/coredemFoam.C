@@ -23,7 +23,8 @@
 // Command line: coredemFoam -case DIR [-restart FILE] [-control EP] [-dem EP] [-session ID]
 // [-timeout S] [-timers] (endpoints default to COREDEM_CONTROL_ENDPOINT, COREDEM_DEM_ENDPOINT,
 // COREDEM_SESSION). -timers: per-stage wall time per CFD step, a table at the end and
-// DIR/../timers-cfd.json (the run folder under `coredem run`).
+// DIR/../timers-cfd.json (the run folder under `coredem run`; decomposed: rank 0's, the other
+// ranks' in timers-cfd-processorN.json). -parallel: a decomposed run (docs/coredemFoam.md).
 
 #include "fvCFD.H"
 #include "singlePhaseTransportModel.H"
@@ -163,7 +164,16 @@ int main(int argc, char* argv[])
     if (timersOn)
     {
         Info<< nl << timers.table(nCells, exchange.direct()).c_str() << endl;
-        const fileName file(runTime.path().path()/"timers-cfd.json");
+        // Decomposed: rank 0's in timers-cfd.json, the others' in timers-cfd-processorN.json.
+        const fileName file
+        (
+            runTime.globalPath().path()
+           /(
+                Pstream::master()
+              ? word("timers-cfd.json")
+              : word("timers-cfd-processor" + Foam::name(Pstream::myProcNo()) + ".json")
+            )
+        );
         {
             std::ofstream out(file.c_str());
             out << timers.json(nCells, exchange.direct());

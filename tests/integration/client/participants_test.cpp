@@ -1,5 +1,6 @@
 // The participants against a real coredem-dem process over tcp loopback: the C API program,
 // coredem-gas (checkpoint + restart with identical ledgers) and the C++ client's argument checks.
+#include <atomic>
 #include <cmath>
 #include <condition_variable>
 #include <cstring>
@@ -513,4 +514,74 @@ TEST(Participants, RankOptionsAreCheckedBeforeConnecting) {
   o.rank = 1;
   expectError(o, false, "follows rank 0");
   expectError(o, true, "truncated control state");
+}
+
+// Protocol 1.2 is needed for fluid_fraction and for decomposed runs: against a DEM server that
+// agrees 1.1 (a stand-in that answers Hello with Welcome{minor 1}) the client refuses both before
+// sending, naming both versions, instead of having the older server silently ignore them.
+TEST(Participants, FluidFractionAndRanksNeedADemServerOfProtocol12) {
+  const auto dir = tempDir("v11");
+  proto::Server oldDem;
+  const std::string oldEp = oldDem.bind("tcp://127.0.0.1:*");
+  std::atomic<bool> stop{false};
+  std::thread server([&] {
+    while (!stop) {
+      auto r = oldDem.receive(100ms);
+      if (!r) {
+        continue;
+      }
+      auto w = r->message.type() == v1::MESSAGE_TYPE_HELLO
+                   ? proto::makeWelcome(v1::ROLE_DEM, "coredem-dem 1.1 (stand-in)", 1, 1,
+                                        r->message.envelope().session_id())
+                   : proto::makeError(v1::ERROR_CODE_UNSUPPORTED, "stand-in");
+      w.setSequence(r->message.envelope().sequence());
+      oldDem.reply(r->peer, std::move(w));
+    }
+  });
+  for (int ranks : {0, 2}) {
+    DemProcess dem(dir);
+    MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2"}), 3s);
+    std::string error;
+    std::thread cfd([&] {
+      coredem::client::Options opt;
+      opt.controlEndpoint = o.controlEndpoint();
+      opt.demEndpoint = oldEp;
+      opt.sessionId = o.session();
+      opt.timeoutSeconds = 20;
+      opt.rankCount = ranks;
+      coredem::client::Participant p(opt);
+      try {
+        p.initialize();
+        EXPECT_EQ(p.demProtocolMinor(), 1);
+        const auto n = static_cast<std::size_t>(p.grid().cellCount());
+        std::vector<double> v3(3 * n, 0.0), t(n, 300.0), rho(n, 1.2), mu(n, 1.8e-5), k(n, 0.03),
+            cp(n, 1000.0), y(n, 1.0), ff(n, 0.5);
+        p.exchange(p.step(), p.dt(),
+                   {{"u_g", v3},
+                    {"grad_p", v3},
+                    {"T_g", t},
+                    {"rho_g", rho},
+                    {"mu_g", mu},
+                    {"kappa_g", k},
+                    {"cp_g", cp},
+                    {"Y_g", y},
+                    {"fluid_fraction", ff}});
+      } catch (const coredem::client::ClientError& e) {
+        error = e.what();
+      }
+    });
+    try {
+      o.run(1, 2e-4, {}, false); // ends by timeout: the participant gave up
+    } catch (const std::exception&) {
+    }
+    cfd.join();
+    EXPECT_NE(error.find("agreed protocol 1.1, this client speaks 1.2"), std::string::npos)
+        << ranks << " ranks: " << error;
+    EXPECT_NE(error.find(ranks > 1 ? "decomposed CFD participant (2 ranks)" : "fluid_fraction"),
+              std::string::npos)
+        << error;
+  }
+  stop = true;
+  server.join();
+  fs::remove_all(dir);
 }
