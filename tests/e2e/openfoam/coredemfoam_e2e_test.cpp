@@ -716,7 +716,8 @@ TEST_F(CoredemFoamE2E, TwoRankRestartContinuesBitwise) {
 }
 
 // (f) Decompositions that cannot run are refused before start (exit 2) naming the mismatch: more
-// ranks than mesh cells (500), and a decomposeParDict of the case for another rank count.
+// ranks than mesh cells (500), a decomposeParDict of the case for another rank count, and one
+// without a method.
 TEST_F(CoredemFoamE2E, BadDecompositionsAreRefusedBeforeStart) {
   const fs::path c =
       makeCase(dir, 0.3, 293.15, std::string("time: {end: 0.002, dt: 1.0e-3}\n") + kFluidizedBed);
@@ -736,6 +737,12 @@ TEST_F(CoredemFoamE2E, BadDecompositionsAreRefusedBeforeStart) {
   log = readAll(dir / "2.log");
   EXPECT_NE(log.find("3 ranks, but"), std::string::npos) << log;
   EXPECT_NE(log.find("decomposes into 2 subdomains"), std::string::npos) << log;
+  writeAll(c / "openfoam" / "system" / "decomposeParDict",
+           "FoamFile { version 2.0; format ascii; class dictionary; object decomposeParDict; }\n"
+           "numberOfSubdomains 3;\n");
+  EXPECT_EQ(runCoredem({"run", c.string(), "--out", (dir / "r3").string()}, dir / "3.log", 60s), 2);
+  log = readAll(dir / "3.log");
+  EXPECT_NE(log.find("names no decomposition method"), std::string::npos) << log;
 }
 
 } // namespace
