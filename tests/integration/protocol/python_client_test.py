@@ -3,7 +3,7 @@
 talks to the C++ loopback server and decodes the C++ golden files.
 
 usage: python_client_test.py PROTOC PROTO_DIR GOLDEN_DIR LOOPBACK_BINARY
-Checks: every golden v1.0 and v1.1 file decodes with Python's protobuf and has the type its name says;
+Checks: every golden v1.0, v1.1 and v1.2 file decodes with Python's protobuf and has the type its name says;
 the golden GasFields arrays hold 0.25 (f+1) + 0.125 i; over tcp loopback a Python DEALER
 handshakes, configures a 4x3x2 grid, sends GasFields built from numpy arrays and receives
 Sources (eps_g = 1, other sources 0, checksums equal to sequential sums of what was sent);
