@@ -674,11 +674,12 @@ particles:
 
 // (f) A decomposed run restarts bit for bit: 8 steps on 2 ranks straight through vs 4, stop,
 // `coredem resume` (the processor folders of the checkpoint), 4 more: the same checkpoint files
-// of every processor, DEM particles and pressure drops.
+// of every processor, DEM particles and pressure drops; outputs.csv lists processor0's folders.
 TEST_F(CoredemFoamE2E, TwoRankRestartContinuesBitwise) {
   const fs::path c = makeCase(dir, 0.9, 293.15,
                               std::string("time: {end: 0.004, dt: 5.0e-4}\n"
-                                          "checkpoint: {every_steps: 4, keep: 3}\n") +
+                                          "checkpoint: {every_steps: 4, keep: 3}\n"
+                                          "output: {every: 4}\n") +
                                   kFluidizedBed);
   const fs::path y = c / "case.yaml";
   writeAll(y, replaceAll(readAll(y), "case: openfoam, timeout_s: 120}",
@@ -718,6 +719,10 @@ TEST_F(CoredemFoamE2E, TwoRankRestartContinuesBitwise) {
   ASSERT_EQ(ta["gas.pressure_drop_Pa"].size(), 8u);
   ASSERT_EQ(tb["gas.pressure_drop_Pa"].size(), 8u);
   EXPECT_EQ(ta["gas.pressure_drop_Pa"], tb["gas.pressure_drop_Pa"]);
+  // The synchronized outputs name processor0's time folders (the decomposed case).
+  const std::string outputs = readAll(a / "outputs.csv");
+  EXPECT_NE(outputs.find(",openfoam/processor0/0.002"), std::string::npos) << outputs;
+  EXPECT_TRUE(fs::is_directory(a / "openfoam" / "processor1" / "0.002"));
 }
 
 // (f) Decompositions that cannot run are refused before start (exit 2) naming the mismatch: more
