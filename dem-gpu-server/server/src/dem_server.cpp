@@ -1215,7 +1215,8 @@ struct DemServer::Impl {
       e.sequenceAfter = lastSequence[r.peer];
     }
     const auto tValidate = Clock::now();
-    if (type == v1::MESSAGE_TYPE_GAS_FIELDS && stepEnd) { // the CFD's step and the transfer
+    // The CFD's step and the transfer (decomposed: until the first rank's GasFields).
+    if (type == v1::MESSAGE_TYPE_GAS_FIELDS && stepEnd && partials.empty()) {
       xt.waitPeer += std::chrono::duration<double>(lastReceived - *stepEnd).count();
     }
     auto s = proto::validate(r.message, e);
