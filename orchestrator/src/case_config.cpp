@@ -626,7 +626,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     }
   }
   if (top.has("cfd")) {
-    const Section f = top.section("cfd", {"participant", "gas_key", "case", "timeout_s", "timers"});
+    const Section f =
+        top.section("cfd", {"participant", "gas_key", "case", "timeout_s", "timers", "ranks"});
     // What a participant takes and allows comes from its row of the participant table.
     c.cfd.participant = f.choice("participant", c.cfd.participant, participantNames());
     const ParticipantDescriptor& p = participant(c.cfd.participant);
@@ -638,6 +639,13 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
     c.cfd.gasKey = f.string("gas_key", std::string("gas"), "key of the prescribed-gas section");
     c.cfd.timeoutSeconds = f.number("timeout_s", 60.0, 0.0, kBig, "deadline in s", true);
     c.cfd.timers = f.onOff("timers", false);
+    c.cfd.ranks = int(f.integer("ranks", 1, 1, 4096, "MPI ranks of the CFD participant"));
+    if (c.cfd.ranks > 1 && p.parallelArgs.empty()) {
+      f.fail(f.markOf("ranks"), "cfd.ranks",
+             fmt::format("{} runs on one process; a decomposed run (ranks > 1) needs a "
+                         "participant that runs under MPI (coredemFoam)",
+                         p.name));
+    }
     if (c.cfd.timers && !p.hasTimers()) {
       std::vector<std::string> withTimers;
       for (const auto& q : participantTable()) {

@@ -1,9 +1,12 @@
 // The participant table (participants.h): every CFD participant that `coredem run` can start,
 // one row each, and the generic code that launches, prepares and checks a row.
+#include <chrono>
 #include <cstdlib>
+#include <fstream>
 #include <stdexcept>
 
 #include <fnmatch.h>
+#include <unistd.h>
 
 #include <coredem/common/log.h>
 #include <coredem/common/process.h>
@@ -15,6 +18,56 @@ namespace fs = std::filesystem;
 
 namespace coredem::orchestrator {
 namespace {
+
+/// Runs an OpenFOAM utility in `work` (log in logDir/<name>.log); throws naming the log on failure.
+void runFoamUtility(const std::string& name, std::vector<std::string> args, const fs::path& work,
+                    const fs::path& logDir) {
+  const fs::path program = findProgram(name);
+  COREDEM_CHECK(!program.empty(), "{} (OpenFOAM) not found on PATH: install Debian's openfoam",
+                name);
+  args.insert(args.begin(), program.string());
+  args.insert(args.end(), {"-case", work.string()});
+  const char* own = std::getenv("WM_PROJECT_DIR");
+  fs::create_directories(logDir);
+  ChildProcess p(name, args, {{"WM_PROJECT_DIR", own != nullptr ? own : "/usr/share/openfoam"}},
+                 logDir / (name + ".log"));
+  COREDEM_CHECK(p.waitFor(std::chrono::minutes(30)), "{} did not finish within 30 min", name);
+  COREDEM_CHECK(p.exitCode() == 0, "{} -case {} failed ({}; see {}):\n{}", name, work.string(),
+                p.exitReason().value_or("?"), p.logFile().string(), p.logTail());
+}
+
+/// coredemFoam on `ranks` processes: the mesh (blockMesh when the case has none),
+/// system/decomposeParDict (written when the case has none: method simple, `ranks` slabs along x;
+/// Debian's OpenFOAM builds scotch as a dummy library) and decomposePar, unless
+/// processor0 .. processor<ranks-1> exist already (a resumed run keeps its decomposition).
+void decomposeOpenFoamCase(const fs::path& work, int ranks, const fs::path& logDir) {
+  auto log = coredem::logger("orchestrator");
+  const fs::path dict = work / "system" / "decomposeParDict";
+  if (!fs::exists(dict)) {
+    std::ofstream out(dict);
+    out << "FoamFile\n{\n    version 2.0;\n    format ascii;\n    class dictionary;\n"
+        << "    object decomposeParDict;\n}\n\n// written by coredem for cfd.ranks: " << ranks
+        << "\nnumberOfSubdomains " << ranks << ";\n\nmethod simple;\n\nsimpleCoeffs\n{\n    n ("
+        << ranks << " 1 1);\n    delta 0.001;\n}\n";
+    COREDEM_CHECK(out.good(), "cannot write {}", dict.string());
+    log->info("wrote {} (method simple: {} slabs along x)", dict.string(), ranks);
+  }
+  if (fs::is_directory(work / ("processor" + std::to_string(ranks - 1))) &&
+      !fs::exists(work / ("processor" + std::to_string(ranks)))) {
+    return;
+  }
+  if (!fs::exists(work / "constant" / "polyMesh" / "faces") &&
+      fs::exists(work / "system" / "blockMeshDict")) {
+    runFoamUtility("blockMesh", {}, work, logDir);
+  }
+  for (const auto& e : fs::directory_iterator(work)) {
+    if (e.path().filename().string().rfind("processor", 0) == 0) {
+      fs::remove_all(e.path());
+    }
+  }
+  runFoamUtility("decomposePar", {"-force"}, work, logDir);
+  log->info("decomposed {} into {} processor folders (decomposePar)", work.string(), ranks);
+}
 
 std::vector<ParticipantDescriptor> makeTable() {
   std::vector<ParticipantDescriptor> t;
@@ -58,6 +111,8 @@ std::vector<ParticipantDescriptor> makeTable() {
     p.caseFolderHint = "give the folder with system/, constant/ and 0/";
     p.workDir = "openfoam";
     p.preflight = &checkOpenFoamCase; // gravity and gas properties equal case.yaml's
+    p.parallelArgs = {"-parallel"};   // cfd.ranks > 1: mpirun -np K coredemFoam ... -parallel
+    p.decompose = &decomposeOpenFoamCase;
     t.push_back(std::move(p));
   }
   return t;
@@ -135,6 +190,18 @@ LaunchCommand launchCommand(const ParticipantDescriptor& p, const CaseConfig& co
       {"dem_client_key_file", in.demClientKeyFile},
       {"restart_file", in.restartFile.string()}};
   LaunchCommand cmd;
+  const int ranks = config.cfd.ranks;
+  if (ranks > 1) {
+    // Debian's OpenMPI: oversubscription allowed (more ranks than cores), root allowed (CI
+    // containers); the COREDEM_* environment is passed to every rank with -x.
+    const fs::path mpirun = findProgram("mpirun");
+    COREDEM_CHECK(!mpirun.empty(), "cfd.ranks: {} needs mpirun (Debian's openmpi-bin) on PATH",
+                  ranks);
+    cmd.argv = {mpirun.string(), "-np", std::to_string(ranks), "--oversubscribe"};
+    if (::geteuid() == 0) {
+      cmd.argv.push_back("--allow-run-as-root");
+    }
+  }
   cmd.argv.push_back(in.program.string());
   auto append = [&](const std::vector<std::string>& args) {
     for (const auto& a : args) {
@@ -158,6 +225,17 @@ LaunchCommand launchCommand(const ParticipantDescriptor& p, const CaseConfig& co
     const char* own = std::getenv(key.c_str());
     cmd.env[key] = own != nullptr ? own : value;
   }
+  if (ranks > 1) {
+    append(p.parallelArgs);
+    // -x NAME for every variable of the participant's environment (mpirun starts the ranks).
+    std::vector<std::string> exports;
+    for (const auto& [key, value] : cmd.env) {
+      exports.insert(exports.end(), {"-x", key});
+    }
+    cmd.argv.insert(cmd.argv.begin() + 4 + (::geteuid() == 0 ? 1 : 0), exports.begin(),
+                    exports.end());
+    cmd.env["OMPI_MCA_rmaps_base_oversubscribe"] = "1";
+  }
   return cmd;
 }
 
@@ -167,14 +245,21 @@ void prepareWorkDir(const ParticipantDescriptor& p, const CaseConfig& config,
     return;
   }
   const fs::path work = runDir / p.workDir;
+  const auto decompose = [&] {
+    if (config.cfd.ranks > 1 && p.decompose != nullptr) {
+      p.decompose(work, config.cfd.ranks, runDir / "logs");
+    }
+  };
   if (!p.caseFolderMarker.empty() && fs::exists(work / p.caseFolderMarker)) {
-    return; // made by the first start; a resumed run keeps it
+    decompose(); // made by the first start; a resumed run keeps it (and its decomposition)
+    return;
   }
   const fs::path src = config.caseDir / config.cfd.caseFolder;
   COREDEM_CHECK(p.caseFolderMarker.empty() || fs::is_regular_file(src / p.caseFolderMarker),
                 "cfd.case: {} is not {} (no {})", src.string(), p.caseFolder, p.caseFolderMarker);
   fs::create_directories(work);
   fs::copy(src, work, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+  decompose();
 }
 
 bool isRestartFile(const ParticipantDescriptor& p, const fs::path& path) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <numeric>
 #include <regex>
 #include <sstream>
@@ -536,6 +537,65 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
   return warnings;
 }
 
+/// Cells of the CFD mesh: the note "nCells:N" of constant/polyMesh/owner, else the product of
+/// the cell counts of every hex block of system/blockMeshDict; nullopt when neither says.
+std::optional<long long> foamCellCount(const fs::path& dir) {
+  std::ifstream owner(dir / "constant" / "polyMesh" / "owner");
+  std::string text((std::istreambuf_iterator<char>(owner)), std::istreambuf_iterator<char>());
+  std::smatch m;
+  const std::string head = text.substr(0, 4096);
+  if (std::regex_search(head, m, std::regex("nCells:\\s*([0-9]+)"))) {
+    return std::stoll(m[1].str());
+  }
+  std::ifstream dict(dir / "system" / "blockMeshDict");
+  text.assign((std::istreambuf_iterator<char>(dict)), std::istreambuf_iterator<char>());
+  const std::regex hex(
+      "hex\\s*\\([^)]*\\)\\s*(?:\\w+\\s*)?\\(\\s*([0-9]+)\\s+([0-9]+)\\s+([0-9]+)\\s*\\)");
+  long long cells = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), hex); it != std::sregex_iterator();
+       ++it) {
+    cells += std::stoll((*it)[1].str()) * std::stoll((*it)[2].str()) * std::stoll((*it)[3].str());
+  }
+  if (cells > 0) {
+    return cells;
+  }
+  return std::nullopt;
+}
+
+/// cfd.ranks > 1: at most one rank per mesh cell, and a system/decomposeParDict of the case (when
+/// it has one) for the same number of subdomains with a method (coredem writes one, method
+/// simple, when the case has none).
+void checkDecomposition(const CaseConfig& c, const Locator& at, const fs::path& dir) {
+  if (c.cfd.ranks <= 1) {
+    return;
+  }
+  if (const auto cells = foamCellCount(dir); cells && c.cfd.ranks > *cells) {
+    at.fail({"cfd", "ranks"}, "cfd.ranks",
+            fmt::format("{} ranks for a mesh of {} cells ({}): every rank needs cells; use at "
+                        "most {} ranks",
+                        c.cfd.ranks, *cells, dir.string(), *cells));
+  }
+  const fs::path dict = dir / "system" / "decomposeParDict";
+  if (!fs::exists(dict)) {
+    return;
+  }
+  const auto n = foamEntry(dict, "numberOfSubdomains");
+  const auto method = foamEntry(dict, "method");
+  if (!method || method->value.empty()) {
+    at.fail({"cfd", "ranks"}, "cfd.ranks",
+            fmt::format("{} names no decomposition method (method simple with simpleCoeffs, "
+                        "hierarchical, ...): add one, or remove the file and coredem writes one",
+                        dict.string()));
+  }
+  if (!n || std::atoi(n->value.c_str()) != c.cfd.ranks) {
+    at.fail({"cfd", "ranks"}, "cfd.ranks",
+            fmt::format("{} ranks, but {}:{} decomposes into {} subdomains: give the same number "
+                        "in both",
+                        c.cfd.ranks, dict.string(), n ? n->line : 0,
+                        n ? n->value : std::string("(no numberOfSubdomains)")));
+  }
+}
+
 void checkOpenFoamCase(const CaseConfig& c) {
   const Locator at(c);
   const fs::path dir = c.caseDir / c.cfd.caseFolder;
@@ -637,6 +697,7 @@ void checkOpenFoamCase(const CaseConfig& c) {
       }
     }
   }
+  checkDecomposition(c, at, dir);
 }
 
 } // namespace coredem::orchestrator

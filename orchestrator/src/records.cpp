@@ -82,25 +82,34 @@ std::string gasOutputFolder(const fs::path& runDir, const std::string& workDir, 
   if (workDir.empty() || !fs::is_directory(runDir / workDir)) {
     return {};
   }
-  std::string best;
-  double bestDiff = 0.5 * dt;
-  for (const auto& e : fs::directory_iterator(runDir / workDir)) {
-    if (!e.is_directory()) {
-      continue;
+  // The time folder nearest `time` (within dt/2) in `folder`, relative to the run folder.
+  const auto search = [&](const fs::path& folder) {
+    std::string best;
+    double bestDiff = 0.5 * dt;
+    for (const auto& e : fs::directory_iterator(runDir / folder)) {
+      if (!e.is_directory()) {
+        continue;
+      }
+      const std::string name = e.path().filename().string();
+      char* end = nullptr;
+      const double t = std::strtod(name.c_str(), &end);
+      if (name.empty() || end != name.c_str() + name.size()) {
+        continue; // not a time folder (constant, system, ...)
+      }
+      const double diff = std::abs(t - time);
+      if (diff <= bestDiff) {
+        bestDiff = diff;
+        best = (folder / name).string();
+      }
     }
-    const std::string name = e.path().filename().string();
-    char* end = nullptr;
-    const double t = std::strtod(name.c_str(), &end);
-    if (name.empty() || end != name.c_str() + name.size()) {
-      continue; // not a time folder (constant, system, ...)
-    }
-    const double diff = std::abs(t - time);
-    if (diff <= bestDiff) {
-      bestDiff = diff;
-      best = (fs::path(workDir) / name).string();
-    }
+    return best;
+  };
+  // A decomposed run (cfd.ranks > 1) writes its time folders per processor: processor0's stands
+  // for the decomposed case (ParaView's reader opens the case with Case Type "Decomposed Case").
+  if (fs::is_directory(runDir / workDir / "processor0")) {
+    return search(fs::path(workDir) / "processor0");
   }
-  return best;
+  return search(fs::path(workDir));
 }
 
 void OverheadTotals::report(spdlog::logger& log, const fs::path& runDir) const {

@@ -138,6 +138,57 @@ Status structure(const Message& message) {
   return {};
 }
 
+/// The partial-message arrays (v1.2): touched_count <= cells, "cells" int64 [M] strictly
+/// ascending and < cells, and for GasFields "fluid_volume" float64 [M].
+Status checkPartial(const Message& message, std::uint64_t rows, std::uint64_t cells) {
+  const std::string what = "partial " + messageTypeName(message.type());
+  if (rows > cells) {
+    return Status::error(v1::ERROR_CODE_SHAPE, what + " lists " + std::to_string(rows) +
+                                                   " coupling cells but the grid has " +
+                                                   std::to_string(cells));
+  }
+  const auto idx = message.findArray(fields::kTouchedCells);
+  if (!idx) {
+    return Status::error(v1::ERROR_CODE_MISSING_FIELD,
+                         what + " lacks the array 'cells' (int64, the coupling cells it lists)");
+  }
+  const std::vector<std::uint64_t> shape{rows};
+  if (idx->dtype() != v1::DTYPE_INT64 || idx->shape() != shape) {
+    return Status::error(v1::ERROR_CODE_SHAPE,
+                         what + ": array 'cells' has dtype " + dtypeName(idx->dtype()) +
+                             " and shape " + shapeString(idx->shape()) + " but int64 " +
+                             shapeString(shape) + " (touched_count) was expected");
+  }
+  const auto v = idx->as<std::int64_t>();
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (v[i] < 0 || static_cast<std::uint64_t>(v[i]) >= cells) {
+      return Status::error(v1::ERROR_CODE_SHAPE,
+                           what + ": cells[" + std::to_string(i) + "] = " + std::to_string(v[i]) +
+                               " is not a coupling cell (0.." + std::to_string(cells - 1) + ")");
+    }
+    if (i > 0 && v[i] <= v[i - 1]) {
+      return Status::error(v1::ERROR_CODE_DUPLICATE_FIELD,
+                           what + ": cells[" + std::to_string(i) + "] = " + std::to_string(v[i]) +
+                               (v[i] == v[i - 1] ? " is listed twice" : " is out of order") +
+                               "; list each coupling cell once, ascending");
+    }
+  }
+  if (message.type() == v1::MESSAGE_TYPE_GAS_FIELDS) {
+    const auto fv = message.findArray(fields::kFluidVolume);
+    if (!fv) {
+      return Status::error(v1::ERROR_CODE_MISSING_FIELD,
+                           what + " lacks the array 'fluid_volume' (float64, m3 per listed cell)");
+    }
+    if (fv->dtype() != v1::DTYPE_FLOAT64 || fv->shape() != shape) {
+      return Status::error(v1::ERROR_CODE_SHAPE, what + ": array 'fluid_volume' has dtype " +
+                                                     dtypeName(fv->dtype()) + " and shape " +
+                                                     shapeString(fv->shape()) + " but float64 " +
+                                                     shapeString(shape) + " was expected");
+    }
+  }
+  return {};
+}
+
 } // namespace
 
 std::uint64_t cellCount(const v1::CouplingMesh& mesh) {
@@ -229,10 +280,39 @@ Status validate(const Message& message, const Expectation& e) {
                                " cells and " + std::to_string(*e.species) +
                                " species; send fields on the configured coupling mesh");
     }
+    const bool partial =
+        type == v1::MESSAGE_TYPE_GAS_FIELDS ? env.gas_fields().partial() : env.sources().partial();
+    std::uint64_t rows = *e.cells;
+    if (partial) {
+      rows = type == v1::MESSAGE_TYPE_GAS_FIELDS ? env.gas_fields().touched_count()
+                                                 : env.sources().touched_count();
+      if (Status p = checkPartial(message, rows, *e.cells); !p.ok()) {
+        return p;
+      }
+    }
     auto required =
         type == v1::MESSAGE_TYPE_GAS_FIELDS ? fields::gasFields() : fields::sourceFields();
-    Status st = checkArrays(message, required, *e.cells, *e.species, e.requireFinite);
+    Status st = checkArrays(message, required, rows, *e.species, e.requireFinite);
     if (!st.ok() || type != v1::MESSAGE_TYPE_GAS_FIELDS) {
+      return st;
+    }
+    if (partial) {
+      // The fluid volumes: positive (finite was checked above).
+      const auto fv = message.values<double>(fields::kFluidVolume);
+      for (std::size_t i = 0; i < fv.size(); ++i) {
+        if (!(fv[i] > 0.0)) {
+          return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION,
+                               "partial GasFields: fluid_volume[" + std::to_string(i) +
+                                   "] = " + std::to_string(fv[i]) +
+                                   " m3; list only coupling cells the rank's cells overlap "
+                                   "(fluid volume > 0)");
+        }
+      }
+      if (message.findArray(fields::kFluidFraction)) {
+        return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION,
+                             "partial GasFields carry fluid_volume; fluid_fraction is formed by "
+                             "the DEM server from the ranks' fluid volumes, do not send it");
+      }
       return st;
     }
     // Optional GasFields arrays: when present, the same dtype and shape rules.

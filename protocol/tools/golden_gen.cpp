@@ -5,6 +5,9 @@
 // and the chemistry switches). The files are committed and never regenerated for a
 // released version: tests/unit/protocol/golden_test.cpp decodes them with the current code
 // forever and checks every value written below. Container format: multipart_file.h.
+// v1.2 (MINOR 2): the v1.1 messages with minor 2 in Hello/Welcome/Reject, the Hello of rank 1 of
+// a 2-rank decomposed CFD participant, and the GasFields and Sources partial (one rank's
+// contributions for the coupling cell it touches, docs/protocol.md "Decomposed CFD").
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -22,6 +25,7 @@ namespace {
 
 constexpr std::uint64_t kCells = 2;   // a 2 x 1 x 1 grid
 constexpr std::uint32_t kSpecies = 2; // O2, N2
+constexpr std::uint64_t kTouched = 1; // v1.2 partial messages: one coupling cell (index 1)
 
 /// Array values of the golden GasFields/Sources: field f (index in fields.h order), flat
 /// index i -> 0.25 * (f + 1) + 0.125 * i (exact in binary).
@@ -169,14 +173,15 @@ void addV11(v1::Configure& c) {
   ch->set_reaction_heat(false);
 }
 
-void addFieldArrays(Message& m, std::span<const fields::FieldSpec> specs) {
+void addFieldArrays(Message& m, std::span<const fields::FieldSpec> specs,
+                    std::uint64_t rows = kCells) {
   std::size_t f = 0;
   for (const auto& spec : specs) {
-    std::vector<double> v(kCells * fields::componentsOf(spec.extent, kSpecies));
+    std::vector<double> v(rows * fields::componentsOf(spec.extent, kSpecies));
     for (std::size_t i = 0; i < v.size(); ++i) {
       v[i] = goldenValue(f, i);
     }
-    m.addArray<double>(spec.name, v, fields::shapeOf(spec.extent, kCells, kSpecies));
+    m.addArray<double>(spec.name, v, fields::shapeOf(spec.extent, rows, kSpecies));
     ++f;
   }
 }
@@ -190,8 +195,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int minor = argc == 3 ? std::atoi(argv[2]) : 0;
-  if (minor != 0 && minor != 1) {
-    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0 or 1\n");
+  if (minor < 0 || minor > 2) {
+    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0, 1 or 2\n");
     return 2;
   }
   std::filesystem::path dir = argv[1];
@@ -206,6 +211,11 @@ int main(int argc, char** argv) {
     e.set_direction(v1::FIELD_DIRECTION_SENDS);
     e.set_unit("m/s");
     Message m = makeHello(v1::ROLE_CFD, "coredem-gas 0.1.0", {"gas_fields", "checkpoint"}, {e});
+    m.envelope().mutable_hello()->set_protocol_minor(std::uint32_t(minor));
+    if (minor >= 2) { // rank 1 of a decomposed CFD participant on 2 ranks
+      m.envelope().mutable_hello()->set_rank(1);
+      m.envelope().mutable_hello()->set_rank_count(2);
+    }
     m.setSessionId("").setSequence(1).setStep(0).setTime(0.0);
     all.emplace_back("hello", std::move(m));
   }
@@ -218,6 +228,7 @@ int main(int argc, char** argv) {
   }
   {
     Message m = makeReject(v1::ERROR_CODE_VERSION, "protocol 1.0 vs 2.3");
+    m.envelope().mutable_reject()->set_server_protocol_minor(std::uint32_t(minor));
     stamp(m, 1);
     all.emplace_back("reject", std::move(m));
   }
@@ -238,7 +249,16 @@ int main(int argc, char** argv) {
   {
     Message m = makeGasFields(3, 0.25, 1e-4, kCells, kSpecies);
     stamp(m, 3);
-    addFieldArrays(m, fields::gasFields());
+    if (minor >= 2) {
+      // Partial: the rank touches coupling cell 1 only, with 0.125 m3 of its 0.5 m3 fluid.
+      m.envelope().mutable_gas_fields()->set_partial(true);
+      m.envelope().mutable_gas_fields()->set_touched_count(kTouched);
+      m.addArray<std::int64_t>(fields::kTouchedCells, std::vector<std::int64_t>{1}, {kTouched});
+      m.addArray<double>(fields::kFluidVolume, std::vector<double>{0.125}, {kTouched});
+      addFieldArrays(m, fields::gasFields(), kTouched);
+    } else {
+      addFieldArrays(m, fields::gasFields());
+    }
     all.emplace_back("gas_fields", std::move(m));
   }
   {
@@ -248,7 +268,14 @@ int main(int argc, char** argv) {
     addNamedValue(l->mutable_energy(), "particles", 5.5e3);
     addNamedValue(l->mutable_species(), "O2", -1.5e-6);
     stamp(m, 3);
-    addFieldArrays(m, fields::sourceFields());
+    if (minor >= 2) { // the answer to the partial GasFields: coupling cell 1 only
+      m.envelope().mutable_sources()->set_partial(true);
+      m.envelope().mutable_sources()->set_touched_count(kTouched);
+      m.addArray<std::int64_t>(fields::kTouchedCells, std::vector<std::int64_t>{1}, {kTouched});
+      addFieldArrays(m, fields::sourceFields(), kTouched);
+    } else {
+      addFieldArrays(m, fields::sourceFields());
+    }
     all.emplace_back("sources", std::move(m));
   }
   {

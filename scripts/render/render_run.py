@@ -127,10 +127,17 @@ def main():
     gas = None
     if gas_dirs:
         case_dir = os.path.join(run_dir, os.path.dirname(gas_dirs[0]))
+        # A decomposed run (cfd.ranks > 1) lists processor0's time folders: the reader assembles
+        # every processor's fields from the case folder above (no reconstructPar).
+        decomposed = os.path.basename(case_dir).startswith("processor")
+        if decomposed:
+            case_dir = os.path.dirname(case_dir)
         foam = os.path.join(case_dir, "case.foam")
         if not os.path.exists(foam):
             open(foam, "w").close()
         gas = OpenFOAMReader(FileName=foam)
+        if decomposed:
+            gas.CaseType = "Decomposed Case"
         gas.MeshRegions = ["internalMesh"]
         gas.UpdatePipelineInformation()
         UpdatePipeline(time=t0, proxy=gas)

@@ -16,6 +16,7 @@ struct coredem_client {
   std::unique_ptr<Participant> participant;
   std::string lastError;
   std::string checkpointDir; // keeps coredem_grant::checkpoint_dir alive
+  std::string controlState;  // keeps coredem_client_control_state's string alive
 };
 
 namespace {
@@ -101,6 +102,61 @@ coredem_status coredem_client_set_timeout(coredem_client* c, double seconds) {
     }
     c->options.timeoutSeconds = seconds;
     c->participant = std::make_unique<Participant>(c->options);
+  });
+}
+
+coredem_status coredem_client_set_rank(coredem_client* c, int32_t rank, int32_t rank_count) {
+  return call(c, "coredem_client_set_rank", [&] {
+    argCheck(rank >= 0 && rank_count >= 0 && (rank_count <= 1 ? rank == 0 : rank < rank_count),
+             "coredem_client_set_rank: rank " + std::to_string(rank) + " of " +
+                 std::to_string(rank_count) + ": the rank must lie in [0, rank_count)");
+    if (participant(c).state() != coredem::client::State::Created) {
+      throw coredem::client::StateError(
+          "coredem_client_set_rank: call it before initialize/follow");
+    }
+    c->options.rank = rank;
+    c->options.rankCount = rank_count;
+    c->participant = std::make_unique<Participant>(c->options);
+  });
+}
+
+coredem_status coredem_client_control_state(coredem_client* c, const char** state, size_t* size) {
+  return call(c, "coredem_client_control_state", [&] {
+    argCheck(state != nullptr && size != nullptr,
+             "coredem_client_control_state: state and size must not be NULL");
+    c->controlState = participant(c).controlState();
+    *state = c->controlState.c_str();
+    *size = c->controlState.size();
+  });
+}
+
+coredem_status coredem_client_follow(coredem_client* c, const char* state, size_t size) {
+  return call(c, "coredem_client_follow", [&] {
+    argCheck(state != nullptr || size == 0, "coredem_client_follow: state is NULL");
+    participant(c).follow(std::string(state != nullptr ? state : "", size));
+  });
+}
+
+coredem_status coredem_client_exchange_partial(coredem_client* c, int64_t step, double dt,
+                                               int64_t n_cells, const int64_t* cells,
+                                               const double* fluid_volume, int32_t n_fields,
+                                               const char* const* names,
+                                               const double* const* values, const size_t* sizes) {
+  return call(c, "coredem_client_exchange_partial", [&] {
+    argCheck(n_cells >= 0 && (n_cells == 0 || (cells != nullptr && fluid_volume != nullptr)),
+             "coredem_client_exchange_partial: cells and fluid_volume must hold n_cells entries");
+    argCheck(n_fields >= 0 &&
+                 (n_fields == 0 || (names != nullptr && values != nullptr && sizes != nullptr)),
+             "coredem_client_exchange_partial: names, values and sizes must hold n_fields entries");
+    std::vector<coredem::client::NamedField> fields;
+    for (int32_t i = 0; i < n_fields; ++i) {
+      argCheck(names[i] != nullptr,
+               "coredem_client_exchange_partial: names[" + std::to_string(i) + "] is NULL");
+      fields.push_back({names[i], coredem::client::ConstView(values[i], sizes[i])});
+    }
+    const std::vector<std::int64_t> list(cells, cells + n_cells);
+    participant(c).exchangePartial(
+        step, dt, list, coredem::client::ConstView(fluid_volume, std::size_t(n_cells)), fields);
   });
 }
 

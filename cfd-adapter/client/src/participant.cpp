@@ -102,6 +102,9 @@ struct Participant::Impl {
 
   Sources sources;
   ExchangeTimes times;
+  int demMinor = 0; ///< the protocol minor agreed with D
+
+  bool decomposed() const { return opt.rankCount > 1; }
 
   void require(std::initializer_list<State> allowed, const char* call, const char* hint) const {
     for (State s : allowed) {
@@ -167,10 +170,14 @@ struct Participant::Impl {
     state = State::Granted;
   }
 
-  proto::Message handshake(proto::Client& client, const std::string& peer) {
+  proto::Message handshake(proto::Client& client, const std::string& peer, bool rank = false) {
     auto hello = proto::makeHello(v1::ROLE_CFD, opt.softwareVersion.empty() ? kLibraryVersion
                                                                             : opt.softwareVersion);
     hello.setSessionId(session);
+    if (rank && decomposed()) {
+      hello.envelope().mutable_hello()->set_rank(static_cast<std::uint32_t>(opt.rank));
+      hello.envelope().mutable_hello()->set_rank_count(static_cast<std::uint32_t>(opt.rankCount));
+    }
     auto reply = client.request(std::move(hello), timeout);
     proto::expectType(reply, v1::MESSAGE_TYPE_WELCOME);
     const auto& w = reply.envelope().welcome();
@@ -182,13 +189,33 @@ struct Participant::Impl {
     return reply;
   }
 
-  void initialize() {
+  void checkRank() const {
+    COREDEM_CHECK(opt.rankCount >= 0 && opt.rank >= 0 &&
+                      (opt.rankCount <= 1 ? opt.rank == 0 : opt.rank < opt.rankCount),
+                  "{}: rank {} of {} ranks: the rank index must lie in [0, rank count)", opt.name,
+                  opt.rank, opt.rankCount);
+  }
+
+  /// Hello to D (with the rank of a decomposed run); a decomposed run needs protocol 1.2.
+  void connectDem() {
+    dem = std::make_unique<proto::Client>(transport(true));
+    dem->connect(demEp);
+    const auto w = handshake(*dem, "DEM server", true);
+    demMinor = static_cast<int>(w.envelope().welcome().protocol_minor());
+    if (decomposed() && demMinor < static_cast<int>(proto::kMinorDecomposed)) {
+      throw ClientError(ErrorCode::Peer,
+                        fmt::format("{}: the DEM server at {} agreed protocol 1.{}, this client "
+                                    "speaks {}; a decomposed CFD participant ({} ranks) needs "
+                                    "1.{} or later on both sides: update coredem-dem",
+                                    opt.name, demEp, demMinor, proto::kProtocolVersion.toString(),
+                                    opt.rankCount, proto::kMinorDecomposed));
+    }
+  }
+
+  void readEnvironment() {
     controlEp = fromEnv(opt.controlEndpoint, "COREDEM_CONTROL_ENDPOINT");
     demEp = fromEnv(opt.demEndpoint, "COREDEM_DEM_ENDPOINT");
     session = fromEnv(opt.sessionId, "COREDEM_SESSION");
-    COREDEM_CHECK(!controlEp.empty(),
-                  "no orchestrator control endpoint: set COREDEM_CONTROL_ENDPOINT "
-                  "(or Options::controlEndpoint / --control), e.g. tcp://127.0.0.1:40123");
     COREDEM_CHECK(!demEp.empty(), "no DEM server endpoint: set COREDEM_DEM_ENDPOINT (or "
                                   "Options::demEndpoint / --dem), e.g. tcp://127.0.0.1:40125");
     COREDEM_CHECK(!session.empty(), "no session id: set COREDEM_SESSION (or Options::sessionId / "
@@ -205,6 +232,19 @@ struct Participant::Impl {
       }
     }
     timeout = std::chrono::milliseconds(static_cast<std::int64_t>(std::ceil(t * 1000.0)));
+  }
+
+  void initialize() {
+    checkRank();
+    COREDEM_CHECK(opt.rank == 0,
+                  "{}: rank {} of a decomposed run follows rank 0 (Participant::follow) instead of "
+                  "calling initialize()",
+                  opt.name, opt.rank);
+    controlEp = fromEnv(opt.controlEndpoint, "COREDEM_CONTROL_ENDPOINT");
+    COREDEM_CHECK(!controlEp.empty(),
+                  "no orchestrator control endpoint: set COREDEM_CONTROL_ENDPOINT "
+                  "(or Options::controlEndpoint / --control), e.g. tcp://127.0.0.1:40123");
+    readEnvironment();
 
     // 1. Hello to O.
     control = std::make_unique<proto::Client>(transport(false));
@@ -245,9 +285,7 @@ struct Participant::Impl {
     startTime = c.start_time();
 
     // 3. Hello to D.
-    dem = std::make_unique<proto::Client>(transport(true));
-    dem->connect(demEp);
-    handshake(*dem, "DEM server");
+    connectDem();
 
     // 4. Ready: the reply is the first grant.
     auto ready = proto::makeConfigured(static_cast<std::uint64_t>(grid.cellCount()), 0,
@@ -262,8 +300,11 @@ struct Participant::Impl {
     }
   }
 
+  /// exchange() of the whole grid (touched == nullptr) or of a rank's cells (exchangePartial).
   const Sources& exchange(std::int64_t s, double d, const std::vector<NamedField>& fields,
-                          const std::vector<NamedBuffer>& into) {
+                          const std::vector<NamedBuffer>& into,
+                          const std::vector<std::int64_t>* touched = nullptr,
+                          ConstView fluidVolume = ConstView()) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
     COREDEM_CHECK(s == step,
@@ -274,8 +315,33 @@ struct Participant::Impl {
                   "exchange(dt = {:.17g} s): the granted dt of step {} is {:.17g} s; the DEM "
                   "sub-cycles exactly the granted dt, so advance by dt()",
                   d, step, dt);
-    const auto cells = static_cast<std::uint64_t>(grid.cellCount());
+    const auto gridCells = static_cast<std::uint64_t>(grid.cellCount());
+    // Rows of every array: the grid's cells, or the rank's listed cells.
+    const auto cells = touched != nullptr ? static_cast<std::uint64_t>(touched->size()) : gridCells;
     const auto ns = static_cast<std::uint64_t>(grid.species.size());
+    const std::string versions = fmt::format("the DEM server at {} agreed protocol 1.{}, this "
+                                             "client speaks {}",
+                                             demEp, demMinor, proto::kProtocolVersion.toString());
+    if (touched != nullptr) {
+      COREDEM_CHECK(demMinor >= static_cast<int>(proto::kMinorDecomposed),
+                    "exchangePartial: {}; partial GasFields need 1.{} or later: update coredem-dem",
+                    versions, proto::kMinorDecomposed);
+      COREDEM_CHECK(fluidVolume.size == touched->size() &&
+                        (touched->empty() || fluidVolume.data != nullptr),
+                    "exchangePartial: {} fluid volumes for {} listed cells", fluidVolume.size,
+                    touched->size());
+      for (std::size_t i = 0; i < touched->size(); ++i) {
+        const std::int64_t g = (*touched)[i];
+        COREDEM_CHECK(g >= 0 && static_cast<std::uint64_t>(g) < gridCells &&
+                          (i == 0 || g > (*touched)[i - 1]),
+                      "exchangePartial: cells[{}] = {}: the list must be strictly ascending "
+                      "coupling cells (0..{})",
+                      i, g, gridCells - 1);
+        COREDEM_CHECK(fluidVolume[i] > 0.0 && std::isfinite(fluidVolume[i]),
+                      "exchangePartial: fluid volume {} m3 of cell {} must be positive",
+                      fluidVolume[i], g);
+      }
+    }
     std::map<std::string, ConstView> given;
     for (const auto& f : fields) {
       const auto named = [&](const auto& spec) { return spec.name == f.name; };
@@ -289,6 +355,16 @@ struct Participant::Impl {
                     f.name);
       COREDEM_CHECK(given.emplace(f.name, f.values).second, "exchange: field '{}' given twice",
                     f.name);
+    }
+    if (given.count(std::string(proto::fields::kFluidFraction)) != 0) {
+      COREDEM_CHECK(touched == nullptr,
+                    "exchangePartial: fluid_fraction is not sent with partial fields (the DEM "
+                    "server forms it from the ranks' fluid volumes)");
+      // A 1.1 server would ignore it silently and run the closures without it.
+      COREDEM_CHECK(demMinor >= static_cast<int>(proto::kMinorDecomposed),
+                    "exchange: {}; fluid_fraction (a mesh that does not fill the coupling grid) "
+                    "needs 1.{} or later: update coredem-dem",
+                    versions, proto::kMinorDecomposed);
     }
     std::map<std::string, const NamedBuffer*> dest;
     for (const auto& b : into) {
@@ -309,8 +385,16 @@ struct Participant::Impl {
       COREDEM_CHECK(dest.emplace(b.name, &b).second, "exchange: buffer for '{}' given twice",
                     b.name);
     }
-    auto msg = proto::makeGasFields(step, time, dt, cells, static_cast<std::uint32_t>(ns));
+    auto msg = proto::makeGasFields(step, time, dt, gridCells, static_cast<std::uint32_t>(ns));
     msg.setSessionId(session);
+    if (touched != nullptr) {
+      msg.envelope().mutable_gas_fields()->set_partial(true);
+      msg.envelope().mutable_gas_fields()->set_touched_count(cells);
+      msg.addArray<std::int64_t>(proto::fields::kTouchedCells,
+                                 std::span<const std::int64_t>(*touched), {cells});
+      msg.addArray<double>(proto::fields::kFluidVolume,
+                           std::span<const double>(fluidVolume.data, fluidVolume.size), {cells});
+    }
     for (const auto& spec : proto::fields::gasFields()) {
       const std::string name(spec.name);
       const auto it = given.find(name);
@@ -375,11 +459,25 @@ struct Participant::Impl {
     proto::Expectation e;
     e.types = {v1::MESSAGE_TYPE_SOURCES};
     e.step = step;
-    e.cells = cells;
+    e.cells = gridCells;
     e.species = ns;
     if (const auto st = proto::validate(*reply, e); !st.ok()) {
       throw proto::ProtocolError(st.code, "DEM server " + demEp + " sent bad Sources for step " +
                                               std::to_string(step) + ": " + st.message);
+    }
+    // A partial GasFields is answered with the sources of the same cells, in the same order.
+    const bool partialReply = reply->envelope().sources().partial();
+    bool sameCells = partialReply == (touched != nullptr);
+    if (sameCells && touched != nullptr) {
+      const auto back = reply->findArray(proto::fields::kTouchedCells)->as<std::int64_t>();
+      sameCells = std::equal(back.begin(), back.end(), touched->begin(), touched->end());
+    }
+    if (!sameCells) {
+      throw proto::ProtocolError(
+          v1::ERROR_CODE_SHAPE, fmt::format("DEM server {} answered the {} GasFields of step {} "
+                                            "with Sources of {}",
+                                            demEp, touched != nullptr ? "partial" : "whole-grid",
+                                            step, partialReply ? "other cells" : "the whole grid"));
     }
     auto kept = std::make_shared<proto::Message>(std::move(*reply));
     Sources next;
@@ -420,6 +518,10 @@ struct Participant::Impl {
   }
 
   void advance(double courant, const Ledgers& ledgers, const std::vector<std::string>& files) {
+    COREDEM_CHECK(opt.rank == 0,
+                  "advance: rank {} of a decomposed run follows rank 0's control state "
+                  "(Participant::follow); only rank 0 reports the step to the orchestrator",
+                  opt.rank);
     COREDEM_CHECK(std::isfinite(courant) && courant >= 0.0,
                   "advance: the Courant number must be finite and >= 0 (got {})", courant);
     COREDEM_CHECK(files.empty() || !checkpointDir.empty(),
@@ -446,6 +548,118 @@ struct Participant::Impl {
     auto done = proto::makeStepDone(step, time, body);
     done.setSessionId(session);
     takeGrantOrShutdown(control->request(std::move(done), timeout), step + 1);
+  }
+
+  // ---- decomposed runs: rank 0's control state for the other ranks ----------------------
+  std::string controlState() const {
+    COREDEM_CHECK(state == State::Granted || state == State::Finished,
+                  "controlState() after initialize() or advance() (state {})", stateName(state));
+    std::string out = "coredem-control-state 1\n";
+    const auto str = [&](const std::string& v) { out += fmt::format("{}:{}\n", v.size(), v); };
+    const auto num = [&](double v) { out += fmt::format("{:a}\n", v); }; // exact (hex float)
+    const auto integer = [&](std::int64_t v) { out += fmt::format("{}\n", v); };
+    for (int a = 0; a < 3; ++a) {
+      num(grid.origin[a]);
+      num(grid.spacing[a]);
+      integer(grid.counts[a]);
+    }
+    integer(static_cast<std::int64_t>(grid.species.size()));
+    for (std::size_t k = 0; k < grid.species.size(); ++k) {
+      str(grid.species[k]);
+      num(grid.molarMasses[k]);
+    }
+    integer(startStep);
+    num(startTime);
+    integer(state == State::Finished ? 1 : 0);
+    str(shutdownReason);
+    integer(step);
+    num(time);
+    num(dt);
+    integer(nSub);
+    num(dtDem);
+    str(checkpointDir);
+    integer(outputRequested ? 1 : 0);
+    return out;
+  }
+
+  void follow(const std::string& text) {
+    COREDEM_CHECK(state == State::Created || state == State::Exchanged,
+                  "follow() is called first (instead of initialize()) and after each exchange; "
+                  "state {}",
+                  stateName(state));
+    std::size_t pos = 0;
+    const auto line = [&]() {
+      const auto end = text.find('\n', pos);
+      COREDEM_CHECK(end != std::string::npos, "follow(): truncated control state");
+      std::string l = text.substr(pos, end - pos);
+      pos = end + 1;
+      return l;
+    };
+    const auto str = [&]() {
+      const auto colon = text.find(':', pos);
+      COREDEM_CHECK(colon != std::string::npos, "follow(): malformed control state");
+      const std::size_t n = std::stoull(text.substr(pos, colon - pos));
+      COREDEM_CHECK(colon + 1 + n < text.size() && text[colon + 1 + n] == '\n',
+                    "follow(): malformed control state");
+      std::string v = text.substr(colon + 1, n);
+      pos = colon + 2 + n;
+      return v;
+    };
+    const auto num = [&]() { return std::strtod(line().c_str(), nullptr); };
+    const auto integer = [&]() { return static_cast<std::int64_t>(std::stoll(line())); };
+    COREDEM_CHECK(line() == "coredem-control-state 1",
+                  "follow(): not a control state of this client library version");
+    Grid g;
+    for (int a = 0; a < 3; ++a) {
+      g.origin[a] = num();
+      g.spacing[a] = num();
+      g.counts[a] = integer();
+    }
+    const std::int64_t nSpecies = integer();
+    for (std::int64_t k = 0; k < nSpecies; ++k) {
+      g.species.push_back(str());
+      g.molarMasses.push_back(num());
+    }
+    const std::int64_t start = integer();
+    const double startT = num();
+    const bool finished = integer() != 0;
+    std::string reason = str();
+    const std::int64_t nextStep = integer();
+    const double nextTime = num();
+    const double nextDt = num();
+    const int nextNSub = static_cast<int>(integer());
+    const double nextDtDem = num();
+    std::string dir = str();
+    const bool output = integer() != 0;
+    if (state == State::Created) {
+      checkRank();
+      COREDEM_CHECK(opt.rank > 0 && opt.rankCount > 1,
+                    "{}: follow() is for ranks > 0 of a decomposed run (rank {} of {})", opt.name,
+                    opt.rank, opt.rankCount);
+      readEnvironment();
+      grid = g;
+      startStep = start;
+      startTime = startT;
+      connectDem();
+    } else if (nextStep != step + 1 && !finished) {
+      throw ClientError(ErrorCode::Protocol,
+                        fmt::format("{}: rank {} is at step {} but rank 0's next grant is of step "
+                                    "{}",
+                                    opt.name, opt.rank, step, nextStep));
+    }
+    if (finished) {
+      shutdownReason = std::move(reason);
+      state = State::Finished;
+      return;
+    }
+    step = nextStep;
+    time = nextTime;
+    dt = nextDt;
+    nSub = nextNSub;
+    dtDem = nextDtDem;
+    checkpointDir = std::move(dir);
+    outputRequested = output;
+    state = State::Granted;
   }
 
   void finalize() {
@@ -571,6 +785,32 @@ const Sources& Participant::exchange(std::int64_t step, double dt,
                  "exchange() once per grant, after initialize() or advance() granted a step");
   return guarded("exchange",
                  [&]() -> const Sources& { return _impl->exchange(step, dt, fields, into); });
+}
+
+const Sources& Participant::exchangePartial(std::int64_t step, double dt,
+                                            const std::vector<std::int64_t>& cells,
+                                            ConstView fluidVolume,
+                                            const std::vector<NamedField>& sums) {
+  _impl->require({State::Granted}, "exchangePartial",
+                 "exchangePartial() once per grant, after initialize()/follow() or advance()");
+  return guarded("exchangePartial", [&]() -> const Sources& {
+    return _impl->exchange(step, dt, sums, {}, &cells, fluidVolume);
+  });
+}
+
+std::string Participant::controlState() const {
+  return guarded("controlState", [&] { return _impl->controlState(); });
+}
+
+void Participant::follow(const std::string& controlState) {
+  _impl->require({State::Created, State::Exchanged}, "follow",
+                 "follow() replaces initialize() on ranks > 0 and takes each next grant after "
+                 "exchangePartial()");
+  guarded("follow", [&] { _impl->follow(controlState); });
+}
+
+int Participant::demProtocolMinor() const {
+  return _impl->demMinor;
 }
 
 ExchangeTimes Participant::lastExchangeTimes() const {

@@ -2,6 +2,7 @@
 
 #include "OFstream.H"
 #include "OSspecific.H"
+#include "Pstream.H"
 
 #include <cstdio>
 #include <cstdlib>
@@ -50,9 +51,16 @@ std::vector<std::string> Checkpoint::write
 {
     const fileName base(dir/"openfoam");
     const word inst(runTime_.timeName());
-    const fileName timeDir(base/inst);
+    // Decomposed: each processor writes its fields into openfoam/processorN/<time> (the layout
+    // of a decomposed case); the master the restart file and the list of every processor's.
+    const word proc(Pstream::parRun() ? "processor" + Foam::name(Pstream::myProcNo()) : "");
+    const fileName timeDir(Pstream::parRun() ? base/proc/inst : base/inst);
     mkDir(timeDir);
     for (regIOobject* f : fields_) writeBinary(*f, timeDir);
+    if (!Pstream::master())
+    {
+        return {};
+    }
 
     const fileName tmp(base/"coredemFoam.restart.tmp");
     {
@@ -76,9 +84,14 @@ std::vector<std::string> Checkpoint::write
     Foam::mv(tmp, base/"coredemFoam.restart");
 
     std::vector<std::string> files{"openfoam/coredemFoam.restart"};
-    for (const regIOobject* f : fields_)
+    for (label p = 0; p < (Pstream::parRun() ? Pstream::nProcs() : 1); ++p)
     {
-        files.push_back("openfoam/" + std::string(inst) + "/" + std::string(f->name()));
+        const std::string sub =
+            Pstream::parRun() ? "processor" + std::to_string(p) + "/" : std::string();
+        for (const regIOobject* f : fields_)
+        {
+            files.push_back("openfoam/" + sub + std::string(inst) + "/" + std::string(f->name()));
+        }
     }
     Info<< "Checkpoint of step " << label(step) << " written to " << timeDir << endl;
     return files;

@@ -23,12 +23,14 @@
 // Command line: coredemFoam -case DIR [-restart FILE] [-control EP] [-dem EP] [-session ID]
 // [-timeout S] [-timers] (endpoints default to COREDEM_CONTROL_ENDPOINT, COREDEM_DEM_ENDPOINT,
 // COREDEM_SESSION). -timers: per-stage wall time per CFD step, a table at the end and
-// DIR/../timers-cfd.json (the run folder under `coredem run`).
+// DIR/../timers-cfd.json (the run folder under `coredem run`; decomposed: rank 0's, the other
+// ranks' in timers-cfd-processorN.json). -parallel: a decomposed run (docs/coredemFoam.md).
 
 #include "fvCFD.H"
 #include "singlePhaseTransportModel.H"
 #include "PhaseIncompressibleTurbulenceModel.H"
 #include "pimpleControl.H"
+#include "processorFvPatch.H"
 #include "fvOptions.H"
 
 #include "checkpoint.H"
@@ -36,6 +38,7 @@
 #include "couplingFields.H"
 #include "couplingGrid.H"
 #include "gasLedgers.H"
+#include "rankControl.H"
 #include "stageTimers.H"
 
 #include "coredem/client/participant.h"
@@ -141,7 +144,10 @@ int main(int argc, char* argv[])
         try
         {
             timers.tic();
-            coupling.advance(CoNum, ledgers.report(), files);
+            // Decomposed: the master reports the step (CoNum and the ledgers are reduced over
+            // the processors) and the others follow its next grant (rankControl.H).
+            if (Pstream::master()) coupling.advance(CoNum, ledgers.report(), files);
+            followMaster(coupling);
             timers.toc(StageTimers::Advance);
         }
         catch (const ::coredem::client::ClientError& e)
@@ -158,7 +164,16 @@ int main(int argc, char* argv[])
     if (timersOn)
     {
         Info<< nl << timers.table(nCells, exchange.direct()).c_str() << endl;
-        const fileName file(runTime.path().path()/"timers-cfd.json");
+        // Decomposed: rank 0's in timers-cfd.json, the others' in timers-cfd-processorN.json.
+        const fileName file
+        (
+            runTime.globalPath().path()
+           /(
+                Pstream::master()
+              ? word("timers-cfd.json")
+              : word("timers-cfd-processor" + Foam::name(Pstream::myProcNo()) + ".json")
+            )
+        );
         {
             std::ofstream out(file.c_str());
             out << timers.json(nCells, exchange.direct());

@@ -31,8 +31,16 @@ CouplingExchange::CouplingExchange
     grid_(grid),
     nCells_(nCells),
     timers_(timers),
-    direct_(false)
+    direct_(false),
+    partial_(Pstream::parRun())
 {
+    if (partial_)
+    {
+        touched_.assign(grid_.touched().begin(), grid_.touched().end());
+        Info<< "Exchange: decomposed, each processor with the DEM server (partial sums of the "
+            << "coupling cells it touches)\n" << endl;
+        return;
+    }
     // Mesh cell order = grid order (one blockMesh block): the fields are sent from and the
     // sources received into the solver's own arrays, with no gather/scatter copies.
     // COREDEM_FOAM_EXCHANGE=copy forces the gather/scatter path (to measure the difference).
@@ -48,9 +56,89 @@ CouplingExchange::CouplingExchange
 }
 
 
+void CouplingExchange::exchangePartial(label step, scalar dt)
+{
+    using ::coredem::client::ConstView;
+
+    // Pack: volume-weighted sums over this processor's cells per touched coupling cell.
+    std::vector<::coredem::client::NamedField> fields;
+    fields.reserve(outputs_.size());
+    for (std::size_t i = 0; i < outputs_.size(); ++i)
+    {
+        CouplingOutput& out = *outputs_[i];
+        if (out.onGrid()) continue; // fluid_fraction: formed by the DEM server
+        out.update();
+        const ConstView v = out.cellValues();
+        grid_.sumTouched(v.data, out.nComponents(), gathered_[i]);
+        fields.push_back({out.name(), gathered_[i]});
+    }
+    timers_.toc(StageTimers::Pack);
+
+    const ::coredem::client::Sources* src = nullptr;
+    try
+    {
+        src = &coupling_.exchangePartial
+        (
+            coupling_.step(), dt, touched_, grid_.partialVolume(), fields
+        );
+    }
+    catch (const ::coredem::client::ClientError& e)
+    {
+        FatalErrorInFunction << "coupling, step " << step << ", processor "
+            << Pstream::myProcNo() << ": " << e.what() << exit(FatalError);
+    }
+    {
+        const ::coredem::client::ExchangeTimes xt = coupling_.lastExchangeTimes();
+        timers_.add(StageTimers::Serialise, xt.serialise);
+        timers_.add(StageTimers::Send, xt.send);
+        timers_.add(StageTimers::Wait, xt.wait);
+        timers_.add(StageTimers::Receive, xt.receive);
+    }
+    timers_.tic();
+
+    // Unpack: the touched cells' sources -> this processor's cells -> inputs.
+    const std::size_t nc = std::size_t(nCells_);
+    for (const std::unique_ptr<CouplingInput>& in : inputs_)
+    {
+        const label nComp = in->nComponents();
+        if (nComp == 0)
+        {
+            in->read(nullptr);
+            continue;
+        }
+        const ConstView v = src->field(in->name());
+        if (v.size != touched_.size()*nComp)
+        {
+            FatalErrorInFunction
+                << "DEM source " << in->name().c_str() << " has " << label(v.size)
+                << " values, expected " << label(touched_.size()*nComp) << exit(FatalError);
+        }
+        double* storage = in->cellStorage();
+        if (storage != nullptr)
+        {
+            grid_.scatterTouched(v.data, nComp, storage, quantity(*in));
+            in->read(storage);
+        }
+        else
+        {
+            scattered_.assign(nc*nComp, 0.0);
+            grid_.scatterTouched(v.data, nComp, scattered_.data(), quantity(*in));
+            in->read(scattered_.data());
+        }
+    }
+    timers_.toc(StageTimers::Unpack);
+}
+
+
 void CouplingExchange::exchange(label step, scalar dt)
 {
     using ::coredem::client::ConstView;
+
+    if (partial_)
+    {
+        exchangePartial(step, dt);
+        return;
+    }
 
     // Pack: the gas at the start of the step, in grid order.
     std::vector<::coredem::client::NamedField> fields;

@@ -268,6 +268,15 @@ void CoredemGrid::computeOverlaps(const fvMesh& mesh)
             partialVolume_.push_back(fluidVolume_[g]);
         }
     }
+    {
+        std::vector<label> pos(std::size_t(nGrid_), -1);
+        for (std::size_t t = 0; t < touched_.size(); ++t) pos[touched_[t]] = label(t);
+        overlapTouched_.resize(overlapGrid_.size());
+        for (std::size_t e = 0; e < overlapGrid_.size(); ++e)
+        {
+            overlapTouched_[e] = pos[overlapGrid_[e]];
+        }
+    }
     if (Pstream::parRun())
     {
         // Decomposed: the fluid volume is the sum of the processors' parts (once per mesh).
@@ -438,6 +447,70 @@ void CoredemGrid::scatter
             const double w = overlapVol_[e];
             const double r = fluidScale_[g];
             const double* s = gridValues + std::size_t(g)*nComp;
+            for (label q = 0; q < nComp; ++q)
+            {
+                c[q] += w*(fraction ? 1 - (1 - s[q])*r : s[q]*r);
+            }
+        }
+        for (label q = 0; q < nComp; ++q) c[q] /= cellVol_[celli];
+    }
+}
+
+void CoredemGrid::sumTouched
+(
+    const scalar* cellValues, label nComp, std::vector<double>& out
+) const
+{
+    out.assign(touched_.size()*std::size_t(nComp), 0.0);
+    const label nCells = label(rowStart_.size()) - 1;
+    for (label celli = 0; celli < nCells; ++celli)
+    {
+        const scalar* v = cellValues + std::size_t(celli)*nComp;
+        for (label e = rowStart_[celli]; e < rowStart_[celli + 1]; ++e)
+        {
+            const label t = overlapTouched_[e];
+            if (t < 0) continue;
+            const double w = overlapVol_[e];
+            double* o = out.data() + std::size_t(t)*nComp;
+            for (label q = 0; q < nComp; ++q) o[q] += w*v[q];
+        }
+    }
+}
+
+
+void CoredemGrid::scatterTouched
+(
+    const double* touchedValues, label nComp, scalar* cellValues, Quantity quantity
+) const
+{
+    const bool fraction = quantity == Quantity::GasFraction;
+    if (fraction)
+    {
+        for (std::size_t t = 0; t < touched_.size(); ++t)
+        {
+            const label g = touched_[t];
+            if (fluidScale_[g] == 0 && touchedValues[t] < 1)
+            {
+                FatalErrorInFunction
+                    << "coupling-grid cell " << describe(g) << " holds particles ("
+                    << (1 - touchedValues[t])*cellVolume() << " m3 of solid) but no fluid: a "
+                    << "particle lies outside the CFD domain (check the walls against the mesh)"
+                    << exit(FatalError);
+            }
+        }
+    }
+    const label nCells = label(rowStart_.size()) - 1;
+    for (label celli = 0; celli < nCells; ++celli)
+    {
+        scalar* c = cellValues + std::size_t(celli)*nComp;
+        for (label q = 0; q < nComp; ++q) c[q] = 0;
+        for (label e = rowStart_[celli]; e < rowStart_[celli + 1]; ++e)
+        {
+            const label t = overlapTouched_[e];
+            if (t < 0) continue;
+            const double w = overlapVol_[e];
+            const double r = fluidScale_[overlapGrid_[e]];
+            const double* s = touchedValues + std::size_t(t)*nComp;
             for (label q = 0; q < nComp; ++q)
             {
                 c[q] += w*(fraction ? 1 - (1 - s[q])*r : s[q]*r);

@@ -1,6 +1,7 @@
 // coredem-dem: D of docs/session.md over the protocol library and the DEM core.
 #include "coredem/server/dem_server.h"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -8,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <random>
+#include <span>
 
 #include <fcntl.h>
 #include <google/protobuf/stubs/logging.h>
@@ -149,8 +151,13 @@ struct DemServer::Impl {
   // ---- the session ---------------------------------------------------------------------
   SessionState state = SessionState::Idle;
   std::string session;
-  proto::PeerId oPeer, cPeer;
-  std::string oName, cName;
+  proto::PeerId oPeer;
+  std::string oName;
+  // The CFD participant: one connection per rank (docs/protocol.md "Decomposed CFD"); rankCount
+  // is fixed by the first CFD Hello (0: none yet) and free again when no rank is connected.
+  std::uint32_t rankCount = 0;
+  std::vector<proto::PeerId> rankPeers;
+  std::vector<std::string> rankNames;
   Clock::time_point started, lastActivity;
   std::map<proto::PeerId, std::uint64_t> lastSequence;
   std::unique_ptr<dem::DemSystem> system;
@@ -162,6 +169,7 @@ struct DemServer::Impl {
   std::int64_t stepsDone = 0; ///< in this session
   std::optional<Grant> grant;
   std::optional<Held> held;
+  std::map<std::uint32_t, Held> partials; ///< partial GasFields of the step, by rank
   ServerLedgers ledgers;
   /// Staggered coupling (Configure option coupling_scheme = staggered, docs/coupling-schemes.md):
   /// GasFields of step n are answered at once with the sources computed in step n-1.
@@ -180,7 +188,37 @@ struct DemServer::Impl {
 
   /// The session's orchestrator or CFD participant (the connections that said Hello).
   bool isMember(const proto::PeerId& p) const {
-    return state != SessionState::Idle && !p.empty() && (p == oPeer || p == cPeer);
+    return state != SessionState::Idle && !p.empty() && (p == oPeer || rankOf(p) >= 0);
+  }
+
+  /// The CFD rank of a connection, or -1.
+  int rankOf(const proto::PeerId& p) const {
+    for (std::size_t r = 0; r < rankPeers.size(); ++r) {
+      if (!p.empty() && rankPeers[r] == p) {
+        return static_cast<int>(r);
+      }
+    }
+    return -1;
+  }
+
+  /// The CFD participant's name for logs ("-" when none).
+  std::string cfdName() const {
+    std::string n;
+    for (std::size_t r = 0; r < rankNames.size(); ++r) {
+      if (!rankPeers[r].empty()) {
+        n = rankNames[r];
+        break;
+      }
+    }
+    if (n.empty()) {
+      return "-";
+    }
+    return rankCount > 1 ? fmt::format("{} ({} ranks)", n, rankCount) : n;
+  }
+
+  bool anyRankConnected() const {
+    return std::any_of(rankPeers.begin(), rankPeers.end(),
+                       [](const proto::PeerId& p) { return !p.empty(); });
   }
 
   // ---- replies ---------------------------------------------------------------------------
@@ -198,8 +236,9 @@ struct DemServer::Impl {
     if (!oPeer.empty() && p == oPeer) {
       return fmt::format("orchestrator '{}'", oName);
     }
-    if (!cPeer.empty() && p == cPeer) {
-      return fmt::format("CFD participant '{}'", cName);
+    if (const int r = rankOf(p); r >= 0) {
+      return rankCount > 1 ? fmt::format("CFD rank {} of {} '{}'", r, rankCount, rankNames[r])
+                           : fmt::format("CFD participant '{}'", rankNames[r]);
     }
     return fmt::format("peer {}", hexPeer(p));
   }
@@ -238,6 +277,9 @@ struct DemServer::Impl {
       refuse(held->request, code,
              "the session ended before this step was granted (" + reason + ")");
     }
+    for (auto& [rank, h] : partials) {
+      refuse(h.request, code, "the session ended before this step ran (" + reason + ")");
+    }
     if (grant) {
       auto m = proto::makeError(code,
                                 "the session ended during step " + std::to_string(grant->step) +
@@ -247,7 +289,7 @@ struct DemServer::Impl {
     }
     const double secs = std::chrono::duration<double>(Clock::now() - started).count();
     log->info("session {} ended: {} (orchestrator '{}', CFD participant '{}', {} steps, {:.1f} s)",
-              session, reason, oName, cName.empty() ? "-" : cName, stepsDone, secs);
+              session, reason, oName, cfdName(), stepsDone, secs);
     if (opt.timers && system) {
       const auto st = system->stageTimes();
       log->info("session {}: {}", session, timersReport(xt, st, secs, true));
@@ -264,14 +306,16 @@ struct DemServer::Impl {
     state = SessionState::Idle;
     session.clear();
     oPeer.clear();
-    cPeer.clear();
+    rankPeers.clear();
+    rankNames.clear();
+    rankCount = 0;
     oName.clear();
-    cName.clear();
     lastSequence.clear();
     system.reset();
     ::malloc_trim(0); // the session's particles and grids go back to the system
     grant.reset();
     held.reset();
+    partials.clear();
     ledgers = ServerLedgers();
     staggered = false;
     lag = StaggeredState();
@@ -307,15 +351,25 @@ struct DemServer::Impl {
     if (p == oPeer) {
       endSession(fmt::format("the connection of orchestrator '{}' closed", oName),
                  v1::ERROR_CODE_TRANSPORT);
-    } else if (p == cPeer) {
-      log->warn("session {}: the connection of CFD participant '{}' closed; a new CFD "
-                "participant may join with the session id",
-                session, cName);
+    } else if (const int r = rankOf(p); r >= 0) {
+      const std::string who = peerName(p);
+      log->warn("session {}: the connection of {} closed; a new CFD participant may join with "
+                "the session id",
+                session, who);
       if (held && held->request.peer == p) {
         held.reset();
       }
-      cPeer.clear();
-      cName.clear();
+      rankPeers[r].clear();
+      rankNames[r].clear();
+      if (!partials.empty()) {
+        partials.erase(static_cast<std::uint32_t>(r));
+        failPartialStep(v1::ERROR_CODE_TRANSPORT,
+                        fmt::format("the connection of {} closed during step {}", who,
+                                    grant ? grant->step : lastStep + 1));
+      }
+      if (!anyRankConnected()) {
+        rankCount = 0;
+      }
     }
   }
 
@@ -375,20 +429,58 @@ struct DemServer::Impl {
                "on its own connection");
         return;
       }
-      if (!cPeer.empty() && cPeer != r.peer) {
+      // Decomposed (v1.2): rank r of K; rank_count 0 (older peers) or 1 is one rank.
+      const std::uint32_t k = std::max<std::uint32_t>(1, h.rank_count());
+      const std::uint32_t rank = h.rank();
+      if (rank >= k) {
+        reject(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+               fmt::format("Hello of CFD rank {} of {}: the rank index must be below the rank "
+                           "count",
+                           rank, k));
+        return;
+      }
+      if (anyRankConnected() && k != rankCount) {
+        reject(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
+               fmt::format("the session's CFD participant runs on {} rank(s) ('{}'); this Hello "
+                           "says {}: every rank of one decomposed run gives the same rank count",
+                           rankCount, cfdName(), k));
+        return;
+      }
+      if (const int mine = rankOf(r.peer); mine >= 0 && static_cast<std::uint32_t>(mine) != rank) {
+        reject(r, v1::ERROR_CODE_SESSION_BUSY,
+               fmt::format("this connection is CFD rank {}; a rank says Hello on its own "
+                           "connection",
+                           mine));
+        return;
+      }
+      if (!anyRankConnected()) {
+        rankCount = k;
+        rankPeers.assign(k, proto::PeerId());
+        rankNames.assign(k, std::string());
+      }
+      if (!rankPeers[rank].empty() && rankPeers[rank] != r.peer) {
         // Each role is bound to the connection that said Hello first; the role is freed when
         // that connection closes (onDisconnected).
         reject(r, v1::ERROR_CODE_SESSION_BUSY,
-               fmt::format("the session already has a CFD participant ('{}') on another "
-                           "connection; a second one is refused",
-                           cName));
+               k == 1 ? fmt::format("the session already has a CFD participant ('{}') on another "
+                                    "connection; a second one is refused",
+                                    rankNames[rank])
+                      : fmt::format("CFD rank {} of {} is already connected ('{}') on another "
+                                    "connection; a duplicate rank index is refused",
+                                    rank, k, rankNames[rank]));
         return;
       }
-      cPeer = r.peer;
-      cName = nameOf(r);
+      rankPeers[rank] = r.peer;
+      rankNames[rank] = nameOf(r);
       lastSequence[r.peer] = env.sequence();
-      log->info("session {}: CFD participant '{}' connected (protocol {}.{}, peer {}{})", session,
-                cName, n.agreed.major, n.agreed.minor, hexPeer(r.peer), keyNote(r));
+      if (k > 1) {
+        log->info("session {}: CFD rank {} of {} '{}' connected (protocol {}.{}, peer {}{})",
+                  session, rank, k, rankNames[rank], n.agreed.major, n.agreed.minor,
+                  hexPeer(r.peer), keyNote(r));
+      } else {
+        log->info("session {}: CFD participant '{}' connected (protocol {}.{}, peer {}{})", session,
+                  rankNames[rank], n.agreed.major, n.agreed.minor, hexPeer(r.peer), keyNote(r));
+      }
     } else {
       reject(r, v1::ERROR_CODE_UNSUPPORTED,
              "coredem-dem takes sessions of an orchestrator (ROLE_ORCHESTRATOR) and its CFD "
@@ -601,6 +693,8 @@ struct DemServer::Impl {
       auto h = std::move(*held);
       held.reset();
       runStep(h.request);
+    } else if (rankCount > 0 && partials.size() == rankCount) {
+      runPartialStep();
     }
   }
 
@@ -616,10 +710,28 @@ struct DemServer::Impl {
   }
 
   void onGasFields(proto::Request& r) {
-    if (r.peer != cPeer) {
+    const int rank = rankOf(r.peer);
+    if (rank < 0) {
       refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
              "GasFields come from the session's CFD participant: send Hello{role=CFD} with the "
              "session id first");
+      return;
+    }
+    if (r.message.envelope().gas_fields().partial()) {
+      onPartialGasFields(r, static_cast<std::uint32_t>(rank));
+      return;
+    }
+    if (rankCount > 1) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             fmt::format("whole-grid GasFields in a session whose CFD participant runs on {} "
+                         "ranks: each rank sends a partial GasFields of the cells it touches "
+                         "(docs/protocol.md \"Decomposed CFD\")",
+                         rankCount));
+      return;
+    }
+    if (!partials.empty()) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             "a partial GasFields of this step is already waiting; send partial ones only");
       return;
     }
     if (held) {
@@ -635,31 +747,200 @@ struct DemServer::Impl {
     runStep(r);
   }
 
-  /// The Sources message answering `r` with the cell sources `s`.
-  void sendSources(const proto::Request& r, const dem::CellSources& s, const v1::Ledger& ledger) {
+  /// One reply of a step: the request it answers and, for a partial GasFields, its cells.
+  struct StepReply {
+    const proto::Request* request = nullptr;
+    std::span<const std::int64_t> cells; ///< partial: the rank's coupling cells
+    bool partial = false;
+  };
+
+  void refuseAll(const std::vector<StepReply>& to, v1::ErrorCode code, const std::string& text) {
+    for (const StepReply& t : to) {
+      refuse(*t.request, code, text);
+    }
+  }
+
+  void runStep(const proto::Request& r) { runStepOn(r.message, {StepReply{&r, {}, false}}); }
+
+  // ---- decomposed CFD (docs/protocol.md "Decomposed CFD") ----------------------------------
+  void onPartialGasFields(proto::Request& r, std::uint32_t rank) {
+    if (held) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             "a whole-grid GasFields of this step is already waiting; send whole-grid ones only");
+      return;
+    }
+    if (partials.count(rank) != 0) {
+      refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE,
+             fmt::format("CFD rank {} already sent its GasFields of step {}", rank,
+                         partials.at(rank).request.message.envelope().step()));
+      return;
+    }
+    partials.emplace(rank, Held{std::move(r), Clock::now()});
+    if (grant && partials.size() == rankCount) {
+      runPartialStep();
+    }
+  }
+
+  /// Answers every waiting rank and the orchestrator's grant with `code`/`text`; the step is
+  /// not run (the orchestrator stops the run).
+  void failPartialStep(v1::ErrorCode code, const std::string& text) {
+    log->error("session {}: {}", session, text);
+    for (auto& [rank, h] : partials) {
+      refuse(h.request, code, text);
+    }
+    partials.clear();
+    if (grant) {
+      send(grant->peer, proto::makeError(code, text, grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT),
+           grant->sequence, grant->step);
+      grant.reset();
+    }
+  }
+
+  /// Combines the K partial GasFields in rank order (independent of their arrival order) into
+  /// the whole-grid gas of the step and runs it: V_g = sum_r V_r,g, f_g = sum_r S_r,g / V_g,
+  /// fluid fraction V_g / V_c (exactly 1 within 1e-12 of V_c, 0 for cells no rank touches, whose
+  /// gas is the volume-weighted average of all cells).
+  void runPartialStep() {
     namespace f = proto::fields;
-    const auto& env = r.message.envelope();
-    auto src =
-        proto::makeSources(env.step(), env.time(), grant->dtCfd, cells, species, grant->nSub);
-    auto add = [&](std::string_view name, const std::vector<double>& v) {
-      src.addArray<double>(name, std::span<const double>(v), f::shapeOf(name, cells, species));
-    };
-    add(f::kVoidFraction, s.epsG);
-    add(f::kDragCoefficient, s.kSl);
-    add(f::kDragCoefficientTimesUs, s.kSlUs);
-    add(f::kHeatCoefficient, s.heatH);
-    add(f::kHeatCoefficientTimesTp, s.heatHTp);
-    add(f::kSpeciesSources, s.rSpecies);
-    add(f::kHomogeneousHeat, s.qHom);
-    *src.envelope().mutable_sources()->mutable_ledger() = ledger;
-    send(r.peer, std::move(src), env.sequence(), env.step());
+    std::map<std::uint32_t, Held> parts;
+    parts.swap(partials);
+    std::vector<StepReply> to;
+    for (auto& [rank, h] : parts) { // std::map: rank order
+      to.push_back(StepReply{
+          &h.request, h.request.message.findArray(f::kTouchedCells)->as<std::int64_t>(), true});
+    }
+    const auto& first = parts.begin()->second.request.message.envelope();
+    const auto n = static_cast<std::size_t>(cells);
+    std::vector<double> volume(n, 0.0);
+    for (const StepReply& t : to) {
+      const auto fv = t.request->message.values<double>(f::kFluidVolume);
+      for (std::size_t i = 0; i < t.cells.size(); ++i) {
+        volume[static_cast<std::size_t>(t.cells[i])] += fv[i];
+      }
+    }
+    double totalVolume = 0.0;
+    for (std::size_t g = 0; g < n; ++g) {
+      totalVolume += volume[g];
+    }
+    if (!(totalVolume > 0.0)) {
+      failPartialStep(v1::ERROR_CODE_INVALID_CONFIGURATION,
+                      fmt::format("step {}: the {} CFD ranks' GasFields touch no coupling cell",
+                                  first.step(), rankCount));
+      refuseAll(to, v1::ERROR_CODE_INVALID_CONFIGURATION, "the ranks touch no coupling cell");
+      return;
+    }
+    auto gas =
+        proto::makeGasFields(first.step(), first.time(), first.gas_fields().dt(), cells, species);
+    for (const auto& spec : f::gasFields()) {
+      const std::size_t q = f::componentsOf(spec.extent, species);
+      std::vector<double> sum(n * q, 0.0), all(q, 0.0);
+      for (const StepReply& t : to) {
+        const auto v = t.request->message.values<double>(spec.name);
+        for (std::size_t i = 0; i < t.cells.size(); ++i) {
+          const std::size_t g = static_cast<std::size_t>(t.cells[i]);
+          for (std::size_t c = 0; c < q; ++c) {
+            sum[g * q + c] += v[i * q + c];
+          }
+        }
+      }
+      for (std::size_t g = 0; g < n; ++g) {
+        for (std::size_t c = 0; c < q; ++c) {
+          all[c] += sum[g * q + c];
+        }
+      }
+      for (std::size_t g = 0; g < n; ++g) {
+        for (std::size_t c = 0; c < q; ++c) {
+          sum[g * q + c] = volume[g] > 0.0 ? sum[g * q + c] / volume[g] : all[c] / totalVolume;
+        }
+      }
+      gas.addArray<double>(spec.name, std::span<const double>(sum),
+                           f::shapeOf(spec.extent, cells, species));
+    }
+    std::vector<double> fraction(n, 1.0);
+    bool partFluid = false;
+    for (std::size_t g = 0; g < n; ++g) {
+      const double v = volume[g];
+      if (v > cellVolume * (1.0 + 1e-6)) {
+        failPartialStep(
+            v1::ERROR_CODE_INVALID_CONFIGURATION,
+            fmt::format("step {}: the CFD ranks' fluid volume in coupling cell {} is {} "
+                        "m3, more than the cell's {} m3 (overlapping decomposition?)",
+                        first.step(), g, v, cellVolume));
+        refuseAll(to, v1::ERROR_CODE_INVALID_CONFIGURATION, "overlapping fluid volumes");
+        return;
+      }
+      fraction[g] = std::abs(v - cellVolume) <= 1e-12 * cellVolume ? 1.0
+                    : v <= 1e-12 * cellVolume                      ? 0.0
+                                                                   : std::min(1.0, v / cellVolume);
+      partFluid = partFluid || fraction[g] != 1.0;
+    }
+    if (partFluid) {
+      gas.addArray<double>(f::kFluidFraction, std::span<const double>(fraction), {cells});
+    }
+    if (const auto st = proto::validateGasRanges(gas); !st.ok()) {
+      const std::string text = "the combined GasFields of the CFD ranks: " + st.message;
+      refuseAll(to, st.code, text);
+      if (grant) {
+        send(grant->peer,
+             proto::makeError(st.code, text, grant->sequence, v1::MESSAGE_TYPE_STEP_GRANT),
+             grant->sequence, grant->step);
+        grant.reset();
+      }
+      return;
+    }
+    runStepOn(gas, to);
+  }
+
+  /// The Sources answering the GasFields `gasMessage` of the step with the cell sources `s`: the
+  /// whole grid, or each rank's cells (decomposed CFD).
+  void sendSources(const std::vector<StepReply>& to, const proto::Message& gasMessage,
+                   const dem::CellSources& s, const v1::Ledger& ledger) {
+    namespace f = proto::fields;
+    const auto& env = gasMessage.envelope();
+    const auto n = static_cast<std::size_t>(cells);
+    const double dt = grant->dtCfd;
+    for (const StepReply& t : to) {
+      const auto& req = t.request->message.envelope();
+      const std::uint64_t rows = t.partial ? t.cells.size() : cells;
+      auto src = proto::makeSources(env.step(), env.time(), dt, cells, species, grant->nSub);
+      if (t.partial) {
+        src.envelope().mutable_sources()->set_partial(true);
+        src.envelope().mutable_sources()->set_touched_count(rows);
+        src.addArray<std::int64_t>(f::kTouchedCells, t.cells, {rows});
+      }
+      std::vector<double> picked;
+      auto add = [&](std::string_view name, const std::vector<double>& v) {
+        std::span<const double> values(v);
+        if (t.partial) {
+          const std::size_t q = v.size() / n;
+          picked.resize(t.cells.size() * q);
+          for (std::size_t i = 0; i < t.cells.size(); ++i) {
+            for (std::size_t c = 0; c < q; ++c) {
+              picked[i * q + c] = v[static_cast<std::size_t>(t.cells[i]) * q + c];
+            }
+          }
+          values = picked;
+        }
+        src.addArray<double>(name, values, f::shapeOf(name, rows, species));
+      };
+      add(f::kVoidFraction, s.epsG);
+      add(f::kDragCoefficient, s.kSl);
+      add(f::kDragCoefficientTimesUs, s.kSlUs);
+      add(f::kHeatCoefficient, s.heatH);
+      add(f::kHeatCoefficientTimesTp, s.heatHTp);
+      add(f::kSpeciesSources, s.rSpecies);
+      add(f::kHomogeneousHeat, s.qHom);
+      *src.envelope().mutable_sources()->mutable_ledger() = ledger;
+      send(t.request->peer, std::move(src), req.sequence(), env.step());
+    }
   }
 
   /// Staggered: answers the GasFields of step n at once with the pending sources of step n-1 (for
   /// the first step of a session without pending sources: those of the current state, evaluated
   /// without advancing) and books them as applied with this step's T_g and Δt, the values the gas
   /// applies them with. False when the session ended.
-  bool sendLaggedSources(const proto::Request& r, const dem::GasFieldsView& gas) {
+  bool sendLaggedSources(const std::vector<StepReply>& to, const proto::Message& gasMessage,
+                         const dem::GasFieldsView& gas) {
     if (!lag.hasPending) {
       try {
         lag.pending = system->evaluateSources(grant->dtCfd / grant->nSub);
@@ -668,9 +949,9 @@ struct DemServer::Impl {
       } catch (const std::exception& e) {
         log->error("session {}: step {}: the initial sources failed in the DEM core: {}", session,
                    grant->step, e.what());
-        refuse(r, v1::ERROR_CODE_INTERNAL,
-               fmt::format("step {}: evaluating the initial sources failed in the DEM core: {}",
-                           grant->step, e.what()));
+        refuseAll(to, v1::ERROR_CODE_INTERNAL,
+                  fmt::format("step {}: evaluating the initial sources failed in the DEM core: {}",
+                              grant->step, e.what()));
         endSession(fmt::format("step {}: the initial sources failed: {}", grant->step, e.what()),
                    v1::ERROR_CODE_INTERNAL);
         return false;
@@ -710,46 +991,46 @@ struct DemServer::Impl {
       }
       ledgers.speciesToGas[k] += sum * cellVolume * dt;
     }
-    sendSources(r, p, lastLedger);
+    sendSources(to, gasMessage, p, lastLedger);
     lag.hasPending = false; // applied by the gas in this step; the step computes the next ones
     return true;
   }
 
-  void runStep(const proto::Request& r) {
-    const auto& env = r.message.envelope();
+  void runStepOn(const proto::Message& gasMessage, const std::vector<StepReply>& to) {
+    const auto& env = gasMessage.envelope();
     const auto& body = env.gas_fields();
     if (std::abs(body.dt() - grant->dtCfd) > kDtTolerance * grant->dtCfd) {
-      refuse(r, v1::ERROR_CODE_OUT_OF_ORDER,
-             fmt::format("GasFields of step {} carry dt = {:.17g} s; the step was granted with "
-                         "dt = {:.17g} s",
-                         env.step(), body.dt(), grant->dtCfd));
+      refuseAll(to, v1::ERROR_CODE_OUT_OF_ORDER,
+                fmt::format("GasFields of step {} carry dt = {:.17g} s; the step was granted with "
+                            "dt = {:.17g} s",
+                            env.step(), body.dt(), grant->dtCfd));
       return;
     }
     const auto t0 = Clock::now();
     namespace f = proto::fields;
     dem::GasFieldsView view;
-    view.ug = r.message.values<double>(f::kGasVelocity);
-    view.gradP = r.message.values<double>(f::kPressureGradient);
-    view.Tg = r.message.values<double>(f::kGasTemperature);
-    view.rhoG = r.message.values<double>(f::kGasDensity);
-    view.muG = r.message.values<double>(f::kGasViscosity);
-    view.kappaG = r.message.values<double>(f::kGasConductivity);
-    view.cpG = r.message.values<double>(f::kGasHeatCapacity);
-    view.Yg = r.message.values<double>(f::kGasMassFractions);
-    if (const auto ff = r.message.findArray(f::kFluidFraction)) {
+    view.ug = gasMessage.values<double>(f::kGasVelocity);
+    view.gradP = gasMessage.values<double>(f::kPressureGradient);
+    view.Tg = gasMessage.values<double>(f::kGasTemperature);
+    view.rhoG = gasMessage.values<double>(f::kGasDensity);
+    view.muG = gasMessage.values<double>(f::kGasViscosity);
+    view.kappaG = gasMessage.values<double>(f::kGasConductivity);
+    view.cpG = gasMessage.values<double>(f::kGasHeatCapacity);
+    view.Yg = gasMessage.values<double>(f::kGasMassFractions);
+    if (const auto ff = gasMessage.findArray(f::kFluidFraction)) {
       view.fluidFraction = ff->as<double>();
     }
     try {
       system->setGasFields(view);
     } catch (const coredem::UserError& e) {
-      refuse(r, v1::ERROR_CODE_INVALID_CONFIGURATION,
-             fmt::format("GasFields of step {}: {}", env.step(), e.what()));
+      refuseAll(to, v1::ERROR_CODE_INVALID_CONFIGURATION,
+                fmt::format("GasFields of step {}: {}", env.step(), e.what()));
       return;
     }
     auto tGas = Clock::now();
     xt.unpack += std::chrono::duration<double>(tGas - t0).count();
     if (staggered) { // the lagged Sources leave before the step is computed (timed as pack_send)
-      if (!sendLaggedSources(r, view)) {
+      if (!sendLaggedSources(to, gasMessage, view)) {
         return;
       }
       const auto tSent = Clock::now();
@@ -767,15 +1048,15 @@ struct DemServer::Impl {
       const std::string reason = fmt::format("the server is stopping: step {} was interrupted ({})",
                                              grant->step, e.what());
       if (!staggered) { // staggered: the GasFields were answered with the lagged Sources
-        refuse(r, v1::ERROR_CODE_UNEXPECTED_MESSAGE, reason);
+        refuseAll(to, v1::ERROR_CODE_UNEXPECTED_MESSAGE, reason);
       }
       endSession(reason); // answers the StepGrant too
       return;
     } catch (const std::exception& e) {
       log->error("session {}: step {} failed in the DEM core: {}", session, grant->step, e.what());
       if (!staggered) {
-        refuse(r, v1::ERROR_CODE_INTERNAL,
-               fmt::format("step {} failed in the DEM core: {}", grant->step, e.what()));
+        refuseAll(to, v1::ERROR_CODE_INTERNAL,
+                  fmt::format("step {} failed in the DEM core: {}", grant->step, e.what()));
       }
       auto m = proto::makeError(v1::ERROR_CODE_INTERNAL, e.what(), grant->sequence,
                                 v1::MESSAGE_TYPE_STEP_GRANT);
@@ -816,9 +1097,10 @@ struct DemServer::Impl {
     const auto tLedgers = Clock::now();
     xt.ledgers += std::chrono::duration<double>(tLedgers - tAdvanced).count();
 
-    // Sources to C (sequential; staggered sent them before advancing).
+    // Sources to C (sequential; staggered sent them before advancing): the whole grid, or each
+    // rank's cells.
     if (!staggered) {
-      sendSources(r, *s, ledger);
+      sendSources(to, gasMessage, *s, ledger);
     }
     lastLedger = ledger;
     xt.packSend += std::chrono::duration<double>(Clock::now() - tLedgers).count();
@@ -1045,7 +1327,7 @@ struct DemServer::Impl {
       return;
     }
     if (type == v1::MESSAGE_TYPE_HEARTBEAT) {
-      if (state != SessionState::Idle && (r.peer == oPeer || r.peer == cPeer)) {
+      if (state != SessionState::Idle && (r.peer == oPeer || rankOf(r.peer) >= 0)) {
         lastActivity = Clock::now();
       }
       send(r.peer, proto::makeHeartbeat(stateName(state)), env.sequence(), lastStep);
@@ -1056,7 +1338,7 @@ struct DemServer::Impl {
              "no active session: an orchestrator starts one with Hello{role=ORCHESTRATOR}");
       return;
     }
-    if (r.peer != oPeer && r.peer != cPeer) {
+    if (r.peer != oPeer && rankOf(r.peer) < 0) {
       refuse(r, v1::ERROR_CODE_UNKNOWN_SESSION,
              "this connection has not joined the active session: send Hello first");
       return;
@@ -1090,12 +1372,15 @@ struct DemServer::Impl {
       e.sequenceAfter = lastSequence[r.peer];
     }
     const auto tValidate = Clock::now();
-    if (type == v1::MESSAGE_TYPE_GAS_FIELDS && stepEnd) { // the CFD's step and the transfer
+    // The CFD's step and the transfer (decomposed: until the first rank's GasFields).
+    if (type == v1::MESSAGE_TYPE_GAS_FIELDS && stepEnd && partials.empty()) {
       xt.waitPeer += std::chrono::duration<double>(lastReceived - *stepEnd).count();
     }
     auto s = proto::validate(r.message, e);
-    if (s.ok() && type == v1::MESSAGE_TYPE_GAS_FIELDS) {
-      s = proto::validateGasRanges(r.message); // physical ranges (docs/protocol.md §3)
+    if (s.ok() && type == v1::MESSAGE_TYPE_GAS_FIELDS && !env.gas_fields().partial()) {
+      // Physical ranges (docs/protocol.md §3); a partial GasFields holds volume-weighted sums,
+      // checked once combined (runPartialStep).
+      s = proto::validateGasRanges(r.message);
     }
     if (type == v1::MESSAGE_TYPE_GAS_FIELDS) {
       xt.validate += std::chrono::duration<double>(Clock::now() - tValidate).count();
@@ -1137,11 +1422,36 @@ struct DemServer::Impl {
              fmt::format("no StepGrant for step {} from orchestrator '{}' within {} s",
                          h.request.message.envelope().step(), oName, opt.grantWaitSeconds));
     }
+    if (!partials.empty()) {
+      auto oldest = partials.begin()->second.since;
+      for (const auto& [rank, h] : partials) {
+        oldest = std::min(oldest, h.since);
+      }
+      if (std::chrono::duration<double>(now - oldest).count() > opt.grantWaitSeconds) {
+        const std::int64_t step = partials.begin()->second.request.message.envelope().step();
+        if (partials.size() < rankCount) {
+          std::string missing;
+          for (std::uint32_t r = 0; r < rankCount; ++r) {
+            if (partials.count(r) == 0) {
+              missing += fmt::format("{}{}", missing.empty() ? "" : ", ", r);
+            }
+          }
+          failPartialStep(v1::ERROR_CODE_TIMEOUT,
+                          fmt::format("no GasFields of step {} from CFD rank(s) {} of {} within {} "
+                                      "s of the first rank's (coredem-dem --grant-wait-s)",
+                                      step, missing, rankCount, opt.grantWaitSeconds));
+        } else {
+          failPartialStep(v1::ERROR_CODE_TIMEOUT,
+                          fmt::format("no StepGrant for step {} from orchestrator '{}' within {} s",
+                                      step, oName, opt.grantWaitSeconds));
+        }
+      }
+    }
     if (state != SessionState::Idle &&
         std::chrono::duration<double>(now - lastActivity).count() > opt.sessionTimeoutSeconds) {
       endSession(fmt::format("no message from orchestrator '{}' or CFD participant '{}' for {} s "
                              "(--timeout-s)",
-                             oName, cName.empty() ? "-" : cName, opt.sessionTimeoutSeconds),
+                             oName, cfdName(), opt.sessionTimeoutSeconds),
                  v1::ERROR_CODE_TIMEOUT);
     }
   }

@@ -53,6 +53,10 @@ int main(int argc, char** argv) {
   app.add_option("--threads", o.threads, "OpenMP threads of the cpu backend (0 = all)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--grant-wait-s", o.grantWaitSeconds,
+                 "longest wait for a step's StepGrant after its GasFields, and for the other CFD "
+                 "ranks' GasFields after the first rank's (a decomposed CFD participant)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--timeout-s", o.sessionTimeoutSeconds,
                  "end a session whose peers are silent this long (s)")
       ->check(CLI::PositiveNumber)

@@ -1,8 +1,12 @@
 // The participants against a real coredem-dem process over tcp loopback: the C API program,
 // coredem-gas (checkpoint + restart with identical ledgers) and the C++ client's argument checks.
+#include <atomic>
 #include <cmath>
+#include <condition_variable>
 #include <cstring>
+#include <deque>
 #include <fstream>
+#include <mutex>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -376,4 +380,208 @@ TEST(Participants, CppClientReceivesIntoCallerBuffersBitwiseAsViews) {
     }
   }
   EXPECT_TRUE(nonZeroDrag) << "the case should give drag (K_sl > 0) somewhere";
+}
+
+// A decomposed CFD participant on 2 ranks (threads here, MPI ranks in coredemFoam): rank 0 talks
+// to the orchestrator and hands its control state to rank 1 (follow()); each rank exchanges its
+// own cells with D (exchangePartial()). Cell 13 of the 27 is shared. The ranks' eps_g together
+// give the particle volume (Σ (1 − ε) V_c over the coupling cells, each counted once) to
+// round-off, and each rank receives exactly its cells.
+TEST(Participants, TwoRanksExchangeTheirOwnCellsAndFollowRankZero) {
+  const auto dir = tempDir("ranks");
+  DemProcess dem(dir);
+  MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2"}));
+  const double h = kBox / kCells, vc = h * h * h;
+  std::mutex m;
+  std::condition_variable cv;
+  std::deque<std::string> states; // rank 0 -> rank 1
+  std::vector<double> solid(2, 0.0);
+  std::vector<int> steps(2, 0);
+  std::string failure;
+  auto body = [&](int rank) {
+    try {
+      coredem::client::Options opt;
+      opt.controlEndpoint = o.controlEndpoint();
+      opt.demEndpoint = dem.endpoint();
+      opt.sessionId = o.session();
+      opt.timeoutSeconds = 20;
+      opt.rank = rank;
+      opt.rankCount = 2;
+      coredem::client::Participant p(opt);
+      auto handOver = [&] {
+        if (rank == 0) {
+          std::lock_guard<std::mutex> lock(m);
+          states.push_back(p.controlState());
+          cv.notify_all();
+        } else {
+          std::unique_lock<std::mutex> lock(m);
+          cv.wait(lock, [&] { return !states.empty(); });
+          const std::string s = states.front();
+          states.pop_front();
+          lock.unlock();
+          p.follow(s);
+        }
+      };
+      if (rank == 0) {
+        p.initialize();
+      }
+      handOver();
+      std::vector<std::int64_t> cells;
+      std::vector<double> volume;
+      for (std::int64_t c = rank == 0 ? 0 : 13; c < (rank == 0 ? 14 : 27); ++c) {
+        cells.push_back(c);
+        volume.push_back(c == 13 ? 0.5 * vc : vc);
+      }
+      const std::size_t n = cells.size();
+      std::vector<double> v3(3 * n), t(n), rho(n), mu(n), k(n), cp(n), y(n);
+      for (std::size_t i = 0; i < n; ++i) { // volume-weighted sums
+        v3[3 * i + 2] = 0.2 * volume[i];
+        t[i] = 300.0 * volume[i];
+        rho[i] = 1.2 * volume[i];
+        mu[i] = 1.8e-5 * volume[i];
+        k[i] = 0.03 * volume[i];
+        cp[i] = 1000.0 * volume[i];
+        y[i] = volume[i];
+      }
+      std::vector<double> zero(3 * n, 0.0);
+      std::vector<coredem::client::NamedField> sums = {
+          {"u_g", v3},  {"grad_p", zero}, {"T_g", t},   {"rho_g", rho},
+          {"mu_g", mu}, {"kappa_g", k},   {"cp_g", cp}, {"Y_g", y}};
+      while (p.isRunning()) {
+        const auto& s = p.exchangePartial(p.step(), p.dt(), cells, volume, sums);
+        const auto eps = s.field("eps_g");
+        if (eps.size != n) {
+          failure += "rank " + std::to_string(rank) + ": eps_g size; ";
+        }
+        solid[std::size_t(rank)] = 0.0;
+        for (std::size_t i = 0; i < eps.size; ++i) {
+          if (!(rank == 1 && cells[i] == 13)) { // the shared cell once
+            solid[std::size_t(rank)] += (1.0 - eps[i]) * vc;
+          }
+        }
+        ++steps[std::size_t(rank)];
+        if (rank == 0) {
+          p.advance(0.0);
+        }
+        handOver();
+      }
+      p.finalize();
+    } catch (const std::exception& e) {
+      std::lock_guard<std::mutex> lock(m);
+      failure += "rank " + std::to_string(rank) + ": " + e.what() + "; ";
+      if (rank == 0) { // let rank 1 end too
+        states.push_back("broken");
+        cv.notify_all();
+      }
+    }
+  };
+  std::thread r0(body, 0), r1(body, 1);
+  const auto res = o.run(3, 2e-4);
+  r0.join();
+  r1.join();
+  EXPECT_EQ(failure, "");
+  EXPECT_EQ(res.cfd.size(), 3u); // one participant for the orchestrator: rank 0's StepDone
+  EXPECT_EQ(steps[0], 3);
+  EXPECT_EQ(steps[1], 3);
+  EXPECT_NEAR(solid[0] + solid[1], kVp, 1e-12 * kVp);
+  EXPECT_EQ(dem.wait(std::chrono::seconds(20)), 0);
+  fs::remove_all(dir);
+}
+
+// Rank identity is checked before anything is sent; ranks > 0 never call initialize() or
+// advance().
+TEST(Participants, RankOptionsAreCheckedBeforeConnecting) {
+  auto expectError = [](coredem::client::Options opt, bool follow, const char* mentions) {
+    opt.controlEndpoint = "tcp://127.0.0.1:1";
+    opt.demEndpoint = "tcp://127.0.0.1:1";
+    opt.sessionId = "s";
+    coredem::client::Participant p(opt);
+    try {
+      if (follow) {
+        p.follow("coredem-control-state 1\n");
+      } else {
+        p.initialize();
+      }
+      ADD_FAILURE() << "no error for " << mentions;
+    } catch (const coredem::client::ClientError& e) {
+      EXPECT_NE(std::string(e.what()).find(mentions), std::string::npos) << e.what();
+    }
+  };
+  coredem::client::Options o;
+  o.rank = 2;
+  o.rankCount = 2;
+  expectError(o, false, "rank 2 of 2 ranks");
+  o.rank = 1;
+  expectError(o, false, "follows rank 0");
+  expectError(o, true, "truncated control state");
+}
+
+// Protocol 1.2 is needed for fluid_fraction and for decomposed runs: against a DEM server that
+// agrees 1.1 (a stand-in that answers Hello with Welcome{minor 1}) the client refuses both before
+// sending, naming both versions, instead of having the older server silently ignore them.
+TEST(Participants, FluidFractionAndRanksNeedADemServerOfProtocol12) {
+  const auto dir = tempDir("v11");
+  proto::Server oldDem;
+  const std::string oldEp = oldDem.bind("tcp://127.0.0.1:*");
+  std::atomic<bool> stop{false};
+  std::thread server([&] {
+    while (!stop) {
+      auto r = oldDem.receive(100ms);
+      if (!r) {
+        continue;
+      }
+      auto w = r->message.type() == v1::MESSAGE_TYPE_HELLO
+                   ? proto::makeWelcome(v1::ROLE_DEM, "coredem-dem 1.1 (stand-in)", 1, 1,
+                                        r->message.envelope().session_id())
+                   : proto::makeError(v1::ERROR_CODE_UNSUPPORTED, "stand-in");
+      w.setSequence(r->message.envelope().sequence());
+      oldDem.reply(r->peer, std::move(w));
+    }
+  });
+  for (int ranks : {0, 2}) {
+    DemProcess dem(dir);
+    MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2"}), 3s);
+    std::string error;
+    std::thread cfd([&] {
+      coredem::client::Options opt;
+      opt.controlEndpoint = o.controlEndpoint();
+      opt.demEndpoint = oldEp;
+      opt.sessionId = o.session();
+      opt.timeoutSeconds = 20;
+      opt.rankCount = ranks;
+      coredem::client::Participant p(opt);
+      try {
+        p.initialize();
+        EXPECT_EQ(p.demProtocolMinor(), 1);
+        const auto n = static_cast<std::size_t>(p.grid().cellCount());
+        std::vector<double> v3(3 * n, 0.0), t(n, 300.0), rho(n, 1.2), mu(n, 1.8e-5), k(n, 0.03),
+            cp(n, 1000.0), y(n, 1.0), ff(n, 0.5);
+        p.exchange(p.step(), p.dt(),
+                   {{"u_g", v3},
+                    {"grad_p", v3},
+                    {"T_g", t},
+                    {"rho_g", rho},
+                    {"mu_g", mu},
+                    {"kappa_g", k},
+                    {"cp_g", cp},
+                    {"Y_g", y},
+                    {"fluid_fraction", ff}});
+      } catch (const coredem::client::ClientError& e) {
+        error = e.what();
+      }
+    });
+    try {
+      o.run(1, 2e-4, {}, false); // ends by timeout: the participant gave up
+    } catch (const std::exception&) {
+    }
+    cfd.join();
+    EXPECT_NE(error.find("agreed protocol 1.1, this client speaks 1.2"), std::string::npos)
+        << ranks << " ranks: " << error;
+    EXPECT_NE(error.find(ranks > 1 ? "decomposed CFD participant (2 ranks)" : "fluid_fraction"),
+              std::string::npos)
+        << error;
+  }
+  stop = true;
+  server.join();
+  fs::remove_all(dir);
 }

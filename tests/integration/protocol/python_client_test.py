@@ -3,7 +3,7 @@
 talks to the C++ loopback server and decodes the C++ golden files.
 
 usage: python_client_test.py PROTOC PROTO_DIR GOLDEN_DIR LOOPBACK_BINARY
-Checks: every golden v1.0 and v1.1 file decodes with Python's protobuf and has the type its name says;
+Checks: every golden v1.0, v1.1 and v1.2 file decodes with Python's protobuf and has the type its name says;
 the golden GasFields arrays hold 0.25 (f+1) + 0.125 i; over tcp loopback a Python DEALER
 handshakes, configures a 4x3x2 grid, sends GasFields built from numpy arrays and receives
 Sources (eps_g = 1, other sources 0, checksums equal to sequential sums of what was sent);
@@ -63,6 +63,31 @@ def main():
                     expected = 0.25 * (f + 1) + 0.125 * np.arange(values.size)
                     assert np.array_equal(values, expected), (name, d.name)
             print(f"python: decoded {len(names)} golden {version} files")
+        # v1.2: the rank of a decomposed CFD participant and partial GasFields/Sources (an int64
+        # cell list, the rank's fluid volumes, one row per listed cell), read by Python's protobuf.
+        gdir = os.path.join(golden_dir, "v1.2")
+        names = sorted(f[:-5] for f in os.listdir(gdir) if f.endswith(".cdmf"))
+        assert len(names) == 15, names
+        for name in names:
+            frames = read_cdmf(os.path.join(gdir, name + ".cdmf"))
+            env = pb.Envelope()
+            env.ParseFromString(frames[0])
+            assert env.WhichOneof("body") == name, (name, env.WhichOneof("body"))
+            if name == "hello":
+                assert (env.hello.protocol_minor, env.hello.rank, env.hello.rank_count) == (2, 1, 2)
+            if name in ("gas_fields", "sources"):
+                body = getattr(env, name)
+                assert body.partial and body.touched_count == 1, body
+                arrays = {d.name: (d, raw) for d, raw in zip(env.arrays, frames[1:])}
+                d, raw = arrays["cells"]
+                assert d.dtype == common.DTYPE_INT64
+                assert np.frombuffer(raw, dtype="<i8").tolist() == [1]
+                if name == "gas_fields":
+                    assert np.frombuffer(arrays["fluid_volume"][1], dtype="<f8").tolist() == [0.125]
+                    assert np.frombuffer(arrays["T_g"][1], dtype="<f8").tolist() == [0.75]
+                else:
+                    assert np.frombuffer(arrays["eps_g"][1], dtype="<f8").tolist() == [0.25]
+        print(f"python: decoded {len(names)} golden v1.2 files")
         # v1.1 Configure: explicit positions and chemistry, read by Python's protobuf.
         env = pb.Envelope()
         env.ParseFromString(read_cdmf(os.path.join(golden_dir, "v1.1", "configure.cdmf"))[0])
@@ -113,7 +138,7 @@ def main():
             hello.hello.role = common.ROLE_CFD
             welcome, _ = request(hello)
             assert welcome.type == common.MESSAGE_TYPE_WELCOME
-            assert welcome.welcome.protocol_minor == 1  # min(server 1.1, client 1.7)
+            assert welcome.welcome.protocol_minor == 2  # min(server 1.2, client 1.7)
             session = welcome.welcome.session_id
 
             nx, ny, nz, ns = 4, 3, 2, 2

@@ -110,6 +110,33 @@ TEST(ParticipantState, CApiReportsStateErrorsWithAMessage) {
   EXPECT_EQ(coredem_client_initialize(nullptr), COREDEM_ERROR_ARGUMENT);
 }
 
+// The C API of decomposed runs: the rank is set before initialize/follow and checked; the
+// partial exchange and the control state follow the participant's states; rank 0 of a decomposed
+// run cannot follow and a rank > 0 cannot initialize.
+TEST(ParticipantState, CApiRanksAreCheckedAndFollowTheStates) {
+  coredem_client* c = nullptr;
+  ASSERT_EQ(coredem_client_create("tcp://127.0.0.1:1", "tcp://127.0.0.1:2", "s", &c), COREDEM_OK);
+  EXPECT_EQ(coredem_client_set_rank(c, 2, 2), COREDEM_ERROR_ARGUMENT);
+  EXPECT_NE(std::string(coredem_client_last_error(c)).find("rank 2 of 2"), std::string::npos);
+  EXPECT_EQ(coredem_client_set_rank(c, 1, 2), COREDEM_OK);
+  EXPECT_EQ(coredem_client_initialize(c), COREDEM_ERROR_ARGUMENT); // rank 1 follows rank 0
+  EXPECT_NE(std::string(coredem_client_last_error(c)).find("follows rank 0"), std::string::npos);
+  const char* state = nullptr;
+  std::size_t size = 0;
+  EXPECT_EQ(coredem_client_control_state(c, &state, &size), COREDEM_ERROR_ARGUMENT);
+  EXPECT_EQ(coredem_client_follow(c, "garbage\n", 8), COREDEM_ERROR_ARGUMENT);
+  EXPECT_NE(std::string(coredem_client_last_error(c)).find("control state"), std::string::npos);
+  const std::int64_t cells[] = {0};
+  const double volume[] = {1.0};
+  EXPECT_EQ(
+      coredem_client_exchange_partial(c, 1, 0.1, 1, cells, volume, 0, nullptr, nullptr, nullptr),
+      COREDEM_ERROR_STATE);
+  EXPECT_EQ(
+      coredem_client_exchange_partial(c, 1, 0.1, 1, nullptr, volume, 0, nullptr, nullptr, nullptr),
+      COREDEM_ERROR_ARGUMENT);
+  coredem_client_destroy(c);
+}
+
 TEST(ParticipantState, AnAbsentOrchestratorIsATimeoutNamingTheEndpoint) {
   coredem::client::Options o;
   o.controlEndpoint = "tcp://127.0.0.1:9"; // nothing listens there (discard port, no server)

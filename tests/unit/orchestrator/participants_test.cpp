@@ -1,6 +1,7 @@
 // The participant table (participants.h): each row's command line, environment, restart file
 // and work folder; an unknown participant names the known ones; the pre-flight check of the
 // prescribed-gas participant validates the gas section in-process with file:line:col.
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/participants.h>
@@ -259,4 +261,48 @@ TEST(Participants, GasSectionValidatedInProcessWithFileLineColumn) {
   }
   // The participant's row names this check.
   EXPECT_EQ(participant("coredem-gas").preflight, &checkGasSection);
+}
+
+// cfd.ranks: K > 1 starts `mpirun -np K --oversubscribe [--allow-run-as-root] -x VAR ...
+// PROGRAM ARGS -parallel` with the participant's environment exported to every rank; 1 (the
+// default) is today's command line; a participant without parallelArgs refuses ranks > 1.
+TEST(Participants, DecomposedOpenFoamRunsUnderMpirun) {
+  const std::string text =
+      replace(kCase, "cfd: {participant: coredem-gas, timeout_s: 30}",
+              "cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120, ranks: 2}");
+  const CaseConfig c = parseCase(text, "case.yaml", fs::temp_directory_path());
+  EXPECT_EQ(c.cfd.ranks, 2);
+  const auto& p = participant("coredemFoam");
+  EXPECT_EQ(p.parallelArgs, (std::vector<std::string>{"-parallel"}));
+  EXPECT_NE(p.decompose, nullptr);
+  const LaunchCommand cmd = launchCommand(p, c, inputs("/runs/r3"));
+  ASSERT_GE(cmd.argv.size(), 8u);
+  EXPECT_EQ(fs::path(cmd.argv[0]).filename(), "mpirun");
+  EXPECT_EQ(cmd.argv[1], "-np");
+  EXPECT_EQ(cmd.argv[2], "2");
+  EXPECT_EQ(cmd.argv[3], "--oversubscribe");
+  EXPECT_EQ(cmd.argv[4] == "--allow-run-as-root", ::geteuid() == 0);
+  const auto prog = std::find(cmd.argv.begin(), cmd.argv.end(), "/opt/coredem/bin/participant");
+  ASSERT_NE(prog, cmd.argv.end());
+  EXPECT_EQ(std::vector<std::string>(prog, cmd.argv.end()),
+            (std::vector<std::string>{"/opt/coredem/bin/participant", "-case", "/runs/r3/openfoam",
+                                      "-parallel"}));
+  // Every variable of the environment is exported to the ranks.
+  for (const char* var : {"COREDEM_CONTROL_ENDPOINT", "COREDEM_DEM_ENDPOINT", "COREDEM_SESSION",
+                          "COREDEM_TIMEOUT_S", "WM_PROJECT_DIR"}) {
+    const auto x = std::find(cmd.argv.begin(), prog, var);
+    ASSERT_NE(x, prog) << var;
+    EXPECT_EQ(*(x - 1), "-x") << var;
+  }
+  EXPECT_EQ(cmd.env.at("OMPI_MCA_rmaps_base_oversubscribe"), "1");
+  // One rank: the serial command line.
+  const CaseConfig one =
+      parseCase(replace(text, ", ranks: 2}", "}"), "case.yaml", fs::temp_directory_path());
+  EXPECT_EQ(one.cfd.ranks, 1);
+  EXPECT_EQ(launchCommand(p, one, inputs("/runs/r3")).argv[0], "/opt/coredem/bin/participant");
+  // coredem-gas runs on one process.
+  const std::string msg = errorOf(replace(kCase, "timeout_s: 30}", "timeout_s: 30, ranks: 2}"));
+  EXPECT_NE(msg.find("cfd.ranks: coredem-gas runs on one process"), std::string::npos) << msg;
+  EXPECT_NE(errorOf(replace(kCase, "timeout_s: 30}", "timeout_s: 30, ranks: 0}")).find("ranks"),
+            std::string::npos);
 }

@@ -40,14 +40,17 @@ TEST(GoldenV1_1, EveryV10MessageTypeHasAV11FileThatDecodes) {
 }
 
 TEST(GoldenV1_1, HandshakeCarriesMinorOne) {
-  EXPECT_EQ(kProtocolVersion, (Version{1, 1}));
+  // This build speaks 1.2 (version_test.cpp); the v1.1 files keep saying 1.1.
   Message h = load("v1.1", "hello", v1::MESSAGE_TYPE_HELLO);
   EXPECT_EQ(h.envelope().hello().protocol_major(), 1u);
   EXPECT_EQ(h.envelope().hello().protocol_minor(), 1u);
   Message w = load("v1.1", "welcome", v1::MESSAGE_TYPE_WELCOME);
   EXPECT_EQ(w.envelope().welcome().protocol_minor(), 1u);
   // A v1.1 peer and a v1.0 peer agree on 1.0 (the orchestrator then refuses chemistry cases).
+  EXPECT_EQ(negotiate(Version{1, 1}, {1, 0}).agreed, (Version{1, 0}));
   EXPECT_EQ(negotiate(kProtocolVersion, {1, 0}).agreed, (Version{1, 0}));
+  // Rank fields of v1.2 are absent from a v1.1 Hello (a v1.2 server reads one rank).
+  EXPECT_EQ(h.envelope().hello().rank_count(), 0u);
 }
 
 TEST(GoldenV1_1, ConfigureCarriesExplicitPositionsAndChemistry) {

@@ -441,3 +441,94 @@ TEST(ValidateGasRanges, OptionalFluidFractionHasOneValuePerCellInZeroOne) {
   EXPECT_EQ(t.code, v1::ERROR_CODE_SHAPE);
   EXPECT_NE(t.message.find("fluid_fraction"), std::string::npos) << t.message;
 }
+
+// Partial GasFields (v1.2, one rank of a decomposed CFD): the listed cells in range, ascending,
+// without duplicates; the counts consistent; fluid volumes positive; every field M rows.
+namespace {
+Message partialGas(std::vector<std::int64_t> cells, std::vector<double> volume,
+                   std::uint64_t touched) {
+  Message m = makeGasFields(1, 0.0, 1e-3, 4, 1);
+  m.envelope().mutable_gas_fields()->set_partial(true);
+  m.envelope().mutable_gas_fields()->set_touched_count(touched);
+  const std::uint64_t rows = cells.size();
+  m.addArray<std::int64_t>(fields::kTouchedCells, cells, {rows});
+  m.addArray<double>(fields::kFluidVolume, volume, {std::uint64_t(volume.size())});
+  for (const auto& spec : fields::gasFields()) {
+    std::vector<double> v(rows * fields::componentsOf(spec.extent, 1), 1.0);
+    m.addArray<double>(spec.name, v, fields::shapeOf(spec.extent, rows, 1));
+  }
+  return m;
+}
+Expectation partialExpectation() {
+  Expectation e;
+  e.types = {v1::MESSAGE_TYPE_GAS_FIELDS};
+  e.cells = 4;
+  e.species = 1;
+  return e;
+}
+} // namespace
+
+TEST(ValidatePartial, AcceptsAscendingCellsInRange) {
+  const Status s = validate(partialGas({0, 3}, {0.5, 1.0}, 2), partialExpectation());
+  EXPECT_TRUE(s.ok()) << s.toString();
+  EXPECT_TRUE(validate(partialGas({}, {}, 0), partialExpectation()).ok()); // touches nothing
+}
+
+TEST(ValidatePartial, RefusesBadListsNamingTheCell) {
+  const Expectation e = partialExpectation();
+  Status s = validate(partialGas({1, 1}, {0.5, 0.5}, 2), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_DUPLICATE_FIELD);
+  EXPECT_NE(s.message.find("cells[1] = 1 is listed twice"), std::string::npos) << s.message;
+  s = validate(partialGas({2, 1}, {0.5, 0.5}, 2), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_DUPLICATE_FIELD);
+  EXPECT_NE(s.message.find("out of order"), std::string::npos) << s.message;
+  s = validate(partialGas({0, 4}, {0.5, 0.5}, 2), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  EXPECT_NE(s.message.find("cells[1] = 4 is not a coupling cell (0..3)"), std::string::npos)
+      << s.message;
+  s = validate(partialGas({0, -1}, {0.5, 0.5}, 2), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  // touched_count disagrees with the arrays, or exceeds the grid.
+  s = validate(partialGas({0, 1}, {0.5, 0.5}, 3), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  EXPECT_NE(s.message.find("'cells'"), std::string::npos) << s.message;
+  s = validate(partialGas({0, 1}, {0.5, 0.5}, 5), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  // fluid_volume of another length, zero, or NaN.
+  s = validate(partialGas({0, 1}, {0.5}, 2), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  EXPECT_NE(s.message.find("fluid_volume"), std::string::npos) << s.message;
+  s = validate(partialGas({0, 1}, {0.5, 0.0}, 2), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_INVALID_CONFIGURATION);
+  EXPECT_NE(s.message.find("fluid_volume[1]"), std::string::npos) << s.message;
+  s = validate(partialGas({0, 1}, {0.5, std::nan("")}, 2), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_NON_FINITE);
+}
+
+TEST(ValidatePartial, RefusesMissingListsAndWholeGridRowsAndFluidFraction) {
+  const Expectation e = partialExpectation();
+  // A whole-grid GasFields flagged partial lacks the cell list.
+  Message whole = makeGasFields(1, 0.0, 1e-3, 4, 1);
+  whole.envelope().mutable_gas_fields()->set_partial(true);
+  whole.envelope().mutable_gas_fields()->set_touched_count(4);
+  for (const auto& spec : fields::gasFields()) {
+    std::vector<double> v(4 * fields::componentsOf(spec.extent, 1), 1.0);
+    whole.addArray<double>(spec.name, v, fields::shapeOf(spec.extent, 4, 1));
+  }
+  Status s = validate(whole, e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_MISSING_FIELD);
+  EXPECT_NE(s.message.find("'cells'"), std::string::npos) << s.message;
+  // int32 cell indices are refused (int64 only).
+  Message narrow = makeGasFields(1, 0.0, 1e-3, 4, 1);
+  narrow.envelope().mutable_gas_fields()->set_partial(true);
+  narrow.envelope().mutable_gas_fields()->set_touched_count(1);
+  narrow.addArray<std::int32_t>(fields::kTouchedCells, std::vector<std::int32_t>{0}, {1});
+  s = validate(narrow, e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  // fluid_fraction is the server's to form.
+  Message ff = partialGas({0}, {0.5}, 1);
+  ff.addArray<double>(fields::kFluidFraction, std::vector<double>{0.5}, {1});
+  s = validate(ff, e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_INVALID_CONFIGURATION);
+  EXPECT_NE(s.message.find("fluid_fraction"), std::string::npos) << s.message;
+}

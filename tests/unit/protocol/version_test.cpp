@@ -28,10 +28,13 @@ TEST(Version, OtherMajorIsRejectedNamingBothVersions) {
   EXPECT_NE(n.status.message.find("0.9"), std::string::npos);
 }
 
-TEST(Version, ThisBuildSpeaksOneDotOne) {
+TEST(Version, ThisBuildSpeaksOneDotTwo) {
   // v1.1: chemistry in Configure (solid species, reactions, chemistry), explicit positions.
-  EXPECT_EQ(kProtocolVersion, (Version{1, 1}));
-  EXPECT_EQ(kProtocolVersion.toString(), "1.1");
-  // With a v1.0 peer the agreed version is 1.0.
+  // v1.2: decomposed CFD (rank identity in Hello, partial GasFields/Sources), fluid_fraction.
+  EXPECT_EQ(kProtocolVersion, (Version{1, 2}));
+  EXPECT_EQ(kProtocolVersion.toString(), "1.2");
+  EXPECT_EQ(kMinorDecomposed, 2u);
+  // With a v1.0 or v1.1 peer the agreed version is that peer's.
   EXPECT_EQ(negotiate(kProtocolVersion, {1, 0}).agreed, (Version{1, 0}));
+  EXPECT_EQ(negotiate(kProtocolVersion, {1, 1}).agreed, (Version{1, 1}));
 }

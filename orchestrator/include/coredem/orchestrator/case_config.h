@@ -93,6 +93,8 @@ struct CfdConfig {
   std::string caseFolder; ///< cfd.case: the participant's input folder, relative to the case folder
   double timeoutSeconds = 60; ///< deadline for C's next StepDone
   bool timers = false;        ///< cfd.timers: the participant's stage timers (RUN/timers-cfd.json)
+  /// cfd.ranks: MPI ranks of a decomposed participant (mpirun -np K ... -parallel); 1 = serial.
+  int ranks = 1;
 };
 
 /// coupling: how CFD and DEM steps follow each other (docs/coupling-schemes.md).

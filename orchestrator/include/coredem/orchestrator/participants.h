@@ -72,6 +72,13 @@ struct ParticipantDescriptor {
   /// In-process check of the participant's input before anything is written (nullptr: none).
   /// Throws CaseError (exit 2) with file:line:col.
   void (*preflight)(const CaseConfig& config) = nullptr;
+  /// Arguments of a decomposed run (cfd.ranks > 1, started as `mpirun -np K PROGRAM ARGS
+  /// PARALLEL_ARGS`), e.g. {"-parallel"}; empty: the participant runs on one process only.
+  std::vector<std::string> parallelArgs;
+  /// Prepares the work folder for `ranks` processes before each start (coredemFoam: the mesh
+  /// and decomposePar), logging into `logDir`; null: nothing to prepare.
+  void (*decompose)(const std::filesystem::path& workDir, int ranks,
+                    const std::filesystem::path& logDir) = nullptr;
 
   /// True when `cfd.timers` is allowed.
   bool hasTimers() const { return !timersArgs.empty(); }

@@ -38,6 +38,14 @@ inline constexpr std::string_view kGasMassFractions = "Y_g";    ///< [N,n_specie
 /// per coupling-cell volume V_c (the CFD side divides by φ_f).
 inline constexpr std::string_view kFluidFraction = "fluid_fraction"; ///< [N] -
 
+// Partial GasFields / Sources (v1.2, one rank of a decomposed CFD participant; body.partial):
+// every array above has M = body.touched_count rows instead of N, one per listed coupling cell.
+/// The coupling cells of the message, strictly ascending, each < N. dtype int64.
+inline constexpr std::string_view kTouchedCells = "cells"; ///< [M] -
+/// GasFields only: the rank's fluid volume in each listed coupling cell (> 0, at most the cell's
+/// volume); the gas fields are then volume-weighted sums sum_c A(c, g) f_c over its cells.
+inline constexpr std::string_view kFluidVolume = "fluid_volume"; ///< [M] m3
+
 // Sources (DEM -> CFD), averaged over the n_sub DEM sub-steps of the CFD step
 inline constexpr std::string_view kVoidFraction = "eps_g";             ///< [N] -
 inline constexpr std::string_view kDragCoefficient = "K_sl";           ///< [N] kg/m3/s

@@ -19,7 +19,11 @@ struct Version {
 };
 
 /// The version this build speaks.
-inline constexpr Version kProtocolVersion{1, 1};
+inline constexpr Version kProtocolVersion{1, 2};
+
+/// First minor version with the fluid_fraction array and the decomposed (M:1) exchange: rank
+/// identity in Hello, partial GasFields/Sources (docs/protocol.md "Decomposed CFD").
+inline constexpr std::uint32_t kMinorDecomposed = 2;
 
 /// Outcome of a handshake.
 struct Negotiation {

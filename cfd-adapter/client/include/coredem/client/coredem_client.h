@@ -77,6 +77,15 @@ coredem_status coredem_client_create(const char* control_endpoint, const char* d
 /* Per-request deadline in seconds (default: COREDEM_TIMEOUT_S or 60). Before initialize. */
 coredem_status coredem_client_set_timeout(coredem_client* c, double seconds);
 coredem_status coredem_client_initialize(coredem_client* c);
+/* Decomposed CFD (protocol 1.2, docs/client.md "Decomposed CFD"): this process is rank `rank` of
+ * `rank_count` (rank_count <= 1: not decomposed). Before initialize/follow. Rank 0 calls
+ * initialize and advance and hands control_state to the other ranks, which call follow instead;
+ * every rank exchanges its own cells with exchange_partial. */
+coredem_status coredem_client_set_rank(coredem_client* c, int32_t rank, int32_t rank_count);
+/* Rank 0: the state the other ranks follow, *state valid until the next call on this handle. */
+coredem_status coredem_client_control_state(coredem_client* c, const char** state, size_t* size);
+/* Ranks > 0: take rank 0's control state (first call: this rank's initialize). */
+coredem_status coredem_client_follow(coredem_client* c, const char* state, size_t size);
 
 coredem_state coredem_client_state(const coredem_client* c);
 /* 1 while O keeps granting steps, else 0. */
@@ -94,6 +103,14 @@ coredem_status coredem_client_species_name(const coredem_client* c, int32_t k, c
 coredem_status coredem_client_exchange(coredem_client* c, int64_t step, double dt, int32_t n_fields,
                                        const char* const* names, const double* const* values,
                                        const size_t* sizes);
+/* Decomposed: this rank's partial GasFields: `cells` (n_cells coupling cells its mesh touches,
+ * ascending), `fluid_volume` (m3 per listed cell) and every gas field as volume-weighted sums,
+ * n_cells rows each; the sources (coredem_client_source) then have n_cells rows. */
+coredem_status coredem_client_exchange_partial(coredem_client* c, int64_t step, double dt,
+                                               int64_t n_cells, const int64_t* cells,
+                                               const double* fluid_volume, int32_t n_fields,
+                                               const char* const* names,
+                                               const double* const* values, const size_t* sizes);
 /* View of a source array of the last exchange (eps_g, K_sl, K_sl_Us, H, H_Tp, R_species,
  * Q_hom); *size in doubles. */
 coredem_status coredem_client_source(const coredem_client* c, const char* name,

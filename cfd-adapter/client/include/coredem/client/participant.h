@@ -136,6 +136,13 @@ struct Options {
   /// Empty: a throw-away pair is generated (enough for a D without an allow-list).
   /// Environment: COREDEM_DEM_CLIENT_KEY_FILE.
   std::string demClientKeyFile;
+  /// Decomposed CFD (protocol 1.2, docs/client.md "Decomposed runs"): this process's rank index
+  /// (0-based) and the number of ranks. rankCount <= 1: not decomposed. Rank 0 talks to the
+  /// orchestrator (initialize(), advance()) and hands its controlState() to the other ranks,
+  /// which call follow() instead; every rank exchanges its own partial fields with D
+  /// (exchangePartial()).
+  int rank = 0;
+  int rankCount = 0;
 };
 
 /// The coupling grid and species from O's Configure.
@@ -225,6 +232,30 @@ public:
   /// passed validation.
   const Sources& exchange(std::int64_t step, double dt, const std::vector<NamedField>& fields,
                           const std::vector<NamedBuffer>& into);
+
+  /// Decomposed runs: sends this rank's partial GasFields and returns the Sources of its cells.
+  /// `cells` lists the coupling cells this rank's mesh cells overlap (strictly ascending, each
+  /// < grid().cellCount(); may be empty), `fluidVolume` this rank's fluid volume in each (m3,
+  /// > 0), and every gas field of exchange() is given as volume-weighted sums over the rank's
+  /// cells, cells.size() rows. The returned arrays have cells.size() rows in the same order
+  /// (per coupling-cell volume, as in exchange()). fluid_fraction is not sent (D forms it).
+  /// Needs a DEM server of protocol 1.2 or later. @pre/@post as exchange()
+  const Sources& exchangePartial(std::int64_t step, double dt,
+                                 const std::vector<std::int64_t>& cells, ConstView fluidVolume,
+                                 const std::vector<NamedField>& sums);
+
+  /// Decomposed runs, rank 0: the state the other ranks follow (grid, species, start, the
+  /// current grant or the end of the run) as an opaque string to broadcast (e.g. with MPI).
+  /// @pre initialize() or advance() returned
+  std::string controlState() const;
+  /// Decomposed runs, ranks > 0: take rank 0's controlState() instead of talking to the
+  /// orchestrator. The first call is this rank's initialize() (it connects to D with its rank);
+  /// each later one, after exchangePartial(), takes the next grant or the end of the run.
+  /// @pre state() == Created or Exchanged; options().rank > 0
+  void follow(const std::string& controlState);
+
+  /// The protocol minor agreed with the DEM server (valid after initialize()/follow()).
+  int demProtocolMinor() const;
 
   /// Where the last exchange() spent its time (zeros before the first).
   ExchangeTimes lastExchangeTimes() const;

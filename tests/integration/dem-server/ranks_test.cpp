@@ -1,0 +1,313 @@
+// coredem-dem with a decomposed CFD participant (protocol v1.2, docs/protocol.md "Decomposed
+// CFD"): K ranks, each on its own connection, send partial GasFields (the coupling cells their
+// cells touch, fluid volumes and volume-weighted sums); D combines them in rank order, steps once
+// and answers each rank with its cells' sources. Checked: the same step from 1 whole-grid
+// participant and from 2 ranks (both arrival orders) gives the same sources and particles
+// (arrival order: bitwise; 1 vs 2 ranks: within round-off, see kRegrouped); rank count mismatch,
+// duplicate rank index, rank index out of range, a silent rank and a rank that leaves are refused
+// with errors naming the rank, never a hang.
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include <gtest/gtest.h>
+
+#include "../client/mini_orchestrator.h"
+#include "server_thread.h"
+
+using namespace coredem::testing;
+
+namespace {
+
+namespace f = proto::fields;
+
+constexpr int kParticles = 60;
+constexpr double kD = 1e-3;
+constexpr double kBox = 6e-3;
+constexpr int kCellsPerAxis = 3;
+constexpr std::size_t kCells = 27;
+constexpr double kH = kBox / kCellsPerAxis;
+/// Relative difference allowed between the 1-rank and the 2-rank sources after 3 steps: the
+/// 2-rank gas is (V_0 f + V_1 f)/(V_0 + V_1) instead of f (a few ulp, 1e-16 relative) and the
+/// DEM's response to it stays within a few hundred ulp over 3 steps of 60 particles.
+constexpr double kRegrouped = 1e-11;
+
+/// The gas of coupling cell c (varies per cell so that a wrong cell order shows).
+struct Gas {
+  std::vector<double> u, gradP, T, rho, mu, kappa, cp, Y;
+  Gas() {
+    for (std::size_t c = 0; c < kCells; ++c) {
+      u.insert(u.end(), {0.01 * double(c % 3), 0.0, 0.3 + 0.01 * double(c)});
+      gradP.insert(gradP.end(), {0.0, 0.0, -11.0 - 0.1 * double(c)});
+      T.push_back(300.0 + double(c));
+      rho.push_back(1.2);
+      mu.push_back(1.8e-5);
+      kappa.push_back(0.026);
+      cp.push_back(1005.0);
+      Y.push_back(1.0);
+    }
+  }
+  std::vector<std::pair<std::string_view, const std::vector<double>*>> arrays() const {
+    return {{f::kGasVelocity, &u},      {f::kPressureGradient, &gradP},
+            {f::kGasTemperature, &T},   {f::kGasDensity, &rho},
+            {f::kGasViscosity, &mu},    {f::kGasConductivity, &kappa},
+            {f::kGasHeatCapacity, &cp}, {f::kGasMassFractions, &Y}};
+  }
+  proto::Message whole(std::int64_t step, double time, double dt,
+                       const std::string& session) const {
+    auto m = proto::makeGasFields(step, time, dt, kCells, 1);
+    m.setSessionId(session);
+    for (const auto& [name, v] : arrays()) {
+      m.addArray<double>(name, *v, f::shapeOf(name, kCells, 1));
+    }
+    return m;
+  }
+  /// Rank `rank` of 2: rank 0 holds cells 0..13 and half of cell 13's volume, rank 1 the other
+  /// half of cell 13 and cells 14..26 (cell 13 is shared).
+  proto::Message partial(int rank, std::int64_t step, double time, double dt,
+                         const std::string& session) const {
+    std::vector<std::int64_t> cells;
+    std::vector<double> volume;
+    const double v = kH * kH * kH;
+    for (std::int64_t c = rank == 0 ? 0 : 13; c < (rank == 0 ? 14 : 27); ++c) {
+      cells.push_back(c);
+      volume.push_back(c == 13 ? (rank == 0 ? 0.375 * v : 0.625 * v) : v);
+    }
+    auto m = proto::makeGasFields(step, time, dt, kCells, 1);
+    m.setSessionId(session);
+    m.envelope().mutable_gas_fields()->set_partial(true);
+    m.envelope().mutable_gas_fields()->set_touched_count(cells.size());
+    m.addArray<std::int64_t>(f::kTouchedCells, cells, {cells.size()});
+    m.addArray<double>(f::kFluidVolume, volume, {volume.size()});
+    for (const auto& [name, values] : arrays()) {
+      const std::size_t q = values->size() / kCells;
+      std::vector<double> sums;
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        for (std::size_t k = 0; k < q; ++k) {
+          sums.push_back(volume[i] * (*values)[std::size_t(cells[i]) * q + k]);
+        }
+      }
+      m.addArray<double>(name, sums, f::shapeOf(name, cells.size(), 1));
+    }
+    return m;
+  }
+};
+
+proto::Client cfdRank(const std::string& ep, const std::string& session, std::uint32_t rank,
+                      std::uint32_t count, v1::MessageType expect = v1::MESSAGE_TYPE_WELCOME,
+                      std::string* reason = nullptr) {
+  proto::Client c;
+  c.connect(ep);
+  auto hello = proto::makeHello(v1::ROLE_CFD, "test cfd rank " + std::to_string(rank));
+  hello.envelope().mutable_hello()->set_rank(rank);
+  hello.envelope().mutable_hello()->set_rank_count(count);
+  hello.setSessionId(session);
+  auto w = c.request(std::move(hello), 10s);
+  EXPECT_EQ(w.type(), expect) << w.envelope().DebugString();
+  if (reason != nullptr && w.type() == v1::MESSAGE_TYPE_REJECT) {
+    *reason = w.envelope().reject().reason();
+  }
+  return c;
+}
+
+void grant(MiniOrchestrator& o, std::int64_t n, double dt, std::uint32_t nSub) {
+  auto g = proto::makeStepGrant(n, double(n - 1) * dt, dt, nSub, dt / nSub);
+  g.setSessionId(o.session());
+  o.dem().send(std::move(g));
+}
+
+/// Whole-grid sources of one step: per array name, kCells rows (assembled from the ranks).
+using GridSources = std::map<std::string, std::vector<double>>;
+
+void take(const proto::Message& src, GridSources& out) {
+  ASSERT_EQ(src.type(), v1::MESSAGE_TYPE_SOURCES) << src.envelope().DebugString();
+  const bool partial = src.envelope().sources().partial();
+  std::vector<std::int64_t> cells;
+  if (partial) {
+    const auto c = src.findArray(f::kTouchedCells)->as<std::int64_t>();
+    cells.assign(c.begin(), c.end());
+  } else {
+    for (std::size_t c = 0; c < kCells; ++c) {
+      cells.push_back(std::int64_t(c));
+    }
+  }
+  for (const auto& spec : f::sourceFields()) {
+    const auto v = src.values<double>(spec.name);
+    const std::size_t q = v.size() / cells.size();
+    auto& dst = out[std::string(spec.name)];
+    dst.resize(kCells * q, 0.0);
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      for (std::size_t k = 0; k < q; ++k) {
+        dst[std::size_t(cells[i]) * q + k] = v[i * q + k];
+      }
+    }
+  }
+}
+
+struct RunResult {
+  GridSources sources;  ///< of the last step
+  v1::StepDone demDone; ///< of the last step
+};
+
+/// Three steps with 1 whole-grid participant (ranks 0) or 2 ranks sending in `order`.
+RunResult run(int ranks, std::vector<int> order = {0, 1}) {
+  ServerThread server;
+  MiniOrchestrator o(server.endpoint(), smallCase(kParticles, kD, kBox, kCellsPerAxis));
+  Gas gas;
+  const double dt = 2e-4;
+  const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
+  std::vector<proto::Client> c;
+  for (int r = 0; r < std::max(ranks, 1); ++r) {
+    c.push_back(cfdRank(server.endpoint(), o.session(), std::uint32_t(r),
+                        std::uint32_t(std::max(ranks, 1))));
+  }
+  RunResult result;
+  for (std::int64_t n = 1; n <= 3; ++n) {
+    const double t = double(n - 1) * dt;
+    grant(o, n, dt, nSub);
+    result.sources.clear();
+    if (ranks == 0) {
+      take(c[0].request(gas.whole(n, t, dt, o.session()), 20s), result.sources);
+    } else {
+      for (int r : order) {
+        c[std::size_t(r)].send(gas.partial(r, n, t, dt, o.session()));
+      }
+      for (int r = 0; r < ranks; ++r) {
+        auto src = c[std::size_t(r)].receive(20s);
+        EXPECT_TRUE(src.has_value()) << "no Sources for rank " << r;
+        if (!src) {
+          return result;
+        }
+        // Each rank gets its own cells only.
+        EXPECT_EQ(src->envelope().sources().touched_count(), r == 0 ? 14u : 14u);
+        take(*src, result.sources);
+      }
+    }
+    auto d = o.dem().receive(20s);
+    EXPECT_TRUE(d.has_value());
+    proto::expectType(*d, v1::MESSAGE_TYPE_STEP_DONE);
+    result.demDone = d->envelope().step_done();
+  }
+  return result;
+}
+
+double relDiff(double a, double b) {
+  const double s = std::max(std::abs(a), std::abs(b));
+  return s > 0 ? std::abs(a - b) / s : 0.0;
+}
+
+} // namespace
+
+TEST(DemServerRanks, ArrivalOrderDoesNotChangeAnyBit) {
+  const RunResult a = run(2, {0, 1});
+  const RunResult b = run(2, {1, 0});
+  ASSERT_FALSE(a.sources.empty());
+  EXPECT_EQ(a.sources, b.sources); // bitwise: combined in rank order whatever the arrival
+  EXPECT_EQ(named(a.demDone.diagnostics(), "mean_T_p"), named(b.demDone.diagnostics(), "mean_T_p"));
+  EXPECT_EQ(named(a.demDone.diagnostics(), "bed_height_m"),
+            named(b.demDone.diagnostics(), "bed_height_m"));
+}
+
+TEST(DemServerRanks, TwoRanksAgreeWithOneWholeGridParticipantToRoundOff) {
+  const RunResult one = run(0);
+  const RunResult two = run(2);
+  ASSERT_EQ(one.sources.size(), two.sources.size());
+  double worst = 0.0, solid = 0.0;
+  for (const auto& [name, v] : one.sources) {
+    const auto& w = two.sources.at(name);
+    ASSERT_EQ(v.size(), w.size()) << name;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      // Relative to the array's largest value (a source that is 0 in one and 1e-30 in the other
+      // is round-off too).
+      double scale = 0.0;
+      for (double x : v) {
+        scale = std::max(scale, std::abs(x));
+      }
+      if (scale > 0) {
+        worst = std::max(worst, std::abs(v[i] - w[i]) / scale);
+      }
+    }
+  }
+  for (double x : one.sources.at("eps_g")) {
+    solid += 1.0 - x;
+  }
+  EXPECT_GT(solid, 0.0); // the step had particles and drag
+  std::printf("largest relative difference 1 vs 2 ranks: %.3g\n", worst);
+  EXPECT_LE(worst, kRegrouped);
+  EXPECT_LE(relDiff(named(one.demDone.diagnostics(), "bed_height_m"),
+                    named(two.demDone.diagnostics(), "bed_height_m")),
+            kRegrouped);
+}
+
+TEST(DemServerRanks, MismatchedCountsDuplicateAndOutOfRangeRanksAreRefused) {
+  ServerThread server;
+  MiniOrchestrator o(server.endpoint(), smallCase(kParticles, kD, kBox, kCellsPerAxis));
+  std::string why;
+  cfdRank(server.endpoint(), o.session(), 2, 2, v1::MESSAGE_TYPE_REJECT, &why);
+  EXPECT_NE(why.find("rank 2 of 2"), std::string::npos) << why;
+  auto r0 = cfdRank(server.endpoint(), o.session(), 0, 2);
+  cfdRank(server.endpoint(), o.session(), 1, 3, v1::MESSAGE_TYPE_REJECT, &why);
+  EXPECT_NE(why.find("runs on 2 rank(s)"), std::string::npos) << why;
+  EXPECT_NE(why.find("says 3"), std::string::npos) << why;
+  cfdRank(server.endpoint(), o.session(), 0, 2, v1::MESSAGE_TYPE_REJECT, &why);
+  EXPECT_NE(why.find("CFD rank 0 of 2 is already connected"), std::string::npos) << why;
+  // A whole-grid GasFields in a 2-rank session is refused.
+  auto r1 = cfdRank(server.endpoint(), o.session(), 1, 2);
+  const double dt = 2e-4;
+  const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
+  grant(o, 1, dt, nSub);
+  auto e = r0.request(Gas().whole(1, 0.0, dt, o.session()), 20s);
+  ASSERT_EQ(e.type(), v1::MESSAGE_TYPE_ERROR);
+  EXPECT_NE(e.envelope().error().message().find("runs on 2 ranks"), std::string::npos)
+      << e.envelope().error().message();
+  // The step still runs with the partial ones.
+  r0.send(Gas().partial(0, 1, 0.0, dt, o.session()));
+  r1.send(Gas().partial(1, 1, 0.0, dt, o.session()));
+  for (auto* c : {&r0, &r1}) {
+    auto s = c->receive(20s);
+    ASSERT_TRUE(s.has_value());
+    EXPECT_EQ(s->type(), v1::MESSAGE_TYPE_SOURCES) << s->envelope().DebugString();
+  }
+  auto d = o.dem().receive(20s);
+  ASSERT_TRUE(d.has_value());
+  EXPECT_EQ(d->type(), v1::MESSAGE_TYPE_STEP_DONE);
+}
+
+TEST(DemServerRanks, ASilentRankFailsTheStepNamingIt) {
+  ServerThread server(600.0, 1.0); // wait 1 s for the other ranks
+  MiniOrchestrator o(server.endpoint(), smallCase(kParticles, kD, kBox, kCellsPerAxis));
+  auto r0 = cfdRank(server.endpoint(), o.session(), 0, 2);
+  auto r1 = cfdRank(server.endpoint(), o.session(), 1, 2);
+  const double dt = 2e-4;
+  const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
+  grant(o, 1, dt, nSub);
+  auto e = r0.request(Gas().partial(0, 1, 0.0, dt, o.session()), 20s);
+  ASSERT_EQ(e.type(), v1::MESSAGE_TYPE_ERROR);
+  EXPECT_EQ(e.envelope().error().code(), v1::ERROR_CODE_TIMEOUT);
+  EXPECT_NE(e.envelope().error().message().find("from CFD rank(s) 1 of 2"), std::string::npos)
+      << e.envelope().error().message();
+  auto g = o.dem().receive(20s); // the orchestrator hears it too
+  ASSERT_TRUE(g.has_value());
+  EXPECT_EQ(g->type(), v1::MESSAGE_TYPE_ERROR);
+  EXPECT_NE(g->envelope().error().message().find("rank(s) 1"), std::string::npos);
+}
+
+TEST(DemServerRanks, ARankThatLeavesFailsTheStepNamingIt) {
+  ServerThread server;
+  MiniOrchestrator o(server.endpoint(), smallCase(kParticles, kD, kBox, kCellsPerAxis));
+  auto r0 = cfdRank(server.endpoint(), o.session(), 0, 2);
+  const double dt = 2e-4;
+  const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
+  {
+    auto r1 = cfdRank(server.endpoint(), o.session(), 1, 2);
+    grant(o, 1, dt, nSub);
+    r0.send(Gas().partial(0, 1, 0.0, dt, o.session()));
+    std::this_thread::sleep_for(200ms);
+  } // rank 1's connection closes (a crashed rank)
+  auto e = r0.receive(20s);
+  ASSERT_TRUE(e.has_value()) << "rank 0 left waiting";
+  ASSERT_EQ(e->type(), v1::MESSAGE_TYPE_ERROR);
+  EXPECT_EQ(e->envelope().error().code(), v1::ERROR_CODE_TRANSPORT);
+  EXPECT_NE(e->envelope().error().message().find("CFD rank 1 of 2"), std::string::npos)
+      << e->envelope().error().message();
+}
