@@ -586,10 +586,6 @@ int slurmMemberMain(const fs::path& dir, int index) {
 
   const bool exitedOk = status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
   const bool ok = exitedOk && runReachedEnd(m->runDir, m->caseDir);
-  // exit 0 before the end: stopped by --walltime; 130: by the forwarded SIGTERM
-  const bool stopped =
-      !ok && (forwarded || exitedOk ||
-              (status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == kInterrupted));
   std::string after;
   if (ok) {
     after = finishMember(db, m->id, m->runDir, status, retries);
@@ -602,6 +598,12 @@ int slurmMemberMain(const fs::path& dir, int index) {
   // preempted task itself where PreemptMode=REQUEUE.
   const std::string jobState = endedTaskState(task);
   const bool ending = jobState.rfind("RUNNING", 0) != 0;
+  // Stopped, not failed: exit 0 before the end (--walltime), 130 (the forwarded SIGTERM), a
+  // signal to this process, or any end while the task is ending. scancel signals every process
+  // of the task: a participant may stop first and coredem then exits 1 ("the other participant
+  // was shut down") before this process forwards its own signal.
+  const bool stopped = forwarded || gSignal != 0 || (ending && !jobState.empty()) || exitedOk ||
+                       (status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == kInterrupted);
   if (stopped) {
     const std::string ckpt = newestCheckpointName(m->runDir);
     const std::string reason =
