@@ -25,6 +25,7 @@ MPI_ARGS="--oversubscribe"
 [ "$(id -u)" = 0 ] && MPI_ARGS="$MPI_ARGS --allow-run-as-root"
 mkdir -p "$OUT"
 # cells per axis (x y z; y vertical): 46 x 48 x 46 ~ 1.0e5, 100 x 100 x 100 = 1.0e6
+# (every command in the loop reads /dev/null: mpirun would otherwise eat the remaining sizes)
 echo "$SIZES" | tr ';' '\n' | while read -r n; do
   [ -n "$n" ] || continue
   set -- $n
@@ -61,13 +62,13 @@ DICT
   # shellcheck disable=SC2086
   mpirun $MPI_ARGS -np 2 "$BUILD/bin/coredemMapCheck" -parallel -case "$d/case/openfoam" \
     -origin '(0 0 0)' -spacing '(0.002 0.002 0.002)' -counts '(20 100 20)' \
-    > "$d/mapcheck-2.log" 2>&1
+    > "$d/mapcheck-2.log" 2>&1 < /dev/null
   grep "map:" "$d/mapcheck-2.log"
   rm -rf "$d/case/openfoam/processor"* "$d/case/openfoam/system/decomposeParDict"
   for ranks in 1 2; do
     sed -i "s/^  ranks: .*//; s/^  case: openfoam.*/  case: openfoam\n  ranks: $ranks/" "$d/case/case.yaml"
     "$BUILD/bin/coredem" run "$d/case" --out "$d/run-$ranks" --timers --no-plots \
-      > "$d/run-$ranks.log" 2>&1
+      > "$d/run-$ranks.log" 2>&1 < /dev/null
     echo "$tag cells, $ranks rank(s):"
     grep -E '"(pack|unpack|serialise|send|wait_dem|receive|step_seconds|exchange_share)"' \
       "$d/run-$ranks/timers-cfd.json" || true
