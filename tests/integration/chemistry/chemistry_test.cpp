@@ -76,7 +76,9 @@ struct Gas {
     for (std::size_t c = 0; c < n; ++c)
       Y.insert(Y.end(), y.begin(), y.end());
   }
-  void apply(DemSystem& s) const { s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, Y}); }
+  void apply(DemSystem& s) const {
+    s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, Y, {}});
+  }
 };
 
 std::vector<Species> clgGas() {

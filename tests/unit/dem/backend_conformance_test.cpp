@@ -160,7 +160,9 @@ struct Gas {
         Y.push_back(g == 0 ? 1.0 : 0.0);
     }
   }
-  void apply(DemSystem& s) const { s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, Y}); }
+  void apply(DemSystem& s) const {
+    s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, Y, {}});
+  }
 };
 
 /// One run of a deck: the sources of every window and the final state.
