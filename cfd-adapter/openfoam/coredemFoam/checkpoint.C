@@ -57,6 +57,14 @@ std::vector<std::string> Checkpoint::write
     const fileName timeDir(Pstream::parRun() ? base/proc/inst : base/inst);
     mkDir(timeDir);
     for (regIOobject* f : fields_) writeBinary(*f, timeDir);
+    if (Pstream::parRun())
+    {
+        // Every processor's files are closed before the master lists them: the orchestrator
+        // checks each listed file as soon as the StepDone arrives (without this, a slower
+        // processor was still writing when the master reported).
+        bool written = true;
+        reduce(written, andOp<bool>());
+    }
     if (!Pstream::master())
     {
         return {};
