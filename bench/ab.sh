@@ -14,7 +14,6 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 base="$1/bin/coredem-bench"
 new="$2/bin/coredem-bench"
 repeat="${3:-3}"
-LOAD_MAX="${LOAD_MAX:-0.5}"
 for b in "$base" "$new"; do
   [[ -x "$b" ]] || { echo "ab.sh: $b not found; build the target coredem-bench in that build directory" >&2; exit 2; }
 done
@@ -25,17 +24,8 @@ python3 "$here/peers/liggghts/make_deck.py" 100000 300 "$out/deck" --deck agitat
   --contacts --skin 1e-4 >/dev/null
 vel="$out/deck/agitated.vel"
 
-below_max() { python3 -c "import sys; sys.exit(0 if float('$1') < float('$LOAD_MAX') else 1)"; }
-wait_quiet() { # one reading decides both the wait and the label
-  local w=0 l
-  l="$(cut -d' ' -f1 /proc/loadavg)"
-  while ! below_max "$l" && [[ $w -lt 240 ]]; do
-    sleep 5
-    w=$((w + 5))
-    l="$(cut -d' ' -f1 /proc/loadavg)"
-  done
-  if below_max "$l"; then echo "load $l"; else echo "load $l LOADED"; fi
-}
+# shellcheck source=bench/quiet.sh
+source "$here/quiet.sh" # wait_quiet
 run() { # tag binary args...
   local tag="$1" bin="$2"; shift 2
   printf '%s %-28s %s\n' "$(date +%H:%M:%S)" "$tag" "$(wait_quiet)"

@@ -52,7 +52,6 @@ else
   END="${END:-0.05}" FINE="${FINE:-4}" FEW="${FEW:-100}" MANY="${MANY:-2000}" REPEAT="${REPEAT:-3}"
 fi
 REPEAT="${repeat_opt:-$REPEAT}"
-LOAD_MAX="${LOAD_MAX:-0.5}"
 coredem="$build/bin/coredem"
 for exe in coredem coredem-dem coredem-gas; do
   [[ -x "$build/bin/$exe" ]] || { echo "staggered.sh: $build/bin/$exe not built" >&2; exit 2; }
@@ -117,17 +116,8 @@ for scheme in sequential staggered; do
 done
 
 # ---- the runs -------------------------------------------------------------------------------
-below_max() { "$python" -c "import sys; sys.exit(0 if float('$1') < float('$LOAD_MAX') else 1)"; }
-wait_quiet() { # one reading decides both the wait and the label
-  local w=0 l
-  l="$(cut -d' ' -f1 /proc/loadavg)"
-  while ! below_max "$l" && [[ $w -lt 240 ]]; do
-    sleep 5
-    w=$((w + 5))
-    l="$(cut -d' ' -f1 /proc/loadavg)"
-  done
-  if below_max "$l"; then echo "load $l"; else echo "load $l LOADED"; fi
-}
+# shellcheck source=bench/quiet.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../quiet.sh" # wait_quiet
 results="$out/results.csv"
 echo "case,scheme,repeat,steps,median_wall_step_s,load" >"$results"
 run() { # case scheme repeat

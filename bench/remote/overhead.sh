@@ -25,12 +25,16 @@
 #                 ledgers of both, the gas evaluation, the orchestrator's bookkeeping
 #   +vs 0         overhead - overhead of RTT 0 (the same cells), and that in round trips
 #
-# Needs root and iproute2 (network namespaces). Environment: BUILD_DIR (default
+# Before each run it waits up to 240 s for the load average to fall below LOAD_MAX (default 0.5;
+# a run started above it is labelled LOADED). Needs root and iproute2 (network namespaces).
+# Environment: BUILD_DIR (default
 # <project>/build: coredem, coredem-dem, coredem-gas, coredem-relay), THREADS (DEM threads,
 # default 2), MBIT (bandwidth limit of the emulated link, default 0 = none), KEEP_DIR (keep
 # cases, runs and results.jsonl there).
 # Tiny check: bench/remote/overhead.sh 1000 "0 1" 3 1
 set -euo pipefail
+# shellcheck source=bench/quiet.sh
+source "$(dirname "${BASH_SOURCE[0]}")/../quiet.sh" # wait_quiet (LOAD_MAX)
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
 die() { echo "overhead.sh: error: $*" >&2; exit 2; }
@@ -136,7 +140,7 @@ for rep in $(seq "$REPEATS"); do
       run="$work/runs/$cells-$cfg-$rep"
       rm -rf "$run"
       mkdir -p "$work/runs"
-      echo "repeat $rep, $cells cells, $([[ $rtt == local ]] && echo "local DEM (loopback)" || echo "round trip $rtt ms"): load average before $(cut -d' ' -f1-3 /proc/loadavg)"
+      echo "repeat $rep, $cells cells, $([[ $rtt == local ]] && echo "local DEM (loopback)" || echo "round trip $rtt ms"): $(wait_quiet) (before: $(cut -d' ' -f1-3 /proc/loadavg))"
       "$BUILD_DIR/bin/coredem" run "$work/cases/$cells-$cfg" --out "$run" --no-plots >"$run.log" 2>&1 ||
         { tail -20 "$run.log" >&2; die "coredem run failed ($cells cells, $cfg): $run.log"; }
       for _ in $(seq 100); do [[ -s "$timers" ]] && break; sleep 0.1; done
