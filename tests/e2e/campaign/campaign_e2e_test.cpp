@@ -17,10 +17,10 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <spawn.h>
-#include <sqlite3.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "campaign_e2e.h"
 #include "coredem_e2e.h"
 
 namespace fs = std::filesystem;
@@ -71,84 +71,21 @@ std::vector<pid_t> childrenOf(pid_t parent) {
   return out;
 }
 
-/// A member row read straight from campaign.db (read-only, as a second process would).
-struct Row {
-  std::string status, exitReason, lastCheckpoint, caseHash, softwareVersion, protocolVersion;
-  int attempts = 0, failures = 0, doneCount = 0, doneEvents = 0;
-  long pid = 0;
-};
+using Row = coredem::e2e::MemberRow;
+using coredem::e2e::stepsOf;
 
 std::map<std::string, Row> readDb(const fs::path& dir) {
-  std::map<std::string, Row> rows;
-  sqlite3* db = nullptr;
-  if (sqlite3_open_v2((dir / "campaign.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr) !=
-      SQLITE_OK) {
-    sqlite3_close(db);
-    return rows;
-  }
-  sqlite3_busy_timeout(db, 5000);
-  sqlite3_stmt* s = nullptr;
-  const char* sql =
-      "SELECT id, status, attempts, failures, done_count, pid, ifnull(exit_reason,''), "
-      "ifnull(last_checkpoint,''), case_hash, ifnull(software_version,''), "
-      "ifnull(protocol_version,''), (SELECT count(*) FROM events e WHERE e.member = m.id AND "
-      "e.event = 'done') FROM members m ORDER BY idx";
-  if (sqlite3_prepare_v2(db, sql, -1, &s, nullptr) == SQLITE_OK) {
-    auto text = [&](int c) {
-      const auto* p = sqlite3_column_text(s, c);
-      return p ? std::string(reinterpret_cast<const char*>(p)) : std::string();
-    };
-    while (sqlite3_step(s) == SQLITE_ROW) {
-      Row r;
-      r.status = text(1);
-      r.attempts = sqlite3_column_int(s, 2);
-      r.failures = sqlite3_column_int(s, 3);
-      r.doneCount = sqlite3_column_int(s, 4);
-      r.pid = static_cast<long>(sqlite3_column_int64(s, 5));
-      r.exitReason = text(6);
-      r.lastCheckpoint = text(7);
-      r.caseHash = text(8);
-      r.softwareVersion = text(9);
-      r.protocolVersion = text(10);
-      r.doneEvents = sqlite3_column_int(s, 11);
-      rows[text(0)] = r;
-    }
-  }
-  sqlite3_finalize(s);
-  sqlite3_close(db);
-  return rows;
+  return coredem::e2e::readCampaignDb(dir);
 }
 
-/// The `step` column of a member's timeseries.csv.
-std::vector<long> stepsOf(const fs::path& runDir) {
-  std::ifstream in(runDir / "timeseries.csv");
-  std::string line;
-  std::getline(in, line);
-  std::vector<long> steps;
-  while (std::getline(in, line)) {
-    steps.push_back(std::stol(line.substr(0, line.find(','))));
-  }
-  return steps;
-}
-
-/// Every member done exactly once (status, done_count, one 'done' event) and its timeseries
-/// holds each step 1..N exactly once.
+/// Every member done exactly once, its process gone and its versions recorded
+/// (campaign_e2e.h).
 void expectAllDoneOnce(const fs::path& dir, std::size_t members, long steps) {
-  const auto rows = readDb(dir);
-  ASSERT_EQ(rows.size(), members);
-  for (const auto& [id, r] : rows) {
-    EXPECT_EQ(r.status, "done") << id << ": " << r.exitReason;
-    EXPECT_EQ(r.doneCount, 1) << id;
-    EXPECT_EQ(r.doneEvents, 1) << id;
+  coredem::e2e::expectAllDoneOnce(dir, members, steps, [](const std::string& id, const Row& r) {
     EXPECT_EQ(r.pid, 0) << id;
     EXPECT_FALSE(r.softwareVersion.empty()) << id;
     EXPECT_FALSE(r.protocolVersion.empty()) << id;
-    const auto s = stepsOf(dir / "members" / id / "run");
-    ASSERT_EQ(static_cast<long>(s.size()), steps) << id;
-    for (long i = 0; i < steps; ++i) {
-      EXPECT_EQ(s[static_cast<std::size_t>(i)], i + 1) << id;
-    }
-  }
+  });
 }
 
 /// summary.csv of an uninterrupted run of cases/kill.yaml (computed once).

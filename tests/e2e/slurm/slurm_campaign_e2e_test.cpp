@@ -17,10 +17,10 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <sqlite3.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "campaign_e2e.h"
 #include "coredem_e2e.h"
 
 namespace fs = std::filesystem;
@@ -44,101 +44,20 @@ int runCoredem(const std::vector<std::string>& args, const fs::path& log,
   return waitExit(start(args, log), timeout);
 }
 
-struct Row {
-  std::string status, exitReason, jobId;
-  int attempts = 0, failures = 0, doneCount = 0, doneEvents = 0;
-  long pid = 0;
-  std::vector<std::string> events; ///< "event: detail" in order
-};
+using Row = coredem::e2e::MemberRow;
+using coredem::e2e::countEvents;
+using coredem::e2e::eventsOf;
+using coredem::e2e::stepsOf;
 
 std::map<std::string, Row> readDb(const fs::path& dir) {
-  std::map<std::string, Row> rows;
-  sqlite3* db = nullptr;
-  if (sqlite3_open_v2((dir / "campaign.db").c_str(), &db, SQLITE_OPEN_READONLY, nullptr) !=
-      SQLITE_OK) {
-    sqlite3_close(db);
-    return rows;
-  }
-  sqlite3_busy_timeout(db, 5000);
-  auto text = [](sqlite3_stmt* s, int c) {
-    const auto* p = sqlite3_column_text(s, c);
-    return p ? std::string(reinterpret_cast<const char*>(p)) : std::string();
-  };
-  sqlite3_stmt* s = nullptr;
-  const char* sql = "SELECT id, status, attempts, failures, done_count, pid, "
-                    "ifnull(exit_reason,''), ifnull(job_id,''), (SELECT count(*) FROM events e "
-                    "WHERE e.member = m.id AND e.event = 'done') FROM members m ORDER BY idx";
-  if (sqlite3_prepare_v2(db, sql, -1, &s, nullptr) == SQLITE_OK) {
-    while (sqlite3_step(s) == SQLITE_ROW) {
-      Row r;
-      r.status = text(s, 1);
-      r.attempts = sqlite3_column_int(s, 2);
-      r.failures = sqlite3_column_int(s, 3);
-      r.doneCount = sqlite3_column_int(s, 4);
-      r.pid = static_cast<long>(sqlite3_column_int64(s, 5));
-      r.exitReason = text(s, 6);
-      r.jobId = text(s, 7);
-      r.doneEvents = sqlite3_column_int(s, 8);
-      rows[text(s, 0)] = r;
-    }
-  }
-  sqlite3_finalize(s);
-  if (sqlite3_prepare_v2(db, "SELECT member, event, ifnull(detail,'') FROM events ORDER BY seq", -1,
-                         &s, nullptr) == SQLITE_OK) {
-    while (sqlite3_step(s) == SQLITE_ROW) {
-      if (rows.count(text(s, 0))) {
-        rows[text(s, 0)].events.push_back(text(s, 1) + ": " + text(s, 2));
-      }
-    }
-  }
-  sqlite3_finalize(s);
-  sqlite3_close(db);
-  return rows;
+  return coredem::e2e::readCampaignDb(dir);
 }
 
-std::string eventsOf(const Row& r) {
-  std::string s;
-  for (const auto& e : r.events) {
-    s += "\n  " + e;
-  }
-  return s;
-}
-
-int countEvents(const Row& r, const std::string& event) {
-  int n = 0;
-  for (const auto& e : r.events) {
-    n += e.rfind(event + ":", 0) == 0;
-  }
-  return n;
-}
-
-std::vector<long> stepsOf(const fs::path& runDir) {
-  std::ifstream in(runDir / "timeseries.csv");
-  std::string line;
-  std::getline(in, line);
-  std::vector<long> steps;
-  while (std::getline(in, line)) {
-    steps.push_back(std::stol(line.substr(0, line.find(','))));
-  }
-  return steps;
-}
-
-/// Every member done exactly once (status, done_count, one 'done' event, a Slurm task id) and
-/// its timeseries holds each step 1..N exactly once.
+/// Every member done exactly once with a Slurm task id (campaign_e2e.h).
 void expectAllDoneOnce(const fs::path& dir, std::size_t members, long steps) {
-  const auto rows = readDb(dir);
-  ASSERT_EQ(rows.size(), members);
-  for (const auto& [id, r] : rows) {
-    EXPECT_EQ(r.status, "done") << id << ": " << r.exitReason << eventsOf(r);
-    EXPECT_EQ(r.doneCount, 1) << id;
-    EXPECT_EQ(r.doneEvents, 1) << id;
+  coredem::e2e::expectAllDoneOnce(dir, members, steps, [](const std::string& id, const Row& r) {
     EXPECT_NE(r.jobId.find('_'), std::string::npos) << id << ": job id '" << r.jobId << "'";
-    const auto s = stepsOf(dir / "members" / id / "run");
-    ASSERT_EQ(static_cast<long>(s.size()), steps) << id;
-    for (long i = 0; i < steps; ++i) {
-      EXPECT_EQ(s[static_cast<std::size_t>(i)], i + 1) << id;
-    }
-  }
+  });
 }
 
 /// Runs a command line through sh; returns its exit code and output.
