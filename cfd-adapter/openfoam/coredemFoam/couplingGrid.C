@@ -420,40 +420,7 @@ void CoredemGrid::scatter
         }
         return;
     }
-    const bool fraction = quantity == Quantity::GasFraction;
-    if (fraction)
-    {
-        // Solid in a grid cell without fluid: a particle outside the fluid domain.
-        for (label g = 0; g < nGrid_; ++g)
-        {
-            if (fluidScale_[g] == 0 && gridValues[g] < 1)
-            {
-                FatalErrorInFunction
-                    << "coupling-grid cell " << describe(g) << " holds particles ("
-                    << (1 - gridValues[g])*cellVolume() << " m3 of solid) but no fluid: a "
-                    << "particle lies outside the CFD domain (check the walls against the mesh)"
-                    << exit(FatalError);
-            }
-        }
-    }
-    const label nCells = label(rowStart_.size()) - 1;
-    for (label celli = 0; celli < nCells; ++celli)
-    {
-        scalar* c = cellValues + std::size_t(celli)*nComp;
-        for (label q = 0; q < nComp; ++q) c[q] = 0;
-        for (label e = rowStart_[celli]; e < rowStart_[celli + 1]; ++e)
-        {
-            const label g = overlapGrid_[e];
-            const double w = overlapVol_[e];
-            const double r = fluidScale_[g];
-            const double* s = gridValues + std::size_t(g)*nComp;
-            for (label q = 0; q < nComp; ++q)
-            {
-                c[q] += w*(fraction ? 1 - (1 - s[q])*r : s[q]*r);
-            }
-        }
-        for (label q = 0; q < nComp; ++q) c[q] /= cellVol_[celli];
-    }
+    scatterRows(gridValues, nComp, cellValues, quantity, nGrid_, nullptr, overlapGrid_);
 }
 
 void CoredemGrid::sumTouched
@@ -483,17 +450,37 @@ void CoredemGrid::scatterTouched
     const double* touchedValues, label nComp, scalar* cellValues, Quantity quantity
 ) const
 {
+    scatterRows
+    (
+        touchedValues, nComp, cellValues, quantity, label(touched_.size()), touched_.data(),
+        overlapTouched_
+    );
+}
+
+
+void CoredemGrid::scatterRows
+(
+    const double* rowValues,
+    label nComp,
+    scalar* cellValues,
+    Quantity quantity,
+    label nRows,
+    const label* rowGrid,
+    const std::vector<label>& overlapRow
+) const
+{
     const bool fraction = quantity == Quantity::GasFraction;
     if (fraction)
     {
-        for (std::size_t t = 0; t < touched_.size(); ++t)
+        // Solid in a grid cell without fluid: a particle outside the fluid domain.
+        for (label t = 0; t < nRows; ++t)
         {
-            const label g = touched_[t];
-            if (fluidScale_[g] == 0 && touchedValues[t] < 1)
+            const label g = rowGrid ? rowGrid[t] : t;
+            if (fluidScale_[g] == 0 && rowValues[t] < 1)
             {
                 FatalErrorInFunction
                     << "coupling-grid cell " << describe(g) << " holds particles ("
-                    << (1 - touchedValues[t])*cellVolume() << " m3 of solid) but no fluid: a "
+                    << (1 - rowValues[t])*cellVolume() << " m3 of solid) but no fluid: a "
                     << "particle lies outside the CFD domain (check the walls against the mesh)"
                     << exit(FatalError);
             }
@@ -506,11 +493,11 @@ void CoredemGrid::scatterTouched
         for (label q = 0; q < nComp; ++q) c[q] = 0;
         for (label e = rowStart_[celli]; e < rowStart_[celli + 1]; ++e)
         {
-            const label t = overlapTouched_[e];
+            const label t = overlapRow[e];
             if (t < 0) continue;
             const double w = overlapVol_[e];
             const double r = fluidScale_[overlapGrid_[e]];
-            const double* s = touchedValues + std::size_t(t)*nComp;
+            const double* s = rowValues + std::size_t(t)*nComp;
             for (label q = 0; q < nComp; ++q)
             {
                 c[q] += w*(fraction ? 1 - (1 - s[q])*r : s[q]*r);
