@@ -108,6 +108,66 @@ std::vector<std::string> manifestFiles(const fs::path& checkpoint, const std::st
   return out;
 }
 
+/// Runs case `c` twice: straight through into dir/straight, and for `stopAfter` steps then
+/// `coredem resume` into dir/resumed; both must exit 0 and the resume must restart coredemFoam
+/// from the checkpoint. Returns {straight, resumed}.
+std::pair<fs::path, fs::path> runStraightAndResumed(const fs::path& dir, const fs::path& c,
+                                                    int stopAfter) {
+  const fs::path a = dir / "straight", b = dir / "resumed";
+  EXPECT_EQ(runCoredem({"run", c.string(), "--out", a.string()}, dir / "a.log"), 0)
+      << readAll(dir / "a.log") << logTail(a);
+  EXPECT_EQ(runCoredem(
+                {"run", c.string(), "--out", b.string(), "--stop-after", std::to_string(stopAfter)},
+                dir / "b.log"),
+            0)
+      << readAll(dir / "b.log") << logTail(b);
+  EXPECT_EQ(runCoredem({"resume", b.string()}, dir / "b.log"), 0)
+      << readAll(dir / "b.log") << logTail(b);
+  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Restarting from"), std::string::npos)
+      << "coredemFoam was not restarted from the checkpoint";
+  return {a, b};
+}
+
+/// The same checkpoint in two runs (ca, cb): the same coredemFoam files, byte for byte (at least
+/// `minCfdFiles`), and one DEM file whose datasets named with one of `prefixes` are byte for
+/// byte equal (at least 5). `what` names the difference in messages ("after the restart").
+/// Returns the coredemFoam files and the DEM datasets compared.
+std::pair<std::vector<std::string>, std::vector<std::string>>
+expectSameCheckpoint(const fs::path& ca, const fs::path& cb, std::size_t minCfdFiles,
+                     const std::vector<std::string>& prefixes, const std::string& what) {
+  const auto fa = manifestFiles(ca, "cfd"), fb = manifestFiles(cb, "cfd");
+  EXPECT_GE(fa.size(), minCfdFiles) << "coredemFoam listed too few checkpoint files";
+  EXPECT_EQ(fa, fb);
+  for (const auto& f : fa) {
+    EXPECT_TRUE(readAll(ca / f) == readAll(cb / f)) << f << " differs " << what;
+  }
+  const auto da = manifestFiles(ca, "dem"), db = manifestFiles(cb, "dem");
+  std::vector<std::string> compared;
+  if (da.size() != 1 || db.size() != 1) {
+    ADD_FAILURE() << "expected one DEM checkpoint file in each run, got " << da.size() << " and "
+                  << db.size();
+    return {fa, compared};
+  }
+  const auto sa = datasetsOf(ca / da[0]), sb = datasetsOf(cb / db[0]);
+  for (const auto& [name, bytes] : sa) {
+    bool selected = false;
+    for (const auto& prefix : prefixes) {
+      selected = selected || name.rfind(prefix, 0) == 0;
+    }
+    if (!selected) {
+      continue;
+    }
+    if (!sb.count(name)) {
+      ADD_FAILURE() << "DEM dataset " << name << " is missing " << what;
+      continue;
+    }
+    EXPECT_TRUE(bytes == sb.at(name)) << "DEM dataset " << name << " differs " << what;
+    compared.push_back(name);
+  }
+  EXPECT_GE(compared.size(), 5u);
+  return {fa, compared};
+}
+
 /// Ergun's pressure gradient (Pa/m) of a packed bed: voidage eps, superficial velocity u.
 double ergunGradient(double eps, double u) {
   const double s = 1.0 - eps;
@@ -272,42 +332,15 @@ TEST_F(CoredemFoamE2E, RestartContinuesWithTheSameFieldsAndDemState) {
                               std::string("time: {end: 0.012, dt: 5.0e-4}\n"
                                           "checkpoint: {every_steps: 12, keep: 3}\n") +
                                   kFluidizedBed);
-  const fs::path a = dir / "straight", b = dir / "resumed";
-  ASSERT_EQ(runCoredem({"run", c.string(), "--out", a.string()}, dir / "a.log"), 0)
-      << readAll(dir / "a.log") << logTail(a);
-  ASSERT_EQ(
-      runCoredem({"run", c.string(), "--out", b.string(), "--stop-after", "12"}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
+  const auto [a, b] = runStraightAndResumed(dir, c, 12);
+  ASSERT_FALSE(HasFailure());
   ASSERT_TRUE(fs::exists(b / "checkpoints" / "00000012" / "manifest.json"));
-  ASSERT_FALSE(fs::exists(b / "checkpoints" / "00000024"));
-  ASSERT_EQ(runCoredem({"resume", b.string()}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
-  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Restarting from"), std::string::npos)
-      << "coredemFoam was not restarted from the checkpoint";
-
   const fs::path ca = a / "checkpoints" / "00000024", cb = b / "checkpoints" / "00000024";
-  const auto fa = manifestFiles(ca, "cfd"), fb = manifestFiles(cb, "cfd");
-  ASSERT_GE(fa.size(), 6u) << "coredemFoam listed too few checkpoint files";
-  ASSERT_EQ(fa, fb);
-  for (const auto& f : fa) {
-    EXPECT_TRUE(readAll(ca / f) == readAll(cb / f)) << f << " differs after the restart";
-  }
+  const auto [fa, compared] =
+      expectSameCheckpoint(ca, cb, 6, {"particles/", "contacts/"}, "after the restart");
+  ASSERT_GE(fa.size(), 2u);
   EXPECT_NE(readAll(ca / fa[1]).find("format      binary"), std::string::npos)
       << fa[1] << " is not binary";
-
-  const auto da = manifestFiles(ca, "dem"), db = manifestFiles(cb, "dem");
-  ASSERT_EQ(da.size(), 1u);
-  ASSERT_EQ(db.size(), 1u);
-  const auto sa = datasetsOf(ca / da[0]), sb = datasetsOf(cb / db[0]);
-  std::size_t compared = 0;
-  for (const auto& [name, bytes] : sa) {
-    if (name.rfind("particles/", 0) == 0 || name.rfind("contacts/", 0) == 0) {
-      ASSERT_TRUE(sb.count(name)) << name;
-      EXPECT_TRUE(bytes == sb.at(name)) << "DEM dataset " << name << " differs after the restart";
-      ++compared;
-    }
-  }
-  EXPECT_GE(compared, 5u);
 
   auto ta = readTimeseries(a), tb = readTimeseries(b);
   ASSERT_EQ(ta["gas.pressure_drop_Pa"].size(), 24u);
@@ -331,38 +364,13 @@ TEST_F(CoredemFoamE2E, RestartOnAGradedMeshContinuesBitwise) {
   writeAll(dict, replaceAll(readAll(dict), "(5 20 5) simpleGrading (1 1 1)",
                             "(8 24 8) simpleGrading (((0.5 0.5 3) (0.5 0.5 0.333)) 1 "
                             "((0.5 0.5 3) (0.5 0.5 0.333)))"));
-  const fs::path a = dir / "straight", b = dir / "resumed";
-  ASSERT_EQ(runCoredem({"run", c.string(), "--out", a.string()}, dir / "a.log"), 0)
-      << readAll(dir / "a.log") << logTail(a);
-  ASSERT_EQ(
-      runCoredem({"run", c.string(), "--out", b.string(), "--stop-after", "12"}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
-  ASSERT_EQ(runCoredem({"resume", b.string()}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
-  const std::string log = readAll(b / "logs" / "cfd.log");
-  EXPECT_NE(log.find("Restarting from"), std::string::npos);
-  EXPECT_NE(log.find("overlap map of 1536 mesh cells"), std::string::npos) << logTail(b);
-
-  const fs::path ca = a / "checkpoints" / "00000024", cb = b / "checkpoints" / "00000024";
-  const auto fa = manifestFiles(ca, "cfd"), fb = manifestFiles(cb, "cfd");
-  ASSERT_GE(fa.size(), 6u);
-  ASSERT_EQ(fa, fb);
-  for (const auto& f : fa) {
-    EXPECT_TRUE(readAll(ca / f) == readAll(cb / f)) << f << " differs after the restart";
-  }
-  const auto da = manifestFiles(ca, "dem"), db = manifestFiles(cb, "dem");
-  ASSERT_EQ(da.size(), 1u);
-  ASSERT_EQ(db.size(), 1u);
-  const auto sa = datasetsOf(ca / da[0]), sb = datasetsOf(cb / db[0]);
-  std::size_t compared = 0;
-  for (const auto& [name, bytes] : sa) {
-    if (name.rfind("particles/", 0) == 0) {
-      ASSERT_TRUE(sb.count(name)) << name;
-      EXPECT_TRUE(bytes == sb.at(name)) << "DEM dataset " << name << " differs after the restart";
-      ++compared;
-    }
-  }
-  EXPECT_GE(compared, 5u);
+  const auto [a, b] = runStraightAndResumed(dir, c, 12);
+  ASSERT_FALSE(HasFailure());
+  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("overlap map of 1536 mesh cells"),
+            std::string::npos)
+      << logTail(b);
+  expectSameCheckpoint(a / "checkpoints" / "00000024", b / "checkpoints" / "00000024", 6,
+                       {"particles/"}, "after the restart");
   auto ta = readTimeseries(a), tb = readTimeseries(b);
   ASSERT_EQ(ta["gas.pressure_drop_Pa"].size(), 24u);
   ASSERT_EQ(tb["gas.pressure_drop_Pa"].size(), 24u);
@@ -398,23 +406,8 @@ TEST_F(CoredemFoamE2E, InPlaceExchangeMatchesCopiesAndTimersAddUp) {
   EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Exchange: gather/scatter copies"),
             std::string::npos);
 
-  const fs::path ca = a / "checkpoints" / "00000012", cb = b / "checkpoints" / "00000012";
-  const auto fa = manifestFiles(ca, "cfd"), fb = manifestFiles(cb, "cfd");
-  ASSERT_GE(fa.size(), 6u);
-  ASSERT_EQ(fa, fb);
-  for (const auto& f : fa) {
-    EXPECT_TRUE(readAll(ca / f) == readAll(cb / f)) << f << " differs between in place and copies";
-  }
-  const auto da = manifestFiles(ca, "dem"), db = manifestFiles(cb, "dem");
-  ASSERT_EQ(da.size(), 1u);
-  ASSERT_EQ(db.size(), 1u);
-  const auto sa = datasetsOf(ca / da[0]), sb = datasetsOf(cb / db[0]);
-  for (const auto& [name, bytes] : sa) {
-    if (name.rfind("particles/", 0) == 0) {
-      ASSERT_TRUE(sb.count(name)) << name;
-      EXPECT_TRUE(bytes == sb.at(name)) << "DEM dataset " << name << " differs";
-    }
-  }
+  expectSameCheckpoint(a / "checkpoints" / "00000012", b / "checkpoints" / "00000012", 6,
+                       {"particles/"}, "between in place and copies");
   auto ta = readTimeseries(a), tb = readTimeseries(b);
   ASSERT_EQ(ta["gas.pressure_drop_Pa"].size(), 12u);
   EXPECT_EQ(ta["gas.pressure_drop_Pa"], tb["gas.pressure_drop_Pa"]);
@@ -760,37 +753,16 @@ TEST_F(CoredemFoamE2E, TwoRankRestartContinuesBitwise) {
   const fs::path y = c / "case.yaml";
   writeAll(y, replaceAll(readAll(y), "case: openfoam, timeout_s: 120}",
                          "case: openfoam, timeout_s: 120, ranks: 2}"));
-  const fs::path a = dir / "straight", b = dir / "resumed";
-  ASSERT_EQ(runCoredem({"run", c.string(), "--out", a.string()}, dir / "a.log"), 0)
-      << readAll(dir / "a.log") << logTail(a);
-  ASSERT_EQ(
-      runCoredem({"run", c.string(), "--out", b.string(), "--stop-after", "4"}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
-  ASSERT_EQ(runCoredem({"resume", b.string()}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
-  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Restarting from"), std::string::npos);
-  const fs::path ca = a / "checkpoints" / "00000008", cb = b / "checkpoints" / "00000008";
-  const auto fa = manifestFiles(ca, "cfd"), fb = manifestFiles(cb, "cfd");
-  ASSERT_EQ(fa, fb);
+  const auto [a, b] = runStraightAndResumed(dir, c, 4);
+  ASSERT_FALSE(HasFailure());
+  const auto [fa, compared] =
+      expectSameCheckpoint(a / "checkpoints" / "00000008", b / "checkpoints" / "00000008", 1,
+                           {"particles/"}, "after the restart");
   std::size_t processorFiles = 0;
   for (const auto& f : fa) {
     processorFiles += f.find("processor1/") != std::string::npos ? 1 : 0;
-    EXPECT_TRUE(readAll(ca / f) == readAll(cb / f)) << f << " differs after the restart";
   }
   EXPECT_GE(processorFiles, 5u); // every field of processor 1 is checkpointed
-  const auto da = manifestFiles(ca, "dem"), db = manifestFiles(cb, "dem");
-  ASSERT_EQ(da.size(), 1u);
-  ASSERT_EQ(db.size(), 1u);
-  const auto sa = datasetsOf(ca / da[0]), sb = datasetsOf(cb / db[0]);
-  std::size_t compared = 0;
-  for (const auto& [name, bytes] : sa) {
-    if (name.rfind("particles/", 0) == 0) {
-      ASSERT_TRUE(sb.count(name)) << name;
-      EXPECT_TRUE(bytes == sb.at(name)) << "DEM dataset " << name << " differs after the restart";
-      ++compared;
-    }
-  }
-  EXPECT_GE(compared, 5u);
   auto ta = readTimeseries(a), tb = readTimeseries(b);
   ASSERT_EQ(ta["gas.pressure_drop_Pa"].size(), 8u);
   ASSERT_EQ(tb["gas.pressure_drop_Pa"].size(), 8u);
@@ -883,36 +855,15 @@ TEST_F(CoredemFoamE2E, StaggeredRestartContinuesWithTheSameFieldsAndDemState) {
                                           "checkpoint: {every_steps: 12, keep: 3}\n"
                                           "coupling: {scheme: staggered}\n") +
                                   kFluidizedBed);
-  const fs::path a = dir / "straight", b = dir / "resumed";
-  ASSERT_EQ(runCoredem({"run", c.string(), "--out", a.string()}, dir / "a.log"), 0)
-      << readAll(dir / "a.log") << logTail(a);
-  ASSERT_EQ(
-      runCoredem({"run", c.string(), "--out", b.string(), "--stop-after", "12"}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
-  ASSERT_EQ(runCoredem({"resume", b.string()}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
-  const fs::path ca = a / "checkpoints" / "00000024", cb = b / "checkpoints" / "00000024";
-  const auto fa = manifestFiles(ca, "cfd"), fb = manifestFiles(cb, "cfd");
-  ASSERT_GE(fa.size(), 6u);
-  ASSERT_EQ(fa, fb);
-  for (const auto& f : fa) {
-    EXPECT_TRUE(readAll(ca / f) == readAll(cb / f)) << f << " differs after the restart";
+  const auto [a, b] = runStraightAndResumed(dir, c, 12);
+  ASSERT_FALSE(HasFailure());
+  const auto [fa, compared] =
+      expectSameCheckpoint(a / "checkpoints" / "00000024", b / "checkpoints" / "00000024", 6,
+                           {"particles/", "contacts/", "server/staggered/"}, "after the restart");
+  std::size_t pending = 0;
+  for (const auto& name : compared) {
+    pending += name.rfind("server/staggered/pending_", 0) == 0 ? 1 : 0;
   }
-  const auto da = manifestFiles(ca, "dem"), db = manifestFiles(cb, "dem");
-  ASSERT_EQ(da.size(), 1u);
-  ASSERT_EQ(db.size(), 1u);
-  const auto sa = datasetsOf(ca / da[0]), sb = datasetsOf(cb / db[0]);
-  std::size_t compared = 0, pending = 0;
-  for (const auto& [name, bytes] : sa) {
-    if (name.rfind("particles/", 0) == 0 || name.rfind("contacts/", 0) == 0 ||
-        name.rfind("server/staggered/", 0) == 0) {
-      ASSERT_TRUE(sb.count(name)) << name;
-      EXPECT_TRUE(bytes == sb.at(name)) << "DEM dataset " << name << " differs after the restart";
-      ++compared;
-      pending += name.rfind("server/staggered/pending_", 0) == 0 ? 1 : 0;
-    }
-  }
-  EXPECT_GE(compared, 5u);
   EXPECT_EQ(pending, 7u) << "the checkpoint holds no pending sources";
   auto ta = readTimeseries(a), tb = readTimeseries(b);
   ASSERT_EQ(ta["gas.pressure_drop_Pa"].size(), 24u);
