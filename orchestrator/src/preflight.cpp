@@ -43,17 +43,12 @@ public:
         break;
       }
       const YAML::Node& cn = n; // const access: a missing key is not added
-      YAML::Node next;
-      if (cn.IsSequence()) {
-        const std::size_t i = std::stoul(key);
-        if (i >= cn.size()) {
-          break;
-        }
-        next = cn[i];
-      } else {
-        next = cn[key];
+      if (cn.IsSequence() && std::stoul(key) >= cn.size()) {
+        break;
       }
-      if (!next) {
+      // Copy-constructed, not assigned: assigning the invalid node of a missing key throws.
+      const YAML::Node next = cn.IsSequence() ? cn[std::stoul(key)] : cn[key];
+      if (!next.IsDefined()) {
         break;
       }
       n.reset(next); // rebind (assignment would overwrite the node's value)
