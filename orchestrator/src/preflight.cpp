@@ -384,44 +384,92 @@ FoamFieldValues readFoamField(const fs::path& file) {
     return out;
   }
   out.found = true;
+  // Scanned by hand, not with std::regex: a nonuniform list can be megabytes long.
   const std::string text = withoutComments(readAll(file));
-  std::smatch m;
-  if (std::regex_search(text, m, std::regex("\\bclass\\s+(\\w+)\\s*;"))) {
-    out.className = m[1].str();
-  }
-  if (std::regex_search(text, m, std::regex("\\bdimensions\\s*\\[([^\\]]*)\\]"))) {
-    std::istringstream in(m[1].str());
-    std::string word, dims;
-    while (in >> word) {
-      dims += (dims.empty() ? "" : " ") + word;
+  const auto isWord = [](char ch) {
+    return std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_';
+  };
+  // Position after the whole word `key` at or after `from` (npos: none before `to`).
+  const auto findWord = [&](const std::string& key, std::size_t from, std::size_t to) {
+    for (std::size_t p = text.find(key, from); p != std::string::npos && p < to;
+         p = text.find(key, p + 1)) {
+      const std::size_t e = p + key.size();
+      if ((p == 0 || !isWord(text[p - 1])) && e < text.size() && !isWord(text[e])) {
+        return e;
+      }
     }
-    out.dimensions = dims;
-    out.dimensionsLine = lineAt(text, std::size_t(m.position(0)));
-  }
-  if (std::regex_search(text, m, std::regex("\\binternalField\\s+(\\w+)([^;]*);"))) {
+    return std::string::npos;
+  };
+  const auto skipSpace = [&](std::size_t p) {
+    while (p < text.size() && std::isspace(static_cast<unsigned char>(text[p])) != 0) {
+      ++p;
+    }
+    return p;
+  };
+  // "uniform X;" or "nonuniform ...;" after a keyword ending at `p`: the value and whether it
+  // is a scalar (nullopt: a vector or something else, left out).
+  const auto valueAt = [&](std::size_t p,
+                           const std::string& patch) -> std::optional<FoamFieldValue> {
     FoamFieldValue v;
-    v.patch = "internalField";
-    v.line = lineAt(text, std::size_t(m.position(0)));
-    v.uniform = m[1].str() == "uniform";
-    const auto x = v.uniform ? uniformScalar(m[2].str()) : std::optional<double>(0.0);
-    if (x) {
-      v.value = *x;
-      out.values.push_back(v);
+    v.patch = patch;
+    v.line = lineAt(text, p);
+    p = skipSpace(p);
+    std::size_t e = p;
+    while (e < text.size() && isWord(text[e])) {
+      ++e;
+    }
+    const std::string kind = text.substr(p, e - p);
+    if (kind == "nonuniform") {
+      v.uniform = false;
+      return v;
+    }
+    const std::size_t semi = text.find(';', e);
+    if (kind != "uniform" || semi == std::string::npos) {
+      return std::nullopt;
+    }
+    const auto x = uniformScalar(text.substr(e, semi - e));
+    if (!x) {
+      return std::nullopt;
+    }
+    v.value = *x;
+    return v;
+  };
+  const std::size_t internal = findWord("internalField", 0, text.size());
+  const std::size_t head = internal == std::string::npos ? text.size() : internal;
+  if (const std::size_t p = findWord("class", 0, head); p != std::string::npos) {
+    const std::size_t b = skipSpace(p);
+    std::size_t e = b;
+    while (e < text.size() && isWord(text[e])) {
+      ++e;
+    }
+    out.className = text.substr(b, e - b);
+  }
+  if (const std::size_t p = findWord("dimensions", 0, head); p != std::string::npos) {
+    const std::size_t open = text.find('[', p), shut = text.find(']', p);
+    if (open != std::string::npos && shut != std::string::npos && open < shut) {
+      std::istringstream in(text.substr(open + 1, shut - open - 1));
+      std::string word, dims;
+      while (in >> word) {
+        dims += (dims.empty() ? "" : " ") + word;
+      }
+      out.dimensions = dims;
+      out.dimensionsLine = lineAt(text, p);
+    }
+  }
+  if (internal != std::string::npos) {
+    if (const auto v = valueAt(internal, "internalField")) {
+      out.values.push_back(*v);
     }
   }
   // boundaryField { name { ... } ... }: the fixedValue patches.
-  const auto bf = text.find("boundaryField");
+  const auto bf = findWord("boundaryField", 0, text.size());
   const auto open = bf == std::string::npos ? bf : text.find('{', bf);
   if (open == std::string::npos) {
     return out;
   }
   std::size_t i = open + 1;
-  static const std::regex type("(^|[\\s;{])type\\s+(\\w+)\\s*;");
-  static const std::regex value("(^|[\\s;{])value\\s+(\\w+)([^;]*);");
-  while (i < text.size()) {
-    while (i < text.size() && std::isspace(static_cast<unsigned char>(text[i])) != 0) {
-      ++i;
-    }
+  while (true) {
+    i = skipSpace(i);
     if (i >= text.size() || text[i] == '}') {
       break;
     }
@@ -441,18 +489,18 @@ FoamFieldValues readFoamField(const fs::path& file) {
         break;
       }
     }
-    const std::string body = text.substr(brace + 1, end - brace - 1);
-    std::smatch t, v;
-    if (std::regex_search(body, t, type) && t[2].str() == "fixedValue" &&
-        std::regex_search(body, v, value)) {
-      FoamFieldValue fv;
-      fv.patch = name;
-      fv.line = lineAt(text, brace + 1 + std::size_t(v.position(0)));
-      fv.uniform = v[2].str() == "uniform";
-      const auto x = fv.uniform ? uniformScalar(v[3].str()) : std::optional<double>(0.0);
-      if (x) {
-        fv.value = *x;
-        out.values.push_back(fv);
+    const std::size_t type = findWord("type", brace + 1, end);
+    if (type != std::string::npos) {
+      const std::size_t b = skipSpace(type);
+      std::size_t e = b;
+      while (e < end && isWord(text[e])) {
+        ++e;
+      }
+      const std::size_t value = findWord("value", brace + 1, end);
+      if (text.compare(b, e - b, "fixedValue") == 0 && e - b == 10 && value != std::string::npos) {
+        if (const auto v = valueAt(value, name)) {
+          out.values.push_back(*v);
+        }
       }
     }
     i = end + 1;

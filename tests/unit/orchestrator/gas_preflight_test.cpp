@@ -155,6 +155,19 @@ TEST(GasPreflight, NonUniformValuesAreSkipped) {
   edit(d / "openfoam" / "0" / "N2", "internalField   uniform 0.608616;",
        "internalField   nonuniform List<scalar> 2(0.5 0.7);");
   EXPECT_EQ(failureOf(d), "");
+  // A long list (a mapped field) is skipped as well, without reading it value by value.
+  std::string values;
+  for (int i = 0; i < 200000; ++i) {
+    values += "0.608616\n";
+  }
+  edit(d / "openfoam" / "0" / "N2", "internalField   nonuniform List<scalar> 2(0.5 0.7);",
+       "internalField   nonuniform List<scalar>\n200000\n(\n" + values + ");");
+  EXPECT_EQ(failureOf(d), "");
+  const FoamFieldValues v = readFoamField(d / "openfoam" / "0" / "N2");
+  ASSERT_EQ(v.values.size(), 2u);
+  EXPECT_FALSE(v.values[0].uniform);
+  EXPECT_EQ(v.values[1].patch, "inlet");
+  EXPECT_EQ(v.values[1].line, 200022);
   fs::remove_all(d);
 }
 
