@@ -525,7 +525,8 @@ void checkFoamGasState(const CaseConfig& c, const Locator& at, const fs::path& d
                           c.species[i].name, f.string()));
     }
   }
-  // ... and no other mass-fraction field: a dimensionless volScalarField not named alpha*.
+  // ... and no other mass-fraction field: a dimensionless volScalarField not named alpha* (phase
+  // fractions) or Ydefault (OpenFOAM's field for species without their own).
   std::vector<std::string> names;
   for (const auto& s : c.species) {
     names.push_back(s.name);
@@ -538,7 +539,7 @@ void checkFoamGasState(const CaseConfig& c, const Locator& at, const fs::path& d
     std::sort(files.begin(), files.end());
     for (const auto& f : files) {
       const std::string name = f.filename().string();
-      if (!fs::is_regular_file(f) || name.rfind("alpha", 0) == 0 ||
+      if (!fs::is_regular_file(f) || name.rfind("alpha", 0) == 0 || name == "Ydefault" ||
           std::find(names.begin(), names.end(), name) != names.end() ||
           (names.empty() && name == kAirSpecies)) {
         continue;

@@ -109,8 +109,10 @@ TEST(GasPreflight, ExtraMassFractionFieldIsRefused) {
                               "OpenFOAM case, but case.yaml has no gas species 'CH4' (species: "
                               "CO, CO2, H2, H2O, N2)"))
       << e;
-  // alpha* fields are not species.
+  // alpha* fields and Ydefault are not species.
   fs::rename(d / "openfoam" / "0" / "CH4", d / "openfoam" / "0" / "alphac");
+  EXPECT_EQ(failureOf(d), "");
+  fs::rename(d / "openfoam" / "0" / "alphac", d / "openfoam" / "0" / "Ydefault");
   EXPECT_EQ(failureOf(d), "");
   fs::remove_all(d);
 }

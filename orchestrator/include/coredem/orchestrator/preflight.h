@@ -43,7 +43,7 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& config);
 /// - model ideal_gas: no constant/thermophysicalProperties unless it is exactly the one coredem
 ///   writes (gas_data.h), and 0/T's uniform internalField equals gas_properties.temperature;
 /// - the case's species are the mass-fraction fields of 0/ (each species has 0/<name>; no other
-///   dimensionless volScalarField but alpha*);
+///   dimensionless volScalarField but alpha* and Ydefault);
 /// - the gas state of 0/ (uniform internalField and fixedValue patch values): T > 0, every mass
 ///   fraction in [0, 1], and where all species are uniform they sum to 1 within
 ///   kMassFractionSumTol (non-uniform values are skipped with an info line).
