@@ -420,6 +420,19 @@ TEST(GasData, MixtureStateCombinesLikeOpenFoam) {
   EXPECT_THROW(idealGasState({"O2"}, {1.0}, T, p), std::invalid_argument);
 }
 
+// Reference: Debian's OpenFOAM v1912 rhoReactingFoam (heRhoThermo, multiComponentMixture,
+// sutherland, janaf) on a one-cell case with the dictionary coredem generates for the five CLG
+// species, H2O/N2 mass fractions 0.391384/0.608616, 1173 K, 101325 Pa; fields written by
+// `rhoReactingFoam -postProcess -func 'writeObjects(rho, thermo:mu, thermo:alpha)'` (8 digits).
+// rho differs by OpenFOAM's gas constant (8314.47 J/kmol/K vs CODATA 8314.462618: 9e-7).
+TEST(GasData, MixtureStateIsOpenFoamsThermo) {
+  const GasState s = idealGasState({"CO", "CO2", "H2", "H2O", "N2"},
+                                   {0.0, 0.0, 0.0, 0.391384, 0.608616}, 1173.0, 101325.0);
+  EXPECT_NEAR(s.density, 0.23910327, 2e-6 * 0.23910327);
+  EXPECT_NEAR(s.viscosity, 4.3687841e-05, 1e-7 * 4.3687841e-05);
+  EXPECT_NEAR(s.conductivity / s.cp, 6.1906876e-05, 1e-6 * 6.1906876e-05); // alpha = kappa/cp
+}
+
 // ------------------------------------------------------------------------ the dictionary
 
 TEST(GasModelDictionary, FiveSpeciesReadBackExactly) {
