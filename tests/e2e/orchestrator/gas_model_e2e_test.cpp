@@ -70,6 +70,9 @@ TEST(GasModelE2E, RunWritesThermophysicalPropertiesIntoTheRunCopy) {
   EXPECT_NE(text.find("inertSpecie air;"), std::string::npos) << text;
   EXPECT_NE(text.find("molWeight       28.96518;"), std::string::npos) << text;
   EXPECT_NE(text.find("pRef            101325;"), std::string::npos) << text;
+  // The air case's one species field.
+  EXPECT_NE(readAll(run / "openfoam" / "0" / "air").find("internalField   uniform 1;"),
+            std::string::npos);
   // The rest of cfd.case is copied as before, and cfd.case itself is not touched.
   EXPECT_TRUE(fs::is_regular_file(run / "openfoam" / "constant" / "transportProperties"));
   EXPECT_FALSE(fs::exists(c / "openfoam" / "constant" / "thermophysicalProperties"));

@@ -422,7 +422,8 @@ TEST(GasData, MixtureStateCombinesLikeOpenFoam) {
 
 // Reference: Debian's OpenFOAM v1912 rhoReactingFoam (heRhoThermo, multiComponentMixture,
 // sutherland, janaf) on a one-cell case with the dictionary coredem generates for the five CLG
-// species, H2O/N2 mass fractions 0.391384/0.608616, 1173 K, 101325 Pa; fields written by
+// species, H2O/N2 mass fractions 0.391384/0.608616, 1173 K, 101325 Pa (and for air); fields
+// written by
 // `rhoReactingFoam -postProcess -func 'writeObjects(rho, thermo:mu, thermo:alpha)'` (8 digits).
 // rho differs by OpenFOAM's gas constant (8314.47 J/kmol/K vs CODATA 8314.462618: 9e-7).
 TEST(GasData, MixtureStateIsOpenFoamsThermo) {
@@ -431,6 +432,10 @@ TEST(GasData, MixtureStateIsOpenFoamsThermo) {
   EXPECT_NEAR(s.density, 0.23910327, 2e-6 * 0.23910327);
   EXPECT_NEAR(s.viscosity, 4.3687841e-05, 1e-7 * 4.3687841e-05);
   EXPECT_NEAR(s.conductivity / s.cp, 6.1906876e-05, 1e-6 * 6.1906876e-05); // alpha = kappa/cp
+  // The air case (generated 0/air, 2-D mesh with empty patches) at 293.15 K.
+  const GasState air = idealGasState({"air"}, {1.0}, 293.15, 101325.0);
+  EXPECT_NEAR(air.density, 1.2041161, 2e-6 * 1.2041161);
+  EXPECT_NEAR(air.viscosity, 1.8134059e-05, 1e-7 * 1.8134059e-05);
 }
 
 // ------------------------------------------------------------------------ the dictionary
@@ -508,8 +513,30 @@ TEST(GasModelDictionary, WrittenIntoTheRunCopyOnlyWithIdealGas) {
   const std::string text((std::istreambuf_iterator<char>(in)), {});
   EXPECT_EQ(text, thermophysicalPropertiesText(c));
   EXPECT_FALSE(fs::exists(file.string() + ".tmp"));
+  // An air case gets its one species field, 0/air (mass fraction 1).
+  ASSERT_TRUE(fs::is_regular_file(d / "run" / "openfoam" / "0" / "air"));
+  std::ifstream airIn(d / "run" / "openfoam" / "0" / "air");
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(airIn)), {}), airFieldText(c));
+  EXPECT_TRUE(contains(airFieldText(c), "internalField   uniform 1;"));
+  EXPECT_TRUE(contains(airFieldText(c), "#includeEtc \"caseDicts/setConstraintTypes\""));
   // The case folder itself is not touched.
   EXPECT_FALSE(fs::exists(d / "case" / "openfoam" / "constant" / "thermophysicalProperties"));
+  EXPECT_FALSE(fs::exists(d / "case" / "openfoam" / "0" / "air"));
+  // A user's 0/Ydefault (or 0/air) is kept: no 0/air written.
+  fs::create_directories(d / "case" / "openfoam" / "0");
+  std::ofstream(d / "case" / "openfoam" / "0" / "Ydefault") << "user";
+  prepareWorkDir(participant("coredemFoam"), c, d / "run3");
+  EXPECT_TRUE(
+      fs::is_regular_file(d / "run3" / "openfoam" / "constant" / "thermophysicalProperties"));
+  EXPECT_FALSE(fs::exists(d / "run3" / "openfoam" / "0" / "air"));
+  fs::remove(d / "case" / "openfoam" / "0" / "Ydefault");
+  // A case with species: their fields come with cfd.case; no 0/air.
+  const CaseConfig withSpecies =
+      parseCase(std::string(kIdealGas) + kSpecies, d / "case" / "case.yaml", d / "case");
+  prepareWorkDir(participant("coredemFoam"), withSpecies, d / "run4");
+  EXPECT_TRUE(
+      fs::is_regular_file(d / "run4" / "openfoam" / "constant" / "thermophysicalProperties"));
+  EXPECT_FALSE(fs::exists(d / "run4" / "openfoam" / "0" / "air"));
   // Constant model: nothing generated.
   const CaseConfig k2 = parseCase(replace(kIdealGas, "model: ideal_gas", "model: constant"),
                                   d / "case" / "case.yaml", d / "case");

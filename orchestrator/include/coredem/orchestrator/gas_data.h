@@ -77,8 +77,14 @@ std::string thermophysicalPropertiesText(const CaseConfig& config);
 inline const std::filesystem::path kThermophysicalProperties =
     std::filesystem::path("constant") / "thermophysicalProperties";
 
-/// Writes thermophysicalPropertiesText(config) into workDir/constant/thermophysicalProperties
-/// (ideal_gas only; no-op for the constant model).
+/// The field 0/air of an ideal-gas case without species: mass fraction 1 everywhere (every patch
+/// `calculated`, constraint patches from OpenFOAM's caseDicts/setConstraintTypes).
+std::string airFieldText(const CaseConfig& config);
+
+/// ideal_gas only (no-op for the constant model): writes thermophysicalPropertiesText(config)
+/// into workDir/constant/thermophysicalProperties and, for a case without species whose copy has
+/// neither 0/air nor 0/Ydefault, airFieldText(config) into workDir/0/air (OpenFOAM's mixture
+/// reads a field per species).
 void writeGeneratedFoamDictionaries(const CaseConfig& config, const std::filesystem::path& workDir);
 
 } // namespace coredem::orchestrator
