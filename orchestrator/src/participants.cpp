@@ -11,6 +11,7 @@
 #include <coredem/common/log.h>
 #include <coredem/common/process.h>
 #include <coredem/gas/gas_model.h>
+#include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/preflight.h>
 
@@ -110,8 +111,9 @@ std::vector<ParticipantDescriptor> makeTable() {
     p.caseFolderMarker = "system/controlDict";
     p.caseFolderHint = "give the folder with system/, constant/ and 0/";
     p.workDir = "openfoam";
-    p.preflight = &checkOpenFoamCase; // gravity and gas properties equal case.yaml's
-    p.parallelArgs = {"-parallel"};   // cfd.ranks > 1: mpirun -np K coredemFoam ... -parallel
+    p.preflight = &checkOpenFoamCase; // gravity, gas model, species and gas state vs case.yaml
+    p.generate = &writeGeneratedFoamDictionaries; // ideal_gas: constant/thermophysicalProperties
+    p.parallelArgs = {"-parallel"}; // cfd.ranks > 1: mpirun -np K coredemFoam ... -parallel
     p.decompose = &decomposeOpenFoamCase;
     t.push_back(std::move(p));
   }
@@ -259,6 +261,9 @@ void prepareWorkDir(const ParticipantDescriptor& p, const CaseConfig& config,
                 "cfd.case: {} is not {} (no {})", src.string(), p.caseFolder, p.caseFolderMarker);
   fs::create_directories(work);
   fs::copy(src, work, fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+  if (p.generate != nullptr) {
+    p.generate(config, work); // e.g. constant/thermophysicalProperties (ideal_gas)
+  }
   decompose();
 }
 

@@ -1,6 +1,7 @@
 // Pre-flight consistency of a case (preflight.h): geometry, packing, temperatures, and the
 // OpenFOAM participant's gravity and gas properties against case.yaml.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -10,7 +11,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <coredem/common/log.h>
 #include <coredem/common/yaml_section.h>
+#include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/preflight.h>
 
 namespace fs = std::filesystem;
@@ -40,17 +43,12 @@ public:
         break;
       }
       const YAML::Node& cn = n; // const access: a missing key is not added
-      YAML::Node next;
-      if (cn.IsSequence()) {
-        const std::size_t i = std::stoul(key);
-        if (i >= cn.size()) {
-          break;
-        }
-        next = cn[i];
-      } else {
-        next = cn[key];
+      if (cn.IsSequence() && std::stoul(key) >= cn.size()) {
+        break;
       }
-      if (!next) {
+      // Copy-constructed, not assigned: assigning the invalid node of a missing key throws.
+      const YAML::Node next = cn.IsSequence() ? cn[std::stoul(key)] : cn[key];
+      if (!next.IsDefined()) {
         break;
       }
       n.reset(next); // rebind (assignment would overwrite the node's value)
@@ -327,6 +325,357 @@ std::optional<MeshBounds> foamMeshBounds(const fs::path& dir) {
     return MeshBounds{b->first, b->second, dictFile.string()};
   }
   return std::nullopt;
+}
+
+/// `text` with // and /* */ comments replaced by spaces (newlines kept, so offsets keep their
+/// lines).
+std::string withoutComments(std::string text) {
+  for (std::size_t i = 0; i + 1 < text.size(); ++i) {
+    if (text[i] == '"') { // a string: skip to its end
+      const auto end = text.find('"', i + 1);
+      i = end == std::string::npos ? text.size() : end;
+      continue;
+    }
+    if (text[i] == '/' && text[i + 1] == '/') {
+      for (; i < text.size() && text[i] != '\n'; ++i) {
+        text[i] = ' ';
+      }
+    } else if (text[i] == '/' && text[i + 1] == '*') {
+      for (; i < text.size() && !(text[i] == '*' && i + 1 < text.size() && text[i + 1] == '/');
+           ++i) {
+        if (text[i] != '\n') {
+          text[i] = ' ';
+        }
+      }
+      if (i + 1 < text.size()) {
+        text[i] = text[i + 1] = ' ';
+      }
+    }
+  }
+  return text;
+}
+
+int lineAt(const std::string& text, std::size_t pos) {
+  return 1 + int(std::count(text.begin(), text.begin() + std::ptrdiff_t(pos), '\n'));
+}
+
+/// The value of "uniform X" when X is one number.
+std::optional<double> uniformScalar(const std::string& value) {
+  std::istringstream in(value);
+  double v = 0.0;
+  std::string rest;
+  if (in >> v && !(in >> rest)) {
+    return v;
+  }
+  return std::nullopt;
+}
+
+std::string readAll(const fs::path& file) {
+  std::ifstream in(file);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+} // namespace
+
+FoamFieldValues readFoamField(const fs::path& file) {
+  FoamFieldValues out;
+  std::ifstream probe(file);
+  if (!fs::is_regular_file(file) || !probe) {
+    return out;
+  }
+  out.found = true;
+  // Scanned by hand, not with std::regex: a nonuniform list can be megabytes long.
+  const std::string text = withoutComments(readAll(file));
+  const auto isWord = [](char ch) {
+    return std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_';
+  };
+  // Position after the whole word `key` at or after `from` (npos: none before `to`).
+  const auto findWord = [&](const std::string& key, std::size_t from, std::size_t to) {
+    for (std::size_t p = text.find(key, from); p != std::string::npos && p < to;
+         p = text.find(key, p + 1)) {
+      const std::size_t e = p + key.size();
+      if ((p == 0 || !isWord(text[p - 1])) && e < text.size() && !isWord(text[e])) {
+        return e;
+      }
+    }
+    return std::string::npos;
+  };
+  const auto skipSpace = [&](std::size_t p) {
+    while (p < text.size() && std::isspace(static_cast<unsigned char>(text[p])) != 0) {
+      ++p;
+    }
+    return p;
+  };
+  // "uniform X;" or "nonuniform ...;" after a keyword ending at `p`: the value and whether it
+  // is a scalar (nullopt: a vector or something else, left out).
+  const auto valueAt = [&](std::size_t p,
+                           const std::string& patch) -> std::optional<FoamFieldValue> {
+    FoamFieldValue v;
+    v.patch = patch;
+    v.line = lineAt(text, p);
+    p = skipSpace(p);
+    std::size_t e = p;
+    while (e < text.size() && isWord(text[e])) {
+      ++e;
+    }
+    const std::string kind = text.substr(p, e - p);
+    if (kind == "nonuniform") {
+      v.uniform = false;
+      return v;
+    }
+    const std::size_t semi = text.find(';', e);
+    if (kind != "uniform" || semi == std::string::npos) {
+      return std::nullopt;
+    }
+    const auto x = uniformScalar(text.substr(e, semi - e));
+    if (!x) {
+      return std::nullopt;
+    }
+    v.value = *x;
+    return v;
+  };
+  const std::size_t internal = findWord("internalField", 0, text.size());
+  const std::size_t head = internal == std::string::npos ? text.size() : internal;
+  if (const std::size_t p = findWord("class", 0, head); p != std::string::npos) {
+    const std::size_t b = skipSpace(p);
+    std::size_t e = b;
+    while (e < text.size() && isWord(text[e])) {
+      ++e;
+    }
+    out.className = text.substr(b, e - b);
+  }
+  if (const std::size_t p = findWord("dimensions", 0, head); p != std::string::npos) {
+    const std::size_t open = text.find('[', p), shut = text.find(']', p);
+    if (open != std::string::npos && shut != std::string::npos && open < shut) {
+      std::istringstream in(text.substr(open + 1, shut - open - 1));
+      std::string word, dims;
+      while (in >> word) {
+        dims += (dims.empty() ? "" : " ") + word;
+      }
+      out.dimensions = dims;
+      out.dimensionsLine = lineAt(text, p);
+    }
+  }
+  if (internal != std::string::npos) {
+    if (const auto v = valueAt(internal, "internalField")) {
+      out.values.push_back(*v);
+    }
+  }
+  // boundaryField { name { ... } ... }: the fixedValue patches.
+  const auto bf = findWord("boundaryField", 0, text.size());
+  const auto open = bf == std::string::npos ? bf : text.find('{', bf);
+  if (open == std::string::npos) {
+    return out;
+  }
+  std::size_t i = open + 1;
+  while (true) {
+    i = skipSpace(i);
+    if (i >= text.size() || text[i] == '}') {
+      break;
+    }
+    const auto brace = text.find('{', i);
+    if (brace == std::string::npos) {
+      break;
+    }
+    std::string name = text.substr(i, brace - i);
+    while (!name.empty() && std::isspace(static_cast<unsigned char>(name.back())) != 0) {
+      name.pop_back();
+    }
+    int depth = 0;
+    std::size_t end = brace;
+    for (; end < text.size(); ++end) {
+      depth += text[end] == '{' ? 1 : text[end] == '}' ? -1 : 0;
+      if (depth == 0) {
+        break;
+      }
+    }
+    const std::size_t type = findWord("type", brace + 1, end);
+    if (type != std::string::npos) {
+      const std::size_t b = skipSpace(type);
+      std::size_t e = b;
+      while (e < end && isWord(text[e])) {
+        ++e;
+      }
+      const std::size_t value = findWord("value", brace + 1, end);
+      if (text.compare(b, e - b, "fixedValue") == 0 && e - b == 10 && value != std::string::npos) {
+        if (const auto v = valueAt(value, name)) {
+          out.values.push_back(*v);
+        }
+      }
+    }
+    i = end + 1;
+  }
+  return out;
+}
+
+namespace {
+
+/// 0/ of the OpenFOAM case: species fields against case.yaml species, and the gas state (T > 0,
+/// mass fractions in [0, 1] summing to 1).
+void checkFoamGasState(const CaseConfig& c, const Locator& at, const fs::path& dir) {
+  auto log = logger("orchestrator");
+  const fs::path zero = dir / "0";
+  // Species fields: each case.yaml species has 0/<name>.
+  for (std::size_t i = 0; i < c.species.size(); ++i) {
+    const fs::path f = zero / c.species[i].name;
+    if (!fs::is_regular_file(f)) {
+      at.fail({"species", std::to_string(i), "name"}, fmt::format("species[{}].name", i),
+              fmt::format("gas species '{}', but the OpenFOAM case has no field {} (its initial "
+                          "and inlet mass fraction); add the field, or remove the species",
+                          c.species[i].name, f.string()));
+    }
+  }
+  // ... and no other mass-fraction field: a dimensionless volScalarField not named alpha* (phase
+  // fractions) or Ydefault (OpenFOAM's field for species without their own).
+  std::vector<std::string> names;
+  for (const auto& s : c.species) {
+    names.push_back(s.name);
+  }
+  if (fs::is_directory(zero)) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(zero)) {
+      files.push_back(e.path());
+    }
+    std::sort(files.begin(), files.end());
+    for (const auto& f : files) {
+      const std::string name = f.filename().string();
+      if (!fs::is_regular_file(f) || name.rfind("alpha", 0) == 0 || name == "Ydefault" ||
+          std::find(names.begin(), names.end(), name) != names.end() ||
+          (names.empty() && name == kAirSpecies)) {
+        continue;
+      }
+      const FoamFieldValues v = readFoamField(f);
+      if (v.className == "volScalarField" && v.dimensions == "0 0 0 0 0 0 0") {
+        at.fail({"species"}, "species",
+                fmt::format("{}:{}: {} is a dimensionless field (a mass fraction) of the OpenFOAM "
+                            "case, but case.yaml has no gas species '{}' (species: {}); add it to "
+                            "species, or remove the file",
+                            f.string(), v.dimensionsLine, name, name,
+                            names.empty() ? std::string("none") : yaml::join(names)));
+      }
+    }
+  }
+  // Temperature: every uniform value > 0.
+  const fs::path tFile = zero / "T";
+  const FoamFieldValues T = readFoamField(tFile);
+  for (const auto& v : T.values) {
+    if (!v.uniform) {
+      log->info("{}:{}: {} of T is non-uniform: not checked before start", tFile.string(), v.line,
+                v.patch);
+    } else if (!(v.value > 0.0)) {
+      at.fail({"cfd", "case"}, "cfd.case",
+              fmt::format("{}:{}: {} T = {:.6g} K: the gas temperature must be > 0 K",
+                          tFile.string(), v.line, v.patch, v.value));
+    }
+  }
+  // ideal_gas: the initial temperature of case.yaml is the one of 0/T.
+  if (c.gasProperties.idealGas() && !T.values.empty() && T.values.front().uniform &&
+      T.values.front().patch == "internalField" &&
+      !close(T.values.front().value, c.gasProperties.temperature)) {
+    const bool has = at.root()["gas_properties"] && at.root()["gas_properties"]["temperature"];
+    at.fail({"gas_properties", "temperature"}, "gas_properties.temperature",
+            fmt::format("{:.6g} K{} (the initial gas of the ideal-gas model), but {}:{} gives "
+                        "internalField T = {:.6g} K; give the same value in both (relative "
+                        "tolerance {:.0e})",
+                        c.gasProperties.temperature,
+                        has ? "" : " (the default; no value in case.yaml)", tFile.string(),
+                        T.values.front().line, T.values.front().value, kFoamEqualityRelTol));
+  }
+  if (c.species.empty()) {
+    return;
+  }
+  // Mass fractions: each in [0, 1]; where every species is uniform, they sum to 1.
+  std::vector<FoamFieldValues> Y;
+  for (const auto& s : c.species) {
+    Y.push_back(readFoamField(zero / s.name));
+  }
+  std::vector<std::string> places; // internalField and the patches, in the first file's order
+  for (std::size_t k = 0; k < Y.size(); ++k) {
+    const fs::path f = zero / c.species[k].name;
+    for (const auto& v : Y[k].values) {
+      if (std::find(places.begin(), places.end(), v.patch) == places.end()) {
+        places.push_back(v.patch);
+      }
+      if (!v.uniform) {
+        log->info("{}:{}: {} of {} is non-uniform: not checked before start", f.string(), v.line,
+                  v.patch, c.species[k].name);
+      } else if (!(v.value >= 0.0 && v.value <= 1.0)) {
+        at.fail({"cfd", "case"}, "cfd.case",
+                fmt::format("{}:{}: {} mass fraction {} = {:.10g}: must lie in [0, 1]", f.string(),
+                            v.line, v.patch, c.species[k].name, v.value));
+      }
+    }
+  }
+  for (const auto& place : places) {
+    double sum = 0.0;
+    std::string terms;
+    bool all = true;
+    for (std::size_t k = 0; k < Y.size() && all; ++k) {
+      const auto it = std::find_if(Y[k].values.begin(), Y[k].values.end(),
+                                   [&](const FoamFieldValue& v) { return v.patch == place; });
+      if (it == Y[k].values.end() || !it->uniform) {
+        all = false;
+        break;
+      }
+      sum += it->value;
+      terms += fmt::format("{}{} {:.10g} ({}:{})", k ? " + " : "", c.species[k].name, it->value,
+                           (zero / c.species[k].name).filename().string(), it->line);
+    }
+    if (!all) {
+      if (place != "internalField") {
+        log->info("{}: patch {} is not a uniform fixedValue in every species field: its mass "
+                  "fractions are not summed before start",
+                  zero.string(), place);
+      }
+      continue;
+    }
+    if (std::abs(sum - 1.0) > kMassFractionSumTol) {
+      at.fail({"species"}, "species",
+              fmt::format("the mass fractions of {} in {} sum to {:.12g}, not 1 (tolerance "
+                          "{:.0e}): {}; make them sum to 1",
+                          place, zero.string(), sum, kMassFractionSumTol, terms));
+    }
+  }
+}
+
+/// constant/thermophysicalProperties of the OpenFOAM case: with ideal_gas coredem writes it (a
+/// user's copy must be exactly that one); with constant it must not exist (it would select the
+/// variable-density solver).
+void checkThermophysicalProperties(const CaseConfig& c, const Locator& at, const fs::path& dir) {
+  const fs::path file = dir / kThermophysicalProperties;
+  if (!fs::exists(file)) {
+    return;
+  }
+  const bool has = at.root()["gas_properties"] && at.root()["gas_properties"]["model"];
+  if (!c.gasProperties.idealGas()) {
+    at.fail({"gas_properties", "model"}, "gas_properties.model",
+            fmt::format("constant{} (properties from constant/transportProperties), but {}:1 "
+                        "exists and would select the ideal-gas solver: the gas model is "
+                        "ambiguous; set gas_properties.model: ideal_gas (coredem then writes that "
+                        "file from case.yaml) or remove the file",
+                        has ? "" : " (the default; no model in case.yaml)", file.string()));
+  }
+  const std::string user = readAll(file), generated = thermophysicalPropertiesText(c);
+  if (user == generated) {
+    return;
+  }
+  // The first line that differs, for the message.
+  std::istringstream a(user), b(generated);
+  std::string la, lb;
+  int line = 0;
+  while (true) {
+    ++line;
+    const bool ga = bool(std::getline(a, la)), gb = bool(std::getline(b, lb));
+    if (!ga || !gb || la != lb) {
+      break;
+    }
+  }
+  at.fail({"gas_properties", "model"}, "gas_properties.model",
+          fmt::format("ideal_gas: coredem writes constant/thermophysicalProperties from case.yaml "
+                      "into the run, but the OpenFOAM case has its own ({}:{} reads '{}', coredem "
+                      "would write '{}'), which would be overwritten: remove it; case.yaml "
+                      "defines the gas",
+                      file.string(), line, la, lb));
 }
 
 } // namespace
@@ -622,7 +971,12 @@ void checkOpenFoamCase(const CaseConfig& c) {
     }
   }
   const fs::path tFile = dir / "constant" / "transportProperties";
+  // With ideal_gas the properties are computed: no constant values to compare.
+  const bool constant = !c.gasProperties.idealGas();
   auto scalar = [&](const std::string& key) -> std::optional<std::pair<double, int>> {
+    if (!constant) {
+      return std::nullopt;
+    }
     const auto e = foamEntry(tFile, key);
     if (!e) {
       return std::nullopt;
@@ -697,6 +1051,8 @@ void checkOpenFoamCase(const CaseConfig& c) {
       }
     }
   }
+  checkThermophysicalProperties(c, at, dir);
+  checkFoamGasState(c, at, dir);
   checkDecomposition(c, at, dir);
 }
 

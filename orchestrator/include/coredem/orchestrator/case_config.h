@@ -38,9 +38,18 @@ struct SpeciesConfig {
   double molarMass = 0.0; ///< kg/mol
 };
 
+/// gas_properties (docs/case-schema.md). model constant: the four properties are given (and equal
+/// the OpenFOAM case's transportProperties). model ideal_gas: they are computed by the CFD from T,
+/// p and the composition (NASA-7 cp, Sutherland viscosity; gas_data.h); here they hold the initial
+/// gas (temperature, pressure, and the mixture's state at them, see parseCase), and coredem writes
+/// constant/thermophysicalProperties into the run's copy of the OpenFOAM case.
 struct GasPropertiesConfig {
+  std::string model = "constant"; ///< constant | ideal_gas
+  bool idealGas() const { return model == "ideal_gas"; }
   double density = 1.204, viscosity = 1.81e-5, conductivity = 0.0257, cp = 1005.0,
          temperature = 293.15, pressure = 101325.0;
+  double diffusivity = 2e-5; ///< ideal_gas: species diffusivity D, m2/s
+  double alphacMin = 0.3;    ///< ideal_gas: smallest gas fraction the gas equations accept
 };
 
 struct MaterialConfig {

@@ -69,6 +69,10 @@ struct ParticipantDescriptor {
   /// (a resumed run keeps it); `{work_dir}` names it.
   std::string workDir;
 
+  /// Writes the input files case.yaml implies into the fresh copy of `cfd.case` (RUN/<workDir>),
+  /// after the copy (coredemFoam: constant/thermophysicalProperties of the ideal-gas model);
+  /// nullptr: none.
+  void (*generate)(const CaseConfig& config, const std::filesystem::path& workDir) = nullptr;
   /// In-process check of the participant's input before anything is written (nullptr: none).
   /// Throws CaseError (exit 2) with file:line:col.
   void (*preflight)(const CaseConfig& config) = nullptr;
@@ -120,7 +124,8 @@ std::string expandTemplate(const std::string& text,
                            const std::map<std::string, std::string>& values);
 
 /// Copies `cfd.case` into RUN/<workDir> unless a copy is there already (no-op for a participant
-/// without a work folder). Throws UserError when `cfd.case` lacks the marker file.
+/// without a work folder), then writes the files case.yaml implies into the copy (the row's
+/// `generate`). Throws UserError when `cfd.case` lacks the marker file.
 void prepareWorkDir(const ParticipantDescriptor& p, const CaseConfig& config,
                     const std::filesystem::path& runDir);
 

@@ -4,6 +4,7 @@
 /// "Pre-flight checks"): what the schema alone cannot see. A failure throws CaseError (exit 2)
 /// with file:line:col of case.yaml and both values; a warning is returned as a line of text.
 
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -33,10 +34,45 @@ inline constexpr double kFoamEqualityRelTol = 1e-3;
 /// ("file:line:col: key: what"); throws CaseError at the first failure.
 std::vector<std::string> checkCaseConsistency(const CaseConfig& config);
 
-/// Pre-flight of the OpenFOAM participant (its row in the participant table): gravity of
-/// case.yaml equals `cfd.case`/constant/g, and gas_properties (density, viscosity = nu·rho, cp,
-/// conductivity) equal constant/transportProperties (rho, nu, cp, kappa) within
-/// kFoamEqualityRelTol. Throws CaseError naming both values and both places.
+/// Pre-flight of the OpenFOAM participant (its row in the participant table), each failure a
+/// CaseError naming both values and both places (docs/orchestrator.md "One source of truth"):
+/// - gravity of case.yaml equals `cfd.case`/constant/g;
+/// - model constant: gas_properties (density, viscosity = nu·rho, cp, conductivity) equal
+///   constant/transportProperties (rho, nu, cp, kappa) within kFoamEqualityRelTol, and there is
+///   no constant/thermophysicalProperties (it would make the gas model ambiguous);
+/// - model ideal_gas: no constant/thermophysicalProperties unless it is exactly the one coredem
+///   writes (gas_data.h), and 0/T's uniform internalField equals gas_properties.temperature;
+/// - the case's species are the mass-fraction fields of 0/ (each species has 0/<name>; no other
+///   dimensionless volScalarField but alpha* and Ydefault);
+/// - the gas state of 0/ (uniform internalField and fixedValue patch values): T > 0, every mass
+///   fraction in [0, 1], and where all species are uniform they sum to 1 within
+///   kMassFractionSumTol (non-uniform values are skipped with an info line).
 void checkOpenFoamCase(const CaseConfig& config);
+
+/// Mass fractions must sum to 1 within this.
+inline constexpr double kMassFractionSumTol = 1e-9;
+
+/// One uniform or non-uniform value of an OpenFOAM field file.
+struct FoamFieldValue {
+  std::string patch;   ///< "internalField", or the patch name of a fixedValue patch
+  bool uniform = true; ///< false: nonuniform (value is 0, not read)
+  double value = 0.0;  ///< the scalar of "uniform X"
+  int line = 0;        ///< 1-based line of the entry
+};
+
+/// What readFoamField found in a field file (0/<name>).
+struct FoamFieldValues {
+  bool found = false;     ///< the file exists and could be read
+  std::string className;  ///< FoamFile class, e.g. volScalarField
+  std::string dimensions; ///< the text inside [ ], e.g. "0 0 0 1 0 0 0"
+  int dimensionsLine = 0;
+  /// internalField first (when it is a scalar), then each fixedValue patch with a scalar value,
+  /// in file order. Vector values are left out.
+  std::vector<FoamFieldValue> values;
+};
+
+/// Reads the class, dimensions, internalField and fixedValue patch values of an ASCII OpenFOAM
+/// field file (comments ignored; macros and #include not expanded).
+FoamFieldValues readFoamField(const std::filesystem::path& file);
 
 } // namespace coredem::orchestrator
