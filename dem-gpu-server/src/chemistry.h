@@ -3,8 +3,9 @@
 /// Chemistry in the DEM sub-step (docs/physics.md §3.5, §4, §6; docs/thermochemistry.md), written
 /// once for every backend like engine_impl.h and heat.h. Per sub-step, after the forces, the drag
 /// deposition (particles sorted by PCM cell) and the heat sources, before the motion update:
-///   1. rates, per particle, with the gas of its PCM cell frozen for the CFD step (ρ_g, Y_g and
-///      the constant pressure): the data-defined reactions (reaction_generic.h), R1 + R2
+///   1. rates, per particle, with the gas of its PCM cell frozen for the CFD step: one gas state
+///      per cell (kernels::cellGasState: c_k = ρ_g Y_k/M_k, x_k = Y_k M_mix/M_k, the case's
+///      thermodynamic pressure for x_k p): the data-defined reactions (reaction_generic.h), R1 + R2
 ///      (clg_char_gasification.h) and R4 + R5 (clg_oc_reduction.h) at T_p
 ///   2. one availability limiter per particle: every rate of the particle is scaled by the same
 ///      s ∈ [0, 1] so that no solid species mass goes negative within Δt and the particle does not
@@ -216,20 +217,15 @@ public:
               pBar[k] = 0.0;
             const std::uint32_t cell = coupled ? pcell[i] : nCells;
             if (gas && cell < nCells) {
-              const double rg = rhoG[cell];
-              double moles = 0.0;
-              for (int k = 0; k < nG; ++k) {
-                conc[k] =
-                    molarConcentration(rg, yg[static_cast<std::size_t>(cell) * nG + k], gasM[k]);
-                moles += conc[k];
-              }
-              // P_j = x_j p (bar), x_j = C_j / Σ C.
-              if (moles > 0.0) {
-                for (int g = 0; g < kGasSpeciesCount; ++g) {
-                  const int k = cp.gasIndex[g];
-                  if (k >= 0)
-                    pBar[g] = conc[k] / moles * cp.pressure * 1.0e-5;
-                }
+              // The cell's one gas state: c_k = ρ_g Y_k/M_k for the concentration rates (data-
+              // defined reactions, R4/R5), x_k = Y_k M_mix/M_k and P_j = x_j p (bar) with the
+              // case's thermodynamic pressure for the char rates (R1/R2).
+              double x[kChemMaxGas];
+              cellGasState(rhoG[cell], yg + static_cast<std::size_t>(cell) * nG, gasM, nG, x, conc);
+              for (int g = 0; g < kGasSpeciesCount; ++g) {
+                const int k = cp.gasIndex[g];
+                if (k >= 0)
+                  pBar[g] = x[k] * cp.pressure * 1.0e-5;
               }
             }
             // Data-defined reactions.
@@ -460,17 +456,22 @@ public:
       const double* epsFrozen = w.cells.epsFrozenHost();
       // Per coupling-cell volume: the gas fraction of the cell is φ_f ε_g (ε_g of the fluid).
       const double* fluid = gf->has(gf->fluid) ? gf->fluid.h() : nullptr;
+      const double* gasM = _gasM.h();
       std::vector<double> srcSum(static_cast<std::size_t>(nG), 0.0);
       double heat = 0.0;
       for (std::size_t c = 0; c < nc; ++c) {
-        double y[kernels::kGasSpeciesCount];
+        // The cell's gas state (the same as the particles' rates use): c_k = ρ_g Y_k/M_k with
+        // the case's molar masses.
+        double x[kChemMaxGas], conc[kChemMaxGas];
+        kernels::cellGasState(rhoH[c], ygH + c * nG, gasM, nG, x, conc);
+        double cw[kernels::kGasSpeciesCount];
         for (int g = 0; g < kernels::kGasSpeciesCount; ++g) {
           const int k = cp.gasIndex[g];
-          y[g] = k >= 0 ? ygH[c * nG + k] : 0.0;
+          cw[g] = k >= 0 ? conc[k] : 0.0;
         }
-        const kernels::WgsCellSources w = kernels::wgsCellSources(
-            cp.wgsParams, tgH[c], fluid != nullptr ? fluid[c] * epsFrozen[c] : epsFrozen[c],
-            rhoH[c], y, window);
+        const kernels::WgsCellSources w = kernels::wgsCellSourcesFromConcentrations(
+            cp.wgsParams, tgH[c], fluid != nullptr ? fluid[c] * epsFrozen[c] : epsFrozen[c], cw,
+            window);
         for (int g = 0; g < kernels::kGasSpeciesCount; ++g) {
           const int k = cp.gasIndex[g];
           if (k < 0)

@@ -434,6 +434,7 @@ public:
     out.heatHTp.assign(nc, 0.0);
     out.rSpecies.assign(nc * static_cast<std::size_t>(_s.nGasSpecies), 0.0);
     out.qHom.assign(nc, 0.0);
+    out.qRad.assign(nc, 0.0);
     _drag.endWindow(w);
     _heat.endWindow(w);
     if (_chem.enabled()) { // R_species, WGS, chemistry ledgers (chemistry.h)

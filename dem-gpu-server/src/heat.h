@@ -8,8 +8,9 @@
 ///      in a fixed order (pair_lists.h, no atomics): contact conduction (Eqs. 22–23) and gas-lens
 ///      conduction (Eqs. 24–26); then per particle convection with the gas of its PCM cell
 ///      (Eqs. 19–21) and radiation (Eqs. 27–28); the sum Q_i (W) is stored
-///   3. per cell: H = Σ G_i/V_c, H_Tp = Σ G_i T_i/V_c (G_i = h_i A_i) and Σ Q_rad,i, added to
-///      the window accumulators (averaged over the sub-steps at the window end)
+///   3. per cell: H = Σ G_i/V_c, H_Tp = Σ G_i T_i/V_c (G_i = h_i A_i) and Σ Q_rad,i/V_c, added
+///      to the window accumulators (averaged over the sub-steps at the window end; the radiation
+///      sum, negated, is the Sources array Q_rad: the heat the gas receives with protocol 1.3)
 ///   4. after the motion update: T_i += Δt Q_i/(m_i c_p,i) (explicit Euler, Eq. 18)
 /// Fixed-temperature walls (HeatSetup::walls, kernels/wall_conduction.h) add their contact and
 /// gas-lens conduction to Q_i in step 2; their heat Σ_i Q_w,i Δt is summed in kWallSlots fixed
@@ -380,10 +381,12 @@ public:
     p.produced(kTemperature);
   }
 
-  /// Averages the heat sources over nSub sub-steps into out.heatH / out.heatHTp (already sized)
-  /// and adds the window's energies to the totals (host). The heat from the gas is booked over
-  /// Δt_CFD, Σ_c (H T_g − H_Tp) V_c Δt_CFD, exactly as the CFD side books its loss, so that the
-  /// two ledgers cancel to round-off (balance.heat_residual_J).
+  /// Averages the heat sources over nSub sub-steps into out.heatH / out.heatHTp / out.qRad
+  /// (already sized) and adds the window's energies to the totals (host). The heat from the gas
+  /// is booked over Δt_CFD, Σ_c (H T_g − H_Tp) V_c Δt_CFD, exactly as the CFD side books its
+  /// loss, so that the two ledgers cancel to round-off (balance.heat_residual_J). The radiation
+  /// the particles received, ⟨Σ_i Q_rad,i⟩ Δt_CFD, is booked in HeatTotals::radiation; out.qRad
+  /// is its negative per cell and V_c (the heat the gas receives with protocol 1.3).
   void endWindow(WindowContext<Exec>& w) {
     const EngineSetup& s = w.setup;
     CellSources& out = w.out;
@@ -412,7 +415,9 @@ public:
       out.heatHTp[c] = acc[3 * c + 1] * avg;
       if (tg != nullptr)
         conv += out.heatH[c] * tg[c] - out.heatHTp[c];
-      rad += acc[3 * c + 2] * avg;
+      const double received = acc[3 * c + 2] * avg; // W/m³ into the cell's particles
+      rad += received;
+      out.qRad[c] = -received;
     }
     _totals.convection += conv * s.cellVolume * w.dtCfd;
     _totals.radiation += rad * s.cellVolume * window;

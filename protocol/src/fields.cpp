@@ -30,6 +30,10 @@ constexpr std::array<FieldSpec, 7> kSourceFields{{
     {kSpeciesSources, v1::EXTENT_SPECIES, "kg/m3/s", "gas species mass sources"},
     {kHomogeneousHeat, v1::EXTENT_SCALAR, "W/m3", "homogeneous reaction heat release"},
 }};
+
+constexpr std::array<FieldSpec, 1> kOptionalSourceFields{{
+    {kRadiationHeat, v1::EXTENT_SCALAR, "W/m3", "radiation heat the particles gave the gas"},
+}};
 } // namespace
 
 std::span<const FieldSpec> gasFields() {
@@ -40,6 +44,9 @@ std::span<const FieldSpec> optionalGasFields() {
 }
 std::span<const FieldSpec> sourceFields() {
   return kSourceFields;
+}
+std::span<const FieldSpec> optionalSourceFields() {
+  return kOptionalSourceFields;
 }
 
 const FieldSpec* findField(std::string_view name) {
@@ -54,6 +61,11 @@ const FieldSpec* findField(std::string_view name) {
     }
   }
   for (const auto& f : kSourceFields) {
+    if (f.name == name) {
+      return &f;
+    }
+  }
+  for (const auto& f : kOptionalSourceFields) {
     if (f.name == name) {
       return &f;
     }

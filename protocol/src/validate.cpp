@@ -293,7 +293,30 @@ Status validate(const Message& message, const Expectation& e) {
     auto required =
         type == v1::MESSAGE_TYPE_GAS_FIELDS ? fields::gasFields() : fields::sourceFields();
     Status st = checkArrays(message, required, rows, *e.species, e.requireFinite);
-    if (!st.ok() || type != v1::MESSAGE_TYPE_GAS_FIELDS) {
+    if (!st.ok()) {
+      return st;
+    }
+    if (type == v1::MESSAGE_TYPE_SOURCES) {
+      // Optional Sources arrays (v1.3 Q_rad): when present, float64 with one row per cell (or
+      // listed cell of a partial Sources); finiteness was checked with every array above.
+      for (const auto& spec : fields::optionalSourceFields()) {
+        const auto v = message.findArray(spec.name);
+        if (!v) {
+          continue;
+        }
+        const auto expected = fields::shapeOf(spec.extent, rows, *e.species);
+        if (v->dtype() != v1::DTYPE_FLOAT64 || v->shape() != expected) {
+          return Status::error(v1::ERROR_CODE_SHAPE,
+                               "array '" + std::string(spec.name) + "' has dtype " +
+                                   dtypeName(v->dtype()) + " and shape " + shapeString(v->shape()) +
+                                   " but float64 " + shapeString(expected) + " was expected for " +
+                                   std::to_string(rows) + (partial ? " listed" : " configured") +
+                                   " cells");
+        }
+      }
+      return st;
+    }
+    if (type != v1::MESSAGE_TYPE_GAS_FIELDS) {
       return st;
     }
     if (partial) {

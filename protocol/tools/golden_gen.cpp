@@ -8,6 +8,8 @@
 // v1.2 (MINOR 2): the v1.1 messages with minor 2 in Hello/Welcome/Reject, the Hello of rank 1 of
 // a 2-rank decomposed CFD participant, and the GasFields and Sources partial (one rank's
 // contributions for the coupling cell it touches, docs/protocol.md "Decomposed CFD").
+// v1.3 (MINOR 3): the v1.2 messages with minor 3 in Hello/Welcome/Reject and the partial Sources
+// also carrying Q_rad (the radiation heat the particles gave the gas) for its one cell.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -195,8 +197,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int minor = argc == 3 ? std::atoi(argv[2]) : 0;
-  if (minor < 0 || minor > 2) {
-    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0, 1 or 2\n");
+  if (minor < 0 || minor > 3) {
+    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0, 1, 2 or 3\n");
     return 2;
   }
   std::filesystem::path dir = argv[1];
@@ -273,6 +275,10 @@ int main(int argc, char** argv) {
       m.envelope().mutable_sources()->set_touched_count(kTouched);
       m.addArray<std::int64_t>(fields::kTouchedCells, std::vector<std::int64_t>{1}, {kTouched});
       addFieldArrays(m, fields::sourceFields(), kTouched);
+      if (minor >= 3) { // v1.3: the radiation heat to the gas, W/m3 (field index 7)
+        m.addArray<double>(fields::kRadiationHeat, std::vector<double>{goldenValue(7, 0)},
+                           fields::shapeOf(fields::kRadiationHeat, kTouched, kSpecies));
+      }
     } else {
       addFieldArrays(m, fields::sourceFields());
     }

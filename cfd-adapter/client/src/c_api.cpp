@@ -255,6 +255,18 @@ coredem_status coredem_client_source(const coredem_client* cc, const char* name,
   });
 }
 
+coredem_status coredem_client_radiation_heat(const coredem_client* cc, const double** values,
+                                             size_t* size) {
+  auto* c = const_cast<coredem_client*>(cc);
+  return call(c, "coredem_client_radiation_heat", [&] {
+    argCheck(values != nullptr && size != nullptr,
+             "coredem_client_radiation_heat: values and size must not be NULL");
+    const auto v = participant(c).sources().radiationHeat();
+    *values = v.size > 0 ? v.data : nullptr;
+    *size = v.size;
+  });
+}
+
 coredem_status coredem_client_advance(coredem_client* c, double courant, int32_t n_ledgers,
                                       const char* const* ledger_names, const double* ledger_values,
                                       int32_t n_files, const char* const* checkpoint_files) {

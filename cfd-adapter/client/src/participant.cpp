@@ -67,6 +67,11 @@ ConstView Sources::field(const std::string& name) const {
   return ConstView(it->second.data(), it->second.size());
 }
 
+ConstView Sources::radiationHeat() const {
+  const std::string name(proto::fields::kRadiationHeat);
+  return has(name) ? field(name) : ConstView();
+}
+
 bool Sources::has(const std::string& name) const {
   return views.count(name) == 1 || arrays.count(name) == 1;
 }
@@ -368,12 +373,15 @@ struct Participant::Impl {
     }
     std::map<std::string, const NamedBuffer*> dest;
     for (const auto& b : into) {
-      const auto spec =
-          std::find_if(proto::fields::sourceFields().begin(), proto::fields::sourceFields().end(),
-                       [&](const auto& sp) { return sp.name == b.name; });
-      COREDEM_CHECK(spec != proto::fields::sourceFields().end(),
+      const auto* spec = proto::fields::findField(b.name);
+      const auto named = [&](const auto& sp) { return sp.name == b.name; };
+      COREDEM_CHECK(spec != nullptr &&
+                        (std::any_of(proto::fields::sourceFields().begin(),
+                                     proto::fields::sourceFields().end(), named) ||
+                         std::any_of(proto::fields::optionalSourceFields().begin(),
+                                     proto::fields::optionalSourceFields().end(), named)),
                     "exchange: '{}' is not a Sources array; the names are eps_g, K_sl, K_sl_Us, H, "
-                    "H_Tp, R_species, Q_hom",
+                    "H_Tp, R_species, Q_hom, Q_rad",
                     b.name);
       const std::uint64_t n = cells * proto::fields::componentsOf(spec->extent, ns);
       COREDEM_CHECK(b.size == n,
@@ -482,9 +490,17 @@ struct Participant::Impl {
     auto kept = std::make_shared<proto::Message>(std::move(*reply));
     Sources next;
     std::vector<std::pair<const NamedBuffer*, std::span<const double>>> copies;
-    for (const auto& spec : proto::fields::sourceFields()) {
+    std::vector<const NamedBuffer*> zeroed; // buffers of optional arrays D did not send
+    std::vector<proto::fields::FieldSpec> received(proto::fields::sourceFields().begin(),
+                                                   proto::fields::sourceFields().end());
+    received.insert(received.end(), proto::fields::optionalSourceFields().begin(),
+                    proto::fields::optionalSourceFields().end());
+    for (const auto& spec : received) {
       const std::string name(spec.name);
       if (!kept->findArray(name)) {
+        if (const auto b = dest.find(name); b != dest.end()) {
+          zeroed.push_back(b->second);
+        }
         continue;
       }
       const auto v = kept->values<double>(name);
@@ -505,6 +521,9 @@ struct Participant::Impl {
         std::memcpy(b->data, v.data(), v.size() * sizeof(double));
       }
       next.views[b->name] = ConstView(b->data, b->size);
+    }
+    for (const NamedBuffer* b : zeroed) {
+      std::fill(b->data, b->data + b->size, 0.0);
     }
     next.step = step;
     next.substeps = kept->envelope().sources().substeps();

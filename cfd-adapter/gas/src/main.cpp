@@ -112,6 +112,9 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
   Ledgers ledgers;
   ledgers.define("gas.heat_from_particles_J", Kind::Energy);
   ledgers.define("gas.heat_homogeneous_J", Kind::Energy);
+  // Radiation heat the particles gave the gas, ∫ Σ_c Q_rad V_c dt (protocol 1.3; stays 0 with an
+  // older DEM server, whose particles radiate to an environment outside the system).
+  ledgers.define("gas.heat_radiation_in_J", Kind::Energy);
   ledgers.define("gas.mass_from_particles_kg", Kind::Mass);
   for (const auto& s : g.species) {
     ledgers.define("gas.species." + s + "_kg", Kind::Species);
@@ -179,12 +182,15 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
     const auto eps = s.field("eps_g"), k = s.field("K_sl"), kus = s.field("K_sl_Us"),
                h = s.field("H"), htp = s.field("H_Tp"), r = s.field("R_species"),
                q = s.field("Q_hom");
-    double heat = 0.0, hom = 0.0, solid = 0.0;
+    const auto qrad = s.radiationHeat(); // empty below protocol 1.3
+    double heat = 0.0, hom = 0.0, solid = 0.0, rad = 0.0;
     double mom[3] = {0.0, 0.0, 0.0};
     std::vector<double> spec(ns, 0.0);
     for (std::size_t c = 0; c < n; ++c) {
       heat += htp[c] - h[c] * f.T_g[c];
       hom += q[c];
+      if (qrad.size == n)
+        rad += qrad[c];
       solid += 1.0 - eps[c];
       for (int a = 0; a < 3; ++a)
         mom[a] += kus[3 * c + a] - k[c] * f.u_g[3 * c + a];
@@ -193,6 +199,7 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
     }
     ledgers.add("gas.heat_from_particles_J", heat * vc * dt);
     ledgers.add("gas.heat_homogeneous_J", hom * vc * dt);
+    ledgers.add("gas.heat_radiation_in_J", rad * vc * dt);
     double mass = 0.0;
     for (std::size_t j = 0; j < ns; ++j) {
       ledgers.add("gas.species." + g.species[j] + "_kg", spec[j] * vc * dt);

@@ -158,6 +158,8 @@ struct DemServer::Impl {
   std::uint32_t rankCount = 0;
   std::vector<proto::PeerId> rankPeers;
   std::vector<std::string> rankNames;
+  /// The protocol minor agreed with each CFD rank's Hello (Q_rad goes only to ranks of 1.3+).
+  std::vector<std::uint32_t> rankMinors;
   Clock::time_point started, lastActivity;
   std::map<proto::PeerId, std::uint64_t> lastSequence;
   std::unique_ptr<dem::DemSystem> system;
@@ -308,6 +310,7 @@ struct DemServer::Impl {
     oPeer.clear();
     rankPeers.clear();
     rankNames.clear();
+    rankMinors.clear();
     rankCount = 0;
     oName.clear();
     lastSequence.clear();
@@ -361,6 +364,7 @@ struct DemServer::Impl {
       }
       rankPeers[r].clear();
       rankNames[r].clear();
+      rankMinors[r] = 0;
       if (!partials.empty()) {
         partials.erase(static_cast<std::uint32_t>(r));
         failPartialStep(v1::ERROR_CODE_TRANSPORT,
@@ -457,6 +461,7 @@ struct DemServer::Impl {
         rankCount = k;
         rankPeers.assign(k, proto::PeerId());
         rankNames.assign(k, std::string());
+        rankMinors.assign(k, 0);
       }
       if (!rankPeers[rank].empty() && rankPeers[rank] != r.peer) {
         // Each role is bound to the connection that said Hello first; the role is freed when
@@ -472,6 +477,7 @@ struct DemServer::Impl {
       }
       rankPeers[rank] = r.peer;
       rankNames[rank] = nameOf(r);
+      rankMinors[rank] = n.agreed.minor;
       lastSequence[r.peer] = env.sequence();
       if (k > 1) {
         log->info("session {}: CFD rank {} of {} '{}' connected (protocol {}.{}, peer {}{})",
@@ -930,6 +936,13 @@ struct DemServer::Impl {
       add(f::kHeatCoefficientTimesTp, s.heatHTp);
       add(f::kSpeciesSources, s.rSpecies);
       add(f::kHomogeneousHeat, s.qHom);
+      // v1.3: the radiation heat of the particles goes to the gas; an older peer never sees it
+      // (the heat then stays with the particles' environment, as before 1.3).
+      if (const int r = rankOf(t.request->peer);
+          r >= 0 && rankMinors[static_cast<std::size_t>(r)] >= proto::kMinorRadiation &&
+          s.qRad.size() == n) {
+        add(f::kRadiationHeat, s.qRad);
+      }
       *src.envelope().mutable_sources()->mutable_ledger() = ledger;
       send(t.request->peer, std::move(src), req.sequence(), env.step());
     }
@@ -976,6 +989,9 @@ struct DemServer::Impl {
         v *= scale;
       }
       for (double& v : p.qHom) {
+        v *= scale;
+      }
+      for (double& v : p.qRad) {
         v *= scale;
       }
     }

@@ -1,5 +1,7 @@
 #include "state_meta.h"
 
+#include <cstdlib>
+
 #include "coredem/common/check.h"
 #include "coredem/common/hdf5.h"
 
@@ -45,6 +47,7 @@ void forEachPending(F&& f, dem::CellSources& p) {
   f("H_Tp", p.heatHTp, 1);
   f("R_species", p.rSpecies, 0); // 0: one column per gas species
   f("Q_hom", p.qHom, 1);
+  f("Q_rad", p.qRad, -1); // -1: one per cell, absent from files written before protocol 1.3
 }
 } // namespace
 
@@ -79,9 +82,14 @@ StaggeredState readStaggeredState(const std::string& path, std::uint64_t cells, 
   if (s.hasPending) {
     forEachPending(
         [&](const char* name, std::vector<double>& v, int width) {
+          const std::string dataset = std::string("pending_") + name;
+          if (width < 0 && !h5::exists(group, dataset)) { // optional (Q_rad): zeros
+            v.assign(static_cast<std::size_t>(cells), 0.0);
+            return;
+          }
           const auto n = static_cast<std::int64_t>(cells) *
-                         (width == 0 ? static_cast<std::int64_t>(species) : width);
-          v = h5::readDataset<double>(group, std::string("pending_") + name, path, n);
+                         (width == 0 ? static_cast<std::int64_t>(species) : std::abs(width));
+          v = h5::readDataset<double>(group, dataset, path, n);
         },
         s.pending);
   }

@@ -132,6 +132,55 @@ TEST(Participants, CoredemGasRunsCheckpointsAndRestartsWithIdenticalLedgers) {
   fs::remove_all(dir);
 }
 
+// Protocol 1.3: coredem-gas books the radiation heat the particles gave the gas
+// (gas.heat_radiation_in_J = Σ Q_rad V_c Δt). Hot beads (900 K, emissivity 0.9) in 300 K gas:
+// it equals the particles' radiation loss −dem.heat_radiation_J to 1e-12 relative, and the
+// coupled energy ledger closes: Δ dem.thermal_energy_J + gas.heat_from_particles_J +
+// gas.heat_radiation_in_J = 0 to round-off (no walls with a temperature: no other heat).
+TEST(Participants, CoredemGasBooksTheRadiationHeatAndTheLedgerCloses) {
+  const auto dir = tempDir("gas-radiation");
+  const auto caseFile = dir / "case.yaml";
+  {
+    std::ofstream out(caseFile);
+    out << "gas:\n"
+           "  u_g: [0.0, 0.0, 0.2]\n"
+           "  T_g: 300.0\n"
+           "  Y_g: {N2: 1.0}\n";
+  }
+  auto cfg = smallCase(kParticles, kD, kBox, kCells, {"N2"});
+  cfg.mutable_particle_sets(0)->set_temperature(900.0);
+  std::vector<v1::StepDone> cfd, dem;
+  double e0 = 0.0;
+  {
+    DemProcess d(dir);
+    MiniOrchestrator o(d.endpoint(), cfg);
+    Child gas({COREDEM_GAS_BIN, "--case", caseFile.string(), "--key", "gas"}, env(o, d.endpoint()));
+    const auto res = o.run(6, 2e-4);
+    cfd = res.cfd;
+    dem = res.dem;
+    EXPECT_EQ(gas.wait(std::chrono::seconds(20)), 0);
+    EXPECT_EQ(d.wait(std::chrono::seconds(20)), 0);
+  }
+  ASSERT_EQ(cfd.size(), 6u);
+  ASSERT_EQ(dem.size(), 6u);
+  // Initial thermal energy: N m c_p T0 (all beads alike).
+  const double mass = 2500.0 * std::numbers::pi * kD * kD * kD / 6.0;
+  e0 = kParticles * mass * 840.0 * 900.0;
+  const auto& c = cfd.back().ledger().energy();
+  const auto& p = dem.back().ledger().energy();
+  const double radIn = named(c, "gas.heat_radiation_in_J");
+  const double radOut = named(p, "dem.heat_radiation_J");
+  ASSERT_LT(radOut, 0.0);
+  EXPECT_NEAR(radIn, -radOut, 1e-12 * -radOut);
+  const double dE = named(p, "dem.thermal_energy_J") - e0;
+  const double residual = dE + named(c, "gas.heat_from_particles_J") + radIn;
+  std::printf("radiation: gas got %.17g J, particles lost %.17g J; coupled residual %.3g J of "
+              "%.3g J exchanged\n",
+              radIn, -radOut, residual, std::abs(dE));
+  EXPECT_NEAR(residual, 0.0, 1e-9 * std::abs(dE) + 1e-12 * e0);
+  fs::remove_all(dir);
+}
+
 TEST(Participants, CppClientChecksArgumentsBeforeSending) {
   const auto dir = tempDir("cpp");
   DemProcess dem(dir);
@@ -315,7 +364,7 @@ TEST(Participants, CppClientReceivesIntoCallerBuffersBitwiseAsViews) {
       },
       failure);
 
-  std::vector<double> eps, kus, h;
+  std::vector<double> eps, kus, h, qr;
   const Recorded buffered = runRecording(
       "buffers", kSteps,
       [&](coredem::client::Participant& p) {
@@ -325,6 +374,7 @@ TEST(Participants, CppClientReceivesIntoCallerBuffersBitwiseAsViews) {
         eps.assign(n, -7.0);
         kus.assign(3 * n, -7.0);
         h.assign(n, -7.0);
+        qr.assign(n, -7.0);
         // Refusals (nothing is sent or written; the step is then exchanged as usual).
         auto expectArgument = [&](std::vector<coredem::client::NamedBuffer> into, const char* what,
                                   const char* mentions) {
@@ -348,9 +398,11 @@ TEST(Participants, CppClientReceivesIntoCallerBuffersBitwiseAsViews) {
         const auto& s = p.exchange(p.step(), p.dt(), fields,
                                    {{"eps_g", eps.data(), eps.size()},
                                     {"K_sl_Us", kus.data(), kus.size()},
-                                    {"H", h.data(), h.size()}});
+                                    {"H", h.data(), h.size()},
+                                    {"Q_rad", qr.data(), qr.size()}});
         if (s.field("eps_g").data != eps.data() || s.field("K_sl_Us").data != kus.data() ||
-            s.field("H").data != h.data()) {
+            s.field("H").data != h.data() || s.radiationHeat().data != qr.data() ||
+            s.radiationHeat().size != n) {
           failure += "field() does not view the caller's buffers; ";
         }
         std::map<std::string, std::vector<double>> out;
@@ -575,11 +627,97 @@ TEST(Participants, FluidFractionAndRanksNeedADemServerOfProtocol12) {
     } catch (const std::exception&) {
     }
     cfd.join();
-    EXPECT_NE(error.find("agreed protocol 1.1, this client speaks 1.2"), std::string::npos)
+    EXPECT_NE(
+        error.find("agreed protocol 1.1, this client speaks " + proto::kProtocolVersion.toString()),
+        std::string::npos)
         << ranks << " ranks: " << error;
     EXPECT_NE(error.find(ranks > 1 ? "decomposed CFD participant (2 ranks)" : "fluid_fraction"),
               std::string::npos)
         << error;
+  }
+  stop = true;
+  server.join();
+  fs::remove_all(dir);
+}
+
+// Protocol 1.3: against a DEM server that agrees 1.2 (a stand-in: Welcome{minor 2}, and Sources
+// without Q_rad, as a 1.2 server sends them) the client reports Q_rad absent: radiationHeat()
+// is empty, has("Q_rad") is false, and a caller buffer given for it is set to zeros.
+TEST(Participants, RadiationHeatIsAbsentFromADemServerOfProtocol12) {
+  const auto dir = tempDir("v12");
+  proto::Server oldDem;
+  const std::string oldEp = oldDem.bind("tcp://127.0.0.1:*");
+  std::atomic<bool> stop{false};
+  std::thread server([&] {
+    while (!stop) {
+      auto r = oldDem.receive(100ms);
+      if (!r) {
+        continue;
+      }
+      const auto& env = r->message.envelope();
+      proto::Message w;
+      if (r->message.type() == v1::MESSAGE_TYPE_HELLO) {
+        w = proto::makeWelcome(v1::ROLE_DEM, "coredem-dem 1.2 (stand-in)", 1, 2, env.session_id());
+      } else if (r->message.type() == v1::MESSAGE_TYPE_GAS_FIELDS) {
+        const auto& g = env.gas_fields();
+        w = proto::makeSources(env.step(), env.time(), g.dt(), g.cell_count(), g.species_count(),
+                               1);
+        for (const auto& spec : proto::fields::sourceFields()) {
+          const auto shape = proto::fields::shapeOf(spec.extent, g.cell_count(), g.species_count());
+          std::uint64_t count = 1;
+          for (auto d : shape)
+            count *= d;
+          w.addArray<double>(spec.name, std::vector<double>(count, 0.0), shape);
+        }
+        w.setSessionId(env.session_id());
+        w.setStep(env.step());
+      } else {
+        w = proto::makeError(v1::ERROR_CODE_UNSUPPORTED, "stand-in");
+      }
+      w.setSequence(env.sequence());
+      oldDem.reply(r->peer, std::move(w));
+    }
+  });
+  {
+    DemProcess dem(dir);
+    MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2"}), 3s);
+    std::string failure = "not run";
+    std::thread cfd([&] {
+      coredem::client::Options opt;
+      opt.controlEndpoint = o.controlEndpoint();
+      opt.demEndpoint = oldEp;
+      opt.sessionId = o.session();
+      opt.timeoutSeconds = 20;
+      coredem::client::Participant p(opt);
+      try {
+        p.initialize();
+        failure.clear();
+        if (p.demProtocolMinor() != 2)
+          failure += "agreed minor " + std::to_string(p.demProtocolMinor()) + "; ";
+        const auto n = static_cast<std::size_t>(p.grid().cellCount());
+        std::vector<std::vector<double>> keep;
+        std::vector<double> qr(n, -7.0);
+        const auto& s =
+            p.exchange(p.step(), p.dt(), gasFields(n, keep), {{"Q_rad", qr.data(), qr.size()}});
+        if (s.radiationHeat().size != 0 || s.radiationHeat().data != nullptr)
+          failure += "radiationHeat() not empty; ";
+        if (s.has("Q_rad"))
+          failure += "has(Q_rad); ";
+        for (double v : qr)
+          if (v != 0.0) {
+            failure += "the Q_rad buffer was not zeroed; ";
+            break;
+          }
+      } catch (const std::exception& e) {
+        failure += std::string("unexpected: ") + e.what();
+      }
+    });
+    try {
+      o.run(1, 2e-4, {}, false); // ends by timeout: the real DEM never gets the GasFields
+    } catch (const std::exception&) {
+    }
+    cfd.join();
+    EXPECT_EQ(failure, "");
   }
   stop = true;
   server.join();

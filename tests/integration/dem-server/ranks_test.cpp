@@ -95,10 +95,12 @@ struct Gas {
 
 proto::Client cfdRank(const std::string& ep, const std::string& session, std::uint32_t rank,
                       std::uint32_t count, v1::MessageType expect = v1::MESSAGE_TYPE_WELCOME,
-                      std::string* reason = nullptr) {
+                      std::string* reason = nullptr,
+                      std::uint32_t minor = proto::kProtocolVersion.minor) {
   proto::Client c;
   c.connect(ep);
   auto hello = proto::makeHello(v1::ROLE_CFD, "test cfd rank " + std::to_string(rank));
+  hello.envelope().mutable_hello()->set_protocol_minor(minor);
   hello.envelope().mutable_hello()->set_rank(rank);
   hello.envelope().mutable_hello()->set_rank_count(count);
   hello.setSessionId(session);
@@ -131,7 +133,13 @@ void take(const proto::Message& src, GridSources& out) {
       cells.push_back(std::int64_t(c));
     }
   }
-  for (const auto& spec : f::sourceFields()) {
+  std::vector<f::FieldSpec> specs(f::sourceFields().begin(), f::sourceFields().end());
+  for (const auto& spec : f::optionalSourceFields()) { // v1.3 Q_rad, when sent
+    if (src.findArray(spec.name)) {
+      specs.push_back(spec);
+    }
+  }
+  for (const auto& spec : specs) {
     const auto v = src.values<double>(spec.name);
     const std::size_t q = v.size() / cells.size();
     auto& dst = out[std::string(spec.name)];
@@ -147,19 +155,30 @@ void take(const proto::Message& src, GridSources& out) {
 struct RunResult {
   GridSources sources;  ///< of the last step
   v1::StepDone demDone; ///< of the last step
+  /// Σ over the steps and cells of Q_rad V_c Δt (J): the radiation heat the gas received.
+  double radiationToGas = 0.0;
+  int stepsWithQrad = 0; ///< steps whose Sources carried Q_rad
 };
 
-/// Three steps with 1 whole-grid participant (ranks 0) or 2 ranks sending in `order`.
-RunResult run(int ranks, std::vector<int> order = {0, 1}) {
+/// Three steps with 1 whole-grid participant (ranks 0) or 2 ranks sending in `order`; `hotT` > 0:
+/// the particles start at that temperature (radiation to the 300 K gas); `minor`: the protocol
+/// minor the CFD ranks say in Hello.
+RunResult run(int ranks, std::vector<int> order = {0, 1}, double hotT = 0.0,
+              std::uint32_t minor = proto::kProtocolVersion.minor) {
   ServerThread server;
-  MiniOrchestrator o(server.endpoint(), smallCase(kParticles, kD, kBox, kCellsPerAxis));
+  v1::Configure cfg = smallCase(kParticles, kD, kBox, kCellsPerAxis);
+  if (hotT > 0.0) {
+    cfg.mutable_particle_sets(0)->set_temperature(hotT);
+  }
+  MiniOrchestrator o(server.endpoint(), cfg);
   Gas gas;
   const double dt = 2e-4;
   const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
   std::vector<proto::Client> c;
   for (int r = 0; r < std::max(ranks, 1); ++r) {
     c.push_back(cfdRank(server.endpoint(), o.session(), std::uint32_t(r),
-                        std::uint32_t(std::max(ranks, 1))));
+                        std::uint32_t(std::max(ranks, 1)), v1::MESSAGE_TYPE_WELCOME, nullptr,
+                        minor));
   }
   RunResult result;
   for (std::int64_t n = 1; n <= 3; ++n) {
@@ -187,6 +206,15 @@ RunResult run(int ranks, std::vector<int> order = {0, 1}) {
     EXPECT_TRUE(d.has_value());
     proto::expectType(*d, v1::MESSAGE_TYPE_STEP_DONE);
     result.demDone = d->envelope().step_done();
+    if (const auto q = result.sources.find(std::string(f::kRadiationHeat));
+        q != result.sources.end()) {
+      ++result.stepsWithQrad;
+      double sum = 0.0;
+      for (double v : q->second) {
+        sum += v * kH * kH * kH * dt;
+      }
+      result.radiationToGas += sum;
+    }
   }
   return result;
 }
@@ -310,4 +338,39 @@ TEST(DemServerRanks, ARankThatLeavesFailsTheStepNamingIt) {
   EXPECT_EQ(e->envelope().error().code(), v1::ERROR_CODE_TRANSPORT);
   EXPECT_NE(e->envelope().error().message().find("CFD rank 1 of 2"), std::string::npos)
       << e->envelope().error().message();
+}
+
+// Protocol 1.3: Q_rad, the radiation heat the particles gave the gas. Hot particles (900 K,
+// emissivity 0.9) in 300 K gas, 3 steps: Σ Q_rad V_c Δt over cells and steps equals the
+// particles' radiation loss (−dem.heat_radiation_J) to 1e-12 relative, whether one whole-grid
+// participant or 2 ranks (partial Sources, each its own cells) receive it; a 1.2 peer receives
+// no Q_rad (the heat then leaves the system as before) and the particles do the same.
+TEST(DemServerRanks, RadiationHeatReachesTheGasWholeGridAndPartial) {
+  const RunResult one = run(0, {0, 1}, 900.0);
+  const RunResult two = run(2, {0, 1}, 900.0);
+  const double lost = -named(one.demDone.ledger().energy(), "dem.heat_radiation_J");
+  ASSERT_GT(lost, 0.0);
+  EXPECT_EQ(one.stepsWithQrad, 3);
+  EXPECT_EQ(two.stepsWithQrad, 3);
+  EXPECT_NEAR(one.radiationToGas, lost, 1e-12 * lost);
+  const double lostTwo = -named(two.demDone.ledger().energy(), "dem.heat_radiation_J");
+  EXPECT_NEAR(two.radiationToGas, lostTwo, 1e-12 * lostTwo);
+  EXPECT_NEAR(two.radiationToGas, one.radiationToGas, kRegrouped * lost);
+  std::printf("radiation to the gas %.17g J, particles lost %.17g J (2 ranks: %.17g, %.17g)\n",
+              one.radiationToGas, lost, two.radiationToGas, lostTwo);
+}
+
+TEST(DemServerRanks, APeerOfProtocol12ReceivesNoRadiationHeat) {
+  const RunResult old = run(0, {0, 1}, 900.0, 2);
+  const RunResult now = run(0, {0, 1}, 900.0);
+  EXPECT_EQ(old.stepsWithQrad, 0);
+  EXPECT_EQ(old.sources.count(std::string(f::kRadiationHeat)), 0u);
+  EXPECT_EQ(now.stepsWithQrad, 3);
+  // The DEM books the same radiation either way (the particles do not know who receives it).
+  EXPECT_EQ(named(old.demDone.ledger().energy(), "dem.heat_radiation_J"),
+            named(now.demDone.ledger().energy(), "dem.heat_radiation_J"));
+  EXPECT_LT(named(old.demDone.ledger().energy(), "dem.heat_radiation_J"), 0.0);
+  // A decomposed 1.2 run gets no Q_rad either.
+  const RunResult oldTwo = run(2, {0, 1}, 900.0, 2);
+  EXPECT_EQ(oldTwo.stepsWithQrad, 0);
 }

@@ -458,6 +458,81 @@ TEST(HeatOptions, ParseAndRejectWithAClearMessage) {
   EXPECT_EQ(validateModels(bad).size(), 1u);
 }
 
+// Radiation heat to the gas (protocol 1.3, CellSources::qRad = Sources Q_rad): hot particles
+// (900 K, emissivity 0.9) in a cold gas (300 K). Over several CFD steps Σ_steps Σ_c Q_rad V_c
+// Δt_CFD equals the radiation heat the particles lost (−dem.heat_radiation_J) to 1e-12 relative,
+// and the per-cell arrays are bitwise the same on 1 and 2 threads. With convection and
+// conduction off the particles' energy change plus the gas's radiation gain is 0 to round-off
+// (what coredem-gas books as gas.heat_radiation_in_J).
+namespace {
+struct RadRun {
+  std::vector<std::vector<double>> qRad; ///< per step
+  double toGas = 0.0;                    ///< Σ_steps Σ_c Q_rad V_c Δt_CFD (J)
+  HeatTotals totals;
+  double e0 = 0, e = 0;
+};
+
+RadRun runHotBed(int threads, int windows, bool radiationOnly) {
+  DemConfig cfg = heatedBed();
+  cfg.particleSets[0].temperature = 900.0;
+  if (radiationOnly) {
+    EXPECT_TRUE(applyModelOption(cfg, "convection", "off"));
+    EXPECT_TRUE(applyModelOption(cfg, "contact_conduction", "off"));
+    EXPECT_TRUE(applyModelOption(cfg, "lens_conduction", "off"));
+  }
+  DemSystem sys(cfg, BackendKind::Cpu, threads);
+  Gas(sys.cellCount(), 300.0, 1.177, 1.85e-5, 0.026, 1007.0).apply(sys);
+  const double vc = cfg.grid.spacing[0] * cfg.grid.spacing[1] * cfg.grid.spacing[2];
+  const double dtCfd = 1e-3;
+  const int nSub = static_cast<int>(std::ceil(dtCfd / sys.dtDemMax()));
+  RadRun r;
+  r.e0 = sys.thermalEnergy();
+  for (int w = 0; w < windows; ++w) {
+    const CellSources& s = sys.advance(dtCfd, nSub);
+    EXPECT_EQ(s.qRad.size(), sys.cellCount());
+    double step = 0.0;
+    for (double q : s.qRad)
+      step += q * vc * dtCfd;
+    r.toGas += step;
+    r.qRad.push_back(s.qRad);
+  }
+  r.totals = sys.heatTotals();
+  r.e = sys.thermalEnergy();
+  return r;
+}
+} // namespace
+
+TEST(HeatStep, RadiationHeatToTheGasEqualsTheParticlesRadiationLoss) {
+  const RadRun a = runHotBed(1, 4, false);
+  const RadRun b = runHotBed(2, 4, false);
+  ASSERT_EQ(a.qRad.size(), b.qRad.size());
+  for (std::size_t w = 0; w < a.qRad.size(); ++w)
+    EXPECT_EQ(a.qRad[w], b.qRad[w]) << "step " << w; // bitwise, 1 vs 2 threads
+  EXPECT_EQ(a.totals.radiation, b.totals.radiation);
+  EXPECT_LT(a.totals.radiation, 0.0); // hot particles lose heat by radiation
+  EXPECT_GT(a.toGas, 0.0);            // which the gas receives
+  EXPECT_NEAR(a.toGas, -a.totals.radiation, 1e-12 * std::fabs(a.totals.radiation));
+  RecordProperty("radiation_to_gas_rel",
+                 sci((a.toGas + a.totals.radiation) / std::fabs(a.totals.radiation)));
+  // Every cell that holds particles radiates (T_p > T_env); the empty cells send 0.
+  bool anyPositive = false;
+  for (double q : a.qRad.back()) {
+    EXPECT_GE(q, 0.0);
+    anyPositive = anyPositive || q > 0.0;
+  }
+  EXPECT_TRUE(anyPositive);
+}
+
+TEST(HeatStep, RadiationOnlyLedgerClosesWithTheGasRadiationTerm) {
+  const RadRun r = runHotBed(1, 3, true);
+  EXPECT_EQ(r.totals.convection, 0.0);
+  ASSERT_GT(r.toGas, 0.0);
+  // Particle energy change + the gas's radiation gain = 0 (nothing else exchanges heat).
+  EXPECT_NEAR((r.e - r.e0) + r.toGas, 0.0, 1e-12 * r.e0);
+  EXPECT_NEAR(r.e - r.e0, r.totals.radiation, 1e-12 * r.e0);
+  RecordProperty("radiation_ledger_residual_rel", sci(((r.e - r.e0) + r.toGas) / r.e0));
+}
+
 // The 1-vs-2-thread and restart cases run two OpenMP threads on a machine shared with other
 // jobs; libgomp's default spinning barriers then stall on a descheduled thread (docs/
 // performance.md "DEM core"). OMP_WAIT_POLICY is read when libgomp starts, so an unset policy

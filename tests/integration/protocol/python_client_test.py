@@ -3,7 +3,7 @@
 talks to the C++ loopback server and decodes the C++ golden files.
 
 usage: python_client_test.py PROTOC PROTO_DIR GOLDEN_DIR LOOPBACK_BINARY
-Checks: every golden v1.0, v1.1 and v1.2 file decodes with Python's protobuf and has the type its name says;
+Checks: every golden v1.0, v1.1, v1.2 and v1.3 file decodes with Python's protobuf and has the type its name says;
 the golden GasFields arrays hold 0.25 (f+1) + 0.125 i; over tcp loopback a Python DEALER
 handshakes, configures a 4x3x2 grid, sends GasFields built from numpy arrays and receives
 Sources (eps_g = 1, other sources 0, checksums equal to sequential sums of what was sent);
@@ -88,6 +88,19 @@ def main():
                 else:
                     assert np.frombuffer(arrays["eps_g"][1], dtype="<f8").tolist() == [0.25]
         print(f"python: decoded {len(names)} golden v1.2 files")
+        # v1.3: the partial Sources also carry Q_rad (float64, one row per listed cell).
+        frames = read_cdmf(os.path.join(golden_dir, "v1.3", "sources.cdmf"))
+        env = pb.Envelope()
+        env.ParseFromString(frames[0])
+        assert env.WhichOneof("body") == "sources"
+        arrays = {d.name: (d, raw) for d, raw in zip(env.arrays, frames[1:])}
+        d, raw = arrays["Q_rad"]
+        assert d.dtype == common.DTYPE_FLOAT64 and list(d.shape) == [1], d
+        assert np.frombuffer(raw, dtype="<f8").tolist() == [2.0]
+        hello = pb.Envelope()
+        hello.ParseFromString(read_cdmf(os.path.join(golden_dir, "v1.3", "hello.cdmf"))[0])
+        assert hello.hello.protocol_minor == 3
+        print("python: decoded the golden v1.3 Sources with Q_rad")
         # v1.1 Configure: explicit positions and chemistry, read by Python's protobuf.
         env = pb.Envelope()
         env.ParseFromString(read_cdmf(os.path.join(golden_dir, "v1.1", "configure.cdmf"))[0])
@@ -138,7 +151,7 @@ def main():
             hello.hello.role = common.ROLE_CFD
             welcome, _ = request(hello)
             assert welcome.type == common.MESSAGE_TYPE_WELCOME
-            assert welcome.welcome.protocol_minor == 2  # min(server 1.2, client 1.7)
+            assert welcome.welcome.protocol_minor == 3  # min(server 1.3, client 1.7)
             session = welcome.welcome.session_id
 
             nx, ny, nz, ns = 4, 3, 2, 2

@@ -40,7 +40,7 @@ TEST(GoldenV1_1, EveryV10MessageTypeHasAV11FileThatDecodes) {
 }
 
 TEST(GoldenV1_1, HandshakeCarriesMinorOne) {
-  // This build speaks 1.2 (version_test.cpp); the v1.1 files keep saying 1.1.
+  // This build speaks a later minor (version_test.cpp); the v1.1 files keep saying 1.1.
   Message h = load("v1.1", "hello", v1::MESSAGE_TYPE_HELLO);
   EXPECT_EQ(h.envelope().hello().protocol_major(), 1u);
   EXPECT_EQ(h.envelope().hello().protocol_minor(), 1u);

@@ -532,3 +532,79 @@ TEST(ValidatePartial, RefusesMissingListsAndWholeGridRowsAndFluidFraction) {
   EXPECT_EQ(s.code, v1::ERROR_CODE_INVALID_CONFIGURATION);
   EXPECT_NE(s.message.find("fluid_fraction"), std::string::npos) << s.message;
 }
+
+// Q_rad (v1.3): optional in Sources; when present float64, one row per cell (or listed cell of a
+// partial Sources) and finite.
+namespace {
+Message sourcesWith(std::uint64_t rows, bool partial, std::vector<double> qRad,
+                    std::vector<std::uint64_t> qShape) {
+  Message m = makeSources(1, 0.0, 1e-3, 4, 1, 10);
+  if (partial) {
+    m.envelope().mutable_sources()->set_partial(true);
+    m.envelope().mutable_sources()->set_touched_count(rows);
+    std::vector<std::int64_t> cells(rows);
+    for (std::uint64_t i = 0; i < rows; ++i) {
+      cells[i] = static_cast<std::int64_t>(i + 1);
+    }
+    m.addArray<std::int64_t>(fields::kTouchedCells, cells, {rows});
+  }
+  for (const auto& spec : fields::sourceFields()) {
+    std::vector<double> v(rows * fields::componentsOf(spec.extent, 1), 0.5);
+    m.addArray<double>(spec.name, v, fields::shapeOf(spec.extent, rows, 1));
+  }
+  if (!qShape.empty()) {
+    m.addArray<double>(fields::kRadiationHeat, qRad, qShape);
+  }
+  return m;
+}
+Expectation sourcesExpectation() {
+  Expectation e;
+  e.types = {v1::MESSAGE_TYPE_SOURCES};
+  e.cells = 4;
+  e.species = 1;
+  return e;
+}
+} // namespace
+
+TEST(ValidateSources, RadiationHeatIsOptionalAndOnePerCell) {
+  const Expectation e = sourcesExpectation();
+  EXPECT_TRUE(validate(sourcesWith(4, false, {}, {}), e).ok()); // a v1.2 Sources: no Q_rad
+  Status s = validate(sourcesWith(4, false, {1.0, -2.0, 0.0, 3.5}, {4}), e);
+  EXPECT_TRUE(s.ok()) << s.toString();
+  s = validate(sourcesWith(2, true, {1.0, -2.0}, {2}), e); // partial: one per listed cell
+  EXPECT_TRUE(s.ok()) << s.toString();
+  // Wrong count (whole grid and partial), wrong shape.
+  s = validate(sourcesWith(4, false, {1.0, 2.0, 3.0}, {3}), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  EXPECT_NE(s.message.find("'Q_rad'"), std::string::npos) << s.message;
+  s = validate(sourcesWith(2, true, {1.0, 2.0, 3.0, 4.0}, {4}), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  EXPECT_NE(s.message.find("listed"), std::string::npos) << s.message;
+  s = validate(sourcesWith(4, false, {1.0, 2.0, 3.0, 4.0}, {4, 1}), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  // Not finite: named with its index.
+  s = validate(sourcesWith(4, false, {1.0, 2.0, std::numeric_limits<double>::infinity(), 4.0}, {4}),
+               e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_NON_FINITE);
+  EXPECT_NE(s.message.find("Q_rad"), std::string::npos) << s.message;
+  // float32 is refused like every coupling array.
+  Message f32 = sourcesWith(4, false, {}, {});
+  f32.addArray<float>(fields::kRadiationHeat, std::vector<float>{1, 2, 3, 4}, {4});
+  EXPECT_EQ(validate(f32, e).code, v1::ERROR_CODE_SHAPE);
+}
+
+TEST(ValidateSources, RadiationHeatRoundTripsBitwise) {
+  const std::vector<double> q = {1.0 / 3.0, -2.5e-7, 0.0, 6.02214076e23};
+  const Message m = sourcesWith(4, false, q, {4});
+  Status s;
+  const Message back = Message::decode(m.encode(), &s);
+  ASSERT_TRUE(s.ok()) << s.toString();
+  ASSERT_TRUE(validate(back, sourcesExpectation()).ok());
+  const auto v = back.values<double>(fields::kRadiationHeat);
+  ASSERT_EQ(v.size(), q.size());
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    EXPECT_EQ(v[i], q[i]) << i;
+  }
+  EXPECT_NE(fields::findField(fields::kRadiationHeat), nullptr);
+  EXPECT_EQ(fields::findField(fields::kRadiationHeat)->unit, "W/m3");
+}

@@ -28,13 +28,18 @@ TEST(Version, OtherMajorIsRejectedNamingBothVersions) {
   EXPECT_NE(n.status.message.find("0.9"), std::string::npos);
 }
 
-TEST(Version, ThisBuildSpeaksOneDotTwo) {
+TEST(Version, ThisBuildSpeaksOneDotThree) {
   // v1.1: chemistry in Configure (solid species, reactions, chemistry), explicit positions.
   // v1.2: decomposed CFD (rank identity in Hello, partial GasFields/Sources), fluid_fraction.
-  EXPECT_EQ(kProtocolVersion, (Version{1, 2}));
-  EXPECT_EQ(kProtocolVersion.toString(), "1.2");
+  // v1.3: the Sources array Q_rad (radiation heat the particles gave the gas).
+  EXPECT_EQ(kProtocolVersion, (Version{1, 3}));
+  EXPECT_EQ(kProtocolVersion.toString(), "1.3");
   EXPECT_EQ(kMinorDecomposed, 2u);
-  // With a v1.0 or v1.1 peer the agreed version is that peer's.
+  EXPECT_EQ(kMinorRadiation, 3u);
+  // With a v1.0, v1.1 or v1.2 peer the agreed version is that peer's.
   EXPECT_EQ(negotiate(kProtocolVersion, {1, 0}).agreed, (Version{1, 0}));
   EXPECT_EQ(negotiate(kProtocolVersion, {1, 1}).agreed, (Version{1, 1}));
+  EXPECT_EQ(negotiate(kProtocolVersion, {1, 2}).agreed, (Version{1, 2}));
+  EXPECT_EQ(negotiate(kProtocolVersion, {1, 3}).agreed, (Version{1, 3}));
+  EXPECT_EQ(negotiate({1, 2}, kProtocolVersion).agreed, (Version{1, 2})); // a 1.2 server
 }

@@ -215,6 +215,11 @@ struct CellSources {
   std::vector<double> heatHTp;  ///< H·T̄_p (W/m³), N
   std::vector<double> rSpecies; ///< R_species (kg/m³/s), N*ns
   std::vector<double> qHom;     ///< homogeneous reaction heat (W/m³), N
+  /// Net radiation heat the particles of the cell gave their environment, per V_c, averaged
+  /// over the sub-steps like H and H_Tp (W/m³, N; positive = heat to the gas): −(1/V_c) ⟨Σ_i
+  /// Q_rad,i⟩. Σ_c qRad V_c Δt_CFD = −Δ HeatTotals::radiation of the window (round-off). Sent as
+  /// the Sources array Q_rad to a CFD peer of protocol 1.3 or later (docs/heat-coupling.md).
+  std::vector<double> qRad;
 };
 
 /// Host copy of the particle state (for tests, snapshots and the server), in the system's

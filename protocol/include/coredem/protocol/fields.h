@@ -54,6 +54,11 @@ inline constexpr std::string_view kHeatCoefficient = "H";              ///< [N] 
 inline constexpr std::string_view kHeatCoefficientTimesTp = "H_Tp";    ///< [N] W/m3 (explicit)
 inline constexpr std::string_view kSpeciesSources = "R_species";       ///< [N,n_species] kg/m3/s
 inline constexpr std::string_view kHomogeneousHeat = "Q_hom";          ///< [N] W/m3
+/// Optional (v1.3, fields::optionalSourceFields()): the net radiation heat the particles of each
+/// coupling cell gave their environment, per coupling-cell volume, averaged over the sub-steps
+/// like H and H_Tp (positive = heat to the gas). Σ_c Q_rad V_c Δt_CFD is the radiation heat the
+/// particles lost in the step. Sent only to a CFD peer of agreed minor >= kMinorRadiation.
+inline constexpr std::string_view kRadiationHeat = "Q_rad"; ///< [N] W/m3
 
 /// One coupling field.
 struct FieldSpec {
@@ -69,6 +74,9 @@ std::span<const FieldSpec> gasFields();
 std::span<const FieldSpec> optionalGasFields();
 /// The arrays a Sources message must carry, in the canonical order.
 std::span<const FieldSpec> sourceFields();
+/// The arrays a Sources message may carry besides (v1.3: Q_rad); validated like the required
+/// ones (dtype float64, one row per cell or listed cell, finite) when present.
+std::span<const FieldSpec> optionalSourceFields();
 /// The spec of a GasFields or Sources field by name; nullptr if the name is not one of them.
 const FieldSpec* findField(std::string_view name);
 

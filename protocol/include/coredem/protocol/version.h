@@ -19,11 +19,16 @@ struct Version {
 };
 
 /// The version this build speaks.
-inline constexpr Version kProtocolVersion{1, 2};
+inline constexpr Version kProtocolVersion{1, 3};
 
 /// First minor version with the fluid_fraction array and the decomposed (M:1) exchange: rank
 /// identity in Hello, partial GasFields/Sources (docs/protocol.md "Decomposed CFD").
 inline constexpr std::uint32_t kMinorDecomposed = 2;
+
+/// First minor version with the Sources array Q_rad (the radiation heat the particles gave the
+/// gas): the DEM server sends it only to a CFD peer whose agreed minor is at least this; below,
+/// the radiation heat stays with the particles' environment (docs/heat-coupling.md).
+inline constexpr std::uint32_t kMinorRadiation = 3;
 
 /// Outcome of a handshake.
 struct Negotiation {

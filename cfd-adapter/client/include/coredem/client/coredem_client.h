@@ -115,6 +115,11 @@ coredem_status coredem_client_exchange_partial(coredem_client* c, int64_t step, 
  * Q_hom); *size in doubles. */
 coredem_status coredem_client_source(const coredem_client* c, const char* name,
                                      const double** values, size_t* size);
+/* Q_rad of the last exchange: the radiation heat the particles gave the gas, W/m3 of coupling
+ * cell, one value per cell (positive = heat to the gas). *values NULL and *size 0 when the DEM
+ * server did not send it (protocol below 1.3). */
+coredem_status coredem_client_radiation_heat(const coredem_client* c, const double** values,
+                                             size_t* size);
 
 /* StepDone to O: Courant number, energy ledgers (name/value pairs, J) and the checkpoint files
  * written for this step; then waits for the next grant or Shutdown. */

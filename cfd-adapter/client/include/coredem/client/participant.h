@@ -156,13 +156,20 @@ struct Grid {
 };
 
 /// Sources of the last exchange (sub-step averages over the CFD step), valid until the next
-/// exchange() or finalize(). Names: eps_g, K_sl, K_sl_Us, H, H_Tp, R_species, Q_hom.
+/// exchange() or finalize(). Names: eps_g, K_sl, K_sl_Us, H, H_Tp, R_species, Q_hom, and with a
+/// DEM server of protocol 1.3 or later Q_rad (radiationHeat()).
 /// Arrays are not copied on receipt: field() views the received frames (kept alive by
 /// `storage`), or the caller's NamedBuffer the array was received into.
 class Sources {
 public:
   /// The named array; throws ClientError(Argument) for a name D did not send.
   ConstView field(const std::string& name) const;
+  /// Q_rad: the net radiation heat the particles of each cell gave the gas, W per m3 of coupling
+  /// cell, sub-step averaged like H and H_Tp (positive = heat to the gas; one value per cell, or
+  /// per listed cell after exchangePartial()). Add it to the gas energy equation as an explicit
+  /// source. Empty (size 0) when the DEM server did not send it (agreed protocol below 1.3: the
+  /// radiation heat then leaves the system, as before 1.3).
+  ConstView radiationHeat() const;
   bool has(const std::string& name) const;
   std::vector<std::string> names() const;
   std::int64_t step = 0;
@@ -229,7 +236,8 @@ public:
   /// (one copy from the received frame, none in between) and field() views them there.
   /// A name that is not a Sources array or a size other than cells x components throws
   /// ClientError(Argument) before anything is sent; buffers are written only after D's reply
-  /// passed validation.
+  /// passed validation. A buffer for Q_rad that D did not send (protocol below 1.3) is set to
+  /// zeros and radiationHeat() stays empty.
   const Sources& exchange(std::int64_t step, double dt, const std::vector<NamedField>& fields,
                           const std::vector<NamedBuffer>& into);
 

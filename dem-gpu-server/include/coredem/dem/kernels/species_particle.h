@@ -74,6 +74,27 @@ DEM_HD double molarConcentration(double rho, double y, double molar) {
   return rho * y / molar;
 }
 
+/// One cell's gas state, the only one the DEM's rates use (docs/thermochemistry.md "Gas state"):
+/// from the cell's density ρ (the per-cell ρ_g the CFD sends) and mass fractions Y_k of the
+/// case's n gas species with molar masses M_k,
+///   M_mix = 1/Σ_k (Y_k/M_k),   x_k = Y_k M_mix/M_k,   c_k = ρ Y_k/M_k  (mol/m³).
+/// Returns M_mix (kg/mol); 0 and x = 0 when Σ Y_k/M_k ≤ 0 (no gas species in the cell). When ρ
+/// is the ideal-gas density p M_mix/(R T), c_k = x_k p/(R T): the rates that use c_k and those
+/// that use x_k p see the same gas.
+DEM_HD double cellGasState(double rho, const double* y, const double* molar, int n, double* x,
+                           double* c) {
+  double s = 0.0;
+  for (int k = 0; k < n; ++k) {
+    s += y[k] / molar[k];
+  }
+  const double mMix = s > 0.0 ? 1.0 / s : 0.0;
+  for (int k = 0; k < n; ++k) {
+    x[k] = s > 0.0 ? y[k] * mMix / molar[k] : 0.0;
+    c[k] = rho * y[k] / molar[k];
+  }
+  return mMix;
+}
+
 /// Ideal-gas density ρ = p M_mix / (R T), kg/m³ (R = 8.314462618 J/(mol K)).
 DEM_HD double idealGasDensity(double p, double molarMix, double t) {
   return p * molarMix / (8.314462618 * t);

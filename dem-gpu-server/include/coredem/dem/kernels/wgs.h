@@ -59,15 +59,12 @@ struct WgsCellSources {
   double heatSource;                   ///< W/m³ into the gas
 };
 
-/// Sources of one cell. T_g (K), ε_g (−), ρ_g (kg/m³), mass fractions Y in GasSpecies order.
+/// Sources of one cell from its molar concentrations c (mol/m³ of gas, GasSpecies order; the
+/// cell's gas state, species_particle.h cellGasState). T_g (K), ε_g (−).
 /// If dt > 0, ω is limited so that no reactant concentration goes negative within dt.
-DEM_HD WgsCellSources wgsCellSources(const WgsParams& p, double tG, double epsG, double rhoG,
-                                     const double* y, double dt = 0.0) {
+DEM_HD WgsCellSources wgsCellSourcesFromConcentrations(const WgsParams& p, double tG, double epsG,
+                                                       const double* c, double dt = 0.0) {
   WgsCellSources out{};
-  double c[kGasSpeciesCount];
-  for (int k = 0; k < kGasSpeciesCount; ++k) {
-    c[k] = rhoG * y[k] / molarMass(static_cast<GasSpecies>(k));
-  }
   double w = wgsRate(p, tG, epsG, c[idx(GasSpecies::CO)], c[idx(GasSpecies::H2O)],
                      c[idx(GasSpecies::CO2)], c[idx(GasSpecies::H2)]);
   if (dt > 0.0) {
@@ -90,6 +87,17 @@ DEM_HD WgsCellSources wgsCellSources(const WgsParams& p, double tG, double epsG,
   out.massSource[idx(GasSpecies::N2)] = 0.0;
   out.heatSource = -reactionEnthalpy(ClgReaction::R3, tG) * w;
   return out;
+}
+
+/// Sources of one cell. T_g (K), ε_g (−), ρ_g (kg/m³), mass fractions Y in GasSpecies order;
+/// C_j = ρ_g Y_j/M_j with the molar masses of the species table (nasa7.h).
+DEM_HD WgsCellSources wgsCellSources(const WgsParams& p, double tG, double epsG, double rhoG,
+                                     const double* y, double dt = 0.0) {
+  double c[kGasSpeciesCount];
+  for (int k = 0; k < kGasSpeciesCount; ++k) {
+    c[k] = rhoG * y[k] / molarMass(static_cast<GasSpecies>(k));
+  }
+  return wgsCellSourcesFromConcentrations(p, tG, epsG, c, dt);
 }
 
 } // namespace coredem::dem::kernels
