@@ -46,6 +46,14 @@ set(_coredem_openfoam_inc_incompressibleTurbulenceModels
 set(_coredem_openfoam_inc_DPMTurbulenceModels
     TurbulenceModels/turbulenceModels/lnInclude TurbulenceModels/incompressible/lnInclude
     TurbulenceModels/phaseIncompressible/lnInclude)
+# The thermophysical libraries of coredemFoam's variable-density gas (rhoReactionThermo).
+set(_coredem_openfoam_inc_specie thermophysicalModels/specie/lnInclude)
+set(_coredem_openfoam_inc_fluidThermophysicalModels
+    thermophysicalModels/specie/lnInclude thermophysicalModels/basic/lnInclude
+    transportModels/compressible/lnInclude)
+set(_coredem_openfoam_inc_reactionThermophysicalModels
+    thermophysicalModels/specie/lnInclude thermophysicalModels/basic/lnInclude
+    transportModels/compressible/lnInclude thermophysicalModels/reactionThermo/lnInclude)
 
 # Ends _coredem_openfoam_resolve with <out_why> = the concatenated message.
 macro(_coredem_openfoam_fail)
@@ -170,7 +178,8 @@ endif()
 #   LIBS      OpenFOAM libraries by their wmake name (as in Make/options EXE_LIBS without -l),
 #             found in COREDEM_OPENFOAM_LIBDIR; the known ones (fvOptions, sampling,
 #             incompressibleTransportModels, turbulenceModels, incompressibleTurbulenceModels,
-#             DPMTurbulenceModels) bring their include directories along.
+#             DPMTurbulenceModels, specie, fluidThermophysicalModels,
+#             reactionThermophysicalModels) bring their include directories along.
 #   INCLUDES  extra include directories (relative ones are taken relative to the current
 #             source dir; use ${COREDEM_OPENFOAM_SRC}/... for other OpenFOAM trees).
 # The application's own directory is on the include path (createFields.H, UEqn.H, ...).

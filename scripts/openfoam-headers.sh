@@ -39,6 +39,10 @@ die() {
 #   TurbulenceModels/{turbulenceModels,incompressible}     incompressible turbulence
 #   TurbulenceModels/phaseIncompressible                   volume-fraction weighted turbulence
 #                                                          (DPMFoam style, libDPMTurbulenceModels)
+#   thermophysicalModels/{specie,basic,reactionThermo},    the ideal-gas mixture of coredemFoam's
+#   transportModels/compressible                           variable-density gas (libspecie,
+#                                                          libfluidThermophysicalModels,
+#                                                          libreactionThermophysicalModels)
 lnInclude_dirs=(
   src/OpenFOAM
   src/OSspecific/POSIX
@@ -50,6 +54,10 @@ lnInclude_dirs=(
   src/TurbulenceModels/turbulenceModels
   src/TurbulenceModels/incompressible
   src/TurbulenceModels/phaseIncompressible
+  src/thermophysicalModels/specie
+  src/thermophysicalModels/basic
+  src/thermophysicalModels/reactionThermo
+  src/transportModels/compressible
 )
 extract_paths=(META-INFO wmake "${lnInclude_dirs[@]}")
 

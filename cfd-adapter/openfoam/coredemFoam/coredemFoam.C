@@ -32,6 +32,7 @@
 #include "pimpleControl.H"
 #include "processorFvPatch.H"
 #include "fvOptions.H"
+#include "rhoReactionThermo.H"
 
 #include "checkpoint.H"
 #include "couplingExchange.H"
@@ -57,6 +58,7 @@ int main(int argc, char* argv[])
     #include "createMesh.H"
     pimpleControl pimple(mesh);
     #include "readGravitationalAcceleration.H"
+    #include "createThermo.H"
     #include "createCoupling.H"
     #include "createFields.H"
 
@@ -64,7 +66,10 @@ int main(int argc, char* argv[])
     // restart uses the checkpoint's fraction, as an uninterrupted run does.
     alphac.oldTime();
 
-    turbulence->validate();
+    if (!variableDensity)
+    {
+        turbulence->validate();
+    }
 
     #include "createCouplingFields.H"
     #include "createLedgers.H"
@@ -92,36 +97,44 @@ int main(int argc, char* argv[])
         alphac.correctBoundaryConditions();
         alphacf = fvc::interpolate(alphac);
 
-        // 2. the gas over the same step.
-        while (pimple.loop())
+        // 2. the gas over the same step (variable density: gasStepVD.H, with its ledgers).
+        if (variableDensity)
         {
-            timers.tic();
-            #include "UEqn.H"
-            timers.toc(StageTimers::UEqn);
-
-            while (pimple.correct())
+            #include "gasStepVD.H"
+        }
+        else
+        {
+            singlePhaseTransportModel& laminarTransport = laminarTransportPtr();
+            while (pimple.loop())
             {
                 timers.tic();
-                #include "pEqn.H"
-                timers.toc(StageTimers::PEqn);
-            }
+                #include "UEqn.H"
+                timers.toc(StageTimers::UEqn);
 
-            if (pimple.turbCorr())
-            {
-                laminarTransport.correct();
-                turbulence->correct();
+                while (pimple.correct())
+                {
+                    timers.tic();
+                    #include "pEqn.H"
+                    timers.toc(StageTimers::PEqn);
+                }
+
+                if (pimple.turbCorr())
+                {
+                    laminarTransport.correct();
+                    turbulence->correct();
+                }
             }
+            timers.tic();
+            #include "TEqn.H"
+            timers.toc(StageTimers::TEqn);
+            timers.tic();
+            #include "YEqn.H"
+            timers.toc(StageTimers::YEqn);
+            #include "alphacContinuityErrs.H"
+
+            // 3. ledgers (cumulative) and the Courant number of this step.
+            #include "updateLedgers.H"
         }
-        timers.tic();
-        #include "TEqn.H"
-        timers.toc(StageTimers::TEqn);
-        timers.tic();
-        #include "YEqn.H"
-        timers.toc(StageTimers::YEqn);
-        #include "alphacContinuityErrs.H"
-
-        // 3. ledgers (cumulative) and the Courant number of this step.
-        #include "updateLedgers.H"
         scalar CoNum = 0;
         {
             const scalarField sumPhi(fvc::surfaceSum(mag(phi))().primitiveField());
