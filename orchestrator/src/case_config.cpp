@@ -767,6 +767,12 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   if (top.has("coupling")) {
     const Section k = top.section("coupling", {"scheme"});
     c.coupling.scheme = k.choice("scheme", c.coupling.scheme, {"sequential", "staggered"});
+    if (c.coupling.scheme == "staggered" && c.gasProperties.idealGas()) {
+      k.fail(k.markOf("scheme"), "coupling.scheme",
+             "staggered is not available with gas_properties.model: ideal_gas yet: the "
+             "variable-density gas books the particle heat exchange for the sequential scheme "
+             "(docs/coredemFoam.md); use scheme: sequential or model: constant");
+    }
   }
 
   if (top.has("checkpoint")) {

@@ -154,10 +154,20 @@ void Session::writeTimeseriesRow(std::int64_t step, double dt, const SubcyclePla
   // sources; docs/coupling-schemes.md) is reported by the DEM server and taken off.
   const auto demHeat = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_from_gas_J");
   const auto gasHeat = protocol::findNamedValue(cd.ledger().energy(), "gas.heat_from_particles_J");
+  // The variable-density gas books the part of the exchange it takes at the end of the step that
+  // the particles saw at its start, and gives it to the gas in the next step
+  // (gas.heat_in_flight_J, docs/coredemFoam.md): taken off the same way.
   const auto inFlight = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_in_flight_J");
+  const auto gasInFlight = protocol::findNamedValue(cd.ledger().energy(), "gas.heat_in_flight_J");
   if (demHeat && gasHeat) {
     row.emplace_back("balance.heat_residual_J",
-                     inFlight ? *demHeat + *gasHeat - *inFlight : *demHeat + *gasHeat);
+                     *demHeat + *gasHeat - inFlight.value_or(0.0) - gasInFlight.value_or(0.0));
+  }
+  // Radiation (protocol 1.3): what the particles radiated is what the gas received.
+  const auto demRad = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_radiation_J");
+  const auto gasRad = protocol::findNamedValue(cd.ledger().energy(), "gas.heat_radiation_J");
+  if (demRad && gasRad) {
+    row.emplace_back("balance.radiation_residual_J", *demRad + *gasRad);
   }
   _timeseries->write(row);
 }

@@ -114,7 +114,7 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
   ledgers.define("gas.heat_homogeneous_J", Kind::Energy);
   // Radiation heat the particles gave the gas, ∫ Σ_c Q_rad V_c dt (protocol 1.3; stays 0 with an
   // older DEM server, whose particles radiate to an environment outside the system).
-  ledgers.define("gas.heat_radiation_in_J", Kind::Energy);
+  ledgers.define("gas.heat_radiation_J", Kind::Energy);
   ledgers.define("gas.mass_from_particles_kg", Kind::Mass);
   for (const auto& s : g.species) {
     ledgers.define("gas.species." + s + "_kg", Kind::Species);
@@ -199,7 +199,7 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
     }
     ledgers.add("gas.heat_from_particles_J", heat * vc * dt);
     ledgers.add("gas.heat_homogeneous_J", hom * vc * dt);
-    ledgers.add("gas.heat_radiation_in_J", rad * vc * dt);
+    ledgers.add("gas.heat_radiation_J", rad * vc * dt);
     double mass = 0.0;
     for (std::size_t j = 0; j < ns; ++j) {
       ledgers.add("gas.species." + g.species[j] + "_kg", spec[j] * vc * dt);

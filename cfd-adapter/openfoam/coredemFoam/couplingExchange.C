@@ -1,5 +1,6 @@
 #include "couplingExchange.H"
 
+#include <algorithm>
 #include <cstdlib>
 #include <string>
 
@@ -56,6 +57,23 @@ CouplingExchange::CouplingExchange
 }
 
 
+void CouplingExchange::readZeros(CouplingInput& in)
+{
+    const std::size_t n = std::size_t(nCells_)*in.nComponents();
+    double* storage = in.cellStorage();
+    if (storage != nullptr)
+    {
+        std::fill(storage, storage + n, 0.0);
+        in.read(storage);
+    }
+    else
+    {
+        scattered_.assign(n, 0.0);
+        in.read(scattered_.data());
+    }
+}
+
+
 void CouplingExchange::exchangePartial(label step, scalar dt)
 {
     using ::coredem::client::ConstView;
@@ -104,6 +122,11 @@ void CouplingExchange::exchangePartial(label step, scalar dt)
         if (nComp == 0)
         {
             in->read(nullptr);
+            continue;
+        }
+        if (in->optional() && !src->has(in->name()))
+        {
+            readZeros(*in);
             continue;
         }
         const ConstView v = src->field(in->name());
@@ -212,6 +235,11 @@ void CouplingExchange::exchange(label step, scalar dt)
         if (nComp == 0)
         {
             in->read(nullptr);
+            continue;
+        }
+        if (in->optional() && !src->has(in->name()))
+        {
+            readZeros(*in);
             continue;
         }
         const ConstView v = src->field(in->name());

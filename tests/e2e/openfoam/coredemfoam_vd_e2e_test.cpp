@@ -1,9 +1,9 @@
 // End-to-end tests of coredemFoam's variable-density gas (a low-Mach ideal-gas mixture, chosen by
 // constant/thermophysicalProperties; docs/coredemFoam.md "Variable-density gas"), run by
 // `coredem` with the real DEM server in the 1 x 4 x 1 cm column of tests/e2e/openfoam/cases/column
-// (y vertical, inlet at the bottom). The case is the template with transportProperties replaced
-// by a thermophysicalProperties of pure N2 (JANAF coefficients of the DEM's table, Sutherland
-// transport), p in Pa and a field N2 = 1:
+// (y vertical, inlet at the bottom). The case is the template with p in Pa, a field N2 = 1 and
+// `gas_properties: {model: ideal_gas}` in case.yaml: coredem writes the thermophysicalProperties
+// of pure N2 (JANAF coefficients of the DEM's table, Sutherland transport) into the run's copy:
 //   (a) hot walls, no particles to speak of: the gas heats up and leaves faster, as an ideal gas
 //       at constant pressure must (u_out = u_in T_out/T_in);
 //   (b) a packed bed: the pressure drop is Ergun's with the thermo's density and viscosity;
@@ -20,6 +20,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <numbers>
 #include <regex>
@@ -45,9 +46,11 @@ using coredem::e2e::replaceAll;
 using coredem::e2e::writeAll;
 
 constexpr double kPRef = 101325.0;
-// N2: molar mass (g/mol), Sutherland coefficients (White, Viscous Fluid Flow, Table 1-2:
-// mu0 1.663e-5 Pa s at T0 273 K, S 107 K -> As = mu0 (T0 + S)/T0^1.5).
-constexpr double kMolarMass = 28.0134, kAs = 1.401e-6, kTs = 107.0;
+// N2: molar mass (g/mol, the DEM's table that coredem writes), Sutherland coefficients (White,
+// Viscous Fluid Flow, Table 1-2: mu0 1.663e-5 Pa s at T0 273 K, S 107 K -> As = mu0 (T0 +
+// S)/T0^1.5).
+constexpr double kMolarMass = 28.014, kTs = 107.0;
+const double kAs = 1.663e-5 * (273.0 + kTs) / std::pow(273.0, 1.5);
 // OpenFOAM's universal gas constant (J/kmol/K, v1912: 1e3 NA k).
 constexpr double kRR = 1e3 * 6.0221417930e+23 * 1.38065e-23;
 
@@ -73,43 +76,6 @@ std::string foamHeader(const std::string& cls, const std::string& loc, const std
                     name);
 }
 
-/// The thermophysicalProperties of the tests: pure N2 (NASA-7 coefficients of the DEM's table,
-/// dem-gpu-server/include/coredem/dem/kernels/nasa7.h).
-std::string thermophysicalProperties() {
-  return foamHeader("dictionary", "constant", "thermophysicalProperties") + R"(
-thermoType
-{
-    type            heRhoThermo;
-    mixture         multiComponentMixture;
-    transport       sutherland;
-    thermo          janaf;
-    energy          sensibleEnthalpy;
-    equationOfState perfectGas;
-    specie          specie;
-}
-species ( N2 );
-inertSpecie N2;
-N2
-{
-    specie         { molWeight 28.0134; }
-    thermodynamics
-    {
-        Tlow 200; Thigh 6000; Tcommon 1000;
-        highCpCoeffs ( 2.95257637 1.3969004e-3 -4.92631603e-7 7.86010195e-11 -4.60755204e-15 -923.948688 5.87188762 );
-        lowCpCoeffs ( 3.53100528 -1.23660988e-4 -5.02999433e-7 2.43530612e-9 -1.40881235e-12 -1046.97628 2.96747038 );
-    }
-    transport      { As 1.401e-06; Ts 107; }
-}
-coredem
-{
-    pRef        101325;
-    D           2e-05;
-    alphacMin   0.3;
-    pressureDropPatches (inlet outlet);
-}
-)";
-}
-
 struct VdCase {
   double uIn = 0.3;    // inlet velocity, m/s
   double tIn = 293.15; // inlet temperature, K
@@ -117,6 +83,7 @@ struct VdCase {
   double tWall = -1;   // > 0: walls held at this temperature (else zero gradient)
   double gravity = -9.81;
   std::string body; // time, materials, particles, models of case.yaml
+  std::string species = "species: [{name: N2, molar_mass: 0.028014}]\n";
 };
 
 /// A case folder in `dir`: the column template turned into a variable-density case.
@@ -125,7 +92,6 @@ fs::path makeVdCase(const fs::path& dir, const VdCase& v) {
   const fs::path of = c / "openfoam";
   fs::create_directories(c);
   fs::copy(kTemplate, of, fs::copy_options::recursive);
-  fs::remove(of / "constant" / "transportProperties");
   for (const auto& e : fs::recursive_directory_iterator(of)) {
     if (e.is_regular_file()) {
       std::string s = readAll(e.path());
@@ -162,14 +128,17 @@ boundaryField
     walls   { type zeroGradient; }
 }
 )");
-  writeAll(of / "constant" / "thermophysicalProperties", thermophysicalProperties());
+  // The template's transportProperties stays: coredemFoam takes pressureDropPatches from it.
+  std::ostringstream t0;
+  t0.precision(17);
+  t0 << v.t0;
   writeAll(c / "case.yaml", std::string(R"(name: column-vd
 grid: {origin: [0, 0, 0], spacing: [0.002, 0.002, 0.002], cells: [5, 20, 5]}
 gravity: [0.0, )") + std::to_string(v.gravity) +
                                 R"(, 0.0]
-gas_properties: {density: 1.204, viscosity: 1.81e-5, conductivity: 0.0257, cp: 1006.0,
-                 temperature: 293.15, pressure: 101325.0}
-walls:
+gas_properties: {model: ideal_gas, temperature: )" +
+                                t0.str() + R"(, pressure: 101325.0}
+)" + v.species + R"(walls:
   box: {min: [0.0, 0.0, 0.0], max: [0.01, 0.04, 0.01]}
   planes: [{point: [0.0, 0.004, 0.0], normal: [0.0, 1.0, 0.0]}]
 cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120}
@@ -378,23 +347,50 @@ particles:
   EXPECT_GT(std::abs(inFlight.back()), 1e-6 * dem.back());
 }
 
-// (d) Impossible start states are refused before the first step with the cell, the field and
-// the value: a negative temperature, a mass fraction above 1, and a kinematic pressure (m2/s2)
-// where the variable-density gas needs Pa.
+/// A non-uniform version of the uniform internalField of an ascii field file of `n` cells, with
+/// `value` in cell `cell` (pre-flight reads uniform values only: these reach coredemFoam).
+std::string withOneCell(const std::string& file, const std::string& uniform, std::size_t n,
+                        std::size_t cell, const std::string& value) {
+  std::string list = "internalField   nonuniform List<scalar> " + std::to_string(n) + "(";
+  for (std::size_t c = 0; c < n; ++c) {
+    list += (c ? " " : "") + (c == cell ? value : uniform);
+  }
+  return replaceAll(file, "internalField   uniform " + uniform + ";", list + ");");
+}
+
+// (d) Impossible start states are refused before the first step, with nothing of a step written:
+// uniform values in the case's 0/ by `coredem`'s pre-flight (exit 2, naming the file and the
+// value), a single bad cell of a non-uniform field by coredemFoam (naming the cell, the field and
+// the value), and a kinematic pressure (m2/s2) where the variable-density gas needs Pa.
 TEST_F(CoredemFoamVdE2E, ImpossibleGasStatesAreRefusedNamingTheCell) {
+  constexpr std::size_t n = 500;
   struct Bad {
     const char* name;
     const char* file;
-    const char* from;
-    const char* to;
+    std::function<std::string(const std::string&)> edit;
+    bool preflight; // refused by coredem before any participant starts
     const char* expect;
   };
   const std::vector<Bad> cases = {
-      {"negative T", "0/T", "internalField   uniform 293.15;", "internalField   uniform -10;",
-       "gas temperature T = -10 K in cell 0"},
-      {"Y above 1", "0/N2", "internalField   uniform 1;", "internalField   uniform 1.5;",
-       "mass fraction N2 = 1.5 in cell 0"},
-      {"kinematic p", "0/p", "[1 -1 -2 0 0 0 0]", "[0 2 -2 0 0 0 0]", "solves p in Pa"},
+      {"negative T", "0/T",
+       [](const std::string& f) {
+         return replaceAll(f, "internalField   uniform 293.15;", "internalField   uniform -10;");
+       },
+       true, "T = -10 K: the gas temperature must be > 0 K"},
+      {"Y above 1", "0/N2",
+       [](const std::string& f) {
+         return replaceAll(f, "internalField   uniform 1;", "internalField   uniform 1.5;");
+       },
+       true, "mass fraction N2 = 1.5: must lie in [0, 1]"},
+      {"negative T in a cell", "0/T",
+       [](const std::string& f) { return withOneCell(f, "293.15", n, 7, "-10"); }, false,
+       "gas temperature T = -10 K in cell 7"},
+      {"Y above 1 in a cell", "0/N2",
+       [](const std::string& f) { return withOneCell(f, "1", n, 3, "1.5"); }, false,
+       "mass fraction N2 = 1.5 in cell 3"},
+      {"kinematic p", "0/p",
+       [](const std::string& f) { return replaceAll(f, "[1 -1 -2 0 0 0 0]", "[0 2 -2 0 0 0 0]"); },
+       false, "solves p in Pa"},
   };
   for (const Bad& b : cases) {
     const fs::path sub = dir / std::regex_replace(b.name, std::regex(" "), "-");
@@ -403,15 +399,24 @@ TEST_F(CoredemFoamVdE2E, ImpossibleGasStatesAreRefusedNamingTheCell) {
     const fs::path c = makeVdCase(sub, v);
     const fs::path f = c / "openfoam" / b.file;
     const std::string before = readAll(f);
-    writeAll(f, replaceAll(before, b.from, b.to));
+    writeAll(f, b.edit(before));
     ASSERT_NE(readAll(f), before) << b.name << ": the test did not change " << f;
     const fs::path run = sub / "run";
-    EXPECT_NE(runCoredem({"run", c.string(), "--out", run.string()}, sub / "coredem.log"), 0)
-        << b.name << " was accepted";
-    const std::string log = readAll(run / "logs" / "cfd.log");
-    EXPECT_NE(log.find(b.expect), std::string::npos)
-        << b.name << ": cfd.log does not say '" << b.expect << "':\n"
-        << logTail(run);
+    const int rc = runCoredem({"run", c.string(), "--out", run.string()}, sub / "coredem.log");
+    if (b.preflight) {
+      EXPECT_EQ(rc, 2) << b.name << ": not refused by the pre-flight";
+      const std::string log = readAll(sub / "coredem.log");
+      EXPECT_NE(log.find(b.expect), std::string::npos)
+          << b.name << ": coredem does not say '" << b.expect << "':\n"
+          << log;
+      EXPECT_FALSE(fs::exists(run / "logs" / "cfd.log")) << b.name << ": coredemFoam started";
+    } else {
+      EXPECT_NE(rc, 0) << b.name << " was accepted";
+      const std::string log = readAll(run / "logs" / "cfd.log");
+      EXPECT_NE(log.find(b.expect), std::string::npos)
+          << b.name << ": cfd.log does not say '" << b.expect << "':\n"
+          << logTail(run);
+    }
     EXPECT_FALSE(fs::exists(run / "openfoam" / "0.001")) << b.name << ": a step was written";
   }
 }
@@ -533,20 +538,22 @@ particles:
 // char's shrinking volume takes in (p_ref dV_solid/(R T), gas.solid_volume_m3), within 1e-6 of
 // the moles produced (observed ~2e-7 with 3 PIMPLE outer correctors, ~5e-10 with 10; with one the
 // species are solved with the last iteration's mass flux and the balance is off by ~1e-3).
-// The case's five gas species are the thermo's; the NASA-7 coefficients are the DEM's table.
+// The case's five gas species are the thermo's (coredem writes the dictionary from case.yaml; the
+// NASA-7 coefficients are the DEM's table).
 TEST_F(CoredemFoamVdE2E, CharGasificationGivesOneIdealGasMolarVolumePerMolProduced) {
   VdCase v;
   v.uIn = 0.1;
   v.tIn = 1173.0;
   v.t0 = 1173.0;
   v.gravity = 0.0;
-  v.body = R"(species:
+  v.species = R"(species:
   - {name: CO, molar_mass: 0.028010}
   - {name: CO2, molar_mass: 0.044009}
   - {name: H2, molar_mass: 0.002016}
   - {name: H2O, molar_mass: 0.018015}
   - {name: N2, molar_mass: 0.028014}
-solid_species:
+)";
+  v.body = R"(solid_species:
   - {name: C, molar_mass: 0.012011}
 time: {end: 0.02, dt: 1.0e-3, dt_dem: 1.0e-3}
 materials:
@@ -578,47 +585,6 @@ models: {heat: "off", motion: frozen, radiation: "off"}
                                   value.str() + "; value " + value.str() +
                                   "; }\n    walls  { type zeroGradient; }\n}\n");
   }
-  writeAll(of / "constant" / "thermophysicalProperties",
-           foamHeader("dictionary", "constant", "thermophysicalProperties") + R"(
-thermoType
-{
-    type heRhoThermo; mixture multiComponentMixture; transport sutherland; thermo janaf;
-    energy sensibleEnthalpy; equationOfState perfectGas; specie specie;
-}
-species ( CO CO2 H2 H2O N2 );
-inertSpecie N2;
-CO
-{
-    specie { molWeight 28.01; }
-    thermodynamics { Tlow 200; Thigh 6000; Tcommon 1000; highCpCoeffs ( 3.0484859 0.0013517281 -4.8579405e-07 7.8853644e-11 -4.6980746e-15 -14266.117 6.0170977 ); lowCpCoeffs ( 3.5795335 -0.00061035369 1.0168143e-06 9.0700586e-10 -9.0442449e-13 -14344.086 3.5084093 ); }
-    transport { As 1.503e-06; Ts 136; }
-}
-CO2
-{
-    specie { molWeight 44.009; }
-    thermodynamics { Tlow 200; Thigh 6000; Tcommon 1000; highCpCoeffs ( 4.6365111 0.0027414569 -9.9589759e-07 1.6038666e-10 -9.1619857e-15 -49024.904 -1.9348955 ); lowCpCoeffs ( 2.356813 0.0089841299 -7.1220632e-06 2.4573008e-09 -1.4288548e-13 -48371.971 9.9009035 ); }
-    transport { As 1.503e-06; Ts 222; }
-}
-H2
-{
-    specie { molWeight 2.016; }
-    thermodynamics { Tlow 200; Thigh 6000; Tcommon 1000; highCpCoeffs ( 2.93286575 0.000826608026 -1.46402364e-07 1.54100414e-11 -6.888048e-16 -813.065581 -1.02432865 ); lowCpCoeffs ( 2.34433112 0.00798052075 -1.9478151e-05 2.01572094e-08 -7.37611761e-12 -917.935173 0.683010238 ); }
-    transport { As 6.899e-07; Ts 97; }
-}
-H2O
-{
-    specie { molWeight 18.015; }
-    thermodynamics { Tlow 200; Thigh 6000; Tcommon 1000; highCpCoeffs ( 2.6770389 0.0029731816 -7.7376889e-07 9.4433514e-11 -4.2689991e-15 -29885.894 6.88255 ); lowCpCoeffs ( 4.1986352 -0.0020364017 6.5203416e-06 -5.4879269e-09 1.771968e-12 -30293.726 -0.84900901 ); }
-    transport { As 2.419e-06; Ts 1064; }
-}
-N2
-{
-    specie { molWeight 28.014; }
-    thermodynamics { Tlow 200; Thigh 6000; Tcommon 1000; highCpCoeffs ( 2.95257637 0.0013969004 -4.92631603e-07 7.86010195e-11 -4.60755204e-15 -923.948688 5.87188762 ); lowCpCoeffs ( 3.53100528 -0.000123660988 -5.02999433e-07 2.43530612e-09 -1.40881235e-12 -1046.97628 2.96747038 ); }
-    transport { As 1.401e-06; Ts 107; }
-}
-coredem { pRef 101325; D 2e-05; alphacMin 0.3; pressureDropPatches (inlet outlet); }
-)");
   std::string sol = readAll(of / "system" / "fvSolution");
   sol = std::regex_replace(sol, std::regex(R"(nOuterCorrectors\s+\d+;)"), "nOuterCorrectors 3;");
   writeAll(of / "system" / "fvSolution", sol);

@@ -133,10 +133,10 @@ TEST(Participants, CoredemGasRunsCheckpointsAndRestartsWithIdenticalLedgers) {
 }
 
 // Protocol 1.3: coredem-gas books the radiation heat the particles gave the gas
-// (gas.heat_radiation_in_J = Σ Q_rad V_c Δt). Hot beads (900 K, emissivity 0.9) in 300 K gas:
+// (gas.heat_radiation_J = Σ Q_rad V_c Δt). Hot beads (900 K, emissivity 0.9) in 300 K gas:
 // it equals the particles' radiation loss −dem.heat_radiation_J to 1e-12 relative, and the
 // coupled energy ledger closes: Δ dem.thermal_energy_J + gas.heat_from_particles_J +
-// gas.heat_radiation_in_J = 0 to round-off (no walls with a temperature: no other heat).
+// gas.heat_radiation_J = 0 to round-off (no walls with a temperature: no other heat).
 TEST(Participants, CoredemGasBooksTheRadiationHeatAndTheLedgerCloses) {
   const auto dir = tempDir("gas-radiation");
   const auto caseFile = dir / "case.yaml";
@@ -168,7 +168,7 @@ TEST(Participants, CoredemGasBooksTheRadiationHeatAndTheLedgerCloses) {
   e0 = kParticles * mass * 840.0 * 900.0;
   const auto& c = cfd.back().ledger().energy();
   const auto& p = dem.back().ledger().energy();
-  const double radIn = named(c, "gas.heat_radiation_in_J");
+  const double radIn = named(c, "gas.heat_radiation_J");
   const double radOut = named(p, "dem.heat_radiation_J");
   ASSERT_LT(radOut, 0.0);
   EXPECT_NEAR(radIn, -radOut, 1e-12 * -radOut);

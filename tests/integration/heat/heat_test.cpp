@@ -463,7 +463,7 @@ TEST(HeatOptions, ParseAndRejectWithAClearMessage) {
 // Δt_CFD equals the radiation heat the particles lost (−dem.heat_radiation_J) to 1e-12 relative,
 // and the per-cell arrays are bitwise the same on 1 and 2 threads. With convection and
 // conduction off the particles' energy change plus the gas's radiation gain is 0 to round-off
-// (what coredem-gas books as gas.heat_radiation_in_J).
+// (what coredem-gas books as gas.heat_radiation_J).
 namespace {
 struct RadRun {
   std::vector<std::vector<double>> qRad; ///< per step

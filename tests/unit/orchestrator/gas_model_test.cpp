@@ -289,6 +289,16 @@ TEST(GasModelParse, PrescribedGasParticipantHasNoIdealGas) {
                "ideal_gas needs a CFD participant"));
 }
 
+// The variable-density gas books the heat split for the sequential scheme only.
+TEST(GasModelParse, StaggeredSchemeIsRefusedWithTheIdealGas) {
+  const std::string e = errorOf(std::string(kIdealGas) + "coupling: {scheme: staggered}\n");
+  EXPECT_TRUE(contains(e, "coupling.scheme: staggered is not available with "
+                          "gas_properties.model: ideal_gas yet"))
+      << e;
+  EXPECT_TRUE(contains(e, "use scheme: sequential")) << e;
+  EXPECT_NO_THROW(parse(std::string(kIdealGas) + "coupling: {scheme: sequential}\n"));
+}
+
 TEST(GasModelParse, SpeciesWithoutDataAreRefusedNamingTheSupportedOnes) {
   const std::string e =
       errorOf(std::string(kIdealGas) + kSpecies + "  - {name: O2, molar_mass: 0.031998}\n");
