@@ -1,6 +1,8 @@
 // Gas data of the ideal-gas model and the generated OpenFOAM dictionary (gas_data.h).
 #include <cmath>
 #include <fstream>
+#include <iterator>
+#include <regex>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -8,6 +10,7 @@
 #include <coredem/common/yaml_section.h>
 #include <coredem/dem/kernels/nasa7.h>
 #include <coredem/orchestrator/gas_data.h>
+#include <coredem/orchestrator/preflight.h>
 
 namespace fs = std::filesystem;
 namespace k = coredem::dem::kernels;
@@ -333,6 +336,16 @@ void writeGeneratedFoamDictionaries(const CaseConfig& config, const fs::path& wo
     return;
   }
   writeFile(workDir / kThermophysicalProperties, thermophysicalPropertiesText(config));
+  // A zero gauge kinematic p (pre-flight allows no other) is the same field in Pa.
+  const fs::path pFile = workDir / "0" / "p";
+  if (isZeroGaugeKinematicPressure(readFoamField(pFile))) {
+    std::ifstream in(pFile, std::ios::binary);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::regex dims(R"(dimensions\s*\[\s*0\s+2\s+-2\s+0\s+0\s+0\s+0\s*\])");
+    writeFile(pFile, std::regex_replace(
+                         text, dims, std::string("dimensions      [") + kPressureDimensions + "]",
+                         std::regex_constants::format_first_only));
+  }
   // OpenFOAM's multiComponentMixture reads one field per species (or 0/Ydefault).
   const fs::path zero = workDir / "0";
   if (config.species.empty() && !fs::exists(zero / kAirSpecies) && !fs::exists(zero / "Ydefault")) {

@@ -496,6 +496,7 @@ FoamFieldValues readFoamField(const fs::path& file) {
       while (e < end && isWord(text[e])) {
         ++e;
       }
+      out.patchTypes.emplace_back(name, text.substr(b, e - b));
       const std::size_t value = findWord("value", brace + 1, end);
       if (text.compare(b, e - b, "fixedValue") == 0 && e - b == 10 && value != std::string::npos) {
         if (const auto v = valueAt(value, name)) {
@@ -506,6 +507,27 @@ FoamFieldValues readFoamField(const fs::path& file) {
     i = end + 1;
   }
   return out;
+}
+
+bool isZeroGaugeKinematicPressure(const FoamFieldValues& p) {
+  if (!p.found || p.dimensions != kKinematicPressureDimensions || p.values.empty()) {
+    return false;
+  }
+  for (const auto& v : p.values) {
+    if (!v.uniform || v.value != 0.0) {
+      return false;
+    }
+  }
+  static const std::vector<std::string> valueless = {
+      "fixedValue", "fixedFluxPressure", "zeroGradient",  "calculated",
+      "empty",      "symmetry",          "symmetryPlane", "wedge",
+      "cyclic",     "processor",         "cyclicAMI"};
+  for (const auto& [patch, type] : p.patchTypes) {
+    if (std::find(valueless.begin(), valueless.end(), type) == valueless.end()) {
+      return false;
+    }
+  }
+  return true;
 }
 
 namespace {
@@ -580,6 +602,25 @@ void checkFoamGasState(const CaseConfig& c, const Locator& at, const fs::path& d
                         c.gasProperties.temperature,
                         has ? "" : " (the default; no value in case.yaml)", tFile.string(),
                         T.values.front().line, T.values.front().value, kFoamEqualityRelTol));
+  }
+  // ideal_gas solves p in Pa: a kinematic 0/p (the constant model's) is accepted only as a zero
+  // gauge pressure, which is the same field in Pa (the run's copy gets Pa dimensions).
+  const fs::path pFile = zero / "p";
+  const FoamFieldValues P = readFoamField(pFile);
+  if (c.gasProperties.idealGas() && P.found && P.dimensions == kKinematicPressureDimensions) {
+    if (isZeroGaugeKinematicPressure(P)) {
+      log->info("{}:{}: p is a zero gauge pressure in m2/s2: the run's copy gets dimensions "
+                "[{}] (Pa), which the ideal-gas model solves",
+                pFile.string(), P.dimensionsLine, kPressureDimensions);
+    } else {
+      at.fail({"gas_properties", "model"}, "gas_properties.model",
+              fmt::format("ideal_gas solves p in Pa, but {}:{} is the constant model's kinematic "
+                          "pressure (dimensions [{}], m2/s2) with values or patch types that are "
+                          "not a zero gauge pressure; give 0/p dimensions [{}] and its values in "
+                          "Pa",
+                          pFile.string(), P.dimensionsLine, kKinematicPressureDimensions,
+                          kPressureDimensions));
+    }
   }
   if (c.species.empty()) {
     return;

@@ -256,3 +256,37 @@ TEST(GasPreflight, ReadFoamFieldFindsInternalAndFixedValues) {
   EXPECT_EQ(v.values[1].line, 19);
   EXPECT_FALSE(readFoamField(kSource / "cases" / "clg" / "openfoam" / "0" / "nope").found);
 }
+
+// ideal_gas solves p in Pa. The constant model's kinematic 0/p (m2/s2) of cases/clg is a zero gauge
+// pressure, the same field in Pa: accepted, and the run's copy gets Pa dimensions (the case folder
+// keeps its file). A non-zero kinematic value, or a patch type with a pressure of its own
+// (totalPressure), is refused naming the file and the dimensions to give.
+TEST(GasPreflight, KinematicPressureIsAcceptedOnlyAsAZeroGauge) {
+  const fs::path d = clgCopy("kinematic-p");
+  makeIdealGas(d);
+  const fs::path p = d / "openfoam" / "0" / "p";
+  ASSERT_TRUE(contains(readText(p), "dimensions      [0 2 -2 0 0 0 0];"));
+  EXPECT_EQ(failureOf(d), "");
+  const CaseConfig c = loadCase(d / "case.yaml");
+  prepareWorkDir(participant("coredemFoam"), c, d / "run");
+  const std::string copied = readText(d / "run" / "openfoam" / "0" / "p");
+  EXPECT_TRUE(contains(copied, "dimensions      [1 -1 -2 0 0 0 0];")) << copied;
+  EXPECT_EQ(readFoamField(d / "run" / "openfoam" / "0" / "p").dimensions, kPressureDimensions);
+  EXPECT_TRUE(contains(readText(p), "dimensions      [0 2 -2 0 0 0 0];"));
+  // With the constant model the copy keeps the kinematic p.
+  const fs::path k = clgCopy("kinematic-p-constant");
+  prepareWorkDir(participant("coredemFoam"), loadCase(k / "case.yaml"), k / "run");
+  EXPECT_TRUE(contains(readText(k / "run" / "openfoam" / "0" / "p"), "[0 2 -2 0 0 0 0]"));
+
+  edit(p, "outlet  { type fixedValue; value uniform 0; }",
+       "outlet  { type fixedValue; value uniform 5; }");
+  std::string e = failureOf(d);
+  EXPECT_TRUE(contains(e, "gas_properties.model: ideal_gas solves p in Pa, but " + p.string() +
+                              ":15 is the constant model's kinematic pressure"))
+      << e;
+  EXPECT_TRUE(contains(e, "give 0/p dimensions [1 -1 -2 0 0 0 0] and its values in Pa")) << e;
+  edit(p, "outlet  { type fixedValue; value uniform 5; }",
+       "outlet  { type totalPressure; p0 uniform 0; value uniform 0; }");
+  e = failureOf(d);
+  EXPECT_TRUE(contains(e, "kinematic pressure")) << e;
+}

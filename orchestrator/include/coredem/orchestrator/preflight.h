@@ -69,7 +69,20 @@ struct FoamFieldValues {
   /// internalField first (when it is a scalar), then each fixedValue patch with a scalar value,
   /// in file order. Vector values are left out.
   std::vector<FoamFieldValue> values;
+  /// (patch, type) of every patch entry of boundaryField, in file order.
+  std::vector<std::pair<std::string, std::string>> patchTypes;
 };
+
+/// The dimensions of the constant model's kinematic pressure p/rho (m2/s2) and of a pressure (Pa)
+/// as readFoamField gives them.
+inline constexpr const char* kKinematicPressureDimensions = "0 2 -2 0 0 0 0";
+inline constexpr const char* kPressureDimensions = "1 -1 -2 0 0 0 0";
+
+/// True when 0/p (read by readFoamField) is a kinematic pressure that is the same field in Pa: a
+/// zero gauge pressure (internalField and every fixedValue patch uniform 0; the other patches of
+/// types that carry no pressure value of their own: fixedFluxPressure, zeroGradient, calculated
+/// and the constraint types).
+bool isZeroGaugeKinematicPressure(const FoamFieldValues& p);
 
 /// Reads the class, dimensions, internalField and fixedValue patch values of an ASCII OpenFOAM
 /// field file (comments ignored; macros and #include not expanded).
