@@ -3,8 +3,9 @@
 #
 # Cost per CFD step of coredemFoam's two gas models (docs/coredemFoam.md): the constant-property
 # gas (constant/transportProperties) and the variable-density ideal-gas mixture
-# (constant/thermophysicalProperties: pure N2, JANAF + Sutherland through OpenFOAM's
-# rhoReactionThermo), on the same empty column at CELLS mesh cells each.
+# (case.yaml gas_properties.model: ideal_gas, pure N2: coredem writes the JANAF + Sutherland
+# dictionary that OpenFOAM's rhoReactionThermo evaluates), on the same empty column at CELLS mesh
+# cells each.
 #
 # The case: the 1 x 4 x 1 cm column of tests/e2e/openfoam/cases/column with its blockMesh refined
 # to (n, 4n, n) cells (n = round((cells/4)^(1/3))) over the 5 x 20 x 5 coupling grid (overlap
@@ -83,9 +84,8 @@ sub(f"{of}/system/blockMeshDict",
 header = ("FoamFile\n{\n    version 2.0;\n    format ascii;\n    class %s;\n"
           "    location \"%s\";\n    object %s;\n}\n")
 if model == "variable":
-    os.remove(f"{of}/constant/transportProperties")
-    sub(f"{of}/0/p", lambda t: t.replace("[0 2 -2 0 0 0 0]", "[1 -1 -2 0 0 0 0]")
-        .replace("uniform 0", "uniform 101325"))
+    # coredem writes constant/thermophysicalProperties (pure N2) from case.yaml's ideal_gas; the
+    # template's zero gauge kinematic p is taken as Pa.
     open(f"{of}/0/N2", "w").write(header % ("volScalarField", "0", "N2") + """
 dimensions [0 0 0 0 0 0 0];
 internalField uniform 1;
@@ -96,34 +96,16 @@ boundaryField
     walls  { type zeroGradient; }
 }
 """)
-    open(f"{of}/constant/thermophysicalProperties", "w").write(
-        header % ("dictionary", "constant", "thermophysicalProperties") + """
-thermoType
-{
-    type heRhoThermo; mixture multiComponentMixture; transport sutherland; thermo janaf;
-    energy sensibleEnthalpy; equationOfState perfectGas; specie specie;
-}
-species ( N2 );
-inertSpecie N2;
-N2
-{
-    specie { molWeight 28.0134; }
-    thermodynamics
-    {
-        Tlow 200; Thigh 6000; Tcommon 1000;
-        highCpCoeffs ( 2.95257637 1.3969004e-3 -4.92631603e-7 7.86010195e-11 -4.60755204e-15 -923.948688 5.87188762 );
-        lowCpCoeffs ( 3.53100528 -1.23660988e-4 -5.02999433e-7 2.43530612e-9 -1.40881235e-12 -1046.97628 2.96747038 );
-    }
-    transport { As 1.401e-06; Ts 107; }
-}
-coredem { pRef 101325; D 2e-05; alphacMin 0.3; pressureDropPatches (inlet outlet); }
-""")
+    gas = ("gas_properties: {model: ideal_gas, temperature: 293.15, pressure: 101325.0}\n"
+           "species: [{name: N2, molar_mass: 0.028014}]")
+else:
+    gas = ("gas_properties: {density: 1.204, viscosity: 1.81e-5, conductivity: 0.0257, "
+           "cp: 1006.0,\n                 temperature: 293.15, pressure: 101325.0}")
 dt = 2e-4
 open(f"{d}/case.yaml", "w").write(f"""name: bench-gas-model-{cells}-{model}
 grid: {{origin: [0, 0, 0], spacing: [0.002, 0.002, 0.002], cells: [5, 20, 5]}}
 gravity: [0.0, -9.81, 0.0]
-gas_properties: {{density: 1.204, viscosity: 1.81e-5, conductivity: 0.0257, cp: 1006.0,
-                 temperature: 293.15, pressure: 101325.0}}
+{gas}
 walls:
   box: {{min: [0.0, 0.0, 0.0], max: [0.01, 0.04, 0.01]}}
 cfd: {{participant: coredemFoam, case: openfoam, timeout_s: 600}}
