@@ -698,6 +698,29 @@ models: {heat: "off", motion: frozen, radiation: "off"}
   const double h2o = ts["gas.species.H2O_kg"].back() / 0.018015;
   EXPECT_NEAR(h2 / co, 1.0, 1e-6);
   EXPECT_NEAR(-h2o / co, 1.0, 1e-6);
+  // Species: what the particles released is what the gas received, per species (1e-10 of the
+  // largest); elements: the carbon the char lost is the carbon of the CO and CO2 produced, and
+  // the O and H of the gas are conserved (the H2O consumed gives the O of CO and the H of H2),
+  // each within 1e-10 of the moles produced.
+  double largest = 0;
+  for (const auto& [name, m] : molarMass) {
+    largest = std::max(largest, std::abs(ts["gas.species." + name + "_kg"].back()));
+  }
+  for (const auto& [name, m] : molarMass) {
+    EXPECT_NEAR(ts["dem.species_to_gas." + name + "_kg"].back(),
+                ts["gas.species." + name + "_kg"].back(), 1e-10 * largest)
+        << name;
+  }
+  const double co2 = ts["gas.species.CO2_kg"].back() / 0.044009;
+  const auto& solid = ts["dem.particle_mass_kg"];
+  // Row 0 is after step 1: the carbon lost since then against the gas produced since then.
+  const double carbonLost = (solid.front() - solid.back()) / 0.012011;
+  const double carbonGas =
+      co + co2 -
+      (ts["gas.species.CO_kg"].front() / 0.028010 + ts["gas.species.CO2_kg"].front() / 0.044009);
+  EXPECT_NEAR(carbonGas, carbonLost, 1e-10 * co) << "carbon";
+  EXPECT_NEAR(co + 2.0 * co2 + h2o, 0.0, 1e-10 * co) << "oxygen";
+  EXPECT_NEAR(2.0 * h2 + 2.0 * h2o, 0.0, 1e-10 * co) << "hydrogen";
 }
 
 // (g) Decomposed: the hot bed of (c) on 1 and 2 ranks, 8 steps. The pressure drop, the gas
