@@ -23,7 +23,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
-#include <type_traits>
 
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
@@ -38,290 +37,9 @@ namespace coredem::dem {
 
 /// Particles ahead whose history rows pass 1 prefetches (CPU; a hint only).
 constexpr std::size_t kPrefetchAhead = 8;
-/// Pass 1 lists a particle's owned candidates in contact this many at a time.
-constexpr int kTouchChunk = 16;
 
 /// The contact module has no ledger (counts and wall forces are read from the particles).
 struct ContactTotals {};
-
-/// The scalar type of Exec's pair loop (kernels/lanes.h): Exec::PairScalar where the backend
-/// names one (cpu: Double2, two pairs at once), else double.
-template <class Exec, class = void>
-struct PairScalarOf {
-  using type = double;
-};
-template <class Exec>
-struct PairScalarOf<Exec, std::void_t<typename Exec::PairScalar>> {
-  using type = typename Exec::PairScalar;
-};
-
-namespace contact_lanes {
-
-/// {p[a], p[b]} as S (one lane: p[a]).
-template <class S>
-DEM_HD S gather(const double* p, long long a, long long b) {
-  if constexpr (kernels::kLanes<S> == 1) {
-    (void)b;
-    return p[a];
-  } else {
-    return S{p[a], p[b]};
-  }
-}
-/// Vectors a and b of the 3-vector array p as lanes.
-template <class S>
-DEM_HD kernels::Vec3T<S> gather3(const double* p, long long a, long long b) {
-  return {gather<S>(p, 3 * a, 3 * b), gather<S>(p, 3 * a + 1, 3 * b + 1),
-          gather<S>(p, 3 * a + 2, 3 * b + 2)};
-}
-/// (u, v) as lanes (one lane: u).
-template <class S>
-DEM_HD S pack(double u, double v) {
-  if constexpr (kernels::kLanes<S> == 1) {
-    (void)v;
-    return u;
-  } else {
-    return S{u, v};
-  }
-}
-template <class S>
-DEM_HD kernels::Vec3T<S> pack3(kernels::Vec3 u, kernels::Vec3 v) {
-  return {pack<S>(u.x, v.x), pack<S>(u.y, v.y), pack<S>(u.z, v.z)};
-}
-/// Lane k.
-template <int k>
-DEM_HD double laneAt(double v) {
-  return v;
-}
-#if defined(COREDEM_DEM_DOUBLE2)
-template <int k>
-inline double laneAt(kernels::Double2 v) {
-  return v[k];
-}
-#endif
-template <int k, class S>
-DEM_HD kernels::Vec3 laneAt3(kernels::Vec3T<S> v) {
-  return {laneAt<k>(v.x), laneAt<k>(v.y), laneAt<k>(v.z)};
-}
-
-} // namespace contact_lanes
-
-/// Pass 1 of the contact module (ContactModule::sources): its arrays (device pointers) and
-/// constants, copied into the loop body.
-struct OwnerPass {
-  const double* x;
-  const double* v;
-  const double* w;
-  const double* r;
-  const double* m;
-  const std::int32_t* mat;
-  const std::int64_t* gid;
-  std::int64_t* hk;
-  double* hd;
-  double* f;
-  double* tq;
-  double* fw;
-  std::int32_t* nc;
-  std::int32_t* nwc;
-  const std::uint32_t* hs;
-  const std::int32_t* half;
-  unsigned char* hit;
-  double* share;
-  const PairProps* pairs;
-  const kernels::PlaneWall* walls;
-  const std::uint32_t* wallNear;
-  std::size_t n;
-  double dt;
-  int nWalls;
-  int nMat;
-  int K;
-  bool coupled; ///< f holds the gas force of the drag module
-
-  /// Particle i while its contacts are evaluated: the history slots it used in the last
-  /// sub-step (copied, as the new ones overwrite them) and the sums.
-  struct Owner {
-    long long i;
-    int used; ///< slots of the last sub-step
-    int slot; ///< slots written in this one
-    kernels::Vec3 F, T;
-    std::int64_t oldKey[kMaxHistorySlots];
-    kernels::Vec3 oldD[kMaxHistorySlots];
-
-    DEM_HD kernels::Vec3 history(std::int64_t key) const {
-      for (int s = 0; s < used; ++s)
-        if (oldKey[s] == key)
-          return oldD[s];
-      return kernels::Vec3{0.0, 0.0, 0.0};
-    }
-  };
-
-  DEM_HD void remember(Owner& o, std::int64_t key, kernels::Vec3 d) const {
-    if (o.slot < K) {
-      hk[o.i * K + o.slot] = key;
-      kernels::store3(hd, o.i * K + o.slot, d);
-    }
-    ++o.slot;
-  }
-
-  /// Owned candidates q0 and q1 in contact, evaluated in the lanes of S (one lane: q0 only),
-  /// then added to o in that order. The LSD law (Eqs. 7–13); every lane gives the bits of
-  /// the scalar evaluation.
-  template <class S>
-  DEM_HD_FORCEINLINE void pairGroup(Owner& o, std::uint32_t q0, std::uint32_t q1) const {
-    using namespace kernels;
-    using namespace contact_lanes;
-    const long long ii = o.i;
-    const std::int32_t j0 = half[q0];
-    const std::int32_t j1 = half[q1];
-    const double xi0 = x[3 * ii], xi1 = x[3 * ii + 1], xi2 = x[3 * ii + 2];
-    const Vec3T<S> d =
-        gather3<S>(x, j0, j1) - Vec3T<S>{pack<S>(xi0, xi0), pack<S>(xi1, xi1), pack<S>(xi2, xi2)};
-    const S l2 = dot(d, d);
-    const S ri = pack<S>(r[ii], r[ii]);
-    const S rj = gather<S>(r, j0, j1);
-    const S rsum = ri + rj;
-    const S l = laneSqrt(l2);
-    const S invL = 1.0 / l;
-    const Vec3T<S> nrm = invL * d;
-    const S deltaN = rsum - l;
-    const PairProps* row = pairs + mat[ii] * nMat;
-    const PairProps& p0 = row[mat[j0]];
-    const PairProps& p1 = row[mat[j1]];
-    const S kn = pack<S>(p0.kn, p1.kn);
-    const S meff = effectiveMass(pack<S>(m[ii], m[ii]), gather<S>(m, j0, j1));
-    const S etan = pack<S>(p0.dampFactor, p1.dampFactor) * laneSqrt(kn * meff);
-    const LsdParamsT<S> lp{kn, pack<S>(p0.kt, p1.kt), etan,
-                           pack<S>(p0.etatFactor, p1.etatFactor) * etan, pack<S>(p0.mu, p1.mu)};
-    const S lij = leverArmInv(l, invL, ri, rj);
-    const S lji = leverArmInv(l, invL, rj, ri);
-    const Vec3T<S> vij =
-        relativeVelocity(gather3<S>(v, ii, ii), gather3<S>(v, j0, j1), gather3<S>(w, ii, ii),
-                         gather3<S>(w, j0, j1), lij, lji, nrm);
-    const std::int64_t key0 = gid[j0];
-    const std::int64_t key1 = gid[j1];
-    const Vec3 h0 = o.history(key0);
-    const Vec3 h1 = kLanes<S> > 1 ? o.history(key1) : h0;
-    const LsdResultT<S> res = lsdContact(lp, nrm, deltaN, vij, lij, pack3<S>(h0, h1), dt);
-    // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
-    const Vec3T<S> shareT = lji * res.nxft;
-    o.F += laneAt3<0>(res.force);
-    o.T += laneAt3<0>(res.torque);
-    remember(o, key0, laneAt3<0>(res.deltaT));
-    store3(share, 2 * static_cast<long long>(q0), laneAt3<0>(res.force));
-    store3(share, 2 * static_cast<long long>(q0) + 1, laneAt3<0>(shareT));
-    if constexpr (kLanes < S >> 1) {
-      o.F += laneAt3<1>(res.force);
-      o.T += laneAt3<1>(res.torque);
-      remember(o, key1, laneAt3<1>(res.deltaT));
-      store3(share, 2 * static_cast<long long>(q1), laneAt3<1>(res.force));
-      store3(share, 2 * static_cast<long long>(q1) + 1, laneAt3<1>(shareT));
-    }
-  }
-
-  template <class S>
-  __attribute__((noinline)) void pairGroupOutOfLine(Owner& o, std::uint32_t q0,
-                                                    std::uint32_t q1) const {
-    pairGroup<S>(o, q0, q1);
-  }
-
-  /// Particle i: its owned pairs in contact, evaluated kLanes<S> at a time (S: lanes.h; a last
-  /// single pair with the scalar code), then its walls. The sums over the pairs are taken in
-  /// candidate order whatever S is. Returns the history slots i needs.
-  template <class S>
-  DEM_HD double particle(std::size_t i) const {
-    using namespace kernels;
-    constexpr int L = kLanes<S>;
-    const long long ii = static_cast<long long>(i);
-    // The history rows of the few particles in contact are scattered through memory:
-    // ask for those of a particle kPrefetchAhead further on while this one computes.
-    if (i + kPrefetchAhead < n && nc[i + kPrefetchAhead] + nwc[i + kPrefetchAhead] > 0) {
-      const std::size_t a = (i + kPrefetchAhead) * static_cast<std::size_t>(K);
-      backend::prefetch(hk + a);
-      backend::prefetch(hd + 3 * a);
-      backend::prefetch(hd + 3 * a + 8);
-    }
-    Owner o;
-    o.i = ii;
-    // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
-    // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
-    o.used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
-    for (int s = 0; s < o.used; ++s) {
-      o.oldKey[s] = hk[i * K + s];
-      o.oldD[s] = load3(hd, ii * K + s);
-    }
-    o.slot = 0;
-    o.F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
-    o.T = Vec3{0.0, 0.0, 0.0};
-    // Particle–particle LSD over the owned candidates: those in contact are listed (up to
-    // kTouchChunk at a time), then evaluated L at a time.
-    const Vec3 xi = load3(x, ii);
-    const double ri = r[i];
-    int owned = 0;
-    std::uint32_t touch[kTouchChunk];
-    const std::uint32_t qEnd = hs[i + 1];
-    for (std::uint32_t q = hs[i]; q < qEnd;) {
-      int nt = 0;
-      for (; q < qEnd && nt < kTouchChunk; ++q) {
-        const std::int32_t j = half[q];
-        const Vec3 d = load3(x, j) - xi;
-        const double l2 = dot(d, d);
-        const double rsum = ri + r[j];
-        const bool touching = l2 < rsum * rsum;
-        hit[q] = touching ? 1 : 0;
-        if (touching)
-          touch[nt++] = q;
-      }
-      int t = 0;
-      if constexpr (L > 1) {
-        for (; t + 1 < nt; t += 2)
-          pairGroupOutOfLine<S>(o, touch[t], touch[t + 1]);
-      }
-      for (; t < nt; ++t)
-        pairGroup<double>(o, touch[t], touch[t]);
-      owned += nt;
-    }
-    // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate
-    // bits of the first 32 (most particles have none), then every wall beyond them.
-    Vec3 FW{0.0, 0.0, 0.0};
-    int wallCount = 0;
-    std::uint32_t bits = wallNear[i];
-    for (int k = bits != 0 ? lowestBit(bits) : 32; k < nWalls;) {
-      const double deltaN = wallOverlap(walls[k], xi, ri);
-      if (deltaN > 0.0) {
-        const int ai = mat[i];
-        const double mi = m[i];
-        const PairProps pp = pairs[ai * nMat + ai];
-        const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
-        const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-        const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-        const LsdResult res =
-            wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii), ri, o.history(key), dt);
-        FW += res.force;
-        o.T += res.torque;
-        remember(o, key, res.deltaT);
-        ++wallCount;
-      }
-      if (k < 32) {
-        bits &= bits - 1;
-        k = bits != 0 ? lowestBit(bits) : 32;
-      } else {
-        ++k;
-      }
-    }
-    Vec3 F = o.F;
-    Vec3 T = o.T;
-    const int slot = o.slot;
-    const int used = o.used;
-    F += FW;
-    for (int s = slot; s < used; ++s)
-      hk[i * K + s] = -1;
-    store3(f, ii, F);
-    store3(tq, ii, T);
-    store3(fw, ii, FW);
-    nc[i] = owned;
-    nwc[i] = wallCount;
-    return static_cast<double>(slot);
-  }
-};
 
 template <class Exec>
 class ContactModule {
@@ -330,7 +48,6 @@ public:
   using Dual = backend::DualArray<T, Exec>;
   template <class T>
   using Dev = backend::DeviceArray<T, Exec>;
-  using PairScalar = typename PairScalarOf<Exec>::type;
 
   void setup(const EngineSetup& s) {
     _pairs.allocate(s.pairs.size());
@@ -397,11 +114,25 @@ public:
     PairLists<Exec>& pl = ctx.pairs;
     if (_wallGeneration != pl.generation())
       buildWallCandidates(ctx);
+    const std::uint32_t* wallNear = _wallNear.d();
+    const double dt = ctx.dt;
     const std::size_t n = p.n;
+    const double* x = p.pos.d();
+    const double* v = p.vel.d();
+    const double* w = p.omega.d();
+    const double* r = p.radius.d();
+    const double* m = p.mass.d();
+    const std::int32_t* mat = p.material.d();
+    const std::int64_t* gid = p.gid.d();
+    std::int64_t* hk = p.histKey.d();
+    double* hd = p.histDisp.d();
     double* f = p.force.d();
     double* tq = p.torque.d();
+    double* fw = p.fwall.d();
     std::int32_t* nc = p.contacts.d();
     std::int32_t* nwc = p.wallContacts.d();
+    const std::uint32_t* hs = pl.halfStart();
+    const std::int32_t* half = pl.half();
     const std::uint32_t* ls = pl.lowStart();
     const std::uint32_t* low = pl.low();
     _hit.reserve(pl.candidates());
@@ -409,40 +140,130 @@ public:
     // Partner shares in the shared scratch: force (3 values), then torque (3), per candidate.
     static_assert(PairLists<Exec>::kScratchWidth >= 6);
     double* share = pl.scratch();
+    const PairProps* pairs = _pairs.d();
+    const kernels::PlaneWall* walls = _walls.d();
+    const int nWalls = static_cast<int>(ctx.setup.walls.size());
+    const int nMat = ctx.setup.nMaterials;
+    const int K = p.K;
+    const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
 
     // Pass 1: the owned pairs and the walls of every particle. reduceMax runs the body once
     // per index (side effects on index i only) and returns the most history slots a particle
     // needs (owned contacts + walls), in the same pass.
-    const OwnerPass c{.x = p.pos.d(),
-                      .v = p.vel.d(),
-                      .w = p.omega.d(),
-                      .r = p.radius.d(),
-                      .m = p.mass.d(),
-                      .mat = p.material.d(),
-                      .gid = p.gid.d(),
-                      .hk = p.histKey.d(),
-                      .hd = p.histDisp.d(),
-                      .f = f,
-                      .tq = tq,
-                      .fw = p.fwall.d(),
-                      .nc = nc,
-                      .nwc = nwc,
-                      .hs = pl.halfStart(),
-                      .half = pl.half(),
-                      .hit = hit,
-                      .share = share,
-                      .pairs = _pairs.d(),
-                      .walls = _walls.d(),
-                      .wallNear = _wallNear.d(),
-                      .n = n,
-                      .dt = ctx.dt,
-                      .nWalls = static_cast<int>(ctx.setup.walls.size()),
-                      .nMat = ctx.setup.nMaterials,
-                      .K = p.K,
-                      .coupled = ctx.setup.coupled};
     ctx.exec.reduceMaxInto(
-        n, [=] DEM_LAMBDA(std::size_t i) { return c.template particle<PairScalar>(i); }, 0.0,
-        ctx.status + kStatusHistorySlots);
+        n,
+        [=] DEM_LAMBDA(std::size_t i) {
+          using namespace kernels;
+          const long long ii = static_cast<long long>(i);
+          const Vec3 xi = load3(x, ii);
+          const Vec3 vi = load3(v, ii);
+          const Vec3 wi = load3(w, ii);
+          const double ri = r[i];
+          const double mi = m[i];
+          const int ai = mat[i];
+          // The history rows of the few particles in contact are scattered through memory:
+          // ask for those of a particle kPrefetchAhead further on while this one computes.
+          if (i + kPrefetchAhead < n && nc[i + kPrefetchAhead] + nwc[i + kPrefetchAhead] > 0) {
+            const std::size_t a = (i + kPrefetchAhead) * static_cast<std::size_t>(K);
+            backend::prefetch(hk + a);
+            backend::prefetch(hd + 3 * a);
+            backend::prefetch(hd + 3 * a + 8);
+          }
+          // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
+          // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
+          const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
+          std::int64_t oldKey[kMaxHistorySlots];
+          Vec3 oldD[kMaxHistorySlots];
+          for (int s = 0; s < used; ++s) {
+            oldKey[s] = hk[i * K + s];
+            oldD[s] = load3(hd, ii * K + s);
+          }
+          int slot = 0;
+          auto history = [&](std::int64_t key) {
+            for (int s = 0; s < used; ++s)
+              if (oldKey[s] == key)
+                return oldD[s];
+            return Vec3{0.0, 0.0, 0.0};
+          };
+          auto remember = [&](std::int64_t key, Vec3 d) {
+            if (slot < K) {
+              hk[i * K + slot] = key;
+              store3(hd, ii * K + slot, d);
+            }
+            ++slot;
+          };
+          Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
+          Vec3 T{0.0, 0.0, 0.0};
+          // Particle–particle LSD (Eqs. 7–13) over the owned candidates.
+          int owned = 0;
+          const std::uint32_t qEnd = hs[i + 1];
+          for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
+            const std::int32_t j = half[q];
+            const Vec3 d = load3(x, j) - xi;
+            const double l2 = dot(d, d);
+            const double rj = r[j];
+            const double rsum = ri + rj;
+            const bool touching = l2 < rsum * rsum;
+            hit[q] = touching ? 1 : 0;
+            if (!touching)
+              continue;
+            const double l = ::sqrt(l2);
+            const double invL = 1.0 / l;
+            const Vec3 nrm = invL * d;
+            const double deltaN = rsum - l;
+            const PairProps pp = pairs[ai * nMat + mat[j]];
+            const double meff = effectiveMass(mi, m[j]);
+            const double etan = pp.dampFactor * ::sqrt(pp.kn * meff);
+            const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+            const double lij = leverArmInv(l, invL, ri, rj);
+            const double lji = leverArmInv(l, invL, rj, ri);
+            const Vec3 vij = relativeVelocity(vi, load3(v, j), wi, load3(w, j), lij, lji, nrm);
+            const std::int64_t key = gid[j];
+            const LsdResult res = lsdContact(lp, nrm, deltaN, vij, lij, history(key), dt);
+            F += res.force;
+            T += res.torque;
+            remember(key, res.deltaT);
+            // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
+            store3(share, 2 * static_cast<long long>(q), res.force);
+            store3(share, 2 * static_cast<long long>(q) + 1, lji * res.nxft);
+            ++owned;
+          }
+          // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate
+          // bits of the first 32 (most particles have none), then every wall beyond them.
+          Vec3 FW{0.0, 0.0, 0.0};
+          int wallCount = 0;
+          std::uint32_t bits = wallNear[i];
+          for (int k = bits != 0 ? lowestBit(bits) : 32; k < nWalls;) {
+            const double deltaN = wallOverlap(walls[k], xi, ri);
+            if (deltaN > 0.0) {
+              const PairProps pp = pairs[ai * nMat + ai];
+              const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
+              const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+              const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
+              const LsdResult res = wallContact(lp, walls[k], deltaN, vi, wi, ri, history(key), dt);
+              FW += res.force;
+              T += res.torque;
+              remember(key, res.deltaT);
+              ++wallCount;
+            }
+            if (k < 32) {
+              bits &= bits - 1;
+              k = bits != 0 ? lowestBit(bits) : 32;
+            } else {
+              ++k;
+            }
+          }
+          F += FW;
+          for (int s = slot; s < used; ++s)
+            hk[i * K + s] = -1;
+          store3(f, ii, F);
+          store3(tq, ii, T);
+          store3(fw, ii, FW);
+          nc[i] = owned;
+          nwc[i] = wallCount;
+          return static_cast<double>(slot);
+        },
+        0.0, ctx.status + kStatusHistorySlots);
 
     // Pass 2: the shares of the pairs owned by the partner, in neighbour-list order.
     // Returns the largest number of contacts of a particle (pairs from both sides, walls).
