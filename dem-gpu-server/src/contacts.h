@@ -156,11 +156,7 @@ public:
           using namespace kernels;
           const long long ii = static_cast<long long>(i);
           const Vec3 xi = load3(x, ii);
-          const Vec3 vi = load3(v, ii);
-          const Vec3 wi = load3(w, ii);
           const double ri = r[i];
-          const double mi = m[i];
-          const int ai = mat[i];
           // The history rows of the few particles in contact are scattered through memory:
           // ask for those of a particle kPrefetchAhead further on while this one computes.
           if (i + kPrefetchAhead < n && nc[i + kPrefetchAhead] + nwc[i + kPrefetchAhead] > 0) {
@@ -194,39 +190,46 @@ public:
           };
           Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
           Vec3 T{0.0, 0.0, 0.0};
-          // Particle–particle LSD (Eqs. 7–13) over the owned candidates.
+          // Particle–particle LSD (Eqs. 7–13) over the owned candidates. i's velocities, mass
+          // and material are read only if it has some (most particles of a dilute bed do not).
           int owned = 0;
           const std::uint32_t qEnd = hs[i + 1];
-          for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
-            const std::int32_t j = half[q];
-            const Vec3 d = load3(x, j) - xi;
-            const double l2 = dot(d, d);
-            const double rj = r[j];
-            const double rsum = ri + rj;
-            const bool touching = l2 < rsum * rsum;
-            hit[q] = touching ? 1 : 0;
-            if (!touching)
-              continue;
-            const double l = ::sqrt(l2);
-            const double invL = 1.0 / l;
-            const Vec3 nrm = invL * d;
-            const double deltaN = rsum - l;
-            const PairProps pp = pairs[ai * nMat + mat[j]];
-            const double meff = effectiveMass(mi, m[j]);
-            const double etan = pp.dampFactor * ::sqrt(pp.kn * meff);
-            const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-            const double lij = leverArmInv(l, invL, ri, rj);
-            const double lji = leverArmInv(l, invL, rj, ri);
-            const Vec3 vij = relativeVelocity(vi, load3(v, j), wi, load3(w, j), lij, lji, nrm);
-            const std::int64_t key = gid[j];
-            const LsdResult res = lsdContact(lp, nrm, deltaN, vij, lij, history(key), dt);
-            F += res.force;
-            T += res.torque;
-            remember(key, res.deltaT);
-            // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
-            store3(share, 2 * static_cast<long long>(q), res.force);
-            store3(share, 2 * static_cast<long long>(q) + 1, lji * res.nxft);
-            ++owned;
+          if (hs[i] < qEnd) {
+            const Vec3 vi = load3(v, ii);
+            const Vec3 wi = load3(w, ii);
+            const double mi = m[i];
+            const int ai = mat[i];
+            for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
+              const std::int32_t j = half[q];
+              const Vec3 d = load3(x, j) - xi;
+              const double l2 = dot(d, d);
+              const double rj = r[j];
+              const double rsum = ri + rj;
+              const bool touching = l2 < rsum * rsum;
+              hit[q] = touching ? 1 : 0;
+              if (!touching)
+                continue;
+              const double l = ::sqrt(l2);
+              const double invL = 1.0 / l;
+              const Vec3 nrm = invL * d;
+              const double deltaN = rsum - l;
+              const PairProps pp = pairs[ai * nMat + mat[j]];
+              const double meff = effectiveMass(mi, m[j]);
+              const double etan = pp.dampFactor * ::sqrt(pp.kn * meff);
+              const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+              const double lij = leverArmInv(l, invL, ri, rj);
+              const double lji = leverArmInv(l, invL, rj, ri);
+              const Vec3 vij = relativeVelocity(vi, load3(v, j), wi, load3(w, j), lij, lji, nrm);
+              const std::int64_t key = gid[j];
+              const LsdResult res = lsdContact(lp, nrm, deltaN, vij, lij, history(key), dt);
+              F += res.force;
+              T += res.torque;
+              remember(key, res.deltaT);
+              // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
+              store3(share, 2 * static_cast<long long>(q), res.force);
+              store3(share, 2 * static_cast<long long>(q) + 1, lji * res.nxft);
+              ++owned;
+            }
           }
           // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate
           // bits of the first 32 (most particles have none), then every wall beyond them.
@@ -236,11 +239,14 @@ public:
           for (int k = bits != 0 ? lowestBit(bits) : 32; k < nWalls;) {
             const double deltaN = wallOverlap(walls[k], xi, ri);
             if (deltaN > 0.0) {
+              const int ai = mat[i];
+              const double mi = m[i];
               const PairProps pp = pairs[ai * nMat + ai];
               const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
               const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
               const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-              const LsdResult res = wallContact(lp, walls[k], deltaN, vi, wi, ri, history(key), dt);
+              const LsdResult res = wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii),
+                                                ri, history(key), dt);
               FW += res.force;
               T += res.torque;
               remember(key, res.deltaT);
