@@ -18,6 +18,7 @@
 #include <omp.h>
 
 #include "../exec_common.h"
+#include "coredem/dem/kernels/lanes.h"
 
 namespace coredem::dem::backend {
 
@@ -25,8 +26,14 @@ struct CpuExec {
   static constexpr bool separateDevice = false;
   static constexpr const char* name = "cpu";
   int threads = 0; ///< 0: OpenMP default
+#if defined(COREDEM_DEM_DOUBLE2)
+  /// The contact loop evaluates two pairs at once, one in each lane (contacts.h, lanes.h).
+  using PairScalar = kernels::Double2;
+#endif
 
-  int threadCount() const { return threads > 0 ? threads : omp_get_max_threads(); }
+  int threadCount() const {
+    return threads > 0 ? threads : omp_get_max_threads();
+  }
 
   // Each thread calls its own copy of the body: a local whose address does not escape, so the
   // compiler may keep the captured pointers in registers instead of reloading them from the
