@@ -72,6 +72,16 @@ DEM_HD OwnedPair<S> ownedPair(kernels::Vec3T<S> d, S l2, S ri, S rj, S mi, S mj,
   return {lsdContact(lp, nrm, deltaN, vij, lij, hist, dt), lji};
 }
 
+/// exec.reduceMaxIntoWide where Exec has it (cpu: the body compiled for AVX where the
+/// processor has it), else exec.reduceMaxInto.
+template <class Exec, class F>
+void reduceMaxIntoWide(Exec& exec, std::size_t n, F f, double init, double* out) {
+  if constexpr (requires { exec.reduceMaxIntoWide(n, f, init, out); })
+    exec.reduceMaxIntoWide(n, f, init, out);
+  else
+    exec.reduceMaxInto(n, f, init, out);
+}
+
 /// Whether Exec evaluates two owned pairs at once (Exec::PairScalar, cpu: kernels::Double2).
 template <class Exec, class = void>
 inline constexpr bool kTwoPairs = false;
@@ -306,8 +316,8 @@ public:
     // Pass 1: the owned pairs and the walls of every particle. reduceMax runs the body once
     // per index (side effects on index i only) and returns the most history slots a particle
     // needs (owned contacts + walls), in the same pass.
-    ctx.exec.reduceMaxInto(
-        n,
+    reduceMaxIntoWide(
+        ctx.exec, n,
         [=] DEM_LAMBDA(std::size_t i) {
           using namespace kernels;
           const long long ii = static_cast<long long>(i);
@@ -448,8 +458,8 @@ public:
 
     // Pass 2: the shares of the pairs owned by the partner, in neighbour-list order.
     // Returns the largest number of contacts of a particle (pairs from both sides, walls).
-    ctx.exec.reduceMaxInto(
-        n,
+    reduceMaxIntoWide(
+        ctx.exec, n,
         [=] DEM_LAMBDA(std::size_t i) {
           using namespace kernels;
           const long long ii = static_cast<long long>(i);
