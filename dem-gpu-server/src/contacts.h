@@ -13,6 +13,10 @@
 ///   pass 2 (per particle j): adds the partner shares of the contacts it does not own, in the
 ///     ascending index order of its neighbour list (a fixed order).
 /// Both passes write only their own index, so the result does not depend on the thread count.
+/// The cpu backend evaluates two consecutive owned candidates in contact at once, one in each
+/// lane of kernels::Double2 (twoOwnedPairs; every lane gives the bits of ownedPair<double>, the
+/// other backends' path), and runs both passes compiled for AVX where the processor has it
+/// (CpuExec::reduceMaxIntoWide; same operations, no FMA).
 /// The LSD law is mirror-exact (lsd_contact.h): j's share is bitwise what evaluating the pair
 /// from j's side gives. History slots (partner gid, −(w+2) for wall w) hold the owned contacts
 /// and the walls only; slots of a state file written when both sides kept their history are
