@@ -18,6 +18,7 @@
 #include <omp.h>
 
 #include "../exec_common.h"
+#include "coredem/dem/kernels/lanes.h"
 
 namespace coredem::dem::backend {
 
@@ -25,8 +26,14 @@ struct CpuExec {
   static constexpr bool separateDevice = false;
   static constexpr const char* name = "cpu";
   int threads = 0; ///< 0: OpenMP default
+#if defined(COREDEM_DEM_DOUBLE2)
+  /// The contact loop evaluates two pairs at once, one in each lane (contacts.h, lanes.h).
+  using PairScalar = kernels::Double2;
+#endif
 
-  int threadCount() const { return threads > 0 ? threads : omp_get_max_threads(); }
+  int threadCount() const {
+    return threads > 0 ? threads : omp_get_max_threads();
+  }
 
   // Each thread calls its own copy of the body: a local whose address does not escape, so the
   // compiler may keep the captured pointers in registers instead of reloading them from the
@@ -56,6 +63,42 @@ struct CpuExec {
         r = std::max(r, g(static_cast<std::size_t>(i)));
     }
     return r;
+  }
+
+  /// reduceMaxInto for a loop whose body is mostly double arithmetic (the contact pass): where
+  /// the processor has AVX, the body is inlined into a copy compiled for AVX, whose
+  /// three-operand encoding needs none of the register copies of SSE2's two-operand forms. Same
+  /// operations, no FMA (not part of AVX): the same results. Chunks of 512 indices as in
+  /// reduceMax.
+  template <class F>
+  void reduceMaxIntoWide(std::size_t n, F f, double init, double* out) const {
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX__)
+    if (hasAvx()) {
+      const std::int64_t m = static_cast<std::int64_t>(n);
+      const std::int64_t chunks = (m + 511) / 512;
+      double r = init;
+#pragma omp parallel num_threads(threadCount()) reduction(max : r) if (m > 256)
+      {
+        const F g = f;
+#pragma omp for schedule(dynamic, 1) nowait
+        for (std::int64_t c = 0; c < chunks; ++c)
+          r = std::max(r, maxOverAvx(g, 512 * c, std::min(m, 512 * c + 512)));
+      }
+      *out = r;
+      return;
+    }
+#endif
+    reduceMaxInto(n, f, init, out);
+  }
+
+  /// Whether the processor (and the operating system) support AVX.
+  static bool hasAvx() {
+#if defined(__x86_64__) && defined(__GNUC__)
+    static const bool avx = __builtin_cpu_supports("avx");
+    return avx;
+#else
+    return false;
+#endif
   }
 
   /// reduceMax whose result stays in device memory (*out; here host and device are one): the
@@ -184,6 +227,17 @@ struct CpuExec {
   }
 
 private:
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX__)
+  /// max over i in [lo, hi) of g(i), g inlined (reduceMaxIntoWide).
+  template <class F>
+  [[gnu::target("avx"), gnu::flatten]] static double maxOverAvx(const F& g, std::int64_t lo,
+                                                                std::int64_t hi) {
+    double r = -__builtin_inf();
+    for (std::int64_t i = lo; i < hi; ++i)
+      r = std::max(r, g(static_cast<std::size_t>(i)));
+    return r;
+  }
+#endif
   /// Below this many keys the radix sort runs on one thread.
   static constexpr std::size_t kParallelSortMin = 16384;
   mutable std::vector<std::uint32_t> _hist, _offsets, _radixTmp;

@@ -6,8 +6,11 @@
 
 #if defined(__CUDACC__)
 #define DEM_HD __host__ __device__ inline
+#define DEM_HD_FORCEINLINE __host__ __device__ __forceinline__
 #else
 #define DEM_HD inline
+/// DEM_HD for a function the compiler must inline (a hot loop's body called from two places).
+#define DEM_HD_FORCEINLINE inline __attribute__((always_inline))
 #endif
 
 #include <cstdint>

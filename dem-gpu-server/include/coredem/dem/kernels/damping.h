@@ -8,6 +8,7 @@
 #include <math.h>
 
 #include "coredem/dem/kernels/common.h"
+#include "coredem/dem/kernels/lanes.h"
 
 namespace coredem::dem::kernels {
 
@@ -26,9 +27,10 @@ DEM_HD double normalDamping(double kn, double meff, double en) {
   return dampingFactor(en) * ::sqrt(kn * meff);
 }
 
-/// Effective mass of a pair (kg); mj <= 0 denotes a wall (m_eff = m_i).
-DEM_HD double effectiveMass(double mi, double mj) {
-  return mj > 0.0 ? mi * mj / (mi + mj) : mi;
+/// Effective mass of a pair (kg); mj <= 0 denotes a wall (m_eff = m_i). S: lanes.h.
+template <class S>
+DEM_HD S effectiveMass(S mi, S mj) {
+  return laneSelect(mj > 0.0, mi * mj / (mi + mj), mi);
 }
 
 } // namespace coredem::dem::kernels

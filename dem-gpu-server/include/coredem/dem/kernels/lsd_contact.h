@@ -20,24 +20,31 @@
 
 namespace coredem::dem::kernels {
 
-/// Per-contact LSD parameters (SI). η_n from Eq. 13 with the pair's m_eff.
-struct LsdParams {
-  double kn;   ///< N/m
-  double kt;   ///< N/m
-  double etan; ///< kg/s
-  double etat; ///< kg/s
-  double mu;   ///< -
+/// Per-contact LSD parameters (SI). η_n from Eq. 13 with the pair's m_eff. S: the scalar type
+/// (lanes.h), double but in the cpu backend's two-pair loop.
+template <class S>
+struct LsdParamsT {
+  S kn;   ///< N/m
+  S kt;   ///< N/m
+  S etan; ///< kg/s
+  S etat; ///< kg/s
+  S mu;   ///< -
 };
+using LsdParams = LsdParamsT<double>;
 
-struct LsdResult {
-  Vec3 force;  ///< f_n + f_t on particle i (N)
-  Vec3 torque; ///< torque on i (N m)
-  Vec3 deltaT; ///< updated accumulated tangential displacement (m), to store
-  Vec3 nxft;   ///< n × f_t (N): torque on i = L_ij n × f_t, on j = L_ji n × f_t (mirror-exact)
+template <class S>
+struct LsdResultT {
+  Vec3T<S> force;  ///< f_n + f_t on particle i (N)
+  Vec3T<S> torque; ///< torque on i (N m)
+  Vec3T<S> deltaT; ///< updated accumulated tangential displacement (m), to store
+  Vec3T<S> nxft; ///< n × f_t (N): torque on i = L_ij n × f_t, on j = L_ji n × f_t (mirror-exact)
 };
+using LsdResult = LsdResultT<double>;
 
 /// Contact point velocity difference v_ij (m/s).
-DEM_HD Vec3 relativeVelocity(Vec3 vi, Vec3 vj, Vec3 wi, Vec3 wj, double lij, double lji, Vec3 n) {
+template <class S>
+DEM_HD Vec3T<S> relativeVelocity(Vec3T<S> vi, Vec3T<S> vj, Vec3T<S> wi, Vec3T<S> wj, S lij, S lji,
+                                 Vec3T<S> n) {
   return (vi - vj) + cross(lij * wi + lji * wj, n);
 }
 
@@ -48,28 +55,32 @@ DEM_HD double leverArm(double l, double ri, double rj) {
 
 /// leverArm with 1/l already known (no division); mirror-exact as leverArm is:
 /// leverArmInv(l, 1/l, rj, ri) uses the negated difference of the same squares.
-DEM_HD double leverArmInv(double l, double invL, double ri, double rj) {
+template <class S>
+DEM_HD S leverArmInv(S l, S invL, S ri, S rj) {
   return 0.5 * l + (ri * ri - rj * rj) * (0.5 * invL);
 }
 
-/// Eqs. 9–10 and 7. @pre deltaN > 0, |n| = 1, p.kt > 0.
-DEM_HD LsdResult lsdContact(const LsdParams& p, Vec3 n, double deltaN, Vec3 vij, double lij,
-                            Vec3 deltaTOld, double dt) {
-  const Vec3 vn = dot(vij, n) * n;
-  const Vec3 vt = vij - vn;
-  const Vec3 fn = (-p.kn * deltaN) * n - p.etan * vn;
-  Vec3 dT = (deltaTOld - dot(deltaTOld, n) * n) + dt * vt;
-  Vec3 fs = -p.kt * dT;
+/// Eqs. 9–10 and 7. @pre deltaN > 0, |n| = 1, p.kt > 0. The Coulomb limit is a lane select:
+/// a lane that does not slide keeps its values bitwise.
+template <class S>
+DEM_HD LsdResultT<S> lsdContact(const LsdParamsT<S>& p, Vec3T<S> n, S deltaN, Vec3T<S> vij, S lij,
+                                Vec3T<S> deltaTOld, double dt) {
+  const Vec3T<S> vn = dot(vij, n) * n;
+  const Vec3T<S> vt = vij - vn;
+  const Vec3T<S> fn = (-p.kn * deltaN) * n - p.etan * vn;
+  Vec3T<S> dT = (deltaTOld - dot(deltaTOld, n) * n) + dt * vt;
+  Vec3T<S> fs = -p.kt * dT;
   // |k_t δ_t| > μ|f_n| compared squared: no square root unless the contact slides.
-  if (dot(fs, fs) > p.mu * p.mu * dot(fn, fn)) {
-    const double fnMag = norm(fn);
-    const double dMag = norm(dT);
-    const Vec3 t = dMag > 0.0 ? (1.0 / dMag) * dT : Vec3{0, 0, 0};
-    fs = (-p.mu * fnMag) * t;
-    dT = (p.mu * fnMag / p.kt) * t;
+  const auto slides = dot(fs, fs) > p.mu * p.mu * dot(fn, fn);
+  if (laneAny(slides)) {
+    const S fnMag = norm(fn);
+    const S dMag = norm(dT);
+    const Vec3T<S> t = laneSelect(dMag > 0.0, (1.0 / dMag) * dT, Vec3T<S>{S{}, S{}, S{}});
+    fs = laneSelect(slides, (-p.mu * fnMag) * t, fs);
+    dT = laneSelect(slides, (p.mu * fnMag / p.kt) * t, dT);
   }
-  const Vec3 ft = fs - p.etat * vt;
-  LsdResult r;
+  const Vec3T<S> ft = fs - p.etat * vt;
+  LsdResultT<S> r;
   r.force = fn + ft;
   r.nxft = cross(n, ft);
   r.torque = lij * r.nxft;

@@ -1,0 +1,175 @@
+// Two owned pairs in the two lanes of Double2 (contacts.h: ownedPair, twoOwnedPairs) give the
+// bits of the scalar evaluation, pair by pair: forces, torques, history and partner shares, for
+// sticking and sliding contacts (a lane of each, or both), unequal radii and masses, two
+// materials, in the SSE2 version and, where the processor has AVX, in the AVX version.
+#include <bit>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "contacts.h"
+
+using namespace coredem::dem;
+using kernels::Vec3;
+
+#if defined(COREDEM_DEM_DOUBLE2)
+
+namespace {
+
+void expectSameBits(double a, double b, const char* what, int c) {
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(a), std::bit_cast<std::uint64_t>(b))
+      << what << " (case " << c << "): " << a << " vs " << b;
+}
+
+void expectSameBits(Vec3 a, Vec3 b, const char* what, int c) {
+  expectSameBits(a.x, b.x, what, c);
+  expectSameBits(a.y, b.y, what, c);
+  expectSameBits(a.z, b.z, what, c);
+}
+
+/// Particle 0 owns two candidates (q = 0, 1: particles 1 and 2), both in contact.
+struct Case {
+  std::vector<double> x, v, w, r, m;
+  std::vector<std::int32_t> mat{0, 0, 0}, half{1, 2};
+  std::vector<PairProps> pairs{
+      PairProps{200.0, 100.0, 0.3, 0.5, 0.3}, PairProps{240.0, 120.0, 0.25, 0.5, 0.4},
+      PairProps{240.0, 120.0, 0.25, 0.5, 0.4}, PairProps{300.0, 150.0, 0.2, 0.4, 0.5}};
+  Vec3 h[2];
+};
+
+Case randomCase(std::mt19937_64& rng, bool slide0, bool slide1) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  Case k;
+  for (int p = 0; p < 3; ++p) {
+    k.r.push_back(4e-4 + 2e-4 * u01(rng));
+    k.m.push_back(1e-6 * (0.5 + u01(rng)));
+    k.mat[p] = static_cast<std::int32_t>(rng() % 2);
+    for (int c = 0; c < 3; ++c) {
+      k.v.push_back(0.3 * u(rng));
+      k.w.push_back(200.0 * u(rng));
+    }
+  }
+  k.x = {0.01 * u(rng), 0.01 * u(rng), 0.01 * u(rng)};
+  for (int p = 1; p < 3; ++p) { // at distance (1 − 2 %) (r_0 + r_p) in a random direction
+    Vec3 n{u(rng), u(rng), u(rng)};
+    n = (1.0 / kernels::norm(n)) * n;
+    const double l = (0.98 + 0.019 * u01(rng)) * (k.r[0] + k.r[p]);
+    for (int c = 0; c < 3; ++c)
+      k.x.push_back(k.x[c] + l * (c == 0 ? n.x : c == 1 ? n.y : n.z));
+  }
+  // Tangential history: a millimetre slides (|k_t δ_t| ≫ μ|f_n|), a micrometre or less sticks.
+  const bool slide[2] = {slide0, slide1};
+  for (int s = 0; s < 2; ++s) {
+    const double a = slide[s] ? 1e-3 : 1e-7;
+    k.h[s] = Vec3{a * u(rng), a * u(rng), a * u(rng)};
+  }
+  return k;
+}
+
+struct Expected {
+  Vec3 force[2], torque[2], deltaT[2], shareTorque[2];
+  bool slides[2];
+};
+
+Expected scalarReference(const Case& k, double dt) {
+  Expected e{};
+  for (int s = 0; s < 2; ++s) {
+    const int j = k.half[s];
+    const Vec3 d = kernels::load3(k.x.data(), j) - kernels::load3(k.x.data(), 0);
+    const PairProps& pp = k.pairs[k.mat[0] * 2 + k.mat[j]];
+    const OwnedPair<double> op = ownedPair(
+        d, kernels::dot(d, d), k.r[0], k.r[j], k.m[0], k.m[j], pp.kn, pp.kt, pp.dampFactor,
+        pp.etatFactor, pp.mu, kernels::load3(k.v.data(), 0), kernels::load3(k.v.data(), j),
+        kernels::load3(k.w.data(), 0), kernels::load3(k.w.data(), j), k.h[s], dt);
+    e.force[s] = op.res.force;
+    e.torque[s] = op.res.torque;
+    e.deltaT[s] = op.res.deltaT;
+    e.shareTorque[s] = op.lji * op.res.nxft;
+    // Sliding caps the stored displacement at μ|f_n|/k_t.
+    e.slides[s] = kernels::norm(op.res.deltaT) < 0.5 * kernels::norm(k.h[s]);
+  }
+  return e;
+}
+
+void checkGroup(bool avx, int cases) {
+  std::mt19937_64 rng(avx ? 7 : 11);
+  const double dt = 1e-6;
+  int slid[2] = {0, 0};
+  for (int c = 0; c < cases; ++c) {
+    Case k = randomCase(rng, c % 4 == 1 || c % 4 == 3, c % 4 == 2 || c % 4 == 3);
+    const Expected e = scalarReference(k, dt);
+    const int K = 4;
+    std::vector<std::int64_t> hk(K, -1);
+    std::vector<double> hd(3 * K, 0.0), share(12, 0.0);
+    const TwoPairArgs a{k.x.data(),
+                        k.v.data(),
+                        k.w.data(),
+                        k.r.data(),
+                        k.m.data(),
+                        k.mat.data(),
+                        k.half.data(),
+                        k.pairs.data(),
+                        hk.data(),
+                        hd.data(),
+                        share.data(),
+                        2,
+                        K,
+                        dt,
+                        avx};
+    double out[12];
+    const int slot = 1; // slots 1 and 2
+    twoOwnedPairs(a, 0, 0, 1, 101, 102, k.h, slot, out);
+    for (int s = 0; s < 2; ++s) {
+      expectSameBits(kernels::load3(out, 2 * s), e.force[s], "force", c);
+      expectSameBits(kernels::load3(out, 2 * s + 1), e.torque[s], "torque", c);
+      expectSameBits(kernels::load3(share.data(), 2 * s), e.force[s], "partner force", c);
+      expectSameBits(kernels::load3(share.data(), 2 * s + 1), e.shareTorque[s], "partner torque",
+                     c);
+      EXPECT_EQ(hk[slot + s], 101 + s);
+      expectSameBits(kernels::load3(hd.data(), slot + s), e.deltaT[s], "history", c);
+      slid[s] += e.slides[s] ? 1 : 0;
+    }
+    EXPECT_EQ(hk[0], -1);
+    EXPECT_EQ(hk[3], -1);
+  }
+  // Each lane slid in about half of the cases, alone or with the other.
+  EXPECT_GT(slid[0], cases / 4);
+  EXPECT_GT(slid[1], cases / 4);
+}
+
+} // namespace
+
+TEST(PairLanes, TwoPairsGiveTheScalarBitsSse2) {
+  checkGroup(false, 4000);
+}
+
+TEST(PairLanes, TwoPairsGiveTheScalarBitsAvx) {
+  if (!cpuHasAvx())
+    GTEST_SKIP() << "the processor has no AVX";
+  checkGroup(true, 4000);
+}
+
+TEST(PairLanes, HistorySlotsBeyondTheRowAreDropped) {
+  std::mt19937_64 rng(3);
+  Case k = randomCase(rng, false, true);
+  const int K = 2;
+  std::vector<std::int64_t> hk(K, -1);
+  std::vector<double> hd(3 * K, 0.0), share(12, 0.0);
+  const TwoPairArgs a{k.x.data(), k.v.data(),   k.w.data(),    k.r.data(),
+                      k.m.data(), k.mat.data(), k.half.data(), k.pairs.data(),
+                      hk.data(),  hd.data(),    share.data(),  2,
+                      K,          1e-6,         false};
+  double out[12];
+  twoOwnedPairs(a, 0, 0, 1, 101, 102, k.h, 1, out); // slot 2 does not exist
+  EXPECT_EQ(hk[0], -1);
+  EXPECT_EQ(hk[1], 101);
+}
+
+#else
+TEST(PairLanes, NotBuiltWithoutDouble2) {
+  GTEST_SKIP() << "kernels::Double2 needs SSE2 without FMA (x86-64 baseline)";
+}
+#endif
