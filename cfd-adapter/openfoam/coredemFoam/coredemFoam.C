@@ -17,8 +17,8 @@
 // Source layout (DPMFoam-style): createCoupling.H (handshake, grid, restart), createFields.H,
 // createCouplingFields.H (the exchanged quantities of couplingFields.H, registered with the
 // exchange of couplingExchange.H, and the checkpointed fields of checkpoint.H), createLedgers.H
-// + updateLedgers.H (the named ledgers of gasLedgers.H), UEqn.H, pEqn.H, TEqn.H, YEqn.H, and the
-// stage timers of stageTimers.H.
+// + updateLedgers.H + boundaryLedgers.H (the named ledgers of gasLedgers.H), UEqn.H, pEqn.H,
+// TEqn.H, YEqn.H, and the stage timers of stageTimers.H.
 //
 // Command line: coredemFoam -case DIR [-restart FILE] [-control EP] [-dem EP] [-session ID]
 // [-timeout S] [-timers] (endpoints default to COREDEM_CONTROL_ENDPOINT, COREDEM_DEM_ENDPOINT,

@@ -34,6 +34,7 @@
 
 #include "coredem_e2e.h"
 #include "coredem_e2e_hdf5.h"
+#include "foam_e2e.h"
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
@@ -45,6 +46,9 @@ const fs::path kTemplate = COREDEM_FOAM_E2E_TEMPLATE;
 
 using coredem::e2e::readAll;
 using coredem::e2e::readTimeseries;
+using coredem::e2e::foam::logTail;
+using coredem::e2e::foam::runCoredem;
+using coredem::e2e::foam::runStraightAndResumed;
 
 using coredem::e2e::datasetsOf;
 using coredem::e2e::writeAll;
@@ -84,19 +88,6 @@ dem: {backend: cpu, threads: 1, timeout_s: 120}
   return c;
 }
 
-/// Runs `coredem args... --no-plots` with output into `log`, with a deadline; returns the exit
-/// code.
-int runCoredem(std::vector<std::string> args, const fs::path& log,
-               std::chrono::seconds timeout = 150s) {
-  args.push_back("--no-plots");
-  return coredem::e2e::waitExit(coredem::e2e::startProgram(kBin / "coredem", args, log), timeout);
-}
-
-std::string logTail(const fs::path& runDir) {
-  std::string s = readAll(runDir / "logs" / "cfd.log");
-  return s.size() > 3000 ? s.substr(s.size() - 3000) : s;
-}
-
 /// Files of one participant listed in a checkpoint manifest.
 std::vector<std::string> manifestFiles(const fs::path& checkpoint, const std::string& who) {
   const std::string m = readAll(checkpoint / "manifest.json");
@@ -106,26 +97,6 @@ std::vector<std::string> manifestFiles(const fs::path& checkpoint, const std::st
     out.push_back((*it)[1].str());
   }
   return out;
-}
-
-/// Runs case `c` twice: straight through into dir/straight, and for `stopAfter` steps then
-/// `coredem resume` into dir/resumed; both must exit 0 and the resume must restart coredemFoam
-/// from the checkpoint. Returns {straight, resumed}.
-std::pair<fs::path, fs::path> runStraightAndResumed(const fs::path& dir, const fs::path& c,
-                                                    int stopAfter) {
-  const fs::path a = dir / "straight", b = dir / "resumed";
-  EXPECT_EQ(runCoredem({"run", c.string(), "--out", a.string()}, dir / "a.log"), 0)
-      << readAll(dir / "a.log") << logTail(a);
-  EXPECT_EQ(runCoredem(
-                {"run", c.string(), "--out", b.string(), "--stop-after", std::to_string(stopAfter)},
-                dir / "b.log"),
-            0)
-      << readAll(dir / "b.log") << logTail(b);
-  EXPECT_EQ(runCoredem({"resume", b.string()}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
-  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Restarting from"), std::string::npos)
-      << "coredemFoam was not restarted from the checkpoint";
-  return {a, b};
 }
 
 /// The same checkpoint in two runs (ca, cb): the same coredemFoam files, byte for byte (at least

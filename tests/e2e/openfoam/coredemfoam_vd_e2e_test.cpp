@@ -31,6 +31,7 @@
 #include <gtest/gtest.h>
 
 #include "coredem_e2e.h"
+#include "foam_e2e.h"
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
@@ -44,6 +45,9 @@ using coredem::e2e::readAll;
 using coredem::e2e::readTimeseries;
 using coredem::e2e::replaceAll;
 using coredem::e2e::writeAll;
+using coredem::e2e::foam::logTail;
+using coredem::e2e::foam::runCoredem;
+using coredem::e2e::foam::runStraightAndResumed;
 
 constexpr double kPRef = 101325.0;
 // N2: molar mass (g/mol, the DEM's table that coredem writes), Sutherland coefficients (White,
@@ -145,17 +149,6 @@ cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120}
 dem: {backend: cpu, threads: 1, timeout_s: 120}
 )" + v.body);
   return c;
-}
-
-int runCoredem(std::vector<std::string> args, const fs::path& log,
-               std::chrono::seconds timeout = 150s) {
-  args.push_back("--no-plots");
-  return coredem::e2e::waitExit(coredem::e2e::startProgram(kBin / "coredem", args, log), timeout);
-}
-
-std::string logTail(const fs::path& runDir) {
-  std::string s = readAll(runDir / "logs" / "cfd.log");
-  return s.size() > 3000 ? s.substr(s.size() - 3000) : s;
 }
 
 /// The cell values of an ascii volScalarField (components = 1) or volVectorField (3) as written
@@ -514,15 +507,8 @@ particles:
      temperature: 293.15, region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.020, 0.01]}}
 )";
   const fs::path c = makeVdCase(dir, v);
-  const fs::path a = dir / "straight", b = dir / "resumed";
-  ASSERT_EQ(runCoredem({"run", c.string(), "--out", a.string()}, dir / "a.log"), 0)
-      << readAll(dir / "a.log") << logTail(a);
-  ASSERT_EQ(
-      runCoredem({"run", c.string(), "--out", b.string(), "--stop-after", "12"}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
-  ASSERT_EQ(runCoredem({"resume", b.string()}, dir / "b.log"), 0)
-      << readAll(dir / "b.log") << logTail(b);
-  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Restarting from"), std::string::npos);
+  const auto [a, b] = runStraightAndResumed(dir, c, 12);
+  ASSERT_FALSE(HasFailure());
   const fs::path ca = a / "checkpoints" / "00000024", cb = b / "checkpoints" / "00000024";
   std::vector<fs::path> files;
   for (const auto& e : fs::recursive_directory_iterator(ca / "openfoam")) {

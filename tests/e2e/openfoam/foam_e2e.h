@@ -1,0 +1,56 @@
+#pragma once
+/// @file
+/// What the coredemFoam end-to-end tests share: running `coredem` on a case (with a deadline, no
+/// plots), the tail of coredemFoam's log for failure messages, and a run straight through
+/// against the same run stopped and resumed. Needs COREDEM_BIN_DIR (the build's bin folder).
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "coredem_e2e.h"
+
+namespace coredem::e2e::foam {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+/// Runs `coredem args... --no-plots` with output into `log`, with a deadline; returns the exit
+/// code.
+inline int runCoredem(std::vector<std::string> args, const fs::path& log,
+                      std::chrono::seconds timeout = 150s) {
+  args.push_back("--no-plots");
+  return waitExit(startProgram(fs::path(COREDEM_BIN_DIR) / "coredem", args, log), timeout);
+}
+
+/// The last 3000 characters of a run's coredemFoam log.
+inline std::string logTail(const fs::path& runDir) {
+  std::string s = readAll(runDir / "logs" / "cfd.log");
+  return s.size() > 3000 ? s.substr(s.size() - 3000) : s;
+}
+
+/// Runs case `c` twice: straight through into dir/straight, and for `stopAfter` steps then
+/// `coredem resume` into dir/resumed; both must exit 0 and the resume must restart coredemFoam
+/// from the checkpoint. Returns {straight, resumed}.
+inline std::pair<fs::path, fs::path> runStraightAndResumed(const fs::path& dir, const fs::path& c,
+                                                           int stopAfter) {
+  const fs::path a = dir / "straight", b = dir / "resumed";
+  EXPECT_EQ(runCoredem({"run", c.string(), "--out", a.string()}, dir / "a.log"), 0)
+      << readAll(dir / "a.log") << logTail(a);
+  EXPECT_EQ(runCoredem(
+                {"run", c.string(), "--out", b.string(), "--stop-after", std::to_string(stopAfter)},
+                dir / "b.log"),
+            0)
+      << readAll(dir / "b.log") << logTail(b);
+  EXPECT_EQ(runCoredem({"resume", b.string()}, dir / "b.log"), 0)
+      << readAll(dir / "b.log") << logTail(b);
+  EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Restarting from"), std::string::npos)
+      << "coredemFoam was not restarted from the checkpoint";
+  return {a, b};
+}
+
+} // namespace coredem::e2e::foam
