@@ -185,6 +185,15 @@ std::vector<double> readCellValues(const fs::path& file, int components, std::si
   return out;
 }
 
+// The packed lattice bed of several tests: 1600 glass beads of 1 mm at 293.15 K, a soft spring
+// (k_n = 10 N/m: a bed at rest needs no more), 16 mm of bed above the distributor.
+const char* kColdBed = R"(materials:
+  - {name: glass, density: 2500.0, k_n: 10.0, e_n: 0.5, friction: 0.3, cp: 840.0}
+particles:
+  - {name: bed, material: glass, count: 1600, diameter: 1.0e-3, packing: lattice,
+     temperature: 293.15, region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.020, 0.01]}}
+)";
+
 class CoredemFoamVdE2E : public coredem::e2e::RunFolderTest {
 protected:
   CoredemFoamVdE2E()
@@ -307,13 +316,7 @@ TEST_F(CoredemFoamVdE2E, ParticleHeatReachesTheGasExactlyWithTheBookedSplit) {
   VdCase v;
   v.uIn = 0.3;
   v.tIn = 400.0;
-  v.body = R"(time: {end: 0.02, dt: 2.5e-4}
-materials:
-  - {name: glass, density: 2500.0, k_n: 10.0, e_n: 0.5, friction: 0.3, cp: 840.0}
-particles:
-  - {name: bed, material: glass, count: 1600, diameter: 1.0e-3, packing: lattice,
-     temperature: 293.15, region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.020, 0.01]}}
-)";
+  v.body = std::string("time: {end: 0.02, dt: 2.5e-4}\n") + kColdBed;
   const fs::path c = makeVdCase(dir, v);
   const fs::path run = dir / "run";
   ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, dir / "coredem.log"), 0)
@@ -498,14 +501,8 @@ TEST_F(CoredemFoamVdE2E, RestartContinuesBitwise) {
   VdCase v;
   v.uIn = 0.3;
   v.tIn = 400.0;
-  v.body = R"(time: {end: 0.006, dt: 2.5e-4}
-checkpoint: {every_steps: 12, keep: 3}
-materials:
-  - {name: glass, density: 2500.0, k_n: 10.0, e_n: 0.5, friction: 0.3, cp: 840.0}
-particles:
-  - {name: bed, material: glass, count: 1600, diameter: 1.0e-3, packing: lattice,
-     temperature: 293.15, region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.020, 0.01]}}
-)";
+  v.body = std::string("time: {end: 0.006, dt: 2.5e-4}\ncheckpoint: {every_steps: 12, keep: 3}\n") +
+           kColdBed;
   const fs::path c = makeVdCase(dir, v);
   const auto [a, b] = runStraightAndResumed(dir, c, 12);
   ASSERT_FALSE(HasFailure());
@@ -566,12 +563,7 @@ walls:
 cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120}
 dem: {backend: cpu, threads: 1, timeout_s: 120}
 time: {end: 0.005, dt: 2.5e-4}
-materials:
-  - {name: glass, density: 2500.0, k_n: 10.0, e_n: 0.5, friction: 0.3, cp: 840.0}
-particles:
-  - {name: bed, material: glass, count: 1600, diameter: 1.0e-3, packing: lattice,
-     temperature: 293.15, region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.020, 0.01]}}
-)");
+)" + std::string(kColdBed));
   const fs::path run = dir / "run";
   ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, dir / "coredem.log"), 0)
       << readAll(dir / "coredem.log") << logTail(run);
@@ -720,13 +712,7 @@ TEST_F(CoredemFoamVdE2E, HotBedOnTwoRanksAgreesWithOneRank) {
     VdCase v;
     v.uIn = 0.3;
     v.tIn = 400.0;
-    v.body = R"(time: {end: 0.002, dt: 2.5e-4}
-materials:
-  - {name: glass, density: 2500.0, k_n: 10.0, e_n: 0.5, friction: 0.3, cp: 840.0}
-particles:
-  - {name: bed, material: glass, count: 1600, diameter: 1.0e-3, packing: lattice,
-     temperature: 293.15, region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.020, 0.01]}}
-)";
+    v.body = std::string("time: {end: 0.002, dt: 2.5e-4}\n") + kColdBed;
     const fs::path d = dir / ("ranks" + std::to_string(ranks));
     const fs::path c = makeVdCase(d, v);
     if (ranks > 1) {
