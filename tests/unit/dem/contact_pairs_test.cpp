@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "contacts.h"
 #include "coredem/dem/kernels/damping.h"
 #include "coredem/dem/kernels/lsd_contact.h"
 #include "coredem/dem/kernels/wall_contact.h"
@@ -355,3 +356,79 @@ TEST(ContactPairs, WallCandidatesMissNoContact) {
     EXPECT_GT(touched, 0u); // the particles did reach the walls
   }
 }
+
+#if defined(COREDEM_DEM_DOUBLE2)
+namespace {
+
+/// A sphere of radius R (material 0) with n small spheres (material 1, radius a) around it at
+/// random directions, the first `touching` pressed onto it, the others within the skin; the big
+/// sphere owns every pair (smallest gid): more owned candidates than a PairBatch holds, so the
+/// cpu backend evaluates it alone (pass1).
+HostState crowdedState(int n, int touching, double R, double a, double skin) {
+  HostState s;
+  s.n = static_cast<std::size_t>(n + 1);
+  s.historySlots = 32;
+  s.neighbourSlots = 256;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto add = [&](Vec3 x, double r, int material, std::int64_t gid) {
+    s.pos.insert(s.pos.end(), {x.x, x.y, x.z});
+    for (int d = 0; d < 3; ++d) {
+      s.vel.push_back(0.05 * u(rng));
+      s.omega.push_back(50.0 * u(rng));
+    }
+    s.radius.push_back(r);
+    s.density.push_back(2500.0);
+    s.mass.push_back(2500.0 * 4.0 / 3.0 * kPi * r * r * r);
+    s.temperature.push_back(300.0);
+    s.material.push_back(material);
+    s.gid.push_back(gid);
+  };
+  const Vec3 c{0.02, 0.02, 0.02};
+  add(c, R, 0, 0);
+  for (int k = 0; k < n; ++k) {
+    Vec3 dir{u(rng), u(rng), u(rng)};
+    dir = (1.0 / kernels::norm(dir)) * dir;
+    add(c + (k < touching ? R + 0.97 * a : R + a + 0.3 * skin) * dir, a, 1, k + 1);
+  }
+  s.xref = s.pos;
+  fillDefaults(s);
+  checkShapes(s, "crowdedState");
+  return s;
+}
+
+} // namespace
+
+// The cpu backend evaluates owned pairs in batches, several at a time in SIMD lanes; cuda-sim
+// runs the same module one particle at a time, one pair at a time (the CUDA path). Same bits.
+TEST(ContactPairs, BatchedLanesGiveThePerParticleBits) {
+  struct Deck {
+    HostState state;
+    EngineSetup setup;
+  };
+  std::vector<Deck> decks;
+  decks.push_back({denseState(8), denseSetup(2)});
+  // One particle owning 3× a batch: the big sphere's neighbours need a wide list and slots.
+  EngineSetup crowded = denseSetup(2);
+  crowded.walls.clear();
+  crowded.maxRadius = 4e-3;
+  crowded.neighbourSlots = 256;
+  crowded.historySlots = 32;
+  decks.push_back(
+      {crowdedState(3 * PairBatch::kCapacity, 20, 4e-3, 0.25e-3, crowded.skin), crowded});
+  for (Deck& d : decks) {
+    auto cpu = makeCpuEngine(d.setup);
+    auto sim = makeCudaSimEngine(d.setup);
+    cpu->setState(d.state);
+    sim->setState(d.state);
+    for (int k = 0; k < 40; ++k) {
+      cpu->subStep(2e-6);
+      sim->subStep(2e-6);
+    }
+    const HostState a = cpu->state();
+    const HostState b = sim->state();
+    expectBitwiseEqual(a, b);
+    EXPECT_GT(*std::max_element(a.contacts.begin(), a.contacts.end()), 0);
+  }
+}
+#endif
