@@ -11,8 +11,10 @@
 /// summing cStart[c]..cEnd[c] in sorted order, which is the order of a loop over all cells, so
 /// the sums are bitwise the same.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
@@ -50,6 +52,7 @@ public:
   void reserveParticles(std::size_t n) {
     _pcell.reserve(n);
     _perm.reserve(n);
+    _sortedN = kNoSort;
   }
 
   /// Per particle: coupling cell (written by computeCells or by the drag pass), nCells outside.
@@ -79,10 +82,37 @@ public:
     });
   }
 
-  /// Sorts the n particles by pcell into perm and the cStart/cEnd ranges.
+  /// Sorts the n particles by pcell into perm and the cStart/cEnd ranges: perm is the stable
+  /// order of pcell (by cell, then index), which depends only on the pcell values. On the cpu
+  /// backend, where the pcell of the last sort is kept, a sort in which no particle changed
+  /// cell keeps perm and the ranges as they are, and one in which a few did (particles cross a
+  /// cell face every few hundred sub-steps) merges them into the last order (mergeChanged):
+  /// the same perm as the full sort (tested), in one sequential pass.
   void sort(Exec& exec, std::size_t n) {
     const std::uint32_t nc = static_cast<std::uint32_t>(_nCells);
+    if constexpr (!Exec::separateDevice) {
+      if (_sortedN == n) {
+        const std::size_t changed = collectChanged(n);
+        if (changed == 0)
+          return;
+        if (changed <= n / kMergeFraction) {
+          mergeChanged(n, changed);
+          ranges(exec, n);
+          return;
+        }
+      }
+    }
     exec.sortByKeyRadix(_pcell.d(), n, nc + 1, _perm.d());
+    if constexpr (!Exec::separateDevice) {
+      _prevPcell.reserve(n);
+      std::copy(_pcell.d(), _pcell.d() + n, _prevPcell.d());
+      _sortedN = n;
+    }
+    ranges(exec, n);
+  }
+
+  /// cStart/cEnd of the occupied cells from perm.
+  void ranges(Exec& exec, std::size_t n) {
     std::uint32_t* cs = _cStart.d();
     std::uint32_t* ce = _cEnd.d();
     const std::uint32_t* pc = _pcell.d();
@@ -130,12 +160,62 @@ public:
   }
 
   std::size_t bytes() const {
-    return _pcell.bytes() + _perm.bytes() + _cStart.bytes() + _cEnd.bytes() + _epsFrozen.bytes();
+    return _pcell.bytes() + _perm.bytes() + _cStart.bytes() + _cEnd.bytes() + _epsFrozen.bytes() +
+           _prevPcell.bytes() + _changed.size() * sizeof(std::uint32_t) + _permTmp.bytes();
   }
 
 private:
+  static constexpr std::size_t kNoSort = ~std::size_t{0};
+  /// Above n / kMergeFraction changed particles the full sort is cheaper than the merge.
+  static constexpr std::size_t kMergeFraction = 16;
+
+  /// Host backend: the particles whose pcell differs from the last sort's, ascending, into
+  /// _changed; returns their count.
+  std::size_t collectChanged(std::size_t n) {
+    const std::uint32_t* pc = _pcell.d();
+    const std::uint32_t* prev = _prevPcell.d();
+    _changed.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (pc[i] != prev[i])
+        _changed.push_back(static_cast<std::uint32_t>(i));
+    }
+    return _changed.size();
+  }
+
+  /// Host backend: the stable order of pcell from the last one, whose entries that did not
+  /// change cell are still in (cell, index) order: the changed particles sorted by (new cell,
+  /// index) and merged in; then the kept pcell updated.
+  void mergeChanged(std::size_t n, std::size_t changed) {
+    const std::uint32_t* pc = _pcell.d();
+    std::uint32_t* prev = _prevPcell.d();
+    auto before = [pc](std::uint32_t a, std::uint32_t b) {
+      return pc[a] != pc[b] ? pc[a] < pc[b] : a < b;
+    };
+    std::sort(_changed.begin(), _changed.end(), before);
+    _permTmp.reserve(n);
+    std::uint32_t* out = _permTmp.d();
+    const std::uint32_t* old = _perm.d();
+    std::size_t o = 0, c = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::uint32_t i = old[k];
+      if (pc[i] != prev[i])
+        continue; // a changed particle: it comes from _changed
+      while (c < changed && before(_changed[c], i))
+        out[o++] = _changed[c++];
+      out[o++] = i;
+    }
+    while (c < changed)
+      out[o++] = _changed[c++];
+    std::copy(out, out + n, _perm.d());
+    for (const std::uint32_t i : _changed)
+      prev[i] = pc[i];
+  }
+
   std::size_t _nCells = 0;
   Dev<std::uint32_t> _pcell, _perm, _cStart, _cEnd;
+  Dev<std::uint32_t> _prevPcell, _permTmp; ///< host backend: pcell of the last sort; merge buffer
+  std::vector<std::uint32_t> _changed;     ///< host backend: particles that changed cell
+  std::size_t _sortedN = kNoSort;          ///< particles of the last sort (kNoSort: none)
   Dual<double> _epsFrozen; ///< nCells: PCM ε_g at the window start (drag, heat, WGS)
 };
 
