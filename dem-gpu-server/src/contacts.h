@@ -47,6 +47,60 @@ namespace coredem::dem {
 /// Particles ahead whose history rows pass 1 prefetches (CPU; a hint only).
 constexpr std::size_t kPrefetchAhead = 8;
 
+/// Candidate j of a particle at xi with radius ri: d = x_j − x_i, |d|², r_j, and whether the two
+/// touch (|d| < r_i + r_j).
+struct Candidate {
+  kernels::Vec3 d;
+  double l2;
+  double rj;
+  bool touching;
+};
+DEM_HD Candidate candidateOf(const double* x, const double* r, kernels::Vec3 xi, double ri,
+                             std::int32_t j) {
+  const kernels::Vec3 d = kernels::load3(x, j) - xi;
+  const double l2 = kernels::dot(d, d);
+  const double rj = r[j];
+  const double rsum = ri + rj;
+  return {d, l2, rj, l2 < rsum * rsum};
+}
+
+/// Asks for the history row of particle i (K slots) when it had contacts in the last sub-step:
+/// the rows of the few particles in contact are scattered through memory, so pass 1 asks for
+/// those of a particle kPrefetchAhead further on while it computes (a hint only).
+DEM_HD void prefetchHistoryRow(const std::int64_t* hk, const double* hd, const std::int32_t* nc,
+                               const std::int32_t* nwc, int K, std::size_t i, std::size_t n) {
+  if (i < n && nc[i] + nwc[i] > 0) {
+    const std::size_t a = i * static_cast<std::size_t>(K);
+    backend::prefetch(hk + a);
+    backend::prefetch(hd + 3 * a);
+    backend::prefetch(hd + 3 * a + 8);
+  }
+}
+
+/// Where pass 1 leaves a particle's results.
+struct Pass1Out {
+  double* f;
+  double* tq;
+  double* fw;
+  std::int64_t* hk;
+  std::int32_t* nc;
+  std::int32_t* nwc;
+  int K;
+};
+
+/// Pass 1's results of particle i: F = its force (gas + owned pairs + walls), T its torque, FW
+/// the walls' part of F; history slots from `slot` to `used` (the last sub-step's) emptied.
+DEM_HD void storePass1(const Pass1Out& o, long long i, kernels::Vec3 F, kernels::Vec3 T,
+                       kernels::Vec3 FW, int slot, int used, int owned, int walls) {
+  for (int s = slot; s < used; ++s)
+    o.hk[i * o.K + s] = -1;
+  kernels::store3(o.f, i, F);
+  kernels::store3(o.tq, i, T);
+  kernels::store3(o.fw, i, FW);
+  o.nc[i] = owned;
+  o.nwc[i] = walls;
+}
+
 /// The contact module has no ledger (counts and wall forces are read from the particles).
 struct ContactTotals {};
 
@@ -401,6 +455,7 @@ public:
     const int K = p.K;
     const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
 
+    const Pass1Out out{f, tq, fw, hk, nc, nwc, K};
     // Pass 1, one particle: its owned pairs and its walls. Returns the history slots it needs
     // (owned contacts + walls); writes only index i.
     auto pass1 = [=] DEM_LAMBDA(std::size_t i) {
@@ -408,14 +463,7 @@ public:
       const long long ii = static_cast<long long>(i);
       const Vec3 xi = load3(x, ii);
       const double ri = r[i];
-      // The history rows of the few particles in contact are scattered through memory:
-      // ask for those of a particle kPrefetchAhead further on while this one computes.
-      if (i + kPrefetchAhead < n && nc[i + kPrefetchAhead] + nwc[i + kPrefetchAhead] > 0) {
-        const std::size_t a = (i + kPrefetchAhead) * static_cast<std::size_t>(K);
-        backend::prefetch(hk + a);
-        backend::prefetch(hd + 3 * a);
-        backend::prefetch(hd + 3 * a + 8);
-      }
+      prefetchHistoryRow(hk, hd, nc, nwc, K, i + kPrefetchAhead, n);
       // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
       // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
       const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
@@ -452,19 +500,15 @@ public:
         const int ai = mat[i];
         for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
           const std::int32_t j = half[q];
-          const Vec3 d = load3(x, j) - xi;
-          const double l2 = dot(d, d);
-          const double rj = r[j];
-          const double rsum = ri + rj;
-          const bool touching = l2 < rsum * rsum;
-          hit[q] = touching ? 1 : 0;
-          if (!touching)
+          const Candidate cj = candidateOf(x, r, xi, ri, j);
+          hit[q] = cj.touching ? 1 : 0;
+          if (!cj.touching)
             continue;
           const PairProps pp = pairs[ai * nMat + mat[j]];
           const std::int64_t key = gid[j];
           const OwnedPair<double> op =
-              ownedPair(d, l2, ri, rj, mi, m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor, pp.mu,
-                        vi, load3(v, j), wi, load3(w, j), history(key), dt);
+              ownedPair(cj.d, cj.l2, ri, cj.rj, mi, m[j], pp.kn, pp.kt, pp.dampFactor,
+                        pp.etatFactor, pp.mu, vi, load3(v, j), wi, load3(w, j), history(key), dt);
           const LsdResult& res = op.res;
           F += res.force;
           T += res.torque;
@@ -488,13 +532,7 @@ public:
         ++wallCount;
       });
       F += FW;
-      for (int s = slot; s < used; ++s)
-        hk[i * K + s] = -1;
-      store3(f, ii, F);
-      store3(tq, ii, T);
-      store3(fw, ii, FW);
-      nc[i] = owned;
-      nwc[i] = wallCount;
+      storePass1(out, ii, F, T, FW, slot, used, owned, wallCount);
       return static_cast<double>(slot);
     };
 
@@ -526,13 +564,7 @@ public:
             const std::uint32_t q1 = hs[end + 1];
             if (count + static_cast<int>(q1 - q0) > B::kCapacity)
               break;
-            if (end + kPrefetchAhead < n &&
-                nc[end + kPrefetchAhead] + nwc[end + kPrefetchAhead] > 0) {
-              const std::size_t a = (end + kPrefetchAhead) * static_cast<std::size_t>(K);
-              backend::prefetch(hk + a);
-              backend::prefetch(hd + 3 * a);
-              backend::prefetch(hd + 3 * a + 8);
-            }
+            prefetchHistoryRow(hk, hd, nc, nwc, K, end + kPrefetchAhead, n);
             if (q0 == q1)
               continue;
             const long long ii = static_cast<long long>(end);
@@ -543,13 +575,9 @@ public:
             int nth = 0; // touching candidates of this particle so far
             for (std::uint32_t q = q0; q < q1; ++q) {
               const std::int32_t j = half[q];
-              const Vec3 d = load3(x, j) - xi;
-              const double l2 = dot(d, d);
-              const double rj = r[j];
-              const double rsum = ri + rj;
-              const bool touching = l2 < rsum * rsum;
-              hit[q] = touching ? 1 : 0;
-              if (!touching)
+              const Candidate cj = candidateOf(x, r, xi, ri, j);
+              hit[q] = cj.touching ? 1 : 0;
+              if (!cj.touching)
                 continue;
               const std::int64_t key = gid[j];
               // A row holds each key once, and a contact that lasts keeps its slot (the nth
@@ -569,12 +597,12 @@ public:
               const PairProps& pp = pairs[mat[end] * nMat + mat[j]];
               const int c = count++;
               auto put = [&](int k, double u) { batch.in[k][c] = u; };
-              put(B::Dx, d.x);
-              put(B::Dy, d.y);
-              put(B::Dz, d.z);
-              put(B::L2, l2);
+              put(B::Dx, cj.d.x);
+              put(B::Dy, cj.d.y);
+              put(B::Dz, cj.d.z);
+              put(B::L2, cj.l2);
               put(B::Ri, ri);
-              put(B::Rj, rj);
+              put(B::Rj, cj.rj);
               put(B::Mi, m[end]);
               put(B::Mj, m[j]);
               put(B::Kn, pp.kn);
@@ -662,13 +690,7 @@ public:
             }
             slot += wallCount > kMaxHistorySlots ? wallCount - kMaxHistorySlots : 0;
             F += FW;
-            for (int s = slot; s < used; ++s)
-              hk[ii * K + s] = -1;
-            store3(f, ii, F);
-            store3(tq, ii, T);
-            store3(fw, ii, FW);
-            nc[i] = owned;
-            nwc[i] = wallCount;
+            storePass1(out, ii, F, T, FW, slot, used, owned, wallCount);
             most = std::max(most, static_cast<double>(slot));
           }
         }
