@@ -48,6 +48,7 @@ using coredem::e2e::readAll;
 using coredem::e2e::readTimeseries;
 using coredem::e2e::foam::logTail;
 using coredem::e2e::foam::runCoredem;
+using coredem::e2e::foam::runOnRanks;
 using coredem::e2e::foam::runStraightAndResumed;
 
 using coredem::e2e::datasetsOf;
@@ -596,23 +597,8 @@ particles:
   std::map<int, std::map<std::string, std::vector<double>>> series;
   for (int ranks : {1, 2, 4}) {
     const fs::path d = dir / ("ranks" + std::to_string(ranks));
-    const fs::path c = makeCase(d, 0.3, 293.15, bed);
-    if (ranks > 1) {
-      const fs::path y = c / "case.yaml";
-      writeAll(y,
-               replaceAll(readAll(y), "case: openfoam, timeout_s: 120}",
-                          "case: openfoam, timeout_s: 120, ranks: " + std::to_string(ranks) + "}"));
-    }
-    const fs::path run = d / "run";
-    ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, d / "coredem.log"), 0)
-        << readAll(d / "coredem.log") << logTail(run);
-    if (ranks > 1) {
-      const std::string log = readAll(run / "logs" / "cfd.log");
-      EXPECT_NE(log.find("Exchange: decomposed"), std::string::npos) << logTail(run);
-      EXPECT_TRUE(fs::is_directory(run / "openfoam" / ("processor" + std::to_string(ranks - 1))));
-      EXPECT_TRUE(fs::exists(run / "openfoam" / "system" / "decomposeParDict"));
-    }
-    series[ranks] = readTimeseries(run);
+    series[ranks] = runOnRanks(d, makeCase(d, 0.3, 293.15, bed), ranks);
+    ASSERT_FALSE(HasFailure()) << ranks << " ranks";
   }
   const auto rel = [](double a, double b) {
     return std::abs(a - b) / std::max({std::abs(a), std::abs(b), 1e-300});
@@ -653,17 +639,8 @@ particles:
   std::map<int, std::map<std::string, std::vector<double>>> series;
   for (int ranks : {1, 2}) {
     const fs::path d = dir / ("heated-ranks" + std::to_string(ranks));
-    const fs::path c = makeCase(d, 0.3, 400.0, bed);
-    if (ranks > 1) {
-      const fs::path y = c / "case.yaml";
-      writeAll(y,
-               replaceAll(readAll(y), "case: openfoam, timeout_s: 120}",
-                          "case: openfoam, timeout_s: 120, ranks: " + std::to_string(ranks) + "}"));
-    }
-    const fs::path run = d / "run";
-    ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, d / "coredem.log"), 0)
-        << readAll(d / "coredem.log") << logTail(run);
-    series[ranks] = readTimeseries(run);
+    series[ranks] = runOnRanks(d, makeCase(d, 0.3, 400.0, bed), ranks);
+    ASSERT_FALSE(HasFailure()) << ranks << " ranks";
   }
   auto& one = series[1];
   auto& two = series[2];

@@ -47,6 +47,7 @@ using coredem::e2e::replaceAll;
 using coredem::e2e::writeAll;
 using coredem::e2e::foam::logTail;
 using coredem::e2e::foam::runCoredem;
+using coredem::e2e::foam::runOnRanks;
 using coredem::e2e::foam::runStraightAndResumed;
 
 constexpr double kPRef = 101325.0;
@@ -714,21 +715,8 @@ TEST_F(CoredemFoamVdE2E, HotBedOnTwoRanksAgreesWithOneRank) {
     v.tIn = 400.0;
     v.body = std::string("time: {end: 0.002, dt: 2.5e-4}\n") + kColdBed;
     const fs::path d = dir / ("ranks" + std::to_string(ranks));
-    const fs::path c = makeVdCase(d, v);
-    if (ranks > 1) {
-      const fs::path y = c / "case.yaml";
-      writeAll(y,
-               replaceAll(readAll(y), "case: openfoam, timeout_s: 120}",
-                          "case: openfoam, timeout_s: 120, ranks: " + std::to_string(ranks) + "}"));
-    }
-    const fs::path run = d / "run";
-    ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, d / "coredem.log"), 0)
-        << readAll(d / "coredem.log") << logTail(run);
-    if (ranks > 1) {
-      EXPECT_NE(readAll(run / "logs" / "cfd.log").find("Exchange: decomposed"), std::string::npos)
-          << logTail(run);
-    }
-    series[ranks] = readTimeseries(run);
+    series[ranks] = runOnRanks(d, makeVdCase(d, v), ranks);
+    ASSERT_FALSE(HasFailure()) << ranks << " ranks";
   }
   for (const char* key :
        {"gas.pressure_drop_Pa", "gas.heat_from_particles_J", "gas.heat_in_flight_J",

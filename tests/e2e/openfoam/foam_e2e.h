@@ -1,11 +1,13 @@
 #pragma once
 /// @file
 /// What the coredemFoam end-to-end tests share: running `coredem` on a case (with a deadline, no
-/// plots), the tail of coredemFoam's log for failure messages, and a run straight through
-/// against the same run stopped and resumed. Needs COREDEM_BIN_DIR (the build's bin folder).
+/// plots), the tail of coredemFoam's log for failure messages, a run straight through against
+/// the same run stopped and resumed, and a case run on K decomposed CFD ranks. Needs
+/// COREDEM_BIN_DIR (the build's bin folder).
 
 #include <chrono>
 #include <filesystem>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -51,6 +53,35 @@ inline std::pair<fs::path, fs::path> runStraightAndResumed(const fs::path& dir, 
   EXPECT_NE(readAll(b / "logs" / "cfd.log").find("Restarting from"), std::string::npos)
       << "coredemFoam was not restarted from the checkpoint";
   return {a, b};
+}
+
+/// Runs case `c` (its case.yaml's cfd line ends in "case: openfoam, timeout_s: 120}") on `ranks`
+/// CFD ranks into dir/run: for ranks > 1 the line gains "ranks: K" and the run must say that
+/// the exchange is decomposed and leave processor folders. Returns the run's timeseries (empty
+/// after a failed run, which fails the test).
+inline std::map<std::string, std::vector<double>> runOnRanks(const fs::path& dir, const fs::path& c,
+                                                             int ranks) {
+  if (ranks > 1) {
+    const fs::path y = c / "case.yaml";
+    const std::string from = "case: openfoam, timeout_s: 120}";
+    const std::string yaml = readAll(y);
+    EXPECT_NE(yaml.find(from), std::string::npos) << y << " has no line to add ranks to";
+    writeAll(y,
+             replaceAll(yaml, from,
+                        "case: openfoam, timeout_s: 120, ranks: " + std::to_string(ranks) + "}"));
+  }
+  const fs::path run = dir / "run";
+  const int rc = runCoredem({"run", c.string(), "--out", run.string()}, dir / "coredem.log");
+  EXPECT_EQ(rc, 0) << readAll(dir / "coredem.log") << logTail(run);
+  if (rc != 0)
+    return {};
+  if (ranks > 1) {
+    EXPECT_NE(readAll(run / "logs" / "cfd.log").find("Exchange: decomposed"), std::string::npos)
+        << logTail(run);
+    EXPECT_TRUE(fs::is_directory(run / "openfoam" / ("processor" + std::to_string(ranks - 1))));
+    EXPECT_TRUE(fs::exists(run / "openfoam" / "system" / "decomposeParDict"));
+  }
+  return readTimeseries(run);
 }
 
 } // namespace coredem::e2e::foam
