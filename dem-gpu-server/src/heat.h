@@ -225,8 +225,18 @@ public:
         const Vec3 xlo = load3(x, lo);
         const double rlo = r[lo];
         const double tlo = T[lo];
-        const double klo = hm[mat[lo]].k;
+        const std::int32_t mlo = mat[lo];
+        const double klo = hm[mlo].k;
         const std::uint32_t clo = lens ? pcell[lo] : nCells;
+        // The owner's invariants. Partners of the same radius (a monodisperse bed: all) take
+        // the equal-radii kernels, bitwise the values of the general ones; of the same
+        // material, the owner's contact conductivity; in the same PCM cell, its κ_g.
+        const double kcSame = contactConductivity(klo, klo);
+        const bool kSamePos = klo + klo > 0.0;
+        const double kgSame = clo < nCells ? 0.5 * (kap[clo] + kap[clo]) : 0.0;
+        const double reachSame = lens ? lensFactor * rlo + rlo : rlo + rlo;
+        const double reachSame2 = reachSame * reachSame;
+        const GasLensEqualRadii lensSame = gasLensEqualRadii(lp, rlo);
         double qc = 0.0, ql = 0.0;
         const std::uint32_t qEnd = hs[i + 1];
         for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
@@ -235,30 +245,47 @@ public:
           const Vec3 d = load3(x, hi) - xlo;
           const double l2 = dot(d, d);
           const double rhi = r[hi];
+          const bool same = rhi == rlo;
           const double big = rlo > rhi ? rlo : rhi;
           const double small = rlo > rhi ? rhi : rlo;
-          const double reach = lens ? lensFactor * big + small : rlo + rhi;
-          if (l2 < reach * reach) {
+          const double reach2 =
+              same ? reachSame2
+                   : (lens ? (lensFactor * big + small) * (lensFactor * big + small)
+                           : (rlo + rhi) * (rlo + rhi));
+          if (l2 < reach2) {
             const double l = ::sqrt(l2);
             const double dT = T[hi] - tlo; // heat into lo = G (T_hi − T_lo)
             if (contact && l < rlo + rhi) {
-              const double khi = hm[mat[hi]].k;
-              if (klo + khi > 0.0)
-                qcab = contactConductance(klo, khi, rlo, rhi, l) * dT;
+              const std::int32_t mhi = mat[hi];
+              if (mhi == mlo) {
+                if (kSamePos)
+                  qcab = (kcSame * (same && l >= rlo ? intersectionCircleRadiusEqual(rlo, l)
+                                                     : intersectionCircleRadius(rlo, rhi, l))) *
+                         dT;
+              } else {
+                const double khi = hm[mhi].k;
+                if (klo + khi > 0.0)
+                  qcab = contactConductance(klo, khi, rlo, rhi, l) * dT;
+              }
             }
             if (lens) {
               // κ_g of the pair: mean of the two PCM cells (a particle outside the grid uses
               // the other's; both outside: no lens) [C].
               const std::uint32_t chi = pcell[hi];
               double kg = 0.0;
-              if (clo < nCells && chi < nCells)
+              if (chi == clo)
+                kg = kgSame;
+              else if (clo < nCells && chi < nCells)
                 kg = 0.5 * (kap[clo] + kap[chi]);
               else if (clo < nCells)
                 kg = kap[clo];
               else if (chi < nCells)
                 kg = kap[chi];
               if (kg > 0.0)
-                qlab = kg * gasLensIntegral(lp, rlo, rhi, l).value * dT;
+                qlab = kg *
+                       (same ? gasLensIntegralEqualRadii(lensSame, l)
+                             : gasLensIntegral(lp, rlo, rhi, l).value) *
+                       dT;
             }
           }
           qc += qcab;

@@ -59,6 +59,16 @@ DEM_HD double intersectionCircleRadius(double ra, double rb, double l) {
   return 2.0 * area / l;
 }
 
+/// intersectionCircleRadius(r, r, l) for two spheres of the same radius r with r ≤ l < 2r, the
+/// pair loop's common case: bitwise its value (the sorted sides are (l, r, r)), without the
+/// branches and the sort. @pre r ≤ l < 2r.
+DEM_HD double intersectionCircleRadiusEqual(double r, double l) {
+  const double lr = l - r;
+  const double p = (l + (r + r)) * (r - lr) * (r + lr) * l;
+  const double area = 0.25 * std::sqrt(p > 0.0 ? p : 0.0);
+  return 2.0 * area / l;
+}
+
 /// Effective contact conductivity 4 k_i k_j/(k_i + k_j), W/(m K) (bitwise symmetric).
 DEM_HD double contactConductivity(double ki, double kj) {
   return 4.0 * (ki * kj) / (ki + kj);

@@ -33,6 +33,8 @@
 /// The result depends on (R_L, R_S, l) only, so Q_ij = −Q_ji bitwise.
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include <coredem/dem/kernels/common.h>
 #include <coredem/dem/kernels/conduction_contact.h>
@@ -184,11 +186,83 @@ DEM_HD GasLensIntegral gasLensIntegralReference(const GasLensParams& p, double r
 /// cancellation grows like R_L/R_S (a sphere against a wall-like partner of 10⁴ R: ~1e-12).
 inline constexpr double kGasLensClosedFormRelError = 1.0e-13;
 
-/// ln(1 + x) for x ≥ 0: log1p near 0, the (cheaper) log of 1 + x above 1, where rounding 1 + x
-/// costs at most 1 ulp of a result ≥ ln 2.
-DEM_HD double gasLensLog1p(double x) {
-  return x > 1.0 ? std::log(1.0 + x) : std::log1p(x);
+namespace detail {
+
+/// Bits of a double and back (host: memcpy, device: the intrinsics).
+DEM_HD_FORCEINLINE std::uint64_t doubleBits(double x) {
+#if defined(__CUDA_ARCH__)
+  return static_cast<std::uint64_t>(__double_as_longlong(x));
+#else
+  std::uint64_t b;
+  std::memcpy(&b, &x, sizeof b);
+  return b;
+#endif
 }
+
+DEM_HD_FORCEINLINE double doubleFromBits(std::uint64_t b) {
+#if defined(__CUDA_ARCH__)
+  return __longlong_as_double(static_cast<long long>(b));
+#else
+  double x;
+  std::memcpy(&x, &b, sizeof x);
+  return x;
+#endif
+}
+
+/// k ln 2 + ln(1 + f) + lo for f in [√2/2 − 1, √2 − 1] and a small correction lo (ln(1 + c/u)
+/// ≈ c/u of a rounded argument u), as fdlibm's e_log.c/k_log.h (Sun Microsystems 1993): with
+/// s = f/(2 + f), ln(1 + f) = 2 atanh s = f − f²/2 + s (f²/2 + R(s²)), R a degree-14 Remez fit
+/// of 2 atanh(s)/s − 2 − … (error below 2^−58.45), ln 2 split into a 32-bit head and its tail.
+/// Pure arithmetic (inlined, no library call); below 1 ulp (fdlibm's bound for ln).
+DEM_HD_FORCEINLINE double logKernel(double f, double k, double lo) {
+  constexpr double ln2Hi = 6.93147180369123816490e-01; // 0x3fe62e42fee00000
+  constexpr double ln2Lo = 1.90821492927058770002e-10; // 0x3dea39ef35793c76
+  constexpr double lg1 = 6.666666666666735130e-01;
+  constexpr double lg2 = 3.999999999940941908e-01;
+  constexpr double lg3 = 2.857142874366239149e-01;
+  constexpr double lg4 = 2.222219843214978396e-01;
+  constexpr double lg5 = 1.818357216161805012e-01;
+  constexpr double lg6 = 1.531383769920937332e-01;
+  constexpr double lg7 = 1.479819860511658591e-01;
+  const double s = f / (2.0 + f);
+  const double z = s * s;
+  const double w = z * z;
+  const double t1 = w * (lg2 + w * (lg4 + w * lg6));
+  const double t2 = z * (lg1 + w * (lg3 + w * (lg5 + w * lg7)));
+  const double r = t2 + t1;
+  const double hfsq = 0.5 * f * f;
+  return k * ln2Hi - ((hfsq - (s * (hfsq + r) + (k * ln2Lo + lo))) - f);
+}
+
+} // namespace detail
+
+/// ln(1 + x) for 0 ≤ x < 2^1023 (finite), the logarithm of the lens integral: pure arithmetic,
+/// no library call (the call made the pair loop spill every live register). Above 1, ln of the
+/// rounded 1 + x (costs at most 1/2 ulp of 1 + x, i.e. 0.72 ulp of a result ≥ ln 2); up to √2 − 1
+/// the kernel on f = x itself; in between on f = (1 + x)/2 − 1 with the rounding error c of
+/// 1 + x (exact, Fast2Sum) added as c/(1 + x). Error bound kGasLensLog1pUlp ulp, tested against
+/// std::log1p over [0, 1e12] (tests/unit/thermochem/conduction_equal_radii_test.cpp).
+DEM_HD_FORCEINLINE double gasLensLog1p(double x) {
+  if (x > 1.0) {
+    // u = 1 + x = 2^k m, m in [√2/2, √2) (fdlibm's split: the mantissa plus 0x95f64… carries
+    // into the exponent exactly when it is above ≈ √2).
+    const std::uint64_t b = detail::doubleBits(1.0 + x);
+    const std::uint64_t mant = b & 0x000fffffffffffffULL;
+    const std::uint64_t carry = (mant + 0x00095f6400000000ULL) & 0x0010000000000000ULL;
+    const int k = static_cast<int>(b >> 52) - 1023 + static_cast<int>(carry >> 52);
+    const double m = detail::doubleFromBits(mant | (0x3ff0000000000000ULL ^ carry));
+    return detail::logKernel(m - 1.0, static_cast<double>(k), 0.0);
+  }
+  if (x <= 0.41421356237309503) {
+    return detail::logKernel(x, 0.0, 0.0);
+  }
+  const double u = 1.0 + x;       // in (√2, 2]
+  const double c = x - (u - 1.0); // exact rounding error of 1 + x
+  return detail::logKernel(0.5 * u - 1.0, 1.0, c / u);
+}
+
+/// Bound on gasLensLog1p()'s error in ulp of the result (observed ≤ 1.0; see gasLensLog1p()).
+inline constexpr double kGasLensLog1pUlp = 2.0;
 
 /// The lens integral I of Eq. 24 (m) in closed form. Depends only on the sorted radii and l.
 ///
@@ -311,6 +385,95 @@ DEM_HD GasLensIntegral gasLensIntegral(const GasLensParams& p, double ri, double
                       l * gasLensLog1p(delta / t2));
   }
   return result(clipped + 0.5 * pi * open);
+}
+
+/// Per-radius constants of gasLensIntegralEqualRadii(), formed once per particle (hoisted out
+/// of the pair loop) exactly as gasLensIntegral() forms them per pair.
+struct GasLensEqualRadii {
+  GasLensParams p; ///< the parameters (for the general path at degenerate distances)
+  double r;        ///< R = R_L = R_S, m
+  double twoR;     ///< 2R: in contact at l < 2R, m
+  double rLens;    ///< (1 + FLPC) R, m
+  double reach;    ///< R_lens + R: no lens at l ≥ reach, m
+  double switch2;  ///< (R_lens − R)(R_lens + R): R_out = R once l² ≤ switch2, m²
+  bool valid;      ///< s_min > 0 and FLPC ≥ 0 (gasLensIntegral()'s check)
+};
+
+DEM_HD GasLensEqualRadii gasLensEqualRadii(const GasLensParams& p, double r) {
+  const double rLens = (1.0 + p.lensFraction) * r;
+  return {p,
+          r,
+          r + r,
+          rLens,
+          rLens + r,
+          (rLens - r) * (rLens + r),
+          p.minSeparation > 0.0 && p.lensFraction >= 0.0};
+}
+
+/// gasLensIntegral(p, R, R, l).value for two spheres of the same radius (c =
+/// gasLensEqualRadii(p, R)): bitwise the same value (the same operations in the same order, with
+/// what is identically 0 for equal radii dropped: D = 0, a − b = 0, so that a_out = |b_out| =
+/// √(b_out²) exactly, R_S − b_in = R_L − a_in, and the two terms of g_out − g_in are equal),
+/// hence the same error bound, kGasLensClosedFormRelError. Cheaper: no square root, two
+/// divisions fewer, the per-radius constants hoisted. Distances l ≤ R (an overlap of more
+/// than half the spheres) take the general function.
+DEM_HD double gasLensIntegralEqualRadii(const GasLensEqualRadii& c, double l) {
+  constexpr double pi = 3.141592653589793;
+  if (!c.valid || !(l < c.reach)) {
+    return 0.0; // invalid parameters, or the lens does not reach the other sphere
+  }
+  if (!(l > c.r)) {
+    return gasLensIntegral(c.p, c.r, c.r, l).value;
+  }
+  const double r = c.r;
+  const double sMin = c.p.minSeparation;
+  const double lMinusBig = l - r;
+  const double half = 0.5 / l;
+  // Outer end (Eq. 26, or R once l² ≤ R_lens² − R²); a_out = b_out for equal radii.
+  double rOut2 = r * r;
+  double bOut = 0.0;
+  if (l * l > c.switch2) {
+    const double lensDrop = (r - (l - c.rLens)) * ((l - c.rLens) + r) * half;
+    const double x = c.rLens - lensDrop;
+    rOut2 = lensDrop * (c.rLens + x);
+    bOut = l - x;
+  }
+  if (!(bOut >= 0.0)) {
+    return gasLensIntegral(c.p, c.r, c.r, l).value; // only by rounding, next to the switch
+  }
+  const double aOut = bOut; // = √(D + b_out²) with D = 0, exactly: √(fl(b²)) = |b| in IEEE
+  // Inner end: in contact (R < l < 2R) the intersection plane is midway, b_in = a_in ≥ 0.
+  double aIn = r;
+  double gIn = lMinusBig - r;
+  double rIn2 = 0.0;
+  if (l < c.twoR) {
+    const double overlap = r - lMinusBig;
+    const double aDrop = overlap * (lMinusBig + r) * half; // R − a_in
+    aIn = r - aDrop;
+    rIn2 = aDrop * (r + aIn);
+    gIn = 0.0;
+  }
+  if (!(rOut2 > rIn2)) {
+    return 0.0;
+  }
+  const double inv = 1.0 / (aIn + aOut);
+  const double rise = (rOut2 - rIn2) * (inv + inv); // g_out − g_in
+  if (gIn + rise <= sMin) {
+    return pi * (rOut2 - rIn2) / sMin; // all clipped
+  }
+  double clipped = 0.0;
+  double g1 = gIn;
+  double delta = rise;
+  if (gIn < sMin) {
+    const double tStar = l - sMin;
+    const double dT = sMin - gIn;
+    const double aStar = 0.5 * tStar;
+    clipped = pi * dT * (2.0 * aIn - dT) * (aIn + aStar) / (2.0 * tStar * sMin);
+    g1 = sMin;
+    delta = rise - dT;
+  }
+  const double open = l * gasLensLog1p(delta / g1) - delta;
+  return clipped + 0.5 * pi * open;
 }
 
 /// Lens conductance κ_g I, W/K.

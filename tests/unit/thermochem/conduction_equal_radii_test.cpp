@@ -1,0 +1,148 @@
+// The equal-radii conduction kernels of the heat pair pass (heat.h) against the general ones:
+// intersectionCircleRadiusEqual() and gasLensIntegralEqualRadii() must give bitwise the values
+// of intersectionCircleRadius() and gasLensIntegral() (so they carry the same error bounds),
+// over the whole range of centre distances the pair pass feeds them.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <coredem/dem/kernels/conduction_contact.h>
+#include <coredem/dem/kernels/conduction_gas_lens.h>
+
+namespace k = coredem::dem::kernels;
+
+namespace {
+
+// Centre distances for spheres of radius r and lens fraction flpc: deep and shallow overlaps
+// (relative 1e-12 … 0.5), touching, the clipped band, open gaps up to the lens reach and beyond,
+// plus random ones.
+std::vector<double> distances(double r, double flpc, double sMin) {
+  std::vector<double> ls;
+  const double reach = (1.0 + flpc) * r + r;
+  for (int e = 0; e <= 12; ++e) {
+    const double f = std::pow(10.0, -e);
+    ls.push_back(2.0 * r * (1.0 - 0.5 * f)); // overlaps of R … 1e-12 R
+    ls.push_back(2.0 * r * (1.0 - f * 1e-1));
+    ls.push_back(2.0 * r + f * 1e-3 * r); // apart by 1e-3 R … 1e-15 R
+  }
+  ls.push_back(2.0 * r);
+  ls.push_back(std::nextafter(2.0 * r, 0.0));
+  ls.push_back(std::nextafter(2.0 * r, 1.0));
+  ls.push_back(r);
+  ls.push_back(std::nextafter(r, 1.0));
+  for (double m : {0.25, 0.5, 0.9, 1.0, 1.1, 2.0, 10.0}) // around the clipping band
+    ls.push_back(2.0 * r + m * sMin);
+  for (int m = 1; m <= 40; ++m)
+    ls.push_back(2.0 * r + (reach - 2.0 * r) * m / 40.0);
+  ls.push_back(std::nextafter(reach, 0.0));
+  ls.push_back(reach);
+  ls.push_back(1.5 * reach);
+  std::mt19937_64 rng(20261202);
+  std::uniform_real_distribution<double> u(0.3 * r, 1.1 * reach);
+  for (int m = 0; m < 2000; ++m)
+    ls.push_back(u(rng));
+  return ls;
+}
+
+} // namespace
+
+TEST(ContactConduction, EqualRadiiCircleIsBitwiseTheGeneralOne) {
+  int count = 0;
+  for (double r : {1e-4, 5e-4, 7.3e-4, 1e-3, 1e-2}) {
+    for (double l : distances(r, 0.2, 1e-6)) {
+      if (!(l >= r && l < 2.0 * r))
+        continue; // the kernel's range (the pair pass takes the general one elsewhere)
+      SCOPED_TRACE(::testing::Message() << "R " << r << " l " << l);
+      EXPECT_EQ(k::intersectionCircleRadiusEqual(r, l), k::intersectionCircleRadius(r, r, l));
+      ++count;
+    }
+  }
+  EXPECT_GT(count, 2000);
+}
+
+TEST(GasLens, EqualRadiiKernelIsBitwiseTheGeneralOne) {
+  int count = 0, positive = 0;
+  for (double r : {1e-4, 5e-4, 7.3e-4, 1e-3, 1e-2}) {
+    for (double flpc : {0.0, 0.1, 0.2, 0.5, 1.0}) {
+      for (double sMin : {1e-10, 1e-8, 1e-6, 1e-5}) {
+        k::GasLensParams p;
+        p.lensFraction = flpc;
+        p.minSeparation = sMin;
+        const k::GasLensEqualRadii c = k::gasLensEqualRadii(p, r);
+        for (double l : distances(r, flpc, sMin)) {
+          SCOPED_TRACE(::testing::Message()
+                       << "R " << r << " FLPC " << flpc << " s_min " << sMin << " l " << l);
+          const double general = k::gasLensIntegral(p, r, r, l).value;
+          const double equal = k::gasLensIntegralEqualRadii(c, l);
+          EXPECT_EQ(equal, general);
+          ++count;
+          positive += general > 0.0;
+        }
+      }
+    }
+  }
+  EXPECT_GT(positive, 0.5 * count);
+  // Invalid parameters: no lens, as the general function's value.
+  k::GasLensParams bad;
+  bad.minSeparation = 0.0;
+  EXPECT_EQ(k::gasLensIntegralEqualRadii(k::gasLensEqualRadii(bad, 1e-3), 1.9e-3), 0.0);
+}
+
+// The identity a_out = √(b_out²) = |b_out| the equal-radii kernel relies on (IEEE binary64,
+// round to nearest, no underflow/overflow).
+TEST(GasLens, SquareRootOfASquareIsExact) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> mant(1.0, 2.0);
+  std::uniform_int_distribution<int> ex(-200, 200);
+  for (int m = 0; m < 1000000; ++m) {
+    const double b = std::ldexp(mant(rng), ex(rng));
+    ASSERT_EQ(std::sqrt(b * b), b) << b;
+  }
+}
+
+// gasLensLog1p (pure arithmetic, no library call) against the long-double log1pl over the
+// arguments the lens produces: δ/g_1 from 0 (at the lens reach) to ~1e7 (R = 1e-2 m against
+// s_min = 1e-10 m), here [0, 1e12]: log-uniform from 1e-20 and uniform on [0, 3] (where the
+// three branches meet), plus the branch points. Error in ulp of the double result.
+TEST(GasLens, Log1pWithinItsUlpBound) {
+  auto ulpError = [](double x) {
+    const long double ref = log1pl(static_cast<long double>(x));
+    const double refD = static_cast<double>(ref);
+    const double ulp = std::nextafter(refD, 1e300) - refD;
+    return static_cast<double>(std::fabs(static_cast<long double>(k::gasLensLog1p(x)) - ref) /
+                               static_cast<long double>(ulp));
+  };
+  double worst = 0.0;
+  std::mt19937_64 rng(20261202);
+  std::uniform_real_distribution<double> logU(std::log(1e-20), std::log(1e12));
+  std::uniform_real_distribution<double> lin(0.0, 3.0);
+  std::vector<double> xs = {0.0,
+                            1e-300,
+                            0.41421356237309503,
+                            std::nextafter(0.41421356237309503, 1.0),
+                            std::nextafter(0.41421356237309503, 0.0),
+                            1.0,
+                            std::nextafter(1.0, 2.0),
+                            std::nextafter(1.0, 0.0),
+                            std::sqrt(2.0) - 1.0,
+                            std::sqrt(2.0),
+                            2.0,
+                            3.0,
+                            1e12};
+  for (int m = 0; m < 1000000; ++m) {
+    xs.push_back(std::exp(logU(rng)));
+    xs.push_back(lin(rng));
+  }
+  for (double x : xs) {
+    const double e = ulpError(x);
+    ASSERT_LE(e, k::kGasLensLog1pUlp) << "x " << x;
+    worst = std::max(worst, e);
+  }
+  EXPECT_EQ(k::gasLensLog1p(0.0), 0.0);
+  std::printf("gasLensLog1p: worst %.3f ulp over %zu arguments\n", worst, xs.size());
+}
