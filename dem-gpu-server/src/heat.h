@@ -42,6 +42,21 @@
 
 namespace coredem::dem {
 
+/// κ_g of a pair (W/(m K)): the mean of the two PCM cells' (a particle outside the grid uses the
+/// other's; both outside: 0) [C]; `same` is the owner's 0.5 (κ_lo + κ_lo) (its cell's, or 0).
+DEM_HD double pairGasConductivity(const double* kap, std::uint32_t clo, std::uint32_t chi,
+                                  std::uint32_t nCells, double same) {
+  if (chi == clo)
+    return same;
+  if (clo < nCells && chi < nCells)
+    return 0.5 * (kap[clo] + kap[chi]);
+  if (clo < nCells)
+    return kap[clo];
+  if (chi < nCells)
+    return kap[chi];
+  return 0.0;
+}
+
 /// Partial-sum slots of the wall heat (fixed count, so the sum order does not depend on threads).
 constexpr std::size_t kWallSlots = 64;
 
@@ -229,13 +244,15 @@ public:
         const double klo = hm[mlo].k;
         const std::uint32_t clo = lens ? pcell[lo] : nCells;
         // The owner's invariants. Partners of the same radius (a monodisperse bed: all) take
-        // the equal-radii kernels, bitwise the values of the general ones; of the same
-        // material, the owner's contact conductivity; in the same PCM cell, its κ_g.
+        // the equal-radii kernels (conduction_contact.h, conduction_gas_lens.h: within
+        // 2^-52 and kGasLensEqualRadiiRelDiff of the general ones); of the same material, the
+        // owner's contact conductivity; in the same PCM cell, its κ_g (bitwise as before).
         const double kcSame = contactConductivity(klo, klo);
         const bool kSamePos = klo + klo > 0.0;
         const double kgSame = clo < nCells ? 0.5 * (kap[clo] + kap[clo]) : 0.0;
         const double reachSame = lens ? lensFactor * rlo + rlo : rlo + rlo;
         const double reachSame2 = reachSame * reachSame;
+        const double twoR = rlo + rlo;
         const GasLensEqualRadii lensSame = gasLensEqualRadii(lp, rlo);
         double qc = 0.0, ql = 0.0;
         const std::uint32_t qEnd = hs[i + 1];
@@ -245,47 +262,47 @@ public:
           const Vec3 d = load3(x, hi) - xlo;
           const double l2 = dot(d, d);
           const double rhi = r[hi];
-          const bool same = rhi == rlo;
-          const double big = rlo > rhi ? rlo : rhi;
-          const double small = rlo > rhi ? rhi : rlo;
-          const double reach2 =
-              same ? reachSame2
-                   : (lens ? (lensFactor * big + small) * (lensFactor * big + small)
-                           : (rlo + rhi) * (rlo + rhi));
-          if (l2 < reach2) {
-            const double l = ::sqrt(l2);
-            const double dT = T[hi] - tlo; // heat into lo = G (T_hi − T_lo)
-            if (contact && l < rlo + rhi) {
-              const std::int32_t mhi = mat[hi];
-              if (mhi == mlo) {
-                if (kSamePos)
-                  qcab = (kcSame * (same && l >= rlo ? intersectionCircleRadiusEqual(rlo, l)
-                                                     : intersectionCircleRadius(rlo, rhi, l))) *
-                         dT;
-              } else {
-                const double khi = hm[mhi].k;
+          if (rhi == rlo) {
+            // Same radius: the equal-radii kernels and the owner's reach.
+            if (l2 < reachSame2) {
+              const double l = ::sqrt(l2);
+              const double dT = T[hi] - tlo; // heat into lo = G (T_hi − T_lo)
+              if (contact && l < twoR) {
+                const std::int32_t mhi = mat[hi];
+                const double rc = l >= rlo ? intersectionCircleRadiusEqual(rlo, l)
+                                           : intersectionCircleRadius(rlo, rlo, l);
+                if (mhi == mlo) {
+                  if (kSamePos)
+                    qcab = (kcSame * rc) * dT;
+                } else {
+                  const double khi = hm[mhi].k;
+                  if (klo + khi > 0.0)
+                    qcab = (contactConductivity(klo, khi) * rc) * dT;
+                }
+              }
+              if (lens) {
+                const double kg = pairGasConductivity(kap, clo, pcell[hi], nCells, kgSame);
+                if (kg > 0.0)
+                  qlab = kg * gasLensIntegralEqualRadii(lensSame, l) * dT;
+              }
+            }
+          } else {
+            const double big = rlo > rhi ? rlo : rhi;
+            const double small = rlo > rhi ? rhi : rlo;
+            const double reach = lens ? lensFactor * big + small : rlo + rhi;
+            if (l2 < reach * reach) {
+              const double l = ::sqrt(l2);
+              const double dT = T[hi] - tlo;
+              if (contact && l < rlo + rhi) {
+                const double khi = hm[mat[hi]].k;
                 if (klo + khi > 0.0)
                   qcab = contactConductance(klo, khi, rlo, rhi, l) * dT;
               }
-            }
-            if (lens) {
-              // κ_g of the pair: mean of the two PCM cells (a particle outside the grid uses
-              // the other's; both outside: no lens) [C].
-              const std::uint32_t chi = pcell[hi];
-              double kg = 0.0;
-              if (chi == clo)
-                kg = kgSame;
-              else if (clo < nCells && chi < nCells)
-                kg = 0.5 * (kap[clo] + kap[chi]);
-              else if (clo < nCells)
-                kg = kap[clo];
-              else if (chi < nCells)
-                kg = kap[chi];
-              if (kg > 0.0)
-                qlab = kg *
-                       (same ? gasLensIntegralEqualRadii(lensSame, l)
-                             : gasLensIntegral(lp, rlo, rhi, l).value) *
-                       dT;
+              if (lens) {
+                const double kg = pairGasConductivity(kap, clo, pcell[hi], nCells, kgSame);
+                if (kg > 0.0)
+                  qlab = kg * gasLensIntegral(lp, rlo, rhi, l).value * dT;
+              }
             }
           }
           qc += qcab;

@@ -388,14 +388,14 @@ DEM_HD GasLensIntegral gasLensIntegral(const GasLensParams& p, double ri, double
 }
 
 /// Per-radius constants of gasLensIntegralEqualRadii(), formed once per particle (hoisted out
-/// of the pair loop) exactly as gasLensIntegral() forms them per pair.
+/// of the pair loop).
 struct GasLensEqualRadii {
   GasLensParams p; ///< the parameters (for the general path at degenerate distances)
   double r;        ///< R = R_L = R_S, m
   double twoR;     ///< 2R: in contact at l < 2R, m
   double rLens;    ///< (1 + FLPC) R, m
   double reach;    ///< R_lens + R: no lens at l ≥ reach, m
-  double switch2;  ///< (R_lens − R)(R_lens + R): R_out = R once l² ≤ switch2, m²
+  double kappa;    ///< κ = R_lens² − R² = (R_lens − R)(R_lens + R), m²
   bool valid;      ///< s_min > 0 and FLPC ≥ 0 (gasLensIntegral()'s check)
 };
 
@@ -410,13 +410,28 @@ DEM_HD GasLensEqualRadii gasLensEqualRadii(const GasLensParams& p, double r) {
           p.minSeparation > 0.0 && p.lensFraction >= 0.0};
 }
 
-/// gasLensIntegral(p, R, R, l).value for two spheres of the same radius (c =
-/// gasLensEqualRadii(p, R)): bitwise the same value (the same operations in the same order, with
-/// what is identically 0 for equal radii dropped: D = 0, a − b = 0, so that a_out = |b_out| =
-/// √(b_out²) exactly, R_S − b_in = R_L − a_in, and the two terms of g_out − g_in are equal),
-/// hence the same error bound, kGasLensClosedFormRelError. Cheaper: no square root, two
-/// divisions fewer, the per-radius constants hoisted. Distances l ≤ R (an overlap of more
-/// than half the spheres) take the general function.
+/// Relative bound on |gasLensIntegralEqualRadii() − gasLensIntegral()| (both closed forms of
+/// the same integral, rounded differently) over the DEM range of
+/// tests/unit/thermochem/conduction_equal_radii_test.cpp; against exact values the equal-radii
+/// form keeps kGasLensClosedFormRelError (tested on the 40-digit values of conduction_test.cpp).
+inline constexpr double kGasLensEqualRadiiRelDiff = 1.0e-14;
+
+/// The lens integral I of Eq. 24 (m) for two spheres of the same radius R (c =
+/// gasLensEqualRadii(p, R)), the pair loop's common case (a monodisperse bed), in the
+/// equal-radii closed form, far shorter than gasLensIntegral()'s:
+///
+///   gap(r) = l − 2√(R² − r²), so r² = R² − ((l − g)/2)² at gap g, and
+///   g_in  = max(l − 2R, 0)                                  (the surfaces meet in contact)
+///   g_out = κ/l (κ = R_lens² − R², the lens circle), or l once l² ≤ κ (R_out = R)
+///   clipped part π (r*² − R_in²)/s_min = π (s_min − g_in)(2l − g_in − s_min)/(4 s_min)
+///   open part (π/2) [l ln(1 + δ/g_1) − δ],  g_1 = max(g_in, s_min),  δ = g_out − g_1
+///
+/// (all clipped if g_out ≤ s_min: π (g_out − g_in)(2l − g_in − g_out)/(4 s_min)). In contact
+/// the clipped part is π(2l − s_min)/4 and δ = κ/l − s_min; apart, g_out − g_in =
+/// (R − (l − R_lens))(R_lens + (l − R))/l without cancellation at the reach. One division, the
+/// logarithm (gasLensLog1p), no square root. Agrees with gasLensIntegral() within
+/// kGasLensEqualRadiiRelDiff, and with exact values within kGasLensClosedFormRelError. Distances
+/// l ≤ R (more than half the spheres overlapping) take the general function.
 DEM_HD double gasLensIntegralEqualRadii(const GasLensEqualRadii& c, double l) {
   constexpr double pi = 3.141592653589793;
   if (!c.valid || !(l < c.reach)) {
@@ -425,55 +440,36 @@ DEM_HD double gasLensIntegralEqualRadii(const GasLensEqualRadii& c, double l) {
   if (!(l > c.r)) {
     return gasLensIntegral(c.p, c.r, c.r, l).value;
   }
-  const double r = c.r;
   const double sMin = c.p.minSeparation;
-  const double lMinusBig = l - r;
-  const double half = 0.5 / l;
-  // Outer end (Eq. 26, or R once l² ≤ R_lens² − R²); a_out = b_out for equal radii.
-  double rOut2 = r * r;
-  double bOut = 0.0;
-  if (l * l > c.switch2) {
-    const double lensDrop = (r - (l - c.rLens)) * ((l - c.rLens) + r) * half;
-    const double x = c.rLens - lensDrop;
-    rOut2 = lensDrop * (c.rLens + x);
-    bOut = l - x;
-  }
-  if (!(bOut >= 0.0)) {
-    return gasLensIntegral(c.p, c.r, c.r, l).value; // only by rounding, next to the switch
-  }
-  const double aOut = bOut; // = √(D + b_out²) with D = 0, exactly: √(fl(b²)) = |b| in IEEE
-  // Inner end: in contact (R < l < 2R) the intersection plane is midway, b_in = a_in ≥ 0.
-  double aIn = r;
-  double gIn = lMinusBig - r;
-  double rIn2 = 0.0;
-  if (l < c.twoR) {
-    const double overlap = r - lMinusBig;
-    const double aDrop = overlap * (lMinusBig + r) * half; // R − a_in
-    aIn = r - aDrop;
-    rIn2 = aDrop * (r + aIn);
-    gIn = 0.0;
-  }
-  if (!(rOut2 > rIn2)) {
-    return 0.0;
-  }
-  const double inv = 1.0 / (aIn + aOut);
-  const double rise = (rOut2 - rIn2) * (inv + inv); // g_out − g_in
-  if (gIn + rise <= sMin) {
-    return pi * (rOut2 - rIn2) / sMin; // all clipped
-  }
+  const bool chord = l * l > c.kappa; // R_out on the lens circle (else R_out = R, g_out = l)
   double clipped = 0.0;
-  double g1 = gIn;
-  double delta = rise;
-  if (gIn < sMin) {
-    const double tStar = l - sMin;
-    const double dT = sMin - gIn;
-    const double aStar = 0.5 * tStar;
-    clipped = pi * dT * (2.0 * aIn - dT) * (aIn + aStar) / (2.0 * tStar * sMin);
+  double g1 = 0.0;
+  double delta = 0.0;
+  if (l < c.twoR) {
+    // In contact: g_in = 0.
+    const double gOut = chord ? c.kappa / l : l;
+    if (gOut <= sMin) {
+      return pi * gOut * (2.0 * l - gOut) / (4.0 * sMin); // all clipped
+    }
+    clipped = 0.25 * pi * (2.0 * l - sMin);
     g1 = sMin;
-    delta = rise - dT;
+    delta = gOut - sMin;
+  } else {
+    const double gIn = l - c.twoR;
+    const double rise = chord ? (c.r - (l - c.rLens)) * (c.rLens + (l - c.r)) / l : c.twoR;
+    if (gIn + rise <= sMin) {
+      return pi * rise * ((2.0 * l - gIn) - (gIn + rise)) / (4.0 * sMin); // all clipped
+    }
+    g1 = gIn;
+    delta = rise;
+    if (gIn < sMin) {
+      const double dS = sMin - gIn;
+      clipped = pi * dS * ((2.0 * l - gIn) - sMin) / (4.0 * sMin);
+      g1 = sMin;
+      delta = rise - dS;
+    }
   }
-  const double open = l * gasLensLog1p(delta / g1) - delta;
-  return clipped + 0.5 * pi * open;
+  return clipped + 0.5 * pi * (l * gasLensLog1p(delta / g1) - delta);
 }
 
 /// Lens conductance κ_g I, W/K.
