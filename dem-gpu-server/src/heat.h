@@ -40,6 +40,14 @@
 #include "pair_lists.h"
 #include "step_module.h"
 
+// The heat passes' loop bodies are large: without this GCC calls them once per particle from
+// the OpenMP loop, reloading every capture each time (host builds only; nvcc inlines anyway).
+#if defined(__CUDACC__)
+#define COREDEM_HEAT_INLINE
+#else
+#define COREDEM_HEAT_INLINE __attribute__((always_inline))
+#endif
+
 namespace coredem::dem {
 
 /// κ_g of a pair (W/(m K)): the mean of the two PCM cells' (a particle outside the grid uses the
@@ -234,7 +242,7 @@ public:
     double* qOwn = _q.d();        // owner's pair sums, contact and lens: _q and _g until 2b
     double* lOwn = _g.d();
     if (contact || lens) {
-      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
         using namespace kernels;
         const long long lo = static_cast<long long>(i);
         const Vec3 xlo = load3(x, lo);
@@ -318,7 +326,7 @@ public:
 
     // 2b. Per-particle heat rate: the pair sums of 2a plus −Q_ab of the pairs the partners own
     //     (low lists, fixed order), convection with the gas of the PCM cell, radiation, walls.
-    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
       using namespace kernels;
       const long long ii = static_cast<long long>(i);
       const double ti = T[i];
