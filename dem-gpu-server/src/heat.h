@@ -291,7 +291,7 @@ public:
               if (lens) {
                 const double kg = pairGasConductivity(kap, clo, pcell[hi], nCells, kgSame);
                 if (kg > 0.0)
-                  qlab = kg * gasLensIntegralEqualRadii(lensSame, l) * dT;
+                  qlab = kg * gasLensIntegralEqualRadii(lp, lensSame, l) * dT;
               }
             }
           } else {

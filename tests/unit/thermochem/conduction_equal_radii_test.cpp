@@ -95,7 +95,7 @@ TEST(GasLens, EqualRadiiKernelMatchesTheGeneralOne) {
           SCOPED_TRACE(::testing::Message()
                        << "R " << r << " FLPC " << flpc << " s_min " << sMin << " l " << l);
           const double general = k::gasLensIntegral(p, r, r, l).value;
-          const double equal = k::gasLensIntegralEqualRadii(c, l);
+          const double equal = k::gasLensIntegralEqualRadii(p, c, l);
           ++count;
           if (general == 0.0) {
             EXPECT_EQ(equal, 0.0);
@@ -128,7 +128,7 @@ TEST(GasLens, EqualRadiiKernelMatchesTheGeneralOne) {
   // Invalid parameters: no lens, as the general function.
   k::GasLensParams bad;
   bad.minSeparation = 0.0;
-  EXPECT_EQ(k::gasLensIntegralEqualRadii(k::gasLensEqualRadii(bad, 1e-3), 1.9e-3), 0.0);
+  EXPECT_EQ(k::gasLensIntegralEqualRadii(bad, k::gasLensEqualRadii(bad, 1e-3), 1.9e-3), 0.0);
 }
 
 // The equal-radii rows of the 40-digit table (conduction_test.cpp), same bound as the general
@@ -149,8 +149,8 @@ TEST(GasLens, EqualRadiiKernelMatchesFortyDigitValues) {
     SCOPED_TRACE(::testing::Message() << "R " << row.r << " l " << row.l << " s_min " << row.sMin);
     k::GasLensParams p;
     p.minSeparation = row.sMin;
-    EXPECT_NEAR(k::gasLensIntegralEqualRadii(k::gasLensEqualRadii(p, row.r), row.l), row.integral,
-                k::kGasLensClosedFormRelError * row.integral);
+    EXPECT_NEAR(k::gasLensIntegralEqualRadii(p, k::gasLensEqualRadii(p, row.r), row.l),
+                row.integral, k::kGasLensClosedFormRelError * row.integral);
   }
 }
 
@@ -194,4 +194,19 @@ TEST(GasLens, Log1pWithinItsUlpBound) {
   }
   EXPECT_EQ(k::gasLensLog1p(0.0), 0.0);
   std::printf("gasLensLog1p: worst %.3f ulp over %zu arguments\n", worst, xs.size());
+  // gasLensLog (u ≥ 1: the contact branch's g_out/s_min) against logl.
+  double worstLog = 0.0;
+  std::uniform_real_distribution<double> logV(0.0, std::log(1e12));
+  for (int m = 0; m < 1000000; ++m) {
+    const double u = m == 0 ? 1.0 : (m == 1 ? 2.0 : std::exp(logV(rng)));
+    const long double ref = logl(static_cast<long double>(u));
+    const double refD = static_cast<double>(ref);
+    const double ulp = std::nextafter(std::max(refD, 1e-300), 1e300) - std::max(refD, 1e-300);
+    const double e = static_cast<double>(fabsl(static_cast<long double>(k::gasLensLog(u)) - ref) /
+                                         static_cast<long double>(ulp));
+    ASSERT_LE(e, k::kGasLensLog1pUlp) << "u " << u;
+    worstLog = std::max(worstLog, e);
+  }
+  EXPECT_EQ(k::gasLensLog(1.0), 0.0);
+  std::printf("gasLensLog: worst %.3f ulp\n", worstLog);
 }

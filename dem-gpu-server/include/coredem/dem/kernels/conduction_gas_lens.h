@@ -236,22 +236,27 @@ DEM_HD_FORCEINLINE double logKernel(double f, double k, double lo) {
 
 } // namespace detail
 
+/// ln u for normal u ≥ 1 (finite): u = 2^k m, m in [√2/2, √2) (fdlibm's split: the mantissa
+/// plus 0x95f64… carries into the exponent exactly when it is above ≈ √2), then the kernel. Pure
+/// arithmetic, below 1 ulp (fdlibm's bound).
+DEM_HD_FORCEINLINE double gasLensLog(double u) {
+  const std::uint64_t b = detail::doubleBits(u);
+  const std::uint64_t mant = b & 0x000fffffffffffffULL;
+  const std::uint64_t carry = (mant + 0x00095f6400000000ULL) & 0x0010000000000000ULL;
+  const int k = static_cast<int>(b >> 52) - 1023 + static_cast<int>(carry >> 52);
+  const double m = detail::doubleFromBits(mant | (0x3ff0000000000000ULL ^ carry));
+  return detail::logKernel(m - 1.0, static_cast<double>(k), 0.0);
+}
+
 /// ln(1 + x) for 0 ≤ x < 2^1023 (finite), the logarithm of the lens integral: pure arithmetic,
 /// no library call (the call made the pair loop spill every live register). Above 1, ln of the
 /// rounded 1 + x (costs at most 1/2 ulp of 1 + x, i.e. 0.72 ulp of a result ≥ ln 2); up to √2 − 1
 /// the kernel on f = x itself; in between on f = (1 + x)/2 − 1 with the rounding error c of
 /// 1 + x (exact, Fast2Sum) added as c/(1 + x). Error bound kGasLensLog1pUlp ulp, tested against
-/// std::log1p over [0, 1e12] (tests/unit/thermochem/conduction_equal_radii_test.cpp).
+/// log1pl over [0, 1e12] (tests/unit/thermochem/conduction_equal_radii_test.cpp).
 DEM_HD_FORCEINLINE double gasLensLog1p(double x) {
   if (x > 1.0) {
-    // u = 1 + x = 2^k m, m in [√2/2, √2) (fdlibm's split: the mantissa plus 0x95f64… carries
-    // into the exponent exactly when it is above ≈ √2).
-    const std::uint64_t b = detail::doubleBits(1.0 + x);
-    const std::uint64_t mant = b & 0x000fffffffffffffULL;
-    const std::uint64_t carry = (mant + 0x00095f6400000000ULL) & 0x0010000000000000ULL;
-    const int k = static_cast<int>(b >> 52) - 1023 + static_cast<int>(carry >> 52);
-    const double m = detail::doubleFromBits(mant | (0x3ff0000000000000ULL ^ carry));
-    return detail::logKernel(m - 1.0, static_cast<double>(k), 0.0);
+    return gasLensLog(1.0 + x);
   }
   if (x <= 0.41421356237309503) {
     return detail::logKernel(x, 0.0, 0.0);
@@ -261,7 +266,8 @@ DEM_HD_FORCEINLINE double gasLensLog1p(double x) {
   return detail::logKernel(0.5 * u - 1.0, 1.0, c / u);
 }
 
-/// Bound on gasLensLog1p()'s error in ulp of the result (observed ≤ 1.0; see gasLensLog1p()).
+/// Bound on gasLensLog1p()'s and gasLensLog()'s errors in ulp of the result (observed ≤ 1.52
+/// and ≤ 1.0; see gasLensLog1p()).
 inline constexpr double kGasLensLog1pUlp = 2.0;
 
 /// The lens integral I of Eq. 24 (m) in closed form. Depends only on the sorted radii and l.
@@ -390,24 +396,18 @@ DEM_HD GasLensIntegral gasLensIntegral(const GasLensParams& p, double ri, double
 /// Per-radius constants of gasLensIntegralEqualRadii(), formed once per particle (hoisted out
 /// of the pair loop).
 struct GasLensEqualRadii {
-  GasLensParams p; ///< the parameters (for the general path at degenerate distances)
-  double r;        ///< R = R_L = R_S, m
-  double twoR;     ///< 2R: in contact at l < 2R, m
-  double rLens;    ///< (1 + FLPC) R, m
-  double reach;    ///< R_lens + R: no lens at l ≥ reach, m
-  double kappa;    ///< κ = R_lens² − R² = (R_lens − R)(R_lens + R), m²
-  bool valid;      ///< s_min > 0 and FLPC ≥ 0 (gasLensIntegral()'s check)
+  double r;      ///< R = R_L = R_S, m
+  double twoR;   ///< 2R: in contact at l < 2R, m
+  double rLens;  ///< (1 + FLPC) R, m
+  double reach;  ///< R_lens + R: no lens at l ≥ reach, m
+  double kappa;  ///< κ = R_lens² − R² = (R_lens − R)(R_lens + R), m²
+  double kappaS; ///< κ/s_min, m
 };
 
 DEM_HD GasLensEqualRadii gasLensEqualRadii(const GasLensParams& p, double r) {
   const double rLens = (1.0 + p.lensFraction) * r;
-  return {p,
-          r,
-          r + r,
-          rLens,
-          rLens + r,
-          (rLens - r) * (rLens + r),
-          p.minSeparation > 0.0 && p.lensFraction >= 0.0};
+  const double kappa = (rLens - r) * (rLens + r);
+  return {r, r + r, rLens, rLens + r, kappa, kappa / p.minSeparation};
 }
 
 /// Relative bound on |gasLensIntegralEqualRadii() − gasLensIntegral()| (both closed forms of
@@ -416,8 +416,8 @@ DEM_HD GasLensEqualRadii gasLensEqualRadii(const GasLensParams& p, double r) {
 /// form keeps kGasLensClosedFormRelError (tested on the 40-digit values of conduction_test.cpp).
 inline constexpr double kGasLensEqualRadiiRelDiff = 1.0e-14;
 
-/// The lens integral I of Eq. 24 (m) for two spheres of the same radius R (c =
-/// gasLensEqualRadii(p, R)), the pair loop's common case (a monodisperse bed), in the
+/// The lens integral I of Eq. 24 (m) for two spheres of the same radius R (p the parameters,
+/// c = gasLensEqualRadii(p, R)), the pair loop's common case (a monodisperse bed), in the
 /// equal-radii closed form, far shorter than gasLensIntegral()'s:
 ///
 ///   gap(r) = l − 2√(R² − r²), so r² = R² − ((l − g)/2)² at gap g, and
@@ -427,26 +427,37 @@ inline constexpr double kGasLensEqualRadiiRelDiff = 1.0e-14;
 ///   open part (π/2) [l ln(1 + δ/g_1) − δ],  g_1 = max(g_in, s_min),  δ = g_out − g_1
 ///
 /// (all clipped if g_out ≤ s_min: π (g_out − g_in)(2l − g_in − g_out)/(4 s_min)). In contact
-/// the clipped part is π(2l − s_min)/4 and δ = κ/l − s_min; apart, g_out − g_in =
-/// (R − (l − R_lens))(R_lens + (l − R))/l without cancellation at the reach. One division, the
-/// logarithm (gasLensLog1p), no square root. Agrees with gasLensIntegral() within
-/// kGasLensEqualRadiiRelDiff, and with exact values within kGasLensClosedFormRelError. Distances
-/// l ≤ R (more than half the spheres overlapping) take the general function.
-DEM_HD double gasLensIntegralEqualRadii(const GasLensEqualRadii& c, double l) {
+/// the clipped part is π(2l − s_min)/4 and 1 + δ/s_min = u = κ/(l s_min), so that (κ/s_min per
+/// radius) I = π(2l − s_min)/4 + (π/2)[l ln u − s_min (u − 1)]; apart, g_out − g_in =
+/// (R − (l − R_lens))(R_lens + (l − R))/l without cancellation at the reach. One or two
+/// divisions, the logarithm (gasLensLog, gasLensLog1p), no square root. Agrees with
+/// gasLensIntegral() within kGasLensEqualRadiiRelDiff, and with exact values within
+/// kGasLensClosedFormRelError. Distances l ≤ R (more than half the spheres overlapping) take the
+/// general function.
+DEM_HD_FORCEINLINE double gasLensIntegralEqualRadii(const GasLensParams& p,
+                                                    const GasLensEqualRadii& c, double l) {
   constexpr double pi = 3.141592653589793;
-  if (!c.valid || !(l < c.reach)) {
+  if (!(p.minSeparation > 0.0) || !(p.lensFraction >= 0.0) || !(l < c.reach)) {
     return 0.0; // invalid parameters, or the lens does not reach the other sphere
   }
   if (!(l > c.r)) {
-    return gasLensIntegral(c.p, c.r, c.r, l).value;
+    return gasLensIntegral(p, c.r, c.r, l).value;
   }
-  const double sMin = c.p.minSeparation;
+  const double sMin = p.minSeparation;
   const bool chord = l * l > c.kappa; // R_out on the lens circle (else R_out = R, g_out = l)
   double clipped = 0.0;
   double g1 = 0.0;
   double delta = 0.0;
   if (l < c.twoR) {
-    // In contact: g_in = 0.
+    // In contact: g_in = 0. Usually g_out/s_min = κ/(l s_min) > 2: then 1 + δ/s_min is that
+    // ratio, formed with one division and no rounding of 1 + x, and δ = s_min (u − 1) (u − 1 is
+    // exact for u ≥ 1).
+    if (chord) {
+      const double u = c.kappaS / l;
+      if (u > 2.0) {
+        return 0.25 * pi * (2.0 * l - sMin) + 0.5 * pi * (l * gasLensLog(u) - sMin * (u - 1.0));
+      }
+    }
     const double gOut = chord ? c.kappa / l : l;
     if (gOut <= sMin) {
       return pi * gOut * (2.0 * l - gOut) / (4.0 * sMin); // all clipped
