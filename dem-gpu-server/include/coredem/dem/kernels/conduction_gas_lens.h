@@ -428,8 +428,9 @@ inline constexpr double kGasLensEqualRadiiRelDiff = 1.0e-14;
 ///
 /// (all clipped if g_out ≤ s_min: π (g_out − g_in)(2l − g_in − g_out)/(4 s_min)). In contact
 /// the clipped part is π(2l − s_min)/4 and 1 + δ/s_min = u = κ/(l s_min), so that (κ/s_min per
-/// radius) I = π(2l − s_min)/4 + (π/2)[l ln u − s_min (u − 1)]; apart, g_out − g_in =
-/// (R − (l − R_lens))(R_lens + (l − R))/l without cancellation at the reach. One or two
+/// radius) I = π(2l − s_min)/4 + (π/2)[l ln u − s_min (u − 1)]; apart, likewise with u =
+/// g_out/g_1 while u > 2, and closer to the reach ln(1 + δ/g_1) with g_out − g_in =
+/// (R − (l − R_lens))(R_lens + (l − R))/l without cancellation. One or two
 /// divisions, the logarithm (gasLensLog, gasLensLog1p), no square root. Agrees with
 /// gasLensIntegral() within kGasLensEqualRadiiRelDiff, and with exact values within
 /// kGasLensClosedFormRelError. Distances l ≤ R (more than half the spheres overlapping) take the
@@ -467,6 +468,24 @@ DEM_HD_FORCEINLINE double gasLensIntegralEqualRadii(const GasLensParams& p,
     delta = gOut - sMin;
   } else {
     const double gIn = l - c.twoR;
+    if (chord) {
+      // Apart, and far enough from the reach that u = 1 + δ/g_1 = g_out/g_1 > 2: as in contact,
+      // ln u directly (u − 1 is exact; l ln u ≥ 2R ln 2 exceeds δ ≤ κ/(2R) for FLPC ≤ 0.9, so
+      // l ln u − δ does not cancel).
+      if (gIn < sMin) {
+        const double u = c.kappaS / l;
+        if (u > 2.0) {
+          const double dS = sMin - gIn;
+          return pi * dS * ((2.0 * l - gIn) - sMin) / (4.0 * sMin) +
+                 0.5 * pi * (l * gasLensLog(u) - sMin * (u - 1.0));
+        }
+      } else {
+        const double u = c.kappa / (l * gIn);
+        if (u > 2.0) {
+          return 0.5 * pi * (l * gasLensLog(u) - gIn * (u - 1.0));
+        }
+      }
+    }
     const double rise = chord ? (c.r - (l - c.rLens)) * (c.rLens + (l - c.r)) / l : c.twoR;
     if (gIn + rise <= sMin) {
       return pi * rise * ((2.0 * l - gIn) - (gIn + rise)) / (4.0 * sMin); // all clipped
