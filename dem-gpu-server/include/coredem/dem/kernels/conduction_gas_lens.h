@@ -213,7 +213,8 @@ DEM_HD_FORCEINLINE double doubleFromBits(std::uint64_t b) {
 /// ≈ c/u of a rounded argument u), as fdlibm's e_log.c/k_log.h (Sun Microsystems 1993): with
 /// s = f/(2 + f), ln(1 + f) = 2 atanh s = f − f²/2 + s (f²/2 + R(s²)), R a degree-14 Remez fit
 /// of 2 atanh(s)/s − 2 − … (error below 2^−58.45), ln 2 split into a 32-bit head and its tail.
-/// Pure arithmetic (inlined, no library call); below 1 ulp (fdlibm's bound for ln).
+/// Pure arithmetic (inlined, no library call); below 1 ulp (fdlibm's bound for ln). Callers
+/// without a correction pass lo = −0.0, which the compiler drops (x + (−0) = x for every x).
 DEM_HD_FORCEINLINE double logKernel(double f, double k, double lo) {
   constexpr double ln2Hi = 6.93147180369123816490e-01; // 0x3fe62e42fee00000
   constexpr double ln2Lo = 1.90821492927058770002e-10; // 0x3dea39ef35793c76
@@ -245,7 +246,7 @@ DEM_HD_FORCEINLINE double gasLensLog(double u) {
   const std::uint64_t carry = (mant + 0x00095f6400000000ULL) & 0x0010000000000000ULL;
   const int k = static_cast<int>(b >> 52) - 1023 + static_cast<int>(carry >> 52);
   const double m = detail::doubleFromBits(mant | (0x3ff0000000000000ULL ^ carry));
-  return detail::logKernel(m - 1.0, static_cast<double>(k), 0.0);
+  return detail::logKernel(m - 1.0, static_cast<double>(k), -0.0);
 }
 
 /// ln(1 + x) for 0 ≤ x < 2^1023 (finite), the logarithm of the lens integral: pure arithmetic,
@@ -259,7 +260,7 @@ DEM_HD_FORCEINLINE double gasLensLog1p(double x) {
     return gasLensLog(1.0 + x);
   }
   if (x <= 0.41421356237309503) {
-    return detail::logKernel(x, 0.0, 0.0);
+    return detail::logKernel(x, 0.0, -0.0);
   }
   const double u = 1.0 + x;       // in (√2, 2]
   const double c = x - (u - 1.0); // exact rounding error of 1 + x
