@@ -252,9 +252,10 @@ public:
         const double klo = hm[mlo].k;
         const std::uint32_t clo = lens ? pcell[lo] : nCells;
         // The owner's invariants. Partners of the same radius (a monodisperse bed: all) take
-        // the equal-radii kernels (conduction_contact.h, conduction_gas_lens.h: within
-        // 2^-52 and kGasLensEqualRadiiRelDiff of the general ones); of the same material, the
-        // owner's contact conductivity; in the same PCM cell, its κ_g (bitwise as before).
+        // the equal-radii kernels (conduction_contact.h: within 2^-52 of the exact contact
+        // radius; conduction_gas_lens.h: within kGasLensEqualRadiiRelDiff of the general lens
+        // form); of the same material, the owner's contact conductivity; in the same PCM cell,
+        // its κ_g (both bitwise as before).
         const double kcSame = contactConductivity(klo, klo);
         const bool kSamePos = klo + klo > 0.0;
         const double kgSame = clo < nCells ? 0.5 * (kap[clo] + kap[clo]) : 0.0;

@@ -20,6 +20,10 @@
 ///    turns the integrand into a rational function of t; derivation at the function). Its
 ///    rounding error is below kGasLensClosedFormRelError = 1e-13 relative over the DEM range;
 ///    it costs one square root, one or two logarithms and a few divisions per pair.
+///  * gasLensIntegralEqualRadii() is the equal-radii case written in gaps (the pair pass's
+///    common case: no square root, one or two divisions), within kGasLensEqualRadiiRelDiff =
+///    1e-14 of gasLensIntegral(). The logarithms of both are gasLensLog()/gasLensLog1p(),
+///    fdlibm's kernel inline (≤ kGasLensLog1pUlp = 2 ulp).
 ///  * gasLensIntegralReference() is the former per-pair adaptive quadrature, kept as the
 ///    independent reference for the tests: the gap without cancellation as
 ///      gap(r) = g0 + (r − R_in)(r + R_in) [1/(a + a0) + 1/(b + b0)],
