@@ -40,7 +40,30 @@
 #include "pair_lists.h"
 #include "step_module.h"
 
+// The heat passes' loop bodies are large: without this GCC calls them once per particle from
+// the OpenMP loop, reloading every capture each time (host builds only; nvcc inlines anyway).
+#if defined(__CUDACC__)
+#define COREDEM_HEAT_INLINE
+#else
+#define COREDEM_HEAT_INLINE __attribute__((always_inline))
+#endif
+
 namespace coredem::dem {
+
+/// κ_g of a pair (W/(m K)): the mean of the two PCM cells' (a particle outside the grid uses the
+/// other's; both outside: 0) [C]; `same` is the owner's 0.5 (κ_lo + κ_lo) (its cell's, or 0).
+DEM_HD double pairGasConductivity(const double* kap, std::uint32_t clo, std::uint32_t chi,
+                                  std::uint32_t nCells, double same) {
+  if (chi == clo)
+    return same;
+  if (clo < nCells && chi < nCells)
+    return 0.5 * (kap[clo] + kap[chi]);
+  if (clo < nCells)
+    return kap[clo];
+  if (chi < nCells)
+    return kap[chi];
+  return 0.0;
+}
 
 /// Partial-sum slots of the wall heat (fixed count, so the sum order does not depend on threads).
 constexpr std::size_t kWallSlots = 64;
@@ -219,14 +242,27 @@ public:
     double* qOwn = _q.d();        // owner's pair sums, contact and lens: _q and _g until 2b
     double* lOwn = _g.d();
     if (contact || lens) {
-      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
         using namespace kernels;
         const long long lo = static_cast<long long>(i);
         const Vec3 xlo = load3(x, lo);
         const double rlo = r[lo];
         const double tlo = T[lo];
-        const double klo = hm[mat[lo]].k;
+        const std::int32_t mlo = mat[lo];
+        const double klo = hm[mlo].k;
         const std::uint32_t clo = lens ? pcell[lo] : nCells;
+        // The owner's invariants. Partners of the same radius (a monodisperse bed: all) take
+        // the equal-radii kernels (conduction_contact.h: within 2^-52 of the exact contact
+        // radius; conduction_gas_lens.h: within kGasLensEqualRadiiRelDiff of the general lens
+        // form); of the same material, the owner's contact conductivity; in the same PCM cell,
+        // its κ_g (both bitwise as before).
+        const double kcSame = contactConductivity(klo, klo);
+        const bool kSamePos = klo + klo > 0.0;
+        const double kgSame = clo < nCells ? 0.5 * (kap[clo] + kap[clo]) : 0.0;
+        const double reachSame = lens ? lensFactor * rlo + rlo : rlo + rlo;
+        const double reachSame2 = reachSame * reachSame;
+        const double twoR = rlo + rlo;
+        const GasLensEqualRadii lensSame = gasLensEqualRadii(lp, rlo);
         double qc = 0.0, ql = 0.0;
         const std::uint32_t qEnd = hs[i + 1];
         for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
@@ -235,30 +271,47 @@ public:
           const Vec3 d = load3(x, hi) - xlo;
           const double l2 = dot(d, d);
           const double rhi = r[hi];
-          const double big = rlo > rhi ? rlo : rhi;
-          const double small = rlo > rhi ? rhi : rlo;
-          const double reach = lens ? lensFactor * big + small : rlo + rhi;
-          if (l2 < reach * reach) {
-            const double l = ::sqrt(l2);
-            const double dT = T[hi] - tlo; // heat into lo = G (T_hi − T_lo)
-            if (contact && l < rlo + rhi) {
-              const double khi = hm[mat[hi]].k;
-              if (klo + khi > 0.0)
-                qcab = contactConductance(klo, khi, rlo, rhi, l) * dT;
+          if (rhi == rlo) {
+            // Same radius: the equal-radii kernels and the owner's reach.
+            if (l2 < reachSame2) {
+              const double l = ::sqrt(l2);
+              const double dT = T[hi] - tlo; // heat into lo = G (T_hi − T_lo)
+              if (contact && l < twoR) {
+                const std::int32_t mhi = mat[hi];
+                const double rc = l >= rlo ? intersectionCircleRadiusEqual(rlo, l)
+                                           : intersectionCircleRadius(rlo, rlo, l);
+                if (mhi == mlo) {
+                  if (kSamePos)
+                    qcab = (kcSame * rc) * dT;
+                } else {
+                  const double khi = hm[mhi].k;
+                  if (klo + khi > 0.0)
+                    qcab = (contactConductivity(klo, khi) * rc) * dT;
+                }
+              }
+              if (lens) {
+                const double kg = pairGasConductivity(kap, clo, pcell[hi], nCells, kgSame);
+                if (kg > 0.0)
+                  qlab = kg * gasLensIntegralEqualRadii(lp, lensSame, l) * dT;
+              }
             }
-            if (lens) {
-              // κ_g of the pair: mean of the two PCM cells (a particle outside the grid uses
-              // the other's; both outside: no lens) [C].
-              const std::uint32_t chi = pcell[hi];
-              double kg = 0.0;
-              if (clo < nCells && chi < nCells)
-                kg = 0.5 * (kap[clo] + kap[chi]);
-              else if (clo < nCells)
-                kg = kap[clo];
-              else if (chi < nCells)
-                kg = kap[chi];
-              if (kg > 0.0)
-                qlab = kg * gasLensIntegral(lp, rlo, rhi, l).value * dT;
+          } else {
+            const double big = rlo > rhi ? rlo : rhi;
+            const double small = rlo > rhi ? rhi : rlo;
+            const double reach = lens ? lensFactor * big + small : rlo + rhi;
+            if (l2 < reach * reach) {
+              const double l = ::sqrt(l2);
+              const double dT = T[hi] - tlo;
+              if (contact && l < rlo + rhi) {
+                const double khi = hm[mat[hi]].k;
+                if (klo + khi > 0.0)
+                  qcab = contactConductance(klo, khi, rlo, rhi, l) * dT;
+              }
+              if (lens) {
+                const double kg = pairGasConductivity(kap, clo, pcell[hi], nCells, kgSame);
+                if (kg > 0.0)
+                  qlab = kg * gasLensIntegral(lp, rlo, rhi, l).value * dT;
+              }
             }
           }
           qc += qcab;
@@ -274,7 +327,7 @@ public:
 
     // 2b. Per-particle heat rate: the pair sums of 2a plus −Q_ab of the pairs the partners own
     //     (low lists, fixed order), convection with the gas of the PCM cell, radiation, walls.
-    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
       using namespace kernels;
       const long long ii = static_cast<long long>(i);
       const double ti = T[i];

@@ -59,6 +59,14 @@ DEM_HD double intersectionCircleRadius(double ra, double rb, double l) {
   return 2.0 * area / l;
 }
 
+/// intersectionCircleRadius(r, r, l) for two spheres of the same radius r with r ≤ l < 2r, the
+/// pair loop's common case: r_c = √((r − l/2)(r + l/2)), where r − l/2 is exact (Sterbenz), so
+/// r_c is within 1 ulp of the exact radius (the Heron form: a few ulp). @pre r ≤ l < 2r.
+DEM_HD double intersectionCircleRadiusEqual(double r, double l) {
+  const double h = 0.5 * l;
+  return std::sqrt((r - h) * (r + h));
+}
+
 /// Effective contact conductivity 4 k_i k_j/(k_i + k_j), W/(m K) (bitwise symmetric).
 DEM_HD double contactConductivity(double ki, double kj) {
   return 4.0 * (ki * kj) / (ki + kj);

@@ -20,6 +20,10 @@
 ///    turns the integrand into a rational function of t; derivation at the function). Its
 ///    rounding error is below kGasLensClosedFormRelError = 1e-13 relative over the DEM range;
 ///    it costs one square root, one or two logarithms and a few divisions per pair.
+///  * gasLensIntegralEqualRadii() is the equal-radii case written in gaps (the pair pass's
+///    common case: no square root, one or two divisions), within kGasLensEqualRadiiRelDiff =
+///    1e-14 of gasLensIntegral(). The logarithms of both are gasLensLog()/gasLensLog1p(),
+///    fdlibm's kernel inline (≤ kGasLensLog1pUlp = 2 ulp).
 ///  * gasLensIntegralReference() is the former per-pair adaptive quadrature, kept as the
 ///    independent reference for the tests: the gap without cancellation as
 ///      gap(r) = g0 + (r − R_in)(r + R_in) [1/(a + a0) + 1/(b + b0)],
@@ -33,6 +37,8 @@
 /// The result depends on (R_L, R_S, l) only, so Q_ij = −Q_ji bitwise.
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include <coredem/dem/kernels/common.h>
 #include <coredem/dem/kernels/conduction_contact.h>
@@ -184,11 +190,90 @@ DEM_HD GasLensIntegral gasLensIntegralReference(const GasLensParams& p, double r
 /// cancellation grows like R_L/R_S (a sphere against a wall-like partner of 10⁴ R: ~1e-12).
 inline constexpr double kGasLensClosedFormRelError = 1.0e-13;
 
-/// ln(1 + x) for x ≥ 0: log1p near 0, the (cheaper) log of 1 + x above 1, where rounding 1 + x
-/// costs at most 1 ulp of a result ≥ ln 2.
-DEM_HD double gasLensLog1p(double x) {
-  return x > 1.0 ? std::log(1.0 + x) : std::log1p(x);
+namespace detail {
+
+/// Bits of a double and back (host: memcpy, device: the intrinsics).
+DEM_HD_FORCEINLINE std::uint64_t doubleBits(double x) {
+#if defined(__CUDA_ARCH__)
+  return static_cast<std::uint64_t>(__double_as_longlong(x));
+#else
+  std::uint64_t b;
+  std::memcpy(&b, &x, sizeof b);
+  return b;
+#endif
 }
+
+DEM_HD_FORCEINLINE double doubleFromBits(std::uint64_t b) {
+#if defined(__CUDA_ARCH__)
+  return __longlong_as_double(static_cast<long long>(b));
+#else
+  double x;
+  std::memcpy(&x, &b, sizeof x);
+  return x;
+#endif
+}
+
+/// k ln 2 + ln(1 + f) + lo for f in [√2/2 − 1, √2 − 1] and a small correction lo (ln(1 + c/u)
+/// ≈ c/u of a rounded argument u), as fdlibm's e_log.c/k_log.h (Sun Microsystems 1993): with
+/// s = f/(2 + f), ln(1 + f) = 2 atanh s = f − f²/2 + s (f²/2 + R(s²)), R a degree-14 Remez fit
+/// of 2 atanh(s)/s − 2 − … (error below 2^−58.45), ln 2 split into a 32-bit head and its tail.
+/// Pure arithmetic (inlined, no library call); below 1 ulp (fdlibm's bound for ln). Callers
+/// without a correction pass lo = −0.0, which the compiler drops (x + (−0) = x for every x).
+DEM_HD_FORCEINLINE double logKernel(double f, double k, double lo) {
+  constexpr double ln2Hi = 6.93147180369123816490e-01; // 0x3fe62e42fee00000
+  constexpr double ln2Lo = 1.90821492927058770002e-10; // 0x3dea39ef35793c76
+  constexpr double lg1 = 6.666666666666735130e-01;
+  constexpr double lg2 = 3.999999999940941908e-01;
+  constexpr double lg3 = 2.857142874366239149e-01;
+  constexpr double lg4 = 2.222219843214978396e-01;
+  constexpr double lg5 = 1.818357216161805012e-01;
+  constexpr double lg6 = 1.531383769920937332e-01;
+  constexpr double lg7 = 1.479819860511658591e-01;
+  const double s = f / (2.0 + f);
+  const double z = s * s;
+  const double w = z * z;
+  const double t1 = w * (lg2 + w * (lg4 + w * lg6));
+  const double t2 = z * (lg1 + w * (lg3 + w * (lg5 + w * lg7)));
+  const double r = t2 + t1;
+  const double hfsq = 0.5 * f * f;
+  return k * ln2Hi - ((hfsq - (s * (hfsq + r) + (k * ln2Lo + lo))) - f);
+}
+
+} // namespace detail
+
+/// ln u for normal u ≥ 1 (finite): u = 2^k m, m in [√2/2, √2) (fdlibm's split: the mantissa
+/// plus 0x95f64… carries into the exponent exactly when it is above ≈ √2), then the kernel. Pure
+/// arithmetic, below 1 ulp (fdlibm's bound).
+DEM_HD_FORCEINLINE double gasLensLog(double u) {
+  const std::uint64_t b = detail::doubleBits(u);
+  const std::uint64_t mant = b & 0x000fffffffffffffULL;
+  const std::uint64_t carry = (mant + 0x00095f6400000000ULL) & 0x0010000000000000ULL;
+  const int k = static_cast<int>(b >> 52) - 1023 + static_cast<int>(carry >> 52);
+  const double m = detail::doubleFromBits(mant | (0x3ff0000000000000ULL ^ carry));
+  return detail::logKernel(m - 1.0, static_cast<double>(k), -0.0);
+}
+
+/// ln(1 + x) for 0 ≤ x < 2^1023 (finite), the logarithm of the lens integral: pure arithmetic,
+/// no library call (the call made the pair loop spill every live register). Above 1, ln of the
+/// rounded 1 + x (costs at most 1/2 ulp of 1 + x, i.e. 0.72 ulp of a result ≥ ln 2); up to √2 − 1
+/// the kernel on f = x itself; in between on f = (1 + x)/2 − 1 with the rounding error c of
+/// 1 + x (exact, Fast2Sum) added as c/(1 + x). Error bound kGasLensLog1pUlp ulp, tested against
+/// log1pl over [0, 1e12] (tests/unit/thermochem/conduction_equal_radii_test.cpp).
+DEM_HD_FORCEINLINE double gasLensLog1p(double x) {
+  if (x > 1.0) {
+    return gasLensLog(1.0 + x);
+  }
+  if (x <= 0.41421356237309503) {
+    return detail::logKernel(x, 0.0, -0.0);
+  }
+  const double u = 1.0 + x;       // in (√2, 2]
+  const double c = x - (u - 1.0); // exact rounding error of 1 + x
+  return detail::logKernel(0.5 * u - 1.0, 1.0, c / u);
+}
+
+/// Bound on gasLensLog1p()'s and gasLensLog()'s errors in ulp of the result (observed ≤ 1.52
+/// and ≤ 1.0; see gasLensLog1p()).
+inline constexpr double kGasLensLog1pUlp = 2.0;
 
 /// The lens integral I of Eq. 24 (m) in closed form. Depends only on the sorted radii and l.
 ///
@@ -311,6 +396,115 @@ DEM_HD GasLensIntegral gasLensIntegral(const GasLensParams& p, double ri, double
                       l * gasLensLog1p(delta / t2));
   }
   return result(clipped + 0.5 * pi * open);
+}
+
+/// Per-radius constants of gasLensIntegralEqualRadii(), formed once per particle (hoisted out
+/// of the pair loop).
+struct GasLensEqualRadii {
+  double r;      ///< R = R_L = R_S, m
+  double twoR;   ///< 2R: in contact at l < 2R, m
+  double rLens;  ///< (1 + FLPC) R, m
+  double reach;  ///< R_lens + R: no lens at l ≥ reach, m
+  double kappa;  ///< κ = R_lens² − R² = (R_lens − R)(R_lens + R), m²
+  double kappaS; ///< κ/s_min, m
+};
+
+DEM_HD GasLensEqualRadii gasLensEqualRadii(const GasLensParams& p, double r) {
+  const double rLens = (1.0 + p.lensFraction) * r;
+  const double kappa = (rLens - r) * (rLens + r);
+  return {r, r + r, rLens, rLens + r, kappa, kappa / p.minSeparation};
+}
+
+/// Relative bound on |gasLensIntegralEqualRadii() − gasLensIntegral()| (both closed forms of
+/// the same integral, rounded differently) over the DEM range of
+/// tests/unit/thermochem/conduction_equal_radii_test.cpp; against exact values the equal-radii
+/// form keeps kGasLensClosedFormRelError (tested on the 40-digit values of conduction_test.cpp).
+inline constexpr double kGasLensEqualRadiiRelDiff = 1.0e-14;
+
+/// The lens integral I of Eq. 24 (m) for two spheres of the same radius R (p the parameters,
+/// c = gasLensEqualRadii(p, R)), the pair loop's common case (a monodisperse bed), in the
+/// equal-radii closed form, far shorter than gasLensIntegral()'s:
+///
+///   gap(r) = l − 2√(R² − r²), so r² = R² − ((l − g)/2)² at gap g, and
+///   g_in  = max(l − 2R, 0)                                  (the surfaces meet in contact)
+///   g_out = κ/l (κ = R_lens² − R², the lens circle), or l once l² ≤ κ (R_out = R)
+///   clipped part π (r*² − R_in²)/s_min = π (s_min − g_in)(2l − g_in − s_min)/(4 s_min)
+///   open part (π/2) [l ln(1 + δ/g_1) − δ],  g_1 = max(g_in, s_min),  δ = g_out − g_1
+///
+/// (all clipped if g_out ≤ s_min: π (g_out − g_in)(2l − g_in − g_out)/(4 s_min)). In contact
+/// the clipped part is π(2l − s_min)/4 and 1 + δ/s_min = u = κ/(l s_min), so that (κ/s_min per
+/// radius) I = π(2l − s_min)/4 + (π/2)[l ln u − s_min (u − 1)]; apart, likewise with u =
+/// g_out/g_1 while u > 2, and closer to the reach ln(1 + δ/g_1) with g_out − g_in =
+/// (R − (l − R_lens))(R_lens + (l − R))/l without cancellation. One or two
+/// divisions, the logarithm (gasLensLog, gasLensLog1p), no square root. Agrees with
+/// gasLensIntegral() within kGasLensEqualRadiiRelDiff, and with exact values within
+/// kGasLensClosedFormRelError. Distances l ≤ R (more than half the spheres overlapping) take the
+/// general function.
+DEM_HD_FORCEINLINE double gasLensIntegralEqualRadii(const GasLensParams& p,
+                                                    const GasLensEqualRadii& c, double l) {
+  constexpr double pi = 3.141592653589793;
+  if (!(p.minSeparation > 0.0) || !(p.lensFraction >= 0.0) || !(l < c.reach)) {
+    return 0.0; // invalid parameters, or the lens does not reach the other sphere
+  }
+  if (!(l > c.r)) {
+    return gasLensIntegral(p, c.r, c.r, l).value;
+  }
+  const double sMin = p.minSeparation;
+  const bool chord = l * l > c.kappa; // R_out on the lens circle (else R_out = R, g_out = l)
+  double clipped = 0.0;
+  double g1 = 0.0;
+  double delta = 0.0;
+  if (l < c.twoR) {
+    // In contact: g_in = 0. Usually g_out/s_min = κ/(l s_min) > 2: then 1 + δ/s_min is that
+    // ratio, formed with one division and no rounding of 1 + x, and δ = s_min (u − 1) (u − 1 is
+    // exact for u ≥ 1).
+    if (chord) {
+      const double u = c.kappaS / l;
+      if (u > 2.0) {
+        return 0.25 * pi * (2.0 * l - sMin) + 0.5 * pi * (l * gasLensLog(u) - sMin * (u - 1.0));
+      }
+    }
+    const double gOut = chord ? c.kappa / l : l;
+    if (gOut <= sMin) {
+      return pi * gOut * (2.0 * l - gOut) / (4.0 * sMin); // all clipped
+    }
+    clipped = 0.25 * pi * (2.0 * l - sMin);
+    g1 = sMin;
+    delta = gOut - sMin;
+  } else {
+    const double gIn = l - c.twoR;
+    if (chord) {
+      // Apart, and far enough from the reach that u = 1 + δ/g_1 = g_out/g_1 > 2: as in contact,
+      // ln u directly (u − 1 is exact; l ln u ≥ 2R ln 2 exceeds δ ≤ κ/(2R) for FLPC ≤ 0.9, so
+      // l ln u − δ does not cancel).
+      if (gIn < sMin) {
+        const double u = c.kappaS / l;
+        if (u > 2.0) {
+          const double dS = sMin - gIn;
+          return pi * dS * ((2.0 * l - gIn) - sMin) / (4.0 * sMin) +
+                 0.5 * pi * (l * gasLensLog(u) - sMin * (u - 1.0));
+        }
+      } else {
+        const double u = c.kappa / (l * gIn);
+        if (u > 2.0) {
+          return 0.5 * pi * (l * gasLensLog(u) - gIn * (u - 1.0));
+        }
+      }
+    }
+    const double rise = chord ? (c.r - (l - c.rLens)) * (c.rLens + (l - c.r)) / l : c.twoR;
+    if (gIn + rise <= sMin) {
+      return pi * rise * ((2.0 * l - gIn) - (gIn + rise)) / (4.0 * sMin); // all clipped
+    }
+    g1 = gIn;
+    delta = rise;
+    if (gIn < sMin) {
+      const double dS = sMin - gIn;
+      clipped = pi * dS * ((2.0 * l - gIn) - sMin) / (4.0 * sMin);
+      g1 = sMin;
+      delta = rise - dS;
+    }
+  }
+  return clipped + 0.5 * pi * (l * gasLensLog1p(delta / g1) - delta);
 }
 
 /// Lens conductance κ_g I, W/K.
