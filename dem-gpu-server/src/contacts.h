@@ -13,23 +13,19 @@
 ///   pass 2 (per particle j): adds the partner shares of the contacts it does not own, in the
 ///     ascending index order of its neighbour list (a fixed order).
 /// Both passes write only their own index, so the result does not depend on the thread count.
-/// The cpu backend gathers the owned pairs in contact of a run of consecutive particles into a
-/// PairBatch and evaluates them several at a time, one pair per lane of a SIMD register (8 with
-/// AVX-512, 4 with AVX, 2 with SSE2: evalPairBatch; every lane gives the bits of
-/// ownedPair<double>, the other backends' path), then sums them per particle in the same order;
-/// both passes run compiled for AVX where the processor has it (CpuExec::reduceMaxIntoWide,
-/// reduceMaxRangesIntoWide; same operations, no FMA contraction).
+/// The cpu backend evaluates two consecutive owned candidates in contact at once, one in each
+/// lane of kernels::Double2 (twoOwnedPairs; every lane gives the bits of ownedPair<double>, the
+/// other backends' path), and runs both passes compiled for AVX where the processor has it
+/// (CpuExec::reduceMaxIntoWide; same operations, no FMA).
 /// The LSD law is mirror-exact (lsd_contact.h): j's share is bitwise what evaluating the pair
 /// from j's side gives. History slots (partner gid, −(w+2) for wall w) hold the owned contacts
 /// and the walls only; slots of a state file written when both sides kept their history are
 /// read as they are (the owner's slot is the one used; the other is dropped at the next sub-step).
 /// Forces add the gas force of the drag module in coupled runs.
 
-#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <string>
 #include <type_traits>
 
@@ -46,60 +42,6 @@ namespace coredem::dem {
 
 /// Particles ahead whose history rows pass 1 prefetches (CPU; a hint only).
 constexpr std::size_t kPrefetchAhead = 8;
-
-/// Candidate j of a particle at xi with radius ri: d = x_j − x_i, |d|², r_j, and whether the two
-/// touch (|d| < r_i + r_j).
-struct Candidate {
-  kernels::Vec3 d;
-  double l2;
-  double rj;
-  bool touching;
-};
-DEM_HD Candidate candidateOf(const double* x, const double* r, kernels::Vec3 xi, double ri,
-                             std::int32_t j) {
-  const kernels::Vec3 d = kernels::load3(x, j) - xi;
-  const double l2 = kernels::dot(d, d);
-  const double rj = r[j];
-  const double rsum = ri + rj;
-  return {d, l2, rj, l2 < rsum * rsum};
-}
-
-/// Asks for the history row of particle i (K slots) when it had contacts in the last sub-step:
-/// the rows of the few particles in contact are scattered through memory, so pass 1 asks for
-/// those of a particle kPrefetchAhead further on while it computes (a hint only).
-DEM_HD void prefetchHistoryRow(const std::int64_t* hk, const double* hd, const std::int32_t* nc,
-                               const std::int32_t* nwc, int K, std::size_t i, std::size_t n) {
-  if (i < n && nc[i] + nwc[i] > 0) {
-    const std::size_t a = i * static_cast<std::size_t>(K);
-    backend::prefetch(hk + a);
-    backend::prefetch(hd + 3 * a);
-    backend::prefetch(hd + 3 * a + 8);
-  }
-}
-
-/// Where pass 1 leaves a particle's results.
-struct Pass1Out {
-  double* f;
-  double* tq;
-  double* fw;
-  std::int64_t* hk;
-  std::int32_t* nc;
-  std::int32_t* nwc;
-  int K;
-};
-
-/// Pass 1's results of particle i: F = its force (gas + owned pairs + walls), T its torque, FW
-/// the walls' part of F; history slots from `slot` to `used` (the last sub-step's) emptied.
-DEM_HD void storePass1(const Pass1Out& o, long long i, kernels::Vec3 F, kernels::Vec3 T,
-                       kernels::Vec3 FW, int slot, int used, int owned, int walls) {
-  for (int s = slot; s < used; ++s)
-    o.hk[i * o.K + s] = -1;
-  kernels::store3(o.f, i, F);
-  kernels::store3(o.tq, i, T);
-  kernels::store3(o.fw, i, FW);
-  o.nc[i] = owned;
-  o.nwc[i] = walls;
-}
 
 /// The contact module has no ledger (counts and wall forces are read from the particles).
 struct ContactTotals {};
@@ -144,195 +86,128 @@ void reduceMaxIntoWide(Exec& exec, std::size_t n, F f, double init, double* out)
     exec.reduceMaxInto(n, f, init, out);
 }
 
-/// The LSD law of particle i against wall w with overlap deltaN > 0 (m_eff = m_i, the
-/// particle's own material pair); hist: the contact's tangential displacement.
-DEM_HD kernels::LsdResult wallPair(const PairProps& pp, const kernels::PlaneWall& wall,
-                                   double deltaN, double mi, kernels::Vec3 vi, kernels::Vec3 wi,
-                                   double ri, kernels::Vec3 hist, double dt) {
-  using namespace kernels;
-  const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
-  const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-  return wallContact(lp, wall, deltaN, vi, wi, ri, hist, dt);
-}
-
-/// Calls f(k, deltaN) for every wall k that particle i (at xi, radius ri) overlaps, in
-/// ascending order: the candidate bits of the first 32 walls (bits: wall candidates of the last
-/// neighbour build; most particles have none), then every wall beyond them.
-template <class F>
-DEM_HD void forEachWallOverlap(std::uint32_t bits, int nWalls, const kernels::PlaneWall* walls,
-                               kernels::Vec3 xi, double ri, F f) {
-  for (int k = bits != 0 ? kernels::lowestBit(bits) : 32; k < nWalls;) {
-    const double deltaN = kernels::wallOverlap(walls[k], xi, ri);
-    if (deltaN > 0.0)
-      f(k, deltaN);
-    if (k < 32) {
-      bits &= bits - 1;
-      k = bits != 0 ? kernels::lowestBit(bits) : 32;
-    } else {
-      ++k;
-    }
-  }
-}
-
-/// Whether Exec evaluates the owned pairs in batches (Exec::kPairBatches, cpu).
+/// Whether Exec evaluates two owned pairs at once (Exec::PairScalar, cpu: kernels::Double2).
+template <class Exec, class = void>
+inline constexpr bool kTwoPairs = false;
 template <class Exec>
-inline constexpr bool kPairBatches = requires {
-  requires Exec::kPairBatches;
-};
+inline constexpr bool kTwoPairs<Exec, std::void_t<typename Exec::PairScalar>> = true;
 
 #if defined(COREDEM_DEM_DOUBLE2)
-/// Owned pairs in contact, gathered by pass 1 of the cpu backend from a run of consecutive
-/// particles (one column per pair, structure of arrays) and evaluated several at a time in the
-/// lanes of a SIMD register by evalPairBatch; then their results, read back in candidate order.
-struct PairBatch {
-  /// Columns (pairs); a run of particles ends before its owned candidates could exceed it.
-  static constexpr int kCapacity = 64;
-  /// Inputs of ownedPair: d, |d|², r_i, r_j, m_i, m_j, the pair's material constants, v_i, v_j,
-  /// ω_i, ω_j and the old tangential displacement.
-  enum In : int {
-    Dx,
-    Dy,
-    Dz,
-    L2,
-    Ri,
-    Rj,
-    Mi,
-    Mj,
-    Kn,
-    Kt,
-    Damp,
-    Etat,
-    Mu,
-    Vix,
-    Viy,
-    Viz,
-    Vjx,
-    Vjy,
-    Vjz,
-    Wix,
-    Wiy,
-    Wiz,
-    Wjx,
-    Wjy,
-    Wjz,
-    Hx,
-    Hy,
-    Hz,
-    kIn
-  };
-  /// Results: force and torque on i, new tangential displacement, the partner's torque.
-  enum Out : int { Fx, Fy, Fz, Tx, Ty, Tz, DTx, DTy, DTz, Sx, Sy, Sz, kOut };
-  alignas(64) double in[kIn][kCapacity];
-  alignas(64) double out[kOut][kCapacity];
-  std::int64_t key[kCapacity]; ///< history key of the pair (the partner's gid)
+/// What twoOwnedPairs reads and writes (pass 1 of ContactModule::sources).
+struct TwoPairArgs {
+  const double* x;
+  const double* v;
+  const double* w;
+  const double* r;
+  const double* m;
+  const std::int32_t* mat;
+  const std::int32_t* half;
+  const PairProps* pairs;
+  std::int64_t* hk;
+  double* hd;
+  double* share;
+  int nMat;
+  int K;
+  double dt;
+  bool avx; ///< twoOwnedPairs runs its AVX version
 };
 
-/// Pairs [g, g + kLanes<S>) of b in the lanes of S: the bits of ownedPair<double> per lane.
-template <class S>
-[[gnu::always_inline]] inline void evalPairGroup(PairBatch& b, int g, double dt) {
+/// Owned candidates q0 < q1 of particle i, both in contact, evaluated in the two lanes of
+/// Double2 (ownedPair): writes their history slots slot and slot + 1 (keys key0, key1; old
+/// displacements h[0], h[1]) and their partners' shares, and returns force and torque on i of
+/// q0 in out[0..6) and of q1 in out[6..12). Called through twoOwnedPairs.
+DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std::uint32_t q0,
+                                          std::uint32_t q1, std::int64_t key0, std::int64_t key1,
+                                          const kernels::Vec3* h, int slot, double* out) {
   using namespace kernels;
-  using B = PairBatch;
-  // Loads and stores straight from and to the columns (no copies through the stack).
-  auto in = [&](int k) {
-    S s;
-    __builtin_memcpy(&s, &b.in[k][g], sizeof(S));
-    return s;
+  using D = Double2;
+  const long long j0 = a.half[q0];
+  const long long j1 = a.half[q1];
+  auto both = [](double u) { return D{u, u}; };
+  auto lanes = [](double u, double v) { return D{u, v}; };
+  auto gather3 = [&](const double* p) {
+    return Vec3T<D>{lanes(p[3 * j0], p[3 * j1]), lanes(p[3 * j0 + 1], p[3 * j1 + 1]),
+                    lanes(p[3 * j0 + 2], p[3 * j1 + 2])};
   };
-  auto in3 = [&](int k) { return Vec3T<S>{in(k), in(k + 1), in(k + 2)}; };
-  auto out3 = [&](int k, Vec3T<S> u) {
-    __builtin_memcpy(&b.out[k][g], &u.x, sizeof(S));
-    __builtin_memcpy(&b.out[k + 1][g], &u.y, sizeof(S));
-    __builtin_memcpy(&b.out[k + 2][g], &u.z, sizeof(S));
+  auto both3 = [&](const double* p) {
+    return Vec3T<D>{both(p[3 * i]), both(p[3 * i + 1]), both(p[3 * i + 2])};
   };
-  const OwnedPair<S> op =
-      ownedPair<S>(in3(B::Dx), in(B::L2), in(B::Ri), in(B::Rj), in(B::Mi), in(B::Mj), in(B::Kn),
-                   in(B::Kt), in(B::Damp), in(B::Etat), in(B::Mu), in3(B::Vix), in3(B::Vjx),
-                   in3(B::Wix), in3(B::Wjx), in3(B::Hx), dt);
-  out3(B::Fx, op.res.force);
-  out3(B::Tx, op.res.torque);
-  out3(B::DTx, op.res.deltaT);
-  out3(B::Sx, op.lji * op.res.nxft);
+  const Vec3T<D> d = gather3(a.x) - both3(a.x);
+  const PairProps* row = a.pairs + a.mat[i] * a.nMat;
+  const PairProps& p0 = row[a.mat[j0]];
+  const PairProps& p1 = row[a.mat[j1]];
+  const OwnedPair<D> op = ownedPair<D>(
+      d, dot(d, d), both(a.r[i]), lanes(a.r[j0], a.r[j1]), both(a.m[i]), lanes(a.m[j0], a.m[j1]),
+      lanes(p0.kn, p1.kn), lanes(p0.kt, p1.kt), lanes(p0.dampFactor, p1.dampFactor),
+      lanes(p0.etatFactor, p1.etatFactor), lanes(p0.mu, p1.mu), both3(a.v), gather3(a.v),
+      both3(a.w), gather3(a.w),
+      Vec3T<D>{lanes(h[0].x, h[1].x), lanes(h[0].y, h[1].y), lanes(h[0].z, h[1].z)}, a.dt);
+  const LsdResultT<D>& res = op.res;
+  const Vec3T<D> shareT = op.lji * res.nxft;
+  const long long k = static_cast<long long>(a.K);
+  if (slot < a.K) {
+    a.hk[i * k + slot] = key0;
+    store3(a.hd, i * k + slot, Vec3{res.deltaT.x[0], res.deltaT.y[0], res.deltaT.z[0]});
+  }
+  if (slot + 1 < a.K) {
+    a.hk[i * k + slot + 1] = key1;
+    store3(a.hd, i * k + slot + 1, Vec3{res.deltaT.x[1], res.deltaT.y[1], res.deltaT.z[1]});
+  }
+  // The partners' shares: force −f (applied in pass 2), torque L_ji n × f_t.
+  const Vec3 f0{res.force.x[0], res.force.y[0], res.force.z[0]};
+  const Vec3 f1{res.force.x[1], res.force.y[1], res.force.z[1]};
+  store3(a.share, 2 * static_cast<long long>(q0), f0);
+  store3(a.share, 2 * static_cast<long long>(q0) + 1, Vec3{shareT.x[0], shareT.y[0], shareT.z[0]});
+  store3(a.share, 2 * static_cast<long long>(q1), f1);
+  store3(a.share, 2 * static_cast<long long>(q1) + 1, Vec3{shareT.x[1], shareT.y[1], shareT.z[1]});
+  store3(out, 0, f0);
+  store3(out, 1, Vec3{res.torque.x[0], res.torque.y[0], res.torque.z[0]});
+  store3(out, 2, f1);
+  store3(out, 3, Vec3{res.torque.x[1], res.torque.y[1], res.torque.z[1]});
 }
 
-/// Pairs [0, count) of b: groups of S, the rest in narrower lanes (no padding).
-template <class S>
-[[gnu::always_inline]] inline void evalPairsAs(PairBatch& b, int count, double dt) {
-  int g = 0;
-  for (; g + kernels::kLanes<S> <= count; g += kernels::kLanes<S>)
-    evalPairGroup<S>(b, g, dt);
-#if defined(COREDEM_DEM_WIDE_LANES)
-  if constexpr (kernels::kLanes < S >> 4) {
-    if (g + 4 <= count) {
-      evalPairGroup<kernels::Double4>(b, g, dt);
-      g += 4;
-    }
-  }
-#endif
-  if constexpr (kernels::kLanes < S >> 2) {
-    if (g + 2 <= count) {
-      evalPairGroup<kernels::Double2>(b, g, dt);
-      g += 2;
-    }
-  }
-  if (g < count)
-    evalPairGroup<double>(b, g, dt);
+/// twoOwnedPairsBody in SSE2 (the x86-64 baseline) and, for processors that have it, in AVX:
+/// the same lane operations in the three-operand encoding, without the register copies of
+/// SSE2's two-operand forms (about a quarter of the instructions), and no FMA (not part of AVX),
+/// so the bits are the same. Out of line: the particle loop and this body each get the
+/// registers to themselves.
+[[gnu::noinline, gnu::flatten]] inline void twoOwnedPairsSse2(const TwoPairArgs& a, long long i,
+                                                              std::uint32_t q0, std::uint32_t q1,
+                                                              std::int64_t key0, std::int64_t key1,
+                                                              const kernels::Vec3* h, int slot,
+                                                              double* out) {
+  twoOwnedPairsBody(a, i, q0, q1, key0, key1, h, slot, out);
 }
-
-// One out-of-line copy per instruction set: the gathering loop and the lane arithmetic each get
-// the registers to themselves, and AVX / AVX-512 code runs only where the processor has it.
-[[gnu::noinline, gnu::flatten]] inline void evalPairBatch1(PairBatch& b, int count, double dt) {
-  for (int g = 0; g < count; ++g)
-    evalPairGroup<double>(b, g, dt);
-}
-[[gnu::noinline, gnu::flatten]] inline void evalPairBatch2(PairBatch& b, int count, double dt) {
-  evalPairsAs<kernels::Double2>(b, count, dt);
-}
-#if defined(COREDEM_DEM_WIDE_LANES)
+#if defined(__x86_64__)
 [[gnu::noinline, gnu::flatten, gnu::target("avx")]] inline void
-evalPairBatch4(PairBatch& b, int count, double dt) {
-  evalPairsAs<kernels::Double4>(b, count, dt);
-}
-[[gnu::noinline, gnu::flatten, gnu::target("avx512f")]] inline void
-evalPairBatch8(PairBatch& b, int count, double dt) {
-  evalPairsAs<kernels::Double8>(b, count, dt);
+twoOwnedPairsAvx(const TwoPairArgs& a, long long i, std::uint32_t q0, std::uint32_t q1,
+                 std::int64_t key0, std::int64_t key1, const kernels::Vec3* h, int slot,
+                 double* out) {
+  twoOwnedPairsBody(a, i, q0, q1, key0, key1, h, slot, out);
 }
 #endif
-
-/// The widest lane count this processor runs: 8 (AVX-512F), 4 (AVX) or 2 (SSE2).
-inline int widestPairLanes() {
-#if defined(COREDEM_DEM_WIDE_LANES)
-  if (__builtin_cpu_supports("avx512f"))
-    return 8;
-  if (__builtin_cpu_supports("avx"))
-    return 4;
-#endif
-  return 2;
-}
-
-/// Evaluates the pairs [0, count) of b, at most `lanes` at a time (1, 2, 4 or 8, at most
-/// widestPairLanes()): every lane count gives the same bits (tested).
-inline void evalPairBatch(PairBatch& b, int count, double dt, int lanes) {
-#if defined(COREDEM_DEM_WIDE_LANES)
-  if (lanes >= 8)
-    return evalPairBatch8(b, count, dt);
-  if (lanes >= 4)
-    return evalPairBatch4(b, count, dt);
-#endif
-  if (lanes >= 2)
-    return evalPairBatch2(b, count, dt);
-  evalPairBatch1(b, count, dt);
-}
-
-/// The lane count of the contact pass: widestPairLanes(), or COREDEM_DEM_PAIR_LANES (1, 2, 4 or
-/// 8, capped at widestPairLanes()) to compare lane counts in a benchmark (results are the same).
-inline int pairLanesToUse() {
-  const int widest = widestPairLanes();
-  if (const char* e = std::getenv("COREDEM_DEM_PAIR_LANES")) {
-    const int want = std::atoi(e);
-    if (want == 1 || want == 2 || want == 4 || want == 8)
-      return want < widest ? want : widest;
+/// twoOwnedPairsAvx if a.avx, else twoOwnedPairsSse2. (Without AVX the group costs 443
+/// instructions per two pairs against 510 for two scalar pairs, about what the call and the
+/// gathers add: pass 1 then counts +0.7 %, not worth a test per pair in the loop.)
+inline void twoOwnedPairs(const TwoPairArgs& a, long long i, std::uint32_t q0, std::uint32_t q1,
+                          std::int64_t key0, std::int64_t key1, const kernels::Vec3* h, int slot,
+                          double* out) {
+#if defined(__x86_64__)
+  if (a.avx) {
+    twoOwnedPairsAvx(a, i, q0, q1, key0, key1, h, slot, out);
+    return;
   }
-  return widest;
+#endif
+  twoOwnedPairsSse2(a, i, q0, q1, key0, key1, h, slot, out);
+}
+
+/// Whether twoOwnedPairs may use AVX (the processor and the operating system support it).
+inline bool cpuHasAvx() {
+#if defined(__x86_64__)
+  return __builtin_cpu_supports("avx");
+#else
+  return false;
+#endif
 }
 #endif
 
@@ -355,30 +230,17 @@ public:
       _walls.h()[k] = s.walls[k];
     _walls.markHostModified();
     _walls.toDevice();
-#if defined(COREDEM_DEM_DOUBLE2)
-    _pairLanes = pairLanesToUse();
-#endif
   }
 
-  bool enabled() const {
-    return true;
-  }
-  std::size_t bytes() const {
-    return _pairs.bytes() + _walls.bytes() + _hit.bytes();
-  }
-  ContactTotals totals() const {
-    return {};
-  }
+  bool enabled() const { return true; }
+  std::size_t bytes() const { return _pairs.bytes() + _walls.bytes() + _hit.bytes(); }
+  ContactTotals totals() const { return {}; }
 
   /// History slots in use in some row (slots at or beyond it are empty everywhere); the
   /// neighbour rebuild moves only these.
-  int usedSlots() const {
-    return _maxUsedSlots;
-  }
+  int usedSlots() const { return _maxUsedSlots; }
   /// After new particles: every slot may be in use.
-  void resetUsedSlots(int slots) {
-    _maxUsedSlots = slots;
-  }
+  void resetUsedSlots(int slots) { _maxUsedSlots = slots; }
 
   void beginWindow(StepContext<Exec>&) {}
   void update(StepContext<Exec>&) {}
@@ -455,253 +317,151 @@ public:
     const int K = p.K;
     const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
 
-    const Pass1Out out{f, tq, fw, hk, nc, nwc, K};
-    // Pass 1, one particle: its owned pairs and its walls. Returns the history slots it needs
-    // (owned contacts + walls); writes only index i.
-    auto pass1 = [=] DEM_LAMBDA(std::size_t i) {
-      using namespace kernels;
-      const long long ii = static_cast<long long>(i);
-      const Vec3 xi = load3(x, ii);
-      const double ri = r[i];
-      prefetchHistoryRow(hk, hd, nc, nwc, K, i + kPrefetchAhead, n);
-      // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
-      // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
-      const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
-      std::int64_t oldKey[kMaxHistorySlots];
-      Vec3 oldD[kMaxHistorySlots];
-      for (int s = 0; s < used; ++s) {
-        oldKey[s] = hk[i * K + s];
-        oldD[s] = load3(hd, ii * K + s);
-      }
-      int slot = 0;
-      auto history = [&](std::int64_t key) {
-        for (int s = 0; s < used; ++s)
-          if (oldKey[s] == key)
-            return oldD[s];
-        return Vec3{0.0, 0.0, 0.0};
-      };
-      auto remember = [&](std::int64_t key, Vec3 d) {
-        if (slot < K) {
-          hk[i * K + slot] = key;
-          store3(hd, ii * K + slot, d);
-        }
-        ++slot;
-      };
-      Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
-      Vec3 T{0.0, 0.0, 0.0};
-      // Particle–particle LSD (Eqs. 7–13) over the owned candidates. i's velocities, mass
-      // and material are read only if it has some (most particles of a dilute bed do not).
-      int owned = 0;
-      const std::uint32_t qEnd = hs[i + 1];
-      if (hs[i] < qEnd) {
-        const Vec3 vi = load3(v, ii);
-        const Vec3 wi = load3(w, ii);
-        const double mi = m[i];
-        const int ai = mat[i];
-        for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
-          const std::int32_t j = half[q];
-          const Candidate cj = candidateOf(x, r, xi, ri, j);
-          hit[q] = cj.touching ? 1 : 0;
-          if (!cj.touching)
-            continue;
-          const PairProps pp = pairs[ai * nMat + mat[j]];
-          const std::int64_t key = gid[j];
-          const OwnedPair<double> op =
-              ownedPair(cj.d, cj.l2, ri, cj.rj, mi, m[j], pp.kn, pp.kt, pp.dampFactor,
-                        pp.etatFactor, pp.mu, vi, load3(v, j), wi, load3(w, j), history(key), dt);
-          const LsdResult& res = op.res;
-          F += res.force;
-          T += res.torque;
-          remember(key, res.deltaT);
-          // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
-          store3(share, 2 * static_cast<long long>(q), res.force);
-          store3(share, 2 * static_cast<long long>(q) + 1, op.lji * res.nxft);
-          ++owned;
-        }
-      }
-      // Walls, in ascending order.
-      Vec3 FW{0.0, 0.0, 0.0};
-      int wallCount = 0;
-      forEachWallOverlap(wallNear[i], nWalls, walls, xi, ri, [&](int k, double deltaN) {
-        const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-        const LsdResult res = wallPair(pairs[mat[i] * nMat + mat[i]], walls[k], deltaN, m[i],
-                                       load3(v, ii), load3(w, ii), ri, history(key), dt);
-        FW += res.force;
-        T += res.torque;
-        remember(key, res.deltaT);
-        ++wallCount;
-      });
-      F += FW;
-      storePass1(out, ii, F, T, FW, slot, used, owned, wallCount);
-      return static_cast<double>(slot);
-    };
-
+#if defined(COREDEM_DEM_DOUBLE2)
+    const TwoPairArgs two{x, v, w, r, m, mat, half, pairs, hk, hd, share, nMat, K, dt, cpuHasAvx()};
+#endif
     // Pass 1: the owned pairs and the walls of every particle. reduceMax runs the body once
     // per index (side effects on index i only) and returns the most history slots a particle
     // needs (owned contacts + walls), in the same pass.
-#if defined(COREDEM_DEM_DOUBLE2)
-    if constexpr (kPairBatches<Exec>) {
-      // cpu: runs of consecutive particles, each in three steps: (a) per particle, its owned
-      // candidates in contact are found and their inputs gathered into a PairBatch (history
-      // read from the particle's unchanged row); (b) the batch is evaluated several pairs at a
-      // time in SIMD lanes; (c) per particle, in candidate order, the results are summed and
-      // stored exactly as pass1 does (walls evaluated first, on the unchanged row, and added
-      // after the pairs): the bits of pass1, which serves a particle with more owned
-      // candidates than a batch holds.
-      const int lanes = _pairLanes;
-      auto run = [=](std::size_t lo, std::size_t hi) {
-        using namespace kernels;
-        using B = PairBatch;
-        B batch;
-        double most = 0.0;
-        std::size_t i = lo;
-        while (i < hi) {
-          // (a) gather
-          int count = 0;
-          std::size_t end = i;
-          for (; end < hi; ++end) {
-            const std::uint32_t q0 = hs[end];
-            const std::uint32_t q1 = hs[end + 1];
-            if (count + static_cast<int>(q1 - q0) > B::kCapacity)
-              break;
-            prefetchHistoryRow(hk, hd, nc, nwc, K, end + kPrefetchAhead, n);
-            if (q0 == q1)
-              continue;
-            const long long ii = static_cast<long long>(end);
-            const Vec3 xi = load3(x, ii);
-            const double ri = r[end];
-            const int used = nc[end] + nwc[end] < K ? nc[end] + nwc[end] : K;
-            const std::int64_t* keys = hk + ii * K;
-            int nth = 0; // touching candidates of this particle so far
-            for (std::uint32_t q = q0; q < q1; ++q) {
+    reduceMaxIntoWide(
+        ctx.exec, n,
+        [=] DEM_LAMBDA(std::size_t i) {
+          using namespace kernels;
+          const long long ii = static_cast<long long>(i);
+          const Vec3 xi = load3(x, ii);
+          const double ri = r[i];
+          // The history rows of the few particles in contact are scattered through memory:
+          // ask for those of a particle kPrefetchAhead further on while this one computes.
+          if (i + kPrefetchAhead < n && nc[i + kPrefetchAhead] + nwc[i + kPrefetchAhead] > 0) {
+            const std::size_t a = (i + kPrefetchAhead) * static_cast<std::size_t>(K);
+            backend::prefetch(hk + a);
+            backend::prefetch(hd + 3 * a);
+            backend::prefetch(hd + 3 * a + 8);
+          }
+          // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
+          // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
+          const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
+          std::int64_t oldKey[kMaxHistorySlots];
+          Vec3 oldD[kMaxHistorySlots];
+          for (int s = 0; s < used; ++s) {
+            oldKey[s] = hk[i * K + s];
+            oldD[s] = load3(hd, ii * K + s);
+          }
+          int slot = 0;
+          auto history = [&](std::int64_t key) {
+            for (int s = 0; s < used; ++s)
+              if (oldKey[s] == key)
+                return oldD[s];
+            return Vec3{0.0, 0.0, 0.0};
+          };
+          auto remember = [&](std::int64_t key, Vec3 d) {
+            if (slot < K) {
+              hk[i * K + slot] = key;
+              store3(hd, ii * K + slot, d);
+            }
+            ++slot;
+          };
+          Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
+          Vec3 T{0.0, 0.0, 0.0};
+          // Particle–particle LSD (Eqs. 7–13) over the owned candidates. i's velocities, mass
+          // and material are read only if it has some (most particles of a dilute bed do not).
+          int owned = 0;
+          const std::uint32_t qEnd = hs[i + 1];
+          if (hs[i] < qEnd) {
+            const Vec3 vi = load3(v, ii);
+            const Vec3 wi = load3(w, ii);
+            const double mi = m[i];
+            const int ai = mat[i];
+            for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
               const std::int32_t j = half[q];
-              const Candidate cj = candidateOf(x, r, xi, ri, j);
-              hit[q] = cj.touching ? 1 : 0;
-              if (!cj.touching)
+              const Vec3 d = load3(x, j) - xi;
+              const double l2 = dot(d, d);
+              const double rj = r[j];
+              const double rsum = ri + rj;
+              const bool touching = l2 < rsum * rsum;
+              hit[q] = touching ? 1 : 0;
+              if (!touching)
                 continue;
-              const std::int64_t key = gid[j];
-              // A row holds each key once, and a contact that lasts keeps its slot (the nth
-              // touching candidate wrote slot nth): look there first.
-              Vec3 h{0.0, 0.0, 0.0};
-              if (nth < used && keys[nth] == key) {
-                h = load3(hd, ii * K + nth);
-              } else {
-                for (int s = 0; s < used; ++s) {
-                  if (keys[s] == key) {
-                    h = load3(hd, ii * K + s);
-                    break;
+#if defined(COREDEM_DEM_DOUBLE2)
+              if constexpr (kTwoPairs<Exec>) {
+                // The next candidate in contact too: both in the two lanes, in this order.
+                if (q + 1 < qEnd) {
+                  const std::int32_t jb = half[q + 1];
+                  const Vec3 db = load3(x, jb) - xi;
+                  const double rsumb = ri + r[jb];
+                  if (dot(db, db) < rsumb * rsumb) {
+                    hit[q + 1] = 1;
+                    const std::int64_t key0 = gid[j];
+                    const std::int64_t key1 = gid[jb];
+                    const Vec3 h[2] = {history(key0), history(key1)};
+                    double out[12];
+                    twoOwnedPairs(two, ii, q, q + 1, key0, key1, h, slot, out);
+                    slot += 2;
+                    F += load3(out, 0);
+                    T += load3(out, 1);
+                    F += load3(out, 2);
+                    T += load3(out, 3);
+                    owned += 2;
+                    ++q;
+                    continue;
                   }
                 }
               }
-              ++nth;
-              const PairProps& pp = pairs[mat[end] * nMat + mat[j]];
-              const int c = count++;
-              auto put = [&](int k, double u) { batch.in[k][c] = u; };
-              put(B::Dx, cj.d.x);
-              put(B::Dy, cj.d.y);
-              put(B::Dz, cj.d.z);
-              put(B::L2, cj.l2);
-              put(B::Ri, ri);
-              put(B::Rj, cj.rj);
-              put(B::Mi, m[end]);
-              put(B::Mj, m[j]);
-              put(B::Kn, pp.kn);
-              put(B::Kt, pp.kt);
-              put(B::Damp, pp.dampFactor);
-              put(B::Etat, pp.etatFactor);
-              put(B::Mu, pp.mu);
-              for (int k = 0; k < 3; ++k) {
-                put(B::Vix + k, v[3 * ii + k]);
-                put(B::Vjx + k, v[3 * j + k]);
-                put(B::Wix + k, w[3 * ii + k]);
-                put(B::Wjx + k, w[3 * j + k]);
-              }
-              put(B::Hx, h.x);
-              put(B::Hy, h.y);
-              put(B::Hz, h.z);
-              batch.key[c] = key;
-            }
-          }
-          if (end == i) { // more owned candidates than a batch holds
-            most = std::max(most, pass1(i));
-            ++i;
-            continue;
-          }
-          // (b) evaluate
-          evalPairBatch(batch, count, dt, lanes);
-          // (c) sum and store
-          int c = 0;
-          for (; i < end; ++i) {
-            const long long ii = static_cast<long long>(i);
-            const Vec3 xi = load3(x, ii);
-            const double ri = r[i];
-            const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
-            // Walls first, while i's history row is unchanged.
-            std::int64_t wallKey[kMaxHistorySlots];
-            LsdResult wallRes[kMaxHistorySlots];
-            int wallCount = 0;
-            forEachWallOverlap(wallNear[i], nWalls, walls, xi, ri, [&](int k, double deltaN) {
-              const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-              Vec3 h{0.0, 0.0, 0.0};
-              for (int s = 0; s < used; ++s) {
-                if (hk[ii * K + s] == key) {
-                  h = load3(hd, ii * K + s);
-                  break;
-                }
-              }
-              if (wallCount < kMaxHistorySlots) {
-                wallKey[wallCount] = key;
-                wallRes[wallCount] = wallPair(pairs[mat[i] * nMat + mat[i]], walls[k], deltaN, m[i],
-                                              load3(v, ii), load3(w, ii), ri, h, dt);
-              }
-              ++wallCount;
-            });
-            Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
-            Vec3 T{0.0, 0.0, 0.0};
-            int slot = 0;
-            const std::uint32_t qEnd = hs[i + 1];
-            for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
-              if (!hit[q])
-                continue;
-              const Vec3 fc{batch.out[B::Fx][c], batch.out[B::Fy][c], batch.out[B::Fz][c]};
-              F += fc;
-              T += Vec3{batch.out[B::Tx][c], batch.out[B::Ty][c], batch.out[B::Tz][c]};
-              if (slot < K) {
-                hk[ii * K + slot] = batch.key[c];
-                store3(hd, ii * K + slot,
-                       Vec3{batch.out[B::DTx][c], batch.out[B::DTy][c], batch.out[B::DTz][c]});
-              }
-              ++slot;
-              store3(share, 2 * static_cast<long long>(q), fc);
-              store3(share, 2 * static_cast<long long>(q) + 1,
-                     Vec3{batch.out[B::Sx][c], batch.out[B::Sy][c], batch.out[B::Sz][c]});
-              ++c;
-            }
-            const int owned = slot;
-            Vec3 FW{0.0, 0.0, 0.0};
-            for (int k = 0; k < wallCount && k < kMaxHistorySlots; ++k) {
-              FW += wallRes[k].force;
-              T += wallRes[k].torque;
-              if (slot < K) {
-                hk[ii * K + slot] = wallKey[k];
-                store3(hd, ii * K + slot, wallRes[k].deltaT);
-              }
-              ++slot;
-            }
-            slot += wallCount > kMaxHistorySlots ? wallCount - kMaxHistorySlots : 0;
-            F += FW;
-            storePass1(out, ii, F, T, FW, slot, used, owned, wallCount);
-            most = std::max(most, static_cast<double>(slot));
-          }
-        }
-        return most;
-      };
-      ctx.exec.reduceMaxRangesIntoWide(n, run, 0.0, ctx.status + kStatusHistorySlots);
-    } else
 #endif
-    {
-      reduceMaxIntoWide(ctx.exec, n, pass1, 0.0, ctx.status + kStatusHistorySlots);
-    }
+              const PairProps pp = pairs[ai * nMat + mat[j]];
+              const std::int64_t key = gid[j];
+              const OwnedPair<double> op =
+                  ownedPair(d, l2, ri, rj, mi, m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor,
+                            pp.mu, vi, load3(v, j), wi, load3(w, j), history(key), dt);
+              const LsdResult& res = op.res;
+              F += res.force;
+              T += res.torque;
+              remember(key, res.deltaT);
+              // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
+              store3(share, 2 * static_cast<long long>(q), res.force);
+              store3(share, 2 * static_cast<long long>(q) + 1, op.lji * res.nxft);
+              ++owned;
+            }
+          }
+          // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate
+          // bits of the first 32 (most particles have none), then every wall beyond them.
+          Vec3 FW{0.0, 0.0, 0.0};
+          int wallCount = 0;
+          std::uint32_t bits = wallNear[i];
+          for (int k = bits != 0 ? lowestBit(bits) : 32; k < nWalls;) {
+            const double deltaN = wallOverlap(walls[k], xi, ri);
+            if (deltaN > 0.0) {
+              const int ai = mat[i];
+              const double mi = m[i];
+              const PairProps pp = pairs[ai * nMat + ai];
+              const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
+              const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+              const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
+              const LsdResult res = wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii),
+                                                ri, history(key), dt);
+              FW += res.force;
+              T += res.torque;
+              remember(key, res.deltaT);
+              ++wallCount;
+            }
+            if (k < 32) {
+              bits &= bits - 1;
+              k = bits != 0 ? lowestBit(bits) : 32;
+            } else {
+              ++k;
+            }
+          }
+          F += FW;
+          for (int s = slot; s < used; ++s)
+            hk[i * K + s] = -1;
+          store3(f, ii, F);
+          store3(tq, ii, T);
+          store3(fw, ii, FW);
+          nc[i] = owned;
+          nwc[i] = wallCount;
+          return static_cast<double>(slot);
+        },
+        0.0, ctx.status + kStatusHistorySlots);
 
     // Pass 2: the shares of the pairs owned by the partner, in neighbour-list order.
     // Returns the largest number of contacts of a particle (pairs from both sides, walls).
@@ -778,9 +538,6 @@ private:
   Dev<unsigned char> _hit;      ///< per candidate: in contact this sub-step (pass 1)
   Dev<std::uint32_t> _wallNear; ///< per particle: wall candidates (buildWallCandidates)
   std::uint64_t _wallGeneration = ~std::uint64_t{0}; ///< pair-list build of _wallNear
-#if defined(COREDEM_DEM_DOUBLE2)
-  int _pairLanes = 2; ///< pairs evaluated at a time (cpu: PairBatch)
-#endif
   int _maxUsedSlots =
       kMaxHistorySlots; ///< max contacts of a particle in the last sub-step (≥ slots in use)
 };

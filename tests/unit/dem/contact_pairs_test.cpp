@@ -357,13 +357,11 @@ TEST(ContactPairs, WallCandidatesMissNoContact) {
   }
 }
 
-#if defined(COREDEM_DEM_DOUBLE2)
 namespace {
 
 /// A sphere of radius R (material 0) with n small spheres (material 1, radius a) around it at
 /// random directions, the first `touching` pressed onto it, the others within the skin; the big
-/// sphere owns every pair (smallest gid): more owned candidates than a PairBatch holds, so the
-/// cpu backend evaluates it alone (pass1).
+/// sphere owns every pair (smallest gid): a long half list, mostly not in contact.
 HostState crowdedState(int n, int touching, double R, double a, double skin) {
   HostState s;
   s.n = static_cast<std::size_t>(n + 1);
@@ -399,23 +397,22 @@ HostState crowdedState(int n, int touching, double R, double a, double skin) {
 
 } // namespace
 
-// The cpu backend evaluates owned pairs in batches, several at a time in SIMD lanes; cuda-sim
-// runs the same module one particle at a time, one pair at a time (the CUDA path). Same bits.
-TEST(ContactPairs, BatchedLanesGiveThePerParticleBits) {
+// The cpu backend evaluates two consecutive owned pairs in contact at once, in the two lanes of
+// Double2; cuda-sim runs the same module one pair at a time (the CUDA path). Same bits.
+TEST(ContactPairs, TwoLanePairsGiveTheOnePairAtATimeBits) {
   struct Deck {
     HostState state;
     EngineSetup setup;
   };
   std::vector<Deck> decks;
   decks.push_back({denseState(8), denseSetup(2)});
-  // One particle owning 3× a batch: the big sphere's neighbours need a wide list and slots.
+  // One particle owning 192 candidates, 20 in contact: a wide neighbour list and more slots.
   EngineSetup crowded = denseSetup(2);
   crowded.walls.clear();
   crowded.maxRadius = 4e-3;
   crowded.neighbourSlots = 256;
   crowded.historySlots = 32;
-  decks.push_back(
-      {crowdedState(3 * PairBatch::kCapacity, 20, 4e-3, 0.25e-3, crowded.skin), crowded});
+  decks.push_back({crowdedState(192, 20, 4e-3, 0.25e-3, crowded.skin), crowded});
   for (Deck& d : decks) {
     auto cpu = makeCpuEngine(d.setup);
     auto sim = makeCudaSimEngine(d.setup);
@@ -431,4 +428,3 @@ TEST(ContactPairs, BatchedLanesGiveThePerParticleBits) {
     EXPECT_GT(*std::max_element(a.contacts.begin(), a.contacts.end()), 0);
   }
 }
-#endif

@@ -1,12 +1,9 @@
-// A batch of owned pairs evaluated in SIMD lanes (contacts.h: PairBatch, evalPairBatch) gives the
-// bits of the scalar evaluation (ownedPair<double>, the other backends' path), pair by pair:
-// forces, torques, new tangential history and the partner's torque, for sticking and sliding
-// contacts in any mix across the lanes, unequal radii and masses, two materials, every batch
-// size from 1 to the capacity (full groups and the narrower tails) and every lane count the
-// processor runs (1, 2, 4 with AVX, 8 with AVX-512F).
+// Two owned pairs in the two lanes of Double2 (contacts.h: ownedPair, twoOwnedPairs) give the
+// bits of the scalar evaluation, pair by pair: forces, torques, history and partner shares, for
+// sticking and sliding contacts (a lane of each, or both), unequal radii and masses, two
+// materials, in the SSE2 version and, where the processor has AVX, in the AVX version.
 #include <bit>
 #include <cstdint>
-#include <cstdlib>
 #include <random>
 #include <vector>
 
@@ -72,131 +69,107 @@ Case randomCase(std::mt19937_64& rng, bool slide0, bool slide1) {
   return k;
 }
 
-/// The pair (0, p) of a random case as one batch column c; its expected results.
-struct Column {
-  Vec3 force, torque, deltaT, shareTorque;
-  bool slides;
+struct Expected {
+  Vec3 force[2], torque[2], deltaT[2], shareTorque[2];
+  bool slides[2];
 };
 
-Column fillColumn(PairBatch& b, int c, const Case& k, int p, double dt) {
-  using B = PairBatch;
-  const int j = k.half[p];
-  const Vec3 d = kernels::load3(k.x.data(), j) - kernels::load3(k.x.data(), 0);
-  const PairProps& pp = k.pairs[k.mat[0] * 2 + k.mat[j]];
-  const double in[B::kIn] = {d.x,
-                             d.y,
-                             d.z,
-                             kernels::dot(d, d),
-                             k.r[0],
-                             k.r[j],
-                             k.m[0],
-                             k.m[j],
-                             pp.kn,
-                             pp.kt,
-                             pp.dampFactor,
-                             pp.etatFactor,
-                             pp.mu,
-                             k.v[0],
-                             k.v[1],
-                             k.v[2],
-                             k.v[3 * j],
-                             k.v[3 * j + 1],
-                             k.v[3 * j + 2],
-                             k.w[0],
-                             k.w[1],
-                             k.w[2],
-                             k.w[3 * j],
-                             k.w[3 * j + 1],
-                             k.w[3 * j + 2],
-                             k.h[p].x,
-                             k.h[p].y,
-                             k.h[p].z};
-  for (int f = 0; f < B::kIn; ++f)
-    b.in[f][c] = in[f];
-  const OwnedPair<double> op =
-      ownedPair(d, kernels::dot(d, d), k.r[0], k.r[j], k.m[0], k.m[j], pp.kn, pp.kt, pp.dampFactor,
-                pp.etatFactor, pp.mu, kernels::load3(k.v.data(), 0), kernels::load3(k.v.data(), j),
-                kernels::load3(k.w.data(), 0), kernels::load3(k.w.data(), j), k.h[p], dt);
-  // Sliding caps the stored displacement at μ|f_n|/k_t.
-  return {op.res.force, op.res.torque, op.res.deltaT, op.lji * op.res.nxft,
-          kernels::norm(op.res.deltaT) < 0.5 * kernels::norm(k.h[p])};
-}
-
-Vec3 outColumn(const PairBatch& b, int f, int c) {
-  return Vec3{b.out[f][c], b.out[f + 1][c], b.out[f + 2][c]};
-}
-
-/// Batches of every size 1..capacity, `rounds` times, evaluated `lanes` at a time.
-void checkBatches(int lanes, int rounds) {
-  using B = PairBatch;
-  std::mt19937_64 rng(7 + lanes);
-  const double dt = 1e-6;
-  int slid = 0, columns = 0;
-  for (int round = 0; round < rounds; ++round) {
-    for (int count = 1; count <= B::kCapacity; ++count) {
-      B b;
-      std::vector<Column> expected;
-      for (int c = 0; c < count; ++c) {
-        const bool slide = (rng() % 2) == 0;
-        const Case k = randomCase(rng, slide, !slide);
-        expected.push_back(fillColumn(b, c, k, static_cast<int>(rng() % 2), dt));
-      }
-      evalPairBatch(b, count, dt, lanes);
-      for (int c = 0; c < count; ++c) {
-        const int id = 1000 * count + c;
-        expectSameBits(outColumn(b, B::Fx, c), expected[c].force, "force", id);
-        expectSameBits(outColumn(b, B::Tx, c), expected[c].torque, "torque", id);
-        expectSameBits(outColumn(b, B::DTx, c), expected[c].deltaT, "history", id);
-        expectSameBits(outColumn(b, B::Sx, c), expected[c].shareTorque, "partner torque", id);
-        slid += expected[c].slides ? 1 : 0;
-        ++columns;
-      }
-      if (::testing::Test::HasFailure())
-        return;
-    }
+Expected scalarReference(const Case& k, double dt) {
+  Expected e{};
+  for (int s = 0; s < 2; ++s) {
+    const int j = k.half[s];
+    const Vec3 d = kernels::load3(k.x.data(), j) - kernels::load3(k.x.data(), 0);
+    const PairProps& pp = k.pairs[k.mat[0] * 2 + k.mat[j]];
+    const OwnedPair<double> op = ownedPair(
+        d, kernels::dot(d, d), k.r[0], k.r[j], k.m[0], k.m[j], pp.kn, pp.kt, pp.dampFactor,
+        pp.etatFactor, pp.mu, kernels::load3(k.v.data(), 0), kernels::load3(k.v.data(), j),
+        kernels::load3(k.w.data(), 0), kernels::load3(k.w.data(), j), k.h[s], dt);
+    e.force[s] = op.res.force;
+    e.torque[s] = op.res.torque;
+    e.deltaT[s] = op.res.deltaT;
+    e.shareTorque[s] = op.lji * op.res.nxft;
+    // Sliding caps the stored displacement at μ|f_n|/k_t.
+    e.slides[s] = kernels::norm(op.res.deltaT) < 0.5 * kernels::norm(k.h[s]);
   }
-  // About half of the columns slid, mixed with sticking ones in the same groups.
-  EXPECT_GT(slid, columns / 4);
-  EXPECT_LT(slid, 3 * columns / 4);
+  return e;
+}
+
+void checkGroup(bool avx, int cases) {
+  std::mt19937_64 rng(avx ? 7 : 11);
+  const double dt = 1e-6;
+  int slid[2] = {0, 0};
+  for (int c = 0; c < cases; ++c) {
+    Case k = randomCase(rng, c % 4 == 1 || c % 4 == 3, c % 4 == 2 || c % 4 == 3);
+    const Expected e = scalarReference(k, dt);
+    const int K = 4;
+    std::vector<std::int64_t> hk(K, -1);
+    std::vector<double> hd(3 * K, 0.0), share(12, 0.0);
+    const TwoPairArgs a{k.x.data(),
+                        k.v.data(),
+                        k.w.data(),
+                        k.r.data(),
+                        k.m.data(),
+                        k.mat.data(),
+                        k.half.data(),
+                        k.pairs.data(),
+                        hk.data(),
+                        hd.data(),
+                        share.data(),
+                        2,
+                        K,
+                        dt,
+                        avx};
+    double out[12];
+    const int slot = 1; // slots 1 and 2
+    twoOwnedPairs(a, 0, 0, 1, 101, 102, k.h, slot, out);
+    for (int s = 0; s < 2; ++s) {
+      expectSameBits(kernels::load3(out, 2 * s), e.force[s], "force", c);
+      expectSameBits(kernels::load3(out, 2 * s + 1), e.torque[s], "torque", c);
+      expectSameBits(kernels::load3(share.data(), 2 * s), e.force[s], "partner force", c);
+      expectSameBits(kernels::load3(share.data(), 2 * s + 1), e.shareTorque[s], "partner torque",
+                     c);
+      EXPECT_EQ(hk[slot + s], 101 + s);
+      expectSameBits(kernels::load3(hd.data(), slot + s), e.deltaT[s], "history", c);
+      slid[s] += e.slides[s] ? 1 : 0;
+    }
+    EXPECT_EQ(hk[0], -1);
+    EXPECT_EQ(hk[3], -1);
+  }
+  // Each lane slid in about half of the cases, alone or with the other.
+  EXPECT_GT(slid[0], cases / 4);
+  EXPECT_GT(slid[1], cases / 4);
 }
 
 } // namespace
 
-TEST(PairLanes, ScalarBatchGivesTheScalarBits) {
-  checkBatches(1, 2);
+TEST(PairLanes, TwoPairsGiveTheScalarBitsSse2) {
+  checkGroup(false, 4000);
 }
 
-TEST(PairLanes, TwoLanesGiveTheScalarBits) {
-  checkBatches(2, 2);
-}
-
-TEST(PairLanes, FourLanesGiveTheScalarBits) {
-  if (widestPairLanes() < 4)
+TEST(PairLanes, TwoPairsGiveTheScalarBitsAvx) {
+  if (!cpuHasAvx())
     GTEST_SKIP() << "the processor has no AVX";
-  checkBatches(4, 2);
+  checkGroup(true, 4000);
 }
 
-TEST(PairLanes, EightLanesGiveTheScalarBits) {
-  if (widestPairLanes() < 8)
-    GTEST_SKIP() << "the processor has no AVX-512F";
-  checkBatches(8, 2);
-}
-
-TEST(PairLanes, LaneCountOverrideIsCappedAtTheProcessor) {
-  const int widest = widestPairLanes();
-  EXPECT_TRUE(widest == 2 || widest == 4 || widest == 8);
-  ::setenv("COREDEM_DEM_PAIR_LANES", "1", 1);
-  EXPECT_EQ(pairLanesToUse(), 1);
-  ::setenv("COREDEM_DEM_PAIR_LANES", "64", 1); // not a lane count: ignored
-  EXPECT_EQ(pairLanesToUse(), widest);
-  ::setenv("COREDEM_DEM_PAIR_LANES", "8", 1);
-  EXPECT_EQ(pairLanesToUse(), widest);
-  ::unsetenv("COREDEM_DEM_PAIR_LANES");
-  EXPECT_EQ(pairLanesToUse(), widest);
+TEST(PairLanes, HistorySlotsBeyondTheRowAreDropped) {
+  std::mt19937_64 rng(3);
+  Case k = randomCase(rng, false, true);
+  const int K = 2;
+  std::vector<std::int64_t> hk(K, -1);
+  std::vector<double> hd(3 * K, 0.0), share(12, 0.0);
+  const TwoPairArgs a{k.x.data(), k.v.data(),   k.w.data(),    k.r.data(),
+                      k.m.data(), k.mat.data(), k.half.data(), k.pairs.data(),
+                      hk.data(),  hd.data(),    share.data(),  2,
+                      K,          1e-6,         false};
+  double out[12];
+  twoOwnedPairs(a, 0, 0, 1, 101, 102, k.h, 1, out); // slot 2 does not exist
+  EXPECT_EQ(hk[0], -1);
+  EXPECT_EQ(hk[1], 101);
 }
 
 #else
 TEST(PairLanes, NotBuiltWithoutDouble2) {
-  GTEST_SKIP() << "the SIMD lanes need SSE2 without FMA (x86-64 baseline)";
+  GTEST_SKIP() << "kernels::Double2 needs SSE2 without FMA (x86-64 baseline)";
 }
 #endif

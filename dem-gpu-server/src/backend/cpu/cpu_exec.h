@@ -26,11 +26,14 @@ struct CpuExec {
   static constexpr bool separateDevice = false;
   static constexpr const char* name = "cpu";
   int threads = 0; ///< 0: OpenMP default
-  /// The contact pass evaluates the owned pairs in batches, several at a time in SIMD lanes
-  /// (contacts.h: PairBatch, lanes.h), through reduceMaxRangesIntoWide.
-  static constexpr bool kPairBatches = true;
+#if defined(COREDEM_DEM_DOUBLE2)
+  /// The contact loop evaluates two pairs at once, one in each lane (contacts.h, lanes.h).
+  using PairScalar = kernels::Double2;
+#endif
 
-  int threadCount() const { return threads > 0 ? threads : omp_get_max_threads(); }
+  int threadCount() const {
+    return threads > 0 ? threads : omp_get_max_threads();
+  }
 
   // Each thread calls its own copy of the body: a local whose address does not escape, so the
   // compiler may keep the captured pointers in registers instead of reloading them from the
@@ -86,37 +89,6 @@ struct CpuExec {
     }
 #endif
     reduceMaxInto(n, f, init, out);
-  }
-
-  /// reduceMaxIntoWide over runs of indices: f(lo, hi) handles every index of [lo, hi) (side
-  /// effects on those indices only) and returns the max over them. Runs of 512 indices, as the
-  /// chunks of reduceMax; f inlined into a copy compiled for AVX where the processor has it.
-  template <class F>
-  void reduceMaxRangesIntoWide(std::size_t n, F f, double init, double* out) const {
-    const std::int64_t m = static_cast<std::int64_t>(n);
-    const std::int64_t chunks = (m + 511) / 512;
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX__)
-    const bool avx = hasAvx();
-#else
-    const bool avx = false;
-#endif
-    double r = init;
-#pragma omp parallel num_threads(threadCount()) reduction(max : r) if (m > 256)
-    {
-      const F g = f;
-#pragma omp for schedule(dynamic, 1) nowait
-      for (std::int64_t c = 0; c < chunks; ++c) {
-        const std::size_t lo = static_cast<std::size_t>(512 * c);
-        const std::size_t hi = static_cast<std::size_t>(std::min(m, 512 * c + 512));
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX__)
-        r = std::max(r, avx ? rangeAvx(g, lo, hi) : g(lo, hi));
-#else
-        (void)avx;
-        r = std::max(r, g(lo, hi));
-#endif
-      }
-    }
-    *out = r;
   }
 
   /// Whether the processor (and the operating system) support AVX.
@@ -264,12 +236,6 @@ private:
     for (std::int64_t i = lo; i < hi; ++i)
       r = std::max(r, g(static_cast<std::size_t>(i)));
     return r;
-  }
-  /// g(lo, hi) inlined into a copy compiled for AVX (reduceMaxRangesIntoWide).
-  template <class F>
-  [[gnu::target("avx"), gnu::flatten]] static double rangeAvx(const F& g, std::size_t lo,
-                                                              std::size_t hi) {
-    return g(lo, hi);
   }
 #endif
   /// Below this many keys the radix sort runs on one thread.
