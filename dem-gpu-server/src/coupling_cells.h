@@ -161,7 +161,7 @@ public:
 
   std::size_t bytes() const {
     return _pcell.bytes() + _perm.bytes() + _cStart.bytes() + _cEnd.bytes() + _epsFrozen.bytes() +
-           _prevPcell.bytes() + _changed.size() * sizeof(std::uint32_t) + _permTmp.bytes();
+           _prevPcell.bytes() + _changed.capacity() * sizeof(std::uint32_t) + _permTmp.bytes();
   }
 
 private:
