@@ -456,9 +456,16 @@ public:
             hk[i * K + s] = -1;
           store3(f, ii, F);
           store3(tq, ii, T);
-          store3(fw, ii, FW);
-          nc[i] = owned;
-          nwc[i] = wallCount;
+          // fwall is zero in every row without wall contacts (zeroed at each rebuild: rows do
+          // not follow their particles), so only rows with wall contacts now or in the last
+          // sub-step are written: most particles never touch a wall, and a store is a cache
+          // line read and written back.
+          if (wallCount > 0 || nwc[i] > 0)
+            store3(fw, ii, FW);
+          if (nc[i] != owned) // mostly unchanged: no store, the line stays clean
+            nc[i] = owned;
+          if (nwc[i] != wallCount)
+            nwc[i] = wallCount;
           return static_cast<double>(slot);
         },
         0.0, ctx.status + kStatusHistorySlots);
@@ -470,20 +477,25 @@ public:
         [=] DEM_LAMBDA(std::size_t i) {
           using namespace kernels;
           const long long ii = static_cast<long long>(i);
-          Vec3 F = load3(f, ii);
-          Vec3 T = load3(tq, ii);
           int pairCount = nc[i]; // + the contacts the partners own
           const std::uint32_t kEnd = ls[i + 1];
-          for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
-            const long long q = low[k];
-            if (!hit[q])
-              continue;
-            F += -load3(share, 2 * q);
-            T += load3(share, 2 * q + 1);
-            ++pairCount;
+          std::uint32_t k = ls[i];
+          while (k < kEnd && !hit[low[k]])
+            ++k;
+          if (k < kEnd) { // force and torque touched only by particles with such contacts
+            Vec3 F = load3(f, ii);
+            Vec3 T = load3(tq, ii);
+            for (; k < kEnd; ++k) {
+              const long long q = low[k];
+              if (!hit[q])
+                continue;
+              F += -load3(share, 2 * q);
+              T += load3(share, 2 * q + 1);
+              ++pairCount;
+            }
+            store3(f, ii, F);
+            store3(tq, ii, T);
           }
-          store3(f, ii, F);
-          store3(tq, ii, T);
           return static_cast<double>(pairCount + nwc[i]);
         },
         0.0, ctx.status + kStatusContactsPerParticle);

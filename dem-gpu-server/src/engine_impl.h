@@ -266,7 +266,8 @@ public:
     computeKeys(g);
     _exec.sortByKey(_keys.d(), n, g.cells, _perm.d());
     // Every kResorted schema field follows its particle. (force, torque, fwall are recomputed
-    // right after the rebuild, xref is reset and the neighbour lists rebuilt: not moved.)
+    // right after the rebuild (fwall zeroed below), xref is reset and the neighbour lists
+    // rebuilt: not moved.)
     // History slots at or beyond the largest count in use are empty in every row: not moved.
     const int usedSlots = _contacts.usedSlots();
     schema::forEachField(_p, [&](const schema::FieldInfo& f, auto& arr) {
@@ -353,8 +354,12 @@ public:
       _p.nbList.allocate(n * static_cast<std::size_t>(_p.M));
     }
     double* xr = _p.xref.d();
+    double* fw = _p.fwall.d(); // zero in rows without wall contacts (contacts.h writes the rest)
     const double* x = _p.pos.d();
-    _exec.parallelFor(3 * n, [=] DEM_LAMBDA(std::size_t k) { xr[k] = x[k]; });
+    _exec.parallelFor(3 * n, [=] DEM_LAMBDA(std::size_t k) {
+      xr[k] = x[k];
+      fw[k] = 0.0;
+    });
     _p.produced(kAllFields);
     _pairLists.invalidate(); // half and low lists follow the new order and lists
     _listValid = true;
