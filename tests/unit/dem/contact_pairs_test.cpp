@@ -352,8 +352,22 @@ TEST(ContactPairs, WallCandidatesMissNoContact) {
       engine->subStep(dt);
       ASSERT_EQ(engine->wallContacts(), expected) << "sub-step " << step << " stale=" << staleList;
       touched += expected;
+      // The wall force is kept only in rows with wall contacts (contacts.h): every other row
+      // reads zero, also after the particle left the wall and after rebuilds re-sorted the rows.
+      const HostState after = engine->state();
+      for (std::size_t i = 0; i < after.n; ++i) {
+        const Vec3 fw = at(after.fwall, i);
+        if (after.wallContacts[i] == 0) {
+          ASSERT_TRUE(fw.x == 0.0 && fw.y == 0.0 && fw.z == 0.0)
+              << "particle " << after.gid[i] << " without wall contact keeps a wall force, "
+              << "sub-step " << step;
+        } else {
+          ASSERT_GT(kernels::norm(fw), 0.0) << "particle " << after.gid[i] << ", sub-step " << step;
+        }
+      }
     }
     EXPECT_GT(touched, 0u); // the particles did reach the walls
+    EXPECT_GE(engine->times().rebuilds, 2u); // rows were re-sorted while particles touched walls
   }
 }
 
