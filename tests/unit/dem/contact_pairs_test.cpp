@@ -366,7 +366,7 @@ TEST(ContactPairs, WallCandidatesMissNoContact) {
         }
       }
     }
-    EXPECT_GT(touched, 0u); // the particles did reach the walls
+    EXPECT_GT(touched, 0u);                  // the particles did reach the walls
     EXPECT_GE(engine->times().rebuilds, 2u); // rows were re-sorted while particles touched walls
   }
 }
