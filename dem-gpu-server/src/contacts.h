@@ -4,19 +4,21 @@
 /// LSD with tangential history), written once for every backend like engine_impl.h.
 ///
 /// Each pair is evaluated once, by its owner: the particle with the smaller global id (gid), a
-/// choice that survives re-sorting, over the engine's half and low lists (pair_lists.h). Per
-/// sub-step, no atomics:
-///   pass 1 (per owner i): every owned candidate in contact is evaluated with the LSD law; the
-///     owner adds f and L_ij n × f_t to its own force and torque, keeps δ_t in its history
-///     slots, and writes the partner's share (−f is implied; L_ji n × f_t) to the pair lists'
-///     per-candidate scratch; then its walls;
-///   pass 2 (per particle j): adds the partner shares of the contacts it does not own, in the
-///     ascending index order of its neighbour list (a fixed order).
-/// Both passes write only their own index, so the result does not depend on the thread count.
+/// choice that survives re-sorting, over the engine's half and low lists (pair_lists.h). No
+/// atomics; the order in which a particle's force and torque receive their terms is fixed by the
+/// lists (pair_lists.h "Slabs": by slab colour, then by the index of the evaluating particle),
+/// so the results do not depend on the thread count or the backend:
+///   cpu (scatter): the owners run slab colour by colour (CpuExec::reduceMaxOverSlabsWide); an
+///     owner i evaluates its owned candidates in contact with the LSD law and adds the
+///     partner's share (−f; torque L_ji n × f_t) straight to the partner's force and torque,
+///     then its walls, and adds its own sum (f, L_ij n × f_t of its pairs, its walls) to its
+///     own force and torque, which start at the gas force (or zero) and zero;
+///   other backends (gather): pass 1 per owner writes the partner's share per candidate and
+///     its own sum per particle; pass 2 per particle adds them in the same order (colours, and
+///     within a colour the evaluating particle's index).
 /// The cpu backend evaluates two consecutive owned candidates in contact at once, one in each
 /// lane of kernels::Double2 (twoOwnedPairs; every lane gives the bits of ownedPair<double>, the
-/// other backends' path), and runs both passes compiled for AVX where the processor has it
-/// (CpuExec::reduceMaxIntoWide; same operations, no FMA).
+/// other backends' path), compiled for AVX where the processor has it (same operations, no FMA).
 /// The LSD law is mirror-exact (lsd_contact.h): j's share is bitwise what evaluating the pair
 /// from j's side gives. History slots (partner gid, −(w+2) for wall w) hold the owned contacts
 /// and the walls only; slots of a state file written when both sides kept their history are
@@ -76,21 +78,19 @@ DEM_HD OwnedPair<S> ownedPair(kernels::Vec3T<S> d, S l2, S ri, S rj, S mi, S mj,
   return {lsdContact(lp, nrm, deltaN, vij, lij, hist, dt), lji};
 }
 
-/// exec.reduceMaxIntoWide where Exec has it (cpu: the body compiled for AVX where the
-/// processor has it), else exec.reduceMaxInto.
-template <class Exec, class F>
-void reduceMaxIntoWide(Exec& exec, std::size_t n, F f, double init, double* out) {
-  if constexpr (requires { exec.reduceMaxIntoWide(n, f, init, out); })
-    exec.reduceMaxIntoWide(n, f, init, out);
-  else
-    exec.reduceMaxInto(n, f, init, out);
-}
-
 /// Whether Exec evaluates two owned pairs at once (Exec::PairScalar, cpu: kernels::Double2).
 template <class Exec, class = void>
 inline constexpr bool kTwoPairs = false;
 template <class Exec>
 inline constexpr bool kTwoPairs<Exec, std::void_t<typename Exec::PairScalar>> = true;
+
+/// Whether Exec runs slabs colour by colour (cpu: reduceMaxOverSlabsWide), so that an owner
+/// adds the partner's share straight to the partner (scatter), else the two gather passes.
+template <class Exec>
+inline constexpr bool kScatter = requires(const Exec& e, double* o) {
+  e.reduceMaxOverSlabsWide(static_cast<const std::uint32_t*>(nullptr), 0,
+                           [](std::size_t) { return 0.0; }, 0.0, o);
+};
 
 #if defined(COREDEM_DEM_DOUBLE2)
 /// What twoOwnedPairs reads and writes (pass 1 of ContactModule::sources).
@@ -105,7 +105,8 @@ struct TwoPairArgs {
   const PairProps* pairs;
   std::int64_t* hk;
   double* hd;
-  double* share;
+  double* f;  ///< force: the partners' shares are added to it (scatter, pair_lists.h "Slabs")
+  double* tq; ///< torque, likewise
   int nMat;
   int K;
   double dt;
@@ -114,8 +115,9 @@ struct TwoPairArgs {
 
 /// Owned candidates q0 < q1 of particle i, both in contact, evaluated in the two lanes of
 /// Double2 (ownedPair): writes their history slots slot and slot + 1 (keys key0, key1; old
-/// displacements h[0], h[1]) and their partners' shares, and returns force and torque on i of
-/// q0 in out[0..6) and of q1 in out[6..12). Called through twoOwnedPairs.
+/// displacements h[0], h[1]), adds their partners' shares to the partners' force and torque
+/// (q0's partner first), and returns force and torque on i of q0 in out[0..6) and of q1 in
+/// out[6..12). Called through twoOwnedPairs.
 DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std::uint32_t q0,
                                           std::uint32_t q1, std::int64_t key0, std::int64_t key1,
                                           const kernels::Vec3* h, int slot, double* out) {
@@ -153,13 +155,13 @@ DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std
     a.hk[i * k + slot + 1] = key1;
     store3(a.hd, i * k + slot + 1, Vec3{res.deltaT.x[1], res.deltaT.y[1], res.deltaT.z[1]});
   }
-  // The partners' shares: force −f (applied in pass 2), torque L_ji n × f_t.
+  // The partners' shares: force −f, torque L_ji n × f_t.
   const Vec3 f0{res.force.x[0], res.force.y[0], res.force.z[0]};
   const Vec3 f1{res.force.x[1], res.force.y[1], res.force.z[1]};
-  store3(a.share, 2 * static_cast<long long>(q0), f0);
-  store3(a.share, 2 * static_cast<long long>(q0) + 1, Vec3{shareT.x[0], shareT.y[0], shareT.z[0]});
-  store3(a.share, 2 * static_cast<long long>(q1), f1);
-  store3(a.share, 2 * static_cast<long long>(q1) + 1, Vec3{shareT.x[1], shareT.y[1], shareT.z[1]});
+  store3(a.f, j0, load3(a.f, j0) - f0);
+  store3(a.tq, j0, load3(a.tq, j0) + Vec3{shareT.x[0], shareT.y[0], shareT.z[0]});
+  store3(a.f, j1, load3(a.f, j1) - f1);
+  store3(a.tq, j1, load3(a.tq, j1) + Vec3{shareT.x[1], shareT.y[1], shareT.z[1]});
   store3(out, 0, f0);
   store3(out, 1, Vec3{res.torque.x[0], res.torque.y[0], res.torque.z[0]});
   store3(out, 2, f1);
@@ -233,7 +235,9 @@ public:
   }
 
   bool enabled() const { return true; }
-  std::size_t bytes() const { return _pairs.bytes() + _walls.bytes() + _hit.bytes(); }
+  std::size_t bytes() const {
+    return _pairs.bytes() + _walls.bytes() + _hit.bytes() + _own.bytes() + _wallNear.bytes();
+  }
   ContactTotals totals() const { return {}; }
 
   /// History slots in use in some row (slots at or beyond it are empty everywhere); the
@@ -280,6 +284,8 @@ public:
   /// (+ the gas force of the drag module in coupled runs); writes force, torque, fwall, histKey,
   /// histDisp, contacts, wallContacts.
   void sources(StepContext<Exec>& ctx) {
+    constexpr bool scatter = kScatter<Exec>;
+    static_assert(scatter || !kTwoPairs<Exec>, "the two-lane pair path scatters");
     ParticleStore<Exec>& p = ctx.particles;
     PairLists<Exec>& pl = ctx.pairs;
     if (_wallGeneration != pl.generation())
@@ -303,218 +309,254 @@ public:
     std::int32_t* nwc = p.wallContacts.d();
     const std::uint32_t* hs = pl.halfStart();
     const std::int32_t* half = pl.half();
-    const std::uint32_t* ls = pl.lowStart();
-    const std::uint32_t* low = pl.low();
-    _hit.reserve(pl.candidates());
-    unsigned char* hit = _hit.d();
-    // Partner shares in the shared scratch: force (3 values), then torque (3), per candidate.
-    static_assert(PairLists<Exec>::kScratchWidth >= 6);
-    double* share = pl.scratch();
     const PairProps* pairs = _pairs.d();
     const kernels::PlaneWall* walls = _walls.d();
     const int nWalls = static_cast<int>(ctx.setup.walls.size());
     const int nMat = ctx.setup.nMaterials;
     const int K = p.K;
     const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
+    // Gather backends: per candidate, in contact this sub-step and the partner's share (force,
+    // then torque, in the shared scratch); per particle, the owner's own sum.
+    unsigned char* hit = nullptr;
+    double* share = nullptr;
+    double* own = nullptr;
+    if constexpr (scatter) {
+      // Force and torque start at the gas force (or zero) and zero; the slabs add the rest.
+      ctx.exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+        const long long ii = static_cast<long long>(i);
+        if (!coupled)
+          kernels::store3(f, ii, kernels::Vec3{0.0, 0.0, 0.0});
+        kernels::store3(tq, ii, kernels::Vec3{0.0, 0.0, 0.0});
+      });
+    } else {
+      _hit.reserve(pl.candidates());
+      _own.reserve(6 * n);
+      hit = _hit.d();
+      static_assert(PairLists<Exec>::kScratchWidth >= 6);
+      share = pl.scratch();
+      own = _own.d();
+    }
 
 #if defined(COREDEM_DEM_DOUBLE2)
-    const TwoPairArgs two{x, v, w, r, m, mat, half, pairs, hk, hd, share, nMat, K, dt, cpuHasAvx()};
+    const TwoPairArgs two{x, v, w, r, m, mat, half, pairs, hk, hd, f, tq, nMat, K, dt, cpuHasAvx()};
 #endif
-    // Pass 1: the owned pairs and the walls of every particle. reduceMax runs the body once
-    // per index (side effects on index i only) and returns the most history slots a particle
-    // needs (owned contacts + walls), in the same pass.
-    reduceMaxIntoWide(
-        ctx.exec, n,
-        [=] DEM_LAMBDA(std::size_t i) {
-          using namespace kernels;
-          const long long ii = static_cast<long long>(i);
-          const Vec3 xi = load3(x, ii);
-          const double ri = r[i];
-          // The history rows of the few particles in contact are scattered through memory:
-          // ask for those of a particle kPrefetchAhead further on while this one computes.
-          if (i + kPrefetchAhead < n && nc[i + kPrefetchAhead] + nwc[i + kPrefetchAhead] > 0) {
-            const std::size_t a = (i + kPrefetchAhead) * static_cast<std::size_t>(K);
-            backend::prefetch(hk + a);
-            backend::prefetch(hd + 3 * a);
-            backend::prefetch(hd + 3 * a + 8);
-          }
-          // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
-          // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
-          const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
-          std::int64_t oldKey[kMaxHistorySlots];
-          Vec3 oldD[kMaxHistorySlots];
-          for (int s = 0; s < used; ++s) {
-            oldKey[s] = hk[i * K + s];
-            oldD[s] = load3(hd, ii * K + s);
-          }
-          int slot = 0;
-          auto history = [&](std::int64_t key) {
-            for (int s = 0; s < used; ++s)
-              if (oldKey[s] == key)
-                return oldD[s];
-            return Vec3{0.0, 0.0, 0.0};
-          };
-          auto remember = [&](std::int64_t key, Vec3 d) {
-            if (slot < K) {
-              hk[i * K + slot] = key;
-              store3(hd, ii * K + slot, d);
-            }
-            ++slot;
-          };
-          Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
-          Vec3 T{0.0, 0.0, 0.0};
-          // Particle–particle LSD (Eqs. 7–13) over the owned candidates. i's velocities, mass
-          // and material are read only if it has some (most particles of a dilute bed do not).
-          int owned = 0;
-          const std::uint32_t qEnd = hs[i + 1];
-          if (hs[i] < qEnd) {
-            const Vec3 vi = load3(v, ii);
-            const Vec3 wi = load3(w, ii);
-            const double mi = m[i];
-            const int ai = mat[i];
-            for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
-              const std::int32_t j = half[q];
-              const Vec3 d = load3(x, j) - xi;
-              const double l2 = dot(d, d);
-              const double rj = r[j];
-              const double rsum = ri + rj;
-              const bool touching = l2 < rsum * rsum;
-              hit[q] = touching ? 1 : 0;
-              if (!touching)
-                continue;
+    // Pass 1 (per owner): its owned pairs and its walls. Returns the history slots a particle
+    // needs (owned contacts + walls); the largest goes to the status array.
+    auto ownerPass = [=] DEM_LAMBDA(std::size_t i) {
+      using namespace kernels;
+      (void)f, (void)tq, (void)hit, (void)share, (void)own; // nvcc: no first capture in if constexpr
+      const long long ii = static_cast<long long>(i);
+      const Vec3 xi = load3(x, ii);
+      const double ri = r[i];
+      // The history rows of the few particles in contact are scattered through memory:
+      // ask for those of a particle kPrefetchAhead further on while this one computes.
+      if (i + kPrefetchAhead < n && nc[i + kPrefetchAhead] + nwc[i + kPrefetchAhead] > 0) {
+        const std::size_t a = (i + kPrefetchAhead) * static_cast<std::size_t>(K);
+        backend::prefetch(hk + a);
+        backend::prefetch(hd + 3 * a);
+        backend::prefetch(hd + 3 * a + 8);
+      }
+      // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
+      // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
+      const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
+      std::int64_t oldKey[kMaxHistorySlots];
+      Vec3 oldD[kMaxHistorySlots];
+      for (int s = 0; s < used; ++s) {
+        oldKey[s] = hk[i * K + s];
+        oldD[s] = load3(hd, ii * K + s);
+      }
+      int slot = 0;
+      auto history = [&](std::int64_t key) {
+        for (int s = 0; s < used; ++s)
+          if (oldKey[s] == key)
+            return oldD[s];
+        return Vec3{0.0, 0.0, 0.0};
+      };
+      auto remember = [&](std::int64_t key, Vec3 d) {
+        if (slot < K) {
+          hk[i * K + slot] = key;
+          store3(hd, ii * K + slot, d);
+        }
+        ++slot;
+      };
+      Vec3 F{0.0, 0.0, 0.0}; // i's own sum: its owned pairs, then its walls
+      Vec3 T{0.0, 0.0, 0.0};
+      // Particle–particle LSD (Eqs. 7–13) over the owned candidates. i's velocities, mass and
+      // material are read only if it has some (most particles of a dilute bed do not).
+      int owned = 0;
+      const std::uint32_t qEnd = hs[i + 1];
+      if (hs[i] < qEnd) {
+        const Vec3 vi = load3(v, ii);
+        const Vec3 wi = load3(w, ii);
+        const double mi = m[i];
+        const int ai = mat[i];
+        for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
+          const std::int32_t j = half[q];
+          const Vec3 d = load3(x, j) - xi;
+          const double l2 = dot(d, d);
+          const double rj = r[j];
+          const double rsum = ri + rj;
+          const bool touching = l2 < rsum * rsum;
+          if constexpr (!kScatter<Exec>)
+            hit[q] = touching ? 1 : 0;
+          if (!touching)
+            continue;
 #if defined(COREDEM_DEM_DOUBLE2)
-              if constexpr (kTwoPairs<Exec>) {
-                // The next candidate in contact too: both in the two lanes, in this order.
-                if (q + 1 < qEnd) {
-                  const std::int32_t jb = half[q + 1];
-                  const Vec3 db = load3(x, jb) - xi;
-                  const double rsumb = ri + r[jb];
-                  if (dot(db, db) < rsumb * rsumb) {
-                    hit[q + 1] = 1;
-                    const std::int64_t key0 = gid[j];
-                    const std::int64_t key1 = gid[jb];
-                    const Vec3 h[2] = {history(key0), history(key1)};
-                    double out[12];
-                    twoOwnedPairs(two, ii, q, q + 1, key0, key1, h, slot, out);
-                    slot += 2;
-                    F += load3(out, 0);
-                    T += load3(out, 1);
-                    F += load3(out, 2);
-                    T += load3(out, 3);
-                    owned += 2;
-                    ++q;
-                    continue;
-                  }
-                }
+          if constexpr (kTwoPairs<Exec>) {
+            // The next candidate in contact too: both in the two lanes, in this order.
+            if (q + 1 < qEnd) {
+              const std::int32_t jb = half[q + 1];
+              const Vec3 db = load3(x, jb) - xi;
+              const double rsumb = ri + r[jb];
+              if (dot(db, db) < rsumb * rsumb) {
+                const std::int64_t key0 = gid[j];
+                const std::int64_t key1 = gid[jb];
+                const Vec3 h[2] = {history(key0), history(key1)};
+                double out[12];
+                twoOwnedPairs(two, ii, q, q + 1, key0, key1, h, slot, out);
+                slot += 2;
+                F += load3(out, 0);
+                T += load3(out, 1);
+                F += load3(out, 2);
+                T += load3(out, 3);
+                owned += 2;
+                ++q;
+                continue;
               }
+            }
+          }
 #endif
-              const PairProps pp = pairs[ai * nMat + mat[j]];
-              const std::int64_t key = gid[j];
-              const OwnedPair<double> op =
-                  ownedPair(d, l2, ri, rj, mi, m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor,
-                            pp.mu, vi, load3(v, j), wi, load3(w, j), history(key), dt);
-              const LsdResult& res = op.res;
-              F += res.force;
-              T += res.torque;
-              remember(key, res.deltaT);
-              // j's share: force −f (applied in pass 2), torque L_ji n × f_t.
-              store3(share, 2 * static_cast<long long>(q), res.force);
-              store3(share, 2 * static_cast<long long>(q) + 1, op.lji * res.nxft);
-              ++owned;
-            }
+          const PairProps pp = pairs[ai * nMat + mat[j]];
+          const std::int64_t key = gid[j];
+          const OwnedPair<double> op =
+              ownedPair(d, l2, ri, rj, mi, m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor, pp.mu,
+                        vi, load3(v, j), wi, load3(w, j), history(key), dt);
+          const LsdResult& res = op.res;
+          F += res.force;
+          T += res.torque;
+          remember(key, res.deltaT);
+          // j's share: force −f, torque L_ji n × f_t.
+          if constexpr (kScatter<Exec>) {
+            store3(f, j, load3(f, j) - res.force);
+            store3(tq, j, load3(tq, j) + op.lji * res.nxft);
+          } else {
+            store3(share, 2 * static_cast<long long>(q), res.force);
+            store3(share, 2 * static_cast<long long>(q) + 1, op.lji * res.nxft);
           }
-          // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate
-          // bits of the first 32 (most particles have none), then every wall beyond them.
-          Vec3 FW{0.0, 0.0, 0.0};
-          int wallCount = 0;
-          std::uint32_t bits = wallNear[i];
-          for (int k = bits != 0 ? lowestBit(bits) : 32; k < nWalls;) {
-            const double deltaN = wallOverlap(walls[k], xi, ri);
-            if (deltaN > 0.0) {
-              const int ai = mat[i];
-              const double mi = m[i];
-              const PairProps pp = pairs[ai * nMat + ai];
-              const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
-              const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-              const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-              const LsdResult res = wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii),
-                                                ri, history(key), dt);
-              FW += res.force;
-              T += res.torque;
-              remember(key, res.deltaT);
-              ++wallCount;
+          ++owned;
+        }
+      }
+      // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate bits
+      // of the first 32 (most particles have none), then every wall beyond them.
+      Vec3 FW{0.0, 0.0, 0.0};
+      int wallCount = 0;
+      std::uint32_t bits = wallNear[i];
+      for (int k = bits != 0 ? lowestBit(bits) : 32; k < nWalls;) {
+        const double deltaN = wallOverlap(walls[k], xi, ri);
+        if (deltaN > 0.0) {
+          const int ai = mat[i];
+          const double mi = m[i];
+          const PairProps pp = pairs[ai * nMat + ai];
+          const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
+          const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+          const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
+          const LsdResult res = wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii), ri,
+                                            history(key), dt);
+          FW += res.force;
+          T += res.torque;
+          remember(key, res.deltaT);
+          ++wallCount;
+        }
+        if (k < 32) {
+          bits &= bits - 1;
+          k = bits != 0 ? lowestBit(bits) : 32;
+        } else {
+          ++k;
+        }
+      }
+      F += FW;
+      for (int s = slot; s < used; ++s)
+        hk[i * K + s] = -1;
+      if constexpr (kScatter<Exec>) { // after the shares of the particles before it (pair_lists.h)
+        store3(f, ii, load3(f, ii) + F);
+        store3(tq, ii, load3(tq, ii) + T);
+      } else {
+        store3(own, 2 * ii, F);
+        store3(own, 2 * ii + 1, T);
+      }
+      // fwall is zero in every row without wall contacts (zeroed at each rebuild: rows do not
+      // follow their particles), so only rows with wall contacts now or in the last sub-step
+      // are written: most particles never touch a wall, and a store is a cache line read and
+      // written back.
+      if (wallCount > 0 || nwc[i] > 0)
+        store3(fw, ii, FW);
+      if (nc[i] != owned) // mostly unchanged: no store, the line stays clean
+        nc[i] = owned;
+      if (nwc[i] != wallCount)
+        nwc[i] = wallCount;
+      return static_cast<double>(slot);
+    };
+    if constexpr (scatter) {
+      ctx.exec.reduceMaxOverSlabsWide(pl.slabStart(), pl.slabs(), ownerPass, 0.0,
+                                      ctx.status + kStatusHistorySlots);
+    } else {
+      ctx.exec.reduceMaxInto(n, ownerPass, 0.0, ctx.status + kStatusHistorySlots);
+      // Pass 2 (per particle): the gas force (or zero), then the terms in the order the
+      // scatter adds them: colour by colour, and within a colour by the evaluating particle's
+      // index (its own sum at its own index among the partners of that colour).
+      const std::uint32_t* ls = pl.lowStart();
+      const std::uint32_t* low = pl.low();
+      const std::uint32_t* lowOwner = pl.lowOwner();
+      const std::uint8_t* colour = pl.colour();
+      ctx.exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+        using namespace kernels;
+        const long long ii = static_cast<long long>(i);
+        Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
+        Vec3 T{0.0, 0.0, 0.0};
+        const std::uint32_t kEnd = ls[i + 1];
+        for (int c = 0; c < 3; ++c) {
+          bool self = colour[i] == c;
+          for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
+            const std::uint32_t o = lowOwner[k];
+            if (colour[o] != c)
+              continue;
+            if (self && o > i) {
+              F += load3(own, 2 * ii);
+              T += load3(own, 2 * ii + 1);
+              self = false;
             }
-            if (k < 32) {
-              bits &= bits - 1;
-              k = bits != 0 ? lowestBit(bits) : 32;
-            } else {
-              ++k;
-            }
+            const long long q = low[k];
+            if (!hit[q])
+              continue;
+            F += -load3(share, 2 * q);
+            T += load3(share, 2 * q + 1);
           }
-          F += FW;
-          for (int s = slot; s < used; ++s)
-            hk[i * K + s] = -1;
-          store3(f, ii, F);
-          store3(tq, ii, T);
-          // fwall is zero in every row without wall contacts (zeroed at each rebuild: rows do
-          // not follow their particles), so only rows with wall contacts now or in the last
-          // sub-step are written: most particles never touch a wall, and a store is a cache
-          // line read and written back.
-          if (wallCount > 0 || nwc[i] > 0)
-            store3(fw, ii, FW);
-          if (nc[i] != owned) // mostly unchanged: no store, the line stays clean
-            nc[i] = owned;
-          if (nwc[i] != wallCount)
-            nwc[i] = wallCount;
-          return static_cast<double>(slot);
-        },
-        0.0, ctx.status + kStatusHistorySlots);
-
-    // Pass 2: the shares of the pairs owned by the partner, in neighbour-list order.
-    // Returns the largest number of contacts of a particle (pairs from both sides, walls).
-    reduceMaxIntoWide(
-        ctx.exec, n,
-        [=] DEM_LAMBDA(std::size_t i) {
-          using namespace kernels;
-          const long long ii = static_cast<long long>(i);
-          int pairCount = nc[i]; // + the contacts the partners own
-          const std::uint32_t kEnd = ls[i + 1];
-          std::uint32_t k = ls[i];
-          while (k < kEnd && !hit[low[k]])
-            ++k;
-          if (k < kEnd) { // force and torque touched only by particles with such contacts
-            Vec3 F = load3(f, ii);
-            Vec3 T = load3(tq, ii);
-            for (; k < kEnd; ++k) {
-              const long long q = low[k];
-              if (!hit[q])
-                continue;
-              F += -load3(share, 2 * q);
-              T += load3(share, 2 * q + 1);
-              ++pairCount;
-            }
-            store3(f, ii, F);
-            store3(tq, ii, T);
+          if (self) {
+            F += load3(own, 2 * ii);
+            T += load3(own, 2 * ii + 1);
           }
-          return static_cast<double>(pairCount + nwc[i]);
-        },
-        0.0, ctx.status + kStatusContactsPerParticle);
+        }
+        store3(f, ii, F);
+        store3(tq, ii, T);
+      });
+    }
     p.produced(kForce | kTorque | kFwall | kHistKey | kHistDisp | kContacts | kWallContacts);
   }
 
-  /// After the sub-step (host): the history slots in use and the contact-count check of the
-  /// values sources() left in the status array. More contacts than slots is an error (the
-  /// sub-step's forces lost some contacts' history).
+  /// After the sub-step (host): the history slots in use, and their check. A particle keeps
+  /// the history of the contacts it owns and of its walls; more of them than slots is an error
+  /// (the sub-step's forces lost some contacts' history).
   void readStatus(const double* status, int K) {
     const double maxSlots = status[kStatusHistorySlots];
-    const double maxContacts = status[kStatusContactsPerParticle];
     _maxUsedSlots = maxSlots < K ? static_cast<int>(maxSlots) : K;
-    if (maxContacts > K) {
-      backend::raiseUserError("a particle has " + std::to_string(static_cast<int>(maxContacts)) +
-                              " simultaneous contacts but only " + std::to_string(K) +
-                              " tangential-history slots; raise NeighbourOptions::historySlots "
-                              "(at most " +
-                              std::to_string(kMaxHistorySlots) + ")");
+    if (maxSlots > K) {
+      backend::raiseUserError(
+          "a particle keeps the tangential history of " +
+          std::to_string(static_cast<int>(maxSlots)) +
+          " contacts (those it owns, walls included) but has only " + std::to_string(K) +
+          " tangential-history slots; raise NeighbourOptions::historySlots (case file: "
+          "dem.history_slots; at most " +
+          std::to_string(kMaxHistorySlots) + ")");
     }
   }
 
@@ -547,7 +589,8 @@ public:
 private:
   Dual<PairProps> _pairs;
   Dual<kernels::PlaneWall> _walls;
-  Dev<unsigned char> _hit;      ///< per candidate: in contact this sub-step (pass 1)
+  Dev<unsigned char> _hit;      ///< gather backends, per candidate: in contact this sub-step
+  Dev<double> _own;             ///< gather backends, per particle: the owner's own force, torque
   Dev<std::uint32_t> _wallNear; ///< per particle: wall candidates (buildWallCandidates)
   std::uint64_t _wallGeneration = ~std::uint64_t{0}; ///< pair-list build of _wallNear
   int _maxUsedSlots =

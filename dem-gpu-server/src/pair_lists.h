@@ -22,9 +22,21 @@
 /// `scratch()` is one such per-candidate buffer of kScratchWidth doubles, shared: a module may
 /// use it only inside its own sources() call (written in its first pass, read in its second),
 /// so the contact and heat modules need no buffer of their own.
+///
+/// Slabs. The build also cuts the particle order into slabs, contiguous index ranges such that
+/// every pair joins particles of the same or of adjacent slabs (from the neighbour lists
+/// themselves: any particle order is valid, a badly sorted one only gives fewer, larger slabs),
+/// and colours them k mod 3. Slabs of one colour share no particle and no neighbour, so a pass
+/// may run them in parallel, each slab in index order, and write pair terms straight into both
+/// particles, the three colours one after another: the cpu backend's contact pass (contacts.h).
+/// The order in which a particle receives its terms is then fixed by the lists alone: by colour,
+/// then by the index of the particle that evaluates them; a backend that gathers instead
+/// (pass 2 over the low lists) follows the same order with colour() and lowOwner(), and gives
+/// the same bits.
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
@@ -53,7 +65,9 @@ public:
 
   std::size_t bytes() const {
     return _count.bytes() + _halfStart.bytes() + _half.bytes() + _lowStart.bytes() + _low.bytes() +
-           _lowPos.bytes() + _scratch.bytes();
+           _lowPos.bytes() + _lowOwner.bytes() + _colour.bytes() + _scratch.bytes() +
+           _slabStart.capacity() * sizeof(std::uint32_t) +
+           _reachHost.capacity() * sizeof(std::uint32_t) + _colourHost.capacity();
   }
 
   /// Counts the builds: a module that derives data from the lists rebuilds it when this changes.
@@ -68,6 +82,13 @@ public:
   const std::uint32_t* low() const { return _low.d(); }
   const std::uint32_t* lowPos() const { return _lowPos.d(); }
   double* scratch() { return _scratch.d(); }
+  /// Per low-list entry k: the index of the particle that owns the candidate.
+  const std::uint32_t* lowOwner() const { return _lowOwner.d(); }
+  /// Per particle: its slab's colour, 0..2.
+  const std::uint8_t* colour() const { return _colour.d(); }
+  /// Host: slab s is the index range [slabStart()[s], slabStart()[s + 1]), s < slabs().
+  const std::uint32_t* slabStart() const { return _slabStart.data(); }
+  int slabs() const { return static_cast<int>(_slabStart.size()) - 1; }
 
   /// Builds the lists from the neighbour lists (public only because nvcc requires it of a
   /// function with device lambdas; call ensure()).
@@ -112,8 +133,10 @@ public:
     std::uint32_t lowTotal = 0;
     Exec::copyToHost(&lowTotal, ls + n, sizeof(lowTotal));
     _low.reserve(lowTotal);
+    _lowOwner.reserve(lowTotal);
     _lowPos.reserve(total > lowTotal ? total : lowTotal);
     std::uint32_t* low = _low.d();
+    std::uint32_t* lowOwner = _lowOwner.d();
     std::uint32_t* lowPos = _lowPos.d();
     const double missing = exec.reduceMax(
         n,
@@ -132,6 +155,7 @@ public:
             } else {
               lowPos[at] = k;
             }
+            lowOwner[k] = static_cast<std::uint32_t>(j);
             low[k++] = at;
           }
           return miss;
@@ -141,9 +165,55 @@ public:
       backend::raiseUserError("the neighbour lists are not symmetric (a state file edited by "
                               "hand?); set /meta@neighbour_list_valid = 0 to rebuild them");
     }
+    buildSlabs(exec, p);
     _total = total;
     _valid = true;
     ++_generation;
+  }
+
+  /// The slabs and their colours (see the file comment). Greedy over the particle order, with
+  /// reach(i) = the largest index among i and its neighbours: slab 0 = {0}; each next slab ends
+  /// where it holds every neighbour of the slab before it,
+  ///   b_{s+2} = max(b_{s+1} + 1, 1 + max reach over slab s),
+  /// so that a pair never skips a slab. In a cell-sorted order a slab is about half a layer of
+  /// neighbour cells. Reads nbCount, nbList; one n-value copy to the host and back (per build).
+  void buildSlabs(Exec& exec, ParticleStore<Exec>& p) {
+    const std::size_t n = p.n;
+    const int M = p.M;
+    const std::int32_t* cnt = p.nbCount.d();
+    const std::int32_t* list = p.nbList.d();
+    std::uint32_t* reach = _count.d(); // n + 1 values, free after the scans above
+    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+      std::uint32_t r = static_cast<std::uint32_t>(i);
+      for (int a = 0; a < cnt[i]; ++a) {
+        const std::uint32_t j = static_cast<std::uint32_t>(list[i * M + a]);
+        r = j > r ? j : r;
+      }
+      reach[i] = r;
+    });
+    _reachHost.resize(n);
+    if (n > 0)
+      Exec::copyToHost(_reachHost.data(), reach, n * sizeof(std::uint32_t));
+    _slabStart.assign(1, 0u);
+    _colourHost.resize(n);
+    std::uint32_t lo = 0; // slab s = [lo, hi), its successor [hi, next)
+    std::uint32_t hi = n > 0 ? 1u : 0u;
+    const auto count = static_cast<std::uint32_t>(n);
+    while (lo < count) {
+      std::uint32_t need = hi; // 1 + the largest reach of slab s: where slab s + 1 must end
+      for (std::uint32_t i = lo; i < hi; ++i)
+        need = _reachHost[i] + 1 > need ? _reachHost[i] + 1 : need;
+      const auto colour = static_cast<std::uint8_t>((_slabStart.size() - 1) % 3);
+      for (std::uint32_t i = lo; i < hi; ++i)
+        _colourHost[i] = colour;
+      _slabStart.push_back(hi);
+      std::uint32_t next = need > hi + 1 ? need : hi + 1;
+      lo = hi;
+      hi = next < count ? next : count;
+    }
+    _colour.reserve(n);
+    if (n > 0)
+      Exec::copyToDevice(_colour.d(), _colourHost.data(), n);
   }
 
 private:
@@ -153,6 +223,11 @@ private:
   Dev<std::uint32_t> _lowStart;  ///< CSR offsets of the low lists, n + 1
   Dev<std::uint32_t> _low;       ///< per low-list entry k: the candidate's q in the half lists
   Dev<std::uint32_t> _lowPos;    ///< per half-list candidate q: its k in the partner's low list
+  Dev<std::uint32_t> _lowOwner;  ///< per low-list entry k: the owner's index
+  Dev<std::uint8_t> _colour;     ///< per particle: its slab's colour (0..2)
+  std::vector<std::uint32_t> _slabStart;  ///< host: slab offsets, slabs + 1
+  std::vector<std::uint32_t> _reachHost;  ///< host scratch of buildSlabs
+  std::vector<std::uint8_t> _colourHost;  ///< host scratch of buildSlabs
   Dev<double> _scratch;          ///< kScratchWidth doubles per candidate, shared (see above)
   std::uint32_t _total = 0;
   std::uint64_t _generation = 0;

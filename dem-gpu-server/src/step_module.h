@@ -31,7 +31,6 @@ namespace coredem::dem {
 enum StatusSlot : int {
   kStatusMaxDisplacement2 = 0, ///< motion: largest displacement² since the list build (m²)
   kStatusHistorySlots,         ///< contacts: most history slots a particle uses
-  kStatusContactsPerParticle,  ///< contacts: most contacts (pairs + walls) of a particle
   kStatusBelowRemoval,         ///< chemistry: 1 when a particle fell below the removal size
   kStatusSlotCount
 };

@@ -51,7 +51,8 @@ TEST(PackedBed, SettledBedWallForceEqualsWeight) {
 }
 
 TEST(PackedBed, TooFewHistorySlotsIsAUserError) {
-  // A simple-cubic packing gives interior particles 6 contacts; 4 slots cannot hold them.
+  // A simple-cubic packing: a particle owns the contacts with its neighbours of larger global
+  // id, 3 at the first corner (and keeps their history); 2 slots cannot hold them.
   DemConfig c;
   ParticleSet s;
   s.packing = Packing::Lattice;
@@ -60,7 +61,7 @@ TEST(PackedBed, TooFewHistorySlotsIsAUserError) {
   s.regionMin = {0, 0, 0};
   s.regionMax = {3 * 0.999e-3, 3 * 0.999e-3, 3 * 0.999e-3};
   c.particleSets.push_back(s);
-  c.neighbour.historySlots = 4;
+  c.neighbour.historySlots = 2;
   DemSystem sys(c, BackendKind::Cpu, 1);
   try {
     sys.advance(sys.dtDemMax(), 1);

@@ -1,5 +1,6 @@
 // Two owned pairs in the two lanes of Double2 (contacts.h: ownedPair, twoOwnedPairs) give the
-// bits of the scalar evaluation, pair by pair: forces, torques, history and partner shares, for
+// bits of the scalar evaluation, pair by pair: forces, torques, history and the partner shares
+// added to the partners' force and torque, for
 // sticking and sliding contacts (a lane of each, or both), unequal radii and masses, two
 // materials, in the SSE2 version and, where the processor has AVX, in the AVX version.
 #include <bit>
@@ -103,7 +104,15 @@ void checkGroup(bool avx, int cases) {
     const Expected e = scalarReference(k, dt);
     const int K = 4;
     std::vector<std::int64_t> hk(K, -1);
-    std::vector<double> hd(3 * K, 0.0), share(12, 0.0);
+    std::vector<double> hd(3 * K, 0.0);
+    // The partners' force and torque hold earlier terms: the shares are added to them.
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<double> force(9), torque(9);
+    for (int q = 0; q < 9; ++q) {
+      force[q] = 1e-3 * u(rng);
+      torque[q] = 1e-7 * u(rng);
+    }
+    const std::vector<double> force0 = force, torque0 = torque;
     const TwoPairArgs a{k.x.data(),
                         k.v.data(),
                         k.w.data(),
@@ -114,7 +123,8 @@ void checkGroup(bool avx, int cases) {
                         k.pairs.data(),
                         hk.data(),
                         hd.data(),
-                        share.data(),
+                        force.data(),
+                        torque.data(),
                         2,
                         K,
                         dt,
@@ -125,15 +135,19 @@ void checkGroup(bool avx, int cases) {
     for (int s = 0; s < 2; ++s) {
       expectSameBits(kernels::load3(out, 2 * s), e.force[s], "force", c);
       expectSameBits(kernels::load3(out, 2 * s + 1), e.torque[s], "torque", c);
-      expectSameBits(kernels::load3(share.data(), 2 * s), e.force[s], "partner force", c);
-      expectSameBits(kernels::load3(share.data(), 2 * s + 1), e.shareTorque[s], "partner torque",
-                     c);
+      const int j = k.half[s];
+      expectSameBits(kernels::load3(force.data(), j), kernels::load3(force0.data(), j) - e.force[s],
+                     "partner force", c);
+      expectSameBits(kernels::load3(torque.data(), j),
+                     kernels::load3(torque0.data(), j) + e.shareTorque[s], "partner torque", c);
       EXPECT_EQ(hk[slot + s], 101 + s);
       expectSameBits(kernels::load3(hd.data(), slot + s), e.deltaT[s], "history", c);
       slid[s] += e.slides[s] ? 1 : 0;
     }
     EXPECT_EQ(hk[0], -1);
     EXPECT_EQ(hk[3], -1);
+    expectSameBits(kernels::load3(force.data(), 0), kernels::load3(force0.data(), 0),
+                   "owner's force (returned, not added)", c);
   }
   // Each lane slid in about half of the cases, alone or with the other.
   EXPECT_GT(slid[0], cases / 4);
@@ -157,11 +171,11 @@ TEST(PairLanes, HistorySlotsBeyondTheRowAreDropped) {
   Case k = randomCase(rng, false, true);
   const int K = 2;
   std::vector<std::int64_t> hk(K, -1);
-  std::vector<double> hd(3 * K, 0.0), share(12, 0.0);
-  const TwoPairArgs a{k.x.data(), k.v.data(),   k.w.data(),    k.r.data(),
-                      k.m.data(), k.mat.data(), k.half.data(), k.pairs.data(),
-                      hk.data(),  hd.data(),    share.data(),  2,
-                      K,          1e-6,         false};
+  std::vector<double> hd(3 * K, 0.0), force(9, 0.0), torque(9, 0.0);
+  const TwoPairArgs a{k.x.data(),   k.v.data(),     k.w.data(), k.r.data(), k.m.data(),
+                      k.mat.data(), k.half.data(),  k.pairs.data(), hk.data(), hd.data(),
+                      force.data(), torque.data(),  2,          K,          1e-6,
+                      false};
   double out[12];
   twoOwnedPairs(a, 0, 0, 1, 101, 102, k.h, 1, out); // slot 2 does not exist
   EXPECT_EQ(hk[0], -1);

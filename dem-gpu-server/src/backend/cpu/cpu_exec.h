@@ -65,30 +65,41 @@ struct CpuExec {
     return r;
   }
 
-  /// reduceMaxInto for a loop whose body is mostly double arithmetic (the contact pass): where
-  /// the processor has AVX, the body is inlined into a copy compiled for AVX, whose
-  /// three-operand encoding needs none of the register copies of SSE2's two-operand forms. Same
-  /// operations, no FMA (not part of AVX): the same results. Chunks of 512 indices as in
-  /// reduceMax.
+  /// max of f(i) over every index of the slabs [start[s], start[s + 1]), s < slabs, run by
+  /// colour: the slabs s ≡ c (mod 3) in parallel for c = 0, 1, 2 in turn (a barrier between
+  /// colours), each slab on one thread in index order (pair_lists.h "Slabs": f may then write
+  /// its pair terms into both particles). Where the processor has AVX, the body is inlined into
+  /// a copy compiled for AVX, whose three-operand encoding needs none of the register copies of
+  /// SSE2's two-operand forms; same operations, no FMA (not part of AVX): the same results.
+  /// `start` is host memory.
   template <class F>
-  void reduceMaxIntoWide(std::size_t n, F f, double init, double* out) const {
+  void reduceMaxOverSlabsWide(const std::uint32_t* start, int slabs, F f, double init,
+                              double* out) const {
+    double r = init;
+    const bool avx = hasAvx();
+#pragma omp parallel num_threads(threadCount()) reduction(max : r) if (slabs > 3)
+    {
+      const F g = f;
+      for (int c = 0; c < 3; ++c) {
+        const int count = slabs > c ? (slabs - c + 2) / 3 : 0;
+#pragma omp for schedule(dynamic, 1)
+        for (int t = 0; t < count; ++t) {
+          const int s = c + 3 * t;
+          const auto lo = static_cast<std::int64_t>(start[s]);
+          const auto hi = static_cast<std::int64_t>(start[s + 1]);
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX__)
-    if (hasAvx()) {
-      const std::int64_t m = static_cast<std::int64_t>(n);
-      const std::int64_t chunks = (m + 511) / 512;
-      double r = init;
-#pragma omp parallel num_threads(threadCount()) reduction(max : r) if (m > 256)
-      {
-        const F g = f;
-#pragma omp for schedule(dynamic, 1) nowait
-        for (std::int64_t c = 0; c < chunks; ++c)
-          r = std::max(r, maxOverAvx(g, 512 * c, std::min(m, 512 * c + 512)));
-      }
-      *out = r;
-      return;
-    }
+          if (avx) {
+            r = std::max(r, maxOverAvx(g, lo, hi));
+            continue;
+          }
 #endif
-    reduceMaxInto(n, f, init, out);
+          for (std::int64_t i = lo; i < hi; ++i)
+            r = std::max(r, g(static_cast<std::size_t>(i)));
+        }
+      }
+    }
+    (void)avx;
+    *out = r;
   }
 
   /// Whether the processor (and the operating system) support AVX.
@@ -228,7 +239,7 @@ struct CpuExec {
 
 private:
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX__)
-  /// max over i in [lo, hi) of g(i), g inlined (reduceMaxIntoWide).
+  /// max over i in [lo, hi) of g(i), g inlined (reduceMaxOverSlabsWide).
   template <class F>
   [[gnu::target("avx"), gnu::flatten]] static double maxOverAvx(const F& g, std::int64_t lo,
                                                                 std::int64_t hi) {
