@@ -88,8 +88,8 @@ inline constexpr bool kTwoPairs<Exec, std::void_t<typename Exec::PairScalar>> = 
 /// adds the partner's share straight to the partner (scatter), else the two gather passes.
 template <class Exec>
 inline constexpr bool kScatter = requires(const Exec& e, double* o) {
-  e.reduceMaxOverSlabsWide(static_cast<const std::uint32_t*>(nullptr), 0,
-                           [](std::size_t) { return 0.0; }, 0.0, o);
+  e.reduceMaxOverSlabsWide(
+      static_cast<const std::uint32_t*>(nullptr), 0, [](std::size_t) { return 0.0; }, 0.0, o);
 };
 
 #if defined(COREDEM_DEM_DOUBLE2)
@@ -344,7 +344,8 @@ public:
     // needs (owned contacts + walls); the largest goes to the status array.
     auto ownerPass = [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
-      (void)f, (void)tq, (void)hit, (void)share, (void)own; // nvcc: no first capture in if constexpr
+      (void)f, (void)tq, (void)hit, (void)share,
+          (void)own; // nvcc: no first capture in if constexpr
       const long long ii = static_cast<long long>(i);
       const Vec3 xi = load3(x, ii);
       const double ri = r[i];
@@ -460,8 +461,8 @@ public:
           const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
           const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
           const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-          const LsdResult res = wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii), ri,
-                                            history(key), dt);
+          const LsdResult res =
+              wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii), ri, history(key), dt);
           FW += res.force;
           T += res.torque;
           remember(key, res.deltaT);
@@ -477,9 +478,13 @@ public:
       F += FW;
       for (int s = slot; s < used; ++s)
         hk[i * K + s] = -1;
-      if constexpr (kScatter<Exec>) { // after the shares of the particles before it (pair_lists.h)
-        store3(f, ii, load3(f, ii) + F);
-        store3(tq, ii, load3(tq, ii) + T);
+      // i's own sum, after the shares of the particles before it (pair_lists.h), if i has
+      // contacts of its own (most particles of a dilute bed have none: no load, no store).
+      if constexpr (kScatter<Exec>) {
+        if (owned + wallCount > 0) {
+          store3(f, ii, load3(f, ii) + F);
+          store3(tq, ii, load3(tq, ii) + T);
+        }
       } else {
         store3(own, 2 * ii, F);
         store3(own, 2 * ii + 1, T);
@@ -514,8 +519,9 @@ public:
         Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
         Vec3 T{0.0, 0.0, 0.0};
         const std::uint32_t kEnd = ls[i + 1];
+        const bool hasOwn = nc[i] + nwc[i] > 0; // as the scatter: no own sum without own contacts
         for (int c = 0; c < 3; ++c) {
-          bool self = colour[i] == c;
+          bool self = hasOwn && colour[i] == c;
           for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
             const std::uint32_t o = lowOwner[k];
             if (colour[o] != c)

@@ -52,6 +52,8 @@ public:
 
   /// Doubles per candidate in scratch() (the contact module's partner force and torque).
   static constexpr int kScratchWidth = 6;
+  /// Smallest slab (particles), but the last (buildSlabs).
+  static constexpr std::uint32_t kMinSlab = 512;
 
   /// The neighbour lists or the particle order changed: rebuilt by the next ensure().
   void invalidate() { _valid = false; }
@@ -172,11 +174,14 @@ public:
   }
 
   /// The slabs and their colours (see the file comment). Greedy over the particle order, with
-  /// reach(i) = the largest index among i and its neighbours: slab 0 = {0}; each next slab ends
-  /// where it holds every neighbour of the slab before it,
-  ///   b_{s+2} = max(b_{s+1} + 1, 1 + max reach over slab s),
-  /// so that a pair never skips a slab. In a cell-sorted order a slab is about half a layer of
-  /// neighbour cells. Reads nbCount, nbList; one n-value copy to the host and back (per build).
+  /// reach(i) = the largest index among i and its neighbours: slab 0 = the first kMinSlab
+  /// particles; each next slab ends where it holds every neighbour of the slab before it,
+  ///   b_{s+2} = max(b_{s+1} + kMinSlab, 1 + max reach over slab s),
+  /// so that a pair never skips a slab. In a cell-sorted order a slab is about a layer of
+  /// neighbour cells; kMinSlab keeps a dilute bed's slabs (few neighbours, short reach) from
+  /// being single particles, each a scheduling step. Fixed, not from the thread count: the
+  /// slabs decide the order of the sums. Reads nbCount, nbList; one n-value copy to the host
+  /// and back (per build).
   void buildSlabs(Exec& exec, ParticleStore<Exec>& p) {
     const std::size_t n = p.n;
     const int M = p.M;
@@ -197,7 +202,7 @@ public:
     _slabStart.assign(1, 0u);
     _colourHost.resize(n);
     std::uint32_t lo = 0; // slab s = [lo, hi), its successor [hi, next)
-    std::uint32_t hi = n > 0 ? 1u : 0u;
+    std::uint32_t hi = n < kMinSlab ? static_cast<std::uint32_t>(n) : kMinSlab;
     const auto count = static_cast<std::uint32_t>(n);
     while (lo < count) {
       std::uint32_t need = hi; // 1 + the largest reach of slab s: where slab s + 1 must end
@@ -207,7 +212,7 @@ public:
       for (std::uint32_t i = lo; i < hi; ++i)
         _colourHost[i] = colour;
       _slabStart.push_back(hi);
-      std::uint32_t next = need > hi + 1 ? need : hi + 1;
+      std::uint32_t next = need > hi + kMinSlab ? need : hi + kMinSlab;
       lo = hi;
       hi = next < count ? next : count;
     }
@@ -225,10 +230,10 @@ private:
   Dev<std::uint32_t> _lowPos;    ///< per half-list candidate q: its k in the partner's low list
   Dev<std::uint32_t> _lowOwner;  ///< per low-list entry k: the owner's index
   Dev<std::uint8_t> _colour;     ///< per particle: its slab's colour (0..2)
-  std::vector<std::uint32_t> _slabStart;  ///< host: slab offsets, slabs + 1
-  std::vector<std::uint32_t> _reachHost;  ///< host scratch of buildSlabs
-  std::vector<std::uint8_t> _colourHost;  ///< host scratch of buildSlabs
-  Dev<double> _scratch;          ///< kScratchWidth doubles per candidate, shared (see above)
+  std::vector<std::uint32_t> _slabStart; ///< host: slab offsets, slabs + 1
+  std::vector<std::uint32_t> _reachHost; ///< host scratch of buildSlabs
+  std::vector<std::uint8_t> _colourHost; ///< host scratch of buildSlabs
+  Dev<double> _scratch; ///< kScratchWidth doubles per candidate, shared (see above)
   std::uint32_t _total = 0;
   std::uint64_t _generation = 0;
   bool _valid = false;

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "backend/cpu/cpu_exec.h"
 #include "contacts.h"
 #include "coredem/dem/kernels/damping.h"
 #include "coredem/dem/kernels/lsd_contact.h"
@@ -220,11 +221,14 @@ TEST(ContactPairs, ForcesMatchAReferenceEvaluatingBothSides) {
 }
 
 TEST(ContactPairs, OneAndTwoThreadsAreBitwiseIdenticalOnADenseBed) {
-  // 512 particles: more than the 256 below which the cpu backend runs a loop serially.
+  // 4,096 particles: more than the 256 below which the cpu backend runs a loop serially, and
+  // more than three slabs of PairLists::kMinSlab, so that the contact pass runs slabs of one
+  // colour on both threads (pair_lists.h "Slabs").
+  static_assert(16 * 16 * 16 > 4 * PairLists<backend::CpuExec>::kMinSlab);
   HostState s[2];
   for (int t = 0; t < 2; ++t) {
     auto engine = makeCpuEngine(denseSetup(t + 1));
-    engine->setState(denseState(8));
+    engine->setState(denseState(16));
     for (int k = 0; k < 60; ++k)
       engine->subStep(2e-6);
     s[t] = engine->state();
@@ -412,14 +416,16 @@ HostState crowdedState(int n, int touching, double R, double a, double skin) {
 } // namespace
 
 // The cpu backend evaluates two consecutive owned pairs in contact at once, in the two lanes of
-// Double2; cuda-sim runs the same module one pair at a time (the CUDA path). Same bits.
+// Double2, and adds the partners' shares slab colour by colour; cuda-sim runs the same module
+// one pair at a time and gathers the shares in a second pass in the same order (the CUDA path).
+// Same bits. The 4,096-particle bed has several slabs of each colour.
 TEST(ContactPairs, TwoLanePairsGiveTheOnePairAtATimeBits) {
   struct Deck {
     HostState state;
     EngineSetup setup;
   };
   std::vector<Deck> decks;
-  decks.push_back({denseState(8), denseSetup(2)});
+  decks.push_back({denseState(16), denseSetup(2)});
   // One particle owning 192 candidates, 20 in contact: a wide neighbour list and more slots.
   EngineSetup crowded = denseSetup(2);
   crowded.walls.clear();

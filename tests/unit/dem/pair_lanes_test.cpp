@@ -172,9 +172,21 @@ TEST(PairLanes, HistorySlotsBeyondTheRowAreDropped) {
   const int K = 2;
   std::vector<std::int64_t> hk(K, -1);
   std::vector<double> hd(3 * K, 0.0), force(9, 0.0), torque(9, 0.0);
-  const TwoPairArgs a{k.x.data(),   k.v.data(),     k.w.data(), k.r.data(), k.m.data(),
-                      k.mat.data(), k.half.data(),  k.pairs.data(), hk.data(), hd.data(),
-                      force.data(), torque.data(),  2,          K,          1e-6,
+  const TwoPairArgs a{k.x.data(),
+                      k.v.data(),
+                      k.w.data(),
+                      k.r.data(),
+                      k.m.data(),
+                      k.mat.data(),
+                      k.half.data(),
+                      k.pairs.data(),
+                      hk.data(),
+                      hd.data(),
+                      force.data(),
+                      torque.data(),
+                      2,
+                      K,
+                      1e-6,
                       false};
   double out[12];
   twoOwnedPairs(a, 0, 0, 1, 101, 102, k.h, 1, out); // slot 2 does not exist
