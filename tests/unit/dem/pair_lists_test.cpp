@@ -33,8 +33,8 @@ void fillRandomGraph(ParticleStore<CpuExec>& p, std::size_t n, double cut, bool 
   std::vector<std::size_t> idx(n);
   std::iota(idx.begin(), idx.end(), 0);
   std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) {
-    return std::make_pair(std::floor(x[3 * a + 2] / cut), x[3 * a])
-         < std::make_pair(std::floor(x[3 * b + 2] / cut), x[3 * b]);
+    return std::make_pair(std::floor(x[3 * a + 2] / cut), x[3 * a]) <
+           std::make_pair(std::floor(x[3 * b + 2] / cut), x[3 * b]);
   });
   if (shuffleOrder)
     std::shuffle(idx.begin(), idx.end(), rng);
@@ -127,7 +127,8 @@ TEST(PairListSlabs, AnyOrderGivesValidSlabs) {
 }
 
 TEST(PairListSlabs, DiluteAndTinySystems) {
-  for (const std::size_t n : {std::size_t{1}, std::size_t{7}, std::size_t{700}, std::size_t{5000}}) {
+  for (const std::size_t n :
+       {std::size_t{1}, std::size_t{7}, std::size_t{700}, std::size_t{5000}}) {
     ParticleStore<CpuExec> p;
     fillRandomGraph(p, n, n > 1000 ? 0.01 : 0.2, false, 3); // 5000: hardly any neighbours
     CpuExec exec;
