@@ -352,7 +352,7 @@ std::vector<ModelOption> makeOptions() {
                  return e;
                }});
   o.push_back({"dem.history_slots", "numerics", fmt::format("integer in [1, {}]", kMaxHistorySlots),
-               "12", "tangential-history slots per particle (simultaneous contacts)",
+               "12", "tangential-history slots per particle (the contacts it owns, walls included)",
                [](DemConfig& c, std::string_view v) {
                  std::string e;
                  const std::string what =

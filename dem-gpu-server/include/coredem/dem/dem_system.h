@@ -147,7 +147,7 @@ struct NeighbourOptions {
   double skinFactor =
       0.1; ///< Verlet skin = skinFactor · d_max; lists rebuilt when a particle moved > skin/2
   int historySlots =
-      12; ///< tangential-history slots per particle (contacts incl. walls), 1..kMaxHistorySlots
+      12; ///< tangential-history slots per particle (owned contacts + walls), 1..kMaxHistorySlots
   int initialNeighbourSlots = 16; ///< neighbour-list width per particle (grows automatically)
 };
 
