@@ -84,14 +84,6 @@ inline constexpr bool kTwoPairs = false;
 template <class Exec>
 inline constexpr bool kTwoPairs<Exec, std::void_t<typename Exec::PairScalar>> = true;
 
-/// Whether Exec runs slabs colour by colour (cpu: reduceMaxOverSlabsWide), so that an owner
-/// adds the partner's share straight to the partner (scatter), else the two gather passes.
-template <class Exec>
-inline constexpr bool kScatter = requires(const Exec& e, double* o) {
-  e.reduceMaxOverSlabsWide(
-      static_cast<const std::uint32_t*>(nullptr), 0, [](std::size_t) { return 0.0; }, 0.0, o);
-};
-
 #if defined(COREDEM_DEM_DOUBLE2)
 /// What twoOwnedPairs reads and writes (pass 1 of ContactModule::sources).
 struct TwoPairArgs {

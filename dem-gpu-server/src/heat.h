@@ -229,21 +229,36 @@ public:
 
     // 2a. Pair terms, each pair once by its owner (the smaller global id, which is also the
     //     canonical "lo" of the pair kernels) over the half lists (pair_lists.h): the owner
-    //     keeps +Q_ab (heat into lo = G (T_hi − T_lo)) and writes it to the per-candidate
-    //     scratch at the partner's low-list position (contact, lens), 0 when the pair is out of
-    //     reach. Q_ab = −Q_ba exactly.
+    //     keeps +Q_ab (heat into lo = G (T_hi − T_lo)) and gives −Q_ab to the partner. Q_ab =
+    //     −Q_ba exactly. Each particle's pair sums (contact, lens) receive their terms in the
+    //     order of pair_lists.h "Slabs" (by colour, then by the evaluating particle's index;
+    //     its own sum at its own index): the cpu backend (scatter) runs the owners slab colour
+    //     by colour and subtracts Q_ab from the partner's sums directly; the gather backends
+    //     write Q_ab to the per-candidate scratch at the partner's low-list position (0 when
+    //     the pair is out of reach) and the owner's sums to qOwn, lOwn, and 2b adds them up in
+    //     that order.
+    constexpr bool scatter = kScatter<Exec>;
     PairLists<Exec>& pl = ctx.pairs;
     const std::uint32_t* hs = pl.halfStart();
     const std::int32_t* half = pl.half();
     const std::uint32_t* ls = pl.lowStart();
     const std::uint32_t* lowPos = pl.lowPos();
+    const std::uint32_t* lowOwner = pl.lowOwner();
+    const std::uint8_t* colour = pl.colour();
     static_assert(PairLists<Exec>::kScratchWidth >= 2);
     double* share = pl.scratch(); // per candidate: Q_ab contact, Q_ab lens (W)
-    double* qOwn = _q.d();        // owner's pair sums, contact and lens: _q and _g until 2b
-    double* lOwn = _g.d();
+    double* qOwn = _q.d(); // pair sums, contact and lens (scatter: complete; gather: the owner's)
+    double* lOwn = _g.d(); //   in _q and _g until 2b
     if (contact || lens) {
-      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
+      if constexpr (scatter) {
+        exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+          qOwn[i] = 0.0;
+          lOwn[i] = 0.0;
+        });
+      }
+      auto ownerPass = [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
         using namespace kernels;
+        (void)share, (void)lowPos, (void)qOwn, (void)lOwn; // nvcc: captured outside if constexpr
         const long long lo = static_cast<long long>(i);
         const Vec3 xlo = load3(x, lo);
         const double rlo = r[lo];
@@ -316,33 +331,70 @@ public:
           }
           qc += qcab;
           ql += qlab;
-          const std::size_t kq = lowPos[q]; // the partner's slot for its share
-          share[2 * kq] = qcab;
-          share[2 * kq + 1] = qlab;
+          if constexpr (kScatter<Exec>) {
+            qOwn[hi] -= qcab;
+            lOwn[hi] -= qlab;
+          } else {
+            const std::size_t kq = lowPos[q]; // the partner's slot for its share
+            share[2 * kq] = qcab;
+            share[2 * kq + 1] = qlab;
+          }
         }
-        qOwn[i] = qc;
-        lOwn[i] = ql;
-      });
+        if constexpr (kScatter<Exec>) { // after the terms of the particles before it
+          qOwn[i] += qc;
+          lOwn[i] += ql;
+        } else {
+          qOwn[i] = qc;
+          lOwn[i] = ql;
+        }
+        return 0.0;
+      };
+      if constexpr (scatter) {
+        exec.reduceMaxOverSlabsWide(pl.slabStart(), pl.slabs(), ownerPass, 0.0, &_unused);
+      } else {
+        exec.parallelFor(n, ownerPass);
+      }
     }
 
     // 2b. Per-particle heat rate: the pair sums of 2a plus −Q_ab of the pairs the partners own
     //     (low lists, fixed order), convection with the gas of the PCM cell, radiation, walls.
     exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
       using namespace kernels;
+      (void)share, (void)ls, (void)lowOwner, (void)colour, (void)qOwn, (void)lOwn; // nvcc, as 2a
       const long long ii = static_cast<long long>(i);
       const double ti = T[i];
       const HeatMaterial mi = hm[mat[i]];
       const std::uint32_t celli = coupled ? pcell[i] : nCells;
       ParticleHeatSources src;
       if (contact || lens) {
-        double qc = qOwn[i], ql = lOwn[i];
-        const std::uint32_t kEnd = ls[i + 1];
-        for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
-          qc -= share[2 * static_cast<std::size_t>(k)];
-          ql -= share[2 * static_cast<std::size_t>(k) + 1];
+        if constexpr (kScatter<Exec>) {
+          src.contactConduction = qOwn[i];
+          src.lensConduction = lOwn[i];
+        } else { // the scatter's order: by colour, then by the evaluating particle's index
+          double qc = 0.0, ql = 0.0;
+          const std::uint32_t kEnd = ls[i + 1];
+          for (int c = 0; c < 3; ++c) {
+            bool self = colour[i] == c;
+            for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
+              const std::uint32_t o = lowOwner[k];
+              if (colour[o] != c)
+                continue;
+              if (self && o > i) {
+                qc += qOwn[i];
+                ql += lOwn[i];
+                self = false;
+              }
+              qc -= share[2 * static_cast<std::size_t>(k)];
+              ql -= share[2 * static_cast<std::size_t>(k) + 1];
+            }
+            if (self) {
+              qc += qOwn[i];
+              ql += lOwn[i];
+            }
+          }
+          src.contactConduction = qc;
+          src.lensConduction = ql;
         }
-        src.contactConduction = qc;
-        src.lensConduction = ql;
       }
       double g = 0.0;
       if (celli < nCells && (conv || rad)) {
@@ -480,6 +532,7 @@ private:
   HeatSetup _h;
   Dual<HeatMaterial> _mat;
   Dev<double> _q, _g, _qrad; ///< per particle: Q_i (W), G_i (W/K), Q_rad,i (W)
+  double _unused = 0.0;      ///< the pair pass's reduction result (cpu slabs), not read
   Dev<double> _cellT;        ///< per cell: Σ T_p (radiation environment)
   Dual<double> _acc;         ///< per cell: Σ_sub H, Σ_sub H_Tp, Σ_sub Q_rad/V_c
   Dual<ThermalWall> _walls;  ///< fixed-temperature walls

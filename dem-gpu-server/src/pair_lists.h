@@ -32,7 +32,7 @@
 /// The order in which a particle receives its terms is then fixed by the lists alone: by colour,
 /// then by the index of the particle that evaluates them; a backend that gathers instead
 /// (pass 2 over the low lists) follows the same order with colour() and lowOwner(), and gives
-/// the same bits.
+/// the same bits. The contact and heat modules both work this way (kScatter: which one).
 
 #include <cstddef>
 #include <cstdint>
@@ -43,6 +43,14 @@
 #include "particle_store.h"
 
 namespace coredem::dem {
+
+/// Whether Exec runs slabs colour by colour (cpu: reduceMaxOverSlabsWide), so that an owner
+/// adds the partner's share straight to the partner (scatter), else the two gather passes.
+template <class Exec>
+inline constexpr bool kScatter = requires(const Exec& e, double* o) {
+  e.reduceMaxOverSlabsWide(
+      static_cast<const std::uint32_t*>(nullptr), 0, [](std::size_t) { return 0.0; }, 0.0, o);
+};
 
 template <class Exec>
 class PairLists {
