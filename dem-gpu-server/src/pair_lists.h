@@ -92,9 +92,9 @@ public:
   const std::uint32_t* low() const { return _low.d(); }
   const std::uint32_t* lowPos() const { return _lowPos.d(); }
   double* scratch() { return _scratch.d(); }
-  /// Per low-list entry k: the index of the particle that owns the candidate.
+  /// Per low-list entry k: the index of the particle that owns the candidate (gather backends).
   const std::uint32_t* lowOwner() const { return _lowOwner.d(); }
-  /// Per particle: its slab's colour, 0..2.
+  /// Per particle: its slab's colour, 0..2 (gather backends).
   const std::uint8_t* colour() const { return _colour.d(); }
   /// Host: slab s is the index range [slabStart()[s], slabStart()[s + 1]), s < slabs().
   const std::uint32_t* slabStart() const { return _slabStart.data(); }
@@ -143,10 +143,11 @@ public:
     std::uint32_t lowTotal = 0;
     Exec::copyToHost(&lowTotal, ls + n, sizeof(lowTotal));
     _low.reserve(lowTotal);
-    _lowOwner.reserve(lowTotal);
+    if constexpr (!kScatter<Exec>) // only the gather backends order by the owner
+      _lowOwner.reserve(lowTotal);
     _lowPos.reserve(total > lowTotal ? total : lowTotal);
     std::uint32_t* low = _low.d();
-    std::uint32_t* lowOwner = _lowOwner.d();
+    std::uint32_t* lowOwner = kScatter<Exec> ? nullptr : _lowOwner.d();
     std::uint32_t* lowPos = _lowPos.d();
     const double missing = exec.reduceMax(
         n,
@@ -165,7 +166,8 @@ public:
             } else {
               lowPos[at] = k;
             }
-            lowOwner[k] = static_cast<std::uint32_t>(j);
+            if (lowOwner != nullptr)
+              lowOwner[k] = static_cast<std::uint32_t>(j);
             low[k++] = at;
           }
           return miss;
@@ -188,8 +190,8 @@ public:
   /// so that a pair never skips a slab. In a cell-sorted order a slab is about a layer of
   /// neighbour cells; kMinSlab keeps a dilute bed's slabs (few neighbours, short reach) from
   /// being single particles, each a scheduling step. Fixed, not from the thread count: the
-  /// slabs decide the order of the sums. Reads nbCount, nbList; one n-value copy to the host
-  /// and back (per build).
+  /// slabs decide the order of the sums. Reads nbCount, nbList; on a device backend one
+  /// n-value copy to the host and one back (the colours), per build.
   void buildSlabs(Exec& exec, ParticleStore<Exec>& p) {
     const std::size_t n = p.n;
     const int M = p.M;
@@ -204,29 +206,39 @@ public:
       }
       reach[i] = r;
     });
-    _reachHost.resize(n);
-    if (n > 0)
-      Exec::copyToHost(_reachHost.data(), reach, n * sizeof(std::uint32_t));
+    const std::uint32_t* reachHost = reach; // one memory on the cpu backend
+    if constexpr (Exec::separateDevice) {
+      _reachHost.resize(n);
+      if (n > 0)
+        Exec::copyToHost(_reachHost.data(), reach, n * sizeof(std::uint32_t));
+      reachHost = _reachHost.data();
+    }
+    constexpr bool colours = !kScatter<Exec>; // only the gather backends read the colours
     _slabStart.assign(1, 0u);
-    _colourHost.resize(n);
+    if constexpr (colours)
+      _colourHost.resize(n);
     std::uint32_t lo = 0; // slab s = [lo, hi), its successor [hi, next)
     std::uint32_t hi = n < kMinSlab ? static_cast<std::uint32_t>(n) : kMinSlab;
     const auto count = static_cast<std::uint32_t>(n);
     while (lo < count) {
       std::uint32_t need = hi; // 1 + the largest reach of slab s: where slab s + 1 must end
       for (std::uint32_t i = lo; i < hi; ++i)
-        need = _reachHost[i] + 1 > need ? _reachHost[i] + 1 : need;
-      const auto colour = static_cast<std::uint8_t>((_slabStart.size() - 1) % 3);
-      for (std::uint32_t i = lo; i < hi; ++i)
-        _colourHost[i] = colour;
+        need = reachHost[i] + 1 > need ? reachHost[i] + 1 : need;
+      if constexpr (colours) {
+        const auto colour = static_cast<std::uint8_t>((_slabStart.size() - 1) % 3);
+        for (std::uint32_t i = lo; i < hi; ++i)
+          _colourHost[i] = colour;
+      }
       _slabStart.push_back(hi);
       std::uint32_t next = need > hi + kMinSlab ? need : hi + kMinSlab;
       lo = hi;
       hi = next < count ? next : count;
     }
-    _colour.reserve(n);
-    if (n > 0)
-      Exec::copyToDevice(_colour.d(), _colourHost.data(), n);
+    if constexpr (colours) {
+      _colour.reserve(n);
+      if (n > 0)
+        Exec::copyToDevice(_colour.d(), _colourHost.data(), n);
+    }
   }
 
 private:

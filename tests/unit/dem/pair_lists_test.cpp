@@ -1,8 +1,9 @@
 // PairLists (pair_lists.h): the slabs that let the cpu contact pass add each pair's share
-// straight to the partner, and the low-list owners the gather backends order by. A slab
+// straight to the partner. A slab
 // partition is valid when every pair joins particles of the same or of adjacent slabs; it must
-// hold for any particle order (a badly sorted one only gives larger slabs), and the colours
-// must be the slab index mod 3.
+// hold for any particle order (a badly sorted one only gives larger slabs). (The colours and
+// low-list owners are built for the gather backends only; that they give the scatter's order
+// is checked by the cpu vs cuda-sim tests, contact_pairs_test.cpp and backend_conformance.)
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -80,10 +81,8 @@ void expectValidSlabs(ParticleStore<CpuExec>& p, PairLists<CpuExec>& pl) {
     if (s + 1 < slabs) {
       EXPECT_GE(start[s + 1] - start[s], PairLists<CpuExec>::kMinSlab) << "slab " << s;
     }
-    for (std::uint32_t i = start[s]; i < start[s + 1]; ++i) {
+    for (std::uint32_t i = start[s]; i < start[s + 1]; ++i)
       slabOf[i] = s;
-      EXPECT_EQ(pl.colour()[i], s % 3) << "particle " << i;
-    }
   }
   const int M = p.M;
   for (std::size_t i = 0; i < n; ++i) {
@@ -91,16 +90,6 @@ void expectValidSlabs(ParticleStore<CpuExec>& p, PairLists<CpuExec>& pl) {
       const auto j = static_cast<std::size_t>(p.nbList.h()[i * M + a]);
       ASSERT_LE(std::abs(slabOf[i] - slabOf[j]), 1)
           << "pair " << i << "-" << j << " skips a slab (" << slabOf[i] << ", " << slabOf[j] << ")";
-    }
-  }
-  // Every low-list entry names its candidate's owner.
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::uint32_t k = pl.lowStart()[i]; k < pl.lowStart()[i + 1]; ++k) {
-      const std::uint32_t q = pl.low()[k];
-      const std::uint32_t o = pl.lowOwner()[k];
-      EXPECT_GE(q, pl.halfStart()[o]);
-      EXPECT_LT(q, pl.halfStart()[o + 1]);
-      EXPECT_EQ(pl.half()[q], static_cast<std::int32_t>(i));
     }
   }
 }
