@@ -70,6 +70,27 @@ Case randomCase(std::mt19937_64& rng, bool slide0, bool slide1) {
   return k;
 }
 
+/// twoOwnedPairs' arguments for a case: K = hk.size() history slots, two materials.
+TwoPairArgs argsFor(Case& k, std::vector<std::int64_t>& hk, std::vector<double>& hd,
+                    std::vector<double>& force, std::vector<double>& torque, double dt, bool avx) {
+  return TwoPairArgs{k.x.data(),
+                     k.v.data(),
+                     k.w.data(),
+                     k.r.data(),
+                     k.m.data(),
+                     k.mat.data(),
+                     k.half.data(),
+                     k.pairs.data(),
+                     hk.data(),
+                     hd.data(),
+                     force.data(),
+                     torque.data(),
+                     2,
+                     static_cast<int>(hk.size()),
+                     dt,
+                     avx};
+}
+
 struct Expected {
   Vec3 force[2], torque[2], deltaT[2], shareTorque[2];
   bool slides[2];
@@ -113,22 +134,7 @@ void checkGroup(bool avx, int cases) {
       torque[q] = 1e-7 * u(rng);
     }
     const std::vector<double> force0 = force, torque0 = torque;
-    const TwoPairArgs a{k.x.data(),
-                        k.v.data(),
-                        k.w.data(),
-                        k.r.data(),
-                        k.m.data(),
-                        k.mat.data(),
-                        k.half.data(),
-                        k.pairs.data(),
-                        hk.data(),
-                        hd.data(),
-                        force.data(),
-                        torque.data(),
-                        2,
-                        K,
-                        dt,
-                        avx};
+    const TwoPairArgs a = argsFor(k, hk, hd, force, torque, dt, avx);
     double out[12];
     const int slot = 1; // slots 1 and 2
     twoOwnedPairs(a, 0, 0, 1, 101, 102, k.h, slot, out);
@@ -172,22 +178,7 @@ TEST(PairLanes, HistorySlotsBeyondTheRowAreDropped) {
   const int K = 2;
   std::vector<std::int64_t> hk(K, -1);
   std::vector<double> hd(3 * K, 0.0), force(9, 0.0), torque(9, 0.0);
-  const TwoPairArgs a{k.x.data(),
-                      k.v.data(),
-                      k.w.data(),
-                      k.r.data(),
-                      k.m.data(),
-                      k.mat.data(),
-                      k.half.data(),
-                      k.pairs.data(),
-                      hk.data(),
-                      hd.data(),
-                      force.data(),
-                      torque.data(),
-                      2,
-                      K,
-                      1e-6,
-                      false};
+  const TwoPairArgs a = argsFor(k, hk, hd, force, torque, 1e-6, false);
   double out[12];
   twoOwnedPairs(a, 0, 0, 1, 101, 102, k.h, 1, out); // slot 2 does not exist
   EXPECT_EQ(hk[0], -1);
