@@ -510,30 +510,20 @@ public:
         const long long ii = static_cast<long long>(i);
         Vec3 F = coupled ? load3(f, ii) : Vec3{0.0, 0.0, 0.0};
         Vec3 T{0.0, 0.0, 0.0};
-        const std::uint32_t kEnd = ls[i + 1];
         const bool hasOwn = nc[i] + nwc[i] > 0; // as the scatter: no own sum without own contacts
-        for (int c = 0; c < 3; ++c) {
-          bool self = hasOwn && colour[i] == c;
-          for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
-            const std::uint32_t o = lowOwner[k];
-            if (colour[o] != c)
-              continue;
-            if (self && o > i) {
+        inSlabOrder(
+            i, hasOwn, ls, lowOwner, colour,
+            [&] {
               F += load3(own, 2 * ii);
               T += load3(own, 2 * ii + 1);
-              self = false;
-            }
-            const long long q = low[k];
-            if (!hit[q])
-              continue;
-            F += -load3(share, 2 * q);
-            T += load3(share, 2 * q + 1);
-          }
-          if (self) {
-            F += load3(own, 2 * ii);
-            T += load3(own, 2 * ii + 1);
-          }
-        }
+            },
+            [&](std::uint32_t k) {
+              const long long q = low[k];
+              if (!hit[q])
+                return;
+              F += -load3(share, 2 * q);
+              T += load3(share, 2 * q + 1);
+            });
         store3(f, ii, F);
         store3(tq, ii, T);
       });

@@ -372,26 +372,16 @@ public:
           src.lensConduction = lOwn[i];
         } else { // the scatter's order: by colour, then by the evaluating particle's index
           double qc = 0.0, ql = 0.0;
-          const std::uint32_t kEnd = ls[i + 1];
-          for (int c = 0; c < 3; ++c) {
-            bool self = colour[i] == c;
-            for (std::uint32_t k = ls[i]; k < kEnd; ++k) {
-              const std::uint32_t o = lowOwner[k];
-              if (colour[o] != c)
-                continue;
-              if (self && o > i) {
+          inSlabOrder(
+              i, true, ls, lowOwner, colour,
+              [&] {
                 qc += qOwn[i];
                 ql += lOwn[i];
-                self = false;
-              }
-              qc -= share[2 * static_cast<std::size_t>(k)];
-              ql -= share[2 * static_cast<std::size_t>(k) + 1];
-            }
-            if (self) {
-              qc += qOwn[i];
-              ql += lOwn[i];
-            }
-          }
+              },
+              [&](std::uint32_t k) {
+                qc -= share[2 * static_cast<std::size_t>(k)];
+                ql -= share[2 * static_cast<std::size_t>(k) + 1];
+              });
           src.contactConduction = qc;
           src.lensConduction = ql;
         }

@@ -52,6 +52,31 @@ inline constexpr bool kScatter = requires(const Exec& e, double* o) {
       static_cast<const std::uint32_t*>(nullptr), 0, [](std::size_t) { return 0.0; }, 0.0, o);
 };
 
+/// The gather backends' pass 2 for particle i: calls own() for i's own sum (if hasOwn) and
+/// partner(k) for each of its low-list entries k, in the order the cpu backend's slabs add the
+/// terms (by colour, then by the evaluating particle's index; i's own sum at its own index).
+template <class Own, class Partner>
+DEM_HD void inSlabOrder(std::size_t i, bool hasOwn, const std::uint32_t* lowStart,
+                        const std::uint32_t* lowOwner, const std::uint8_t* colour, Own&& own,
+                        Partner&& partner) {
+  const std::uint32_t kEnd = lowStart[i + 1];
+  for (int c = 0; c < 3; ++c) {
+    bool self = hasOwn && colour[i] == c;
+    for (std::uint32_t k = lowStart[i]; k < kEnd; ++k) {
+      const std::uint32_t o = lowOwner[k];
+      if (colour[o] != c)
+        continue;
+      if (self && o > i) {
+        own();
+        self = false;
+      }
+      partner(k);
+    }
+    if (self)
+      own();
+  }
+}
+
 template <class Exec>
 class PairLists {
 public:
