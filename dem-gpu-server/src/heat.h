@@ -4,9 +4,9 @@
 /// written once for every backend like engine_impl.h. Per sub-step, after the contact forces and
 /// the drag deposition (which leaves the particles sorted by PCM cell):
 ///   1. cell means of T_p for the radiation environment (§3.4 (a), including the particle)
-///   2. pair terms once per pair by its owner over the half lists, the partner's share gathered
-///      in a fixed order (pair_lists.h, no atomics): contact conduction (Eqs. 22–23) and gas-lens
-///      conduction (Eqs. 24–26); then per particle convection with the gas of its PCM cell
+///   2. pair terms once per pair by its owner over the half lists, the partner's share added in
+///      a fixed order (pair_lists.h "Slabs", no atomics): contact conduction (Eqs. 22–23) and
+///      gas-lens conduction (Eqs. 24–26); then per particle convection with the gas of its PCM cell
 ///      (Eqs. 19–21) and radiation (Eqs. 27–28); the sum Q_i (W) is stored
 ///   3. per cell: H = Σ G_i/V_c, H_Tp = Σ G_i T_i/V_c (G_i = h_i A_i) and Σ Q_rad,i/V_c, added
 ///      to the window accumulators (averaged over the sub-steps at the window end; the radiation
