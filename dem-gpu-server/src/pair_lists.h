@@ -21,7 +21,9 @@
 ///
 /// `scratch()` is one such per-candidate buffer of kScratchWidth doubles, shared: a module may
 /// use it only inside its own sources() call (written in its first pass, read in its second),
-/// so the contact and heat modules need no buffer of their own.
+/// so the contact and heat modules need no buffer of their own. The low lists, `lowPos`,
+/// `lowOwner`, the colours and the scratch exist on the gather backends only (kScatter below:
+/// the cpu backend writes straight into the partner and needs none of them).
 ///
 /// Slabs. The build also cuts the particle order into slabs, contiguous index ranges such that
 /// every pair joins particles of the same or of adjacent slabs (from the neighbour lists
@@ -149,7 +151,9 @@ public:
     std::uint32_t total = 0;
     Exec::copyToHost(&total, hs + n, sizeof(total));
     _half.reserve(total);
-    _scratch.reserve(kScratchWidth * static_cast<std::size_t>(total));
+    constexpr bool gather = !kScatter<Exec>; // low lists, owners, scratch: gather backends only
+    if constexpr (gather)
+      _scratch.reserve(kScratchWidth * static_cast<std::size_t>(total));
     std::int32_t* half = _half.d();
     exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
       std::uint32_t k = hs[i];
@@ -167,13 +171,15 @@ public:
     exec.exclusiveScan(c, ls, n + 1);
     std::uint32_t lowTotal = 0;
     Exec::copyToHost(&lowTotal, ls + n, sizeof(lowTotal));
-    _low.reserve(lowTotal);
-    if constexpr (!kScatter<Exec>) // only the gather backends order by the owner
+    if constexpr (gather) {
+      _low.reserve(lowTotal);
       _lowOwner.reserve(lowTotal);
-    _lowPos.reserve(total > lowTotal ? total : lowTotal);
-    std::uint32_t* low = _low.d();
-    std::uint32_t* lowOwner = kScatter<Exec> ? nullptr : _lowOwner.d();
-    std::uint32_t* lowPos = _lowPos.d();
+      _lowPos.reserve(total > lowTotal ? total : lowTotal);
+    }
+    // The scatter backends walk the low lists only to check that the lists are symmetric.
+    std::uint32_t* low = gather ? _low.d() : nullptr;
+    std::uint32_t* lowOwner = gather ? _lowOwner.d() : nullptr;
+    std::uint32_t* lowPos = gather ? _lowPos.d() : nullptr;
     const double missing = exec.reduceMax(
         n,
         [=] DEM_LAMBDA(std::size_t i) {
@@ -188,12 +194,14 @@ public:
               ++at;
             if (at == hs[j + 1]) {
               miss = 1.0;
-            } else {
+            } else if (lowPos != nullptr) {
               lowPos[at] = k;
             }
-            if (lowOwner != nullptr)
+            if (low != nullptr) {
               lowOwner[k] = static_cast<std::uint32_t>(j);
-            low[k++] = at;
+              low[k] = at;
+            }
+            ++k;
           }
           return miss;
         },
