@@ -356,8 +356,9 @@ public:
       }
     }
 
-    // 2b. Per-particle heat rate: the pair sums of 2a plus −Q_ab of the pairs the partners own
-    //     (low lists, fixed order), convection with the gas of the PCM cell, radiation, walls.
+    // 2b. Per-particle heat rate: the pair sums of 2a (gather backends: the owner's sums and
+    //     −Q_ab of the pairs the partners own, in the slab order), convection with the gas of
+    //     the PCM cell, radiation, walls.
     exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
       using namespace kernels;
       (void)share, (void)ls, (void)lowOwner, (void)colour, (void)qOwn, (void)lOwn; // nvcc, as 2a
