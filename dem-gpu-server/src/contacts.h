@@ -20,14 +20,24 @@
 /// lane of kernels::Double2 (twoOwnedPairs; every lane gives the bits of ownedPair<double>, the
 /// other backends' path), compiled for AVX where the processor has it (same operations, no FMA).
 /// The LSD law is mirror-exact (lsd_contact.h): j's share is bitwise what evaluating the pair
-/// from j's side gives. History slots (partner gid, −(w+2) for wall w) hold the owned contacts
-/// and the walls only; slots of a state file written when both sides kept their history are
-/// read as they are (the owner's slot is the one used; the other is dropped at the next sub-step).
-/// Forces add the gas force of the drag module in coupled runs.
+/// from j's side gives. Forces add the gas force of the drag module in coupled runs.
+///
+/// Tangential history. Between two neighbour builds the history of a pair lives with its
+/// candidate in the half list (`_hc`, three doubles per owned candidate, in half-list order:
+/// read and written as one stream by the owner, no key, no search; zero when the pair is not
+/// in contact). The particles' history slots (histKey, histDisp: partner gid or −(w+2) for wall
+/// w, and δ_t) are the form that follows a particle through a re-sort and into a state file:
+/// flushHistory() writes the candidates' history into them (before the engine re-sorts the
+/// particles or hands out its state) and loadHistory() reads them back into the candidates of
+/// new lists. Walls keep their history in the slots all along, at the front of the row (the
+/// first wallContacts slots). A particle's slots hold its walls and the contacts it owns; slots
+/// of a state file written when both sides kept their history are read as they are (the
+/// owner's is the one used; the other is dropped at the next flush).
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <type_traits>
 
@@ -44,6 +54,16 @@ namespace coredem::dem {
 
 /// Particles ahead whose history rows pass 1 prefetches (CPU; a hint only).
 constexpr std::size_t kPrefetchAhead = 8;
+
+/// Whether v is +0 in every component, bit for bit: no tangential history (−0 is kept as the
+/// history it is, so that flushing and loading it gives back the same bits).
+DEM_HD bool zeroBits(kernels::Vec3 v) {
+  std::uint64_t b[3];
+  memcpy(&b[0], &v.x, sizeof(double));
+  memcpy(&b[1], &v.y, sizeof(double));
+  memcpy(&b[2], &v.z, sizeof(double));
+  return (b[0] | b[1] | b[2]) == 0;
+}
 
 /// The contact module has no ledger (counts and wall forces are read from the particles).
 struct ContactTotals {};
@@ -95,24 +115,20 @@ struct TwoPairArgs {
   const std::int32_t* mat;
   const std::int32_t* half;
   const PairProps* pairs;
-  std::int64_t* hk;
-  double* hd;
+  double* hc; ///< tangential history per owned candidate (3 doubles)
   double* f;  ///< force: the partners' shares are added to it (scatter, pair_lists.h "Slabs")
   double* tq; ///< torque, likewise
   int nMat;
-  int K;
   double dt;
   bool avx; ///< twoOwnedPairs runs its AVX version
 };
 
 /// Owned candidates q0 < q1 of particle i, both in contact, evaluated in the two lanes of
-/// Double2 (ownedPair): writes their history slots slot and slot + 1 (keys key0, key1; old
-/// displacements h[0], h[1]), adds their partners' shares to the partners' force and torque
-/// (q0's partner first), and returns force and torque on i of q0 in out[0..6) and of q1 in
-/// out[6..12). Called through twoOwnedPairs.
+/// Double2 (ownedPair): updates their tangential history (a.hc), adds their partners' shares
+/// to the partners' force and torque (q0's partner first), and returns force and torque on i of
+/// q0 in out[0..6) and of q1 in out[6..12). Called through twoOwnedPairs.
 DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std::uint32_t q0,
-                                          std::uint32_t q1, std::int64_t key0, std::int64_t key1,
-                                          const kernels::Vec3* h, int slot, double* out) {
+                                          std::uint32_t q1, double* out) {
   using namespace kernels;
   using D = Double2;
   const long long j0 = a.half[q0];
@@ -130,23 +146,18 @@ DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std
   const PairProps* row = a.pairs + a.mat[i] * a.nMat;
   const PairProps& p0 = row[a.mat[j0]];
   const PairProps& p1 = row[a.mat[j1]];
+  const Vec3 h0 = load3(a.hc, q0);
+  const Vec3 h1 = load3(a.hc, q1);
   const OwnedPair<D> op = ownedPair<D>(
       d, dot(d, d), both(a.r[i]), lanes(a.r[j0], a.r[j1]), both(a.m[i]), lanes(a.m[j0], a.m[j1]),
       lanes(p0.kn, p1.kn), lanes(p0.kt, p1.kt), lanes(p0.dampFactor, p1.dampFactor),
       lanes(p0.etatFactor, p1.etatFactor), lanes(p0.mu, p1.mu), both3(a.v), gather3(a.v),
       both3(a.w), gather3(a.w),
-      Vec3T<D>{lanes(h[0].x, h[1].x), lanes(h[0].y, h[1].y), lanes(h[0].z, h[1].z)}, a.dt);
+      Vec3T<D>{lanes(h0.x, h1.x), lanes(h0.y, h1.y), lanes(h0.z, h1.z)}, a.dt);
   const LsdResultT<D>& res = op.res;
   const Vec3T<D> shareT = op.lji * res.nxft;
-  const long long k = static_cast<long long>(a.K);
-  if (slot < a.K) {
-    a.hk[i * k + slot] = key0;
-    store3(a.hd, i * k + slot, Vec3{res.deltaT.x[0], res.deltaT.y[0], res.deltaT.z[0]});
-  }
-  if (slot + 1 < a.K) {
-    a.hk[i * k + slot + 1] = key1;
-    store3(a.hd, i * k + slot + 1, Vec3{res.deltaT.x[1], res.deltaT.y[1], res.deltaT.z[1]});
-  }
+  store3(a.hc, q0, Vec3{res.deltaT.x[0], res.deltaT.y[0], res.deltaT.z[0]});
+  store3(a.hc, q1, Vec3{res.deltaT.x[1], res.deltaT.y[1], res.deltaT.z[1]});
   // The partners' shares: force −f, torque L_ji n × f_t.
   const Vec3 f0{res.force.x[0], res.force.y[0], res.force.z[0]};
   const Vec3 f1{res.force.x[1], res.force.y[1], res.force.z[1]};
@@ -167,32 +178,28 @@ DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std
 /// registers to themselves.
 [[gnu::noinline, gnu::flatten]] inline void twoOwnedPairsSse2(const TwoPairArgs& a, long long i,
                                                               std::uint32_t q0, std::uint32_t q1,
-                                                              std::int64_t key0, std::int64_t key1,
-                                                              const kernels::Vec3* h, int slot,
                                                               double* out) {
-  twoOwnedPairsBody(a, i, q0, q1, key0, key1, h, slot, out);
+  twoOwnedPairsBody(a, i, q0, q1, out);
 }
 #if defined(__x86_64__)
 [[gnu::noinline, gnu::flatten, gnu::target("avx")]] inline void
 twoOwnedPairsAvx(const TwoPairArgs& a, long long i, std::uint32_t q0, std::uint32_t q1,
-                 std::int64_t key0, std::int64_t key1, const kernels::Vec3* h, int slot,
                  double* out) {
-  twoOwnedPairsBody(a, i, q0, q1, key0, key1, h, slot, out);
+  twoOwnedPairsBody(a, i, q0, q1, out);
 }
 #endif
 /// twoOwnedPairsAvx if a.avx, else twoOwnedPairsSse2. (Without AVX the group costs 443
 /// instructions per two pairs against 510 for two scalar pairs, about what the call and the
 /// gathers add: pass 1 then counts +0.7 %, not worth a test per pair in the loop.)
 inline void twoOwnedPairs(const TwoPairArgs& a, long long i, std::uint32_t q0, std::uint32_t q1,
-                          std::int64_t key0, std::int64_t key1, const kernels::Vec3* h, int slot,
                           double* out) {
 #if defined(__x86_64__)
   if (a.avx) {
-    twoOwnedPairsAvx(a, i, q0, q1, key0, key1, h, slot, out);
+    twoOwnedPairsAvx(a, i, q0, q1, out);
     return;
   }
 #endif
-  twoOwnedPairsSse2(a, i, q0, q1, key0, key1, h, slot, out);
+  twoOwnedPairsSse2(a, i, q0, q1, out);
 }
 
 /// Whether twoOwnedPairs may use AVX (the processor and the operating system support it).
@@ -228,7 +235,8 @@ public:
 
   bool enabled() const { return true; }
   std::size_t bytes() const {
-    return _pairs.bytes() + _walls.bytes() + _hit.bytes() + _own.bytes() + _wallNear.bytes();
+    return _pairs.bytes() + _walls.bytes() + _hit.bytes() + _own.bytes() + _wallNear.bytes() +
+           _hc.bytes();
   }
   ContactTotals totals() const { return {}; }
 
@@ -272,6 +280,100 @@ public:
     _wallGeneration = ctx.pairs.generation();
   }
 
+  /// New pair lists (a rebuild, a new state): each owned candidate's tangential history from
+  /// its owner's slots (key: the partner's gid; zero if there is none), and the wall slots
+  /// moved to the front of the row, the rest of the slots read emptied. Reads gid, contacts,
+  /// the pair lists; writes histKey, histDisp, wallContacts (the walls found, normally
+  /// unchanged).
+  void loadHistory(StepContext<Exec>& ctx) {
+    ParticleStore<Exec>& p = ctx.particles;
+    PairLists<Exec>& pl = ctx.pairs;
+    _hc.reserve(3 * static_cast<std::size_t>(pl.candidates()));
+    double* hc = _hc.d();
+    std::int64_t* hk = p.histKey.d();
+    double* hd = p.histDisp.d();
+    const std::int32_t* nc = p.contacts.d();
+    std::int32_t* nwc = p.wallContacts.d();
+    const std::int64_t* gid = p.gid.d();
+    const std::uint32_t* hs = pl.halfStart();
+    const std::int32_t* half = pl.half();
+    const long long K = p.K;
+    ctx.exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
+      using namespace kernels;
+      const long long row = static_cast<long long>(i) * K;
+      // Slots in use: the last sub-step's contacts and walls (format ≤ 2 states: nc counted
+      // every contact, both sides' slots are then read; the owner's is used).
+      const long long used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
+      for (std::uint32_t q = hs[i]; q < hs[i + 1]; ++q) {
+        const std::int64_t key = gid[half[q]];
+        Vec3 d{0.0, 0.0, 0.0};
+        for (long long s = 0; s < used; ++s) {
+          if (hk[row + s] == key) {
+            d = load3(hd, row + s);
+            break;
+          }
+        }
+        store3(hc, q, d);
+      }
+      int walls = 0;
+      for (long long s = 0; s < used; ++s) {
+        const std::int64_t key = hk[row + s];
+        if (key <= -2) {
+          if (s != walls) {
+            hk[row + walls] = key;
+            store3(hd, row + walls, load3(hd, row + s));
+          }
+          ++walls;
+        }
+      }
+      for (long long s = walls; s < used; ++s)
+        hk[row + s] = -1;
+      if (nwc[i] != walls)
+        nwc[i] = walls;
+    });
+    p.produced(kHistKey | kHistDisp | kWallContacts);
+    _hcGeneration = pl.generation();
+  }
+
+  /// The owned candidates' tangential history into the owners' slots, after their walls, and
+  /// every other slot emptied: the slots are then complete (a re-sort moves them, a state
+  /// holds them). Only while the candidates hold the history (their lists are the current
+  /// ones); else the slots already are. Reads gid, wallContacts, the pair lists; writes
+  /// histKey, histDisp.
+  void flushHistory(StepContext<Exec>& ctx) {
+    ParticleStore<Exec>& p = ctx.particles;
+    PairLists<Exec>& pl = ctx.pairs;
+    if (!pl.valid() || _hcGeneration != pl.generation() || p.n == 0)
+      return;
+    const double* hc = _hc.d();
+    std::int64_t* hk = p.histKey.d();
+    double* hd = p.histDisp.d();
+    const std::int32_t* nwc = p.wallContacts.d();
+    const std::int64_t* gid = p.gid.d();
+    const std::uint32_t* hs = pl.halfStart();
+    const std::int32_t* half = pl.half();
+    const long long K = p.K;
+    ctx.exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
+      using namespace kernels;
+      const long long row = static_cast<long long>(i) * K;
+      long long s = nwc[i] < K ? nwc[i] : K;
+      for (std::uint32_t q = hs[i]; q < hs[i + 1]; ++q) {
+        const Vec3 d = load3(hc, q);
+        if (zeroBits(d))
+          continue;
+        if (s < K) { // more is an error the sub-step reported (readStatus)
+          hk[row + s] = gid[half[q]];
+          store3(hd, row + s, d);
+        }
+        ++s;
+      }
+      for (; s < K; ++s) // written only where a key is left (rows are mostly clean)
+        if (hk[row + s] != -1)
+          hk[row + s] = -1;
+    });
+    p.produced(kHistKey | kHistDisp);
+  }
+
   /// Reads pos, vel, omega, radius, mass, material, gid, histKey, histDisp, the pair lists
   /// (+ the gas force of the drag module in coupled runs); writes force, torque, fwall, histKey,
   /// histDisp, contacts, wallContacts.
@@ -282,6 +384,8 @@ public:
     PairLists<Exec>& pl = ctx.pairs;
     if (_wallGeneration != pl.generation())
       buildWallCandidates(ctx);
+    if (_hcGeneration != pl.generation())
+      loadHistory(ctx);
     const std::uint32_t* wallNear = _wallNear.d();
     const double dt = ctx.dt;
     const std::size_t n = p.n;
@@ -291,9 +395,9 @@ public:
     const double* r = p.radius.d();
     const double* m = p.mass.d();
     const std::int32_t* mat = p.material.d();
-    const std::int64_t* gid = p.gid.d();
     std::int64_t* hk = p.histKey.d();
     double* hd = p.histDisp.d();
+    double* hc = _hc.d();
     double* f = p.force.d();
     double* tq = p.torque.d();
     double* fw = p.fwall.d();
@@ -330,7 +434,7 @@ public:
     }
 
 #if defined(COREDEM_DEM_DOUBLE2)
-    const TwoPairArgs two{x, v, w, r, m, mat, half, pairs, hk, hd, f, tq, nMat, K, dt, cpuHasAvx()};
+    const TwoPairArgs two{x, v, w, r, m, mat, half, pairs, hc, f, tq, nMat, dt, cpuHasAvx()};
 #endif
     // Pass 1 (per owner): its owned pairs and its walls. Returns the history slots a particle
     // needs (owned contacts + walls); the largest goes to the status array.
@@ -341,17 +445,16 @@ public:
       const long long ii = static_cast<long long>(i);
       const Vec3 xi = load3(x, ii);
       const double ri = r[i];
-      // The history rows of the few particles in contact are scattered through memory:
+      // The history slots of the few particles touching walls are scattered through memory:
       // ask for those of a particle kPrefetchAhead further on while this one computes.
-      if (i + kPrefetchAhead < n && nc[i + kPrefetchAhead] + nwc[i + kPrefetchAhead] > 0) {
+      if (i + kPrefetchAhead < n && nwc[i + kPrefetchAhead] > 0) {
         const std::size_t a = (i + kPrefetchAhead) * static_cast<std::size_t>(K);
         backend::prefetch(hk + a);
         backend::prefetch(hd + 3 * a);
-        backend::prefetch(hd + 3 * a + 8);
       }
-      // Slots in use are compacted at the front: the last sub-step used nc + nwc of them
-      // (format ≤ 2 states: nc counted every contact, both sides' slots are then read).
-      const int used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
+      // Wall history: the first nwc slots (the walls of the last sub-step), read before they
+      // are rewritten.
+      const int used = nwc[i] < K ? nwc[i] : K;
       std::int64_t oldKey[kMaxHistorySlots];
       Vec3 oldD[kMaxHistorySlots];
       for (int s = 0; s < used; ++s) {
@@ -359,18 +462,11 @@ public:
         oldD[s] = load3(hd, ii * K + s);
       }
       int slot = 0;
-      auto history = [&](std::int64_t key) {
+      auto wallHistory = [&](std::int64_t key) {
         for (int s = 0; s < used; ++s)
           if (oldKey[s] == key)
             return oldD[s];
         return Vec3{0.0, 0.0, 0.0};
-      };
-      auto remember = [&](std::int64_t key, Vec3 d) {
-        if (slot < K) {
-          hk[i * K + slot] = key;
-          store3(hd, ii * K + slot, d);
-        }
-        ++slot;
       };
       Vec3 F{0.0, 0.0, 0.0}; // i's own sum: its owned pairs, then its walls
       Vec3 T{0.0, 0.0, 0.0};
@@ -392,8 +488,12 @@ public:
           const bool touching = l2 < rsum * rsum;
           if constexpr (!kScatter<Exec>)
             hit[q] = touching ? 1 : 0;
-          if (!touching)
+          if (!touching) {
+            // Out of contact: no history (written only if there was some).
+            if (!zeroBits(load3(hc, q)))
+              store3(hc, q, Vec3{0.0, 0.0, 0.0});
             continue;
+          }
 #if defined(COREDEM_DEM_DOUBLE2)
           if constexpr (kTwoPairs<Exec>) {
             // The next candidate in contact too: both in the two lanes, in this order.
@@ -402,12 +502,8 @@ public:
               const Vec3 db = load3(x, jb) - xi;
               const double rsumb = ri + r[jb];
               if (dot(db, db) < rsumb * rsumb) {
-                const std::int64_t key0 = gid[j];
-                const std::int64_t key1 = gid[jb];
-                const Vec3 h[2] = {history(key0), history(key1)};
                 double out[12];
-                twoOwnedPairs(two, ii, q, q + 1, key0, key1, h, slot, out);
-                slot += 2;
+                twoOwnedPairs(two, ii, q, q + 1, out);
                 F += load3(out, 0);
                 T += load3(out, 1);
                 F += load3(out, 2);
@@ -420,14 +516,13 @@ public:
           }
 #endif
           const PairProps pp = pairs[ai * nMat + mat[j]];
-          const std::int64_t key = gid[j];
           const OwnedPair<double> op =
               ownedPair(d, l2, ri, rj, mi, m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor, pp.mu,
-                        vi, load3(v, j), wi, load3(w, j), history(key), dt);
+                        vi, load3(v, j), wi, load3(w, j), load3(hc, q), dt);
           const LsdResult& res = op.res;
           F += res.force;
           T += res.torque;
-          remember(key, res.deltaT);
+          store3(hc, q, res.deltaT);
           // j's share: force −f, torque L_ji n × f_t.
           if constexpr (kScatter<Exec>) {
             store3(f, j, load3(f, j) - res.force);
@@ -453,11 +548,15 @@ public:
           const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
           const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
           const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-          const LsdResult res =
-              wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii), ri, history(key), dt);
+          const LsdResult res = wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii), ri,
+                                            wallHistory(key), dt);
           FW += res.force;
           T += res.torque;
-          remember(key, res.deltaT);
+          if (slot < K) {
+            hk[i * K + slot] = key;
+            store3(hd, ii * K + slot, res.deltaT);
+          }
+          ++slot;
           ++wallCount;
         }
         if (k < 32) {
@@ -491,7 +590,7 @@ public:
         nc[i] = owned;
       if (nwc[i] != wallCount)
         nwc[i] = wallCount;
-      return static_cast<double>(slot);
+      return static_cast<double>(owned + wallCount); // history slots i needs
     };
     if constexpr (scatter) {
       ctx.exec.reduceMaxOverSlabsWide(pl.slabStart(), pl.slabs(), ownerPass, 0.0,
@@ -581,6 +680,8 @@ private:
   Dev<double> _own;             ///< gather backends, per particle: the owner's own force, torque
   Dev<std::uint32_t> _wallNear; ///< per particle: wall candidates (buildWallCandidates)
   std::uint64_t _wallGeneration = ~std::uint64_t{0}; ///< pair-list build of _wallNear
+  Dev<double> _hc; ///< per owned candidate: tangential history δ_t (zero out of contact)
+  std::uint64_t _hcGeneration = ~std::uint64_t{0}; ///< pair-list build _hc belongs to
   int _maxUsedSlots =
       kMaxHistorySlots; ///< max contacts of a particle in the last sub-step (≥ slots in use)
 };

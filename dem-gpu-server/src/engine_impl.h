@@ -105,6 +105,8 @@ public:
   }
 
   HostState state() override {
+    StepContext<Exec> ctx = stepContext(0.0);
+    _contacts.flushHistory(ctx); // the history slots complete
     _p.toHost(kAllFields);
     HostState s;
     s.n = _p.n;
@@ -262,6 +264,8 @@ public:
   void rebuild() {
     const std::size_t n = _p.n;
     _p.require(kAllFields);
+    StepContext<Exec> ctx = stepContext(0.0);
+    _contacts.flushHistory(ctx); // the history follows its particle in the slots
     NbGrid g = neighbourGrid();
     computeKeys(g);
     _exec.sortByKey(_keys.d(), n, g.cells, _perm.d());

@@ -70,9 +70,9 @@ Case randomCase(std::mt19937_64& rng, bool slide0, bool slide1) {
   return k;
 }
 
-/// twoOwnedPairs' arguments for a case: K = hk.size() history slots, two materials.
-TwoPairArgs argsFor(Case& k, std::vector<std::int64_t>& hk, std::vector<double>& hd,
-                    std::vector<double>& force, std::vector<double>& torque, double dt, bool avx) {
+/// twoOwnedPairs' arguments for a case: hc holds the two candidates' history, two materials.
+TwoPairArgs argsFor(Case& k, std::vector<double>& hc, std::vector<double>& force,
+                    std::vector<double>& torque, double dt, bool avx) {
   return TwoPairArgs{k.x.data(),
                      k.v.data(),
                      k.w.data(),
@@ -81,12 +81,10 @@ TwoPairArgs argsFor(Case& k, std::vector<std::int64_t>& hk, std::vector<double>&
                      k.mat.data(),
                      k.half.data(),
                      k.pairs.data(),
-                     hk.data(),
-                     hd.data(),
+                     hc.data(),
                      force.data(),
                      torque.data(),
                      2,
-                     static_cast<int>(hk.size()),
                      dt,
                      avx};
 }
@@ -123,9 +121,7 @@ void checkGroup(bool avx, int cases) {
   for (int c = 0; c < cases; ++c) {
     Case k = randomCase(rng, c % 4 == 1 || c % 4 == 3, c % 4 == 2 || c % 4 == 3);
     const Expected e = scalarReference(k, dt);
-    const int K = 4;
-    std::vector<std::int64_t> hk(K, -1);
-    std::vector<double> hd(3 * K, 0.0);
+    std::vector<double> hc{k.h[0].x, k.h[0].y, k.h[0].z, k.h[1].x, k.h[1].y, k.h[1].z};
     // The partners' force and torque hold earlier terms: the shares are added to them.
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     std::vector<double> force(9), torque(9);
@@ -134,10 +130,9 @@ void checkGroup(bool avx, int cases) {
       torque[q] = 1e-7 * u(rng);
     }
     const std::vector<double> force0 = force, torque0 = torque;
-    const TwoPairArgs a = argsFor(k, hk, hd, force, torque, dt, avx);
+    const TwoPairArgs a = argsFor(k, hc, force, torque, dt, avx);
     double out[12];
-    const int slot = 1; // slots 1 and 2
-    twoOwnedPairs(a, 0, 0, 1, 101, 102, k.h, slot, out);
+    twoOwnedPairs(a, 0, 0, 1, out);
     for (int s = 0; s < 2; ++s) {
       expectSameBits(kernels::load3(out, 2 * s), e.force[s], "force", c);
       expectSameBits(kernels::load3(out, 2 * s + 1), e.torque[s], "torque", c);
@@ -146,12 +141,9 @@ void checkGroup(bool avx, int cases) {
                      "partner force", c);
       expectSameBits(kernels::load3(torque.data(), j),
                      kernels::load3(torque0.data(), j) + e.shareTorque[s], "partner torque", c);
-      EXPECT_EQ(hk[slot + s], 101 + s);
-      expectSameBits(kernels::load3(hd.data(), slot + s), e.deltaT[s], "history", c);
+      expectSameBits(kernels::load3(hc.data(), s), e.deltaT[s], "history", c);
       slid[s] += e.slides[s] ? 1 : 0;
     }
-    EXPECT_EQ(hk[0], -1);
-    EXPECT_EQ(hk[3], -1);
     expectSameBits(kernels::load3(force.data(), 0), kernels::load3(force0.data(), 0),
                    "owner's force (returned, not added)", c);
   }
@@ -170,19 +162,6 @@ TEST(PairLanes, TwoPairsGiveTheScalarBitsAvx) {
   if (!cpuHasAvx())
     GTEST_SKIP() << "the processor has no AVX";
   checkGroup(true, 4000);
-}
-
-TEST(PairLanes, HistorySlotsBeyondTheRowAreDropped) {
-  std::mt19937_64 rng(3);
-  Case k = randomCase(rng, false, true);
-  const int K = 2;
-  std::vector<std::int64_t> hk(K, -1);
-  std::vector<double> hd(3 * K, 0.0), force(9, 0.0), torque(9, 0.0);
-  const TwoPairArgs a = argsFor(k, hk, hd, force, torque, 1e-6, false);
-  double out[12];
-  twoOwnedPairs(a, 0, 0, 1, 101, 102, k.h, 1, out); // slot 2 does not exist
-  EXPECT_EQ(hk[0], -1);
-  EXPECT_EQ(hk[1], 101);
 }
 
 #else

@@ -189,6 +189,13 @@ TEST(ParticleSchema, EveryResortedRowFollowsItsParticle) {
       return;
     const std::size_t w = sc::valuesPerParticle(f, after.extents());
     ASSERT_EQ(va.size(), n * w) << f.name;
+    if (f.per == sc::Per::History) {
+      // The contact module rewrites the history slots from the contacts (contacts.h:
+      // loadHistory, flushHistory): tags that are not the history of a contact are emptied.
+      // That history follows its particle through re-sorts is checked with real contacts
+      // (ContactPairs.HistoryFollowsItsPairThroughNeighbourRebuilds).
+      return;
+    }
     for (std::size_t i = 0; i < n; ++i) {
       const std::size_t j = rowOf.at(after.gid[i]);
       for (std::size_t k = 0; k < w; ++k) {
