@@ -15,7 +15,7 @@ packages=(
   openfoam
   python3 python3-matplotlib python3-h5py python3-zmq python3-protobuf python3-yaml
   # coredem render and the ParaView e2e tests (pvbatch on a private Xvfb)
-  paraview xvfb
+  paraview python3-paraview xvfb
   # used by scripts/openfoam-headers.sh to fetch Debian's OpenFOAM sources
   dpkg-dev bzip2 ca-certificates
   # the committed .clang-format is enforced by scripts/check-format.sh (CI)
