@@ -148,12 +148,12 @@ DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std
   const PairProps& p1 = row[a.mat[j1]];
   const Vec3 h0 = load3(a.hc, q0);
   const Vec3 h1 = load3(a.hc, q1);
-  const OwnedPair<D> op = ownedPair<D>(
-      d, dot(d, d), both(a.r[i]), lanes(a.r[j0], a.r[j1]), both(a.m[i]), lanes(a.m[j0], a.m[j1]),
-      lanes(p0.kn, p1.kn), lanes(p0.kt, p1.kt), lanes(p0.dampFactor, p1.dampFactor),
-      lanes(p0.etatFactor, p1.etatFactor), lanes(p0.mu, p1.mu), both3(a.v), gather3(a.v),
-      both3(a.w), gather3(a.w),
-      Vec3T<D>{lanes(h0.x, h1.x), lanes(h0.y, h1.y), lanes(h0.z, h1.z)}, a.dt);
+  const OwnedPair<D> op =
+      ownedPair<D>(d, dot(d, d), both(a.r[i]), lanes(a.r[j0], a.r[j1]), both(a.m[i]),
+                   lanes(a.m[j0], a.m[j1]), lanes(p0.kn, p1.kn), lanes(p0.kt, p1.kt),
+                   lanes(p0.dampFactor, p1.dampFactor), lanes(p0.etatFactor, p1.etatFactor),
+                   lanes(p0.mu, p1.mu), both3(a.v), gather3(a.v), both3(a.w), gather3(a.w),
+                   Vec3T<D>{lanes(h0.x, h1.x), lanes(h0.y, h1.y), lanes(h0.z, h1.z)}, a.dt);
   const LsdResultT<D>& res = op.res;
   const Vec3T<D> shareT = op.lji * res.nxft;
   store3(a.hc, q0, Vec3{res.deltaT.x[0], res.deltaT.y[0], res.deltaT.z[0]});
@@ -200,6 +200,97 @@ inline void twoOwnedPairs(const TwoPairArgs& a, long long i, std::uint32_t q0, s
   }
 #endif
   twoOwnedPairsSse2(a, i, q0, q1, out);
+}
+
+/// One owned candidate q of particle i in contact, the scalar evaluation (ownedPair<double>):
+/// updates its history, adds the partner's share to the partner, returns force and torque on i
+/// in out[0..6).
+inline void oneOwnedPair(const TwoPairArgs& a, long long i, std::uint32_t q, double* out) {
+  using namespace kernels;
+  const long long j = a.half[q];
+  const Vec3 d = load3(a.x, j) - load3(a.x, i);
+  const PairProps& pp = a.pairs[a.mat[i] * a.nMat + a.mat[j]];
+  const OwnedPair<double> op = ownedPair(
+      d, dot(d, d), a.r[i], a.r[j], a.m[i], a.m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor,
+      pp.mu, load3(a.v, i), load3(a.v, j), load3(a.w, i), load3(a.w, j), load3(a.hc, q), a.dt);
+  const LsdResult& res = op.res;
+  store3(a.hc, q, res.deltaT);
+  store3(a.f, j, load3(a.f, j) - res.force);
+  store3(a.tq, j, load3(a.tq, j) + op.lji * res.nxft);
+  store3(out, 0, res.force);
+  store3(out, 1, res.torque);
+}
+
+#if defined(COREDEM_DEM_DOUBLE4)
+/// Three or four owned candidates q[0..count) of particle i, all in contact, in the four lanes
+/// of kernels::Double4 (AVX; with three, the fourth lane repeats the third pair and is
+/// dropped): as twoOwnedPairsBody, pair k's force and torque on i in out[6k..6k+6), the
+/// partners' shares added in the order of q. Every lane gives the bits of ownedPair<double>
+/// (no FMA: not part of AVX).
+[[gnu::noinline, gnu::flatten, gnu::target("avx")]] inline void
+fourOwnedPairsAvx(const TwoPairArgs& a, long long i, const std::uint32_t* q, int count,
+                  double* out) {
+  using namespace kernels;
+  using D = Double4;
+  const std::uint32_t q3 = q[count > 3 ? 3 : 2];
+  const long long j0 = a.half[q[0]], j1 = a.half[q[1]], j2 = a.half[q[2]], j3 = a.half[q3];
+  auto both = [](double u) { return D{u, u, u, u}; };
+  auto lanes = [&](const double* p) { return D{p[j0], p[j1], p[j2], p[j3]}; };
+  auto gather3 = [&](const double* p) {
+    return Vec3T<D>{D{p[3 * j0], p[3 * j1], p[3 * j2], p[3 * j3]},
+                    D{p[3 * j0 + 1], p[3 * j1 + 1], p[3 * j2 + 1], p[3 * j3 + 1]},
+                    D{p[3 * j0 + 2], p[3 * j1 + 2], p[3 * j2 + 2], p[3 * j3 + 2]}};
+  };
+  auto both3 = [&](const double* p) {
+    return Vec3T<D>{both(p[3 * i]), both(p[3 * i + 1]), both(p[3 * i + 2])};
+  };
+  auto hist3 = [&] {
+    const double* h = a.hc;
+    const long long h0 = 3 * static_cast<long long>(q[0]), h1 = 3 * static_cast<long long>(q[1]),
+                    h2 = 3 * static_cast<long long>(q[2]), h3 = 3 * static_cast<long long>(q3);
+    return Vec3T<D>{D{h[h0], h[h1], h[h2], h[h3]}, D{h[h0 + 1], h[h1 + 1], h[h2 + 1], h[h3 + 1]},
+                    D{h[h0 + 2], h[h1 + 2], h[h2 + 2], h[h3 + 2]}};
+  };
+  const Vec3T<D> d = gather3(a.x) - both3(a.x);
+  const PairProps* row = a.pairs + a.mat[i] * a.nMat;
+  const PairProps* pk[4] = {&row[a.mat[j0]], &row[a.mat[j1]], &row[a.mat[j2]], &row[a.mat[j3]]};
+  auto prop = [&](double PairProps::*f) { return D{pk[0]->*f, pk[1]->*f, pk[2]->*f, pk[3]->*f}; };
+  const OwnedPair<D> op = ownedPair<D>(
+      d, dot(d, d), both(a.r[i]), lanes(a.r), both(a.m[i]), lanes(a.m), prop(&PairProps::kn),
+      prop(&PairProps::kt), prop(&PairProps::dampFactor), prop(&PairProps::etatFactor),
+      prop(&PairProps::mu), both3(a.v), gather3(a.v), both3(a.w), gather3(a.w), hist3(), a.dt);
+  const LsdResultT<D>& res = op.res;
+  const Vec3T<D> shareT = op.lji * res.nxft;
+  const long long js[4] = {j0, j1, j2, j3};
+  for (int k = 0; k < count; ++k) {
+    const long long j = js[k];
+    const Vec3 f{res.force.x[k], res.force.y[k], res.force.z[k]};
+    store3(a.hc, q[k], Vec3{res.deltaT.x[k], res.deltaT.y[k], res.deltaT.z[k]});
+    store3(a.f, j, load3(a.f, j) - f);
+    store3(a.tq, j, load3(a.tq, j) + Vec3{shareT.x[k], shareT.y[k], shareT.z[k]});
+    store3(out, 2 * k, f);
+    store3(out, 2 * k + 1, Vec3{res.torque.x[k], res.torque.y[k], res.torque.z[k]});
+  }
+}
+#endif
+
+/// count (1..4) owned candidates q[0..count) of particle i in contact, in q order: four lanes
+/// for three or four (AVX), two lanes for two, the scalar path for one; without AVX, two lanes
+/// at a time and the scalar path for an odd one. Pair k's force and torque on i in
+/// out[6k..6k+6).
+inline void ownedPairs(const TwoPairArgs& a, long long i, const std::uint32_t* q, int count,
+                       double* out) {
+#if defined(COREDEM_DEM_DOUBLE4)
+  if (a.avx && count >= 3) {
+    fourOwnedPairsAvx(a, i, q, count, out);
+    return;
+  }
+#endif
+  int k = 0;
+  for (; k + 1 < count; k += 2)
+    twoOwnedPairs(a, i, q[k], q[k + 1], out + 6 * k);
+  if (k < count)
+    oneOwnedPair(a, i, q[k], out + 6 * k);
 }
 
 /// Whether twoOwnedPairs may use AVX (the processor and the operating system support it).
@@ -473,6 +564,20 @@ public:
       // Particle–particle LSD (Eqs. 7–13) over the owned candidates. i's velocities, mass and
       // material are read only if it has some (most particles of a dilute bed do not).
       int owned = 0;
+#if defined(COREDEM_DEM_DOUBLE2)
+      std::uint32_t pending[4]; // cpu: candidates in contact not yet evaluated
+      int nPending = 0;
+      auto evaluatePending = [&] {
+        double out[24];
+        ownedPairs(two, ii, pending, nPending, out);
+        for (int k = 0; k < nPending; ++k) {
+          F += load3(out, 2 * k);
+          T += load3(out, 2 * k + 1);
+        }
+        owned += nPending;
+        nPending = 0;
+      };
+#endif
       const std::uint32_t qEnd = hs[i + 1];
       if (hs[i] < qEnd) {
         const Vec3 vi = load3(v, ii);
@@ -496,23 +601,11 @@ public:
           }
 #if defined(COREDEM_DEM_DOUBLE2)
           if constexpr (kTwoPairs<Exec>) {
-            // The next candidate in contact too: both in the two lanes, in this order.
-            if (q + 1 < qEnd) {
-              const std::int32_t jb = half[q + 1];
-              const Vec3 db = load3(x, jb) - xi;
-              const double rsumb = ri + r[jb];
-              if (dot(db, db) < rsumb * rsumb) {
-                double out[12];
-                twoOwnedPairs(two, ii, q, q + 1, out);
-                F += load3(out, 0);
-                T += load3(out, 1);
-                F += load3(out, 2);
-                T += load3(out, 3);
-                owned += 2;
-                ++q;
-                continue;
-              }
-            }
+            // Up to four candidates in contact at once, in this order (ownedPairs).
+            pending[nPending++] = q;
+            if (nPending == 4)
+              evaluatePending();
+            continue;
           }
 #endif
           const PairProps pp = pairs[ai * nMat + mat[j]];
@@ -533,6 +626,10 @@ public:
           }
           ++owned;
         }
+#if defined(COREDEM_DEM_DOUBLE2)
+        if (nPending > 0)
+          evaluatePending();
+#endif
       }
       // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate bits
       // of the first 32 (most particles have none), then every wall beyond them.

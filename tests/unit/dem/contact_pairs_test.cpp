@@ -295,7 +295,7 @@ TEST(ContactPairs, HistoryFollowsItsPairThroughNeighbourRebuilds) {
   st.historySlots = kSlots;
   st.neighbourSlots = 32;
   for (int k = 0; k < kStacks; ++k) {
-    const double a = 0.7 * k; // the top bead's direction in the horizontal plane
+    const double a = 0.7 * k;              // the top bead's direction in the horizontal plane
     const double x0 = 4.0 * kDiameter * k; // stacks far apart
     // Bottom on the floor, top on the bottom, at their static overlaps (2mg/k_n, mg/k_n).
     const double zb = r - 2.0 * m * g / kn;

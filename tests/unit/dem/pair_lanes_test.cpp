@@ -73,20 +73,10 @@ Case randomCase(std::mt19937_64& rng, bool slide0, bool slide1) {
 /// twoOwnedPairs' arguments for a case: hc holds the two candidates' history, two materials.
 TwoPairArgs argsFor(Case& k, std::vector<double>& hc, std::vector<double>& force,
                     std::vector<double>& torque, double dt, bool avx) {
-  return TwoPairArgs{k.x.data(),
-                     k.v.data(),
-                     k.w.data(),
-                     k.r.data(),
-                     k.m.data(),
-                     k.mat.data(),
-                     k.half.data(),
-                     k.pairs.data(),
-                     hc.data(),
-                     force.data(),
-                     torque.data(),
-                     2,
-                     dt,
-                     avx};
+  return TwoPairArgs{k.x.data(), k.v.data(),   k.w.data(),    k.r.data(),
+                     k.m.data(), k.mat.data(), k.half.data(), k.pairs.data(),
+                     hc.data(),  force.data(), torque.data(), 2,
+                     dt,         avx};
 }
 
 struct Expected {
@@ -163,6 +153,89 @@ TEST(PairLanes, TwoPairsGiveTheScalarBitsAvx) {
     GTEST_SKIP() << "the processor has no AVX";
   checkGroup(true, 4000);
 }
+
+#if defined(COREDEM_DEM_DOUBLE4)
+// Three and four pairs through ownedPairs: in the four AVX lanes (fourOwnedPairsAvx; the fourth
+// lane of a group of three changes nothing) and, without AVX, two lanes and the scalar path:
+// the bits of the scalar evaluation, pair by pair, sticking and sliding, two materials.
+TEST(PairLanes, FourLanesGiveTheScalarBits) {
+  if (!cpuHasAvx())
+    GTEST_SKIP() << "the processor has no AVX";
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(-1.0, 1.0), u01(0.0, 1.0);
+  const double dt = 1e-6;
+  int slid = 0;
+  for (int c = 0; c < 4000; ++c) {
+    const int count = 3 + c % 2;
+    const bool avx = c % 4 < 2;
+    // Particle 0 owns candidates q = 0..count-1 (particles 1..count), all in contact.
+    const int np = count + 1;
+    std::vector<double> x, v, w, r, m;
+    std::vector<std::int32_t> mat(np), half;
+    for (int p = 0; p < np; ++p) {
+      r.push_back(4e-4 + 2e-4 * u01(rng));
+      m.push_back(1e-6 * (0.5 + u01(rng)));
+      mat[p] = static_cast<std::int32_t>(rng() % 2);
+      for (int k = 0; k < 3; ++k) {
+        v.push_back(0.3 * u(rng));
+        w.push_back(200.0 * u(rng));
+      }
+    }
+    x = {0.01 * u(rng), 0.01 * u(rng), 0.01 * u(rng)};
+    for (int p = 1; p < np; ++p) {
+      Vec3 n{u(rng), u(rng), u(rng)};
+      n = (1.0 / kernels::norm(n)) * n;
+      const double l = (0.98 + 0.019 * u01(rng)) * (r[0] + r[p]);
+      x.push_back(x[0] + l * n.x);
+      x.push_back(x[1] + l * n.y);
+      x.push_back(x[2] + l * n.z);
+      half.push_back(p);
+    }
+    std::vector<double> hc;
+    for (int k = 0; k < count; ++k) {
+      const double a = (c / 2 + k) % 3 == 0 ? 1e-3 : 1e-7; // slides : sticks
+      for (int d = 0; d < 3; ++d)
+        hc.push_back(a * u(rng));
+    }
+    std::vector<double> force(3 * np), torque(3 * np);
+    for (int k = 0; k < 3 * np; ++k) {
+      force[k] = 1e-3 * u(rng);
+      torque[k] = 1e-7 * u(rng);
+    }
+    const std::vector<double> hc0 = hc, force0 = force, torque0 = torque;
+    std::vector<PairProps> pairs{
+        PairProps{200.0, 100.0, 0.3, 0.5, 0.3}, PairProps{240.0, 120.0, 0.25, 0.5, 0.4},
+        PairProps{240.0, 120.0, 0.25, 0.5, 0.4}, PairProps{300.0, 150.0, 0.2, 0.4, 0.5}};
+    const TwoPairArgs a{x.data(),      v.data(),    w.data(),     r.data(),  m.data(),
+                        mat.data(),    half.data(), pairs.data(), hc.data(), force.data(),
+                        torque.data(), 2,           dt,           avx};
+    const std::uint32_t q[4] = {0, 1, 2, 3};
+    double out[24];
+    ownedPairs(a, 0, q, count, out);
+    for (int k = 0; k < count; ++k) {
+      const int j = half[k];
+      const Vec3 d = kernels::load3(x.data(), j) - kernels::load3(x.data(), 0);
+      const PairProps& pp = pairs[mat[0] * 2 + mat[j]];
+      const OwnedPair<double> op =
+          ownedPair(d, kernels::dot(d, d), r[0], r[j], m[0], m[j], pp.kn, pp.kt, pp.dampFactor,
+                    pp.etatFactor, pp.mu, kernels::load3(v.data(), 0), kernels::load3(v.data(), j),
+                    kernels::load3(w.data(), 0), kernels::load3(w.data(), j),
+                    kernels::load3(hc0.data(), k), dt);
+      expectSameBits(kernels::load3(out, 2 * k), op.res.force, "force", c);
+      expectSameBits(kernels::load3(out, 2 * k + 1), op.res.torque, "torque", c);
+      expectSameBits(kernels::load3(hc.data(), k), op.res.deltaT, "history", c);
+      expectSameBits(kernels::load3(force.data(), j),
+                     kernels::load3(force0.data(), j) - op.res.force, "partner force", c);
+      expectSameBits(kernels::load3(torque.data(), j),
+                     kernels::load3(torque0.data(), j) + op.lji * op.res.nxft, "partner torque", c);
+      slid += kernels::norm(op.res.deltaT) < 0.5 * kernels::norm(kernels::load3(hc0.data(), k));
+    }
+    expectSameBits(kernels::load3(force.data(), 0), kernels::load3(force0.data(), 0),
+                   "owner's force (returned, not added)", c);
+  }
+  EXPECT_GT(slid, 2000) << "too few sliding lanes: the Coulomb branch is not exercised";
+}
+#endif
 
 #else
 TEST(PairLanes, NotBuiltWithoutDouble2) {

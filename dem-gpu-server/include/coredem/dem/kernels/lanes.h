@@ -2,8 +2,8 @@
 /// @file
 /// Scalar types of the pair kernels. The kernels of vec3.h, damping.h and lsd_contact.h are
 /// templates on their scalar type S: S = double everywhere (host and device), and S = Double2
-/// in the cpu backend's contact loop, which evaluates two pairs at once, one in each lane of an
-/// SSE2 register (contacts.h).
+/// or Double4 in the cpu backend's contact loop, which evaluates two pairs at once, one in each
+/// lane of an SSE2 register, or up to four in an AVX register (contacts.h).
 ///
 /// Same bits in every lane: +, −, ×, ÷ and √ are correctly rounded IEEE operations whether they
 /// act on one double or on each lane of two, the kernels' expressions are evaluated in the same
@@ -26,6 +26,12 @@
 #include <emmintrin.h>
 /// Defined where kernels::Double2 exists: the cpu backend evaluates pairs two at a time.
 #define COREDEM_DEM_DOUBLE2 1
+#if defined(__x86_64__)
+#include <immintrin.h>
+/// Defined where kernels::Double4 exists (functions compiled for AVX only, chosen at run time
+/// where the processor has it: contacts.h).
+#define COREDEM_DEM_DOUBLE4 1
+#endif
 #endif
 
 namespace coredem::dem::kernels {
@@ -60,6 +66,24 @@ inline bool laneAny(Mask2 m) {
 inline Double2 laneSelect(Mask2 m, Double2 a, Double2 b) {
   return reinterpret_cast<Double2>((reinterpret_cast<Mask2>(a) & m) |
                                    (reinterpret_cast<Mask2>(b) & ~m));
+}
+#endif
+
+#if defined(COREDEM_DEM_DOUBLE4)
+/// Four doubles in one AVX register, as Double2. Its operations are compiled for AVX: use it
+/// only in functions with gnu::target("avx"), called where the processor has AVX.
+typedef double Double4 __attribute__((vector_size(32)));
+using Mask4 = decltype(Double4{} < Double4{});
+
+[[gnu::target("avx")]] inline Double4 laneSqrt(Double4 x) {
+  return _mm256_sqrt_pd(x);
+}
+[[gnu::target("avx")]] inline bool laneAny(Mask4 m) {
+  return _mm256_movemask_pd(reinterpret_cast<__m256d>(m)) != 0;
+}
+[[gnu::target("avx")]] inline Double4 laneSelect(Mask4 m, Double4 a, Double4 b) {
+  return reinterpret_cast<Double4>((reinterpret_cast<Mask4>(a) & m) |
+                                   (reinterpret_cast<Mask4>(b) & ~m));
 }
 #endif
 
