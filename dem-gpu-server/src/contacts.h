@@ -16,9 +16,10 @@
 ///   other backends (gather): pass 1 per owner writes the partner's share per candidate and
 ///     its own sum per particle; pass 2 per particle adds them in the same order (colours, and
 ///     within a colour the evaluating particle's index).
-/// The cpu backend evaluates two consecutive owned candidates in contact at once, one in each
-/// lane of kernels::Double2 (twoOwnedPairs; every lane gives the bits of ownedPair<double>, the
-/// other backends' path), compiled for AVX where the processor has it (same operations, no FMA).
+/// The cpu backend evaluates a particle's owned candidates in contact up to four at once
+/// (ownedPairs): three or four in the lanes of kernels::Double4 where the processor has AVX,
+/// two in the lanes of kernels::Double2 (SSE2, or AVX's encoding of the same operations), one
+/// alone; every lane gives the bits of ownedPair<double>, the other backends' path (no FMA).
 /// The LSD law is mirror-exact (lsd_contact.h): j's share is bitwise what evaluating the pair
 /// from j's side gives. Forces add the gas force of the drag module in coupled runs.
 ///
