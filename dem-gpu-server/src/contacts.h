@@ -372,6 +372,31 @@ public:
     _wallGeneration = ctx.pairs.generation();
   }
 
+  /// What loadHistory and flushHistory read and write (device pointers).
+  struct HistoryArrays {
+    double* hc;               ///< per owned candidate: δ_t
+    std::int64_t* hk;         ///< per particle and slot: key
+    double* hd;               ///< per particle and slot: δ_t
+    const std::int32_t* nc;   ///< contacts
+    std::int32_t* nwc;        ///< wallContacts
+    const std::int64_t* gid;  ///< global ids
+    const std::uint32_t* hs;  ///< half-list starts
+    const std::int32_t* half; ///< half lists
+    long long K;              ///< slots per particle
+  };
+  HistoryArrays historyArrays(StepContext<Exec>& ctx) {
+    ParticleStore<Exec>& p = ctx.particles;
+    return {_hc.d(),
+            p.histKey.d(),
+            p.histDisp.d(),
+            p.contacts.d(),
+            p.wallContacts.d(),
+            p.gid.d(),
+            ctx.pairs.halfStart(),
+            ctx.pairs.half(),
+            p.K};
+  }
+
   /// New pair lists (a rebuild, a new state): each owned candidate's tangential history from
   /// its owner's slots (key: the partner's gid; zero if there is none), and the wall slots
   /// moved to the front of the row, the rest of the slots read emptied. Reads gid, contacts,
@@ -379,25 +404,21 @@ public:
   /// unchanged).
   void loadHistory(StepContext<Exec>& ctx) {
     ParticleStore<Exec>& p = ctx.particles;
-    PairLists<Exec>& pl = ctx.pairs;
-    _hc.reserve(3 * static_cast<std::size_t>(pl.candidates()));
-    double* hc = _hc.d();
-    std::int64_t* hk = p.histKey.d();
-    double* hd = p.histDisp.d();
-    const std::int32_t* nc = p.contacts.d();
-    std::int32_t* nwc = p.wallContacts.d();
-    const std::int64_t* gid = p.gid.d();
-    const std::uint32_t* hs = pl.halfStart();
-    const std::int32_t* half = pl.half();
-    const long long K = p.K;
+    _hc.reserve(3 * static_cast<std::size_t>(ctx.pairs.candidates()));
+    const HistoryArrays a = historyArrays(ctx);
     ctx.exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
+      double* hc = a.hc;
+      std::int64_t* hk = a.hk;
+      double* hd = a.hd;
+      const std::int32_t* half = a.half;
+      const long long K = a.K;
       const long long row = static_cast<long long>(i) * K;
       // Slots in use: the last sub-step's contacts and walls (format ≤ 2 states: nc counted
       // every contact, both sides' slots are then read; the owner's is used).
-      const long long used = nc[i] + nwc[i] < K ? nc[i] + nwc[i] : K;
-      for (std::uint32_t q = hs[i]; q < hs[i + 1]; ++q) {
-        const std::int64_t key = gid[half[q]];
+      const long long used = a.nc[i] + a.nwc[i] < K ? a.nc[i] + a.nwc[i] : K;
+      for (std::uint32_t q = a.hs[i]; q < a.hs[i + 1]; ++q) {
+        const std::int64_t key = a.gid[half[q]];
         Vec3 d{0.0, 0.0, 0.0};
         for (long long s = 0; s < used; ++s) {
           if (hk[row + s] == key) {
@@ -420,11 +441,11 @@ public:
       }
       for (long long s = walls; s < used; ++s)
         hk[row + s] = -1;
-      if (nwc[i] != walls)
-        nwc[i] = walls;
+      if (a.nwc[i] != walls)
+        a.nwc[i] = walls;
     });
     p.produced(kHistKey | kHistDisp | kWallContacts);
-    _hcGeneration = pl.generation();
+    _hcGeneration = ctx.pairs.generation();
   }
 
   /// The owned candidates' tangential history into the owners' slots, after their walls, and
@@ -437,24 +458,20 @@ public:
     PairLists<Exec>& pl = ctx.pairs;
     if (!pl.valid() || _hcGeneration != pl.generation() || p.n == 0)
       return;
-    const double* hc = _hc.d();
-    std::int64_t* hk = p.histKey.d();
-    double* hd = p.histDisp.d();
-    const std::int32_t* nwc = p.wallContacts.d();
-    const std::int64_t* gid = p.gid.d();
-    const std::uint32_t* hs = pl.halfStart();
-    const std::int32_t* half = pl.half();
-    const long long K = p.K;
+    const HistoryArrays a = historyArrays(ctx);
     ctx.exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
       using namespace kernels;
+      std::int64_t* hk = a.hk;
+      double* hd = a.hd;
+      const long long K = a.K;
       const long long row = static_cast<long long>(i) * K;
-      long long s = nwc[i] < K ? nwc[i] : K;
-      for (std::uint32_t q = hs[i]; q < hs[i + 1]; ++q) {
-        const Vec3 d = load3(hc, q);
+      long long s = a.nwc[i] < K ? a.nwc[i] : K;
+      for (std::uint32_t q = a.hs[i]; q < a.hs[i + 1]; ++q) {
+        const Vec3 d = load3(a.hc, q);
         if (zeroBits(d))
           continue;
         if (s < K) { // more is an error the sub-step reported (readStatus)
-          hk[row + s] = gid[half[q]];
+          hk[row + s] = a.gid[a.half[q]];
           store3(hd, row + s, d);
         }
         ++s;
