@@ -237,29 +237,25 @@ fourOwnedPairsAvx(const TwoPairArgs& a, long long i, const std::uint32_t* q, int
   const long long j0 = a.half[q[0]], j1 = a.half[q[1]], j2 = a.half[q[2]], j3 = a.half[q3];
   auto both = [](double u) { return D{u, u, u, u}; };
   auto lanes = [&](const double* p) { return D{p[j0], p[j1], p[j2], p[j3]}; };
-  auto gather3 = [&](const double* p) {
-    return Vec3T<D>{D{p[3 * j0], p[3 * j1], p[3 * j2], p[3 * j3]},
-                    D{p[3 * j0 + 1], p[3 * j1 + 1], p[3 * j2 + 1], p[3 * j3 + 1]},
-                    D{p[3 * j0 + 2], p[3 * j1 + 2], p[3 * j2 + 2], p[3 * j3 + 2]}};
+  // Vec3 rows k0..k3 of p (the partners' rows, or the candidates' history rows) in the lanes.
+  auto rows3 = [](const double* p, long long k0, long long k1, long long k2, long long k3) {
+    return Vec3T<D>{D{p[3 * k0], p[3 * k1], p[3 * k2], p[3 * k3]},
+                    D{p[3 * k0 + 1], p[3 * k1 + 1], p[3 * k2 + 1], p[3 * k3 + 1]},
+                    D{p[3 * k0 + 2], p[3 * k1 + 2], p[3 * k2 + 2], p[3 * k3 + 2]}};
   };
+  auto gather3 = [&](const double* p) { return rows3(p, j0, j1, j2, j3); };
   auto both3 = [&](const double* p) {
     return Vec3T<D>{both(p[3 * i]), both(p[3 * i + 1]), both(p[3 * i + 2])};
-  };
-  auto hist3 = [&] {
-    const double* h = a.hc;
-    const long long h0 = 3 * static_cast<long long>(q[0]), h1 = 3 * static_cast<long long>(q[1]),
-                    h2 = 3 * static_cast<long long>(q[2]), h3 = 3 * static_cast<long long>(q3);
-    return Vec3T<D>{D{h[h0], h[h1], h[h2], h[h3]}, D{h[h0 + 1], h[h1 + 1], h[h2 + 1], h[h3 + 1]},
-                    D{h[h0 + 2], h[h1 + 2], h[h2 + 2], h[h3 + 2]}};
   };
   const Vec3T<D> d = gather3(a.x) - both3(a.x);
   const PairProps* row = a.pairs + a.mat[i] * a.nMat;
   const PairProps* pk[4] = {&row[a.mat[j0]], &row[a.mat[j1]], &row[a.mat[j2]], &row[a.mat[j3]]};
   auto prop = [&](double PairProps::*f) { return D{pk[0]->*f, pk[1]->*f, pk[2]->*f, pk[3]->*f}; };
-  const OwnedPair<D> op = ownedPair<D>(
-      d, dot(d, d), both(a.r[i]), lanes(a.r), both(a.m[i]), lanes(a.m), prop(&PairProps::kn),
-      prop(&PairProps::kt), prop(&PairProps::dampFactor), prop(&PairProps::etatFactor),
-      prop(&PairProps::mu), both3(a.v), gather3(a.v), both3(a.w), gather3(a.w), hist3(), a.dt);
+  const OwnedPair<D> op =
+      ownedPair<D>(d, dot(d, d), both(a.r[i]), lanes(a.r), both(a.m[i]), lanes(a.m),
+                   prop(&PairProps::kn), prop(&PairProps::kt), prop(&PairProps::dampFactor),
+                   prop(&PairProps::etatFactor), prop(&PairProps::mu), both3(a.v), gather3(a.v),
+                   both3(a.w), gather3(a.w), rows3(a.hc, q[0], q[1], q[2], q3), a.dt);
   const LsdResultT<D>& res = op.res;
   const Vec3T<D> shareT = op.lji * res.nxft;
   const long long js[4] = {j0, j1, j2, j3};
