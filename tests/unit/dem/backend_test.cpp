@@ -2,12 +2,15 @@
 // tests are written once, templated on the backend, and instantiated for cpu and cuda
 // (cuda skips when it is not built or no device is present).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <thread>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include "backend/cpu/cpu_exec.h"
 #include "coredem/common/check.h"
@@ -23,6 +26,63 @@ TEST(CpuBackend, ParallelForTouchesEveryIndexOnce) {
   exec.parallelFor(hits.size(), [=](std::size_t i) { h[i] += 1; });
   for (int v : hits)
     ASSERT_EQ(v, 1);
+}
+
+// Work hand-out of the cpu backend's loops (ItemClaims): every item once, a thread's own block
+// taken from its front in order (it stays on its part of the particle order), and the rest of
+// a late thread's block taken by the others from the back (thread 0 starts 50 ms late here, as
+// a descheduled thread on a shared machine would).
+TEST(CpuBackend, ItemClaimsHandEachItemOutOnceOwnBlockFirst) {
+  constexpr int team = 4;
+  for (const std::uint32_t count : {0u, 1u, 3u, 4u, 1000u}) {
+    for (const bool late : {false, true}) {
+      backend::ItemClaims claims;
+      const std::uint32_t counts[2] = {count, count / 2};
+      std::vector<int> taker(count, -1), taker2(count / 2, -1);
+      std::vector<std::vector<std::uint32_t>> order(team);
+      int got = 0; // threads OpenMP gave the region
+#pragma omp parallel num_threads(team)
+      {
+        const int t = omp_get_thread_num();
+#pragma omp single
+        {
+          got = omp_get_num_threads();
+          claims.init(got, 2, counts);
+        }
+        if (late && t == 0)
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        claims.run(0, t, [&](std::uint32_t item) {
+          EXPECT_EQ(taker[item], -1) << "item " << item << " handed out twice";
+          taker[item] = t;
+          order[static_cast<std::size_t>(t)].push_back(item);
+          if (!late)
+            std::this_thread::sleep_for(std::chrono::microseconds(20));
+        });
+        claims.run(1, t, [&](std::uint32_t item) { taker2[item] = t; });
+      }
+      for (std::uint32_t k = 0; k < count; ++k)
+        ASSERT_NE(taker[k], -1) << "item " << k << " of " << count << " never handed out";
+      for (std::uint32_t k = 0; k < count / 2; ++k)
+        ASSERT_NE(taker2[k], -1) << "item " << k << " of the second set never handed out";
+      for (int t = 0; t < got; ++t) {
+        const std::uint32_t lo = count * t / got, hi = count * (t + 1) / got;
+        // Own items first, from the block's front, consecutive.
+        std::uint32_t next = lo;
+        for (const std::uint32_t item : order[static_cast<std::size_t>(t)]) {
+          if (item < lo || item >= hi)
+            break;
+          EXPECT_EQ(item, next) << "thread " << t << " took its own block out of order";
+          ++next;
+        }
+      }
+      if (late && count == 1000u && got > 1) { // the others took over the late thread's items
+        int stolen = 0;
+        for (std::uint32_t k = 0; k < count / static_cast<std::uint32_t>(got); ++k)
+          stolen += taker[k] != 0 ? 1 : 0;
+        EXPECT_GT(stolen, 0) << "nobody took over the late thread's items";
+      }
+    }
+  }
 }
 
 TEST(CpuBackend, ReduceMaxIsExact) {
