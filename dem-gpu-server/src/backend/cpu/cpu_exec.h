@@ -31,10 +31,10 @@ namespace coredem::dem::backend {
 /// order; once its block is done it claims items from the back of the others' blocks. A thread
 /// thus works on the same part of the particle order in every pass: on a machine whose cores do
 /// not share their last-level cache (two chiplets), a thread that roamed over all particles
-/// would fetch each row from the other core's cache or from memory in every pass (the dilute
-/// benchmark deck ran 1.9× faster on two threads with the blocks than with dynamic chunks; docs/
-/// performance.md). A claim is one compare-and-swap on the owner's cache line: the counters only
-/// hand out indices (the data is ordered by the region's barriers), so relaxed order suffices.
+/// fetched each row from the other core's cache or from memory in every pass (with dynamic
+/// chunks the dilute benchmark deck ran 1.8× slower on two threads; docs/performance.md). A
+/// claim is one compare-and-swap on the owner's cache line; the counters only hand out
+/// indices (the data is ordered by the region's barriers), so relaxed order suffices.
 class ItemClaims {
 public:
   ItemClaims() = default;
@@ -325,6 +325,10 @@ private:
   template <class Body>
   void inChunks(std::size_t n, Body&& body) const {
     const auto m = static_cast<std::int64_t>(n);
+    if (omp_get_num_threads() == 1) { // nothing to hand out
+      body(std::int64_t{0}, m);
+      return;
+    }
 #pragma omp single
     {
       const auto chunks = static_cast<std::uint32_t>((m + kChunk - 1) / kChunk);
