@@ -122,6 +122,12 @@ struct TwoPairArgs {
   int nMat;
   double dt;
   bool avx; ///< twoOwnedPairs runs its AVX version
+
+  /// Properties of the pair (i, j); a one-material run reads no material index (the rows
+  /// of a pass's few contacts are otherwise each one more cache line to wait for).
+  DEM_HD const PairProps& props(long long i, long long j) const {
+    return nMat == 1 ? pairs[0] : pairs[mat[i] * nMat + mat[j]];
+  }
 };
 
 /// Owned candidates q0 < q1 of particle i, both in contact, evaluated in the two lanes of
@@ -144,9 +150,8 @@ DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std
     return Vec3T<D>{both(p[3 * i]), both(p[3 * i + 1]), both(p[3 * i + 2])};
   };
   const Vec3T<D> d = gather3(a.x) - both3(a.x);
-  const PairProps* row = a.pairs + a.mat[i] * a.nMat;
-  const PairProps& p0 = row[a.mat[j0]];
-  const PairProps& p1 = row[a.mat[j1]];
+  const PairProps& p0 = a.props(i, j0);
+  const PairProps& p1 = a.props(i, j1);
   const Vec3 h0 = load3(a.hc, q0);
   const Vec3 h1 = load3(a.hc, q1);
   const OwnedPair<D> op =
@@ -210,7 +215,7 @@ inline void oneOwnedPair(const TwoPairArgs& a, long long i, std::uint32_t q, dou
   using namespace kernels;
   const long long j = a.half[q];
   const Vec3 d = load3(a.x, j) - load3(a.x, i);
-  const PairProps& pp = a.pairs[a.mat[i] * a.nMat + a.mat[j]];
+  const PairProps& pp = a.props(i, j);
   const OwnedPair<double> op = ownedPair(
       d, dot(d, d), a.r[i], a.r[j], a.m[i], a.m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor,
       pp.mu, load3(a.v, i), load3(a.v, j), load3(a.w, i), load3(a.w, j), load3(a.hc, q), a.dt);
@@ -248,8 +253,7 @@ fourOwnedPairsAvx(const TwoPairArgs& a, long long i, const std::uint32_t* q, int
     return Vec3T<D>{both(p[3 * i]), both(p[3 * i + 1]), both(p[3 * i + 2])};
   };
   const Vec3T<D> d = gather3(a.x) - both3(a.x);
-  const PairProps* row = a.pairs + a.mat[i] * a.nMat;
-  const PairProps* pk[4] = {&row[a.mat[j0]], &row[a.mat[j1]], &row[a.mat[j2]], &row[a.mat[j3]]};
+  const PairProps* pk[4] = {&a.props(i, j0), &a.props(i, j1), &a.props(i, j2), &a.props(i, j3)};
   auto prop = [&](double PairProps::*f) { return D{pk[0]->*f, pk[1]->*f, pk[2]->*f, pk[3]->*f}; };
   const OwnedPair<D> op =
       ownedPair<D>(d, dot(d, d), both(a.r[i]), lanes(a.r), both(a.m[i]), lanes(a.m),
