@@ -48,7 +48,6 @@
 
 namespace coredem::dem {
 
-constexpr std::uint32_t kEmptyCell = 0xffffffffu;
 /// Columns moved per pass when particles are reordered (scratch = N·4 doubles).
 constexpr int kReorderBlock = 4;
 
@@ -156,7 +155,7 @@ public:
 
   std::size_t memoryBytes() const override {
     auto& self = const_cast<EngineImpl&>(*this);
-    return self._p.bytes() + _keys.bytes() + _perm.bytes() + _cellStart.bytes() + _cellEnd.bytes() +
+    return self._p.bytes() + _keys.bytes() + _perm.bytes() + _cellOffset.bytes() +
            _scratch.bytes() + _cells.bytes() + _pairLists.bytes() + _drag.bytes() +
            _contacts.bytes() + _heat.bytes() + _chem.bytes() + _gas.bytes();
   }
@@ -284,20 +283,18 @@ public:
     });
     computeKeys(g); // keys of the sorted order (ascending)
 
-    _cellStart.reserve(g.cells);
-    _cellEnd.reserve(g.cells);
-    std::uint32_t* cs = _cellStart.d();
-    std::uint32_t* ce = _cellEnd.d();
+    // Cell offsets (CSR over the sorted keys): the particles of cell c are [off[c], off[c + 1]);
+    // cells of one x-row are consecutive keys, so a row of the 27-cell stencil is one index
+    // range. Index i writes off[c] = i for the cells after key[i − 1] up to key[i].
+    _cellOffset.reserve(static_cast<std::size_t>(g.cells) + 1);
+    std::uint32_t* off = _cellOffset.d();
     const std::uint32_t* keys = _keys.d();
-    _exec.parallelFor(g.cells, [=] DEM_LAMBDA(std::size_t c) {
-      cs[c] = kEmptyCell;
-      ce[c] = 0;
-    });
-    _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
-      if (i == 0 || keys[i] != keys[i - 1])
-        cs[keys[i]] = static_cast<std::uint32_t>(i);
-      if (i + 1 == n || keys[i] != keys[i + 1])
-        ce[keys[i]] = static_cast<std::uint32_t>(i + 1);
+    const std::uint32_t cells = g.cells;
+    _exec.parallelFor(n + 1, [=] DEM_LAMBDA(std::size_t i) {
+      const std::uint32_t lo = i == 0 ? 0u : keys[i - 1] + 1u;
+      const std::uint32_t hi = i == n ? cells : keys[i];
+      for (std::uint32_t c = lo; c <= hi; ++c)
+        off[c] = static_cast<std::uint32_t>(i);
     });
 
     for (;;) {
@@ -317,6 +314,8 @@ public:
         const int cz =
             static_cast<int>(key / (static_cast<std::uint32_t>(gg.dims[0]) * gg.dims[1]));
         int count = 0;
+        const int x0 = cx > 0 ? cx - 1 : 0;
+        const int x1 = cx + 1 < gg.dims[0] ? cx + 1 : gg.dims[0] - 1;
         for (int dz = -1; dz <= 1; ++dz) {
           const int z = cz + dz;
           if (z < 0 || z >= gg.dims[2])
@@ -325,25 +324,18 @@ public:
             const int y = cy + dy;
             if (y < 0 || y >= gg.dims[1])
               continue;
-            for (int dx = -1; dx <= 1; ++dx) {
-              const int xx = cx + dx;
-              if (xx < 0 || xx >= gg.dims[0])
+            // Cells x0..x1 of row (y, z): one index range, in the order of the cells.
+            const std::uint32_t row = static_cast<std::uint32_t>(gg.dims[0] * (y + gg.dims[1] * z));
+            const std::uint32_t end = off[row + x1 + 1];
+            for (std::uint32_t j = off[row + x0]; j < end; ++j) {
+              if (j == i)
                 continue;
-              const std::uint32_t c =
-                  static_cast<std::uint32_t>(xx + gg.dims[0] * (y + gg.dims[1] * z));
-              const std::uint32_t b = cs[c];
-              if (b == kEmptyCell)
-                continue;
-              for (std::uint32_t j = b; j < ce[c]; ++j) {
-                if (j == i)
-                  continue;
-                const kernels::Vec3 d = kernels::load3(x, j) - xi;
-                const double cut = ri + r[j] + skin;
-                if (kernels::dot(d, d) < cut * cut) {
-                  if (count < width)
-                    list[i * width + count] = static_cast<std::int32_t>(j);
-                  ++count;
-                }
+              const kernels::Vec3 d = kernels::load3(x, j) - xi;
+              const double cut = ri + r[j] + skin;
+              if (kernels::dot(d, d) < cut * cut) {
+                if (count < width)
+                  list[i * width + count] = static_cast<std::int32_t>(j);
+                ++count;
               }
             }
           }
@@ -579,7 +571,7 @@ private:
   bool _hasGas = false;
   CouplingCells<Exec> _cells; ///< PCM cell binning and frozen ε_g, read by the modules
   PairLists<Exec> _pairLists; ///< half and low lists of the neighbour lists (pair_lists.h)
-  Dev<std::uint32_t> _keys, _perm, _cellStart, _cellEnd; ///< neighbour search
+  Dev<std::uint32_t> _keys, _perm, _cellOffset; ///< neighbour search
   Dev<unsigned char> _scratch;
   bool _listValid = false;
   StageTimes _t;
