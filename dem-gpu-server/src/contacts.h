@@ -253,13 +253,24 @@ fourOwnedPairsAvx(const TwoPairArgs& a, long long i, const std::uint32_t* q, int
     return Vec3T<D>{both(p[3 * i]), both(p[3 * i + 1]), both(p[3 * i + 2])};
   };
   const Vec3T<D> d = gather3(a.x) - both3(a.x);
-  const PairProps* pk[4] = {&a.props(i, j0), &a.props(i, j1), &a.props(i, j2), &a.props(i, j3)};
-  auto prop = [&](double PairProps::*f) { return D{pk[0]->*f, pk[1]->*f, pk[2]->*f, pk[3]->*f}; };
-  const OwnedPair<D> op =
-      ownedPair<D>(d, dot(d, d), both(a.r[i]), lanes(a.r), both(a.m[i]), lanes(a.m),
-                   prop(&PairProps::kn), prop(&PairProps::kt), prop(&PairProps::dampFactor),
-                   prop(&PairProps::etatFactor), prop(&PairProps::mu), both3(a.v), gather3(a.v),
-                   both3(a.w), gather3(a.w), rows3(a.hc, q[0], q[1], q[2], q3), a.dt);
+  // The pair properties in the lanes: one broadcast each in a one-material run (the four
+  // lanes would otherwise load the same row four times), else each lane's row.
+  D props[5];
+  constexpr double PairProps::*kProp[5] = {&PairProps::kn, &PairProps::kt, &PairProps::dampFactor,
+                                           &PairProps::etatFactor, &PairProps::mu};
+  if (a.nMat == 1) {
+    for (int k = 0; k < 5; ++k)
+      props[k] = both(a.pairs[0].*kProp[k]);
+  } else {
+    const PairProps* pk[4] = {&a.props(i, j0), &a.props(i, j1), &a.props(i, j2),
+                              &a.props(i, j3)};
+    for (int k = 0; k < 5; ++k)
+      props[k] = D{pk[0]->*kProp[k], pk[1]->*kProp[k], pk[2]->*kProp[k], pk[3]->*kProp[k]};
+  }
+  const OwnedPair<D> op = ownedPair<D>(
+      d, dot(d, d), both(a.r[i]), lanes(a.r), both(a.m[i]), lanes(a.m), props[0], props[1],
+      props[2], props[3], props[4], both3(a.v), gather3(a.v), both3(a.w), gather3(a.w),
+      rows3(a.hc, q[0], q[1], q[2], q3), a.dt);
   const LsdResultT<D>& res = op.res;
   const Vec3T<D> shareT = op.lji * res.nxft;
   const long long js[4] = {j0, j1, j2, j3};
