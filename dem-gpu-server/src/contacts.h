@@ -262,15 +262,14 @@ fourOwnedPairsAvx(const TwoPairArgs& a, long long i, const std::uint32_t* q, int
     for (int k = 0; k < 5; ++k)
       props[k] = both(a.pairs[0].*kProp[k]);
   } else {
-    const PairProps* pk[4] = {&a.props(i, j0), &a.props(i, j1), &a.props(i, j2),
-                              &a.props(i, j3)};
+    const PairProps* pk[4] = {&a.props(i, j0), &a.props(i, j1), &a.props(i, j2), &a.props(i, j3)};
     for (int k = 0; k < 5; ++k)
       props[k] = D{pk[0]->*kProp[k], pk[1]->*kProp[k], pk[2]->*kProp[k], pk[3]->*kProp[k]};
   }
-  const OwnedPair<D> op = ownedPair<D>(
-      d, dot(d, d), both(a.r[i]), lanes(a.r), both(a.m[i]), lanes(a.m), props[0], props[1],
-      props[2], props[3], props[4], both3(a.v), gather3(a.v), both3(a.w), gather3(a.w),
-      rows3(a.hc, q[0], q[1], q[2], q3), a.dt);
+  const OwnedPair<D> op =
+      ownedPair<D>(d, dot(d, d), both(a.r[i]), lanes(a.r), both(a.m[i]), lanes(a.m), props[0],
+                   props[1], props[2], props[3], props[4], both3(a.v), gather3(a.v), both3(a.w),
+                   gather3(a.w), rows3(a.hc, q[0], q[1], q[2], q3), a.dt);
   const LsdResultT<D>& res = op.res;
   const Vec3T<D> shareT = op.lji * res.nxft;
   const long long js[4] = {j0, j1, j2, j3};
