@@ -42,6 +42,7 @@
 #include "engine.h"
 #include "gas_fields.h"
 #include "heat.h"
+#include "motion.h"
 #include "pair_lists.h"
 #include "particle_store.h"
 #include "step_module.h"
@@ -445,8 +446,9 @@ public:
     }
   }
 
-  /// Symplectic Euler. Reads force, torque, mass, radius; writes pos, vel, omega, and the
-  /// largest displacement² since the last neighbour-list build (kStatusMaxDisplacement2).
+  /// Symplectic Euler (motion.h). Reads force, torque, mass, radius; writes pos, vel, omega,
+  /// and the largest displacement² since the last neighbour-list build
+  /// (kStatusMaxDisplacement2).
   void integrate(double dt) {
     const double* f = _p.force.d();
     const double* tq = _p.torque.d();
@@ -466,24 +468,18 @@ public:
       _p.produced(kVel | kOmega);
       return;
     }
-    _exec.reduceMaxInto(
-        _p.n,
-        [=] DEM_LAMBDA(std::size_t i) {
-          using namespace kernels;
-          const long long ii = static_cast<long long>(i);
-          const double invM = 1.0 / m[i];
-          const Vec3 vn =
-              load3(v, ii) + (dt * invM) * (load3(f, ii) + gravityForce(m[i], g)); // Eq. 6
-          const double invI = 1.0 / (0.4 * m[i] * r[i] * r[i]); // I = 2/5 m R² (Eq. 7)
-          store3(w, ii, load3(w, ii) + (dt * invI) * load3(tq, ii));
-          store3(v, ii, vn);
-          const Vec3 xn = load3(x, ii) + dt * vn;
-          store3(x, ii, xn);
-          const Vec3 d = xn - load3(xr, ii);
-          const double d2 = dot(d, d);
-          return d2 == d2 ? d2 : HUGE_VAL; // NaN forces a rebuild, which reports it
-        },
-        0.0, _status.d() + kStatusMaxDisplacement2);
+    const MotionArrays a{f, tq, m, r, xr, x, v, w, g, dt};
+    double* out = _status.d() + kStatusMaxDisplacement2;
+    auto one = [=] DEM_LAMBDA(std::size_t i) { return moveParticle(a, static_cast<long long>(i)); };
+    if constexpr (kRangeLoops<Exec>) { // cpu: four particles at a time where it has AVX
+      (void)one;
+      const bool avx = Exec::hasAvx();
+      _exec.reduceMaxOverRangesInto(
+          _p.n, [a, avx](std::int64_t lo, std::int64_t hi) { return moveRange(a, lo, hi, avx); },
+          0.0, out);
+    } else {
+      _exec.reduceMaxInto(_p.n, one, 0.0, out);
+    }
     _p.produced(kPos | kVel | kOmega);
   }
 

@@ -136,6 +136,21 @@ struct CpuExec {
     return r;
   }
 
+  /// reduceMaxInto over [0, n) in ranges: f(lo, hi) returns the max over the indices [lo, hi)
+  /// (−∞ for none), so that a body may work on several at a time, e.g. in the lanes of a
+  /// register (motion.h). The ranges are the chunks of parallelFor.
+  template <class F>
+  void reduceMaxOverRangesInto(std::size_t n, F f, double init, double* out) const {
+    const std::int64_t m = static_cast<std::int64_t>(n);
+    double r = init;
+#pragma omp parallel num_threads(threadCount()) reduction(max : r) if (m > kChunk / 2)
+    {
+      const F g = f;
+      inChunks(n, [&](std::int64_t lo, std::int64_t hi) { r = std::max(r, g(lo, hi)); });
+    }
+    *out = r;
+  }
+
   /// max of f(i) over every index of the slabs [start[s], start[s + 1]), s < slabs, run by
   /// colour: the slabs s ≡ c (mod 3) in parallel for c = 0, 1, 2 in turn (a barrier between
   /// colours), each slab on one thread in index order (pair_lists.h "Slabs": f may then write

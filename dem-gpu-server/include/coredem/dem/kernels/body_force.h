@@ -7,8 +7,10 @@
 
 namespace coredem::dem::kernels {
 
-DEM_HD Vec3 gravityForce(double mass, Vec3 g) {
-  return mass * g;
+/// S = double, or a lane type of lanes.h (one particle per lane; g is the same for all).
+template <class S>
+DEM_HD Vec3T<S> gravityForce(S mass, Vec3 g) {
+  return {mass * g.x, mass * g.y, mass * g.z};
 }
 
 } // namespace coredem::dem::kernels
