@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+
 #include <math.h>
 
 #include "coredem/dem/kernels/lanes.h"
@@ -61,9 +62,9 @@ inline constexpr bool kRangeLoops = requires(const Exec& e, double* o) {
                                                                          long long i) {
   using D = kernels::Double4;
   const double* q = p + 3 * i;
-  const __m256d a = _mm256_loadu_pd(q);     // x0 y0 z0 x1
-  const __m256d b = _mm256_loadu_pd(q + 4); // y1 z1 x2 y2
-  const __m256d c = _mm256_loadu_pd(q + 8); // z2 x3 y3 z3
+  const __m256d a = _mm256_loadu_pd(q);                    // x0 y0 z0 x1
+  const __m256d b = _mm256_loadu_pd(q + 4);                // y1 z1 x2 y2
+  const __m256d c = _mm256_loadu_pd(q + 8);                // z2 x3 y3 z3
   const __m256d xy02 = _mm256_permute2f128_pd(a, b, 0x30); // x0 y0 x2 y2
   const __m256d zx13 = _mm256_permute2f128_pd(a, c, 0x21); // z0 x1 z2 x3
   const __m256d yz13 = _mm256_permute2f128_pd(b, c, 0x30); // y1 z1 y3 z3
@@ -89,7 +90,7 @@ inline constexpr bool kRangeLoops = requires(const Exec& e, double* o) {
 
 /// moveRange for a processor with AVX.
 [[gnu::target("avx"), gnu::flatten]] inline double moveRangeAvx(const MotionArrays& a,
-                                                                 std::int64_t lo, std::int64_t hi) {
+                                                                std::int64_t lo, std::int64_t hi) {
   using namespace kernels;
   using D = Double4;
   double moved2 = -HUGE_VAL;
@@ -97,10 +98,9 @@ inline constexpr bool kRangeLoops = requires(const Exec& e, double* o) {
   for (; i + 4 <= hi; i += 4) {
     const D m = reinterpret_cast<D>(_mm256_loadu_pd(a.m + i));
     const D r = reinterpret_cast<D>(_mm256_loadu_pd(a.r + i));
-    const MotionT<D> s = symplecticEuler<D>(loadRows4(a.x, i), loadRows4(a.v, i),
-                                            loadRows4(a.w, i), loadRows4(a.f, i),
-                                            loadRows4(a.tq, i), m, r, a.g, loadRows4(a.xref, i),
-                                            a.dt);
+    const MotionT<D> s = symplecticEuler<D>(loadRows4(a.x, i), loadRows4(a.v, i), loadRows4(a.w, i),
+                                            loadRows4(a.f, i), loadRows4(a.tq, i), m, r, a.g,
+                                            loadRows4(a.xref, i), a.dt);
     storeRows4(a.w, i, s.w);
     storeRows4(a.v, i, s.v);
     storeRows4(a.x, i, s.x);

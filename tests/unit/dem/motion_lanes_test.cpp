@@ -21,8 +21,8 @@ namespace {
 struct Particles {
   std::vector<double> f, tq, m, r, xref, x, v, w;
   MotionArrays arrays(Vec3 g, double dt) {
-    return {f.data(), tq.data(), m.data(), r.data(), xref.data(), x.data(), v.data(), w.data(),
-            g, dt};
+    return {f.data(), tq.data(), m.data(), r.data(), xref.data(),
+            x.data(), v.data(),  w.data(), g,        dt};
   }
 };
 
@@ -62,8 +62,7 @@ TEST(Motion, OneStepFollowsTheSymplecticEulerFormulas) {
   const Vec3 xref{0.0099, 0.02, 0.0301};
   const kernels::MotionT<double> s = kernels::symplecticEuler(x0, v0, w0, f, tq, m, r, g, xref, dt);
   const double inertia = 0.4 * m * r * r;
-  const double vx = v0.x + dt * f.x / m, vy = v0.y + dt * f.y / m,
-               vz = v0.z + dt * (f.z / m + g.z);
+  const double vx = v0.x + dt * f.x / m, vy = v0.y + dt * f.y / m, vz = v0.z + dt * (f.z / m + g.z);
   EXPECT_NEAR(s.v.x, vx, 1e-15 * std::abs(vx));
   EXPECT_NEAR(s.v.y, vy, 1e-15 * std::abs(vy));
   EXPECT_NEAR(s.v.z, vz, 1e-15 * std::abs(vz));
