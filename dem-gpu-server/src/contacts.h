@@ -571,6 +571,14 @@ public:
         backend::prefetch(hk + a);
         backend::prefetch(hd + 3 * a);
       }
+      // A particle without owned candidates and without walls, now or in the last sub-step
+      // (most particles of a dilute bed), has nothing to evaluate, no history and no force to
+      // add: only its contact count to clear.
+      if (hs[i] == hs[i + 1] && wallNear[i] == 0 && nwc[i] == 0) {
+        if (nc[i] != 0)
+          nc[i] = 0;
+        return 0.0;
+      }
       // Wall history: the first nwc slots (the walls of the last sub-step), read before they
       // are rewritten.
       const int used = nwc[i] < K ? nwc[i] : K;
