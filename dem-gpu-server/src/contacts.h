@@ -41,6 +41,7 @@
 #include <cstring>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
@@ -314,6 +315,298 @@ inline bool cpuHasAvx() {
 }
 #endif
 
+/// One owner's part of the contact pass (ContactModule::sources, pass 1): its owned pairs in
+/// contact and its walls; returns the history slots it needs (owned contacts + walls). Its
+/// candidates in contact come from its half list (operator(), owner<false>) or, on the cpu
+/// backend, from the list SlabContacts made of its slab's (owner<true>).
+template <class Exec>
+struct OwnerContacts {
+  const double* x;
+  const double* v;
+  const double* w;
+  const double* r;
+  const double* m;
+  const std::int32_t* mat;
+  std::int64_t* hk;
+  double* hd;
+  double* hc;
+  double* f;
+  double* tq;
+  double* fw;
+  std::int32_t* nc;
+  std::int32_t* nwc;
+  const std::uint32_t* hs;
+  const std::int32_t* half;
+  const std::uint32_t* wallNear;
+  const PairProps* pairs;
+  const kernels::PlaneWall* walls;
+  int nWalls;
+  int nMat;
+  int K;
+  std::size_t n;
+  double dt;
+  unsigned char* hit; ///< gather backends: per candidate, in contact
+  double* share;      ///< gather backends: per candidate, the partner's share
+  double* own;        ///< gather backends: per particle, its own sum
+#if defined(COREDEM_DEM_DOUBLE2)
+  TwoPairArgs two;
+#endif
+
+  DEM_HD double operator()(std::size_t i) const {
+    std::uint32_t h = 0;
+    return owner<false>(i, nullptr, nullptr, h, 0);
+  }
+
+  /// kFromHits: i's candidates in contact are hits[h..) while their owner (qOwner) is i; h
+  /// ends past them.
+  template <bool kFromHits>
+  DEM_HD_FORCEINLINE double owner(std::size_t i, const std::uint32_t* hits,
+                                  const std::uint32_t* qOwner, std::uint32_t& h,
+                                  std::uint32_t nh) const {
+    (void)hits, (void)qOwner, (void)h, (void)nh;
+    using namespace kernels;
+    const long long ii = static_cast<long long>(i);
+    const Vec3 xi = load3(x, ii);
+    const double ri = r[i];
+    // The history slots of the few particles touching walls are scattered through memory:
+    // ask for those of a particle kPrefetchAhead further on while this one computes.
+    if (i + kPrefetchAhead < n && nwc[i + kPrefetchAhead] > 0) {
+      const std::size_t a = (i + kPrefetchAhead) * static_cast<std::size_t>(K);
+      backend::prefetch(hk + a);
+      backend::prefetch(hd + 3 * a);
+    }
+    // A particle without owned candidates and without walls, now or in the last sub-step
+    // (most particles of a dilute bed), has nothing to evaluate, no history and no force to
+    // add: only its contact count to clear. (From a slab's list: the slab pass skips them.)
+    if constexpr (!kFromHits) {
+      if (hs[i] == hs[i + 1] && wallNear[i] == 0 && nwc[i] == 0) {
+        if (nc[i] != 0)
+          nc[i] = 0;
+        return 0.0;
+      }
+    }
+    // Wall history: the first nwc slots (the walls of the last sub-step), read before they
+    // are rewritten.
+    const int used = nwc[i] < K ? nwc[i] : K;
+    std::int64_t oldKey[kMaxHistorySlots];
+    Vec3 oldD[kMaxHistorySlots];
+    for (int s = 0; s < used; ++s) {
+      oldKey[s] = hk[i * K + s];
+      oldD[s] = load3(hd, ii * K + s);
+    }
+    int slot = 0;
+    auto wallHistory = [&](std::int64_t key) {
+      for (int s = 0; s < used; ++s)
+        if (oldKey[s] == key)
+          return oldD[s];
+      return Vec3{0.0, 0.0, 0.0};
+    };
+    Vec3 F{0.0, 0.0, 0.0}; // i's own sum: its owned pairs, then its walls
+    Vec3 T{0.0, 0.0, 0.0};
+    // Particle–particle LSD (Eqs. 7–13) over the owned candidates. i's velocities, mass and
+    // material are read only if it has some (most particles of a dilute bed do not).
+    int owned = 0;
+#if defined(COREDEM_DEM_DOUBLE2)
+    std::uint32_t pending[4]; // cpu: candidates in contact not yet evaluated
+    int nPending = 0;
+    auto evaluatePending = [&] {
+      double out[24];
+      ownedPairs(two, ii, pending, nPending, out);
+      for (int k = 0; k < nPending; ++k) {
+        F += load3(out, 2 * k);
+        T += load3(out, 2 * k + 1);
+      }
+      owned += nPending;
+      nPending = 0;
+    };
+#endif
+#if defined(COREDEM_DEM_DOUBLE2)
+    if constexpr (kFromHits) {
+      // The slab's candidates in contact (SlabContacts), i's first at hits[h].
+      for (; h < nh && qOwner[hits[h]] == i; ++h) {
+        pending[nPending++] = hits[h];
+        if (nPending == 4)
+          evaluatePending();
+      }
+      if (nPending > 0)
+        evaluatePending();
+    } else
+#endif
+    {
+      const std::uint32_t qEnd = hs[i + 1];
+      if (hs[i] < qEnd) {
+        const Vec3 vi = load3(v, ii);
+        const Vec3 wi = load3(w, ii);
+        const double mi = m[i];
+        const int ai = mat[i];
+        for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
+          const std::int32_t j = half[q];
+          const Vec3 d = load3(x, j) - xi;
+          const double l2 = dot(d, d);
+          const double rj = r[j];
+          const double rsum = ri + rj;
+          const bool touching = l2 < rsum * rsum;
+          if constexpr (!kScatter<Exec>)
+            hit[q] = touching ? 1 : 0;
+          if (!touching) {
+            // Out of contact: no history (written only if there was some).
+            if (!zeroBits(load3(hc, q)))
+              store3(hc, q, Vec3{0.0, 0.0, 0.0});
+            continue;
+          }
+#if defined(COREDEM_DEM_DOUBLE2)
+          if constexpr (kTwoPairs<Exec>) {
+            // Up to four candidates in contact at once, in this order (ownedPairs).
+            pending[nPending++] = q;
+            if (nPending == 4)
+              evaluatePending();
+            continue;
+          }
+#endif
+          const PairProps pp = pairs[ai * nMat + mat[j]];
+          const OwnedPair<double> op =
+              ownedPair(d, l2, ri, rj, mi, m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor, pp.mu,
+                        vi, load3(v, j), wi, load3(w, j), load3(hc, q), dt);
+          const LsdResult& res = op.res;
+          F += res.force;
+          T += res.torque;
+          store3(hc, q, res.deltaT);
+          // j's share: force −f, torque L_ji n × f_t.
+          if constexpr (kScatter<Exec>) {
+            store3(f, j, load3(f, j) - res.force);
+            store3(tq, j, load3(tq, j) + op.lji * res.nxft);
+          } else {
+            store3(share, 2 * static_cast<long long>(q), res.force);
+            store3(share, 2 * static_cast<long long>(q) + 1, op.lji * res.nxft);
+          }
+          ++owned;
+        }
+#if defined(COREDEM_DEM_DOUBLE2)
+        if (nPending > 0)
+          evaluatePending();
+#endif
+      }
+    }
+    // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate bits
+    // of the first 32 (most particles have none), then every wall beyond them.
+    Vec3 FW{0.0, 0.0, 0.0};
+    int wallCount = 0;
+    std::uint32_t bits = wallNear[i];
+    for (int k = bits != 0 ? lowestBit(bits) : 32; k < nWalls;) {
+      const double deltaN = wallOverlap(walls[k], xi, ri);
+      if (deltaN > 0.0) {
+        const int ai = mat[i];
+        const double mi = m[i];
+        const PairProps pp = pairs[ai * nMat + ai];
+        const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
+        const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+        const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
+        const LsdResult res =
+            wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii), ri, wallHistory(key), dt);
+        FW += res.force;
+        T += res.torque;
+        if (slot < K) {
+          hk[i * K + slot] = key;
+          store3(hd, ii * K + slot, res.deltaT);
+        }
+        ++slot;
+        ++wallCount;
+      }
+      if (k < 32) {
+        bits &= bits - 1;
+        k = bits != 0 ? lowestBit(bits) : 32;
+      } else {
+        ++k;
+      }
+    }
+    F += FW;
+    for (int s = slot; s < used; ++s)
+      hk[i * K + s] = -1;
+    // i's own sum, after the shares of the particles before it (pair_lists.h), if i has
+    // contacts of its own (most particles of a dilute bed have none: no load, no store).
+    if constexpr (kScatter<Exec>) {
+      if (owned + wallCount > 0) {
+        store3(f, ii, load3(f, ii) + F);
+        store3(tq, ii, load3(tq, ii) + T);
+      }
+    } else {
+      store3(own, 2 * ii, F);
+      store3(own, 2 * ii + 1, T);
+    }
+    // fwall is zero in every row without wall contacts (zeroed at each rebuild: rows do not
+    // follow their particles), so only rows with wall contacts now or in the last sub-step
+    // are written: most particles never touch a wall, and a store is a cache line read and
+    // written back.
+    if (wallCount > 0 || nwc[i] > 0)
+      store3(fw, ii, FW);
+    if (nc[i] != owned) // mostly unchanged: no store, the line stays clean
+      nc[i] = owned;
+    if (nwc[i] != wallCount)
+      nwc[i] = wallCount;
+    return static_cast<double>(owned + wallCount); // history slots i needs
+  }
+};
+
+#if defined(COREDEM_DEM_DOUBLE2)
+/// The cpu backend's contact pass over one slab [lo, hi) (CpuExec::reduceMaxOverSlabRanges):
+/// the same owner by owner work, in the same order (same bits), arranged for how many
+/// candidates are in contact. In a dilute slab (most candidates apart) first one loop over all
+/// its owned candidates, in half-list order, which lists those in contact and clears the
+/// history of the others, then the owners with something to do (a contact listed, walls now or
+/// in the last sub-step, a contact count to clear), each with OwnerContacts::owner<true>: one
+/// branch per candidate that is almost always "apart", instead of a loop per owner whose length
+/// (0 to 5) the processor cannot predict. A dense slab (most candidates in contact: a packed
+/// bed) goes owner by owner (OwnerContacts::operator()), where the contacts are found and
+/// evaluated in one visit. Which of the two is decided per slab from its last sub-step.
+template <class Exec>
+struct SlabContacts {
+  OwnerContacts<Exec> owners;
+  const std::uint32_t* qOwner; ///< owner of each owned candidate (PairLists::halfOwner)
+  std::uint32_t* hits;         ///< per candidate: the slabs' candidates in contact (scratch)
+  unsigned char* dense;        ///< per slab: most of its candidates were in contact
+
+  double operator()(int s, std::int64_t lo, std::int64_t hi) const {
+    using namespace kernels;
+    const OwnerContacts<Exec>& o = owners;
+    const std::uint32_t qa = o.hs[lo], qb = o.hs[hi];
+    double most = -HUGE_VAL;
+    if (dense[s]) {
+      double found = 0.0; // contacts and walls
+      for (std::int64_t i = lo; i < hi; ++i) {
+        const double k = o(static_cast<std::size_t>(i));
+        most = k > most ? k : most;
+        found += k;
+      }
+      dense[s] = 2.0 * found > static_cast<double>(qb - qa) ? 1 : 0;
+      return most;
+    }
+    std::uint32_t nh = qa; // hits[qa, nh): this slab's candidates in contact
+    for (std::uint32_t q = qa; q < qb; ++q) {
+      const std::uint32_t i = qOwner[q];
+      const std::int32_t j = o.half[q];
+      const Vec3 d = load3(o.x, j) - load3(o.x, static_cast<long long>(i));
+      const double rsum = o.r[i] + o.r[j];
+      const bool touching = dot(d, d) < rsum * rsum; // as OwnerContacts::owner<false>
+      hits[nh] = q;
+      nh += touching ? 1u : 0u;
+      if (!touching && !zeroBits(load3(o.hc, q)))
+        store3(o.hc, q, Vec3{0.0, 0.0, 0.0}); // out of contact: no history
+    }
+    std::uint32_t h = qa;
+    for (std::int64_t is = lo; is < hi; ++is) {
+      const auto i = static_cast<std::uint32_t>(is);
+      const bool listed = h < nh && qOwner[hits[h]] == i;
+      if (!listed && o.wallNear[i] == 0 && o.nwc[i] == 0 && o.nc[i] == 0)
+        continue;
+      const double k = o.template owner<true>(i, hits, qOwner, h, nh);
+      most = k > most ? k : most;
+    }
+    dense[s] = 2 * (nh - qa) > qb - qa ? 1 : 0;
+    return most;
+  }
+};
+#endif
+
 template <class Exec>
 class ContactModule {
 public:
@@ -338,7 +631,7 @@ public:
   bool enabled() const { return true; }
   std::size_t bytes() const {
     return _pairs.bytes() + _walls.bytes() + _hit.bytes() + _own.bytes() + _wallNear.bytes() +
-           _hc.bytes();
+           _hc.bytes() + _hits.bytes() + _dense.capacity();
   }
   ContactTotals totals() const { return {}; }
 
@@ -555,179 +848,30 @@ public:
 #if defined(COREDEM_DEM_DOUBLE2)
     const TwoPairArgs two{x, v, w, r, m, mat, half, pairs, hc, f, tq, nMat, dt, cpuHasAvx()};
 #endif
-    // Pass 1 (per owner): its owned pairs and its walls. Returns the history slots a particle
-    // needs (owned contacts + walls); the largest goes to the status array.
-    auto ownerPass = [=] DEM_LAMBDA(std::size_t i) {
-      using namespace kernels;
-      (void)f, (void)tq, (void)hit, (void)share,
-          (void)own; // nvcc: no first capture in if constexpr
-      const long long ii = static_cast<long long>(i);
-      const Vec3 xi = load3(x, ii);
-      const double ri = r[i];
-      // The history slots of the few particles touching walls are scattered through memory:
-      // ask for those of a particle kPrefetchAhead further on while this one computes.
-      if (i + kPrefetchAhead < n && nwc[i + kPrefetchAhead] > 0) {
-        const std::size_t a = (i + kPrefetchAhead) * static_cast<std::size_t>(K);
-        backend::prefetch(hk + a);
-        backend::prefetch(hd + 3 * a);
-      }
-      // A particle without owned candidates and without walls, now or in the last sub-step
-      // (most particles of a dilute bed), has nothing to evaluate, no history and no force to
-      // add: only its contact count to clear.
-      if (hs[i] == hs[i + 1] && wallNear[i] == 0 && nwc[i] == 0) {
-        if (nc[i] != 0)
-          nc[i] = 0;
-        return 0.0;
-      }
-      // Wall history: the first nwc slots (the walls of the last sub-step), read before they
-      // are rewritten.
-      const int used = nwc[i] < K ? nwc[i] : K;
-      std::int64_t oldKey[kMaxHistorySlots];
-      Vec3 oldD[kMaxHistorySlots];
-      for (int s = 0; s < used; ++s) {
-        oldKey[s] = hk[i * K + s];
-        oldD[s] = load3(hd, ii * K + s);
-      }
-      int slot = 0;
-      auto wallHistory = [&](std::int64_t key) {
-        for (int s = 0; s < used; ++s)
-          if (oldKey[s] == key)
-            return oldD[s];
-        return Vec3{0.0, 0.0, 0.0};
-      };
-      Vec3 F{0.0, 0.0, 0.0}; // i's own sum: its owned pairs, then its walls
-      Vec3 T{0.0, 0.0, 0.0};
-      // Particle–particle LSD (Eqs. 7–13) over the owned candidates. i's velocities, mass and
-      // material are read only if it has some (most particles of a dilute bed do not).
-      int owned = 0;
+    // Pass 1 (per owner): its owned pairs and its walls (OwnerContacts). The largest count of
+    // history slots a particle needs goes to the status array.
+    const OwnerContacts<Exec> ownerPass {
+      x, v, w, r, m, mat, hk, hd, hc, f, tq, fw, nc, nwc, hs, half, wallNear, pairs, walls, nWalls,
+          nMat, K, n, dt, hit, share, own
 #if defined(COREDEM_DEM_DOUBLE2)
-      std::uint32_t pending[4]; // cpu: candidates in contact not yet evaluated
-      int nPending = 0;
-      auto evaluatePending = [&] {
-        double out[24];
-        ownedPairs(two, ii, pending, nPending, out);
-        for (int k = 0; k < nPending; ++k) {
-          F += load3(out, 2 * k);
-          T += load3(out, 2 * k + 1);
-        }
-        owned += nPending;
-        nPending = 0;
-      };
+          ,
+          two
 #endif
-      const std::uint32_t qEnd = hs[i + 1];
-      if (hs[i] < qEnd) {
-        const Vec3 vi = load3(v, ii);
-        const Vec3 wi = load3(w, ii);
-        const double mi = m[i];
-        const int ai = mat[i];
-        for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
-          const std::int32_t j = half[q];
-          const Vec3 d = load3(x, j) - xi;
-          const double l2 = dot(d, d);
-          const double rj = r[j];
-          const double rsum = ri + rj;
-          const bool touching = l2 < rsum * rsum;
-          if constexpr (!kScatter<Exec>)
-            hit[q] = touching ? 1 : 0;
-          if (!touching) {
-            // Out of contact: no history (written only if there was some).
-            if (!zeroBits(load3(hc, q)))
-              store3(hc, q, Vec3{0.0, 0.0, 0.0});
-            continue;
-          }
-#if defined(COREDEM_DEM_DOUBLE2)
-          if constexpr (kTwoPairs<Exec>) {
-            // Up to four candidates in contact at once, in this order (ownedPairs).
-            pending[nPending++] = q;
-            if (nPending == 4)
-              evaluatePending();
-            continue;
-          }
-#endif
-          const PairProps pp = pairs[ai * nMat + mat[j]];
-          const OwnedPair<double> op =
-              ownedPair(d, l2, ri, rj, mi, m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor, pp.mu,
-                        vi, load3(v, j), wi, load3(w, j), load3(hc, q), dt);
-          const LsdResult& res = op.res;
-          F += res.force;
-          T += res.torque;
-          store3(hc, q, res.deltaT);
-          // j's share: force −f, torque L_ji n × f_t.
-          if constexpr (kScatter<Exec>) {
-            store3(f, j, load3(f, j) - res.force);
-            store3(tq, j, load3(tq, j) + op.lji * res.nxft);
-          } else {
-            store3(share, 2 * static_cast<long long>(q), res.force);
-            store3(share, 2 * static_cast<long long>(q) + 1, op.lji * res.nxft);
-          }
-          ++owned;
-        }
-#if defined(COREDEM_DEM_DOUBLE2)
-        if (nPending > 0)
-          evaluatePending();
-#endif
-      }
-      // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate bits
-      // of the first 32 (most particles have none), then every wall beyond them.
-      Vec3 FW{0.0, 0.0, 0.0};
-      int wallCount = 0;
-      std::uint32_t bits = wallNear[i];
-      for (int k = bits != 0 ? lowestBit(bits) : 32; k < nWalls;) {
-        const double deltaN = wallOverlap(walls[k], xi, ri);
-        if (deltaN > 0.0) {
-          const int ai = mat[i];
-          const double mi = m[i];
-          const PairProps pp = pairs[ai * nMat + ai];
-          const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
-          const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-          const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-          const LsdResult res = wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii), ri,
-                                            wallHistory(key), dt);
-          FW += res.force;
-          T += res.torque;
-          if (slot < K) {
-            hk[i * K + slot] = key;
-            store3(hd, ii * K + slot, res.deltaT);
-          }
-          ++slot;
-          ++wallCount;
-        }
-        if (k < 32) {
-          bits &= bits - 1;
-          k = bits != 0 ? lowestBit(bits) : 32;
-        } else {
-          ++k;
-        }
-      }
-      F += FW;
-      for (int s = slot; s < used; ++s)
-        hk[i * K + s] = -1;
-      // i's own sum, after the shares of the particles before it (pair_lists.h), if i has
-      // contacts of its own (most particles of a dilute bed have none: no load, no store).
-      if constexpr (kScatter<Exec>) {
-        if (owned + wallCount > 0) {
-          store3(f, ii, load3(f, ii) + F);
-          store3(tq, ii, load3(tq, ii) + T);
-        }
-      } else {
-        store3(own, 2 * ii, F);
-        store3(own, 2 * ii + 1, T);
-      }
-      // fwall is zero in every row without wall contacts (zeroed at each rebuild: rows do not
-      // follow their particles), so only rows with wall contacts now or in the last sub-step
-      // are written: most particles never touch a wall, and a store is a cache line read and
-      // written back.
-      if (wallCount > 0 || nwc[i] > 0)
-        store3(fw, ii, FW);
-      if (nc[i] != owned) // mostly unchanged: no store, the line stays clean
-        nc[i] = owned;
-      if (nwc[i] != wallCount)
-        nwc[i] = wallCount;
-      return static_cast<double>(owned + wallCount); // history slots i needs
     };
     if constexpr (scatter) {
+#if defined(COREDEM_DEM_DOUBLE2)
+      if (_denseGeneration != pl.generation()) { // new slabs: each starts as a dilute one
+        _dense.assign(static_cast<std::size_t>(pl.slabs()), 0);
+        _denseGeneration = pl.generation();
+      }
+      _hits.reserve(pl.candidates());
+      const SlabContacts<Exec> slabPass{ownerPass, pl.halfOwner(), _hits.d(), _dense.data()};
+      ctx.exec.reduceMaxOverSlabRanges(pl.slabStart(), pl.slabs(), slabPass, 0.0,
+                                       ctx.status + kStatusHistorySlots);
+#else
       ctx.exec.reduceMaxOverSlabsWide(pl.slabStart(), pl.slabs(), ownerPass, 0.0,
                                       ctx.status + kStatusHistorySlots);
+#endif
     } else {
       ctx.exec.reduceMaxInto(n, ownerPass, 0.0, ctx.status + kStatusHistorySlots);
       // Pass 2 (per particle): the gas force (or zero), then the terms in the order the
@@ -812,7 +956,10 @@ private:
   Dev<unsigned char> _hit;      ///< gather backends, per candidate: in contact this sub-step
   Dev<double> _own;             ///< gather backends, per particle: the owner's own force, torque
   Dev<std::uint32_t> _wallNear; ///< per particle: wall candidates (buildWallCandidates)
-  std::uint64_t _wallGeneration = ~std::uint64_t{0}; ///< pair-list build of _wallNear
+  Dev<std::uint32_t> _hits;     ///< cpu: per owned candidate, scratch of SlabContacts
+  std::vector<unsigned char> _dense; ///< cpu: per slab, SlabContacts goes owner by owner
+  std::uint64_t _denseGeneration = ~std::uint64_t{0}; ///< pair-list build of _dense
+  std::uint64_t _wallGeneration = ~std::uint64_t{0};  ///< pair-list build of _wallNear
   Dev<double> _hc; ///< per owned candidate: tangential history δ_t (zero out of contact)
   std::uint64_t _hcGeneration = ~std::uint64_t{0}; ///< pair-list build _hc belongs to
   int _maxUsedSlots =

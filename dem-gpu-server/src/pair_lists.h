@@ -101,9 +101,9 @@ public:
   }
 
   std::size_t bytes() const {
-    return _count.bytes() + _halfStart.bytes() + _half.bytes() + _lowStart.bytes() + _low.bytes() +
-           _lowPos.bytes() + _lowOwner.bytes() + _colour.bytes() + _scratch.bytes() +
-           _slabStart.capacity() * sizeof(std::uint32_t) +
+    return _count.bytes() + _halfStart.bytes() + _half.bytes() + _halfOwner.bytes() +
+           _lowStart.bytes() + _low.bytes() + _lowPos.bytes() + _lowOwner.bytes() +
+           _colour.bytes() + _scratch.bytes() + _slabStart.capacity() * sizeof(std::uint32_t) +
            _reachHost.capacity() * sizeof(std::uint32_t) + _colourHost.capacity();
   }
 
@@ -115,6 +115,8 @@ public:
 
   const std::uint32_t* halfStart() const { return _halfStart.d(); }
   const std::int32_t* half() const { return _half.d(); }
+  /// Per owned candidate q: its owner, the particle whose half list holds it (scatter backends).
+  const std::uint32_t* halfOwner() const { return _halfOwner.d(); }
   const std::uint32_t* lowStart() const { return _lowStart.d(); }
   const std::uint32_t* low() const { return _low.d(); }
   const std::uint32_t* lowPos() const { return _lowPos.d(); }
@@ -155,12 +157,18 @@ public:
     if constexpr (gather)
       _scratch.reserve(kScratchWidth * static_cast<std::size_t>(total));
     std::int32_t* half = _half.d();
+    if constexpr (!gather)
+      _halfOwner.reserve(total + 1);
+    std::uint32_t* halfOwner = gather ? nullptr : _halfOwner.d();
     exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
       std::uint32_t k = hs[i];
       for (int a = 0; a < cnt[i]; ++a) {
         const std::int32_t j = list[i * M + a];
-        if (gid[j] > gid[i])
+        if (gid[j] > gid[i]) {
+          if (halfOwner != nullptr)
+            halfOwner[k] = static_cast<std::uint32_t>(i);
           half[k++] = j;
+        }
       }
     });
     exec.parallelFor(n + 1, [=] DEM_LAMBDA(std::size_t i) {
@@ -278,6 +286,7 @@ private:
   Dev<std::uint32_t> _count;     ///< owned candidates per particle (scan input), n + 1
   Dev<std::uint32_t> _halfStart; ///< CSR offsets of the half lists, n + 1
   Dev<std::int32_t> _half;       ///< owned candidates (partner index), ascending per particle
+  Dev<std::uint32_t> _halfOwner; ///< scatter backends: owner of each owned candidate
   Dev<std::uint32_t> _lowStart;  ///< CSR offsets of the low lists, n + 1
   Dev<std::uint32_t> _low;       ///< per low-list entry k: the candidate's q in the half lists
   Dev<std::uint32_t> _lowPos;    ///< per half-list candidate q: its k in the partner's low list

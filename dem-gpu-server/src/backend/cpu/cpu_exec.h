@@ -152,15 +152,31 @@ struct CpuExec {
   }
 
   /// max of f(i) over every index of the slabs [start[s], start[s + 1]), s < slabs, run by
-  /// colour: the slabs s ≡ c (mod 3) in parallel for c = 0, 1, 2 in turn (a barrier between
-  /// colours), each slab on one thread in index order (pair_lists.h "Slabs": f may then write
-  /// its pair terms into both particles). Where the processor has AVX, the body is inlined into
-  /// a copy compiled for AVX, whose three-operand encoding needs none of the register copies of
-  /// SSE2's two-operand forms; same operations, no FMA (not part of AVX): the same results.
-  /// `start` is host memory.
+  /// colour (reduceMaxOverSlabRanges), each slab in index order.
   template <class F>
   void reduceMaxOverSlabsWide(const std::uint32_t* start, int slabs, F f, double init,
                               double* out) const {
+    reduceMaxOverSlabRanges(
+        start, slabs,
+        [f](int, std::int64_t lo, std::int64_t hi) {
+          double r = -__builtin_inf();
+          for (std::int64_t i = lo; i < hi; ++i)
+            r = std::max(r, f(static_cast<std::size_t>(i)));
+          return r;
+        },
+        init, out);
+  }
+
+  /// max of f(s, lo, hi) over the slabs s < slabs, [lo, hi) = [start[s], start[s + 1]) (f
+  /// returns the max over its slab), run by colour: the slabs s ≡ c (mod 3) in parallel for
+  /// c = 0, 1, 2 in turn (a barrier between colours), each slab on one thread (pair_lists.h
+  /// "Slabs": f may then write its pair terms into both particles). Where the processor has
+  /// AVX, f is inlined into a copy compiled for AVX, whose three-operand encoding needs none of
+  /// the register copies of SSE2's two-operand forms; same operations, no FMA (not part of
+  /// AVX): the same results. `start` is host memory.
+  template <class F>
+  void reduceMaxOverSlabRanges(const std::uint32_t* start, int slabs, F f, double init,
+                               double* out) const {
     double r = init;
     const bool avx = hasAvx();
 #pragma omp parallel num_threads(threadCount()) reduction(max : r) if (slabs > 3)
@@ -184,12 +200,11 @@ struct CpuExec {
           const auto hi = static_cast<std::int64_t>(start[s + 1]);
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX__)
           if (avx) {
-            r = std::max(r, maxOverAvx(g, lo, hi));
+            r = std::max(r, slabAvx(g, s, lo, hi));
             return;
           }
 #endif
-          for (std::int64_t i = lo; i < hi; ++i)
-            r = std::max(r, g(static_cast<std::size_t>(i)));
+          r = std::max(r, g(s, lo, hi));
         });
       }
     }
@@ -355,14 +370,11 @@ private:
     });
   }
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX__)
-  /// max over i in [lo, hi) of g(i), g inlined (reduceMaxOverSlabsWide).
+  /// g(s, lo, hi) inlined into code compiled for AVX (reduceMaxOverSlabRanges).
   template <class F>
-  [[gnu::target("avx"), gnu::flatten]] static double maxOverAvx(const F& g, std::int64_t lo,
-                                                                std::int64_t hi) {
-    double r = -__builtin_inf();
-    for (std::int64_t i = lo; i < hi; ++i)
-      r = std::max(r, g(static_cast<std::size_t>(i)));
-    return r;
+  [[gnu::target("avx"), gnu::flatten]] static double slabAvx(const F& g, int s, std::int64_t lo,
+                                                             std::int64_t hi) {
+    return g(s, lo, hi);
   }
 #endif
   /// Below this many keys the radix sort runs on one thread.
