@@ -91,6 +91,36 @@ private:
   int _team = 1;
 };
 
+/// One flag per slab: done (CpuExec::reduceMaxOverSlabRanges).
+class SlabFlags {
+public:
+  SlabFlags() = default;
+  SlabFlags(const SlabFlags&) {} // a copy gets its own flags
+  SlabFlags& operator=(const SlabFlags&) { return *this; }
+  /// slabs flags, all clear (called by one thread before a region).
+  void reset(int slabs) {
+    const auto n = static_cast<std::size_t>(slabs > 0 ? slabs : 0);
+    if (n > _capacity) {
+      _flags.reset(new std::atomic<std::uint32_t>[n]);
+      _capacity = n;
+    }
+    for (std::size_t s = 0; s < n; ++s)
+      _flags[s].store(0, std::memory_order_relaxed);
+  }
+  std::atomic<std::uint32_t>* flags() { return _flags.get(); }
+
+private:
+  std::unique_ptr<std::atomic<std::uint32_t>[]> _flags;
+  std::size_t _capacity = 0;
+};
+
+/// A spinning thread's hint to the processor (x86: pause).
+inline void spinPause() {
+#if defined(__x86_64__) || defined(__i386__)
+  __builtin_ia32_pause();
+#endif
+}
+
 struct CpuExec {
   static constexpr bool separateDevice = false;
   static constexpr const char* name = "cpu";
@@ -111,6 +141,7 @@ struct CpuExec {
   template <class F>
   void parallelFor(std::size_t n, F f) const {
     const std::int64_t m = static_cast<std::int64_t>(n);
+    initChunks(n);
 #pragma omp parallel num_threads(threadCount()) if (m > kChunk / 2)
     {
       const F g = f;
@@ -125,6 +156,7 @@ struct CpuExec {
   double reduceMax(std::size_t n, F f, double init) const {
     const std::int64_t m = static_cast<std::int64_t>(n);
     double r = init;
+    initChunks(n);
 #pragma omp parallel num_threads(threadCount()) reduction(max : r) if (m > kChunk / 2)
     {
       const F g = f;
@@ -143,6 +175,7 @@ struct CpuExec {
   void reduceMaxOverRangesInto(std::size_t n, F f, double init, double* out) const {
     const std::int64_t m = static_cast<std::int64_t>(n);
     double r = init;
+    initChunks(n);
 #pragma omp parallel num_threads(threadCount()) reduction(max : r) if (m > kChunk / 2)
     {
       const F g = f;
@@ -168,43 +201,50 @@ struct CpuExec {
   }
 
   /// max of f(s, lo, hi) over the slabs s < slabs, [lo, hi) = [start[s], start[s + 1]) (f
-  /// returns the max over its slab), run by colour: the slabs s ≡ c (mod 3) in parallel for
-  /// c = 0, 1, 2 in turn (a barrier between colours), each slab on one thread (pair_lists.h
-  /// "Slabs": f may then write its pair terms into both particles). Where the processor has
-  /// AVX, f is inlined into a copy compiled for AVX, whose three-operand encoding needs none of
-  /// the register copies of SSE2's two-operand forms; same operations, no FMA (not part of
-  /// AVX): the same results. `start` is host memory.
+  /// returns the max over its slab), run by colour: the slabs s ≡ c (mod 3) for c = 0, 1, 2 in
+  /// turn, each slab on one thread (pair_lists.h "Slabs": f may then write its pair terms into
+  /// both particles). No barrier between colours: slab s writes into slabs s − 1 .. s + 1, so it
+  /// shares particles with the slabs within two of it, all of other colours; it starts once
+  /// those of lower colours are done, and those of higher colours wait for it. Each particle
+  /// thus receives its terms in colour order, as with a barrier, while a thread done with its
+  /// slabs of one colour goes on with the next wherever its neighbours allow. (Every slab of a
+  /// colour is claimed before any of the next: a slab waits only for slabs being worked on.)
+  /// Where the processor has AVX, f is inlined into a copy compiled for AVX, whose three-operand
+  /// encoding needs none of the register copies of SSE2's two-operand forms; same operations,
+  /// no FMA (not part of AVX): the same results. `start` is host memory.
   template <class F>
   void reduceMaxOverSlabRanges(const std::uint32_t* start, int slabs, F f, double init,
                                double* out) const {
     double r = init;
     const bool avx = hasAvx();
+    std::uint32_t counts[3];
+    for (int c = 0; c < 3; ++c)
+      counts[c] = slabs > c ? static_cast<std::uint32_t>((slabs - c + 2) / 3) : 0u;
+    _claims.init(threadCount(), 3, counts);
+    _slabDone.reset(slabs);
+    std::atomic<std::uint32_t>* done = _slabDone.flags();
 #pragma omp parallel num_threads(threadCount()) reduction(max : r) if (slabs > 3)
     {
       const F g = f;
       const int t = omp_get_thread_num();
-#pragma omp single
-      {
-        std::uint32_t counts[3];
-        for (int c = 0; c < 3; ++c)
-          counts[c] = slabs > c ? static_cast<std::uint32_t>((slabs - c + 2) / 3) : 0u;
-        _claims.init(omp_get_num_threads(), 3, counts);
-      } // (barrier)
       for (int c = 0; c < 3; ++c) {
-        if (c > 0) {
-#pragma omp barrier
-        }
         _claims.run(c, t, [&](std::uint32_t item) {
           const int s = c + 3 * static_cast<int>(item);
+          for (int d = -2; d <= 2; ++d) { // the slabs within two of lower colour
+            const int q = s + d;
+            if (d != 0 && q >= 0 && q < slabs && q % 3 < c)
+              while (done[q].load(std::memory_order_acquire) == 0)
+                spinPause();
+          }
           const auto lo = static_cast<std::int64_t>(start[s]);
           const auto hi = static_cast<std::int64_t>(start[s + 1]);
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX__)
-          if (avx) {
+          if (avx)
             r = std::max(r, slabAvx(g, s, lo, hi));
-            return;
-          }
+          else
 #endif
-          r = std::max(r, g(s, lo, hi));
+            r = std::max(r, g(s, lo, hi));
+          done[s].store(1, std::memory_order_release);
         });
       }
     }
@@ -350,8 +390,16 @@ struct CpuExec {
 private:
   /// Indices per work item of parallelFor and reduceMax.
   static constexpr std::int64_t kChunk = 512;
+  /// Before a parallel region of inChunks(n, ...): its chunks handed out to a team of
+  /// threadCount() (a smaller team takes the missing threads' chunks over as it does a slow
+  /// thread's; the end of the last region has joined every thread that claimed from them).
+  void initChunks(std::size_t n) const {
+    const auto chunks =
+        static_cast<std::uint32_t>((static_cast<std::int64_t>(n) + kChunk - 1) / kChunk);
+    _claims.init(threadCount(), 1, &chunks);
+  }
   /// Inside a parallel region: body(lo, hi) over [0, n) in chunks of kChunk, claimed through
-  /// _claims (this thread's contiguous part first).
+  /// _claims (this thread's contiguous part first; initChunks(n) before the region).
   template <class Body>
   void inChunks(std::size_t n, Body&& body) const {
     const auto m = static_cast<std::int64_t>(n);
@@ -359,11 +407,6 @@ private:
       body(std::int64_t{0}, m);
       return;
     }
-#pragma omp single
-    {
-      const auto chunks = static_cast<std::uint32_t>((m + kChunk - 1) / kChunk);
-      _claims.init(omp_get_num_threads(), 1, &chunks);
-    } // (barrier)
     _claims.run(0, omp_get_thread_num(), [&](std::uint32_t c) {
       const std::int64_t lo = static_cast<std::int64_t>(c) * kChunk;
       body(lo, std::min(m, lo + kChunk));
@@ -379,7 +422,8 @@ private:
 #endif
   /// Below this many keys the radix sort runs on one thread.
   static constexpr std::size_t kParallelSortMin = 16384;
-  mutable ItemClaims _claims; ///< work items of the parallel loops
+  mutable ItemClaims _claims;  ///< work items of the parallel loops
+  mutable SlabFlags _slabDone; ///< slabs done (reduceMaxOverSlabRanges)
   mutable std::vector<std::uint32_t> _hist, _offsets, _radixTmp;
   mutable std::vector<std::size_t> _radixCount;
 };
