@@ -156,14 +156,32 @@ public:
 
   std::size_t memoryBytes() const override {
     auto& self = const_cast<EngineImpl&>(*this);
-    return self._p.bytes() + _keys.bytes() + _perm.bytes() + _cellOffset.bytes() +
-           _scratch.bytes() + _cells.bytes() + _pairLists.bytes() + _drag.bytes() +
-           _contacts.bytes() + _heat.bytes() + _chem.bytes() + _gas.bytes();
+    return self._p.bytes() + self._spare.bytes() + _keys.bytes() + _perm.bytes() +
+           _cellOffset.bytes() + _scratch.bytes() + _cells.bytes() + _pairLists.bytes() +
+           _drag.bytes() + _contacts.bytes() + _heat.bytes() + _chem.bytes() + _gas.bytes();
   }
 
   // ---------------------------------------------------------------- neighbour search
+  /// Reorders the `width` entries per particle of one array by _perm in one pass: gathered
+  /// into `spare` (the same field of _spare, sized here once), which then takes its place.
+  template <class T>
+  void reorderInto(Dual<T>& arr, Dual<T>& spare, int width) {
+    const std::size_t n = _p.n;
+    spare.allocate(arr.size());
+    const T* a = arr.d();
+    T* b = spare.d();
+    const std::uint32_t* perm = _perm.d();
+    _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+      const T* src = a + static_cast<std::size_t>(perm[i]) * width;
+      for (int q = 0; q < width; ++q)
+        b[i * width + q] = src[q];
+    });
+    arr.swap(spare);
+  }
+
   /// Reorders the first `columns` of the `width` entries per particle of one array by _perm,
-  /// kReorderBlock columns at a time through an N·kReorderBlock scratch buffer.
+  /// kReorderBlock columns at a time through an N·kReorderBlock scratch buffer (the history
+  /// slots: mostly unused, too wide for a spare).
   template <class T>
   void reorder(Dual<T>& arr, int width, int columns = -1) {
     const std::size_t n = _p.n;
@@ -274,13 +292,16 @@ public:
     // rebuilt: not moved.)
     // History slots at or beyond the largest count in use are empty in every row: not moved.
     const int usedSlots = _contacts.usedSlots();
-    schema::forEachField(_p, [&](const schema::FieldInfo& f, auto& arr) {
+    schema::forEachField(_p, _spare, [&](const schema::FieldInfo& f, auto& arr, auto& spare) {
       if (!f.has(schema::kResorted))
         return;
       const int width = _p.width(f);
       if (width == 0)
         return;
-      reorder(arr, width, f.per == schema::Per::History ? f.components * usedSlots : width);
+      if (f.per == schema::Per::History)
+        reorder(arr, width, f.components * usedSlots);
+      else
+        reorderInto(arr, spare, width);
     });
     computeKeys(g); // keys of the sorted order (ascending)
 
@@ -563,7 +584,8 @@ private:
   EngineSetup _s;
   Exec _exec;
   ParticleStore<Exec> _p;
-  GasFields<Exec> _gas; ///< per-cell gas fields of the CFD step, read by the modules
+  ParticleStore<Exec> _spare; ///< rebuild: where a re-sorted per-particle field is gathered
+  GasFields<Exec> _gas;       ///< per-cell gas fields of the CFD step, read by the modules
   bool _hasGas = false;
   CouplingCells<Exec> _cells; ///< PCM cell binning and frozen ε_g, read by the modules
   PairLists<Exec> _pairLists; ///< half and low lists of the neighbour lists (pair_lists.h)

@@ -69,6 +69,14 @@ public:
 
   void markHostModified() { _hostNewer = true; }
   void markDeviceModified() { _deviceNewer = true; }
+  /// Exchanges the two arrays (buffers, sizes, transfer state): no element is copied.
+  void swap(DualArray& o) noexcept {
+    std::swap(_h, o._h);
+    std::swap(_d, o._d);
+    std::swap(_n, o._n);
+    std::swap(_hostNewer, o._hostNewer);
+    std::swap(_deviceNewer, o._deviceNewer);
+  }
   /// Copies host → device if the host copy was modified since the last transfer.
   void toDevice() {
     if (_hostNewer)
