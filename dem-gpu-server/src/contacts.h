@@ -561,13 +561,30 @@ struct OwnerContacts {
 template <class Exec>
 struct SlabContacts {
   OwnerContacts<Exec> owners;
-  const std::uint32_t* qOwner; ///< owner of each owned candidate (PairLists::halfOwner)
-  std::uint32_t* hits;         ///< per candidate: the slabs' candidates in contact (scratch)
-  unsigned char* dense;        ///< per slab: most of its candidates were in contact
+  const std::uint32_t* qOwner;    ///< owner of each owned candidate (PairLists::halfOwner)
+  std::uint32_t* hits;            ///< per candidate: the slabs' candidates in contact (scratch)
+  unsigned char* dense;           ///< per slab: most of its candidates were in contact
+  const std::uint32_t* slabStart; ///< host: the slabs (PairLists::slabStart)
+  int slabs;                      ///< PairLists::slabs
+  bool zeroForce;                 ///< force starts at zero (not at the gas force)
+
+  /// A slab of colour 0 (the first colour run) first zeroes the torque (and the force, unless
+  /// it holds the gas force) of the slabs slabsClearedBy gives: each row once, before any slab
+  /// adds to it (the slabs within two of a slab of colour 0 wait for it), and still in the
+  /// cache when its own pairs add to it.
+  void zeroReach(int s) const {
+    const SlabSpan span = slabsClearedBy(s, slabs);
+    const std::size_t lo = slabStart[span.first], hi = slabStart[span.last];
+    if (zeroForce)
+      std::memset(owners.f + 3 * lo, 0, 3 * (hi - lo) * sizeof(double));
+    std::memset(owners.tq + 3 * lo, 0, 3 * (hi - lo) * sizeof(double));
+  }
 
   double operator()(int s, std::int64_t lo, std::int64_t hi) const {
     using namespace kernels;
     const OwnerContacts<Exec>& o = owners;
+    if (s % 3 == 0)
+      zeroReach(s);
     const std::uint32_t qa = o.hs[lo], qb = o.hs[hi];
     double most = -HUGE_VAL;
     if (dense[s]) {
@@ -829,6 +846,7 @@ public:
     double* share = nullptr;
     double* own = nullptr;
     if constexpr (scatter) {
+#if !defined(COREDEM_DEM_DOUBLE2) // (else inside the slabs: SlabContacts::zeroReach)
       // Force and torque start at the gas force (or zero) and zero; the slabs add the rest.
       ctx.exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
         const long long ii = static_cast<long long>(i);
@@ -836,6 +854,7 @@ public:
           kernels::store3(f, ii, kernels::Vec3{0.0, 0.0, 0.0});
         kernels::store3(tq, ii, kernels::Vec3{0.0, 0.0, 0.0});
       });
+#endif
     } else {
       _hit.reserve(pl.candidates());
       _own.reserve(6 * n);
@@ -865,7 +884,8 @@ public:
         _denseGeneration = pl.generation();
       }
       _hits.reserve(pl.candidates());
-      const SlabContacts<Exec> slabPass{ownerPass, pl.halfOwner(), _hits.d(), _dense.data()};
+      const SlabContacts<Exec> slabPass{ownerPass,      pl.halfOwner(), _hits.d(), _dense.data(),
+                                        pl.slabStart(), pl.slabs(),     !coupled};
       ctx.exec.reduceMaxOverSlabRanges(pl.slabStart(), pl.slabs(), slabPass, 0.0,
                                        ctx.status + kStatusHistorySlots);
 #else

@@ -54,6 +54,22 @@ inline constexpr bool kScatter = requires(const Exec& e, double* o) {
       static_cast<const std::uint32_t*>(nullptr), 0, [](std::size_t) { return 0.0; }, 0.0, o);
 };
 
+/// The slabs [first, last) whose accumulators slab s of colour 0 clears before its pair terms,
+/// when a scatter pass clears them inside its first colour instead of in a pass of its own
+/// (contacts.h, SlabContacts): the slabs its pairs reach, s − 1, s and s + 1, and the last slab
+/// where that is s + 2 (no slab of colour 0 follows it). Over the slabs of colour 0 every slab
+/// is cleared once, and no two of them clear the same slab (they may run at the same time).
+struct SlabSpan {
+  int first, last;
+};
+inline SlabSpan slabsClearedBy(int s, int slabs) {
+  const int first = s > 0 ? s - 1 : 0;
+  int last = s + 2 < slabs ? s + 2 : slabs;
+  if (last == slabs - 1)
+    last = slabs;
+  return {first, last};
+}
+
 /// The gather backends' pass 2 for particle i: calls own() for i's own sum (if hasOwn) and
 /// partner(k) for each of its low-list entries k, in the order the cpu backend's slabs add the
 /// terms (by colour, then by the evaluating particle's index; i's own sum at its own index).

@@ -133,3 +133,28 @@ TEST(PairListSlabs, DiluteAndTinySystems) {
     }
   }
 }
+
+TEST(PairListSlabs, ColourZeroClearsEverySlabOnceAndAllItReaches) {
+  // The cpu contact pass clears force and torque inside its first colour (slabsClearedBy):
+  // every slab exactly once, and each slab of colour 0 clears at least the slabs its own pairs
+  // reach (s − 1 .. s + 1) before adding to them. The other slabs that add to a cleared slab are
+  // of colours 1 and 2 and within two of the slab of colour 0 that cleared it: they wait for it
+  // (CpuExec::reduceMaxOverSlabRanges).
+  for (int slabs = 1; slabs <= 14; ++slabs) {
+    std::vector<int> cleared(static_cast<std::size_t>(slabs), 0);
+    for (int s = 0; s < slabs; s += 3) {
+      const SlabSpan span = slabsClearedBy(s, slabs);
+      ASSERT_LE(0, span.first);
+      ASSERT_LE(span.last, slabs);
+      EXPECT_LE(span.first, std::max(s - 1, 0)) << slabs << " slabs, slab " << s;
+      EXPECT_GE(span.last, std::min(s + 2, slabs)) << slabs << " slabs, slab " << s;
+      for (int k = span.first; k < span.last; ++k) {
+        ++cleared[static_cast<std::size_t>(k)];
+        EXPECT_LE(std::abs(k - s), 2)
+            << "slab " << k << " is cleared by slab " << s << ", which it does not wait for";
+      }
+    }
+    for (int k = 0; k < slabs; ++k)
+      EXPECT_EQ(cleared[static_cast<std::size_t>(k)], 1) << slabs << " slabs, slab " << k;
+  }
+}
