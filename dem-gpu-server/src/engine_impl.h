@@ -24,11 +24,14 @@
 /// and for the velocity-dependent LSD law velocity Verlet (LIGGGHTS) gave the same rebound
 /// ratios in a binary-collision check (docs/performance.md "Integrator").
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <string>
+#include <vector>
 
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
@@ -156,27 +159,51 @@ public:
 
   std::size_t memoryBytes() const override {
     auto& self = const_cast<EngineImpl&>(*this);
-    return self._p.bytes() + self._spare.bytes() + _keys.bytes() + _perm.bytes() +
-           _cellOffset.bytes() + _scratch.bytes() + _cells.bytes() + _pairLists.bytes() +
-           _drag.bytes() + _contacts.bytes() + _heat.bytes() + _chem.bytes() + _gas.bytes();
+    std::size_t spares = 0;
+    for (const auto& sp : _spares)
+      spares += sp->bytes();
+    return self._p.bytes() + spares + _keys.bytes() + _perm.bytes() + _cellOffset.bytes() +
+           _scratch.bytes() + _cells.bytes() + _pairLists.bytes() + _drag.bytes() +
+           _contacts.bytes() + _heat.bytes() + _chem.bytes() + _gas.bytes();
   }
 
   // ---------------------------------------------------------------- neighbour search
   /// Reorders the `width` entries per particle of one array by _perm in one pass: gathered
-  /// into `spare` (the same field of _spare, sized here once), which then takes its place.
+  /// into a spare buffer of its size in bytes, which then takes its place; the array's old
+  /// buffer is the spare of the next array of that size. One spare per size (e.g. 24, 8 and
+  /// 4 bytes per particle), not one per field.
   template <class T>
-  void reorderInto(Dual<T>& arr, Dual<T>& spare, int width) {
+  void reorderInto(Dual<T>& arr, int width) {
     const std::size_t n = _p.n;
-    spare.allocate(arr.size());
+    Dual<unsigned char>& spare = spareOfBytes(arr.bytes());
     const T* a = arr.d();
-    T* b = spare.d();
+    T* b = reinterpret_cast<T*>(spare.d());
     const std::uint32_t* perm = _perm.d();
     _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
       const T* src = a + static_cast<std::size_t>(perm[i]) * width;
       for (int q = 0; q < width; ++q)
         b[i * width + q] = src[q];
     });
-    arr.swap(spare);
+    arr.swapBuffers(spare);
+  }
+  /// Frees the spares of sizes no re-sorted field has any more (particles added or removed).
+  void dropUnusedSpares() {
+    std::vector<std::size_t> sizes;
+    schema::forEachField(_p, [&](const schema::FieldInfo& f, auto& arr) {
+      if (f.has(schema::kResorted) && f.per != schema::Per::History)
+        sizes.push_back(arr.bytes());
+    });
+    std::erase_if(_spares, [&](const auto& sp) {
+      return std::find(sizes.begin(), sizes.end(), sp->size()) == sizes.end();
+    });
+  }
+  Dual<unsigned char>& spareOfBytes(std::size_t bytes) {
+    for (auto& s : _spares)
+      if (s->size() == bytes)
+        return *s;
+    _spares.push_back(std::make_unique<Dual<unsigned char>>());
+    _spares.back()->allocate(bytes);
+    return *_spares.back();
   }
 
   /// Reorders the first `columns` of the `width` entries per particle of one array by _perm,
@@ -292,7 +319,8 @@ public:
     // rebuilt: not moved.)
     // History slots at or beyond the largest count in use are empty in every row: not moved.
     const int usedSlots = _contacts.usedSlots();
-    schema::forEachField(_p, _spare, [&](const schema::FieldInfo& f, auto& arr, auto& spare) {
+    dropUnusedSpares();
+    schema::forEachField(_p, [&](const schema::FieldInfo& f, auto& arr) {
       if (!f.has(schema::kResorted))
         return;
       const int width = _p.width(f);
@@ -301,7 +329,7 @@ public:
       if (f.per == schema::Per::History)
         reorder(arr, width, f.components * usedSlots);
       else
-        reorderInto(arr, spare, width);
+        reorderInto(arr, width);
     });
     computeKeys(g); // keys of the sorted order (ascending)
 
@@ -584,8 +612,9 @@ private:
   EngineSetup _s;
   Exec _exec;
   ParticleStore<Exec> _p;
-  ParticleStore<Exec> _spare; ///< rebuild: where a re-sorted per-particle field is gathered
-  GasFields<Exec> _gas;       ///< per-cell gas fields of the CFD step, read by the modules
+  /// rebuild: the spare buffers re-sorted per-particle fields are gathered into, one per size
+  std::vector<std::unique_ptr<Dual<unsigned char>>> _spares;
+  GasFields<Exec> _gas; ///< per-cell gas fields of the CFD step, read by the modules
   bool _hasGas = false;
   CouplingCells<Exec> _cells; ///< PCM cell binning and frozen ε_g, read by the modules
   PairLists<Exec> _pairLists; ///< half and low lists of the neighbour lists (pair_lists.h)

@@ -69,11 +69,18 @@ public:
 
   void markHostModified() { _hostNewer = true; }
   void markDeviceModified() { _deviceNewer = true; }
-  /// Exchanges the two arrays (buffers, sizes, transfer state): no element is copied.
-  void swap(DualArray& o) noexcept {
-    std::swap(_h, o._h);
-    std::swap(_d, o._d);
-    std::swap(_n, o._n);
+  /// Exchanges the buffers (and transfer state) of two arrays of the same size in bytes, of
+  /// any element types: no element is copied. (The buffers' alignment, that of allocHost and
+  /// allocDevice, suits every element type.)
+  template <class U>
+  void swapBuffers(DualArray<U, Exec>& o) noexcept {
+    static_assert(alignof(T) <= 64 && alignof(U) <= 64);
+    T* h = _h;
+    T* d = _d;
+    _h = reinterpret_cast<T*>(o._h);
+    _d = reinterpret_cast<T*>(o._d);
+    o._h = reinterpret_cast<U*>(h);
+    o._d = reinterpret_cast<U*>(d);
     std::swap(_hostNewer, o._hostNewer);
     std::swap(_deviceNewer, o._deviceNewer);
   }
@@ -91,6 +98,8 @@ public:
   }
 
 private:
+  template <class, class>
+  friend class DualArray;
   void release() {
     if (Exec::separateDevice)
       Exec::freeDevice(_d);
