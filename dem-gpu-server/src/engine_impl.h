@@ -231,6 +231,60 @@ public:
     }
   }
 
+  /// Reorders the history slots in use (the first `used`: keys, and δ_t up to the last key in
+  /// use of each row) by _perm, through the scratch: the keys in blocks of kReorderBlock
+  /// columns, then δ_t slot by slot and only in the rows whose slot holds history (most rows of a
+  /// dilute bed hold none: their δ_t lines are not touched). δ_t of an empty slot is never read
+  /// (contacts.h), and stays what the row held. _keys holds each row's slot count meanwhile
+  /// (computeKeys rewrites it after the re-sort).
+  void reorderHistory(int used) {
+    const std::size_t n = _p.n;
+    const int K = _p.K;
+    if (used > K)
+      used = K;
+    if (used <= 0)
+      return;
+    std::int64_t* hk = _p.histKey.d();
+    double* hd = _p.histDisp.d();
+    std::uint32_t* count = _keys.d(); // slots to move per row (new order)
+    const std::uint32_t* perm = _perm.d();
+    auto* tk = reinterpret_cast<std::int64_t*>(_scratch.d());
+    for (int c0 = 0; c0 < used; c0 += kReorderBlock) {
+      const int w = used - c0 < kReorderBlock ? used - c0 : kReorderBlock;
+      const bool first = c0 == 0;
+      _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+        const std::int64_t* src = hk + static_cast<std::size_t>(perm[i]) * K + c0;
+        std::uint32_t last = first ? 0u : count[i];
+        for (int q = 0; q < w; ++q) {
+          tk[i * w + q] = src[q];
+          if (src[q] != -1)
+            last = static_cast<std::uint32_t>(c0 + q + 1);
+        }
+        count[i] = last;
+      });
+      _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+        for (int q = 0; q < w; ++q)
+          hk[i * K + c0 + q] = tk[i * w + q];
+      });
+    }
+    double* td = reinterpret_cast<double*>(_scratch.d());
+    static_assert(kReorderBlock >= 3, "one slot's δ_t per particle in the scratch");
+    for (int c = 0; c < used; ++c) {
+      _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+        if (static_cast<int>(count[i]) > c) {
+          const double* src = hd + 3 * (static_cast<std::size_t>(perm[i]) * K + c);
+          for (int q = 0; q < 3; ++q)
+            td[3 * i + q] = src[q];
+        }
+      });
+      _exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+        if (static_cast<int>(count[i]) > c)
+          for (int q = 0; q < 3; ++q)
+            hd[3 * (i * K + c) + q] = td[3 * i + q];
+      });
+    }
+  }
+
   /// Neighbour grid over the particles' bounding box; cell size 2 R_max + skin.
   struct NbGrid {
     double lo[3];
@@ -326,11 +380,12 @@ public:
       const int width = _p.width(f);
       if (width == 0)
         return;
-      if (f.per == schema::Per::History)
-        reorder(arr, width, f.components * usedSlots);
-      else
+      if (f.per != schema::Per::History)
         reorderInto(arr, width);
+      else if (f.member != "histKey" && f.member != "histDisp") // (those: reorderHistory)
+        reorder(arr, width, f.components * usedSlots);
     });
+    reorderHistory(usedSlots);
     computeKeys(g); // keys of the sorted order (ascending)
 
     // Cell offsets (CSR over the sorted keys): the particles of cell c are [off[c], off[c + 1]);
