@@ -563,6 +563,7 @@ struct SlabContacts {
   OwnerContacts<Exec> owners;
   const std::uint32_t* qOwner;    ///< owner of each owned candidate (PairLists::halfOwner)
   std::uint32_t* hits;            ///< per candidate: the slabs' candidates in contact (scratch)
+  std::uint32_t* work;            ///< per particle: the slabs' owners with work (scratch)
   unsigned char* dense;           ///< per slab: most of its candidates were in contact
   const std::uint32_t* slabStart; ///< host: the slabs (PairLists::slabStart)
   int slabs;                      ///< PairLists::slabs
@@ -597,6 +598,8 @@ struct SlabContacts {
       dense[s] = 2.0 * found > static_cast<double>(qb - qa) ? 1 : 0;
       return most;
     }
+    std::uint32_t* has = work + lo; // per particle of the slab: a candidate in contact
+    std::memset(has, 0, static_cast<std::size_t>(hi - lo) * sizeof(std::uint32_t));
     std::uint32_t nh = qa; // hits[qa, nh): this slab's candidates in contact
     for (std::uint32_t q = qa; q < qb; ++q) {
       const std::uint32_t i = qOwner[q];
@@ -606,17 +609,24 @@ struct SlabContacts {
       const bool touching = dot(d, d) < rsum * rsum; // as OwnerContacts::owner<false>
       hits[nh] = q;
       nh += touching ? 1u : 0u;
+      has[i - lo] |= touching ? 1u : 0u;
       if (!touching && !zeroBits(load3(o.hc, q)))
         store3(o.hc, q, Vec3{0.0, 0.0, 0.0}); // out of contact: no history
     }
-    std::uint32_t h = qa;
+    // The owners with something to do, in order, listed without a branch per particle (over
+    // `has` itself: entry k is written after entry i >= k was read).
+    std::uint32_t nw = 0;
     for (std::int64_t is = lo; is < hi; ++is) {
       const auto i = static_cast<std::uint32_t>(is);
-      const bool listed = h < nh && qOwner[hits[h]] == i;
-      if (!listed && o.wallNear[i] == 0 && o.nwc[i] == 0 && o.nc[i] == 0)
-        continue;
-      const double k = o.template owner<true>(i, hits, qOwner, h, nh);
-      most = k > most ? k : most;
+      const std::uint32_t any =
+          has[i - lo] | o.wallNear[i] | static_cast<std::uint32_t>(o.nwc[i] | o.nc[i]);
+      has[nw] = i;
+      nw += any != 0 ? 1u : 0u;
+    }
+    std::uint32_t h = qa;
+    for (std::uint32_t k = 0; k < nw; ++k) {
+      const double c = o.template owner<true>(has[k], hits, qOwner, h, nh);
+      most = c > most ? c : most;
     }
     dense[s] = 2 * (nh - qa) > qb - qa ? 1 : 0;
     return most;
@@ -648,7 +658,7 @@ public:
   bool enabled() const { return true; }
   std::size_t bytes() const {
     return _pairs.bytes() + _walls.bytes() + _hit.bytes() + _own.bytes() + _wallNear.bytes() +
-           _hc.bytes() + _hits.bytes() + _dense.capacity();
+           _hc.bytes() + _hits.bytes() + _work.bytes() + _dense.capacity();
   }
   ContactTotals totals() const { return {}; }
 
@@ -884,8 +894,9 @@ public:
         _denseGeneration = pl.generation();
       }
       _hits.reserve(pl.candidates());
-      const SlabContacts<Exec> slabPass{ownerPass,      pl.halfOwner(), _hits.d(), _dense.data(),
-                                        pl.slabStart(), pl.slabs(),     !coupled};
+      _work.reserve(n);
+      const SlabContacts<Exec> slabPass{ownerPass,     pl.halfOwner(), _hits.d(),  _work.d(),
+                                        _dense.data(), pl.slabStart(), pl.slabs(), !coupled};
       ctx.exec.reduceMaxOverSlabRanges(pl.slabStart(), pl.slabs(), slabPass, 0.0,
                                        ctx.status + kStatusHistorySlots);
 #else
@@ -977,6 +988,7 @@ private:
   Dev<double> _own;             ///< gather backends, per particle: the owner's own force, torque
   Dev<std::uint32_t> _wallNear; ///< per particle: wall candidates (buildWallCandidates)
   Dev<std::uint32_t> _hits;     ///< cpu: per owned candidate, scratch of SlabContacts
+  Dev<std::uint32_t> _work;     ///< cpu: per particle, scratch of SlabContacts
   std::vector<unsigned char> _dense; ///< cpu: per slab, SlabContacts goes owner by owner
   std::uint64_t _denseGeneration = ~std::uint64_t{0}; ///< pair-list build of _dense
   std::uint64_t _wallGeneration = ~std::uint64_t{0};  ///< pair-list build of _wallNear
