@@ -26,13 +26,14 @@
 /// Tangential history. Between two neighbour builds the history of a pair lives with its
 /// candidate in the half list (`_hc`, three doubles per owned candidate, in half-list order:
 /// read and written as one stream by the owner, no key, no search; zero when the pair is not
-/// in contact). The particles' history slots (histKey, histDisp: partner gid or −(w+2) for wall
-/// w, and δ_t) are the form that follows a particle through a re-sort and into a state file:
-/// flushHistory() writes the candidates' history into them (before the engine re-sorts the
-/// particles or hands out its state) and loadHistory() reads them back into the candidates of
-/// new lists. Walls keep their history in the slots all along, at the front of the row (the
-/// first wallContacts slots). A particle's slots hold its walls and the contacts it owns; slots
-/// of a state file written when both sides kept their history are read as they are (the
+/// in contact). The particles' history slots (histKey, histDisp: partner gid, or for a wall
+/// touch −(2 + w + nWalls·f) for feature f of analytic wall w and −(2 + nWalls·kMaxWallFeatures
+/// + t) for mesh triangle t (wall_lists.h), and δ_t) are the form that follows a particle through a
+/// re-sort and into a state file: flushHistory() writes the candidates' history into them (before
+/// the engine re-sorts the particles or hands out its state) and loadHistory() reads them back into
+/// the candidates of new lists. Walls keep their history in the slots all along, at the front of
+/// the row (the first wallContacts slots). A particle's slots hold its walls and the contacts it
+/// owns; slots of a state file written when both sides kept their history are read as they are (the
 /// owner's is the one used; the other is dropped at the next flush).
 
 #include <array>
@@ -47,10 +48,12 @@
 #include "backend/exec_common.h"
 #include "coredem/dem/kernels/damping.h"
 #include "coredem/dem/kernels/lsd_contact.h"
+#include "coredem/dem/kernels/mesh_contact.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_contact.h"
 #include "pair_lists.h"
 #include "step_module.h"
+#include "wall_lists.h"
 
 namespace coredem::dem {
 
@@ -339,8 +342,12 @@ struct OwnerContacts {
   const std::int32_t* half;
   const std::uint32_t* wallNear;
   const PairProps* pairs;
-  const kernels::PlaneWall* walls;
+  const kernels::Wall* walls;
   int nWalls;
+  const kernels::MeshTriangle* tris;
+  const std::uint32_t* meshStart;
+  const std::uint32_t* meshList;
+  std::int64_t meshKeyBase;
   int nMat;
   int K;
   std::size_t n;
@@ -487,22 +494,22 @@ struct OwnerContacts {
 #endif
       }
     }
-    // Walls (m_eff = m_i, the particle's material), in ascending order: the candidate bits
-    // of the first 32 (most particles have none), then every wall beyond them.
+    // Walls (m_eff = m_i, the particle's material): the analytic walls in ascending order (the
+    // candidate bits of the first kNearBits, most particles have none, then every wall beyond
+    // them), each with its touches in feature order; then the mesh walls' touches.
     Vec3 FW{0.0, 0.0, 0.0};
     int wallCount = 0;
-    std::uint32_t bits = wallNear[i];
-    for (int k = bits != 0 ? lowestBit(bits) : 32; k < nWalls;) {
-      const double deltaN = wallOverlap(walls[k], xi, ri);
-      if (deltaN > 0.0) {
-        const int ai = mat[i];
-        const double mi = m[i];
-        const PairProps pp = pairs[ai * nMat + ai];
-        const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
-        const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
-        const std::int64_t key = -(static_cast<std::int64_t>(k) + 2);
-        const LsdResult res =
-            wallContact(lp, walls[k], deltaN, load3(v, ii), load3(w, ii), ri, wallHistory(key), dt);
+    const std::uint32_t nearBits = wallNear[i];
+    if (nearBits != 0) {
+      const int ai = mat[i];
+      const double mi = m[i];
+      const PairProps pp = pairs[ai * nMat + ai];
+      const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
+      const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+      const Vec3 vi = load3(v, ii);
+      const Vec3 wi = load3(w, ii);
+      auto touch = [&](double h, Vec3 nw, std::int64_t key, Vec3 history) {
+        const LsdResult res = wallContact(lp, nw, ri - h, vi, wi, ri, history, dt);
         FW += res.force;
         T += res.torque;
         if (slot < K) {
@@ -511,12 +518,64 @@ struct OwnerContacts {
         }
         ++slot;
         ++wallCount;
+      };
+      std::uint32_t bits = nearBits & ~WallLists<Exec>::kMeshBit;
+      constexpr int kBits = WallLists<Exec>::kNearBits;
+      for (int k = bits != 0 ? lowestBit(bits) : kBits; k < nWalls;) {
+        WallTouch wt[kMaxWallTouches];
+        const int nt = wallTouches(walls[k], xi, ri, wt);
+        for (int c = 0; c < nt; ++c) {
+          const std::int64_t key = -(2 + k + static_cast<std::int64_t>(nWalls) * wt[c].feature);
+          // A touch new to this feature continues the history of another feature of the same
+          // wall (a sphere rolling over a rim onto a cap).
+          Vec3 hist{0.0, 0.0, 0.0};
+          int from = -1;
+          for (int s = 0; s < used; ++s) {
+            const std::int64_t o = -oldKey[s] - 2;
+            if (oldKey[s] == key) {
+              from = s;
+              break;
+            }
+            if (from < 0 && o >= 0 && o < meshKeyBase && o % nWalls == k)
+              from = s;
+          }
+          if (from >= 0)
+            hist = oldD[from];
+          touch(wt[c].h, wt[c].n, key, hist);
+        }
+        if (k < kBits) {
+          bits &= bits - 1;
+          k = bits != 0 ? lowestBit(bits) : kBits;
+        } else {
+          ++k;
+        }
       }
-      if (k < 32) {
-        bits &= bits - 1;
-        k = bits != 0 ? lowestBit(bits) : 32;
-      } else {
-        ++k;
+      if (nearBits & WallLists<Exec>::kMeshBit) {
+        MeshTouch mt[kMaxMeshTouches];
+        const std::uint32_t m0 = meshStart[i];
+        const int nm =
+            meshTouches(tris, meshList + m0, static_cast<int>(meshStart[i + 1] - m0), xi, ri, mt);
+        for (int c = 0; c < nm; ++c) {
+          const std::int64_t key = -(2 + meshKeyBase + static_cast<std::int64_t>(mt[c].tri));
+          // A touch new to this triangle continues the history of a triangle sharing a vertex
+          // with it (a sphere sliding across an edge or a vertex).
+          const MeshTriangle& t = tris[mt[c].tri];
+          int from = -1;
+          for (int s = 0; s < used; ++s) {
+            if (oldKey[s] == key) {
+              from = s;
+              break;
+            }
+            const std::int64_t o = -oldKey[s] - 2 - meshKeyBase;
+            if (from < 0 && o >= 0) {
+              const MeshTriangle& u = tris[o];
+              for (int a = 0; a < 3; ++a)
+                if (u.v[a] == t.v[0] || u.v[a] == t.v[1] || u.v[a] == t.v[2])
+                  from = s;
+            }
+          }
+          touch(mt[c].h, mt[c].n, key, from >= 0 ? oldD[from] : Vec3{0.0, 0.0, 0.0});
+        }
       }
     }
     F += FW;
@@ -648,17 +707,12 @@ public:
       _pairs.h()[k] = s.pairs[k];
     _pairs.markHostModified();
     _pairs.toDevice();
-    _walls.allocate(s.walls.size());
-    for (std::size_t k = 0; k < s.walls.size(); ++k)
-      _walls.h()[k] = s.walls[k];
-    _walls.markHostModified();
-    _walls.toDevice();
   }
 
   bool enabled() const { return true; }
   std::size_t bytes() const {
-    return _pairs.bytes() + _walls.bytes() + _hit.bytes() + _own.bytes() + _wallNear.bytes() +
-           _hc.bytes() + _hits.bytes() + _work.bytes() + _dense.capacity();
+    return _pairs.bytes() + _hit.bytes() + _own.bytes() + _hc.bytes() + _hits.bytes() +
+           _work.bytes() + _dense.capacity();
   }
   ContactTotals totals() const { return {}; }
 
@@ -671,36 +725,6 @@ public:
   void beginWindow(StepContext<Exec>&) {}
   void update(StepContext<Exec>&) {}
   void endWindow(WindowContext<Exec>&) {}
-
-  /// Wall candidates per particle, a bit per wall (all bits beyond 32 walls), from the positions
-  /// of the last neighbour build (xref): a particle moves at most skin/2 from xref before the
-  /// next build, so one whose gap to a wall at xref is at least skin/2 cannot touch it until
-  /// then (radii only shrink). Rebuilt with the pair lists; reads xref, radius.
-  void buildWallCandidates(StepContext<Exec>& ctx) {
-    ParticleStore<Exec>& p = ctx.particles;
-    _wallNear.reserve(p.n);
-    std::uint32_t* near = _wallNear.d();
-    const double* xr = p.xref.d();
-    const double* r = p.radius.d();
-    const kernels::PlaneWall* walls = _walls.d();
-    const int nWalls = static_cast<int>(ctx.setup.walls.size());
-    const double halfSkin = 0.5 * ctx.setup.skin;
-    ctx.exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
-      std::uint32_t bits = 0;
-      if (nWalls > 32) {
-        bits = 0xffffffffu;
-      } else {
-        const kernels::Vec3 xi = kernels::load3(xr, static_cast<long long>(i));
-        for (int k = 0; k < nWalls; ++k) {
-          // Not "≥ skin/2 away" (also catches NaN): a candidate.
-          if (!(-kernels::wallOverlap(walls[k], xi, r[i]) >= halfSkin))
-            bits |= 1u << k;
-        }
-      }
-      near[i] = bits;
-    });
-    _wallGeneration = ctx.pairs.generation();
-  }
 
   /// What loadHistory and flushHistory read and write (device pointers).
   struct HistoryArrays {
@@ -821,11 +845,11 @@ public:
     static_assert(scatter || !kTwoPairs<Exec>, "the two-lane pair path scatters");
     ParticleStore<Exec>& p = ctx.particles;
     PairLists<Exec>& pl = ctx.pairs;
-    if (_wallGeneration != pl.generation())
-      buildWallCandidates(ctx);
+    WallLists<Exec>& wl = ctx.walls;
+    wl.ensure(ctx.exec, p, pl.generation(), ctx.setup.skin);
     if (_hcGeneration != pl.generation())
       loadHistory(ctx);
-    const std::uint32_t* wallNear = _wallNear.d();
+    const std::uint32_t* wallNear = wl.near();
     const double dt = ctx.dt;
     const std::size_t n = p.n;
     const double* x = p.pos.d();
@@ -845,8 +869,12 @@ public:
     const std::uint32_t* hs = pl.halfStart();
     const std::int32_t* half = pl.half();
     const PairProps* pairs = _pairs.d();
-    const kernels::PlaneWall* walls = _walls.d();
-    const int nWalls = static_cast<int>(ctx.setup.walls.size());
+    const kernels::Wall* walls = wl.walls();
+    const int nWalls = wl.wallCount();
+    const kernels::MeshTriangle* tris = wl.triangles();
+    const std::uint32_t* meshStart = wl.meshStart();
+    const std::uint32_t* meshList = wl.meshList();
+    const std::int64_t meshKeyBase = wl.meshKeyBase();
     const int nMat = ctx.setup.nMaterials;
     const int K = p.K;
     const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
@@ -881,7 +909,7 @@ public:
     // history slots a particle needs goes to the status array.
     const OwnerContacts<Exec> ownerPass {
       x, v, w, r, m, mat, hk, hd, hc, f, tq, fw, nc, nwc, hs, half, wallNear, pairs, walls, nWalls,
-          nMat, K, n, dt, hit, share, own
+          tris, meshStart, meshList, meshKeyBase, nMat, K, n, dt, hit, share, own
 #if defined(COREDEM_DEM_DOUBLE2)
           ,
           two
@@ -983,15 +1011,12 @@ public:
 
 private:
   Dual<PairProps> _pairs;
-  Dual<kernels::PlaneWall> _walls;
-  Dev<unsigned char> _hit;      ///< gather backends, per candidate: in contact this sub-step
-  Dev<double> _own;             ///< gather backends, per particle: the owner's own force, torque
-  Dev<std::uint32_t> _wallNear; ///< per particle: wall candidates (buildWallCandidates)
-  Dev<std::uint32_t> _hits;     ///< cpu: per owned candidate, scratch of SlabContacts
-  Dev<std::uint32_t> _work;     ///< cpu: per particle, scratch of SlabContacts
+  Dev<unsigned char> _hit;  ///< gather backends, per candidate: in contact this sub-step
+  Dev<double> _own;         ///< gather backends, per particle: the owner's own force, torque
+  Dev<std::uint32_t> _hits; ///< cpu: per owned candidate, scratch of SlabContacts
+  Dev<std::uint32_t> _work; ///< cpu: per particle, scratch of SlabContacts
   std::vector<unsigned char> _dense; ///< cpu: per slab, SlabContacts goes owner by owner
   std::uint64_t _denseGeneration = ~std::uint64_t{0}; ///< pair-list build of _dense
-  std::uint64_t _wallGeneration = ~std::uint64_t{0};  ///< pair-list build of _wallNear
   Dev<double> _hc; ///< per owned candidate: tangential history δ_t (zero out of contact)
   std::uint64_t _hcGeneration = ~std::uint64_t{0}; ///< pair-list build _hc belongs to
   int _maxUsedSlots =

@@ -18,6 +18,7 @@
 #include "coredem/dem/kernels/damping.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
 #include "coredem/dem/time_handler.h"
+#include "coredem/dem/triangle_mesh.h"
 #include "engine.h"
 #include "state_io.h"
 
@@ -90,6 +91,37 @@ void DemConfig::addBox(const std::array<double, 3>& lo, const std::array<double,
   }
 }
 
+Wall Wall::plane(const std::array<double, 3>& point, const std::array<double, 3>& normal) {
+  Wall w;
+  w.point = point;
+  w.normal = normal;
+  return w;
+}
+
+Wall Wall::cylinder(const std::array<double, 3>& point, const std::array<double, 3>& axis,
+                    double radius, double start, double end, WallSide side, bool capStart,
+                    bool capEnd) {
+  Wall w;
+  w.shape = WallShape::Cylinder;
+  w.point = point;
+  w.normal = axis;
+  w.radius = w.radiusEnd = radius;
+  w.start = start;
+  w.end = end;
+  w.side = side;
+  w.capStart = capStart;
+  w.capEnd = capEnd;
+  return w;
+}
+
+Wall Wall::cone(const std::array<double, 3>& point, const std::array<double, 3>& axis, double start,
+                double end, double rStart, double rEnd, WallSide side, bool capStart, bool capEnd) {
+  Wall w = cylinder(point, axis, rStart, start, end, side, capStart, capEnd);
+  w.shape = WallShape::Cone;
+  w.radiusEnd = rEnd;
+  return w;
+}
+
 namespace {
 
 /// splitmix64: small, portable, reproducible.
@@ -103,6 +135,8 @@ struct Rng {
   }
   double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; } // [0, 1)
 };
+
+void checkWall(const Wall& w, std::size_t k);
 
 void validate(const DemConfig& c) {
   COREDEM_CHECK(!c.materials.empty(), "DemConfig.materials is empty; define at least one material");
@@ -168,10 +202,21 @@ void validate(const DemConfig& c) {
       }
     }
   }
-  for (const Wall& w : c.walls) {
-    const double l = std::hypot(w.normal[0], w.normal[1], w.normal[2]);
-    COREDEM_CHECK(l > 0 && std::isfinite(l),
-                  "a wall has a zero or non-finite normal; give a nonzero normal");
+  for (std::size_t k = 0; k < c.walls.size(); ++k)
+    checkWall(c.walls[k], k);
+  for (const MeshWall& m : c.meshes) {
+    COREDEM_CHECK(!m.triangles.empty() && m.triangles.size() % 3 == 0 && !m.vertices.empty() &&
+                      m.vertices.size() % 3 == 0,
+                  "mesh wall '{}': needs vertices as x,y,z triples and triangles as index "
+                  "triples ({} vertex values, {} index values)",
+                  m.name, m.vertices.size(), m.triangles.size());
+    for (double v : m.vertices)
+      COREDEM_CHECK(std::isfinite(v), "mesh wall '{}': a vertex coordinate is not finite", m.name);
+    const auto nv = static_cast<std::int64_t>(m.vertices.size() / 3);
+    for (std::size_t t = 0; t < m.triangles.size(); ++t)
+      COREDEM_CHECK(m.triangles[t] >= 0 && m.triangles[t] < nv,
+                    "mesh wall '{}': triangle {} names vertex {}, not one of its {} vertices",
+                    m.name, t / 3 + 1, m.triangles[t], nv);
   }
   const CouplingGrid& g = c.grid;
   const bool any = g.counts[0] != 0 || g.counts[1] != 0 || g.counts[2] != 0;
@@ -296,6 +341,96 @@ std::string hex16(std::uint64_t h) {
   return buf;
 }
 
+/// A wall's own consistency (finite, positive where it must be).
+void checkWall(const Wall& w, std::size_t k) {
+  const double l = std::hypot(w.normal[0], w.normal[1], w.normal[2]);
+  const char* what = w.shape == WallShape::Plane ? "normal" : "axis";
+  COREDEM_CHECK(l > 0 && std::isfinite(l), "wall {} has a zero or non-finite {}; give a nonzero {}",
+                k + 1, what, what);
+  for (double p : w.point)
+    COREDEM_CHECK(std::isfinite(p), "wall {}: its point is not finite", k + 1);
+  if (w.shape == WallShape::Plane)
+    return;
+  const bool infinite = std::isinf(w.start) && std::isinf(w.end);
+  COREDEM_CHECK(std::isfinite(w.radius) && w.radius >= 0 && std::isfinite(w.radiusEnd) &&
+                    w.radiusEnd >= 0,
+                "wall {}: radius {} / {} m: give finite radii >= 0", k + 1, w.radius, w.radiusEnd);
+  if (w.shape == WallShape::Cylinder) {
+    COREDEM_CHECK(w.radius > 0, "wall {}: a cylinder needs a radius > 0 (got {} m)", k + 1,
+                  w.radius);
+    COREDEM_CHECK(infinite || (std::isfinite(w.start) && std::isfinite(w.end) && w.start < w.end),
+                  "wall {}: cylinder extent [{}, {}] m: give start < end, both finite, or "
+                  "neither (an infinite cylinder)",
+                  k + 1, w.start, w.end);
+    COREDEM_CHECK(!infinite || (!w.capStart && !w.capEnd),
+                  "wall {}: an infinite cylinder has no ends to cap; give start and end", k + 1);
+  } else {
+    COREDEM_CHECK(std::isfinite(w.start) && std::isfinite(w.end) && w.start < w.end,
+                  "wall {}: cone extent [{}, {}] m: give finite start < end", k + 1, w.start,
+                  w.end);
+    COREDEM_CHECK(w.radius > 0 || w.radiusEnd > 0,
+                  "wall {}: a cone needs a radius > 0 at one end at least", k + 1);
+  }
+}
+
+/// The engine's form of a wall (kernels/wall_contact.h): a plane, or a profile revolved about a
+/// unit axis (optional bottom cap, side, optional top cap).
+kernels::Wall kernelWall(const Wall& w) {
+  const double l = std::hypot(w.normal[0], w.normal[1], w.normal[2]);
+  const kernels::Vec3 p{w.point[0], w.point[1], w.point[2]};
+  const kernels::Vec3 n{w.normal[0] / l, w.normal[1] / l, w.normal[2] / l};
+  if (w.shape == WallShape::Plane)
+    return kernels::planeWall(p, n);
+  kernels::Wall k{};
+  k.point = p;
+  k.normal = n;
+  k.kind = kernels::kWallRevolved;
+  k.side = w.side == WallSide::Inside ? 1 : (w.side == WallSide::Outside ? -1 : 0);
+  if (std::isinf(w.start) && std::isinf(w.end)) {
+    k.infinite = 1;
+    k.points = 2;
+    k.r[0] = k.r[1] = w.radius;
+    return k;
+  }
+  auto add = [&](double t, double r) {
+    k.t[k.points] = t;
+    k.r[k.points] = r;
+    ++k.points;
+  };
+  if (w.capStart && w.radius > 0)
+    add(w.start, 0.0);
+  add(w.start, w.radius);
+  add(w.end, w.radiusEnd);
+  if (w.capEnd && w.radiusEnd > 0)
+    add(w.end, 0.0);
+  return k;
+}
+
+/// The mesh walls' triangles with vertex and edge ids unique over all meshes.
+std::vector<kernels::MeshTriangle> kernelTriangles(const std::vector<MeshWall>& meshes) {
+  std::vector<kernels::MeshTriangle> out;
+  std::int32_t vBase = 0, eBase = 0;
+  for (const MeshWall& m : meshes) {
+    TriangleMesh tm{m.name, m.vertices, m.triangles};
+    const MeshTopology topo = meshTopology(tm);
+    const std::size_t nt = m.triangles.size() / 3;
+    for (std::size_t t = 0; t < nt; ++t) {
+      kernels::MeshTriangle k{};
+      kernels::Vec3* corner[3] = {&k.a, &k.b, &k.c};
+      for (int c = 0; c < 3; ++c) {
+        const std::int32_t v = m.triangles[3 * t + c];
+        *corner[c] = kernels::Vec3{m.vertices[3 * v], m.vertices[3 * v + 1], m.vertices[3 * v + 2]};
+        k.v[c] = vBase + v;
+        k.e[c] = eBase + topo.triangleEdges[3 * t + c];
+      }
+      out.push_back(k);
+    }
+    vBase += static_cast<std::int32_t>(m.vertices.size() / 3);
+    eBase += topo.edgeCount;
+  }
+  return out;
+}
+
 /// FNV-1a over a canonical text of everything except the particle sets.
 std::string hashConfig(const DemConfig& c) {
   std::string t;
@@ -312,9 +447,25 @@ std::string hashConfig(const DemConfig& c) {
       num(m.cp), num(m.conductivity), num(m.emissivity);
   }
   t += "|walls:";
-  for (const Wall& w : c.walls)
+  for (const Wall& w : c.walls) {
     for (int d = 0; d < 3; ++d)
       num(w.point[d]), num(w.normal[d]);
+    if (w.shape != WallShape::Plane) { // (planes alone hash as before)
+      t += w.shape == WallShape::Cylinder ? "cyl" : "cone";
+      for (double v : {w.radius, w.radiusEnd, w.start, w.end})
+        num(v);
+      t += static_cast<char>('0' + static_cast<int>(w.side));
+      t += w.capStart ? 'S' : '-';
+      t += w.capEnd ? 'E' : '-';
+    }
+  }
+  for (const MeshWall& m : c.meshes) {
+    t += "|mesh:" + m.name + ":";
+    for (double v : m.vertices)
+      num(v);
+    for (std::int32_t i : m.triangles)
+      t += std::to_string(i) + ",";
+  }
   t += "|g:";
   for (double v : c.gravity)
     num(v);
@@ -371,7 +522,7 @@ double dtDemMaxFor(const DemConfig& config, const std::vector<double>& minMass) 
       tcol = std::min(tcol,
                       kernels::collisionTime(pp.kn, meff, pp.dampFactor * std::sqrt(pp.kn * meff)));
     }
-    if (!config.walls.empty()) {
+    if (!config.walls.empty() || !config.meshes.empty()) {
       const PairProps pp = pairProps(config.materials[a], config.materials[a]);
       tcol = std::min(tcol, kernels::collisionTime(pp.kn, minMass[a],
                                                    pp.dampFactor * std::sqrt(pp.kn * minMass[a])));
@@ -484,11 +635,9 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   for (std::size_t a = 0; a < nm; ++a)
     for (std::size_t b = 0; b < nm; ++b)
       es.pairs.push_back(pairProps(config.materials[a], config.materials[b]));
-  for (const Wall& w : config.walls) {
-    const double l = std::hypot(w.normal[0], w.normal[1], w.normal[2]);
-    es.walls.push_back(kernels::PlaneWall{{w.point[0], w.point[1], w.point[2]},
-                                          {w.normal[0] / l, w.normal[1] / l, w.normal[2] / l}});
-  }
+  for (const Wall& w : config.walls)
+    es.walls.push_back(kernelWall(w));
+  es.triangles = kernelTriangles(config.meshes);
   es.gravity = {config.gravity[0], config.gravity[1], config.gravity[2]};
   es.nCells = config.grid.cellCount();
   es.coupled = es.nCells > 0;
@@ -541,10 +690,12 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
     if (h.enabled && config.wallTemperature > 0.0 && (h.wallConduction || h.wallLensConduction)) {
       const double kw =
           config.materials[static_cast<std::size_t>(config.wallMaterial)].conductivity;
-      for (const kernels::PlaneWall& w : es.walls)
-        hs.walls.push_back(ThermalWall{w, config.wallTemperature, kw});
+      hs.walls = ThermalWalls{true, config.wallTemperature, kw};
       hs.wallParams = kernels::WallConductionParams{
           h.wallConduction, h.wallLensConduction && es.coupled, h.lensFraction, h.minSeparation};
+      // Wall candidates within the lens's reach (wall_lists.h).
+      if (hs.wallParams.lens)
+        es.wallReachFactor = 1.0 + h.lensFraction;
     }
     es.reach = (h.enabled && hs.lensConduction) ? h.lensFraction * rmax : 0.0;
   }

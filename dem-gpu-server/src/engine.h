@@ -11,6 +11,7 @@
 #include "chemistry_setup.h"
 #include "coredem/dem/dem_system.h"
 #include "coredem/dem/kernels/drag.h"
+#include "coredem/dem/kernels/mesh_contact.h"
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_contact.h"
@@ -27,8 +28,10 @@ struct PairProps {
 /// Everything the engine needs besides the particles. Plain data.
 struct EngineSetup {
   int nMaterials = 1;
-  std::vector<PairProps> pairs; ///< nMaterials², [a*nMaterials + b]; walls use [a*n + a]
-  std::vector<kernels::PlaneWall> walls;
+  std::vector<PairProps> pairs;     ///< nMaterials², [a*nMaterials + b]; walls use [a*n + a]
+  std::vector<kernels::Wall> walls; ///< analytic walls (kernels/wall_contact.h)
+  std::vector<kernels::MeshTriangle> triangles; ///< mesh walls (kernels/mesh_contact.h)
+  double wallReachFactor = 1.0; ///< walls are candidates within f·R + skin/2 (wall_lists.h)
   kernels::Vec3 gravity{0, 0, 0};
   bool coupled = false;
   kernels::GridParams grid{}; ///< valid when coupled

@@ -74,6 +74,7 @@ public:
     }
     _cells.setup(_s.coupled ? _s.nCells : 0);
     _drag.setup(_s);
+    _wallLists.setup(_s);
     _contacts.setup(_s);
     _heat.setup(_s.heat, _s.coupled ? _s.nCells : 0);
     _chem.setup(_s.chem, _s.coupled ? _s.nCells : 0);
@@ -163,8 +164,8 @@ public:
     for (const auto& sp : _spares)
       spares += sp->bytes();
     return self._p.bytes() + spares + _keys.bytes() + _perm.bytes() + _cellOffset.bytes() +
-           _scratch.bytes() + _cells.bytes() + _pairLists.bytes() + _drag.bytes() +
-           _contacts.bytes() + _heat.bytes() + _chem.bytes() + _gas.bytes();
+           _scratch.bytes() + _cells.bytes() + _pairLists.bytes() + _wallLists.bytes() +
+           _drag.bytes() + _contacts.bytes() + _heat.bytes() + _chem.bytes() + _gas.bytes();
   }
 
   // ---------------------------------------------------------------- neighbour search
@@ -470,7 +471,8 @@ public:
   // ---------------------------------------------------------------- window and sub-step
   /// What the modules see this sub-step (dt = 0 at the window boundaries).
   StepContext<Exec> stepContext(double dt) {
-    return StepContext<Exec>{_exec, _p, _s, gasOrNull(), _cells, _pairLists, dt, _status.d()};
+    return StepContext<Exec>{_exec,      _p,         _s, gasOrNull(), _cells,
+                             _pairLists, _wallLists, dt, _status.d()};
   }
   const GasFields<Exec>* gasOrNull() const { return _hasGas && _s.coupled ? &_gas : nullptr; }
 
@@ -673,6 +675,7 @@ private:
   bool _hasGas = false;
   CouplingCells<Exec> _cells; ///< PCM cell binning and frozen ε_g, read by the modules
   PairLists<Exec> _pairLists; ///< half and low lists of the neighbour lists (pair_lists.h)
+  WallLists<Exec> _wallLists; ///< walls and wall candidates per particle (wall_lists.h)
   Dev<std::uint32_t> _keys, _perm, _cellOffset; ///< neighbour search
   Dev<unsigned char> _scratch;
   bool _listValid = false;

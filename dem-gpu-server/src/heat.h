@@ -31,11 +31,13 @@
 #include "coredem/dem/kernels/conduction_contact.h"
 #include "coredem/dem/kernels/conduction_gas_lens.h"
 #include "coredem/dem/kernels/convection.h"
+#include "coredem/dem/kernels/mesh_contact.h"
 #include "coredem/dem/kernels/particle_energy.h"
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/radiation.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_conduction.h"
+#include "coredem/dem/kernels/wall_contact.h"
 #include "heat_setup.h"
 #include "pair_lists.h"
 #include "step_module.h"
@@ -84,12 +86,7 @@ public:
       _mat.h()[k] = h.materials[k];
     _mat.markHostModified();
     _mat.toDevice();
-    if (!h.walls.empty()) {
-      _walls.allocate(h.walls.size());
-      for (std::size_t k = 0; k < h.walls.size(); ++k)
-        _walls.h()[k] = h.walls[k];
-      _walls.markHostModified();
-      _walls.toDevice();
+    if (h.walls.enabled) {
       _wallAcc.allocate(kWallSlots);
       for (std::size_t k = 0; k < kWallSlots; ++k)
         _wallAcc.h()[k] = 0.0;
@@ -110,7 +107,7 @@ public:
 
   std::size_t bytes() const {
     return _mat.bytes() + _q.bytes() + _g.bytes() + _qrad.bytes() + _cellT.bytes() + _acc.bytes() +
-           _walls.bytes() + _qw.bytes() + _wallAcc.bytes() + _convFactors.bytes();
+           _qw.bytes() + _wallAcc.bytes() + _convFactors.bytes();
   }
 
   /// Heat the particles received since construction (or the restored totals).
@@ -217,15 +214,24 @@ public:
     const std::uint32_t* cs = cStart;
     const std::uint32_t* ce = cEnd;
     const double lensFactor = 1.0 + lp.lensFraction;
-    const int nWalls = static_cast<int>(_h.walls.size());
-    const ThermalWall* tw = nWalls > 0 ? _walls.d() : nullptr;
+    const bool thermalWalls = _h.walls.enabled;
+    const ThermalWalls tw = _h.walls;
+    WallLists<Exec>& wl = ctx.walls;
+    if (thermalWalls)
+      wl.ensure(exec, p, ctx.pairs.generation(), s.skin);
+    const int nWalls = wl.wallCount();
+    const kernels::Wall* walls = wl.walls();
+    const std::uint32_t* wallNear = thermalWalls ? wl.near() : nullptr;
+    const kernels::MeshTriangle* tris = wl.triangles();
+    const std::uint32_t* meshStart = wl.meshStart();
+    const std::uint32_t* meshList = wl.meshList();
     const kernels::WallConductionParams wp = _h.wallParams;
     const bool wallLens = wp.lens && coupled && hasKappa;
     // A wall is reached within R (contact) or (1 + FLPC) R (lens).
     const double wallReach = wallLens ? 1.0 + wp.lensFraction : 1.0;
-    if (nWalls > 0)
+    if (thermalWalls)
       _qw.reserve(n);
-    double* qwOut = nWalls > 0 ? _qw.d() : nullptr;
+    double* qwOut = thermalWalls ? _qw.d() : nullptr;
 
     // 2a. Pair terms, each pair once by its owner (the smaller global id, which is also the
     //     canonical "lo" of the pair kernels) over the half lists (pair_lists.h): the owner
@@ -405,14 +411,39 @@ public:
         }
       }
       double qw = 0.0;
-      if (nWalls > 0) {
-        const Vec3 xi = load3(x, ii);
-        const double kgw = (wallLens && celli < nCells) ? kap[celli] : 0.0;
-        for (int k = 0; k < nWalls; ++k) {
-          const double h = dot(xi - tw[k].plane.point, tw[k].plane.normal);
-          if (!(h < wallReach * r[i]))
-            continue;
-          qw += wallConductionHeat(wp, mi.k, tw[k].k, kgw, r[i], h, tw[k].temperature, ti);
+      if (thermalWalls) {
+        // The touches the contact module finds (wall_lists.h), within the lens's reach; each
+        // conducts as a plane at the touch's distance (kernels/wall_conduction.h).
+        const std::uint32_t nearBits = wallNear[i];
+        if (nearBits != 0) {
+          const Vec3 xi = load3(x, ii);
+          const double kgw = (wallLens && celli < nCells) ? kap[celli] : 0.0;
+          const double reach = wallReach * r[i];
+          auto conduct = [&](double h) {
+            qw += wallConductionHeat(wp, mi.k, tw.k, kgw, r[i], h, tw.temperature, ti);
+          };
+          constexpr int kBits = WallLists<Exec>::kNearBits;
+          std::uint32_t bits = nearBits & ~WallLists<Exec>::kMeshBit;
+          for (int k = bits != 0 ? lowestBit(bits) : kBits; k < nWalls;) {
+            WallTouch wt[kMaxWallTouches];
+            const int nt = wallTouches(walls[k], xi, reach, wt);
+            for (int c = 0; c < nt; ++c)
+              conduct(wt[c].h);
+            if (k < kBits) {
+              bits &= bits - 1;
+              k = bits != 0 ? lowestBit(bits) : kBits;
+            } else {
+              ++k;
+            }
+          }
+          if (nearBits & WallLists<Exec>::kMeshBit) {
+            MeshTouch mt[kMaxMeshTouches];
+            const std::uint32_t m0 = meshStart[i];
+            const int nm = meshTouches(tris, meshList + m0, static_cast<int>(meshStart[i + 1] - m0),
+                                       xi, reach, mt);
+            for (int c = 0; c < nm; ++c)
+              conduct(mt[c].h);
+          }
         }
         qwOut[i] = qw;
       }
@@ -422,7 +453,7 @@ public:
     });
 
     // Wall heat of this sub-step, in kWallSlots fixed partial sums (J).
-    if (nWalls > 0) {
+    if (thermalWalls) {
       double* wa = _wallAcc.d();
       const double* qwIn = _qw.d();
       exec.parallelFor(kWallSlots, [=] DEM_LAMBDA(std::size_t sl) {
@@ -487,7 +518,7 @@ public:
     const EngineSetup& s = w.setup;
     CellSources& out = w.out;
     const int nSub = w.nSub;
-    if (_h.enabled && !_h.walls.empty()) {
+    if (_h.enabled && _h.walls.enabled) {
       _wallAcc.toHost();
       double wall = 0.0;
       for (std::size_t k = 0; k < kWallSlots; ++k) {
@@ -526,7 +557,6 @@ private:
   double _unused = 0.0;      ///< the pair pass's reduction result (cpu slabs), not read
   Dev<double> _cellT;        ///< per cell: Σ T_p (radiation environment)
   Dual<double> _acc;         ///< per cell: Σ_sub H, Σ_sub H_Tp, Σ_sub Q_rad/V_c
-  Dual<ThermalWall> _walls;  ///< fixed-temperature walls
   Dev<double> _qw;           ///< per particle: Q_wall,i (W)
   Dual<double> _wallAcc;     ///< kWallSlots partial sums of Σ_sub Σ_i Q_wall,i Δt (J)
   Dev<kernels::NusseltFactors> _convFactors; ///< per cell: Nusselt factors of the window

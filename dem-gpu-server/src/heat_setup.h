@@ -19,11 +19,12 @@ struct HeatMaterial {
   double emissivity; ///< −
 };
 
-/// A wall held at a fixed temperature (kernels/wall_conduction.h); adiabatic walls are not listed.
-struct ThermalWall {
-  kernels::PlaneWall plane; ///< unit inward normal
-  double temperature;       ///< K, > 0
-  double k;                 ///< wall material conductivity, W/(m K)
+/// The walls' thermal condition (kernels/wall_conduction.h): every wall of the run (analytic
+/// and mesh, wall_lists.h) held at one temperature; adiabatic walls: not enabled.
+struct ThermalWalls {
+  bool enabled = false;
+  double temperature = 0.0; ///< K, > 0
+  double k = 0.0;           ///< wall material conductivity, W/(m K)
 };
 
 struct HeatSetup {
@@ -38,7 +39,7 @@ struct HeatSetup {
   kernels::ConvectionParams convectionParams{};
   kernels::GasLensParams lensParams{};
   std::vector<HeatMaterial> materials;
-  std::vector<ThermalWall> walls;             ///< fixed-temperature walls (empty: adiabatic)
+  ThermalWalls walls;                         ///< fixed-temperature walls (or adiabatic)
   kernels::WallConductionParams wallParams{}; ///< contact / lens switches, FLPC, s_min
 };
 

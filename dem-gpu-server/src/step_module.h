@@ -21,6 +21,7 @@
 #include "gas_fields.h"
 #include "pair_lists.h"
 #include "particle_store.h"
+#include "wall_lists.h"
 
 namespace coredem::dem {
 
@@ -48,6 +49,8 @@ struct StepContext {
   CouplingCells<Exec>& cells;
   /// Half and low pair lists of the current neighbour lists (pair_lists.h); valid in sources().
   PairLists<Exec>& pairs;
+  /// The walls and each particle's wall candidates (wall_lists.h); ensure() before use.
+  WallLists<Exec>& walls;
   double dt; ///< sub-step length Δt_DEM (s)
   /// Device array of kStatusSlotCount values (StatusSlot), read by the engine after the sub-step.
   double* status;

@@ -239,7 +239,7 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
     cfg.addBox(vec(c.walls().box().min()), vec(c.walls().box().max()));
   }
   for (const auto& p : c.walls().planes()) {
-    cfg.walls.push_back(dem::Wall{vec(p.point()), vec(p.normal())});
+    cfg.walls.push_back(dem::Wall::plane(vec(p.point()), vec(p.normal())));
   }
   cfg.wallTemperature = c.walls().temperature(); // 0 = adiabatic (docs/heat-coupling.md "Walls")
   if (c.walls().temperature() > 0.0) {

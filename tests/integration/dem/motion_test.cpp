@@ -11,7 +11,7 @@ TEST(Wall, SlidingSphereReachesRollingAtFiveSevenths) {
   // ends rolling at v = 5/7 v0 (angular momentum about the contact point is conserved).
   DemConfig c;
   c.materials[0].mu = 0.3;
-  c.walls.push_back(Wall{{0, 0, 0}, {0, 0, 1}});
+  c.walls.push_back(Wall::plane({0, 0, 0}, {0, 0, 1}));
   ParticleSet s;
   s.packing = Packing::Explicit;
   const double r = 0.5e-3, m = 2500 * 4.0 / 3.0 * kPi * r * r * r;

@@ -35,7 +35,7 @@ EngineSetup denseSetup(int threads) {
   const PairProps b{300.0, 150.0, 0.2, 0.5, 0.5};
   const PairProps ab{240.0, 120.0, 0.3, 0.5, 0.3};
   s.pairs = {a, ab, ab, b};
-  s.walls = {kernels::PlaneWall{Vec3{0, 0, 0}, Vec3{0, 0, 1}}};
+  s.walls = {kernels::planeWall(Vec3{0, 0, 0}, Vec3{0, 0, 1})};
   s.maxRadius = 0.55 * kDiameter;
   s.skin = 0.1 * kDiameter;
   s.historySlots = kSlots;
@@ -191,8 +191,8 @@ TEST(ContactPairs, ForcesMatchAReferenceEvaluatingBothSides) {
           ++sliding;
       }
     }
-    for (const PlaneWall& w : setup.walls) {
-      const double dn = wallOverlap(w, xi, ri);
+    for (const kernels::Wall& w : setup.walls) {
+      const double dn = ri - dot(xi - w.point, w.normal);
       if (dn <= 0.0)
         continue;
       const PairProps pp = setup.pairs[s0.material[i] * setup.nMaterials + s0.material[i]];
@@ -200,7 +200,8 @@ TEST(ContactPairs, ForcesMatchAReferenceEvaluatingBothSides) {
       const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
       Vec3 hist{0, 0, 0};
       slotOf(s0, i, -2, hist);
-      const LsdResult res = wallContact(lp, w, dn, at(s0.vel, i), at(s0.omega, i), ri, hist, dt);
+      const LsdResult res =
+          wallContact(lp, w.normal, dn, at(s0.vel, i), at(s0.omega, i), ri, hist, dt);
       F += res.force;
       T += res.torque;
     }
@@ -402,12 +403,12 @@ TEST(ContactPairs, StatesAndRestartsLeaveTheRunUnchanged) {
 TEST(ContactPairs, WallCandidatesMissNoContact) {
   EngineSetup s = denseSetup(1);
   const double L = 10.0 * kDiameter;
-  s.walls = {kernels::PlaneWall{Vec3{0, 0, 0}, Vec3{1, 0, 0}},
-             kernels::PlaneWall{Vec3{L, 0, 0}, Vec3{-1, 0, 0}},
-             kernels::PlaneWall{Vec3{0, 0, 0}, Vec3{0, 1, 0}},
-             kernels::PlaneWall{Vec3{0, L, 0}, Vec3{0, -1, 0}},
-             kernels::PlaneWall{Vec3{0, 0, 0}, Vec3{0, 0, 1}},
-             kernels::PlaneWall{Vec3{0, 0, L}, Vec3{0, 0, -1}}};
+  s.walls = {kernels::planeWall(Vec3{0, 0, 0}, Vec3{1, 0, 0}),
+             kernels::planeWall(Vec3{L, 0, 0}, Vec3{-1, 0, 0}),
+             kernels::planeWall(Vec3{0, 0, 0}, Vec3{0, 1, 0}),
+             kernels::planeWall(Vec3{0, L, 0}, Vec3{0, -1, 0}),
+             kernels::planeWall(Vec3{0, 0, 0}, Vec3{0, 0, 1}),
+             kernels::planeWall(Vec3{0, 0, L}, Vec3{0, 0, -1})};
   HostState st;
   st.historySlots = kSlots;
   st.neighbourSlots = 32;
@@ -467,7 +468,7 @@ TEST(ContactPairs, WallCandidatesMissNoContact) {
       std::size_t expected = 0;
       for (std::size_t i = 0; i < before.n; ++i)
         for (const auto& w : s.walls)
-          expected += kernels::wallOverlap(w, at(before.pos, i), before.radius[i]) > 0.0 ? 1 : 0;
+          expected += before.radius[i] - kernels::wallClearance(w, at(before.pos, i)) > 0.0 ? 1 : 0;
       engine->subStep(dt);
       ASSERT_EQ(engine->wallContacts(), expected) << "sub-step " << step << " stale=" << staleList;
       touched += expected;

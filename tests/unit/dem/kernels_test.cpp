@@ -116,8 +116,11 @@ TEST(LsdContact, LeverArmRadicalPlane) {
 }
 
 TEST(WallContact, OverlapNormalAndLever) {
-  const PlaneWall w{{0, 0, 0}, {0, 0, 1}};
-  EXPECT_DOUBLE_EQ(wallOverlap(w, Vec3{5, 5, 4e-4}, 5e-4), 1e-4);
+  const Wall wall = planeWall({0, 0, 0}, {0, 0, 1});
+  WallTouch t[kMaxWallTouches];
+  ASSERT_EQ(wallTouches(wall, Vec3{5, 5, 4e-4}, 5e-4, t), 1);
+  EXPECT_DOUBLE_EQ(5e-4 - t[0].h, 1e-4);
+  const Vec3 w = t[0].n;
   const LsdParams p{1000, 2000.0 / 7, 0.0, 0.0, 0.1};
   const LsdResult r =
       wallContact(p, w, 1e-4, Vec3{0, 0, 0}, Vec3{0, 0, 0}, 5e-4, Vec3{0, 0, 0}, 1e-6);

@@ -18,6 +18,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -116,10 +117,57 @@ struct ParticleSet {
   std::vector<double> angularVelocities;   ///< Explicit (optional): same layout (rad/s)
 };
 
-/// An infinite rigid plane wall; particles live on the side its normal points to.
+/// The shape of an analytic wall (docs/physics.md "Walls").
+enum class WallShape {
+  Plane,    ///< infinite plane; particles on the side its normal points to
+  Cylinder, ///< finite (start < end) or infinite cylinder about an axis
+  Cone      ///< frustum about an axis: radius `radius` at `start`, `radiusEnd` at `end`
+};
+
+/// Which side of a cylinder or cone the particles are on.
+enum class WallSide {
+  Inside,  ///< the axis side: a vessel
+  Outside, ///< away from the axis: around a solid insert (a tube, a rod)
+  Both     ///< a thin shell touched from either side (e.g. a draft tube)
+};
+
+/// A rigid wall: a plane, or a cylinder or cone about an axis (an axial extent, optional flat
+/// caps closing either end). Contact regions and features: kernels/wall_contact.h.
 struct Wall {
+  WallShape shape = WallShape::Plane;
+  /// Plane: a point on it. Cylinder/cone: the axis origin (axial coordinate 0).
   std::array<double, 3> point{0, 0, 0};
-  std::array<double, 3> normal{0, 0, 1}; ///< need not be unit length (normalised)
+  /// Plane: the normal towards the particles. Cylinder/cone: the axis direction (the axial
+  /// coordinate grows along it). Need not be unit length (normalised).
+  std::array<double, 3> normal{0, 0, 1};
+  double radius = 0.0;    ///< cylinder radius; cone radius at `start` (m, ≥ 0)
+  double radiusEnd = 0.0; ///< cone radius at `end` (m, ≥ 0)
+  /// Axial extent (m, from `point` along the axis). A cylinder with both infinite (the
+  /// default) is infinite; a cone needs a finite extent.
+  double start = -std::numeric_limits<double>::infinity();
+  double end = std::numeric_limits<double>::infinity();
+  WallSide side = WallSide::Inside;
+  bool capStart = false; ///< a flat disc closes the `start` end
+  bool capEnd = false;   ///< a flat disc closes the `end` end
+
+  /// A plane through `point` with normal `normal` towards the particles.
+  static Wall plane(const std::array<double, 3>& point, const std::array<double, 3>& normal);
+  /// A cylinder of radius `radius` about the axis through `point` along `axis`, over
+  /// [start, end] (both infinite: an infinite cylinder).
+  static Wall cylinder(const std::array<double, 3>& point, const std::array<double, 3>& axis,
+                       double radius, double start, double end, WallSide side = WallSide::Inside,
+                       bool capStart = false, bool capEnd = false);
+  /// A cone (frustum) with radius rStart at `start` and rEnd at `end` along the axis.
+  static Wall cone(const std::array<double, 3>& point, const std::array<double, 3>& axis,
+                   double start, double end, double rStart, double rEnd,
+                   WallSide side = WallSide::Inside, bool capStart = false, bool capEnd = false);
+};
+
+/// A triangle-mesh wall (coredem/dem/triangle_mesh.h: read from STL, checked, welded).
+struct MeshWall {
+  std::string name;                    ///< where it came from (messages)
+  std::vector<double> vertices;        ///< x0,y0,z0,... (m)
+  std::vector<std::int32_t> triangles; ///< 3 vertex indices per triangle
 };
 
 /// Uniform Cartesian coupling grid (PCM cells): cell = i + nx*(j + ny*k). counts = 0: no coupling.
@@ -157,6 +205,7 @@ struct DemConfig {
   std::vector<Material> materials{Material{}};
   std::vector<ParticleSet> particleSets;
   std::vector<Wall> walls;
+  std::vector<MeshWall> meshes; ///< triangle-mesh walls (two-sided), besides `walls`
   std::array<double, 3> gravity{0.0, 0.0, -9.81}; ///< m/s²
   CouplingGrid grid;
   std::vector<Species> solidSpecies; ///< per-particle composition entries

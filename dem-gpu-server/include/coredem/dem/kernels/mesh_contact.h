@@ -1,0 +1,172 @@
+#pragma once
+/// @file
+/// Sphere–triangle-mesh wall contact (docs/physics.md §2, walls): the closest point of each
+/// candidate triangle, then one contact per surface feature the sphere touches.
+///
+/// A triangle's closest point to the sphere centre x lies in one of seven regions: its face,
+/// one of its three edges, one of its three vertices (Voronoi regions of the triangle). A sphere
+/// over a shared edge or vertex of a flat or convex surface finds that feature's point in every
+/// triangle sharing it, and a sphere over a face near an edge finds the edge again in the
+/// neighbour. So, over the triangles within reach:
+///   * a face touch is kept;
+///   * an edge touch is dropped if a triangle holding that edge is touched on its face, or the
+///     same edge was already kept (it is one feature);
+///   * a vertex touch is dropped if a touched face or edge holds the vertex, or the same vertex
+///     was already kept.
+/// What is left is one contact per feature of the surface the sphere really touches: one on a
+/// flat or convex region (continuous as the sphere slides across edges and vertices: at a
+/// region boundary the face and the edge point coincide), two or more in a concave valley (one
+/// per face), as with analytic walls. Triangles are two-sided; h = |x − p| ≥ 0 and the normal
+/// points from the closest point p towards x (the triangle's own normal if x lies on it).
+///
+/// History key of a touch: −(2 + keyBase + triangle index), the triangle that holds the kept
+/// feature first in candidate order (ascending index).
+
+#include <cstdint>
+
+#include "coredem/dem/kernels/common.h"
+#include "coredem/dem/kernels/vec3.h"
+
+namespace coredem::dem::kernels {
+
+/// One triangle of a mesh wall with its topology (ids unique over all meshes of a run).
+struct MeshTriangle {
+  Vec3 a, b, c;
+  std::int32_t v[3]; ///< vertex ids of a, b, c
+  std::int32_t e[3]; ///< edge ids: e[0] = ab, e[1] = bc, e[2] = ca
+};
+
+/// Region of a triangle's closest point: kRegionFace, kRegionEdge + k (edge k), kRegionVertex + k.
+enum TriangleRegion : int { kRegionFace = 0, kRegionEdge = 1, kRegionVertex = 4 };
+
+/// Closest point of triangle t to x and the region it lies in.
+struct TrianglePoint {
+  Vec3 p;
+  int region;
+};
+
+/// The closest point of triangle t to x (Voronoi regions of vertices, then edges, then face).
+DEM_HD TrianglePoint closestOnTriangle(const MeshTriangle& t, Vec3 x) {
+  const Vec3 ab = t.b - t.a, ac = t.c - t.a, ap = x - t.a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0.0 && d2 <= 0.0)
+    return {t.a, kRegionVertex + 0};
+  const Vec3 bp = x - t.b;
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3)
+    return {t.b, kRegionVertex + 1};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0)
+    return {t.a + (d1 / (d1 - d3)) * ab, kRegionEdge + 0};
+  const Vec3 cp = x - t.c;
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6)
+    return {t.c, kRegionVertex + 2};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0)
+    return {t.a + (d2 / (d2 - d6)) * ac, kRegionEdge + 2};
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double u = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {t.b + u * (t.c - t.b), kRegionEdge + 1};
+  }
+  const double inv = 1.0 / (va + vb + vc);
+  return {t.a + (vb * inv) * ab + (vc * inv) * ac, kRegionFace};
+}
+
+/// Distance (m) from x to triangle t.
+DEM_HD double triangleDistance(const MeshTriangle& t, Vec3 x) {
+  const Vec3 e = x - closestOnTriangle(t, x).p;
+  return ::sqrt(dot(e, e));
+}
+
+/// Most touches of one sphere with the mesh walls considered at once (more within reach are
+/// ignored, farthest in candidate order first: a sphere over a mesh finer than itself).
+inline constexpr int kMaxMeshTouches = 16;
+
+/// One kept touch of a sphere with a mesh wall.
+struct MeshTouch {
+  double h;          ///< distance from the centre to the surface (m), ≥ 0
+  Vec3 n;            ///< unit normal from the surface towards the centre
+  std::uint32_t tri; ///< the triangle holding the feature (the history key's)
+  int region;        ///< TriangleRegion of the feature in that triangle
+};
+
+namespace detail {
+/// Whether triangle t holds edge id e.
+DEM_HD bool holdsEdge(const MeshTriangle& t, std::int32_t e) {
+  return t.e[0] == e || t.e[1] == e || t.e[2] == e;
+}
+/// Whether triangle t holds vertex id v.
+DEM_HD bool holdsVertex(const MeshTriangle& t, std::int32_t v) {
+  return t.v[0] == v || t.v[1] == v || t.v[2] == v;
+}
+} // namespace detail
+
+/// The touches (h < reach) of a sphere centred at x with the candidate triangles
+/// tris[cand[k]], k < nCand (ascending), one per touched feature as the file comment says;
+/// writes at most kMaxMeshTouches to out and returns their number.
+DEM_HD int meshTouches(const MeshTriangle* tris, const std::uint32_t* cand, int nCand, Vec3 x,
+                       double reach, MeshTouch* out) {
+  // Pass 1: every triangle within reach, its closest point.
+  int raw = 0;
+  for (int k = 0; k < nCand && raw < kMaxMeshTouches; ++k) {
+    const MeshTriangle& t = tris[cand[k]];
+    const TrianglePoint cp = closestOnTriangle(t, x);
+    const Vec3 e = x - cp.p;
+    const double h2 = dot(e, e);
+    if (!(h2 < reach * reach))
+      continue;
+    const double h = ::sqrt(h2);
+    Vec3 n;
+    if (h > 0.0) {
+      n = (1.0 / h) * e;
+    } else {
+      const Vec3 c = cross(t.b - t.a, t.c - t.a);
+      n = (1.0 / ::sqrt(dot(c, c))) * c;
+    }
+    out[raw++] = MeshTouch{h, n, cand[k], cp.region};
+  }
+  // Pass 2: drop the features held by a touched face or edge, and repeated features (marked
+  // first, then compacted: the tests read every raw touch).
+  std::uint32_t dropped = 0;
+  for (int k = 0; k < raw; ++k) {
+    const MeshTouch m = out[k];
+    bool drop = false;
+    if (m.region >= kRegionVertex) {
+      const std::int32_t vid = tris[m.tri].v[m.region - kRegionVertex];
+      for (int j = 0; j < raw && !drop; ++j) {
+        if (j == k)
+          continue;
+        const MeshTriangle& o = tris[out[j].tri];
+        const int rj = out[j].region;
+        if (rj == kRegionFace)
+          drop = detail::holdsVertex(o, vid);
+        else if (rj < kRegionVertex)
+          drop = o.v[rj - kRegionEdge] == vid || o.v[(rj - kRegionEdge + 1) % 3] == vid;
+        else
+          drop = j < k && o.v[rj - kRegionVertex] == vid;
+      }
+    } else if (m.region >= kRegionEdge) {
+      const std::int32_t eid = tris[m.tri].e[m.region - kRegionEdge];
+      for (int j = 0; j < raw && !drop; ++j) {
+        if (j == k)
+          continue;
+        const MeshTriangle& o = tris[out[j].tri];
+        const int rj = out[j].region;
+        if (rj == kRegionFace)
+          drop = detail::holdsEdge(o, eid);
+        else if (rj < kRegionVertex)
+          drop = j < k && o.e[rj - kRegionEdge] == eid;
+      }
+    }
+    dropped |= drop ? (1u << k) : 0u;
+  }
+  int kept = 0;
+  for (int k = 0; k < raw; ++k)
+    if (!(dropped >> k & 1u))
+      out[kept++] = out[k];
+  return kept;
+}
+
+} // namespace coredem::dem::kernels

@@ -1,0 +1,285 @@
+#pragma once
+/// @file
+/// The run's walls on the device and, per particle, the walls it may touch until the next
+/// neighbour rebuild (the candidates the contact and heat modules evaluate).
+///
+/// * Analytic walls (kernels/wall_contact.h: planes, surfaces of revolution): a bit per wall
+///   for the first kNearBits walls; walls beyond them are candidates of every particle.
+/// * Mesh walls (kernels/mesh_contact.h): a binned triangle search. The bins (a uniform grid
+///   over the meshes' bounding box, each bin listing the triangles whose box, grown by the
+///   largest reach, overlaps it) are built once on the host: walls do not move. At each rebuild
+///   every particle looks up the bin of its reference position and keeps the triangles of that
+///   bin within its reach, in ascending index (a count pass, a scan, a fill pass: the same
+///   kernels on every backend); bit kMeshBit of its wall bits says it has some.
+///
+/// A particle moves at most skin/2 from its reference position (xref) before the next rebuild
+/// and radii only shrink, so a wall or triangle farther than f·R + skin/2 from xref cannot come
+/// within f·R of the centre until then (f = EngineSetup::wallReachFactor: 1 for contacts,
+/// 1 + FLPC when the heat module's wall gas lens is on).
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "backend/arrays.h"
+#include "coredem/dem/kernels/mesh_contact.h"
+#include "coredem/dem/kernels/vec3.h"
+#include "coredem/dem/kernels/wall_contact.h"
+#include "engine.h"
+#include "particle_store.h"
+
+namespace coredem::dem {
+
+template <class Exec>
+class WallLists {
+public:
+  template <class T>
+  using Dual = backend::DualArray<T, Exec>;
+  template <class T>
+  using Dev = backend::DeviceArray<T, Exec>;
+
+  /// Analytic walls with a bit of their own; the bit kMeshBit says "mesh candidates".
+  static constexpr int kNearBits = 31;
+  static constexpr std::uint32_t kMeshBit = 1u << 31;
+  /// Most bins of the triangle search (the bin edge grows to stay below).
+  static constexpr std::size_t kMaxBins = std::size_t{1} << 22;
+
+  void setup(const EngineSetup& s) {
+    _nWalls = static_cast<int>(s.walls.size());
+    _walls.allocate(s.walls.size());
+    std::copy(s.walls.begin(), s.walls.end(), _walls.h());
+    _walls.markHostModified();
+    _walls.toDevice();
+    _reachFactor = s.wallReachFactor;
+    _nTris = s.triangles.size();
+    if (_nTris > 0)
+      buildBins(s);
+  }
+
+  int wallCount() const { return _nWalls; }
+  const kernels::Wall* walls() const { return _walls.d(); }
+  bool hasMeshes() const { return _nTris > 0; }
+  const kernels::MeshTriangle* triangles() const { return _tris.d(); }
+  /// Per particle: wall bits (bit k < kNearBits: analytic wall k, all bits when there are more
+  /// walls than bits; kMeshBit: mesh candidates).
+  const std::uint32_t* near() const { return _near.d(); }
+  /// Per particle: its mesh candidates meshList()[meshStart()[i] .. meshStart()[i + 1]).
+  const std::uint32_t* meshStart() const { return _meshStart.d(); }
+  const std::uint32_t* meshList() const { return _meshList.d(); }
+  /// History key base of the mesh triangles: a touch of triangle t has key −(2 + base + t).
+  std::int64_t meshKeyBase() const {
+    return static_cast<std::int64_t>(_nWalls) * kernels::kMaxWallFeatures;
+  }
+  std::size_t bytes() const {
+    return _walls.bytes() + _tris.bytes() + _binStart.bytes() + _binTris.bytes() + _near.bytes() +
+           _meshStart.bytes() + _meshList.bytes();
+  }
+
+  /// The candidates of the neighbour lists of build `generation`, from xref (rebuilt once per
+  /// build). Reads xref, radius.
+  void ensure(Exec& exec, ParticleStore<Exec>& p, std::uint64_t generation, double skin) {
+    if (_generation == generation && _n == p.n)
+      return;
+    _generation = generation;
+    _n = p.n;
+    _near.reserve(p.n);
+    std::uint32_t* near = _near.d();
+    const double* xr = p.xref.d();
+    const double* r = p.radius.d();
+    const kernels::Wall* walls = _walls.d();
+    const int nWalls = _nWalls;
+    const double halfSkin = 0.5 * skin;
+    const double f = _reachFactor;
+    exec.parallelFor(p.n, [=] DEM_LAMBDA(std::size_t i) {
+      std::uint32_t bits = 0;
+      if (nWalls > kNearBits) {
+        bits = ~kMeshBit;
+      } else {
+        const kernels::Vec3 xi = kernels::load3(xr, static_cast<long long>(i));
+        const double reach = f * r[i] + halfSkin;
+        for (int k = 0; k < nWalls; ++k) {
+          // Not "at least reach away" (also catches NaN): a candidate.
+          if (!(kernels::wallClearance(walls[k], xi) >= reach))
+            bits |= 1u << k;
+        }
+      }
+      near[i] = bits;
+    });
+    if (_nTris > 0)
+      buildMeshLists(exec, p, halfSkin);
+  }
+
+private:
+  /// Bin of a point, or −1 outside the bins.
+  struct Bins {
+    kernels::Vec3 lo;
+    double inv;
+    int nx, ny, nz;
+    DEM_HD long long at(kernels::Vec3 x) const {
+      const double fx = (x.x - lo.x) * inv, fy = (x.y - lo.y) * inv, fz = (x.z - lo.z) * inv;
+      if (!(fx >= 0.0 && fy >= 0.0 && fz >= 0.0 && fx < nx && fy < ny && fz < nz))
+        return -1;
+      return static_cast<long long>(fx) +
+             nx * (static_cast<long long>(fy) + ny * static_cast<long long>(fz));
+    }
+  };
+
+  /// Visits the triangles of particle i's bin within its reach, in ascending index.
+  struct MeshSearch {
+    const double* xr;
+    const double* r;
+    const kernels::MeshTriangle* tris;
+    const std::uint32_t* bs;
+    const std::uint32_t* bt;
+    Bins bins;
+    double f;
+    double halfSkin;
+    template <class Take>
+    DEM_HD void operator()(std::size_t i, Take&& take) const {
+      const kernels::Vec3 xi = kernels::load3(xr, static_cast<long long>(i));
+      const long long b = bins.at(xi);
+      if (b < 0)
+        return;
+      const double reach = f * r[i] + halfSkin;
+      for (std::uint32_t k = bs[b]; k < bs[b + 1]; ++k)
+        if (!(kernels::triangleDistance(tris[bt[k]], xi) >= reach)) // NaN: a candidate
+          take(bt[k]);
+    }
+  };
+
+  void buildBins(const EngineSetup& s) {
+    using kernels::Vec3;
+    _tris.allocate(_nTris);
+    std::copy(s.triangles.begin(), s.triangles.end(), _tris.h());
+    _tris.markHostModified();
+    _tris.toDevice();
+    // Reach of the largest particle: its triangles lie within this of its reference position.
+    const double grow = s.wallReachFactor * s.maxRadius + 0.5 * s.skin;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    auto boxOf = [&](const kernels::MeshTriangle& t, double* a, double* b) {
+      const Vec3 v[3] = {t.a, t.b, t.c};
+      for (int d = 0; d < 3; ++d) {
+        a[d] = HUGE_VAL, b[d] = -HUGE_VAL;
+        for (const Vec3& p : v) {
+          const double c = d == 0 ? p.x : (d == 1 ? p.y : p.z);
+          a[d] = std::min(a[d], c - grow);
+          b[d] = std::max(b[d], c + grow);
+        }
+      }
+    };
+    for (const kernels::MeshTriangle& t : s.triangles) {
+      double a[3], b[3];
+      boxOf(t, a, b);
+      for (int d = 0; d < 3; ++d)
+        lo[d] = std::min(lo[d], a[d]), hi[d] = std::max(hi[d], b[d]);
+    }
+    // Bin edge: twice the reach, or larger to stay within kMaxBins.
+    double h = std::max(2.0 * grow, 1e-12);
+    auto count = [&](double e) {
+      std::size_t c = 1;
+      for (int d = 0; d < 3; ++d)
+        c *= static_cast<std::size_t>(std::ceil((hi[d] - lo[d]) / e));
+      return c;
+    };
+    while (count(h) > kMaxBins)
+      h *= 1.25;
+    Bins b{Vec3{lo[0], lo[1], lo[2]}, 1.0 / h, 0, 0, 0};
+    b.nx = std::max(1, static_cast<int>(std::ceil((hi[0] - lo[0]) / h)));
+    b.ny = std::max(1, static_cast<int>(std::ceil((hi[1] - lo[1]) / h)));
+    b.nz = std::max(1, static_cast<int>(std::ceil((hi[2] - lo[2]) / h)));
+    _bins = b;
+    const std::size_t nb = static_cast<std::size_t>(b.nx) * b.ny * b.nz;
+    // Each triangle in every bin its grown box overlaps (counts, then the lists, in index order).
+    std::vector<std::uint32_t> start(nb + 1, 0), fill;
+    auto range = [&](const kernels::MeshTriangle& t, int* i0, int* i1) {
+      double a[3], c[3];
+      boxOf(t, a, c);
+      const int n[3] = {b.nx, b.ny, b.nz};
+      for (int d = 0; d < 3; ++d) {
+        i0[d] = std::clamp(static_cast<int>(std::floor((a[d] - lo[d]) / h)), 0, n[d] - 1);
+        i1[d] = std::clamp(static_cast<int>(std::floor((c[d] - lo[d]) / h)), 0, n[d] - 1);
+      }
+    };
+    for (int pass = 0; pass < 2; ++pass) {
+      if (pass == 1) {
+        for (std::size_t k = 0; k < nb; ++k)
+          start[k + 1] += start[k];
+        fill.assign(start.begin(), start.end() - 1);
+        _binTris.allocate(std::max<std::size_t>(start[nb], 1));
+      }
+      for (std::size_t t = 0; t < _nTris; ++t) {
+        int i0[3], i1[3];
+        range(s.triangles[t], i0, i1);
+        for (int z = i0[2]; z <= i1[2]; ++z)
+          for (int y = i0[1]; y <= i1[1]; ++y)
+            for (int x = i0[0]; x <= i1[0]; ++x) {
+              const std::size_t k = static_cast<std::size_t>(x) +
+                                    static_cast<std::size_t>(b.nx) *
+                                        (static_cast<std::size_t>(y) +
+                                         static_cast<std::size_t>(b.ny) * z);
+              if (pass == 0)
+                ++start[k + 1];
+              else
+                _binTris.h()[fill[k]++] = static_cast<std::uint32_t>(t);
+            }
+      }
+    }
+    _binStart.allocate(nb + 1);
+    std::copy(start.begin(), start.end(), _binStart.h());
+    _binStart.markHostModified();
+    _binStart.toDevice();
+    _binTris.markHostModified();
+    _binTris.toDevice();
+  }
+
+  /// Per particle, the triangles of its bin within reach (count, scan, fill).
+  void buildMeshLists(Exec& exec, ParticleStore<Exec>& p, double halfSkin) {
+    const std::size_t n = p.n;
+    _meshCount.reserve(n + 1);
+    _meshStart.reserve(n + 1);
+    std::uint32_t* cnt = _meshCount.d();
+    std::uint32_t* near = _near.d();
+    const double* xr = p.xref.d();
+    const double* r = p.radius.d();
+    const kernels::MeshTriangle* tris = _tris.d();
+    const std::uint32_t* bs = _binStart.d();
+    const std::uint32_t* bt = _binTris.d();
+    const MeshSearch visit{xr, r, tris, bs, bt, _bins, _reachFactor, halfSkin};
+    exec.parallelFor(n + 1, [=] DEM_LAMBDA(std::size_t i) {
+      std::uint32_t c = 0;
+      if (i < n)
+        visit(i, [&](std::uint32_t) { ++c; });
+      cnt[i] = c;
+      if (i < n && c > 0)
+        near[i] |= kMeshBit;
+    });
+    std::uint32_t* ms = _meshStart.d();
+    exec.exclusiveScan(cnt, ms, n + 1);
+    std::uint32_t total = 0;
+    Exec::copyToHost(&total, ms + n, sizeof(total));
+    _meshList.reserve(std::max<std::uint32_t>(total, 1));
+    std::uint32_t* ml = _meshList.d();
+    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+      std::uint32_t at = ms[i];
+      visit(i, [&](std::uint32_t t) { ml[at++] = t; });
+    });
+  }
+
+  int _nWalls = 0;
+  std::size_t _nTris = 0;
+  double _reachFactor = 1.0;
+  Dual<kernels::Wall> _walls;
+  Dual<kernels::MeshTriangle> _tris;
+  Dual<std::uint32_t> _binStart; ///< per bin + 1: start of its triangles in _binTris
+  Dual<std::uint32_t> _binTris;  ///< triangles of every bin, ascending per bin
+  Bins _bins{};
+  Dev<std::uint32_t> _near;      ///< per particle: wall bits
+  Dev<std::uint32_t> _meshCount; ///< per particle + 1: mesh candidates (scan input)
+  Dev<std::uint32_t> _meshStart; ///< per particle + 1: start of its mesh candidates
+  Dev<std::uint32_t> _meshList;  ///< mesh candidates of every particle
+  std::uint64_t _generation = ~std::uint64_t{0};
+  std::size_t _n = ~std::size_t{0};
+};
+
+} // namespace coredem::dem
