@@ -402,12 +402,6 @@ struct OwnerContacts {
       oldD[s] = load3(hd, ii * K + s);
     }
     int slot = 0;
-    auto wallHistory = [&](std::int64_t key) {
-      for (int s = 0; s < used; ++s)
-        if (oldKey[s] == key)
-          return oldD[s];
-      return Vec3{0.0, 0.0, 0.0};
-    };
     Vec3 F{0.0, 0.0, 0.0}; // i's own sum: its owned pairs, then its walls
     Vec3 T{0.0, 0.0, 0.0};
     // Particle–particle LSD (Eqs. 7–13) over the owned candidates. i's velocities, mass and

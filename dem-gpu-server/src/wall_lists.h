@@ -110,7 +110,7 @@ public:
       buildMeshLists(exec, p, halfSkin);
   }
 
-private:
+  // (Public for nvcc: a function holding an extended device lambda cannot be private.)
   /// Bin of a point, or −1 outside the bins.
   struct Bins {
     kernels::Vec3 lo;
@@ -214,10 +214,10 @@ private:
         for (int z = i0[2]; z <= i1[2]; ++z)
           for (int y = i0[1]; y <= i1[1]; ++y)
             for (int x = i0[0]; x <= i1[0]; ++x) {
-              const std::size_t k = static_cast<std::size_t>(x) +
-                                    static_cast<std::size_t>(b.nx) *
-                                        (static_cast<std::size_t>(y) +
-                                         static_cast<std::size_t>(b.ny) * z);
+              const std::size_t k =
+                  static_cast<std::size_t>(x) +
+                  static_cast<std::size_t>(b.nx) *
+                      (static_cast<std::size_t>(y) + static_cast<std::size_t>(b.ny) * z);
               if (pass == 0)
                 ++start[k + 1];
               else
@@ -266,6 +266,7 @@ private:
     });
   }
 
+private:
   int _nWalls = 0;
   std::size_t _nTris = 0;
   double _reachFactor = 1.0;

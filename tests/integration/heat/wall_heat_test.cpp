@@ -4,6 +4,7 @@
 // adiabatic walls transfer nothing. Real DemSystem runs on the cpu backend.
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "coredem/dem/dem_system.h"
 #include "coredem/dem/kernels/wall_conduction.h"
 #include "coredem/dem/models.h"
+#include "coredem/dem/triangle_mesh.h"
 
 using namespace coredem::dem;
 namespace k = coredem::dem::kernels;
@@ -150,4 +152,50 @@ TEST(WallHeat, CoupledWallLensAddsToContact) {
   EXPECT_GT(onlyTemperature(sys) - kT0, 0.1);
   EXPECT_NEAR(sys.heatTotals().wall, sys.thermalEnergy() - e0, 1e-12 * e0);
   RecordProperty("wall_lens_share", sci(lensShare));
+}
+
+// Every wall type conducts as its tangent plane at the touch's distance h (docs/physics.md
+// §3.2 "Walls"): the coupled bead of CoupledWallLensAddsToContact (contact + gas lens) heats at
+// the plane formula's rate against the box floor, against the inside of a vertical cylinder of
+// radius 1 m (the curvature neglected: the exact lens differs by O(R/R_c) = 5e-4), and against a
+// triangulated floor with the bead over a vertex shared by six triangles (one touch, not six).
+// T after 100 sub-steps to 1e-10 K of the plane's Euler recursion.
+TEST(WallHeat, CylinderAndTriangleWallsConductAsThePlane) {
+  const double h = 0.5 * kD - kDelta;
+  const double kg = 0.0257;
+  k::WallConductionParams wp;
+  const double g =
+      k::wallContactConductance(kKp, kKw, 0.5 * kD, h) + kg * k::wallLensIntegral(wp, 0.5 * kD, h);
+  const double mc = massHeatCapacity(), dt = 1e-4;
+  const double want = kTw + (kT0 - kTw) * std::pow(1.0 - g / mc * dt, 100);
+  for (int variant = 0; variant < 3; ++variant) {
+    DemConfig cfg = bead(kTw);
+    cfg.walls.clear();
+    const double c = 5e-3, rc = 1.0;
+    if (variant == 0) {
+      cfg.walls.push_back(Wall::plane({0, 0, 0}, {0, 0, 1}));
+      cfg.particleSets[0].positions = {c, c, h};
+    } else if (variant == 1) {
+      const double inf = std::numeric_limits<double>::infinity();
+      cfg.walls.push_back(Wall::cylinder({c - h + rc, c, 0}, {0, 0, 1}, rc, -inf, inf));
+      cfg.particleSets[0].positions = {c, c, c};
+    } else {
+      const TriangleMesh floor = meshRectangle({0, 0, 0}, {1e-2, 0, 0}, {0, 1e-2, 0}, 4, 4);
+      cfg.meshes.push_back(MeshWall{"floor", floor.vertices, floor.triangles});
+      cfg.particleSets[0].positions = {c, c, h};
+    }
+    cfg.grid.origin = {0, 0, 0};
+    cfg.grid.spacing = {1e-2, 1e-2, 1e-2};
+    cfg.grid.counts = {1, 1, 1};
+    ASSERT_TRUE(applyModelOption(cfg, "convection", "off"));
+    ASSERT_TRUE(applyModelOption(cfg, "lens_conduction", "off"));
+    DemSystem sys(cfg, BackendKind::Cpu, 1);
+    std::vector<double> u(3, 0.0), gp(3, 0.0), tg(1, kT0), rho(1, 1.204), mu(1, 1.81e-5),
+        kappa(1, kg), cp(1, 1006.0);
+    sys.setGasFields(GasFieldsView{u, gp, tg, rho, mu, kappa, cp, {}, {}});
+    const double e0 = sys.thermalEnergy();
+    sys.advance(100 * dt, 100);
+    EXPECT_NEAR(onlyTemperature(sys), want, 1e-10) << "variant " << variant;
+    EXPECT_NEAR(sys.heatTotals().wall, sys.thermalEnergy() - e0, 1e-12 * e0);
+  }
 }

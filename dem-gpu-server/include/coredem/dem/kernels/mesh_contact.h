@@ -4,20 +4,24 @@
 /// candidate triangle, then one contact per surface feature the sphere touches.
 ///
 /// A triangle's closest point to the sphere centre x lies in one of seven regions: its face,
-/// one of its three edges, one of its three vertices (Voronoi regions of the triangle). A sphere
-/// over a shared edge or vertex of a flat or convex surface finds that feature's point in every
-/// triangle sharing it, and a sphere over a face near an edge finds the edge again in the
-/// neighbour. So, over the triangles within reach:
-///   * a face touch is kept;
-///   * an edge touch is dropped if a triangle holding that edge is touched on its face, or the
-///     same edge was already kept (it is one feature);
-///   * a vertex touch is dropped if a touched face or edge holds the vertex, or the same vertex
-///     was already kept.
-/// What is left is one contact per feature of the surface the sphere really touches: one on a
-/// flat or convex region (continuous as the sphere slides across edges and vertices: at a
-/// region boundary the face and the edge point coincide), two or more in a concave valley (one
-/// per face), as with analytic walls. Triangles are two-sided; h = |x − p| ≥ 0 and the normal
-/// points from the closest point p towards x (the triangle's own normal if x lies on it).
+/// one of its three edges, one of its three vertices (Voronoi regions of the triangle). The
+/// contacts of a sphere with the surface are the local minima of the distance from x over the
+/// surface: a triangle's closest point p is one unless a neighbouring triangle has points
+/// nearer to x around p. So, over the triangles within reach:
+///   * a face touch is kept (the distance has its minimum inside that face), once where two
+///     coplanar faces both claim the same point of their shared edge (rounding);
+///   * an edge touch is kept only if every other triangle holding that edge also has its
+///     closest point on it (x is in the edge's own Voronoi region: a convex edge, or a flat
+///     surface exactly over the edge), once for the edge;
+///   * a vertex touch likewise only if every triangle holding the vertex has its closest point
+///     at the vertex, once for the vertex.
+/// What is left is one contact per feature the sphere really touches: one on a flat or convex
+/// region, continuous as the sphere slides across edges and vertices (at a region boundary the
+/// face and the edge point coincide), even on a mesh finer than the contact patch; two or more
+/// in a concave valley (one per face), as with analytic walls. Every triangle holding a touched
+/// edge or vertex is itself within reach (it holds a point at the touch's distance), so the
+/// test sees all of them. Triangles are two-sided; h = |x − p| ≥ 0 and the normal points from
+/// p towards x (the triangle's own normal if x lies on it).
 ///
 /// History key of a touch: −(2 + keyBase + triangle index), the triangle that holds the kept
 /// feature first in candidate order (ascending index).
@@ -127,38 +131,35 @@ DEM_HD int meshTouches(const MeshTriangle* tris, const std::uint32_t* cand, int 
     }
     out[raw++] = MeshTouch{h, n, cand[k], cp.region};
   }
-  // Pass 2: drop the features held by a touched face or edge, and repeated features (marked
-  // first, then compacted: the tests read every raw touch).
+  // Pass 2: keep an edge or vertex touch only where every triangle holding the feature is
+  // touched on that same feature, once per feature (marked first, then compacted: the tests
+  // read every raw touch).
   std::uint32_t dropped = 0;
   for (int k = 0; k < raw; ++k) {
     const MeshTouch m = out[k];
+    if (m.region == kRegionFace) {
+      // Two coplanar faces both claiming a point of their shared edge (rounding): once.
+      for (int j = 0; j < k; ++j)
+        if (out[j].region == kRegionFace && dot(out[j].n, m.n) > 1.0 - 1e-12 &&
+            ::fabs(out[j].h - m.h) <= 1e-12 * reach)
+          dropped |= 1u << k;
+      continue;
+    }
+    const bool vertex = m.region >= kRegionVertex;
+    const MeshTriangle& mt = tris[m.tri];
+    const std::int32_t id = vertex ? mt.v[m.region - kRegionVertex] : mt.e[m.region - kRegionEdge];
     bool drop = false;
-    if (m.region >= kRegionVertex) {
-      const std::int32_t vid = tris[m.tri].v[m.region - kRegionVertex];
-      for (int j = 0; j < raw && !drop; ++j) {
-        if (j == k)
-          continue;
-        const MeshTriangle& o = tris[out[j].tri];
-        const int rj = out[j].region;
-        if (rj == kRegionFace)
-          drop = detail::holdsVertex(o, vid);
-        else if (rj < kRegionVertex)
-          drop = o.v[rj - kRegionEdge] == vid || o.v[(rj - kRegionEdge + 1) % 3] == vid;
-        else
-          drop = j < k && o.v[rj - kRegionVertex] == vid;
-      }
-    } else if (m.region >= kRegionEdge) {
-      const std::int32_t eid = tris[m.tri].e[m.region - kRegionEdge];
-      for (int j = 0; j < raw && !drop; ++j) {
-        if (j == k)
-          continue;
-        const MeshTriangle& o = tris[out[j].tri];
-        const int rj = out[j].region;
-        if (rj == kRegionFace)
-          drop = detail::holdsEdge(o, eid);
-        else if (rj < kRegionVertex)
-          drop = j < k && o.e[rj - kRegionEdge] == eid;
-      }
+    for (int j = 0; j < raw && !drop; ++j) {
+      if (j == k)
+        continue;
+      const MeshTriangle& o = tris[out[j].tri];
+      if (!(vertex ? detail::holdsVertex(o, id) : detail::holdsEdge(o, id)))
+        continue;
+      const int rj = out[j].region;
+      const bool same =
+          vertex ? (rj >= kRegionVertex && o.v[rj - kRegionVertex] == id)
+                 : (rj >= kRegionEdge && rj < kRegionVertex && o.e[rj - kRegionEdge] == id);
+      drop = same ? j < k : true;
     }
     dropped |= drop ? (1u << k) : 0u;
   }

@@ -1,0 +1,236 @@
+// Reactor walls (kernels/wall_contact.h, kernels/mesh_contact.h, wall_lists.h): a triangulated
+// plane behaves as the analytic plane wherever a sphere hits or rolls (faces, edges, vertices,
+// coarse and fine triangles), and a packed bed in a cylinder (analytic and STL) rests on its
+// walls with exactly its weight. Whole DemSystem runs on the cpu backend.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "coredem/dem/triangle_mesh.h"
+#include "dem_test_util.h"
+
+using namespace coredem::dem;
+using namespace coredem::dem::testing;
+
+namespace {
+
+MeshWall meshWall(const TriangleMesh& m) {
+  return MeshWall{m.name, m.vertices, m.triangles};
+}
+
+/// The floor z = 0 as an analytic plane (quads = 0) or as a rectangle of quads × quads squares
+/// of edge `side` (two triangles each, diagonals from (i, j) to (i + 1, j + 1)) with a grid
+/// node at the origin.
+void addFloor(DemConfig& c, int quads, double side) {
+  if (quads == 0) {
+    c.walls.push_back(Wall::plane({0, 0, 0}, {0, 0, 1}));
+    return;
+  }
+  const double half = 0.5 * quads * side;
+  c.meshes.push_back(meshWall(
+      meshRectangle({-half, -half, 0}, {quads * side, 0, 0}, {0, quads * side, 0}, quads, quads)));
+}
+
+struct Bounce {
+  double restitution;
+  int contactSteps;
+};
+
+/// A 1 mm glass sphere (k_n = 1000 N/m, e_n = 0.97, no gravity) falling at v onto the floor at
+/// (x, y); the first overlap at `phase` of a step.
+Bounce bounce(int quads, double side, double x, double y, double phase = 0.3) {
+  DemConfig c;
+  c.gravity = {0, 0, 0};
+  addFloor(c, quads, side);
+  const double r = 0.5e-3, v = 0.5;
+  ParticleSet s;
+  s.packing = Packing::Explicit;
+  s.diameter = 2 * r;
+  c.particleSets.push_back(s);
+  DemSystem probe(
+      [&] {
+        DemConfig p = c;
+        p.particleSets[0].positions = {x, y, 1.0};
+        return p;
+      }(),
+      BackendKind::Cpu, 1);
+  const double dt = probe.dtDemMax();
+  c.particleSets[0].positions = {x, y, r + v * dt * (5 + phase)};
+  c.particleSets[0].velocities = {0, 0, -v};
+  DemSystem sys(c, BackendKind::Cpu, 1);
+  Bounce b{0.0, 0};
+  bool started = false;
+  for (int k = 0; k < 400; ++k) {
+    sys.advance(dt, 1);
+    if (sys.contactCount() > 0) {
+      EXPECT_EQ(sys.contactCount(), 1u) << "one contact with the floor, not " << sys.contactCount();
+      ++b.contactSteps;
+      started = true;
+    } else if (started) {
+      break;
+    }
+  }
+  const ParticleData p = sys.particles();
+  b.restitution = p.velocity[2] / v;
+  EXPECT_NEAR(p.velocity[0], 0.0, 1e-12) << "a head-on hit pushes straight back";
+  EXPECT_NEAR(p.velocity[1], 0.0, 1e-12);
+  return b;
+}
+
+} // namespace
+
+// Head-on: the triangulated floor gives the analytic plane's restitution (to 1e-3) and contact
+// duration (to 2 Δt_DEM) wherever the sphere hits: inside a face, on an axis-parallel edge, on
+// a diagonal edge, on a vertex (shared by six triangles), with triangles larger (4 mm) and
+// smaller (0.25 mm) than the sphere's contact patch.
+TEST(MeshWall, HeadOnOnATriangulatedPlaneMatchesThePlaneWall) {
+  const Bounce plane = bounce(0, 0.0, 0.0, 0.0);
+  EXPECT_NEAR(plane.restitution, 0.97, 0.01); // the LSD law itself (docs/physics.md §2.1)
+  struct Where {
+    const char* name;
+    double fx, fy; // in units of the quad edge, from a grid node
+  };
+  const Where where[] = {{"face", 0.71, 0.23},
+                         {"axis-parallel edge", 0.5, 0.0},
+                         {"diagonal edge", 0.5, 0.5},
+                         {"vertex", 0.0, 0.0}};
+  for (const auto& [quads, side] : {std::pair{4, 4e-3}, std::pair{32, 0.25e-3}}) {
+    for (const Where& w : where) {
+      const Bounce m = bounce(quads, side, w.fx * side, w.fy * side);
+      EXPECT_NEAR(m.restitution, plane.restitution, 1e-3)
+          << w.name << ", triangles of " << side << " m";
+      EXPECT_LE(std::abs(m.contactSteps - plane.contactSteps), 2)
+          << w.name << ", triangles of " << side << " m";
+    }
+  }
+}
+
+namespace {
+struct Roll {
+  double v;         ///< final speed (m/s)
+  double maxDevFz;  ///< largest |F_z − m g| over the run after the first 5 ms (N)
+  double weight;    ///< m g (N)
+  std::size_t most; ///< most contacts at once
+};
+
+/// A sphere launched sliding (ω = 0) at v0 along +x at height y0 on the floor (μ = 0.3),
+/// sub-step by sub-step for 0.1 s (docs/physics.md §2.1: rolling at 5/7 v0 after 39 ms).
+Roll roll(int quads, double side, double y0) {
+  DemConfig c;
+  c.materials[0].mu = 0.3;
+  const double r = 0.5e-3, m = 2500 * 4.0 / 3.0 * kPi * r * r * r, v0 = 0.4;
+  if (quads == 0) {
+    c.walls.push_back(Wall::plane({0, 0, 0}, {0, 0, 1}));
+  } else {
+    // From x = −5 mm to 45 mm, y in [−5, 5] mm.
+    const int nx = static_cast<int>(std::lround(50e-3 / side));
+    c.meshes.push_back(meshWall(meshRectangle({-5e-3, -quads * side / 2, 0}, {nx * side, 0, 0},
+                                              {0, quads * side, 0}, nx, quads)));
+  }
+  ParticleSet s;
+  s.packing = Packing::Explicit;
+  s.positions = {0, y0, r - m * 9.81 / 1000.0}; // resting overlap m g / k_n
+  s.velocities = {v0, 0, 0};
+  c.particleSets.push_back(s);
+  DemSystem sys(c, BackendKind::Cpu, 1);
+  const double dt = sys.dtDemMax();
+  const int steps = static_cast<int>(0.1 / dt);
+  Roll out{0.0, 0.0, m * 9.81, 0};
+  for (int k = 0; k < steps; ++k) {
+    sys.advance(dt, 1);
+    out.most = std::max(out.most, sys.contactCount());
+    if (k * dt > 5e-3)
+      out.maxDevFz = std::max(out.maxDevFz, std::abs(sys.wallForce()[2] - out.weight));
+  }
+  out.v = sys.particles().velocity[0];
+  return out;
+}
+} // namespace
+
+// Rolling across shared edges: a sphere launched sliding on a triangulated floor ends rolling
+// at 5/7 v0 (to 1 %) as on the analytic plane, with one contact at a time and no force spike:
+// the normal force stays as close to the weight as on the plane (within 1 % of m g more), on a
+// path along a grid line (through every vertex on it) and one across faces and edges, with
+// triangles of 1 mm and of 0.2 mm (finer than the contact patch, ≈ 0.1 mm).
+TEST(MeshWall, RollingAcrossEdgesKeepsFiveSeventhsWithoutForceSpikes) {
+  const double v0 = 0.4;
+  const Roll plane = roll(0, 0.0, 0.0);
+  EXPECT_NEAR(plane.v, 5.0 / 7.0 * v0, 0.01 * 5.0 / 7.0 * v0);
+  for (const auto& [quads, side] : {std::pair{10, 1e-3}, std::pair{20, 0.2e-3}}) {
+    for (double y0 : {0.0, 0.37 * side}) {
+      const Roll m = roll(quads, side, y0);
+      const std::string what =
+          "triangles of " + std::to_string(side) + " m, path y = " + std::to_string(y0);
+      EXPECT_NEAR(m.v, 5.0 / 7.0 * v0, 0.01 * 5.0 / 7.0 * v0) << what;
+      EXPECT_NEAR(m.v, plane.v, 1e-3 * plane.v) << what;
+      EXPECT_EQ(m.most, 1u) << what;
+      EXPECT_LE(m.maxDevFz, plane.maxDevFz + 0.01 * m.weight) << what;
+    }
+  }
+}
+
+namespace {
+/// 200 spheres of 1 mm settled in a vertical cylinder (radius 4 mm, floor at z = 0): the
+/// analytic cylinder with its bottom cap, or the same as a closed STL surface (64 facets
+/// around, so the facets' inner radius is R cos(π/64)).
+double settledWallForceOverWeight(bool stl, double* sideForce) {
+  DemConfig c;
+  c.materials[0].kn = 100; // as PackedBed.SettledBedWallForceEqualsWeight
+  c.materials[0].en = 0.3;
+  c.materials[0].mu = 0.3;
+  const double d = 1e-3, R = 4e-3, H = 40e-3;
+  if (stl) {
+    c.meshes.push_back(
+        meshWall(meshRevolved({0, 0, 0}, {0, 0, 1}, {{{0.0, R}, {H, R}}}, 64, true, true)));
+  } else {
+    c.walls.push_back(
+        Wall::cylinder({0, 0, 0}, {0, 0, 1}, R, 0.0, H, WallSide::Inside, true, true));
+  }
+  ParticleSet s;
+  s.packing = Packing::Random;
+  s.count = 200;
+  s.diameter = d;
+  const double a = 0.99 * R * std::cos(kPi / 64) / std::sqrt(2.0); // a square inside the facets
+  s.regionMin = {-a, -a, 0};
+  s.regionMax = {a, a, 0.9 * H};
+  s.seed = 7;
+  c.particleSets.push_back(s);
+  DemSystem sys(c, BackendKind::Cpu, 1);
+  const double dtCfd = 1e-3;
+  const int nSub = TimeHandler::subStepsFor(dtCfd, sys.dtDemMax());
+  for (int k = 0; k < 500; ++k)
+    sys.advance(dtCfd, nSub);
+  const ParticleData p = sys.particles();
+  double weight = 0, vmax = 0;
+  for (std::size_t i = 0; i < p.count; ++i) {
+    weight += p.mass[i] * 9.81;
+    vmax =
+        std::max(vmax, std::hypot(p.velocity[3 * i], p.velocity[3 * i + 1], p.velocity[3 * i + 2]));
+  }
+  EXPECT_LT(vmax, 1e-3) << "bed not settled";
+  std::array<double, 3> mean{0, 0, 0};
+  const int samples = 200;
+  for (int k = 0; k < samples; ++k) {
+    sys.advance(sys.dtDemMax(), 1);
+    const auto f = sys.wallForce();
+    for (int q = 0; q < 3; ++q)
+      mean[q] += f[q] / samples;
+  }
+  *sideForce = std::hypot(mean[0], mean[1]) / weight;
+  EXPECT_GT(sys.pairContactCount(), p.count);
+  return mean[2] / weight;
+}
+} // namespace
+
+// A packed bed in a cylinder: the walls (side and floor together) carry its weight to 0.1 %,
+// with no net sideways force, for the analytic cylinder and its STL.
+TEST(CylinderWall, PackedBedWallForceEqualsWeightPrimitiveAndStl) {
+  for (bool stl : {false, true}) {
+    double side = 1.0;
+    const double ratio = settledWallForceOverWeight(stl, &side);
+    EXPECT_NEAR(ratio, 1.0, 1e-3) << (stl ? "STL cylinder" : "analytic cylinder");
+    EXPECT_LT(side, 1e-3) << (stl ? "STL cylinder" : "analytic cylinder");
+  }
+}
