@@ -24,7 +24,9 @@
 /// cylinder (`infinite`) is one segment r = r_0 over every t.
 ///
 /// For each touch: distance h from the centre to the surface (signed on a one-sided wall's
-/// face, negative behind it) and the unit normal n̂ from the wall towards the centre; then
+/// face, negative behind it: a particle pushed slightly through is pushed back; one behind a
+/// revolved wall's face by more than the reach is on its far side and does not touch it) and the
+/// unit normal n̂ from the wall towards the centre; then
 ///   overlap δ_n = R − h,  contact normal (i → wall) n = −n̂,  lever arm L = R − δ_n,
 ///   v_ij = v_i + L ω_i × n.
 
@@ -110,7 +112,8 @@ DEM_HD int wallTouches(const Wall& w, Vec3 x, double reach, WallTouch* out) {
     } else if (w.side == 0 && hSigned < 0.0) {
       h = -hSigned, nt = -nt, nr = -nr;
     }
-    if (h < reach && count < kMaxWallTouches)
+    // Behind a one-sided face by more than the reach: the far side of the wall, no touch.
+    if (h < reach && h > -reach && count < kMaxWallTouches)
       out[count++] = WallTouch{h, toSpace(nt, nr), feature};
   };
   if (w.infinite) {
@@ -144,7 +147,7 @@ DEM_HD int wallTouches(const Wall& w, Vec3 x, double reach, WallTouch* out) {
   return count;
 }
 
-/// Smallest distance (m) from x to the wall's surface, negative behind a one-sided face: no
+/// Smallest distance (m) from x to the wall's surface (a plane: signed, negative behind it): no
 /// touch with reach ≤ this is possible until x moves (a bound for candidate lists).
 DEM_HD double wallClearance(const Wall& w, Vec3 x) {
   if (w.kind == kWallPlane)
@@ -154,7 +157,7 @@ DEM_HD double wallClearance(const Wall& w, Vec3 x) {
   const Vec3 rv = d - tx * w.normal;
   const double s = ::sqrt(dot(rv, rv));
   if (w.infinite)
-    return w.side == 1 ? w.r[0] - s : (w.side == -1 ? s - w.r[0] : ::fabs(w.r[0] - s));
+    return ::fabs(w.r[0] - s);
   double best = HUGE_VAL;
   for (int k = 0; k + 1 < w.points; ++k) {
     const double dt = w.t[k + 1] - w.t[k], dr = w.r[k + 1] - w.r[k];
@@ -163,12 +166,7 @@ DEM_HD double wallClearance(const Wall& w, Vec3 x) {
     double lam = l2 > 0.0 ? (pt * dt + pr * dr) / l2 : 0.0;
     lam = lam < 0.0 ? 0.0 : (lam > 1.0 ? 1.0 : lam);
     const double et = pt - lam * dt, es = pr - lam * dr;
-    double h = ::sqrt(et * et + es * es);
-    if (l2 > 0.0 && w.side != 0) {
-      const double hs = (pt * dr - pr * dt) / ::sqrt(l2) * static_cast<double>(w.side);
-      if (hs < 0.0)
-        h = hs; // behind the face (or its extension): as close as it gets
-    }
+    const double h = ::sqrt(et * et + es * es);
     best = h < best ? h : best;
   }
   return best;
