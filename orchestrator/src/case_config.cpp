@@ -9,6 +9,7 @@
 
 #include <coredem/common/yaml_section.h>
 #include <coredem/dem/models.h>
+#include <coredem/dem/triangle_mesh.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/participants.h>
@@ -334,7 +335,161 @@ void checkIdealGas(const Section& top, CaseConfig& c) {
   p.cp = s.cp;
 }
 
+/// The axis of a cylinder or cone: nonzero, returned normalised.
+Vec3 wallAxis(const Section& s) {
+  Vec3 a = s.vec3("axis", std::nullopt, "axis direction, e.g. [0, 0, 1]");
+  const double len = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  if (!(len > 0.0) || !std::isfinite(len)) {
+    s.fail(s.markOf("axis"), s.full("axis"), "must be a nonzero direction, e.g. [0, 0, 1]");
+  }
+  for (double& x : a) {
+    x /= len;
+  }
+  return a;
+}
+
+/// side and caps of a cylinder or cone (caps need a finite extent).
+void wallSideAndCaps(const Section& s, RevolvedWallConfig& r) {
+  r.side = s.choice("side", std::string("inside"), {"inside", "outside", "both"});
+  if (!s.has("caps")) {
+    return;
+  }
+  const YAML::Node caps = s.raw("caps");
+  if (!caps.IsSequence()) {
+    s.fail(s.markOf("caps"), s.full("caps"),
+           fmt::format("expected a list of the ends to close: [], [start], [end] or [start, end]; "
+                       "got {}",
+                       describe(caps)));
+  }
+  for (std::size_t k = 0; k < caps.size(); ++k) {
+    const std::string key = fmt::format("{}[{}]", s.full("caps"), k);
+    if (!caps[k].IsScalar() || (caps[k].Scalar() != "start" && caps[k].Scalar() != "end")) {
+      s.fail(caps[k].Mark(), key,
+             fmt::format("{} is not an end; allowed: start, end", describe(caps[k])));
+    }
+    bool& cap = caps[k].Scalar() == "start" ? r.capStart : r.capEnd;
+    if (cap) {
+      s.fail(caps[k].Mark(), key, fmt::format("'{}' is listed twice", caps[k].Scalar()));
+    }
+    cap = true;
+  }
+  if ((r.capStart || r.capEnd) && !r.finite) {
+    s.fail(s.markOf("caps"), s.full("caps"),
+           "an infinite cylinder has no ends to cap; give 'from' and 'to' (m along the axis) or "
+           "remove 'caps'");
+  }
+}
+
+/// The axial extent from/to of a cylinder (both or neither) or a cone (both required).
+void wallExtent(const Section& s, RevolvedWallConfig& r) {
+  if (r.cone) {
+    s.require("from", "m along the axis from 'point' where the cone starts");
+    s.require("to", "m along the axis from 'point' where the cone ends, > from");
+  } else if (s.has("from") != s.has("to")) {
+    const std::string given = s.has("from") ? "from" : "to";
+    s.fail(s.markOf(given), s.full(given),
+           "give both 'from' and 'to' (a finite cylinder) or neither (an infinite cylinder)");
+  }
+  r.finite = s.has("from");
+  if (!r.finite) {
+    return;
+  }
+  r.from = s.number("from", std::nullopt, -kBig, kBig, "m along the axis from 'point'");
+  r.to = s.number("to", std::nullopt, -kBig, kBig, "m along the axis from 'point', > from");
+  if (!(r.to > r.from)) {
+    s.fail(s.markOf("to"), s.full("to"),
+           fmt::format("{} m must exceed from = {} m (the axis points from 'from' to 'to')", r.to,
+                       r.from));
+  }
+}
+
+/// walls.cylinders, walls.cones, walls.meshes (protocol v1.4; docs/case-schema.md "walls").
+void parseWallShapes(const Section& w, CaseConfig& c) {
+  if (w.has("cylinders")) {
+    for (const auto& s :
+         w.list("cylinders", {"point", "axis", "radius", "from", "to", "side", "caps"},
+                "cylinder walls")) {
+      RevolvedWallConfig r;
+      r.index = c.walls.revolved.size();
+      r.point = s.vec3("point", std::nullopt, "m, a point on the axis");
+      r.axis = wallAxis(s);
+      r.radiusFrom = r.radiusTo = s.number("radius", std::nullopt, 0.0, kBig, "m, > 0", true);
+      wallExtent(s, r);
+      wallSideAndCaps(s, r);
+      c.walls.revolved.push_back(r);
+    }
+  }
+  if (w.has("cones")) {
+    std::size_t index = 0;
+    for (const auto& s : w.list(
+             "cones", {"point", "axis", "from", "to", "radius_from", "radius_to", "side", "caps"},
+             "cone (frustum) walls")) {
+      RevolvedWallConfig r;
+      r.cone = true;
+      r.index = index++;
+      r.point = s.vec3("point", std::nullopt, "m, a point on the axis");
+      r.axis = wallAxis(s);
+      wallExtent(s, r);
+      r.radiusFrom = s.number("radius_from", std::nullopt, 0.0, kBig, "m at 'from', >= 0");
+      r.radiusTo = s.number("radius_to", std::nullopt, 0.0, kBig, "m at 'to', >= 0");
+      if (!(r.radiusFrom > 0.0 || r.radiusTo > 0.0)) {
+        s.fail(s.markOf("radius_to"), s.full("radius_to"),
+               "a cone needs a radius > 0 at one end at least (radius_from or radius_to)");
+      }
+      wallSideAndCaps(s, r);
+      c.walls.revolved.push_back(r);
+    }
+  }
+  if (!w.has("meshes")) {
+    return;
+  }
+  // The walls are expected inside the coupling grid (pre-flight checks that too): a mesh far
+  // larger than the grid is probably in millimetres. The grid is required in every case, so it is
+  // always the domain (a DEM-only case still has one, covering its walls).
+  std::array<double, 6> domain{};
+  for (int d = 0; d < 3; ++d) {
+    domain[std::size_t(d)] = c.grid.origin[std::size_t(d)];
+    domain[std::size_t(d) + 3] =
+        c.grid.origin[std::size_t(d)] +
+        c.grid.spacing[std::size_t(d)] * double(c.grid.cells[std::size_t(d)]);
+  }
+  for (const auto& s : w.list("meshes", {"file", "scale", "closed"}, "triangle-mesh walls")) {
+    MeshWallConfig m;
+    m.file = s.string("file", std::nullopt, "STL file, relative to the case folder");
+    m.scale = s.number("scale", 1.0, 0.0, kBig,
+                       "factor to metres, > 0 (1: file in m, 0.001: file in mm)", true);
+    m.closed = s.onOff("closed", false);
+    // Relative to the case folder, like initial_state and cfd.case: a resumed run finds the file
+    // through run.json's case_dir, a campaign member through the links to the base case's files.
+    m.path = fs::absolute(c.caseDir / m.file);
+    if (!fs::is_regular_file(m.path)) {
+      s.fail(s.markOf("file"), s.full("file"),
+             fmt::format("file '{}' not found (looked for {}); give an STL file (ASCII or binary) "
+                         "relative to the case folder",
+                         m.file, m.path.string()));
+    }
+    try {
+      dem::TriangleMesh mesh = dem::readStl(m.path, dem::StlOptions{m.scale});
+      mesh.name = m.file;
+      dem::checkMesh(mesh, dem::MeshCheckOptions{m.closed, domain});
+      m.vertices = std::move(mesh.vertices);
+      m.triangles = std::move(mesh.triangles);
+    } catch (const dem::MeshError& e) {
+      std::string what = e.what();
+      if (m.closed && what.find("not closed") != std::string::npos) {
+        what += fmt::format(" (or set {}: false for an open wall)", s.full("closed"));
+      }
+      s.fail(s.markOf("file"), s.full("file"), what);
+    }
+    c.walls.meshes.push_back(std::move(m));
+  }
+}
+
 } // namespace
+
+std::string RevolvedWallConfig::key() const {
+  return fmt::format("walls.{}[{}]", cone ? "cones" : "cylinders", index);
+}
 
 int materialIndex(const CaseConfig& config, const std::string& name) {
   for (std::size_t i = 0; i < config.materials.size(); ++i) {
@@ -617,7 +772,8 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   }
 
   if (top.has("walls")) {
-    const Section w = top.section("walls", {"box", "planes", "material", "thermal", "temperature"});
+    const Section w = top.section("walls", {"box", "planes", "cylinders", "cones", "meshes",
+                                            "material", "thermal", "temperature"});
     if (w.has("box")) {
       const Section b = w.section("box", {"min", "max"});
       c.walls.box =
@@ -629,6 +785,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
                                   pl.vec3("normal", std::nullopt, "into the domain")});
       }
     }
+    parseWallShapes(w, c);
     c.walls.material = w.string("material", c.materials.front().name, "material of the walls");
     if (materialIndex(c, c.walls.material) < 0) {
       w.fail(w.markOf("material"), "walls.material",

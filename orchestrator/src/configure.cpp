@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
 
 #include <coredem/protocol/coupling_scheme.h>
 
@@ -123,6 +124,31 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
     *p->mutable_point() = vec(pl.point);
     *p->mutable_normal() = vec(pl.normal);
   }
+  // v1.4: cylinders and cones, triangle meshes (the session refuses a server below 1.4 first).
+  for (const auto& r : c.walls.revolved) {
+    auto* w = walls->add_revolved();
+    *w->mutable_point() = vec(r.point);
+    *w->mutable_axis() = vec(r.axis);
+    w->set_cone(r.cone);
+    w->set_radius_start(r.radiusFrom);
+    w->set_radius_end(r.radiusTo);
+    w->set_infinite(!r.finite);
+    if (r.finite) {
+      w->set_start(r.from);
+      w->set_end(r.to);
+    }
+    w->set_side(r.side == "outside"
+                    ? v1::WALL_SIDE_OUTSIDE
+                    : (r.side == "both" ? v1::WALL_SIDE_BOTH : v1::WALL_SIDE_INSIDE));
+    w->set_cap_start(r.capStart);
+    w->set_cap_end(r.capEnd);
+  }
+  for (const auto& m : c.walls.meshes) {
+    auto* w = walls->add_meshes();
+    w->set_name(m.file); // as in case.yaml: part of the DEM's config hash, stable across restarts
+    w->mutable_vertices()->Add(m.vertices.begin(), m.vertices.end());
+    w->mutable_triangles()->Add(m.triangles.begin(), m.triangles.end());
+  }
   walls->set_material_id(std::uint32_t(std::max(0, materialIndex(c, c.walls.material))));
   walls->set_temperature(c.walls.temperature);
   *cfg.mutable_gravity() = vec(c.gravity);
@@ -145,6 +171,62 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
   cfg.set_output_directory(fs::absolute(runDir).string());
   addChemistryToConfigure(c, cfg); // v1.1: solid species, reactions, chemistry
   return cfg;
+}
+
+std::string demVersionRefusal(const CaseConfig& c, std::uint32_t agreedMajor,
+                              std::uint32_t agreedMinor) {
+  // Chemistry travels in Configure fields of protocol v1.1, which a v1.0 server would ignore.
+  if (c.usesChemistry() && agreedMinor < 1) {
+    return fmt::format("the DEM server speaks protocol {}.{}, but this case uses chemistry "
+                       "(solid_species, reactions or chemistry), which needs protocol 1.1; use a "
+                       "coredem-dem built from this release",
+                       agreedMajor, agreedMinor);
+  }
+  // Cylinders, cones and meshes travel in Walls fields of v1.4: an older server would run
+  // without those walls and let the particles fall through them.
+  if (c.usesWallShapes() && agreedMinor < protocol::kMinorWallShapes) {
+    std::string what;
+    const auto add = [&](const std::string& item) { what += (what.empty() ? "" : ", ") + item; };
+    std::size_t cylinders = 0, cones = 0;
+    for (const auto& r : c.walls.revolved) {
+      ++(r.cone ? cones : cylinders);
+    }
+    if (cylinders > 0) {
+      add(fmt::format("{} in walls.cylinders", cylinders));
+    }
+    if (cones > 0) {
+      add(fmt::format("{} in walls.cones", cones));
+    }
+    if (!c.walls.meshes.empty()) {
+      add(fmt::format("{} in walls.meshes", c.walls.meshes.size()));
+    }
+    return fmt::format("the DEM server speaks protocol {}.{}, but this case has cylinder, cone or "
+                       "mesh walls ({}), which need protocol 1.{} (this coredem speaks {}); an "
+                       "older server would ignore them and the particles would pass through. Use "
+                       "a coredem-dem built from this release, or give the walls as walls.box and "
+                       "walls.planes",
+                       agreedMajor, agreedMinor, what, protocol::kMinorWallShapes,
+                       protocol::kProtocolVersion.toString());
+  }
+  return {};
+}
+
+std::string configureSizeRefusal(const v1::Configure& configure, std::int64_t maxBytes) {
+  const auto bytes = static_cast<std::int64_t>(configure.ByteSizeLong());
+  // The envelope around the body and the server's allowance of 4 KiB for it are left as slack.
+  if (maxBytes <= 0 || bytes <= maxBytes) {
+    return {};
+  }
+  std::uint64_t triangles = 0;
+  for (const auto& m : configure.walls().meshes()) {
+    triangles += std::uint64_t(m.triangles_size()) / 3;
+  }
+  return fmt::format("the Configure message is {:.1f} MiB ({} triangles in walls.meshes), more "
+                     "than the DEM server's message limit of {:.0f} MiB (coredem-dem "
+                     "--max-message-mb), which would close the connection without a reply; "
+                     "coarsen the mesh walls (about 24 bytes per triangle of a welded mesh) or "
+                     "start coredem-dem with a larger --max-message-mb and give it as dem.endpoint",
+                     double(bytes) / 1048576.0, triangles, double(maxBytes) / 1048576.0);
 }
 
 std::string couplingSchemeMismatch(const CaseConfig& c, const v1::StepDone& demDone,

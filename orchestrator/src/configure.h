@@ -23,6 +23,18 @@ SubcyclePlan planFor(const CaseConfig& c, double dt, double dtDemMax);
 v1::Configure buildConfigure(const CaseConfig& c, const std::filesystem::path& runDir, double dtCfd,
                              const SubcyclePlan& plan);
 
+/// Why this case cannot be sent to a DEM server that agreed protocol `agreedMajor`.`agreedMinor`
+/// (a Configure field it would ignore), or "" when it can: chemistry needs 1.1, cylinder, cone
+/// and mesh walls need 1.4 (protocol::kMinorWallShapes). The text names both versions, what needs
+/// the newer one and what to do.
+std::string demVersionRefusal(const CaseConfig& c, std::uint32_t agreedMajor,
+                              std::uint32_t agreedMinor);
+
+/// Why `configure` is too large for a DEM server that accepts messages of at most `maxBytes`
+/// (coredem-dem --max-message-mb; a larger frame closes the connection without a reply), or ""
+/// when it fits. Names the size, the limit and the mesh walls' triangles that make it large.
+std::string configureSizeRefusal(const v1::Configure& configure, std::int64_t maxBytes);
+
 /// Why the DEM server's StepDone of `step` does not match the case's coupling scheme
 /// (docs/coupling-schemes.md "How the scheme is negotiated"), or "" when it does: a staggered
 /// server reports the diagnostic coupling_lag_steps = 1, a sequential one none.

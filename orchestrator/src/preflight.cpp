@@ -15,6 +15,7 @@
 #include <coredem/common/yaml_section.h>
 #include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/preflight.h>
+#include <coredem/orchestrator/wall_geometry.h>
 
 namespace fs = std::filesystem;
 
@@ -746,6 +747,48 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
     }
   }
 
+  // Cylinders and cones that hold the particles (side inside or both) and mesh walls inside the
+  // coupling grid too. A wall the particles are outside of (an insert) bounds nothing; the axial
+  // directions of an infinite cylinder are unbounded and left to the other walls.
+  for (const auto& w : c.walls.revolved) {
+    if (w.side == "outside") {
+      continue;
+    }
+    const Bounds wb = wallBounds(w);
+    Box b{wb.lo, wb.hi};
+    for (std::size_t d = 0; d < 3; ++d) {
+      b.lo[d] = std::isfinite(b.lo[d]) ? b.lo[d] : grid.lo[d];
+      b.hi[d] = std::isfinite(b.hi[d]) ? b.hi[d] : grid.hi[d];
+    }
+    const std::string why = outside(b, grid, tol);
+    if (!why.empty()) {
+      at.fail({"walls", w.cone ? "cones" : "cylinders", std::to_string(w.index)}, w.key(),
+              fmt::format("the {} spans {}, beyond the coupling grid {} ({}); particles outside "
+                          "the grid get no gas forces: enlarge grid.cells or grid.origin, or move "
+                          "or shrink the wall",
+                          w.cone ? "cone" : "cylinder", fmtBox(b), fmtBox(grid), why));
+    }
+  }
+  for (std::size_t k = 0; k < c.walls.meshes.size(); ++k) {
+    const Bounds mb = meshBounds(c.walls.meshes[k]);
+    const Box b{mb.lo, mb.hi};
+    const std::string why = outside(b, grid, tol);
+    if (!why.empty()) {
+      at.fail({"walls", "meshes", std::to_string(k), "file"},
+              fmt::format("walls.meshes[{}].file", k),
+              fmt::format("the mesh '{}' spans {}, beyond the coupling grid {} ({}); enlarge "
+                          "grid.cells or grid.origin, or check the mesh's position and scale",
+                          c.walls.meshes[k].file, fmtBox(b), fmtBox(grid), why));
+    }
+  }
+  // Closed mesh walls hold the particles: their inside, for the test of every set below.
+  std::vector<std::optional<ClosedSurface>> closed(c.walls.meshes.size());
+  for (std::size_t k = 0; k < c.walls.meshes.size(); ++k) {
+    if (c.walls.meshes[k].closed) {
+      closed[k].emplace(c.walls.meshes[k].vertices, c.walls.meshes[k].triangles);
+    }
+  }
+
   for (std::size_t i = 0; i < c.particles.size(); ++i) {
     const auto& p = c.particles[i];
     const std::string idx = std::to_string(i);
@@ -799,6 +842,55 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
                               "wall; move the region to the side the normal points to",
                               setName(p, i), fmtVec(x), dist, k, fmtVec(pl.point),
                               fmtVec(pl.normal), r));
+        }
+      }
+    }
+    // Inside every cylinder and cone that holds the particles, where its extent reaches them:
+    // the centres (explicit, or the corners of the region of centres cut to the wall's extent,
+    // which bound the convex excess over the radius) at least a radius from the lateral surface.
+    for (const auto& w : c.walls.revolved) {
+      if (w.side != "inside") {
+        continue;
+      }
+      std::vector<Vec3> centres = p.positions;
+      if (centres.empty()) {
+        Bounds box;
+        for (std::size_t d = 0; d < 3; ++d) {
+          box.lo[d] = std::min(p.regionMin[d] + r, p.regionMax[d] - r);
+          box.hi[d] = std::max(p.regionMax[d] - r, p.regionMin[d] + r);
+        }
+        centres = cornersWithinExtent(box, w);
+      }
+      for (const auto& x : centres) {
+        const std::optional<double> clear = insideClearance(w, x);
+        if (clear && *clear < r * (1.0 - kMaxInitialOverlapFraction) - tol) {
+          at.fail(where, key,
+                  fmt::format("{}: a particle centre at {} (axial coordinate {:.6g} m) is {:.6g} m "
+                              "inside the {} {}, less than the particle radius {:.6g} m: the "
+                              "particles would start in or beyond its wall; move the {} towards "
+                              "the axis (point {}, axis {}), shrink it, or widen the {}",
+                              setName(p, i), fmtVec(x), axialCoordinate(w, x), *clear,
+                              w.cone ? "cone" : "cylinder", w.key(), r,
+                              p.positions.empty() ? "region" : "positions", fmtVec(w.point),
+                              fmtVec(w.axis), w.cone ? "cone" : "cylinder"));
+        }
+      }
+    }
+    // Inside every closed mesh wall: the centres (explicit, or the corners of the region).
+    for (std::size_t k = 0; k < closed.size(); ++k) {
+      if (!closed[k]) {
+        continue;
+      }
+      for (const auto& x : extremeCentres(p)) {
+        if (!closed[k]->contains(x)) {
+          at.fail(where, key,
+                  fmt::format("{}: the particle centre {} lies outside the closed mesh wall "
+                              "walls.meshes[{}] ('{}', spanning {}); move the {} inside the "
+                              "surface, or check the mesh's position and scale",
+                              setName(p, i), fmtVec(x), k, c.walls.meshes[k].file,
+                              fmtBox(Box{meshBounds(c.walls.meshes[k]).lo,
+                                         meshBounds(c.walls.meshes[k]).hi}),
+                              p.positions.empty() ? "region" : "positions"));
         }
       }
     }

@@ -121,14 +121,12 @@ void Session::startDem() {
              welcome.envelope().welcome().software_version(),
              welcome.envelope().welcome().protocol_major(),
              welcome.envelope().welcome().protocol_minor());
-  // Chemistry travels in Configure fields of protocol v1.1, which a v1.0 server would ignore.
-  if (_c.usesChemistry() && welcome.envelope().welcome().protocol_minor() < 1) {
-    throw ParticipantFault(
-        kDemName, fmt::format("the DEM server speaks protocol {}.{}, but this case uses chemistry "
-                              "(solid_species, reactions or chemistry), which needs protocol 1.1; "
-                              "use a coredem-dem built from this release",
-                              welcome.envelope().welcome().protocol_major(),
-                              welcome.envelope().welcome().protocol_minor()));
+  // Configure fields the agreed version does not have (chemistry: 1.1, wall shapes: 1.4) would
+  // be ignored by the server: refuse before sending.
+  if (const std::string why = demVersionRefusal(_c, welcome.envelope().welcome().protocol_major(),
+                                                welcome.envelope().welcome().protocol_minor());
+      !why.empty()) {
+    throw ParticipantFault(kDemName, why);
   }
 }
 
@@ -203,6 +201,15 @@ void Session::configureDem(std::int64_t startStep, double startTime, const fs::p
   _configure.set_start_time(startTime);
   if (!initialState.empty()) {
     _configure.set_initial_state_file(fs::absolute(initialState).string());
+  }
+  // A Configure with large mesh walls may exceed the server's message limit: the server started
+  // here has the default limit; one at dem.endpoint may have been given a larger one.
+  if (const std::string why = configureSizeRefusal(_configure, protocol::kDefaultMaxMessageBytes);
+      !why.empty()) {
+    if (_c.dem.endpoint.empty()) {
+      throw CaseError(why);
+    }
+    _log->warn("{} (unless the server at {} was started with a larger limit)", why, _demEndpoint);
   }
   Message msg = protocol::makeConfigure(_configure);
   msg.setSessionId(_session).setStep(startStep).setTime(startTime);

@@ -612,6 +612,45 @@ Status validateConfigure(const v1::Configure& c) {
       return bad("a wall plane has a zero normal");
     }
   }
+  // v1.4: cylinders, cones and meshes (the DEM server checks their geometry when it builds the
+  // system; here the structure a reader relies on).
+  for (int i = 0; i < c.walls().revolved_size(); ++i) {
+    const auto& r = c.walls().revolved(i);
+    const std::string which = "walls.revolved[" + std::to_string(i) + "]";
+    if (!finite3(r.point()) || !finite3(r.axis()) ||
+        (r.axis().x() == 0 && r.axis().y() == 0 && r.axis().z() == 0)) {
+      return bad(which + " needs a finite point and a finite nonzero axis");
+    }
+    if (!(r.radius_start() >= 0) || !(r.radius_end() >= 0) || !std::isfinite(r.radius_start()) ||
+        !std::isfinite(r.radius_end())) {
+      return bad(which + " needs finite radii >= 0");
+    }
+    if (r.infinite()
+            ? r.cone()
+            : !(std::isfinite(r.start()) && std::isfinite(r.end()) && r.start() < r.end())) {
+      return bad(which + (r.cone() ? " (a cone) needs a finite extent start < end"
+                                   : " needs start < end, both finite, or infinite = true"));
+    }
+  }
+  for (int i = 0; i < c.walls().meshes_size(); ++i) {
+    const auto& m = c.walls().meshes(i);
+    const std::string which =
+        "walls.meshes[" + std::to_string(i) + "] ('" + printable(m.name()) + "')";
+    if (m.vertices_size() == 0 || m.vertices_size() % 3 != 0 || m.triangles_size() == 0 ||
+        m.triangles_size() % 3 != 0) {
+      return bad(which + " needs vertices as x,y,z triples and triangles as index triples (" +
+                 std::to_string(m.vertices_size()) + " vertex values, " +
+                 std::to_string(m.triangles_size()) + " index values)");
+    }
+    const std::int64_t nv = m.vertices_size() / 3;
+    for (int t = 0; t < m.triangles_size(); ++t) {
+      if (m.triangles(t) < 0 || m.triangles(t) >= nv) {
+        return bad(which + " triangle " + std::to_string(t / 3) + " names vertex " +
+                   std::to_string(m.triangles(t)) + ", not one of its " + std::to_string(nv) +
+                   " vertices");
+      }
+    }
+  }
   return {};
 }
 

@@ -10,6 +10,8 @@
 // contributions for the coupling cell it touches, docs/protocol.md "Decomposed CFD").
 // v1.3 (MINOR 3): the v1.2 messages with minor 3 in Hello/Welcome/Reject and the partial Sources
 // also carrying Q_rad (the radiation heat the particles gave the gas) for its one cell.
+// v1.4 (MINOR 4): the v1.3 messages with minor 4 in Hello/Welcome/Reject and a Configure whose
+// walls also hold a capped cylinder, a cone and a two-triangle mesh (walls.revolved, .meshes).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -175,6 +177,41 @@ void addV11(v1::Configure& c) {
   ch->set_reaction_heat(false);
 }
 
+/// v1.4 additions to the golden Configure (tests/unit/protocol/golden_v1_4_test.cpp checks them):
+/// a cylinder, a cone and a mesh wall.
+void addV14(v1::Configure& c) {
+  auto* w = c.mutable_walls();
+  auto* cyl = w->add_revolved();
+  cyl->mutable_point()->set_y(0.5);
+  cyl->mutable_point()->set_z(0.25);
+  cyl->mutable_axis()->set_z(1.0);
+  cyl->set_radius_start(0.5);
+  cyl->set_radius_end(0.5);
+  cyl->set_start(0.0);
+  cyl->set_end(2.0);
+  cyl->set_side(v1::WALL_SIDE_INSIDE);
+  cyl->set_cap_start(true);
+  auto* cone = w->add_revolved();
+  cone->set_cone(true);
+  cone->mutable_point()->set_y(0.5);
+  cone->mutable_point()->set_z(0.25);
+  cone->mutable_axis()->set_z(2.0); // need not be unit length
+  cone->set_radius_start(0.125);
+  cone->set_radius_end(0.375);
+  cone->set_start(0.5);
+  cone->set_end(1.5);
+  cone->set_side(v1::WALL_SIDE_OUTSIDE);
+  cone->set_cap_end(true);
+  auto* mesh = w->add_meshes();
+  mesh->set_name("plate.stl");
+  for (double v : {-0.5, 0.0, 1.0, 0.5, 0.0, 1.0, 0.5, 1.0, 1.0, -0.5, 1.0, 1.0}) {
+    mesh->add_vertices(v);
+  }
+  for (int i : {0, 1, 2, 0, 2, 3}) {
+    mesh->add_triangles(i);
+  }
+}
+
 void addFieldArrays(Message& m, std::span<const fields::FieldSpec> specs,
                     std::uint64_t rows = kCells) {
   std::size_t f = 0;
@@ -197,8 +234,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int minor = argc == 3 ? std::atoi(argv[2]) : 0;
-  if (minor < 0 || minor > 3) {
-    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0, 1, 2 or 3\n");
+  if (minor < 0 || minor > 4) {
+    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0, 1, 2, 3 or 4\n");
     return 2;
   }
   std::filesystem::path dir = argv[1];
@@ -238,6 +275,9 @@ int main(int argc, char** argv) {
     v1::Configure c = goldenConfigure();
     if (minor >= 1) {
       addV11(c);
+    }
+    if (minor >= 4) {
+      addV14(c);
     }
     Message m = makeConfigure(c);
     stamp(m, 2);

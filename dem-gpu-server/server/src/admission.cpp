@@ -124,6 +124,9 @@ std::string admitConfigure(const v1::Configure& c, const Limits& l) {
       {"particle_sets (count)", n(c.particle_sets_size()), l.particleSets, "particle sets"},
       {"reactions (count)", n(c.reactions_size()), l.reactions, "reactions"},
       {"options (count)", n(c.options_size()), l.options, "model options by name"},
+      {"walls.revolved (count)", n(c.walls().revolved_size()), l.revolvedWalls,
+       "cylinder and cone walls"},
+      {"walls.meshes (count)", n(c.walls().meshes_size()), l.meshWalls, "mesh walls"},
       {"sub_cycling.n_sub", c.sub_cycling().n_sub(), l.subSteps,
        "sub-steps per CFD step, coredem-dem --max-sub-steps"},
   };
@@ -152,6 +155,23 @@ std::string admitConfigure(const v1::Configure& c, const Limits& l) {
       return e;
     }
   }
+  // Mesh walls (v1.4): the counts over all meshes before any copy is made.
+  std::uint64_t triangles = 0, vertices = 0;
+  for (const auto& m : c.walls().meshes()) {
+    if (auto e = checkName("walls.meshes name", m.name()); !e.empty()) {
+      return e;
+    }
+    triangles = addSat(triangles, n(m.triangles_size()) / 3);
+    vertices = addSat(vertices, n(m.vertices_size()) / 3);
+  }
+  if (triangles > l.meshTriangles) {
+    return over("walls.meshes[].triangles (total, triangles)", triangles, l.meshTriangles,
+                "mesh-wall triangles; coarsen the STL surfaces");
+  }
+  if (vertices > l.meshVertices) {
+    return over("walls.meshes[].vertices (total, vertices)", vertices, l.meshVertices,
+                "mesh-wall vertices; coarsen the STL surfaces");
+  }
   std::uint64_t particles = 0;
   for (const auto& ps : c.particle_sets()) {
     particles = addSat(particles, ps.count());
@@ -167,13 +187,15 @@ std::string admitConfigure(const v1::Configure& c, const Limits& l) {
     return over("coupling_mesh cells (x*y*z)", cells, l.cells,
                 budget + ", about " + formatBytes(MemoryModel::kCellBase) + " per cell");
   }
-  const std::uint64_t need = estimateBytes(particles, cells, n(c.species_size()),
-                                           n(c.solid_species_size()), n(c.materials_size()));
+  const std::uint64_t need = addSat(estimateBytes(particles, cells, n(c.species_size()),
+                                                  n(c.solid_species_size()), n(c.materials_size())),
+                                    mulSat(triangles, MemoryModel::kMeshTriangle));
   if (need > l.memoryBytes) {
     return "Configure: the estimated memory " + formatBytes(need) + " (" + count(particles) +
            " particles, " + count(cells) + " cells, " + std::to_string(c.species_size()) +
-           " gas species, " + std::to_string(c.materials_size()) + " materials) exceeds the " +
-           budget + "; give fewer particles or cells, or raise --max-memory";
+           " gas species, " + std::to_string(c.materials_size()) + " materials" +
+           (triangles > 0 ? ", " + count(triangles) + " mesh-wall triangles" : std::string()) +
+           ") exceeds the " + budget + "; give fewer particles or cells, or raise --max-memory";
   }
   return {};
 }

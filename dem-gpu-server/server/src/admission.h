@@ -22,6 +22,9 @@ struct MemoryModel {
   static constexpr std::uint64_t kCellPerSpecies = 48;
   /// Per material pair (the pair table is n_materials^2).
   static constexpr std::uint64_t kMaterialPair = 64;
+  /// Per mesh-wall triangle: the message copy, the DemConfig copy, the engine's triangle with its
+  /// edge and vertex ids, the binned search.
+  static constexpr std::uint64_t kMeshTriangle = 512;
 };
 
 struct Limits {
@@ -33,7 +36,12 @@ struct Limits {
   std::uint64_t solidSpecies = 256;
   std::uint64_t particleSets = 4096;
   std::uint64_t reactions = 1024;
-  std::uint64_t options = 256;     ///< Configure.options entries
+  std::uint64_t options = 256;        ///< Configure.options entries
+  std::uint64_t revolvedWalls = 4096; ///< Configure.walls.revolved (cylinders, cones)
+  std::uint64_t meshWalls = 256;      ///< Configure.walls.meshes
+  /// Triangles and vertices over all mesh walls (a 10^6-triangle STL is 1-3·10^6 vertices).
+  std::uint64_t meshTriangles = std::uint64_t{1} << 24;
+  std::uint64_t meshVertices = std::uint64_t{3} << 24;
   std::uint64_t subSteps = 100000; ///< n_sub of a StepGrant (--max-sub-steps)
   std::uint64_t nameBytes = 256;   ///< any name or option key/value
 };

@@ -2,6 +2,7 @@
 #include "configure_map.h"
 
 #include <algorithm>
+#include <limits>
 #include <map>
 
 #include "coredem/common/check.h"
@@ -240,6 +241,47 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   }
   for (const auto& p : c.walls().planes()) {
     cfg.walls.push_back(dem::Wall::plane(vec(p.point()), vec(p.normal())));
+  }
+  // v1.4: cylinders and cones (their geometry is checked when the system is built), meshes.
+  for (int i = 0; i < c.walls().revolved_size(); ++i) {
+    const auto& r = c.walls().revolved(i);
+    dem::WallSide side = dem::WallSide::Inside;
+    switch (r.side()) {
+    case v1::WALL_SIDE_UNSPECIFIED:
+    case v1::WALL_SIDE_INSIDE:
+      break;
+    case v1::WALL_SIDE_OUTSIDE:
+      side = dem::WallSide::Outside;
+      break;
+    case v1::WALL_SIDE_BOTH:
+      side = dem::WallSide::Both;
+      break;
+    default:
+      COREDEM_CHECK(false,
+                    "Configure: walls.revolved[{}] has an unknown side {}; use WALL_SIDE_INSIDE, "
+                    "OUTSIDE or BOTH",
+                    i, static_cast<int>(r.side()));
+    }
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    const double start = r.infinite() ? -kInf : r.start();
+    const double end = r.infinite() ? kInf : r.end();
+    cfg.walls.push_back(
+        r.cone() ? dem::Wall::cone(vec(r.point()), vec(r.axis()), start, end, r.radius_start(),
+                                   r.radius_end(), side, r.cap_start(), r.cap_end())
+                 : dem::Wall::cylinder(vec(r.point()), vec(r.axis()), r.radius_start(), start, end,
+                                       side, r.cap_start(), r.cap_end()));
+  }
+  for (int i = 0; i < c.walls().meshes_size(); ++i) {
+    const auto& m = c.walls().meshes(i);
+    COREDEM_CHECK(m.vertices_size() % 3 == 0 && m.triangles_size() % 3 == 0,
+                  "Configure: walls.meshes[{}] ('{}') has {} vertex values and {} index values; "
+                  "give x,y,z triples and index triples",
+                  i, m.name(), m.vertices_size(), m.triangles_size());
+    dem::MeshWall d;
+    d.name = m.name().empty() ? "mesh-" + std::to_string(i) : m.name();
+    d.vertices.assign(m.vertices().begin(), m.vertices().end());
+    d.triangles.assign(m.triangles().begin(), m.triangles().end());
+    cfg.meshes.push_back(std::move(d));
   }
   cfg.wallTemperature = c.walls().temperature(); // 0 = adiabatic (docs/heat-coupling.md "Walls")
   if (c.walls().temperature() > 0.0) {

@@ -151,7 +151,7 @@ def main():
             hello.hello.role = common.ROLE_CFD
             welcome, _ = request(hello)
             assert welcome.type == common.MESSAGE_TYPE_WELCOME
-            assert welcome.welcome.protocol_minor == 3  # min(server 1.3, client 1.7)
+            assert welcome.welcome.protocol_minor == 4  # min(server 1.4, client 1.7)
             session = welcome.welcome.session_id
 
             nx, ny, nz, ns = 4, 3, 2, 2

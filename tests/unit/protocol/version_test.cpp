@@ -28,18 +28,21 @@ TEST(Version, OtherMajorIsRejectedNamingBothVersions) {
   EXPECT_NE(n.status.message.find("0.9"), std::string::npos);
 }
 
-TEST(Version, ThisBuildSpeaksOneDotThree) {
+TEST(Version, ThisBuildSpeaksOneDotFour) {
   // v1.1: chemistry in Configure (solid species, reactions, chemistry), explicit positions.
   // v1.2: decomposed CFD (rank identity in Hello, partial GasFields/Sources), fluid_fraction.
   // v1.3: the Sources array Q_rad (radiation heat the particles gave the gas).
-  EXPECT_EQ(kProtocolVersion, (Version{1, 3}));
-  EXPECT_EQ(kProtocolVersion.toString(), "1.3");
+  // v1.4: cylinder, cone and triangle-mesh walls in Configure (Walls.revolved, Walls.meshes).
+  EXPECT_EQ(kProtocolVersion, (Version{1, 4}));
+  EXPECT_EQ(kProtocolVersion.toString(), "1.4");
   EXPECT_EQ(kMinorDecomposed, 2u);
   EXPECT_EQ(kMinorRadiation, 3u);
-  // With a v1.0, v1.1 or v1.2 peer the agreed version is that peer's.
+  EXPECT_EQ(kMinorWallShapes, 4u);
+  // With a v1.0 to v1.3 peer the agreed version is that peer's.
   EXPECT_EQ(negotiate(kProtocolVersion, {1, 0}).agreed, (Version{1, 0}));
   EXPECT_EQ(negotiate(kProtocolVersion, {1, 1}).agreed, (Version{1, 1}));
   EXPECT_EQ(negotiate(kProtocolVersion, {1, 2}).agreed, (Version{1, 2}));
   EXPECT_EQ(negotiate(kProtocolVersion, {1, 3}).agreed, (Version{1, 3}));
-  EXPECT_EQ(negotiate({1, 2}, kProtocolVersion).agreed, (Version{1, 2})); // a 1.2 server
+  EXPECT_EQ(negotiate(kProtocolVersion, {1, 4}).agreed, (Version{1, 4}));
+  EXPECT_EQ(negotiate({1, 3}, kProtocolVersion).agreed, (Version{1, 3})); // a 1.3 server
 }

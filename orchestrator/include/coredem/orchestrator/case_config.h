@@ -76,9 +76,37 @@ struct PlaneConfig {
   Vec3 point{}, normal{};
 };
 
+/// A cylinder or cone wall about an axis (walls.cylinders[], walls.cones[]; protocol v1.4).
+struct RevolvedWallConfig {
+  bool cone = false; ///< false: walls.cylinders[index], true: walls.cones[index]
+  std::size_t index = 0;
+  Vec3 point{};                          ///< m, on the axis (axial coordinate 0)
+  Vec3 axis{0, 0, 1};                    ///< unit direction (normalised from case.yaml)
+  double radiusFrom = 0.0;               ///< m, radius at `from` (a cylinder's radius)
+  double radiusTo = 0.0;                 ///< m, radius at `to` (a cylinder: = radiusFrom)
+  bool finite = true;                    ///< false: an infinite cylinder (no from/to)
+  double from = 0.0, to = 0.0;           ///< m along the axis from `point`, from < to (when finite)
+  std::string side = "inside";           ///< inside | outside | both
+  bool capStart = false, capEnd = false; ///< flat discs closing `from` / `to`
+  /// "walls.cylinders[0]" (messages)
+  std::string key() const;
+};
+
+/// A triangle-mesh wall read from an STL file (walls.meshes[]; protocol v1.4).
+struct MeshWallConfig {
+  std::string file;             ///< as written in case.yaml, relative to the case folder
+  std::filesystem::path path;   ///< absolute
+  double scale = 1.0;           ///< coordinates multiplied by this (0.001: file in mm)
+  bool closed = false;          ///< a closed surface is required (and particles must be inside)
+  std::vector<double> vertices; ///< m, x0,y0,z0,x1,... (welded, scaled)
+  std::vector<std::int32_t> triangles; ///< 3 vertex indices per triangle
+};
+
 struct WallsConfig {
   std::optional<std::pair<Vec3, Vec3>> box;
   std::vector<PlaneConfig> planes;
+  std::vector<RevolvedWallConfig> revolved; ///< cylinders then cones, in case.yaml order
+  std::vector<MeshWallConfig> meshes;
   std::string material;
   double temperature = 0.0;
 };
@@ -197,6 +225,9 @@ struct CaseConfig {
   bool usesChemistry() const {
     return !solidSpecies.empty() || !reactions.empty() || chemistry.present;
   }
+  /// True when the case has cylinder, cone or mesh walls: needs a v1.4 server
+  /// (protocol::kMinorWallShapes).
+  bool usesWallShapes() const { return !walls.revolved.empty() || !walls.meshes.empty(); }
 };
 
 /// Loads and validates CASE_DIR/case.yaml (or a file path). Throws CaseError.

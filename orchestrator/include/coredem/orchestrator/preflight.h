@@ -27,10 +27,13 @@ inline constexpr double kImplausibleTemperatureK = 200.0;
 inline constexpr double kFoamEqualityRelTol = 1e-3;
 
 /// The case's geometry and temperatures: the coupling grid covers the particles' initial
-/// region and walls.box; the particles lie inside walls.box and on the inner side of every
-/// plane; lattice regions hold `count` sites, random regions a solid fraction below
-/// kMaxRandomSolidFraction, explicit positions overlap by at most kMaxInitialOverlapFraction;
-/// temperatures below kImplausibleTemperatureK are warned about. Returns the warnings
+/// region, walls.box, the cylinders and cones with side inside or both, and the mesh walls; the
+/// particles lie inside walls.box, on the inner side of every plane, at least a radius inside
+/// every side-inside cylinder and cone over the axial extent where it reaches them, and (their
+/// centres) inside every closed mesh wall; lattice regions hold `count` sites, random regions a
+/// solid fraction below kMaxRandomSolidFraction, explicit positions overlap by at most
+/// kMaxInitialOverlapFraction; temperatures below kImplausibleTemperatureK are warned about.
+/// Returns the warnings
 /// ("file:line:col: key: what"); throws CaseError at the first failure.
 std::vector<std::string> checkCaseConsistency(const CaseConfig& config);
 

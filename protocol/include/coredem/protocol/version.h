@@ -19,7 +19,7 @@ struct Version {
 };
 
 /// The version this build speaks.
-inline constexpr Version kProtocolVersion{1, 3};
+inline constexpr Version kProtocolVersion{1, 4};
 
 /// First minor version with the fluid_fraction array and the decomposed (M:1) exchange: rank
 /// identity in Hello, partial GasFields/Sources (docs/protocol.md "Decomposed CFD").
@@ -29,6 +29,11 @@ inline constexpr std::uint32_t kMinorDecomposed = 2;
 /// gas): the DEM server sends it only to a CFD peer whose agreed minor is at least this; below,
 /// the radiation heat stays with the particles' environment (docs/heat-coupling.md).
 inline constexpr std::uint32_t kMinorRadiation = 3;
+
+/// First minor version with cylinder, cone and triangle-mesh walls (Configure.walls.revolved and
+/// .meshes). An older server ignores them, so the orchestrator refuses to send a case with such
+/// walls to a DEM server whose agreed minor is below this.
+inline constexpr std::uint32_t kMinorWallShapes = 4;
 
 /// Outcome of a handshake.
 struct Negotiation {
