@@ -1,6 +1,9 @@
 // coredem-bench dem: throughput of the DEM core on the decks of bench/decks.md.
 //   coredem-bench dem --case packed --particles 100000 --steps 500 --backend cpu --threads 2
 //   [--json] [--velocities FILE] [--coupled] [--heat] [--jitter A]
+//   coredem-bench dem --case hopper --walls primitive|stl|none [--closed] [--deck-dir DIR]
+//   [--outlet D/d] [--sample K] [--until F] [--fit-lo F --fit-hi F] [--samples-out FILE]
+//   [--settle-only] [--resettle]   (the hopper deck: bench/commands/hopper.cpp)
 // Prints particle_steps_per_s, contacts per particle, bytes per particle and the time per
 // stage, and the translational kinetic energy at the start and the end (the peer scripts
 // compare it with LIGGGHTS'). Figures are measured, never asserted.
@@ -23,6 +26,7 @@
 #include "commands.h"
 #include "coredem/common/check.h"
 #include "coredem/dem/dem_system.h"
+#include "hopper.h"
 
 namespace {
 
@@ -97,7 +101,7 @@ void jitterSites(DemConfig& cfg, double amplitude, std::uint64_t seed) {
 }
 
 int runDem(int argc, char** argv) {
-  CLI::App app{"DEM core throughput on the packed / agitated decks (bench/decks.md)",
+  CLI::App app{"DEM core throughput on the packed / agitated / hopper decks (bench/decks.md)",
                "coredem-bench dem"};
   std::string deckName = "packed", backend = "cpu", velocityFile;
   std::size_t n = 10000;
@@ -106,9 +110,11 @@ int runDem(int argc, char** argv) {
   bool json = false, coupled = false, heat = false;
   int nSub = 50;
   double jitter = 0.0;
-  app.add_option("--case", deckName, "deck: packed | agitated")
-      ->check(CLI::IsMember({"packed", "agitated"}));
-  app.add_option("--particles", n, "number of particles")->check(CLI::Range(1.0, 2.0e9));
+  coredem::bench::hopper::Options hop;
+  app.add_option("--case", deckName, "deck: packed | agitated | hopper")
+      ->check(CLI::IsMember({"packed", "agitated", "hopper"}));
+  app.add_option("--particles", n, "number of particles (default 10000; hopper: 20000)")
+      ->check(CLI::Range(1.0, 2.0e9));
   app.add_option("--steps", steps, "measured DEM steps")->check(CLI::PositiveNumber);
   app.add_option("--warmup", warmup, "unmeasured steps first")->check(CLI::NonNegativeNumber);
   app.add_option("--backend", backend,
@@ -133,12 +139,60 @@ int runDem(int argc, char** argv) {
                  "random-like bed (e.g. --case packed --jitter 0.02: touching and lens-gap "
                  "pairs mixed)")
       ->check(CLI::Range(0.0, 0.5));
+  // The hopper deck's own options (bench/decks.md `hopper`).
+  std::vector<CLI::Option*> hopperOnly{
+      app.add_option("--walls", hop.walls,
+                     "hopper: primitive (analytic cone + cylinder) | stl (the same as STL "
+                     "meshes) | none (the settled bed alone, no walls, no gravity)")
+          ->check(CLI::IsMember({"primitive", "stl", "none"})),
+      app.add_flag("--closed", hop.closed,
+                   "hopper: keep the outlet closed by its plate (the settled bed at rest)"),
+      app.add_option("--deck-dir", hop.deckDir,
+                     "hopper: directory for the settled bed and the STL files (reused when it "
+                     "holds them for the same N and outlet; default: a temporary one)"),
+      app.add_option("--outlet", hop.outlet, "hopper: outlet diameter in particle diameters")
+          ->check(CLI::Range(2.0, 40.0)),
+      app.add_option("--sample", hop.sample,
+                     "hopper: count the discharged particles every K steps (default 500)")
+          ->check(CLI::PositiveNumber),
+      app.add_option("--until", hop.until,
+                     "hopper: stop once this fraction has been discharged (the steps are then "
+                     "a maximum)")
+          ->check(CLI::Range(0.0, 1.0)),
+      app.add_option("--fit-lo", hop.fitLo,
+                     "hopper: discharged fraction where the rate fit starts (default 0.2)")
+          ->check(CLI::Range(0.0, 1.0)),
+      app.add_option("--fit-hi", hop.fitHi,
+                     "hopper: discharged fraction where the rate fit ends (default 0.8)")
+          ->check(CLI::Range(0.0, 1.0)),
+      app.add_option("--samples-out", hop.samplesOut,
+                     "hopper: write the samples 't below_outlet wall_contacts pair_contacts "
+                     "advance_wall_s rebuilds'"),
+      app.add_flag("--settle-only", hop.settleOnly,
+                   "hopper: settle (or find) the bed and write the deck files, run nothing"),
+      app.add_flag("--resettle", hop.resettle,
+                   "hopper: settle again even if the deck directory holds a settled bed")};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
   try {
+    if (deckName == "hopper") {
+      COREDEM_CHECK(!coupled && velocityFile.empty() && jitter == 0,
+                    "--case hopper takes none of --coupled, --velocities, --jitter");
+      hop.n = app.count("--particles") ? n : 20000;
+      hop.steps = steps;
+      hop.warmup = warmup;
+      hop.threads = threads;
+      hop.backend = backend;
+      hop.skin = skin;
+      hop.json = json;
+      hop.heat = heat;
+      return coredem::bench::hopper::run(hop);
+    }
+    for (const CLI::Option* opt : hopperOnly)
+      COREDEM_CHECK(opt->count() == 0, "{} applies to --case hopper only", opt->get_name());
     DemConfig cfg = deck(deckName, n);
     if (skin >= 0)
       cfg.neighbour.skinFactor = skin;

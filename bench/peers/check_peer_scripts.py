@@ -13,7 +13,11 @@
 4. dpmfoam/report.py's sub-step check passes a synthetic log with the intended counts and
    fails (exit 4) one with 2x the counts;
 5. liggghts/report.py's deck check passes a synthetic LIGGGHTS screen output that matches the
-   deck and reports each of a wrong timestep, skin, step count and initial kinetic energy.
+   deck and reports each of a wrong timestep, skin, step count and initial kinetic energy;
+6. the hopper deck (N = 60): coredem-bench settles it into a deck directory; make_hopper.py's
+   hopper.data holds the same particles and its ke_initial equals coredem-bench's for the
+   primitive and stl variants (1e-12); the STL files have 64 facets around per profile segment;
+   a second run reuses the settled bed; hopper_report.py's rate fit is exact on a straight line.
 No timing is measured or asserted.
 """
 
@@ -104,6 +108,47 @@ def check_liggghts_report(tmp):
                   f"liggghts report.py reports a wrong {name} ({bad})")
 
 
+def check_hopper(bench, tmp):
+    import make_hopper  # noqa: E402
+    rep = load("hop_report", os.path.join(HERE, "liggghts", "hopper_report.py"))
+    deck = os.path.join(tmp, "hopper")
+    n = 60
+    base = [bench, "dem", "--case", "hopper", "--particles", str(n), "--deck-dir", deck,
+            "--threads", "1", "--json"]
+    out = subprocess.run(base + ["--settle-only"], check=True, capture_output=True, text=True)
+    first = json.loads(out.stdout)
+    check(not first["cached"] and first["settle_steps"] > 0,
+          f"hopper: coredem-bench settles N={n} into the deck directory")
+    kv = make_hopper.read_deck(deck)
+    rows = make_hopper.read_particles(deck)
+    check(int(kv["n"]) == n and len(rows) == n, f"hopper: hopper.particles holds {n} particles")
+    for name, tri in (("hopper.stl", 2 * 64 * 2), ("cone.stl", 2 * 64), ("bin.stl", 2 * 64)):
+        got = rep.stl_triangles(os.path.join(deck, name))
+        check(got == tri, f"hopper: {name} has {got} triangles, expected {tri}")
+    for walls in ("primitive", "stl"):
+        r = subprocess.run([sys.executable, os.path.join(HERE, "liggghts", "make_hopper.py"), deck,
+                            "10", "--walls", walls], check=True, capture_output=True, text=True)
+        par = dict(line.split(" = ", 1) for line in r.stdout.splitlines() if " = " in line)
+        ours = json.loads(subprocess.run(base + ["--walls", walls, "--steps", "1", "--warmup", "0"],
+                                         check=True, capture_output=True, text=True).stdout)
+        ke, ke_l = ours["ke_initial"], float(par["ke_initial"])
+        check(abs(ke - ke_l) <= 1e-12 * max(abs(ke), 1e-300) and ours["deck_cached"],
+              f"hopper {walls}: the settled bed is reused and make_hopper.py's ke_initial "
+              f"{ke_l!r} = coredem-bench's {ke!r}")
+        check(abs(float(par["dt"]) - ours["dt_dem"]) <= 1e-6 * ours["dt_dem"],
+              f"hopper {walls}: the same timestep")
+    with open(os.path.join(deck, "hopper.data")) as f:
+        text = f.read()
+    atoms = text.split("Atoms\n\n", 1)[1].split("\n\nVelocities", 1)[0].splitlines()
+    same = len(atoms) == n and all(
+        [float(w) for w in a.split()[4:7]] == list(rows[i][:3]) for i, a in enumerate(atoms))
+    check(same, "hopper: hopper.data has hopper.particles' positions, in order, exactly")
+    samples = [(0.01 * k, 1000.0 * 0.01 * k) for k in range(20)]
+    rate = rep.fit_rate(samples, 200, 0.2, 0.8)[0]
+    check(rate is not None and abs(rate - 1000.0) < 1e-9,
+          f"hopper_report.py's fit of a straight line: {rate}")
+
+
 def main(bench):
     mass = make_deck.material()["mass"]
     with tempfile.TemporaryDirectory() as tmp:
@@ -153,6 +198,7 @@ def main(bench):
                   f"dpmfoam report.py sub-step check on {factor}x the intended counts: "
                   f"{'passes' if expect_ok else 'fails'} (ratio {ratio})")
         check_liggghts_report(tmp)
+        check_hopper(bench, tmp)
     if failures:
         print(f"{len(failures)} check(s) failed")
         return 1

@@ -44,7 +44,9 @@ usage() {
   sed -n '2,40p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2
   exit 2
 }
-die() { echo "compare.sh: error: $*" >&2; exit 2; }
+SCRIPT=compare.sh
+# shellcheck source=common.sh
+source "$here/common.sh" # die, require_peer_tools, check_load, liggghts_run
 
 [[ $# -eq 2 ]] || usage
 N="$1"
@@ -89,12 +91,7 @@ fi
 [[ "$LOAD_MAX" =~ ^[0-9]*\.?[0-9]+$ ]] || die "LOAD_MAX must be a number, got '$LOAD_MAX'"
 [[ "$LOAD_WAIT" =~ ^[0-9]+$ ]] || die "LOAD_WAIT must be a non-negative integer (seconds), got '$LOAD_WAIT'"
 
-command -v python3 >/dev/null || die "python3 not found (it generates the deck)"
-command -v timeout >/dev/null || die "timeout (coreutils) not found"
-command -v "$LIGGGHTS" >/dev/null ||
-  die "LIGGGHTS executable '$LIGGGHTS' not found. Install it with: scripts/install-deps.sh --with-peers (Debian packages liggghts, openmpi-bin; or apt-get install -y liggghts openmpi-bin), or point LIGGGHTS= at it."
-command -v "$MPIRUN" >/dev/null ||
-  die "MPI launcher '$MPIRUN' not found. Install it with: scripts/install-deps.sh --with-peers (Debian package openmpi-bin), or point MPIRUN= at it."
+require_peer_tools
 
 ours="$BUILD_DIR/bin/coredem-bench"
 ours_missing=""
@@ -117,51 +114,13 @@ echo "== decks (bench/decks.md): ${DECKS}; N = $N, $WARMUP untimed + $STEPS time
 echo "machine: $(nproc) cores visible, ${cpu_model:-unknown CPU}; load average now: $(cut -d' ' -f1-3 /proc/loadavg)"
 [[ "$ALLOW_LOAD" == 1 ]] && echo "ALLOW_LOAD=1: runs started at load >= $LOAD_MAX are labelled LOADED"
 
-# The load average before a run; refuses (exit 5) at >= LOAD_MAX unless ALLOW_LOAD=1.
-above_max() { python3 -c "import sys; sys.exit(0 if float('$1') >= float('$LOAD_MAX') else 1)"; }
-check_load() { # $1 = file to record it in, $2 = label
-  local load waited=0
-  load="$(cut -d' ' -f1 /proc/loadavg)"
-  if [[ "$ALLOW_LOAD" != 1 ]]; then
-    while above_max "$load" && [[ $waited -lt $LOAD_WAIT ]]; do
-      sleep 5
-      waited=$((waited + 5))
-      load="$(cut -d' ' -f1 /proc/loadavg)"
-    done
-    [[ $waited -gt 0 ]] && echo "  (waited $waited s for the load average to fall)"
-  fi
-  echo "$load" >"$1"
-  if above_max "$load"; then
-    if [[ "$ALLOW_LOAD" == 1 ]]; then
-      echo "  $2: load average $load >= $LOAD_MAX: LOADED (ALLOW_LOAD=1)"
-    else
-      echo "compare.sh: error: load average $load >= LOAD_MAX=$LOAD_MAX before $2 after waiting $LOAD_WAIT s; wait for a quiet machine or set ALLOW_LOAD=1 (such runs are labelled LOADED)" >&2
-      exit 5
-    fi
-  else
-    echo "  $2: load average $load"
-  fi
-}
-
 ours_status="ok"
 [[ "$LIGGGHTS_ONLY" == 1 ]] && ours_status="skipped (LIGGGHTS_ONLY=1)"
 [[ -n "$ours_missing" ]] && ours_status="not run. $ours_missing"
 
 run_liggghts() { # $1 = deck dir, $2 = deck, $3 = ranks, $4 = run dir, $5 = repetition
-  local rc=0 mpi_args=(-np "$3")
-  [[ "$(id -u)" == 0 ]] && mpi_args+=(--allow-run-as-root)
-  [[ "$3" -gt "$(nproc)" ]] && mpi_args+=(--oversubscribe)
-  # shellcheck disable=SC2206
-  [[ -n "$MPI_FLAGS" ]] && mpi_args+=($MPI_FLAGS)
-  [[ "$5" == 1 ]] && echo "  LIGGGHTS: $MPIRUN ${mpi_args[*]} $LIGGGHTS -in in.$2 -log none -echo screen   (in $1)"
-  check_load "$4/load.liggghts.$5" "LIGGGHTS run $5"
-  (cd "$1" && timeout "$RUN_TIMEOUT" "$MPIRUN" "${mpi_args[@]}" "$LIGGGHTS" -in "in.$2" -log none -echo screen \
-    >"$4/screen.liggghts.$5" 2>&1) || rc=$?
-  if [[ $rc -ne 0 ]]; then
-    tail -n 30 "$4/screen.liggghts.$5" >&2 || true
-    [[ $rc -eq 124 ]] && die "LIGGGHTS did not finish within RUN_TIMEOUT=$RUN_TIMEOUT s"
-    die "LIGGGHTS failed (exit $rc); its last output is above"
-  fi
+  liggghts_run "$1" "in.$2" "$3" "$4/screen.liggghts.$5" "$4/load.liggghts.$5" "LIGGGHTS run $5" \
+    "$([[ "$5" == 1 ]] && echo 1 || echo 0)"
 }
 
 run_ours() { # $1 = deck dir, $2 = deck, $3 = threads, $4 = run dir, $5 = repetition
