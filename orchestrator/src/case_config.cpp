@@ -2,6 +2,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -11,6 +12,7 @@
 #include <coredem/dem/models.h>
 #include <coredem/dem/triangle_mesh.h>
 #include <coredem/orchestrator/case_config.h>
+#include <coredem/orchestrator/foam_patches.h>
 #include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/preflight.h>
@@ -26,6 +28,9 @@ using yaml::join;
 using yaml::Section;
 
 constexpr double kBig = std::numeric_limits<double>::max();
+
+const std::vector<std::string> kWallKeys = {"box",    "planes",   "cylinders", "cones",
+                                            "meshes", "material", "thermal",   "temperature"};
 
 // ---------------------------------------------------------------- chemistry (protocol v1.1)
 /// Kinetic overrides of chemistry.clg (same names as coredem::dem::clgKineticNames(), which the
@@ -403,7 +408,7 @@ void wallExtent(const Section& s, RevolvedWallConfig& r) {
   }
 }
 
-/// walls.cylinders, walls.cones, walls.meshes (protocol v1.4; docs/case-schema.md "walls").
+/// walls.cylinders, walls.cones (protocol v1.4; docs/case-schema.md "walls").
 void parseWallShapes(const Section& w, CaseConfig& c) {
   if (w.has("cylinders")) {
     for (const auto& s :
@@ -440,6 +445,102 @@ void parseWallShapes(const Section& w, CaseConfig& c) {
       c.walls.revolved.push_back(r);
     }
   }
+}
+
+/// The patch names of walls.meshes[i].from_cfd: a list of names (or one name).
+std::vector<std::string> patchNames(const Section& s) {
+  const YAML::Node n = s.raw("from_cfd");
+  std::vector<std::string> names;
+  if (n.IsScalar()) {
+    names.push_back(n.Scalar());
+  } else if (n.IsSequence()) {
+    for (std::size_t i = 0; i < n.size(); ++i) {
+      if (!n[i].IsScalar() || n[i].Scalar().empty()) {
+        s.fail(n[i].Mark(), fmt::format("{}[{}]", s.full("from_cfd"), i),
+               fmt::format("expected a patch name, found {}", describe(n[i])));
+      }
+      names.push_back(n[i].Scalar());
+    }
+  }
+  if (names.empty()) {
+    s.fail(s.markOf("from_cfd"), s.full("from_cfd"),
+           fmt::format("expected a list of patch names of the CFD mesh, e.g. [walls], found {}",
+                       describe(n)));
+  }
+  return names;
+}
+
+/// walls.meshes[i].from_cfd: the wall from patches of the OpenFOAM case's mesh (cfd.case).
+void meshFromCfd(const Section& s, const CaseConfig& c, bool cfdSection, MeshWallConfig& m) {
+  const std::string key = s.full("from_cfd");
+  const ParticipantDescriptor& p = participant(c.cfd.participant);
+  if (!p.openFoamCase) {
+    std::vector<std::string> foam;
+    for (const auto& q : participantTable()) {
+      if (q.openFoamCase) {
+        foam.push_back(q.name);
+      }
+    }
+    s.fail(s.markOf("from_cfd"), key,
+           fmt::format("from_cfd takes the walls from the mesh of the OpenFOAM case in cfd.case, "
+                       "but the CFD participant is {} ({}), which has no mesh; use "
+                       "cfd: {{participant: {}, case: <OpenFOAM case folder>}}, or give the wall "
+                       "as an STL file (walls.meshes[].file)",
+                       p.name, cfdSection ? "cfd.participant" : "the default: no cfd section",
+                       join(foam)));
+  }
+  m.fromCfd = patchNames(s);
+  const fs::path foamCase = fs::absolute(c.caseDir / c.cfd.caseFolder).lexically_normal();
+  m.path = foamCase / "constant" / "polyMesh";
+  m.name = fmt::format("{}/constant/polyMesh:{}", c.cfd.caseFolder, join(m.fromCfd));
+  if (m.name.size() > 200) { // the DEM server's limit on names is 256 bytes
+    m.name = fmt::format("{}... ({} patches)", m.name.substr(0, 170), m.fromCfd.size());
+  }
+  FoamPatchSurface surface;
+  try {
+    surface = readFoamPatches(foamCase, m.fromCfd);
+  } catch (const FoamMeshError& e) {
+    s.fail(s.markOf("from_cfd"), key, e.what());
+  }
+  dem::TriangleMesh mesh;
+  mesh.name = m.name;
+  mesh.vertices = std::move(surface.vertices);
+  mesh.triangles = std::move(surface.triangles);
+  try {
+    // No domain: the mesh is in metres (OpenFOAM's points are); the pre-flight compares it with
+    // the coupling grid.
+    dem::checkMesh(mesh, dem::MeshCheckOptions{m.closed, std::nullopt});
+  } catch (const dem::MeshError& e) {
+    std::string what = e.what();
+    // Triangle numbers mean nothing to the user: name the mesh face it comes from.
+    std::string face;
+    static const std::regex triangle("triangle ([0-9]+)");
+    std::smatch hit;
+    if (std::regex_search(what, hit, triangle)) {
+      const std::size_t t = std::stoul(hit[1].str()) - 1;
+      if (t < surface.sourceFace.size()) {
+        face = fmt::format(" (triangle {} is part of face {} of patch '{}')", t + 1,
+                           surface.sourceFace[t], m.fromCfd[surface.sourcePatch[t]]);
+      }
+    }
+    // The STL checker's advice (export the surface again) does not fit a CFD mesh.
+    const auto advice = what.find("; a closed wall is required");
+    if (advice != std::string::npos && what.find("not closed") != std::string::npos) {
+      what = fmt::format("{}{}; a closed wall is required ({}: true): name every patch around "
+                         "the fluid in {}, or set {}: false for an open wall",
+                         what.substr(0, advice), face, s.full("closed"), key, s.full("closed"));
+    } else {
+      what += face + "; check the CFD mesh (checkMesh)";
+    }
+    s.fail(s.markOf("from_cfd"), key, what);
+  }
+  m.vertices = std::move(mesh.vertices);
+  m.triangles = std::move(mesh.triangles);
+}
+
+/// walls.meshes (protocol v1.4; docs/case-schema.md "walls"): STL files or patches of the CFD
+/// mesh. Called after the cfd section (from_cfd reads cfd.case).
+void parseMeshWalls(const Section& w, CaseConfig& c, bool cfdSection) {
   if (!w.has("meshes")) {
     return;
   }
@@ -453,12 +554,29 @@ void parseWallShapes(const Section& w, CaseConfig& c) {
         c.grid.origin[std::size_t(d)] +
         c.grid.spacing[std::size_t(d)] * double(c.grid.cells[std::size_t(d)]);
   }
-  for (const auto& s : w.list("meshes", {"file", "scale", "closed"}, "triangle-mesh walls")) {
+  for (const auto& s :
+       w.list("meshes", {"file", "from_cfd", "scale", "closed"}, "triangle-mesh walls")) {
     MeshWallConfig m;
-    m.file = s.string("file", std::nullopt, "STL file, relative to the case folder");
+    m.closed = s.onOff("closed", false);
+    if (s.has("file") && s.has("from_cfd")) {
+      s.fail(s.markOf("from_cfd"), s.full("from_cfd"),
+             "give either 'file' (an STL file) or 'from_cfd' (patches of the CFD mesh), not both");
+    }
+    if (s.has("from_cfd")) {
+      if (s.has("scale")) {
+        s.fail(s.markOf("scale"), s.full("scale"),
+               "not used with from_cfd: the CFD mesh's points are in metres already; remove it");
+      }
+      meshFromCfd(s, c, cfdSection, m);
+      c.walls.meshes.push_back(std::move(m));
+      continue;
+    }
+    m.file = s.string("file", std::nullopt,
+                      "STL file, relative to the case folder (or from_cfd: patches of the CFD "
+                      "mesh)");
+    m.name = m.file;
     m.scale = s.number("scale", 1.0, 0.0, kBig,
                        "factor to metres, > 0 (1: file in m, 0.001: file in mm)", true);
-    m.closed = s.onOff("closed", false);
     // Relative to the case folder, like initial_state and cfd.case: a resumed run finds the file
     // through run.json's case_dir, a campaign member through the links to the base case's files.
     m.path = fs::absolute(c.caseDir / m.file);
@@ -772,8 +890,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   }
 
   if (top.has("walls")) {
-    const Section w = top.section("walls", {"box", "planes", "cylinders", "cones", "meshes",
-                                            "material", "thermal", "temperature"});
+    const Section w = top.section("walls", kWallKeys);
     if (w.has("box")) {
       const Section b = w.section("box", {"min", "max"});
       c.walls.box =
@@ -916,6 +1033,9 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
       f.fail(f.markOf("timers"), "cfd.timers",
              fmt::format("stage timers exist in {} only; remove the key", join(withTimers)));
     }
+  }
+  if (top.has("walls")) { // after cfd: walls.meshes[].from_cfd reads cfd.case
+    parseMeshWalls(top.section("walls", kWallKeys), c, top.has("cfd"));
   }
   c.hasGasSection = top.has("gas");
   if (c.gasProperties.idealGas()) {

@@ -145,7 +145,7 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
   }
   for (const auto& m : c.walls.meshes) {
     auto* w = walls->add_meshes();
-    w->set_name(m.file); // as in case.yaml: part of the DEM's config hash, stable across restarts
+    w->set_name(m.name); // from case.yaml: part of the DEM's config hash, stable across restarts
     w->mutable_vertices()->Add(m.vertices.begin(), m.vertices.end());
     w->mutable_triangles()->Add(m.triangles.begin(), m.triangles.end());
   }

@@ -110,6 +110,7 @@ std::vector<ParticipantDescriptor> makeTable() {
     p.caseFolder = "an OpenFOAM case folder";
     p.caseFolderMarker = "system/controlDict";
     p.caseFolderHint = "give the folder with system/, constant/ and 0/";
+    p.openFoamCase = true; // walls.meshes[].from_cfd reads its constant/polyMesh
     p.workDir = "openfoam";
     p.preflight = &checkOpenFoamCase; // gravity, gas model, species and gas state vs case.yaml
     p.generate = &writeGeneratedFoamDictionaries; // ideal_gas: constant/thermophysicalProperties

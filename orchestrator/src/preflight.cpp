@@ -774,11 +774,13 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
     const Box b{mb.lo, mb.hi};
     const std::string why = outside(b, grid, tol);
     if (!why.empty()) {
-      at.fail({"walls", "meshes", std::to_string(k), "file"},
-              fmt::format("walls.meshes[{}].file", k),
+      const MeshWallConfig& m = c.walls.meshes[k];
+      at.fail({"walls", "meshes", std::to_string(k), m.sourceKey()},
+              fmt::format("walls.meshes[{}].{}", k, m.sourceKey()),
               fmt::format("the mesh '{}' spans {}, beyond the coupling grid {} ({}); enlarge "
-                          "grid.cells or grid.origin, or check the mesh's position and scale",
-                          c.walls.meshes[k].file, fmtBox(b), fmtBox(grid), why));
+                          "grid.cells or grid.origin, or check the mesh's position and scale{}",
+                          m.name, fmtBox(b), fmtBox(grid), why,
+                          m.fromCfd.empty() ? "" : " (the coupling grid must cover the CFD mesh)"));
     }
   }
   // Closed mesh walls hold the particles: their inside, for the test of every set below.
@@ -887,7 +889,7 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
                   fmt::format("{}: the particle centre {} lies outside the closed mesh wall "
                               "walls.meshes[{}] ('{}', spanning {}); move the {} inside the "
                               "surface, or check the mesh's position and scale",
-                              setName(p, i), fmtVec(x), k, c.walls.meshes[k].file,
+                              setName(p, i), fmtVec(x), k, c.walls.meshes[k].name,
                               fmtBox(Box{meshBounds(c.walls.meshes[k]).lo,
                                          meshBounds(c.walls.meshes[k]).hi}),
                               p.positions.empty() ? "region" : "positions"));

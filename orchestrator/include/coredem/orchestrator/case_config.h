@@ -92,14 +92,23 @@ struct RevolvedWallConfig {
   std::string key() const;
 };
 
-/// A triangle-mesh wall read from an STL file (walls.meshes[]; protocol v1.4).
+/// A triangle-mesh wall read from an STL file or built from patches of the CFD mesh
+/// (walls.meshes[]; protocol v1.4).
 struct MeshWallConfig {
-  std::string file;             ///< as written in case.yaml, relative to the case folder
-  std::filesystem::path path;   ///< absolute
+  std::string file;           ///< as written in case.yaml, relative to the case folder; or empty
+  std::filesystem::path path; ///< absolute: the STL file, or the CFD case's constant/polyMesh
+  /// from_cfd: patches of the CFD mesh (cfd.case/constant/polyMesh) whose faces are the wall;
+  /// empty for an STL file.
+  std::vector<std::string> fromCfd;
+  /// What messages and Configure call the wall: `file`, or "<cfd.case>/constant/polyMesh
+  /// patches a, b" (stable across restarts: part of the DEM's configuration hash).
+  std::string name;
   double scale = 1.0;           ///< coordinates multiplied by this (0.001: file in mm)
   bool closed = false;          ///< a closed surface is required (and particles must be inside)
   std::vector<double> vertices; ///< m, x0,y0,z0,x1,... (welded, scaled)
   std::vector<std::int32_t> triangles; ///< 3 vertex indices per triangle
+  /// The key of case.yaml the wall comes from: "file" or "from_cfd" (messages).
+  const char* sourceKey() const { return fromCfd.empty() ? "file" : "from_cfd"; }
 };
 
 struct WallsConfig {

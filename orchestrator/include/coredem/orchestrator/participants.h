@@ -65,6 +65,9 @@ struct ParticipantDescriptor {
   std::string caseFolderMarker;
   /// What to give instead when the marker is missing (pre-flight message).
   std::string caseFolderHint;
+  /// True when `cfd.case` is an OpenFOAM case: walls.meshes[].from_cfd may take the DEM walls
+  /// from the patches of its constant/polyMesh.
+  bool openFoamCase = false;
   /// Folder of the run folder into which `cfd.case` is copied once before the first start
   /// (a resumed run keeps it); `{work_dir}` names it.
   std::string workDir;
