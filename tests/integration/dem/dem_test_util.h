@@ -1,5 +1,7 @@
 #pragma once
 // Helpers shared by the DEM integration tests.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -27,6 +29,31 @@ inline std::vector<double> momentum(const ParticleData& p) {
     for (int d = 0; d < 3; ++d)
       s[d] += p.mass[idx[g]] * p.velocity[3 * idx[g] + d];
   return s;
+}
+
+/// What a settled bed rests on: its weight m g (N, g = 9.81), its fastest particle (m/s) and the
+/// walls' force on it averaged over `samples` further sub-steps of Δt_DEM,max (residual
+/// vibration averages out; the mean differs from the weight by Δ(momentum)/T).
+struct RestingLoad {
+  double weight = 0.0;
+  double vmax = 0.0;
+  std::array<double, 3> wallForce{0.0, 0.0, 0.0};
+};
+inline RestingLoad restingLoad(DemSystem& sys, int samples = 200) {
+  const ParticleData p = sys.particles();
+  RestingLoad out;
+  for (std::size_t i = 0; i < p.count; ++i) {
+    out.weight += p.mass[i] * 9.81;
+    out.vmax = std::max(
+        out.vmax, std::hypot(p.velocity[3 * i], p.velocity[3 * i + 1], p.velocity[3 * i + 2]));
+  }
+  for (int k = 0; k < samples; ++k) {
+    sys.advance(sys.dtDemMax(), 1);
+    const auto f = sys.wallForce();
+    for (int q = 0; q < 3; ++q)
+      out.wallForce[q] += f[q] / samples;
+  }
+  return out;
 }
 
 /// The `agitated` deck of bench/decks.md with n particles (box walls optional).

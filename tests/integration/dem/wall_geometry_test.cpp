@@ -246,25 +246,12 @@ double settledWallForceOverWeight(bool stl, double* sideForce) {
   const int nSub = TimeHandler::subStepsFor(dtCfd, sys.dtDemMax());
   for (int k = 0; k < 500; ++k)
     sys.advance(dtCfd, nSub);
-  const ParticleData p = sys.particles();
-  double weight = 0, vmax = 0;
-  for (std::size_t i = 0; i < p.count; ++i) {
-    weight += p.mass[i] * 9.81;
-    vmax =
-        std::max(vmax, std::hypot(p.velocity[3 * i], p.velocity[3 * i + 1], p.velocity[3 * i + 2]));
-  }
-  EXPECT_LT(vmax, 1e-3) << "bed not settled";
-  std::array<double, 3> mean{0, 0, 0};
-  const int samples = 200;
-  for (int k = 0; k < samples; ++k) {
-    sys.advance(sys.dtDemMax(), 1);
-    const auto f = sys.wallForce();
-    for (int q = 0; q < 3; ++q)
-      mean[q] += f[q] / samples;
-  }
-  *sideForce = std::hypot(mean[0], mean[1]) / weight;
-  EXPECT_GT(sys.pairContactCount(), p.count);
-  return mean[2] / weight;
+  const std::size_t n = sys.particles().count;
+  const RestingLoad load = restingLoad(sys);
+  EXPECT_LT(load.vmax, 1e-3) << "bed not settled";
+  *sideForce = std::hypot(load.wallForce[0], load.wallForce[1]) / load.weight;
+  EXPECT_GT(sys.pairContactCount(), n);
+  return load.wallForce[2] / load.weight;
 }
 } // namespace
 
