@@ -40,6 +40,7 @@
 #include "couplingGrid.H"
 #include "gasLedgers.H"
 #include "rankControl.H"
+#include "reconstructCells.H"
 #include "stageTimers.H"
 
 #include "coredem/client/participant.h"
