@@ -34,6 +34,7 @@ using namespace coredem::dem;
 using coredem::bench::addCouplingGrid;
 using coredem::bench::BenchGas;
 using coredem::bench::deck;
+using coredem::bench::kineticEnergy;
 
 /// Initial velocities, one particle per line "vx vy vz" (m/s), in the deck's site order
 /// (bench/peers/liggghts/make_deck.py writes them for the agitated deck).
@@ -60,17 +61,6 @@ std::vector<double> readVelocities(const std::string& path, std::size_t n) {
     throw coredem::UserError(path + ": " + std::to_string(v.size() / 3) + " velocities for " +
                              std::to_string(n) + " particles");
   return v;
-}
-
-/// Translational kinetic energy ½ Σ m v² (J), as LIGGGHTS' thermo `ke` with `norm no`.
-double kineticEnergy(const DemSystem& sys) {
-  const ParticleData p = sys.particles();
-  double e = 0;
-  for (std::size_t i = 0; i < p.count; ++i)
-    e += 0.5 * p.mass[i] *
-         (p.velocity[3 * i] * p.velocity[3 * i] + p.velocity[3 * i + 1] * p.velocity[3 * i + 1] +
-          p.velocity[3 * i + 2] * p.velocity[3 * i + 2]);
-  return e;
 }
 
 /// --jitter: moves the deck's lattice sites by uniform[−a, a)·d_p per component (splitmix64

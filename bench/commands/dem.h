@@ -61,6 +61,18 @@ inline void addCouplingGrid(coredem::dem::DemConfig& cfg, double cell) {
 }
 
 /// Uniform gas fields for the benchmarks: air at T_g rising at `uz` m/s, hydrostatic ∇p.
+/// Translational kinetic energy ½ Σ m v² (J), as LIGGGHTS' thermo `ke` with `norm no` (the
+/// peer scripts compare it to check that both codes start from the same particles).
+inline double kineticEnergy(const coredem::dem::DemSystem& sys) {
+  const coredem::dem::ParticleData p = sys.particles();
+  double e = 0;
+  for (std::size_t i = 0; i < p.count; ++i)
+    e += 0.5 * p.mass[i] *
+         (p.velocity[3 * i] * p.velocity[3 * i] + p.velocity[3 * i + 1] * p.velocity[3 * i + 1] +
+          p.velocity[3 * i + 2] * p.velocity[3 * i + 2]);
+  return e;
+}
+
 struct BenchGas {
   std::vector<double> ug, gradP, Tg, rho, mu, kappa, cp;
   BenchGas(std::size_t cells, double uz, double tg) {

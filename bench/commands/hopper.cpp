@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "coredem/common/check.h"
+#include "dem.h"
 
 namespace coredem::bench::hopper {
 
@@ -504,16 +505,6 @@ Fit fitRate(const std::vector<Sample>& samples, std::size_t n, double lo, double
 
 double beverloo(double rhoB, double c, double k, double outletD) {
   return c * rhoB * std::sqrt(kGravity) * std::pow(outletD - k * kDiameter, 2.5);
-}
-
-double kineticEnergy(const DemSystem& sys) {
-  const ParticleData p = sys.particles();
-  double e = 0;
-  for (std::size_t i = 0; i < p.count; ++i)
-    e += 0.5 * p.mass[i] *
-         (p.velocity[3 * i] * p.velocity[3 * i] + p.velocity[3 * i + 1] * p.velocity[3 * i + 1] +
-          p.velocity[3 * i + 2] * p.velocity[3 * i + 2]);
-  return e;
 }
 
 std::size_t countBelow(const DemSystem& sys, double z) {

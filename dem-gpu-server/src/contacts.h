@@ -342,12 +342,7 @@ struct OwnerContacts {
   const std::int32_t* half;
   const std::uint32_t* wallNear;
   const PairProps* pairs;
-  const kernels::Wall* walls;
-  int nWalls;
-  const kernels::MeshTriangle* tris;
-  const std::uint32_t* meshStart;
-  const std::uint32_t* meshList;
-  std::int64_t meshKeyBase;
+  WallView wv;
   int nMat;
   int K;
   std::size_t n;
@@ -513,64 +508,19 @@ struct OwnerContacts {
         ++slot;
         ++wallCount;
       };
-      std::uint32_t bits = nearBits & ~WallLists<Exec>::kMeshBit;
-      constexpr int kBits = WallLists<Exec>::kNearBits;
-      for (int k = bits != 0 ? lowestBit(bits) : kBits; k < nWalls;) {
-        WallTouch wt[kMaxWallTouches];
-        const int nt = wallTouches(walls[k], xi, ri, wt);
-        for (int c = 0; c < nt; ++c) {
-          const std::int64_t key = -(2 + k + static_cast<std::int64_t>(nWalls) * wt[c].feature);
-          // A touch new to this feature continues the history of another feature of the same
-          // wall (a sphere rolling over a rim onto a cap).
-          Vec3 hist{0.0, 0.0, 0.0};
-          int from = -1;
-          for (int s = 0; s < used; ++s) {
-            const std::int64_t o = -oldKey[s] - 2;
-            if (oldKey[s] == key) {
-              from = s;
-              break;
-            }
-            if (from < 0 && o >= 0 && o < meshKeyBase && o % nWalls == k)
-              from = s;
+      wv.touches(nearBits, i, xi, ri, [&](double h, Vec3 nw, std::int64_t key) {
+        // The history of this feature, else that of a neighbouring one (WallView::continues).
+        int from = -1;
+        for (int s = 0; s < used; ++s) {
+          if (oldKey[s] == key) {
+            from = s;
+            break;
           }
-          if (from >= 0)
-            hist = oldD[from];
-          touch(wt[c].h, wt[c].n, key, hist);
+          if (from < 0 && wv.continues(key, oldKey[s]))
+            from = s;
         }
-        if (k < kBits) {
-          bits &= bits - 1;
-          k = bits != 0 ? lowestBit(bits) : kBits;
-        } else {
-          ++k;
-        }
-      }
-      if (nearBits & WallLists<Exec>::kMeshBit) {
-        MeshTouch mt[kMaxMeshTouches];
-        const std::uint32_t m0 = meshStart[i];
-        const int nm =
-            meshTouches(tris, meshList + m0, static_cast<int>(meshStart[i + 1] - m0), xi, ri, mt);
-        for (int c = 0; c < nm; ++c) {
-          const std::int64_t key = -(2 + meshKeyBase + static_cast<std::int64_t>(mt[c].tri));
-          // A touch new to this triangle continues the history of a triangle sharing a vertex
-          // with it (a sphere sliding across an edge or a vertex).
-          const MeshTriangle& t = tris[mt[c].tri];
-          int from = -1;
-          for (int s = 0; s < used; ++s) {
-            if (oldKey[s] == key) {
-              from = s;
-              break;
-            }
-            const std::int64_t o = -oldKey[s] - 2 - meshKeyBase;
-            if (from < 0 && o >= 0) {
-              const MeshTriangle& u = tris[o];
-              for (int a = 0; a < 3; ++a)
-                if (u.v[a] == t.v[0] || u.v[a] == t.v[1] || u.v[a] == t.v[2])
-                  from = s;
-            }
-          }
-          touch(mt[c].h, mt[c].n, key, from >= 0 ? oldD[from] : Vec3{0.0, 0.0, 0.0});
-        }
-      }
+        touch(h, nw, key, from >= 0 ? oldD[from] : Vec3{0.0, 0.0, 0.0});
+      });
     }
     F += FW;
     for (int s = slot; s < used; ++s)
@@ -863,12 +813,7 @@ public:
     const std::uint32_t* hs = pl.halfStart();
     const std::int32_t* half = pl.half();
     const PairProps* pairs = _pairs.d();
-    const kernels::Wall* walls = wl.walls();
-    const int nWalls = wl.wallCount();
-    const kernels::MeshTriangle* tris = wl.triangles();
-    const std::uint32_t* meshStart = wl.meshStart();
-    const std::uint32_t* meshList = wl.meshList();
-    const std::int64_t meshKeyBase = wl.meshKeyBase();
+    const WallView wv = wl.view();
     const int nMat = ctx.setup.nMaterials;
     const int K = p.K;
     const bool coupled = ctx.setup.coupled; // force holds the gas force of the drag module
@@ -902,8 +847,8 @@ public:
     // Pass 1 (per owner): its owned pairs and its walls (OwnerContacts). The largest count of
     // history slots a particle needs goes to the status array.
     const OwnerContacts<Exec> ownerPass {
-      x, v, w, r, m, mat, hk, hd, hc, f, tq, fw, nc, nwc, hs, half, wallNear, pairs, walls, nWalls,
-          tris, meshStart, meshList, meshKeyBase, nMat, K, n, dt, hit, share, own
+      x, v, w, r, m, mat, hk, hd, hc, f, tq, fw, nc, nwc, hs, half, wallNear, pairs, wv, nMat, K, n,
+          dt, hit, share, own
 #if defined(COREDEM_DEM_DOUBLE2)
           ,
           two

@@ -219,12 +219,8 @@ public:
     WallLists<Exec>& wl = ctx.walls;
     if (thermalWalls)
       wl.ensure(exec, p, ctx.pairs.generation(), s.skin);
-    const int nWalls = wl.wallCount();
-    const kernels::Wall* walls = wl.walls();
+    const WallView wv = wl.view();
     const std::uint32_t* wallNear = thermalWalls ? wl.near() : nullptr;
-    const kernels::MeshTriangle* tris = wl.triangles();
-    const std::uint32_t* meshStart = wl.meshStart();
-    const std::uint32_t* meshList = wl.meshList();
     const kernels::WallConductionParams wp = _h.wallParams;
     const bool wallLens = wp.lens && coupled && hasKappa;
     // A wall is reached within R (contact) or (1 + FLPC) R (lens).
@@ -418,32 +414,9 @@ public:
         if (nearBits != 0) {
           const Vec3 xi = load3(x, ii);
           const double kgw = (wallLens && celli < nCells) ? kap[celli] : 0.0;
-          const double reach = wallReach * r[i];
-          auto conduct = [&](double h) {
+          wv.touches(nearBits, i, xi, wallReach * r[i], [&](double h, Vec3, std::int64_t) {
             qw += wallConductionHeat(wp, mi.k, tw.k, kgw, r[i], h, tw.temperature, ti);
-          };
-          constexpr int kBits = WallLists<Exec>::kNearBits;
-          std::uint32_t bits = nearBits & ~WallLists<Exec>::kMeshBit;
-          for (int k = bits != 0 ? lowestBit(bits) : kBits; k < nWalls;) {
-            WallTouch wt[kMaxWallTouches];
-            const int nt = wallTouches(walls[k], xi, reach, wt);
-            for (int c = 0; c < nt; ++c)
-              conduct(wt[c].h);
-            if (k < kBits) {
-              bits &= bits - 1;
-              k = bits != 0 ? lowestBit(bits) : kBits;
-            } else {
-              ++k;
-            }
-          }
-          if (nearBits & WallLists<Exec>::kMeshBit) {
-            MeshTouch mt[kMaxMeshTouches];
-            const std::uint32_t m0 = meshStart[i];
-            const int nm = meshTouches(tris, meshList + m0, static_cast<int>(meshStart[i + 1] - m0),
-                                       xi, reach, mt);
-            for (int c = 0; c < nm; ++c)
-              conduct(mt[c].h);
-          }
+          });
         }
         qwOut[i] = qw;
       }

@@ -31,6 +31,72 @@
 
 namespace coredem::dem {
 
+/// Analytic walls with a candidate bit of their own; bit kWallMeshBit says "mesh candidates".
+inline constexpr int kWallNearBits = 31;
+inline constexpr std::uint32_t kWallMeshBit = 1u << 31;
+
+/// The walls as the contact and heat kernels read them (device pointers), and the one order in
+/// which a particle's touches are found: its candidate analytic walls ascending (the bits of the
+/// first kWallNearBits, then every wall beyond them), each wall's touches in feature order, then
+/// its mesh touches (kernels/mesh_contact.h).
+struct WallView {
+  const kernels::Wall* walls;
+  int nWalls;
+  const kernels::MeshTriangle* tris;
+  const std::uint32_t* meshStart;
+  const std::uint32_t* meshList;
+  std::int64_t meshKeyBase; ///< nWalls · kMaxWallFeatures
+
+  /// Calls f(h, n, key) for every touch of particle i (centre x) within `reach` with the walls
+  /// of its candidate bits: h the distance to the surface, n the unit normal from the wall
+  /// towards the centre, key the touch's history key (−(2 + k + nWalls·f) for feature f of
+  /// analytic wall k, −(2 + meshKeyBase + t) for triangle t).
+  template <class F>
+  DEM_HD void touches(std::uint32_t nearBits, std::size_t i, kernels::Vec3 x, double reach,
+                      F&& f) const {
+    std::uint32_t bits = nearBits & ~kWallMeshBit;
+    for (int k = bits != 0 ? kernels::lowestBit(bits) : kWallNearBits; k < nWalls;) {
+      kernels::WallTouch wt[kernels::kMaxWallTouches];
+      const int nt = kernels::wallTouches(walls[k], x, reach, wt);
+      for (int c = 0; c < nt; ++c)
+        f(wt[c].h, wt[c].n, -(2 + k + static_cast<std::int64_t>(nWalls) * wt[c].feature));
+      if (k < kWallNearBits) {
+        bits &= bits - 1;
+        k = bits != 0 ? kernels::lowestBit(bits) : kWallNearBits;
+      } else {
+        ++k;
+      }
+    }
+    if (nearBits & kWallMeshBit) {
+      kernels::MeshTouch mt[kernels::kMaxMeshTouches];
+      const std::uint32_t m0 = meshStart[i];
+      const int nm = kernels::meshTouches(tris, meshList + m0,
+                                          static_cast<int>(meshStart[i + 1] - m0), x, reach, mt);
+      for (int c = 0; c < nm; ++c)
+        f(mt[c].h, mt[c].n, -(2 + meshKeyBase + static_cast<std::int64_t>(mt[c].tri)));
+    }
+  }
+
+  /// Whether a touch new to `key` takes over the history of the last sub-step's wall touch
+  /// `old`: another feature of the same analytic wall (a sphere rolling over a rim onto a cap),
+  /// or a triangle sharing a vertex with the new one (sliding across an edge or a vertex).
+  DEM_HD bool continues(std::int64_t key, std::int64_t old) const {
+    const std::int64_t o = -old - 2, k = -key - 2;
+    if (o < 0)
+      return false;
+    if (k < meshKeyBase)
+      return o < meshKeyBase && o % nWalls == k % nWalls;
+    if (o < meshKeyBase)
+      return false;
+    const kernels::MeshTriangle& t = tris[k - meshKeyBase];
+    const kernels::MeshTriangle& u = tris[o - meshKeyBase];
+    for (int a = 0; a < 3; ++a)
+      if (u.v[a] == t.v[0] || u.v[a] == t.v[1] || u.v[a] == t.v[2])
+        return true;
+    return false;
+  }
+};
+
 template <class Exec>
 class WallLists {
 public:
@@ -39,9 +105,8 @@ public:
   template <class T>
   using Dev = backend::DeviceArray<T, Exec>;
 
-  /// Analytic walls with a bit of their own; the bit kMeshBit says "mesh candidates".
-  static constexpr int kNearBits = 31;
-  static constexpr std::uint32_t kMeshBit = 1u << 31;
+  static constexpr int kNearBits = kWallNearBits;
+  static constexpr std::uint32_t kMeshBit = kWallMeshBit;
   /// Most bins of the triangle search (the bin edge grows to stay below).
   static constexpr std::size_t kMaxBins = std::size_t{1} << 22;
 
@@ -70,6 +135,10 @@ public:
   /// History key base of the mesh triangles: a touch of triangle t has key −(2 + base + t).
   std::int64_t meshKeyBase() const {
     return static_cast<std::int64_t>(_nWalls) * kernels::kMaxWallFeatures;
+  }
+  /// What the kernels read (device pointers).
+  WallView view() const {
+    return {_walls.d(), _nWalls, _tris.d(), _meshStart.d(), _meshList.d(), meshKeyBase()};
   }
   std::size_t bytes() const {
     return _walls.bytes() + _tris.bytes() + _binStart.bytes() + _binTris.bytes() + _near.bytes() +

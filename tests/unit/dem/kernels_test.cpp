@@ -1,5 +1,7 @@
 // Kernel unit tests on the CPU against docs/physics.md §1.1 and §2 (Eqs. 9–17).
 #include <cmath>
+#include <initializer_list>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -131,6 +133,68 @@ TEST(WallContact, OverlapNormalAndLever) {
   const double L = 5e-4 - 1e-4;
   EXPECT_NEAR(s.deltaT.x, -100 * L * 1e-6, 1e-18);
   EXPECT_GT(s.force.x, 0.0); // friction opposes the contact point's slip
+}
+
+namespace {
+/// A wall revolved about the z axis through the origin from a profile of (t, r) points.
+Wall revolved(std::initializer_list<std::pair<double, double>> profile, int side) {
+  Wall w{};
+  w.point = Vec3{0, 0, 0};
+  w.normal = Vec3{0, 0, 1};
+  w.kind = kWallRevolved;
+  w.side = side;
+  for (const auto& [t, r] : profile) {
+    w.t[w.points] = t;
+    w.r[w.points] = r;
+    ++w.points;
+  }
+  return w;
+}
+} // namespace
+
+// Surfaces of revolution (docs/physics.md §2.1 "Walls"): distances and normals against the
+// geometry by hand, to round-off (1e-15 m), for a capped vessel (inside), a capped insert
+// (outside, with its convex rims) and a cone.
+TEST(WallContact, RevolvedFacesRimsCornersAndTheFarSide) {
+  const double R = 0.01, H = 0.05, reach = 5e-4, tol = 1e-15;
+  WallTouch t[kMaxWallTouches];
+  // Vessel: bottom cap, side, top cap, particles inside.
+  const Wall vessel = revolved({{0, 0}, {0, R}, {H, R}, {H, 0}}, 1);
+  ASSERT_EQ(wallTouches(vessel, Vec3{R - 4e-4, 0, H / 2}, reach, t), 1);
+  EXPECT_NEAR(t[0].h, 4e-4, tol);
+  EXPECT_NEAR(t[0].n.x, -1.0, tol); // towards the axis
+  EXPECT_EQ(t[0].feature, 1);
+  // The corner of floor and side: one touch per face (a concave corner), in feature order.
+  ASSERT_EQ(wallTouches(vessel, Vec3{0, R - 4e-4, 3e-4}, reach, t), 2);
+  EXPECT_NEAR(t[0].h, 3e-4, tol);
+  EXPECT_NEAR(t[0].n.z, 1.0, tol);
+  EXPECT_NEAR(t[1].h, 4e-4, tol);
+  EXPECT_NEAR(t[1].n.y, -1.0, tol);
+  // Slightly through the side: pushed back (h < 0); far behind it: the wall's other side.
+  ASSERT_EQ(wallTouches(vessel, Vec3{R + 1e-4, 0, H / 2}, reach, t), 1);
+  EXPECT_NEAR(t[0].h, -1e-4, tol);
+  EXPECT_EQ(wallTouches(vessel, Vec3{R + 2e-3, 0, H / 2}, reach, t), 0);
+  // Insert (outside): beyond its top rim the rim itself, distance and normal from the rim
+  // point; along the side up to the rim the side, continuous at the rim's boundary.
+  const Wall insert = revolved({{0, 0}, {0, R}, {H, R}, {H, 0}}, -1);
+  const double a = 2e-4, b = 3e-4;
+  ASSERT_EQ(wallTouches(insert, Vec3{R + b, 0, H + a}, reach, t), 1);
+  EXPECT_NEAR(t[0].h, std::hypot(a, b), tol);
+  EXPECT_NEAR(t[0].n.x, b / std::hypot(a, b), 1e-12);
+  EXPECT_NEAR(t[0].n.z, a / std::hypot(a, b), 1e-12);
+  EXPECT_EQ(t[0].feature, 3 + 2 - 1); // segments 0..2, then the interior points 1, 2
+  ASSERT_EQ(wallTouches(insert, Vec3{R + b, 0, H - 1e-9}, reach, t), 1);
+  EXPECT_NEAR(t[0].h, b, tol);
+  ASSERT_EQ(wallTouches(insert, Vec3{R + b, 0, H + 1e-9}, reach, t), 1);
+  EXPECT_NEAR(t[0].h, b, 1e-12);
+  // Cone (frustum) from r = 4 mm at t = 0 to R at t = H: the distance to its line.
+  const double r0 = 0.004;
+  const Wall cone = revolved({{0, r0}, {H, R}}, 1);
+  const double s = 0.006, z = 0.02, L = std::hypot(H, R - r0);
+  const double expect = ((r0 + (R - r0) * z / H) - s) * H / L; // (radius at z − s) cos(angle)
+  ASSERT_EQ(wallTouches(cone, Vec3{0, s, z}, 1e-2, t), 1);
+  EXPECT_NEAR(t[0].h, expect, tol);
+  EXPECT_LE(wallClearance(cone, Vec3{0, s, z}), t[0].h + tol);
 }
 
 TEST(Drag, GidaspowErgunBranch) {
