@@ -50,4 +50,8 @@ if(NOT COREDEM_CUDA STREQUAL "OFF")
 endif()
 
 # --- OpenFOAM (resolved in cmake/CoredemOpenFOAM.cmake) ----------------------------------
-include(CoredemOpenFOAM)
+if(COREDEM_CORE_ONLY)
+  set(COREDEM_OPENFOAM_ENABLED OFF)
+else()
+  include(CoredemOpenFOAM)
+endif()

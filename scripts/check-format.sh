@@ -13,7 +13,7 @@ if ! command -v clang-format >/dev/null 2>&1; then
   exit 2
 fi
 
-mapfile -t files < <(git ls-files '*.h' '*.cpp' '*.cu')
+mapfile -t files < <(git ls-files '*.h' '*.cpp' '*.cu' '*.cuh')
 bad=()
 for f in "${files[@]}"; do
   if ! clang-format --dry-run --Werror "$f" >/dev/null 2>&1; then

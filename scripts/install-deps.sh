@@ -12,6 +12,8 @@ packages=(
   libzmq3-dev cppzmq-dev libprotobuf-dev protobuf-compiler
   libhdf5-dev hdf5-tools libyaml-cpp-dev libspdlog-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev libsqlite3-dev
+  # GoogleTest as a source tree: the DEM core built alone (tests/integration/core-build, gpu-check)
+  googletest
   openfoam
   python3 python3-matplotlib python3-h5py python3-zmq python3-protobuf python3-yaml
   # coredem render and the ParaView e2e tests (pvbatch on a private Xvfb)

@@ -21,12 +21,11 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "commands.h"
 #include "coredem/common/check.h"
 #include "coredem/dem/dem_system.h"
 #include "hopper.h"
+#include "options.h"
 
 namespace {
 
@@ -91,8 +90,9 @@ void jitterSites(DemConfig& cfg, double amplitude, std::uint64_t seed) {
 }
 
 int runDem(int argc, char** argv) {
-  CLI::App app{"DEM core throughput on the packed / agitated / hopper decks (bench/decks.md)",
-               "coredem-bench dem"};
+  coredem::bench::Args app{
+      "DEM core throughput on the packed / agitated / hopper decks (bench/decks.md)",
+      "coredem-bench dem"};
   std::string deckName = "packed", backend = "cpu", velocityFile;
   std::size_t n = 10000;
   int steps = 500, threads = 2, warmup = 20;
@@ -101,72 +101,66 @@ int runDem(int argc, char** argv) {
   int nSub = 50;
   double jitter = 0.0;
   coredem::bench::hopper::Options hop;
-  app.add_option("--case", deckName, "deck: packed | agitated | hopper")
-      ->check(CLI::IsMember({"packed", "agitated", "hopper"}));
-  app.add_option("--particles", n, "number of particles (default 10000; hopper: 20000)")
-      ->check(CLI::Range(1.0, 2.0e9));
-  app.add_option("--steps", steps, "measured DEM steps")->check(CLI::PositiveNumber);
-  app.add_option("--warmup", warmup, "unmeasured steps first")->check(CLI::NonNegativeNumber);
-  app.add_option("--backend", backend,
-                 "cpu | cuda | auto | cuda-sim (cpu kernels, cuda memory model)")
-      ->check(CLI::IsMember({"cpu", "cuda", "auto", "cuda-sim"}));
-  app.add_option("--threads", threads, "OpenMP threads (cpu backend)")
-      ->check(CLI::NonNegativeNumber);
-  app.add_option("--skin", skin, "Verlet skin as a fraction of d_max (default: the library's)");
-  app.add_flag("--json", json, "print one JSON object");
-  app.add_option("--velocities", velocityFile,
-                 "initial velocities from a file, one particle per line 'vx vy vz' (m/s), in "
-                 "the deck's site order (replaces the deck's seeded ones)");
-  app.add_flag("--coupled", coupled,
-               "add a PCM coupling grid (cells of 4 d_p) with air rising at 0.5 m/s");
-  app.add_flag("--heat", heat,
-               "switch the heat module on (the decks are mechanics only; with --coupled: "
-               "conduction, convection with the gas, lens; radiation needs an emissivity)");
-  app.add_option("--nsub", nSub, "with --coupled: DEM sub-steps per CFD step")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--jitter", jitter,
-                 "move each lattice site by uniform[-a, a) d_p per component (seeded): a "
-                 "random-like bed (e.g. --case packed --jitter 0.02: touching and lens-gap "
-                 "pairs mixed)")
-      ->check(CLI::Range(0.0, 0.5));
+  app.option("--case", deckName, "deck: packed | agitated | hopper")
+      .oneOf({"packed", "agitated", "hopper"});
+  app.option("--particles", n, "number of particles (default 10000; hopper: 20000)")
+      .range(1.0, 2.0e9);
+  app.option("--steps", steps, "measured DEM steps").positive();
+  app.option("--warmup", warmup, "unmeasured steps first").nonNegative();
+  app.option("--backend", backend, "cpu | cuda | auto | cuda-sim (cpu kernels, cuda memory model)")
+      .oneOf({"cpu", "cuda", "auto", "cuda-sim"});
+  app.option("--threads", threads, "OpenMP threads (cpu backend)").nonNegative();
+  app.option("--skin", skin, "Verlet skin as a fraction of d_max (default: the library's)");
+  app.flag("--json", json, "print one JSON object");
+  app.option("--velocities", velocityFile,
+             "initial velocities from a file, one particle per line 'vx vy vz' (m/s), in "
+             "the deck's site order (replaces the deck's seeded ones)");
+  app.flag("--coupled", coupled,
+           "add a PCM coupling grid (cells of 4 d_p) with air rising at 0.5 m/s");
+  app.flag("--heat", heat,
+           "switch the heat module on (the decks are mechanics only; with --coupled: "
+           "conduction, convection with the gas, lens; radiation needs an emissivity)");
+  app.option("--nsub", nSub, "with --coupled: DEM sub-steps per CFD step").positive();
+  app.option("--jitter", jitter,
+             "move each lattice site by uniform[-a, a) d_p per component (seeded): a "
+             "random-like bed (e.g. --case packed --jitter 0.02: touching and lens-gap "
+             "pairs mixed)")
+      .range(0.0, 0.5);
   // The hopper deck's own options (bench/decks.md `hopper`).
-  std::vector<CLI::Option*> hopperOnly{
-      app.add_option("--walls", hop.walls,
-                     "hopper: primitive (analytic cone + cylinder) | stl (the same as STL "
-                     "meshes) | none (the settled bed alone, no walls, no gravity)")
-          ->check(CLI::IsMember({"primitive", "stl", "none"})),
-      app.add_flag("--closed", hop.closed,
-                   "hopper: keep the outlet closed by its plate (the settled bed at rest)"),
-      app.add_option("--deck-dir", hop.deckDir,
-                     "hopper: directory for the settled bed and the STL files (reused when it "
-                     "holds them for the same N and outlet; default: a temporary one)"),
-      app.add_option("--outlet", hop.outlet, "hopper: outlet diameter in particle diameters")
-          ->check(CLI::Range(2.0, 40.0)),
-      app.add_option("--sample", hop.sample,
-                     "hopper: count the discharged particles every K steps (default 500)")
-          ->check(CLI::PositiveNumber),
-      app.add_option("--until", hop.until,
-                     "hopper: stop once this fraction has been discharged (the steps are then "
-                     "a maximum)")
-          ->check(CLI::Range(0.0, 1.0)),
-      app.add_option("--fit-lo", hop.fitLo,
-                     "hopper: discharged fraction where the rate fit starts (default 0.2)")
-          ->check(CLI::Range(0.0, 1.0)),
-      app.add_option("--fit-hi", hop.fitHi,
-                     "hopper: discharged fraction where the rate fit ends (default 0.8)")
-          ->check(CLI::Range(0.0, 1.0)),
-      app.add_option("--samples-out", hop.samplesOut,
-                     "hopper: write the samples 't below_outlet wall_contacts pair_contacts "
-                     "advance_wall_s rebuilds'"),
-      app.add_flag("--settle-only", hop.settleOnly,
-                   "hopper: settle (or find) the bed and write the deck files, run nothing"),
-      app.add_flag("--resettle", hop.resettle,
-                   "hopper: settle again even if the deck directory holds a settled bed")};
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
+  std::vector<const coredem::bench::Opt*> hopperOnly{
+      &app.option("--walls", hop.walls,
+                  "hopper: primitive (analytic cone + cylinder) | stl (the same as STL "
+                  "meshes) | none (the settled bed alone, no walls, no gravity)")
+           .oneOf({"primitive", "stl", "none"}),
+      &app.flag("--closed", hop.closed,
+                "hopper: keep the outlet closed by its plate (the settled bed at rest)"),
+      &app.option("--deck-dir", hop.deckDir,
+                  "hopper: directory for the settled bed and the STL files (reused when it "
+                  "holds them for the same N and outlet; default: a temporary one)"),
+      &app.option("--outlet", hop.outlet, "hopper: outlet diameter in particle diameters")
+           .range(2.0, 40.0),
+      &app.option("--sample", hop.sample,
+                  "hopper: count the discharged particles every K steps (default 500)")
+           .positive(),
+      &app.option("--until", hop.until,
+                  "hopper: stop once this fraction has been discharged (the steps are then "
+                  "a maximum)")
+           .range(0.0, 1.0),
+      &app.option("--fit-lo", hop.fitLo,
+                  "hopper: discharged fraction where the rate fit starts (default 0.2)")
+           .range(0.0, 1.0),
+      &app.option("--fit-hi", hop.fitHi,
+                  "hopper: discharged fraction where the rate fit ends (default 0.8)")
+           .range(0.0, 1.0),
+      &app.option("--samples-out", hop.samplesOut,
+                  "hopper: write the samples 't below_outlet wall_contacts pair_contacts "
+                  "advance_wall_s rebuilds'"),
+      &app.flag("--settle-only", hop.settleOnly,
+                "hopper: settle (or find) the bed and write the deck files, run nothing"),
+      &app.flag("--resettle", hop.resettle,
+                "hopper: settle again even if the deck directory holds a settled bed")};
+  if (const int rc = app.parse(argc, argv); rc >= 0)
+    return rc;
   try {
     if (deckName == "hopper") {
       COREDEM_CHECK(!coupled && velocityFile.empty() && jitter == 0,
@@ -181,8 +175,8 @@ int runDem(int argc, char** argv) {
       hop.heat = heat;
       return coredem::bench::hopper::run(hop);
     }
-    for (const CLI::Option* opt : hopperOnly)
-      COREDEM_CHECK(opt->count() == 0, "{} applies to --case hopper only", opt->get_name());
+    for (const coredem::bench::Opt* opt : hopperOnly)
+      COREDEM_CHECK(opt->count() == 0, "{} applies to --case hopper only", opt->name());
     DemConfig cfg = deck(deckName, n);
     if (skin >= 0)
       cfg.neighbour.skinFactor = skin;

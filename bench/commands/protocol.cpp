@@ -23,7 +23,6 @@
 #include <thread>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -35,6 +34,7 @@
 #include <coredem/protocol/validate.h>
 
 #include "commands.h"
+#include "options.h"
 
 namespace {
 
@@ -342,25 +342,22 @@ double measureValidate(const std::vector<std::shared_ptr<std::vector<double>>>& 
 }
 
 int runProtocolBench(int argc, char** argv) {
-  CLI::App app{"Round-trip throughput of the coupling transport vs memcpy", "protocol"};
+  coredem::bench::Args app{"Round-trip throughput of the coupling transport vs memcpy", "protocol"};
   std::uint64_t cells = 100000;
   std::size_t nFields = 16;
   bool json = false;
   double seconds = 1.0;
   std::vector<std::string> transports{"tcp", "ipc"};
   bool sameProcess = false;
-  app.add_option("--cells", cells, "cells N (doubles per array)")->check(CLI::PositiveNumber);
-  app.add_option("--fields", nFields, "arrays F per message")->check(CLI::PositiveNumber);
-  app.add_flag("--json", json, "print one JSON object");
-  app.add_option("--seconds", seconds, "minimum measuring time per transport");
-  app.add_option("--transports", transports, "tcp, ipc, tcp-raw (bare cppzmq)")->delimiter(',');
-  app.add_flag("--same-process", sameProcess,
-               "run the echo server as a thread of this process (default: a child process)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
+  app.option("--cells", cells, "cells N (doubles per array)").positive();
+  app.option("--fields", nFields, "arrays F per message").positive();
+  app.flag("--json", json, "print one JSON object");
+  app.option("--seconds", seconds, "minimum measuring time per transport");
+  app.option("--transports", transports, "tcp, ipc, tcp-raw (bare cppzmq)");
+  app.flag("--same-process", sameProcess,
+           "run the echo server as a thread of this process (default: a child process)");
+  if (const int rc = app.parse(argc, argv); rc >= 0)
+    return rc;
 
   std::vector<std::shared_ptr<std::vector<double>>> arrays;
   for (std::size_t f = 0; f < nFields; ++f) {

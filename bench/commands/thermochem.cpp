@@ -22,13 +22,13 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <omp.h>
 
 #include "commands.h"
 #include "coredem/common/check.h"
 #include "coredem/dem/dem_system.h"
 #include "dem.h"
+#include "options.h"
 
 namespace {
 
@@ -244,28 +244,23 @@ tc::ChemTimes runChemistryCpu(const tc::ChemInput& in, int reps, int threads) {
 }
 
 int runThermochem(int argc, char** argv) {
-  CLI::App app{
+  coredem::bench::Args app{
       "Thermochemistry sub-models: ns per particle and DEM sub-step (seed Table 2 / Fig. 19)",
       "coredem-bench thermochem"};
   Options o;
   bool json = false;
-  app.add_option("--particles", o.n, "number of particles")->check(CLI::Range(1.0, 2.0e9));
-  app.add_option("--threads", o.threads, "OpenMP threads (cpu backend; 0 = OpenMP default)")
-      ->check(CLI::NonNegativeNumber);
-  app.add_option("--backend", o.backend, "cpu | cuda | auto")
-      ->check(CLI::IsMember({"cpu", "cuda", "auto"}));
-  app.add_option("--case", o.deckName, "deck of bench/decks.md: packed | agitated")
-      ->check(CLI::IsMember({"packed", "agitated"}));
-  app.add_option("--steps", o.steps, "measured sub-steps per repeat")->check(CLI::PositiveNumber);
-  app.add_option("--warmup", o.warmup, "unmeasured sub-steps first")->check(CLI::NonNegativeNumber);
-  app.add_option("--repeat", o.repeat, "measured runs per variant (medians reported)")
-      ->check(CLI::PositiveNumber);
-  app.add_flag("--json", json, "print one JSON object");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
+  app.option("--particles", o.n, "number of particles").range(1.0, 2.0e9);
+  app.option("--threads", o.threads, "OpenMP threads (cpu backend; 0 = OpenMP default)")
+      .nonNegative();
+  app.option("--backend", o.backend, "cpu | cuda | auto").oneOf({"cpu", "cuda", "auto"});
+  app.option("--case", o.deckName, "deck of bench/decks.md: packed | agitated")
+      .oneOf({"packed", "agitated"});
+  app.option("--steps", o.steps, "measured sub-steps per repeat").positive();
+  app.option("--warmup", o.warmup, "unmeasured sub-steps first").nonNegative();
+  app.option("--repeat", o.repeat, "measured runs per variant (medians reported)").positive();
+  app.flag("--json", json, "print one JSON object");
+  if (const int rc = app.parse(argc, argv); rc >= 0)
+    return rc;
   try {
     const BackendKind kind = parseBackend(o.backend);
     const CudaProbe probe = probeCuda();

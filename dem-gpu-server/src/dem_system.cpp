@@ -300,8 +300,9 @@ std::vector<double> placeParticles(const ParticleSet& s, const std::atomic<bool>
   while (p.size() < 3 * s.count) {
     if (interrupt != nullptr && (attempts & 4095) == 0 &&
         interrupt->load(std::memory_order_relaxed)) {
-      throw Interrupted(fmt::format("interrupted while placing particle set '{}' ({} of {} placed)",
-                                    s.name, p.size() / 3, s.count));
+      throw Interrupted(
+          coredem::format("interrupted while placing particle set '{}' ({} of {} placed)", s.name,
+                          p.size() / 3, s.count));
     }
     COREDEM_CHECK(
         ++attempts < maxAttempts,
@@ -565,7 +566,7 @@ struct DemSystem::Impl {
       return makeCudaSimEngine(setup);
     return makeCpuEngine(setup);
   }
-  std::shared_ptr<spdlog::logger> log = coredem::logger("dem.system");
+  std::shared_ptr<coredem::Logger> log = coredem::logger("dem.system");
 };
 
 DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
@@ -786,7 +787,7 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
   m.engine->beginWindow();
   for (int s = 0; s < nSub; ++s) {
     if (m.interrupt != nullptr && m.interrupt->load(std::memory_order_relaxed)) {
-      throw Interrupted(fmt::format("interrupted after {} of {} sub-steps", s, nSub));
+      throw Interrupted(coredem::format("interrupted after {} of {} sub-steps", s, nSub));
     }
     m.engine->subStep(dt);
     m.time.add(dt);

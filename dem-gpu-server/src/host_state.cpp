@@ -26,13 +26,14 @@ double defaultValue(schema::Default d, const HostState& s, std::size_t i) {
 template <class T>
 void assignDefault(const schema::FieldInfo& f, HostState& s, std::vector<T>& v) {
   if (f.def == schema::Default::Required) {
-    throw InternalError(
-        fmt::format("particle field '{}' ({}) has no default and was not set", f.name, f.member));
+    throw InternalError(coredem::format("particle field '{}' ({}) has no default and was not set",
+                                        f.name, f.member));
   }
   if (f.def == schema::Default::Diameter && s.radius.size() != s.n) {
-    throw InternalError(fmt::format("particle field '{}': its default needs radius, which holds {} "
-                                    "values for {} particles",
-                                    f.name, s.radius.size(), s.n));
+    throw InternalError(
+        coredem::format("particle field '{}': its default needs radius, which holds {} "
+                        "values for {} particles",
+                        f.name, s.radius.size(), s.n));
   }
   const std::size_t w = schema::valuesPerParticle(f, s.extents());
   v.resize(s.n * w);
@@ -46,10 +47,11 @@ void assignDefault(const schema::FieldInfo& f, HostState& s, std::vector<T>& v) 
 void checkShapes(const HostState& s, const char* where) {
   schema::forEachField(s, [&](const schema::FieldInfo& f, const auto& v) {
     if (v.size() != s.expectedSize(f)) {
-      throw InternalError(fmt::format("{}: particle field '{}' holds {} values, expected {} ({} "
-                                      "particles × {} per particle)",
-                                      where, f.name, v.size(), s.expectedSize(f), s.n,
-                                      schema::valuesPerParticle(f, s.extents())));
+      throw InternalError(
+          coredem::format("{}: particle field '{}' holds {} values, expected {} ({} "
+                          "particles × {} per particle)",
+                          where, f.name, v.size(), s.expectedSize(f), s.n,
+                          schema::valuesPerParticle(f, s.extents())));
     }
   });
 }

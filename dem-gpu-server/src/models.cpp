@@ -159,9 +159,9 @@ namespace {
 std::string withSuggestion(std::string_view value, std::span<const std::string_view> names,
                            const std::string& allowed) {
   const std::string guess = didYouMean(value, names);
-  return fmt::format("'{}' is not allowed{}; allowed: {}", value,
-                     guess.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", guess),
-                     allowed);
+  return coredem::format(
+      "'{}' is not allowed{}; allowed: {}", value,
+      guess.empty() ? std::string() : coredem::format(" (did you mean '{}'?)", guess), allowed);
 }
 
 /// The family entry named `value`, or the message saying what is allowed (`extra`: further
@@ -198,7 +198,7 @@ std::optional<double> number(std::string_view value, double lo, bool loOpen, dou
                   (loOpen ? v > lo : v >= lo) && v <= hi;
   if (ok)
     return v;
-  error = fmt::format("'{}' is not allowed; expected {}", value, what);
+  error = coredem::format("'{}' is not allowed; expected {}", value, what);
   return std::nullopt;
 }
 
@@ -210,7 +210,7 @@ std::optional<int> integer(std::string_view value, int lo, int hi, std::string_v
   const auto r = std::from_chars(value.data(), end, v);
   if (r.ec == std::errc() && r.ptr == end && v >= lo && v <= hi)
     return v;
-  error = fmt::format("'{}' is not allowed; expected {}", value, what);
+  error = coredem::format("'{}' is not allowed; expected {}", value, what);
   return std::nullopt;
 }
 
@@ -351,16 +351,16 @@ std::vector<ModelOption> makeOptions() {
                    c.neighbour.skinFactor = *x;
                  return e;
                }});
-  o.push_back({"dem.history_slots", "numerics", fmt::format("integer in [1, {}]", kMaxHistorySlots),
-               "12", "tangential-history slots per particle (the contacts it owns, walls included)",
-               [](DemConfig& c, std::string_view v) {
-                 std::string e;
-                 const std::string what =
-                     fmt::format("an integer in [1, {}] (12)", kMaxHistorySlots);
-                 if (const auto x = integer(v, 1, kMaxHistorySlots, what, e))
-                   c.neighbour.historySlots = *x;
-                 return e;
-               }});
+  o.push_back(
+      {"dem.history_slots", "numerics", coredem::format("integer in [1, {}]", kMaxHistorySlots),
+       "12", "tangential-history slots per particle (the contacts it owns, walls included)",
+       [](DemConfig& c, std::string_view v) {
+         std::string e;
+         const std::string what = coredem::format("an integer in [1, {}] (12)", kMaxHistorySlots);
+         if (const auto x = integer(v, 1, kMaxHistorySlots, what, e))
+           c.neighbour.historySlots = *x;
+         return e;
+       }});
   return o;
 }
 
@@ -404,9 +404,10 @@ validateModels(std::span<const std::pair<std::string, std::string>> models) {
       const std::string guess = didYouMean(key, keys);
       issues.push_back(
           {i, key, true,
-           fmt::format("unknown model key{}; allowed keys: {}",
-                       guess.empty() ? std::string() : fmt::format(" (did you mean '{}'?)", guess),
-                       allKeys)});
+           coredem::format("unknown model key{}; allowed keys: {}",
+                           guess.empty() ? std::string()
+                                         : coredem::format(" (did you mean '{}'?)", guess),
+                           allKeys)});
       continue;
     }
     std::string error = o->apply(scratch, value);

@@ -23,6 +23,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "coredem/common/check.h"
 #include "coredem/dem/dem_system.h"
 
 using namespace coredem::dem;
@@ -457,6 +458,7 @@ TYPED_TEST(StageConformance, FrozenMode) {
   expectClose(byGid(start.p, start.p.position), byGid(r.p, r.p.position), 0.0, "frozen position");
 }
 
+#if COREDEM_DEM_STATE_FILES
 TYPED_TEST(StageConformance, RestartContinuesTheStraightRun) {
   const auto dir = std::filesystem::temp_directory_path() /
                    ("coredem_conformance_" + std::to_string(::getpid()));
@@ -476,3 +478,16 @@ TYPED_TEST(StageConformance, RestartContinuesTheStraightRun) {
   tail.states.erase(tail.states.begin(), tail.states.begin() + 4);
   expectSameRun(tail, resumed, this->tol, this->kind != BackendKind::Cuda);
 }
+#else
+// The DEM core built alone has no HDF5: the restart above is not compiled there, and a state file
+// is refused with a message that says what to build.
+TYPED_TEST(StageConformance, StateFilesAreRefusedWithoutHdf5) {
+  DemSystem sys(burningBed(), this->kind);
+  try {
+    sys.writeState("state.h5");
+    FAIL() << "writeState succeeded in a build without state files";
+  } catch (const coredem::UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("COREDEM_CORE_ONLY"), std::string::npos) << e.what();
+  }
+}
+#endif

@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include <spdlog/fmt/fmt.h>
+#include "coredem/common/format.h"
 
 namespace coredem {
 
@@ -31,7 +31,7 @@ public:
 #define COREDEM_CHECK(cond, ...)                                                                   \
   do {                                                                                             \
     if (!(cond)) {                                                                                 \
-      throw ::coredem::UserError(fmt::format(__VA_ARGS__));                                        \
+      throw ::coredem::UserError(::coredem::format(__VA_ARGS__));                                  \
     }                                                                                              \
   } while (false)
 
@@ -39,8 +39,8 @@ public:
 #define COREDEM_ASSERT(cond)                                                                       \
   do {                                                                                             \
     if (!(cond)) {                                                                                 \
-      throw ::coredem::InternalError(fmt::format("internal error: assertion '{}' failed at {}:{}", \
-                                                 #cond, __FILE__, __LINE__));                      \
+      throw ::coredem::InternalError(::coredem::format(                                            \
+          "internal error: assertion '{}' failed at {}:{}", #cond, __FILE__, __LINE__));           \
     }                                                                                              \
   } while (false)
 #else

@@ -3,31 +3,31 @@
 /// The cuda backend: kernel launch for parallelFor, CUB for sort/scan/reduce, cudaMalloc /
 /// pinned host memory. Thin on purpose: the physics is the shared engine_impl.h.
 
-#include "../exec_common.h"
-#include "../sync_counters.h"
-
+#include <cstddef>
+#include <cstdint>
 #include <cub/device/device_radix_sort.cuh>
 #include <cub/device/device_reduce.cuh>
 #include <cub/device/device_scan.cuh>
 #include <cuda/functional>
-#include <cuda_runtime.h>
-
-#include <cstddef>
-#include <cstdint>
 #include <string>
 
+#include <cuda_runtime.h>
+
+#include "../exec_common.h"
+#include "../sync_counters.h"
+
 /// Wraps every CUDA runtime call: throws with file:line and a hint.
-#define DEM_CUDA_CHECK(expr)                                                                   \
-  do {                                                                                         \
-    const cudaError_t demCudaErr_ = (expr);                                                    \
-    if (demCudaErr_ != cudaSuccess) {                                                          \
-      ::coredem::dem::backend::raiseUserError(                                                 \
-          std::string("CUDA call '") + #expr + "' failed at " + __FILE__ + ":" +               \
-          std::to_string(__LINE__) + ": " + cudaGetErrorName(demCudaErr_) + ": " +             \
-          cudaGetErrorString(demCudaErr_) +                                                    \
-          " (check the GPU and its driver with nvidia-smi, and CUDA_VISIBLE_DEVICES; "         \
-          "--backend cpu runs without it)");                                                   \
-    }                                                                                          \
+#define DEM_CUDA_CHECK(expr)                                                                       \
+  do {                                                                                             \
+    const cudaError_t demCudaErr_ = (expr);                                                        \
+    if (demCudaErr_ != cudaSuccess) {                                                              \
+      ::coredem::dem::backend::raiseUserError(                                                     \
+          std::string("CUDA call '") + #expr + "' failed at " + __FILE__ + ":" +                   \
+          std::to_string(__LINE__) + ": " + cudaGetErrorName(demCudaErr_) + ": " +                 \
+          cudaGetErrorString(demCudaErr_) +                                                        \
+          " (check the GPU and its driver with nvidia-smi, and CUDA_VISIBLE_DEVICES; "             \
+          "--backend cpu runs without it)");                                                       \
+    }                                                                                              \
   } while (false)
 
 namespace coredem::dem::backend {
@@ -35,13 +35,15 @@ namespace coredem::dem::backend {
 template <class F>
 __global__ void forEachKernel(std::size_t n, F f) {
   const std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i < n) f(i);
+  if (i < n)
+    f(i);
 }
 
 template <class F>
 __global__ void evalKernel(std::size_t n, F f, double* out) {
   const std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i < n) out[i] = f(i);
+  if (i < n)
+    out[i] = f(i);
 }
 
 /// *out = max(*v, init) (v == nullptr: init): the last step of reduceMaxInto, on the device.
@@ -54,14 +56,15 @@ template <class T>
 __global__ void iotaKernel(std::size_t n, T* v) {
   static_assert(sizeof(T) == 4, "32-bit indices");
   const std::size_t i = static_cast<std::size_t>(blockIdx.x) * blockDim.x + threadIdx.x;
-  if (i < n) v[i] = static_cast<T>(i);
+  if (i < n)
+    v[i] = static_cast<T>(i);
 }
 
 struct CudaExec {
   static constexpr bool separateDevice = true;
   static constexpr const char* name = "cuda";
   static constexpr unsigned kBlock = 256;
-  int threads = 0;  ///< unused (kept for a uniform set-up)
+  int threads = 0; ///< unused (kept for a uniform set-up)
 
   static unsigned blocks(std::size_t n) { return static_cast<unsigned>((n + kBlock - 1) / kBlock); }
 
@@ -74,7 +77,8 @@ struct CudaExec {
 
   template <class F>
   void parallelFor(std::size_t n, F f) const {
-    if (n == 0) return;
+    if (n == 0)
+      return;
     ++syncCounters().launches;
     forEachKernel<<<blocks(n), kBlock>>>(n, f);
     checkLaunch();
@@ -82,7 +86,8 @@ struct CudaExec {
 
   template <class F>
   double reduceMax(std::size_t n, F f, double init) const {
-    if (n == 0) return init;
+    if (n == 0)
+      return init;
     double* vals = scratch<double>(_vals, _valsCap, n + 1);
     syncCounters().launches += 2;
     ++syncCounters().hostRoundTrips;
@@ -109,7 +114,7 @@ struct CudaExec {
     }
     double* vals = scratch<double>(_vals, _valsCap, n + 1);
     syncCounters().launches += 2;
-    evalKernel<<<blocks(n), kBlock>>>(n, f, vals);  // f once per index (it may write)
+    evalKernel<<<blocks(n), kBlock>>>(n, f, vals); // f once per index (it may write)
     checkLaunch();
     std::size_t tmpBytes = 0;
     DEM_CUDA_CHECK(cub::DeviceReduce::Reduce(nullptr, tmpBytes, vals, out, static_cast<int>(n),
@@ -128,11 +133,14 @@ struct CudaExec {
   }
 
   /// Stable LSD radix sort of (key, index) pairs; perm receives the indices.
-  void sortByKey(const std::uint32_t* keys, std::size_t n, std::uint32_t numKeys, std::uint32_t* perm) const {
-    if (n == 0) return;
+  void sortByKey(const std::uint32_t* keys, std::size_t n, std::uint32_t numKeys,
+                 std::uint32_t* perm) const {
+    if (n == 0)
+      return;
     syncCounters().launches += 2;
     int bits = 1;
-    while (bits < 32 && (1ull << bits) < numKeys) ++bits;
+    while (bits < 32 && (1ull << bits) < numKeys)
+      ++bits;
     std::uint32_t* buf = scratch<std::uint32_t>(_sortBuf, _sortCap, 2 * n);
     std::uint32_t* keysOut = buf;
     std::uint32_t* iota = buf + n;
@@ -154,25 +162,37 @@ struct CudaExec {
 
   static void* allocHost(std::size_t bytes) {
     void* p = nullptr;
-    if (bytes) DEM_CUDA_CHECK(cudaMallocHost(&p, bytes));
+    if (bytes)
+      DEM_CUDA_CHECK(cudaMallocHost(&p, bytes));
     return p;
   }
-  static void freeHost(void* p) { if (p) cudaFreeHost(p); }
+  static void freeHost(void* p) {
+    if (p)
+      cudaFreeHost(p);
+  }
   static void* allocDevice(std::size_t bytes) {
     void* p = nullptr;
-    if (bytes) DEM_CUDA_CHECK(cudaMalloc(&p, bytes));
+    if (bytes)
+      DEM_CUDA_CHECK(cudaMalloc(&p, bytes));
     return p;
   }
-  static void freeDevice(void* p) { if (p) cudaFree(p); }
+  static void freeDevice(void* p) {
+    if (p)
+      cudaFree(p);
+  }
   static void copyToDevice(void* d, const void* h, std::size_t bytes) {
-    if (bytes) DEM_CUDA_CHECK(cudaMemcpy(d, h, bytes, cudaMemcpyHostToDevice));
+    if (bytes)
+      DEM_CUDA_CHECK(cudaMemcpy(d, h, bytes, cudaMemcpyHostToDevice));
   }
   static void copyToHost(void* h, const void* d, std::size_t bytes) {
-    if (bytes) ++syncCounters().hostRoundTrips;
-    if (bytes) DEM_CUDA_CHECK(cudaMemcpy(h, d, bytes, cudaMemcpyDeviceToHost));
+    if (bytes)
+      ++syncCounters().hostRoundTrips;
+    if (bytes)
+      DEM_CUDA_CHECK(cudaMemcpy(h, d, bytes, cudaMemcpyDeviceToHost));
   }
   static void copyDeviceToDevice(void* dst, const void* src, std::size_t bytes) {
-    if (bytes) DEM_CUDA_CHECK(cudaMemcpy(dst, src, bytes, cudaMemcpyDeviceToDevice));
+    if (bytes)
+      DEM_CUDA_CHECK(cudaMemcpy(dst, src, bytes, cudaMemcpyDeviceToDevice));
   }
   static void synchronize() {
     ++syncCounters().deviceSyncs;
@@ -186,10 +206,14 @@ struct CudaExec {
     Mark() = default;
     Mark(const Mark&) = delete;
     Mark& operator=(const Mark&) = delete;
-    ~Mark() { if (e) cudaEventDestroy(e); }
+    ~Mark() {
+      if (e)
+        cudaEventDestroy(e);
+    }
   };
   static void mark(Mark& m) {
-    if (!m.e) DEM_CUDA_CHECK(cudaEventCreate(&m.e));
+    if (!m.e)
+      DEM_CUDA_CHECK(cudaEventCreate(&m.e));
     DEM_CUDA_CHECK(cudaEventRecord(m.e));
   }
   static double seconds(const Mark& a, const Mark& b) {
