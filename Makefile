@@ -22,8 +22,14 @@ build: configure
 run: build
 	scripts/run-default.sh $(BUILD_DIR)
 
+# The whole suite, then scripts/test-summary.py: the counts by label and group, and a failure on
+# any failed, unexpectedly skipped or missing test (a group that should run but is not there).
 test: build
-	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+	@rm -f $(BUILD_DIR)/ctest-junit.xml
+	@rc=0; cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) --test-output-size-passed 262144 \
+	  --test-output-size-failed 1048576 --output-junit $(abspath $(BUILD_DIR))/ctest-junit.xml \
+	  || rc=$$?; \
+	/usr/bin/python3 $(CURDIR)/scripts/test-summary.py . ctest-junit.xml || rc=1; exit $$rc
 
 format:
 	git ls-files '*.h' '*.cpp' '*.cu' '*.cuh' | xargs clang-format -i

@@ -169,8 +169,9 @@ if(NOT COREDEM_OPENFOAM STREQUAL "OFF")
                         "-DCOREDEM_OPENFOAM=AUTO (skip it when unavailable) or OFF.")
   else()
     message(WARNING "OpenFOAM participant disabled (COREDEM_OPENFOAM=AUTO): "
-                    "${_coredem_openfoam_why}. Configure with -DCOREDEM_OPENFOAM=OFF to silence "
-                    "this, or fix it and configure again.")
+                    "${_coredem_openfoam_why}. Its tests are not built and `make test` fails "
+                    "(coverage.openfoam.missing): fix it and configure again, or configure with "
+                    "-DCOREDEM_OPENFOAM=OFF to leave the OpenFOAM participant and its tests out.")
   endif()
 endif()
 

@@ -16,6 +16,8 @@ packages=(
   googletest
   openfoam
   python3 python3-matplotlib python3-h5py python3-zmq python3-protobuf python3-yaml
+  # the generators of the tests' reference values (tests/unit/thermochem/reference)
+  python3-mpmath
   # coredem render and the ParaView e2e tests (pvbatch on a private Xvfb)
   paraview python3-paraview xvfb
   # used by scripts/openfoam-headers.sh to fetch Debian's OpenFOAM sources

@@ -8,7 +8,9 @@
 // travels the delay. Bytes keep their order; a half-close (EOF) is passed on after the bytes
 // before it; a reset or error on one side closes both. At most `--max-queued-mb` are held per
 // direction (then the relay stops reading that side, which TCP turns into back-pressure).
-// SIGTERM or SIGINT closes every connection and exits 0.
+// SIGTERM or SIGINT closes every connection and exits 0. `--trace-chunks` logs every chunk once
+// it is written on: its connection, direction, size and when it was read, due and written (ns on
+// the relay's steady clock), so that tests check the delay and the bandwidth from the log.
 //
 // Used where the kernel has no `tc qdisc netem` (tests/e2e/remote, bench/remote/link.sh). Plain
 // POSIX sockets and poll(); no CoReDEM library.
@@ -101,7 +103,8 @@ void setNoDelay(int fd) {
 }
 
 struct Chunk {
-  Clock::time_point due; ///< when it may be written to the other side
+  Clock::time_point read; ///< when it was read from its side
+  Clock::time_point due;  ///< when it may be written to the other side
   std::vector<char> bytes;
   std::size_t offset = 0; ///< bytes of it already written
 };
@@ -116,6 +119,7 @@ struct Direction {
   bool shutDown = false;       ///< EOF passed on to `to`
   Clock::time_point linkFree;  ///< with a bandwidth limit: when the link is free again
   std::uint64_t forwarded = 0; ///< bytes written to `to`
+  std::string trace;           ///< with --trace-chunks: "<connection> up|down", else empty
   bool done() const { return shutDown; }
 };
 
@@ -150,6 +154,7 @@ bool readSide(Direction& d, const Settings& s) {
   }
   c.bytes.resize(static_cast<std::size_t>(n));
   const auto now = Clock::now();
+  c.read = now;
   if (s.bytesPerSecond > 0.0) {
     const auto tx = std::chrono::duration_cast<Clock::duration>(
         std::chrono::duration<double>(double(n) / s.bytesPerSecond));
@@ -179,6 +184,14 @@ bool writeSide(Direction& d) {
     if (c.offset < c.bytes.size()) {
       return true; // the socket buffer is full: wait for POLLOUT
     }
+    if (!d.trace.empty()) {
+      auto ns = [](Clock::time_point t) {
+        return std::to_string(
+            std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
+      };
+      logLine("chunk " + d.trace + " " + std::to_string(c.bytes.size()) + " bytes read_ns " +
+              ns(c.read) + " due_ns " + ns(c.due) + " written_ns " + ns(Clock::now()));
+    }
     d.queue.pop_front();
   }
   if (d.eof && d.queue.empty() && !d.shutDown) {
@@ -193,7 +206,7 @@ bool wantsWrite(const Direction& d, Clock::time_point now) {
 }
 
 int run(const std::string& listenAt, const std::string& targetAt, double delayMs, double mbit,
-        double maxQueuedMb, const std::string& portFile) {
+        double maxQueuedMb, const std::string& portFile, bool traceChunks) {
   Settings s;
   s.delay = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double, std::milli>(delayMs));
@@ -316,6 +329,10 @@ int run(const std::string& listenAt, const std::string& targetAt, double delayMs
           c.up.to = tfd;
           c.down.from = tfd;
           c.down.to = cfd;
+          if (traceChunks) {
+            c.up.trace = c.name + " up";
+            c.down.trace = c.name + " down";
+          }
           logLine("connection from " + c.name + " relayed to " + describe(targetAddr));
         }
       }
@@ -383,6 +400,9 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("--port-file", portFile, "write the HOST:PORT listened on to this file");
+  bool traceChunks = false;
+  app.add_flag("--trace-chunks", traceChunks,
+               "log each chunk when written on: size and read/due/written times (ns)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -394,5 +414,5 @@ int main(int argc, char** argv) {
   ::sigaction(SIGINT, &sa, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
   ::prctl(PR_SET_TIMERSLACK, 1UL); // wake up on time (the default slack is 50 us)
-  return run(listenAt, targetAt, delayMs, mbit, maxQueuedMb, portFile);
+  return run(listenAt, targetAt, delayMs, mbit, maxQueuedMb, portFile, traceChunks);
 }

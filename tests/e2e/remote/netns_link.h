@@ -162,6 +162,14 @@ public:
     return ok;
   }
 
+  /// `tc qdisc show` of both ends of the veth pair (host end first).
+  std::string qdiscs() const {
+    std::string host, ns;
+    shell("tc qdisc show dev " + _hostVeth, &host);
+    shell(inside("tc qdisc show dev " + _nsVeth), &ns);
+    return host + ns;
+  }
+
   /// netem on both ends: `oneWayMs` each way (round trip = 2 x oneWayMs); 0 removes it.
   bool setNetemDelay(double oneWayMs) const {
     bool ok = true;

@@ -122,6 +122,10 @@ particles:
   return c;
 }
 
+constexpr const char* kParaviewOptOut =
+    " (the paraview test group: scripts/install-deps.sh installs paraview and xvfb; opt out with "
+    "-DCOREDEM_TEST_OPT_OUT=paraview)";
+
 /// pvbatch and the way to run it here ({sh, with-xvfb.sh, pvbatch} without a display), or the
 /// reason it cannot run.
 struct Pvbatch {
@@ -297,9 +301,10 @@ int ClgRun::status_ = -1;
 // ParaView's XDMF reader shows each species column under its name, with the .h5's values.
 TEST_F(ClgRun, ParaViewReadsSpeciesByName) {
   const Pvbatch pv = findPvbatch();
-  if (!pv.missing.empty()) {
-    GTEST_SKIP() << pv.missing;
+  if (COREDEM_PARAVIEW_OPTED_OUT) {
+    GTEST_SKIP() << "opted out (COREDEM_TEST_OPT_OUT=paraview)";
   }
+  ASSERT_TRUE(pv.missing.empty()) << pv.missing << kParaviewOptOut;
   std::vector<std::string> args(pv.command.begin() + 1, pv.command.end());
   args.insert(args.end(), {COREDEM_CHECK_XDMF_SCRIPT, run_.string(), "species_C", "species_Fe2O3",
                            "species_Fe3O4", "species_Al2O3", "velocity", "temperature", "diameter",
@@ -320,9 +325,10 @@ TEST_F(ClgRun, ParaViewReadsSpeciesByName) {
 // `coredem render` draws one time: a PNG of particles over the gas slice, many colours.
 TEST_F(ClgRun, RenderDrawsOneTime) {
   const Pvbatch pv = findPvbatch();
-  if (!pv.missing.empty()) {
-    GTEST_SKIP() << pv.missing;
+  if (COREDEM_PARAVIEW_OPTED_OUT) {
+    GTEST_SKIP() << "opted out (COREDEM_TEST_OPT_OUT=paraview)";
   }
+  ASSERT_TRUE(pv.missing.empty()) << pv.missing << kParaviewOptOut;
   const fs::path out = dir_ / "render";
   const fs::path log = dir_ / "render-cli.log";
   ASSERT_EQ(runProgram(kBin / "coredem",
@@ -340,9 +346,8 @@ TEST_F(ClgRun, RenderDrawsOneTime) {
   ASSERT_EQ(pngs.size(), 1u) << "one time asked for";
   EXPECT_GT(fs::file_size(pngs[0]), 5000u);
   const std::string python = COREDEM_PYTHON;
-  if (python.empty()) {
-    GTEST_SKIP() << "no python with matplotlib to count the picture's colours";
-  }
+  ASSERT_FALSE(python.empty()) << "no python with matplotlib to count the picture's colours "
+                                  "(scripts/install-deps.sh)";
   // Distinct colours: the particles' colour map and the gas slice's, not one flat colour.
   const fs::path count = dir_ / "colours.txt";
   ASSERT_EQ(runProgram(python,
@@ -357,8 +362,8 @@ TEST_F(ClgRun, RenderDrawsOneTime) {
 }
 
 // docs/tutorial.md, as written: its ```bash blocks run in order, in one bash (set -euo pipefail),
-// in a folder that looks like the repository root (docs/, cases/, build/bin). Without ParaView
-// the render block is left out (and said so).
+// in a folder that looks like the repository root (docs/, cases/, build/bin). With the paraview
+// test group opted out the render block is left out (and the test says so by skipping).
 TEST_F(ResultsE2E, TutorialRunsAsWritten) {
   const std::string md = readAll(kSource / "docs" / "tutorial.md");
   std::string script = "set -euo pipefail\n";
@@ -371,7 +376,7 @@ TEST_F(ResultsE2E, TutorialRunsAsWritten) {
     ASSERT_NE(end, std::string::npos) << "unterminated code block";
     const std::string block = md.substr(begin, end - begin);
     at = end + 3;
-    if (block.find("coredem render") != std::string::npos && !pv.missing.empty()) {
+    if (block.find("coredem render") != std::string::npos && COREDEM_PARAVIEW_OPTED_OUT) {
       renderSkipped = true;
       continue;
     }
@@ -399,8 +404,10 @@ TEST_F(ResultsE2E, TutorialRunsAsWritten) {
   EXPECT_TRUE(fs::exists(run / "plots" / "timeseries.png"));
   EXPECT_NE(readAll(log).find("mybed/case.yaml: valid"), std::string::npos) << tail(log);
   if (renderSkipped) {
-    GTEST_SKIP() << "the tutorial ran without its render step: " << pv.missing;
+    GTEST_SKIP() << "opted out (COREDEM_TEST_OPT_OUT=paraview): the tutorial ran without its "
+                    "render step";
   }
+  ASSERT_TRUE(pv.missing.empty()) << pv.missing << kParaviewOptOut;
   EXPECT_TRUE(fs::exists(run / "render" / "velocity_00000020.png")) << tail(log);
 }
 

@@ -140,7 +140,8 @@ TEST(ChemistryStep, MfixReactiveChemistryCaseFollowsTheAnalyticSolution) {
   DemSystem sys(cfg, BackendKind::Cpu, 1);
   Gas(1, 300.0, 1.2, {0.5, 0.5}).apply(sys);
   const double m0 = sys.particles().mass[0];
-  EXPECT_NEAR(m0, 3.5342917e-5, 1e-12);
+  // A 3 mm sphere at 2500 kg/m³.
+  EXPECT_NEAR(m0, 2500.0 * M_PI / 6.0 * 27e-9, 1e-15 * m0);
   const double rB = 2.0 * kMB * kOmega; // −r_B, kg/s
   const double tEnd = m0 * 0.5 / rB;
   auto mass = [&](double t) { return m0 - rB * (1.0 - kMD / (2.0 * kMB)) * std::min(t, tEnd); };
@@ -183,11 +184,12 @@ TEST(ChemistryStep, MfixReactiveChemistryCaseFollowsTheAnalyticSolution) {
       EXPECT_NEAR(tot.gasProduced[0], gasA, 1e-12 * std::fabs(gasA));
     }
   }
-  // Final: X_D = 0.45454545, X_I = 0.54545455, B exhausted.
+  // Final: X_D = 5/11, X_I = 6/11 (m = m0 (1/2 + 1/2 M_D/(2 M_B)) = 11/12 m0), B exhausted.
   const ParticleData p = sys.particles();
-  EXPECT_NEAR(p.species[1], 0.45454545, 3e-5);
-  EXPECT_NEAR(p.species[2], 0.54545455, 3e-5);
-  EXPECT_NEAR(p.mass[0], 3.23976742e-5, 8e-6 * 3.23976742e-5);
+  EXPECT_NEAR(p.species[1], 5.0 / 11.0, 3e-5);
+  EXPECT_NEAR(p.species[2], 6.0 / 11.0, 3e-5);
+  EXPECT_NEAR(p.mass[0], mass(tEnd), 8e-6 * mass(tEnd));
+  EXPECT_NEAR(mass(tEnd), 11.0 / 12.0 * m0, 1e-15 * m0);
   EXPECT_GE(p.species[0], 0.0); // B exhausted, never negative (availability limiter)
   EXPECT_LT(p.species[0], 1e-15);
   RecordProperty("rc_mass_rel_err", sci(maxMassErr));

@@ -267,9 +267,12 @@ TEST(Participants, CommandLinesRefuseBadInputWithExitCode2) {
 }
 
 TEST(Participants, PythonCtypesParticipantRunsAgainstARealServer) {
-  if (std::string(COREDEM_PYTHON).empty()) {
-    GTEST_SKIP() << "no python3 with numpy (COREDEM_PYTHON)";
+  if (COREDEM_PYTHON_OPTED_OUT) {
+    GTEST_SKIP() << "opted out (COREDEM_TEST_OPT_OUT=python)";
   }
+  ASSERT_FALSE(std::string(COREDEM_PYTHON).empty())
+      << "no python3 with numpy (COREDEM_PYTHON): run scripts/install-deps.sh, or opt out with "
+         "-DCOREDEM_TEST_OPT_OUT=python";
   const auto dir = tempDir("python");
   DemProcess dem(dir);
   MiniOrchestrator o(dem.endpoint(), smallCase(kParticles, kD, kBox, kCells, {"N2", "O2"}));

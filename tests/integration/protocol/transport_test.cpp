@@ -228,7 +228,8 @@ TEST(Transport, CurveOnLoopback) {
     serverKeys = generateCurveKeyPair();
     clientKeys = generateCurveKeyPair();
   } catch (const ProtocolError& e) {
-    GTEST_SKIP() << e.what();
+    // Debian's libzmq5 is built with libsodium: CURVE is part of every supported build.
+    FAIL() << "no CURVE in this libzmq: " << e.what();
   }
   TransportOptions so;
   so.curve.serverPublicKey = serverKeys.first;

@@ -1,8 +1,11 @@
 // coredem-relay (bench/remote/relay.cpp), the delaying TCP relay of the emulated remote link:
 // bytes through it arrive identical and in order both ways, a half-close is passed on after the
-// bytes before it, each crossing adds at least the configured one-way delay, a bandwidth limit
-// is a lower bound on the transfer time, an unreachable target closes only that connection, and
-// SIGTERM ends it with exit 0. Lower bounds only: no timing upper bound is asserted.
+// bytes before it, each crossing is held for the configured one-way delay, a bandwidth limit
+// spaces the chunks by their transmission time, an unreachable target closes only that
+// connection, and SIGTERM ends it with exit 0. The delay and the bandwidth are checked from what
+// the relay logs (--trace-chunks: each chunk's read, due and written times on its own clock) and
+// from the order of those events, not by timing the test: no assertion depends on how fast the
+// machine is.
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -10,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -141,7 +145,7 @@ std::string readFile(const fs::path& p) {
 /// A coredem-relay process on 127.0.0.1:any in front of `target`.
 class Relay {
 public:
-  Relay(const std::string& target, double delayMs, double mbit = 0.0) {
+  Relay(const std::string& target, double delayMs, double mbit = 0.0, bool trace = false) {
     _dir = fs::temp_directory_path() /
            ("coredem-relay-test-" + std::to_string(::getpid()) + "-" + std::to_string(_count++));
     fs::remove_all(_dir);
@@ -157,6 +161,9 @@ public:
                                      std::to_string(mbit),
                                      "--port-file",
                                      (_dir / "port").string()};
+    if (trace) {
+      argv.push_back("--trace-chunks");
+    }
     coredem::SpawnOptions o;
     o.ownProcessGroup = false;
     _pid = coredem::spawnProcess("coredem-relay", argv, _dir / "relay.log", o);
@@ -197,6 +204,32 @@ private:
   std::string _address;
 };
 
+/// One line of --trace-chunks: "chunk HOST:PORT up|down N bytes read_ns R due_ns D written_ns W".
+struct TracedChunk {
+  std::string connection, direction;
+  long long bytes = 0, read = 0, due = 0, written = 0;
+};
+
+std::vector<TracedChunk> tracedChunks(const std::string& log, const std::string& direction) {
+  std::vector<TracedChunk> out;
+  std::istringstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    const auto at = line.find("coredem-relay: chunk ");
+    if (at == std::string::npos) {
+      continue;
+    }
+    std::istringstream w(line.substr(at + 21));
+    TracedChunk c;
+    std::string word;
+    w >> c.connection >> c.direction >> c.bytes >> word >> word >> c.read >> word >> c.due >>
+        word >> c.written;
+    if (c.direction == direction) {
+      out.push_back(c);
+    }
+  }
+  return out;
+}
+
 } // namespace
 
 TEST(Relay, BytesArriveIdenticalAndInOrderBothWaysAndAHalfCloseFollowsThem) {
@@ -235,45 +268,104 @@ TEST(Relay, BytesArriveIdenticalAndInOrderBothWaysAndAHalfCloseFollowsThem) {
   EXPECT_EQ(relay.terminate(), 0) << relay.log();
 }
 
-TEST(Relay, EachRoundTripTakesAtLeastTwiceTheOneWayDelay) {
+// Every chunk is due exactly the one-way delay after it was read and is written no earlier; and
+// since the echo can answer only what the relay wrote, each message's reply leaves the relay at
+// least twice the delay after the request came in (read -> due -> written -> echoed -> read ->
+// due -> written, all on the relay's clock).
+TEST(Relay, EachCrossingIsHeldForTheOneWayDelay) {
   EchoServer echo;
   constexpr double kDelayMs = 5.0;
-  Relay relay(echo.address(), kDelayMs);
+  constexpr long long kDelayNs = 5'000'000;
+  constexpr int kMessages = 20;
+  constexpr std::size_t kSize = 100;
+  Relay relay(echo.address(), kDelayMs, 0.0, true);
   const int fd = connectTo(relay.address());
   ASSERT_GE(fd, 0) << relay.log();
-  char msg[100] = {};
-  for (int i = 0; i < 20; ++i) {
+  char msg[kSize] = {};
+  for (int i = 0; i < kMessages; ++i) {
     std::memset(msg, 'a' + i, sizeof msg);
-    const auto t0 = Clock::now();
     ASSERT_TRUE(sendAll(fd, msg, sizeof msg));
     char back[sizeof msg];
     ASSERT_TRUE(recvAll(fd, back, sizeof back));
-    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     EXPECT_EQ(std::memcmp(msg, back, sizeof msg), 0);
-    EXPECT_GE(ms, 2.0 * kDelayMs) << "round trip " << i;
   }
   ::close(fd);
   EXPECT_EQ(relay.terminate(), 0) << relay.log();
+  const std::string log = relay.log();
+  const auto up = tracedChunks(log, "up");
+  const auto down = tracedChunks(log, "down");
+  ASSERT_FALSE(up.empty()) << log;
+  ASSERT_FALSE(down.empty()) << log;
+  long long upBytes = 0, downBytes = 0;
+  for (const auto* list : {&up, &down}) {
+    for (const TracedChunk& c : *list) {
+      EXPECT_EQ(c.due - c.read, kDelayNs) << c.direction << " chunk read at " << c.read;
+      EXPECT_GE(c.written, c.due) << c.direction << " chunk read at " << c.read;
+      (list == &up ? upBytes : downBytes) += c.bytes;
+    }
+  }
+  EXPECT_EQ(upBytes, kMessages * kSize);
+  EXPECT_EQ(downBytes, kMessages * kSize);
+  // Message i is bytes [i kSize, (i + 1) kSize) both ways: the up chunk holding its first byte
+  // was read before the down chunk holding its last byte was written, by at least 2 delays.
+  auto chunkOf = [](const std::vector<TracedChunk>& list, long long byte) {
+    long long end = 0;
+    for (const TracedChunk& c : list) {
+      end += c.bytes;
+      if (byte < end) {
+        return c;
+      }
+    }
+    return TracedChunk{};
+  };
+  for (int i = 0; i < kMessages; ++i) {
+    const TracedChunk request = chunkOf(up, i * static_cast<long long>(kSize));
+    const TracedChunk reply = chunkOf(down, (i + 1) * static_cast<long long>(kSize) - 1);
+    EXPECT_GE(reply.written - request.read, 2 * kDelayNs) << "message " << i;
+  }
 }
 
-TEST(Relay, ABandwidthLimitIsALowerBoundOnTheTransferTime) {
+// With --mbit each direction is a link of that rate: from the logged read times the test
+// recomputes when the link is free again (max(free, read) + bytes/rate, as
+// bench/remote/relay.cpp defines it) and finds every chunk due exactly then; no chunk is written
+// before it is due, so the transfer spans at least bytes/rate on the relay's clock.
+TEST(Relay, ABandwidthLimitSpacesTheChunksByTheirTransmissionTime) {
   EchoServer echo;
   constexpr double kMbit = 40.0;
-  Relay relay(echo.address(), 0.0, kMbit);
+  Relay relay(echo.address(), 0.0, kMbit, true);
   const int fd = connectTo(relay.address());
   ASSERT_GE(fd, 0) << relay.log();
   std::vector<char> sent(1 << 20, 'x'), got(sent.size());
-  const auto t0 = Clock::now();
   std::thread writer([&] { ASSERT_TRUE(sendAll(fd, sent.data(), sent.size())); });
   ASSERT_TRUE(recvAll(fd, got.data(), got.size())) << relay.log();
-  const double s = std::chrono::duration<double>(Clock::now() - t0).count();
   writer.join();
   EXPECT_TRUE(got == sent);
-  // Each direction is a 40 Mbit/s link: 1 MiB needs 0.21 s to cross it (the two directions
-  // overlap, so once is the bound).
-  EXPECT_GE(s, double(sent.size()) * 8.0 / (kMbit * 1e6));
   ::close(fd);
   EXPECT_EQ(relay.terminate(), 0) << relay.log();
+  const std::string log = relay.log();
+  const double bytesPerSecond = kMbit * 1e6 / 8.0;
+  for (const char* direction : {"up", "down"}) {
+    SCOPED_TRACE(direction);
+    const auto chunks = tracedChunks(log, direction);
+    ASSERT_GE(chunks.size(), 2u) << log;
+    long long linkFree = 0, bytes = 0, transmission = 0;
+    for (const TracedChunk& c : chunks) {
+      const long long tx = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                               std::chrono::duration<double>(double(c.bytes) / bytesPerSecond))
+                               .count();
+      linkFree = std::max(linkFree, c.read) + tx;
+      EXPECT_EQ(c.due, linkFree) << "chunk read at " << c.read;
+      EXPECT_GE(c.written, c.due) << "chunk read at " << c.read;
+      bytes += c.bytes;
+      transmission += tx;
+    }
+    EXPECT_EQ(bytes, static_cast<long long>(sent.size()));
+    // 1 MiB at 40 Mbit/s: 0.21 s of transmission (each chunk's time truncated to the ns).
+    EXPECT_GE(transmission,
+              static_cast<long long>(double(sent.size()) * 8.0 / (kMbit * 1e6) * 1e9) -
+                  static_cast<long long>(chunks.size()));
+    EXPECT_GE(chunks.back().written - chunks.front().read, transmission);
+  }
 }
 
 TEST(Relay, AnUnreachableTargetClosesThatConnectionAndTheRelayKeepsServing) {

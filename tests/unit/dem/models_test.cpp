@@ -1,6 +1,8 @@
 // Model registries (coredem/dem/models.h): every row parses its own default, every family name
 // maps to its enum and back, the kernels dispatch on each enum, and bad keys/values are reported
 // with the allowed ones.
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -156,13 +158,40 @@ TEST(ModelRegistry, DidYouMean) {
   EXPECT_EQ(didYouMean("xyz", c), "");
 }
 
-// Kernels dispatch on the enums: each value selects its own function.
-TEST(ModelDispatch, DragLaw) {
+// The drag dispatcher with DragLaw::Gidaspow against the published Gidaspow (1994) law written out
+// here, independently of the kernels (docs/physics.md §2.2): ε clipped to 0.35; Ergun
+//   β = 150 (1−ε)² μ/(ε d²) + 1.75 (1−ε) ρ |Δu|/d            for ε ≤ 0.8,
+// Wen–Yu β = ¾ C_D ε (1−ε) ρ |Δu| ε^−2.65/d, C_D = 24/Re (1 + 0.15 Re^0.687) (Re < 1000, else
+// 0.44), Re = ε ρ d |Δu|/μ, above; the per-particle coefficient β V_p/(1−ε). Air-like gas, 1 mm
+// particle, at gas fractions on both sides of the switch, slips from creeping (Re 0.07) to Re >
+// 1000 (Newton regime). Only the operation order differs: 1e-13 relative.
+TEST(ModelDispatch, DragLawIsGidaspowsPublishedFormula) {
   const k::DragParams p{k::DragLaw::Gidaspow, k::GidaspowParams{}};
-  for (double eps : {0.3, 0.5, 0.8, 0.9, 0.999}) {
-    EXPECT_EQ(k::particleDragCoefficient(p, eps, 1.2, 1.8e-5, 1e-3, 5e-10, 0.7),
-              k::gidaspowParticleCoefficient(p.gidaspow, eps, 1.2, 1.8e-5, 1e-3, 5e-10, 0.7));
+  const double rho = 1.2, mu = 1.8e-5, d = 1e-3, v = 5e-10;
+  auto published = [&](double epsCell, double slip) {
+    const double eps = std::max(epsCell, 0.35);
+    double beta = 0.0;
+    if (eps <= 0.8) {
+      beta = 150.0 * (1 - eps) * (1 - eps) * mu / (eps * d * d) + 1.75 * (1 - eps) * rho * slip / d;
+    } else {
+      const double re = eps * rho * d * slip / mu;
+      const double cd = re < 1000.0 ? 24.0 / re * (1.0 + 0.15 * std::pow(re, 0.687)) : 0.44;
+      beta = 0.75 * cd * eps * (1 - eps) * rho * slip * std::pow(eps, -2.65) / d;
+    }
+    return beta * v / (1 - eps);
+  };
+  int points = 0;
+  for (double eps : {0.3, 0.35, 0.5, 0.8, 0.80001, 0.9, 0.999}) {
+    for (double slip : {1e-3, 0.7, 5.0, 20.0}) {
+      SCOPED_TRACE(::testing::Message() << "eps " << eps << " slip " << slip);
+      const double want = published(eps, slip);
+      EXPECT_NEAR(k::particleDragCoefficient(p, eps, rho, mu, d, v, slip), want, 1e-13 * want);
+      ++points;
+    }
   }
+  EXPECT_EQ(points, 28);
+  // Re = 0.999·1.2·1e-3·20/1.8e-5 = 1332 > 1000: the Newton branch (C_D = 0.44) was reached.
+  EXPECT_GT(0.999 * rho * d * 20.0 / mu, 1000.0);
 }
 
 TEST(ModelDispatch, NusseltModel) {

@@ -14,6 +14,8 @@
 #include <coredem/dem/kernels/conduction_contact.h>
 #include <coredem/dem/kernels/conduction_gas_lens.h>
 
+#include "reference/thermochem_reference.h"
+
 namespace k = coredem::dem::kernels;
 
 namespace {
@@ -131,27 +133,23 @@ TEST(GasLens, EqualRadiiKernelMatchesTheGeneralOne) {
   EXPECT_EQ(k::gasLensIntegralEqualRadii(bad, k::gasLensEqualRadii(bad, 1e-3), 1.9e-3), 0.0);
 }
 
-// The equal-radii rows of the 40-digit table (conduction_test.cpp), same bound as the general
-// closed form.
+// The equal-radii rows of the 40-digit table (reference/make_thermochem_reference.py,
+// conduction_test.cpp), same bound as the general closed form.
 TEST(GasLens, EqualRadiiKernelMatchesFortyDigitValues) {
-  struct Row {
-    double r, l, sMin, integral;
-  };
-  const Row rows[] = {
-      {0.001, 0.0019500000000000001, 1e-10, 0.047518891972462871403},
-      {0.001, 0.001999999, 1e-06, 0.019741374890600020929},
-      {0.001, 0.0020003, 1e-06, 0.018801428534031667521},
-      {0.001, 0.0021, 1e-08, 0.0022678800834538365616},
-      {0.001, 0.002199998, 1e-06, 3.427205954291401435e-8},
-      {0.01, 0.021999998, 1e-06, 3.427193383744377616e-8},
-  };
-  for (const Row& row : rows) {
-    SCOPED_TRACE(::testing::Message() << "R " << row.r << " l " << row.l << " s_min " << row.sMin);
+  int rows = 0;
+  for (const auto& row : coredem::test::thermochem_ref::kLensIntegral) {
+    if (row.big != row.small) {
+      continue;
+    }
+    ++rows;
+    const double r = row.big;
+    SCOPED_TRACE(::testing::Message() << "R " << r << " l " << row.l << " s_min " << row.sMin);
     k::GasLensParams p;
     p.minSeparation = row.sMin;
-    EXPECT_NEAR(k::gasLensIntegralEqualRadii(p, k::gasLensEqualRadii(p, row.r), row.l),
-                row.integral, k::kGasLensClosedFormRelError * row.integral);
+    EXPECT_NEAR(k::gasLensIntegralEqualRadii(p, k::gasLensEqualRadii(p, r), row.l), row.integral,
+                k::kGasLensClosedFormRelError * row.integral);
   }
+  EXPECT_EQ(rows, 6);
 }
 
 // gasLensLog1p (pure arithmetic, no library call) against the long-double log1pl over the

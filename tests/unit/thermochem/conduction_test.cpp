@@ -1,6 +1,7 @@
 // Contact conduction (docs/physics.md §3.2) and gas-lens conduction (§3.3) vs the MFiX reference
-// constants (§8.1, §8.2), reference values computed independently in Python (docs/physics.md §8),
-// closed forms and an independent fine long-double quadrature.
+// constants (§8.1, §8.2), reference values computed independently with mpmath (50 digits) by
+// reference/make_thermochem_reference.py (thermochem_reference.h), closed forms and an
+// independent fine long-double quadrature.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -14,8 +15,11 @@
 #include <coredem/dem/kernels/conduction_quadrature.h>
 #include <coredem/dem/verification/analytic.h>
 
+#include "reference/thermochem_reference.h"
+
 namespace k = coredem::dem::kernels;
 namespace v = coredem::dem::verification;
+namespace ref = coredem::test::thermochem_ref;
 
 namespace {
 constexpr double kPi = 3.141592653589793;
@@ -131,18 +135,20 @@ TEST(Quadrature, GaussKronrodExactnessAndAdaptivity) {
 
 // ---- contact conduction -------------------------------------------------------------------
 
-// MFiX-CC (§8.1): r_c = 1.475235004121685e-05 m (the independent Python reference values, acos
-// form, ~1e-12 accurate); a = A_C = 0.01027998273952850 s⁻¹ (MFiX file) and b =
-// 0.004106681767591312 (the independent Python reference values).
+// MFiX-CC (§8.1): r_c, a = A_C and b vs the reference script (exact decimal positions). The
+// overlap 1.33e-8 m is a difference of ~3.3e-3 m distances: the double distance carries ~3e-11
+// relative error into it, half of that into r_c → 1e-10 relative.
 TEST(ContactConduction, MfixReferenceConstants) {
   const double rc = k::intersectionCircleRadius(1.5e-3, 1.8e-3, kMfixCcDistance);
-  EXPECT_NEAR(rc, 1.475235004121685e-05, 1e-10 * rc);
+  EXPECT_NEAR(rc, ref::kMfixCcContactRadius, 1e-10 * rc);
   const auto c = v::contactConductionCoefficients(3.0e-3, v::musserMaterialA(), 3.6e-3,
                                                   v::musserMaterialB(), kMfixCcDistance);
+  EXPECT_NEAR(c.a, ref::kMfixCcA, 1e-10 * c.a);
+  EXPECT_NEAR(c.b, ref::kMfixCcB, 1e-10 * c.b);
+  // The MFiX file's A_C = 0.01027998273952850 s⁻¹ (15 digits) agrees to its rounding.
   EXPECT_NEAR(c.a, 0.01027998273952850, 1e-10 * c.a);
-  EXPECT_NEAR(c.b, 0.004106681767591312, 1e-10 * c.b);
   // Errata check: the seed's factor 2 would give half of A_C.
-  EXPECT_GT(std::fabs(c.a / 0.01027998273952850 - 0.5), 0.4);
+  EXPECT_GT(std::fabs(c.a / ref::kMfixCcA - 0.5), 0.4);
 }
 
 // Stable intersection radius: equal spheres have r_c = √((R − l/2)(R + l/2)) exactly; the
@@ -161,35 +167,24 @@ TEST(ContactConduction, IntersectionRadiusIsAccurateForTinyOverlaps) {
   EXPECT_EQ(k::contactConductance(1.0, 2.0, 1e-3, 2e-3, 3e-3), 0.0);
 }
 
-// Seed variants (§8.1 table; the independent Python reference values): particle 1 = A (3.0 mm,
-// 373.15 K), particle 2 = material B (278.15 K). Printed digits: r_c 6 significant, a/b 7, T 1e-4
-// K.
+// Seed variants (§8.1 table, the reference script's full digits): particle 1 = A (3.0 mm,
+// 373.15 K), particle 2 = material B (278.15 K). The overlaps are ≥ 3e-3 of the distance, so
+// the double distance costs ≤ 1e-13 relative in r_c: r_c, a, b at 1e-12 relative, the
+// temperatures at 1e-9 K.
 TEST(ContactConduction, SeedVariantTable) {
-  struct Row {
-    double d2, ov, rc, a, b, tInf, t1, t2;
-  };
-  const Row rows[] = {
-      {2.4e-3, 1e-5, 1.15358e-4, 8.038552e-02, 1.083803e-01, 332.6944, 338.8205, 324.4350},
-      {2.4e-3, 4e-5, 2.30040e-4, 1.603001e-01, 2.161256e-01, 332.6944, 333.6324, 331.4298},
-      {3.0e-3, 1e-5, 1.22372e-4, 8.527360e-02, 5.886498e-02, 316.9472, 330.2448, 307.7678},
-      {3.0e-3, 4e-5, 2.44131e-4, 1.701196e-01, 1.174348e-01, 316.9472, 320.1162, 314.7596},
-      {3.6e-3, 1e-5, 1.27820e-4, 8.906987e-02, 3.558193e-02, 305.2678, 324.7842, 297.4713},
-      {3.6e-3, 2e-5, 1.80623e-4, 1.258650e-01, 5.028096e-02, 305.2678, 316.9296, 300.6091},
-      {3.6e-3, 3e-5, 2.21044e-4, 1.540313e-01, 6.153295e-02, 305.2678, 313.1305, 302.1268},
-      {3.6e-3, 4e-5, 2.55038e-4, 1.777200e-01, 7.099619e-02, 305.2678, 310.9119, 303.0131}};
-  for (const Row& r : rows) {
+  for (const auto& r : ref::kSeedContact) {
     SCOPED_TRACE(r.d2);
     SCOPED_TRACE(r.ov);
     const double l = 1.5e-3 + 0.5 * r.d2 - r.ov;
-    EXPECT_NEAR(k::intersectionCircleRadius(1.5e-3, 0.5 * r.d2, l), r.rc, 5e-6 * r.rc);
+    EXPECT_NEAR(k::intersectionCircleRadius(1.5e-3, 0.5 * r.d2, l), r.rc, 1e-12 * r.rc);
     const auto c = v::contactConductionCoefficients(3.0e-3, v::musserMaterialA(), r.d2,
                                                     v::musserMaterialB(), l);
-    EXPECT_NEAR(c.a, r.a, 5e-7 * r.a);
-    EXPECT_NEAR(c.b, r.b, 5e-7 * r.b);
-    EXPECT_NEAR(v::twoParticleEquilibrium(c.a, c.b, 373.15, 278.15), r.tInf, 5e-5);
+    EXPECT_NEAR(c.a, r.a, 1e-12 * r.a);
+    EXPECT_NEAR(c.b, r.b, 1e-12 * r.b);
+    EXPECT_NEAR(v::twoParticleEquilibrium(c.a, c.b, 373.15, 278.15), r.tInf, 1e-9);
     const auto t = v::twoParticleExchange(c.a, c.b, 373.15, 278.15, 10.0);
-    EXPECT_NEAR(t.t1, r.t1, 5e-5);
-    EXPECT_NEAR(t.t2, r.t2, 5e-5);
+    EXPECT_NEAR(t.t1, r.t1, 1e-9);
+    EXPECT_NEAR(t.t2, r.t2, 1e-9);
   }
 }
 
@@ -216,39 +211,33 @@ TEST(Conduction, PairTermsAreExactlyAntisymmetric) {
 
 // ---- gas lens ------------------------------------------------------------------------------
 
-// MFiX-PFP (§8.2): R_out = 5.565457e-4 m, R_in = 0, exact I = 3.675223767717116e-3 m
-// (the independent Python reference values, tolerance 1e-12 absolute per piece → ~3e-10 relative),
-// a, b from it. MFiX's own a = 0.0401067383 comes from its loose EPS = 1e-2 Simpson (6.7e-5
-// relative).
+// MFiX-PFP (§8.2): R_out, R_in = 0, I and a, b vs the reference script (mpmath quadrature at
+// 50 digits); the closed form is within kGasLensClosedFormRelError = 1e-13 of I, the double
+// distance adds ~1e-16: 1e-12 relative. MFiX's own a = 0.0401067383 comes from its loose
+// EPS = 1e-2 Simpson (6.7e-5 relative).
 TEST(GasLens, MfixReferenceConstants) {
   const k::GasLensParams p;
   const auto geo = k::gasLensGeometry(p, 1.5e-3, 1.8e-3, kMfixPfpDistance);
   EXPECT_TRUE(geo.active);
   EXPECT_FALSE(geo.contact);
   EXPECT_EQ(geo.rIn, 0.0);
-  EXPECT_NEAR(geo.rOut, 5.565457e-4, 5e-11);
+  EXPECT_NEAR(geo.rOut, ref::kMfixPfpOuterRadius, 1e-12 * ref::kMfixPfpOuterRadius);
   const auto in = k::gasLensIntegral(p, 1.5e-3, 1.8e-3, kMfixPfpDistance);
   EXPECT_TRUE(in.converged);
-  EXPECT_NEAR(in.value, 3.675223767717116e-3, 1e-9 * in.value);
+  EXPECT_NEAR(in.value, ref::kMfixPfpIntegral, 1e-12 * in.value);
   const auto c = v::gasLensCoefficients(3.0e-3, v::musserMaterialA(), 3.6e-3, v::musserMaterialB(),
                                         kMfixPfpDistance, v::kMusserLensGasConductivity);
-  EXPECT_NEAR(c.a, 4.010942558902641e-02, 1e-9 * c.a);
-  EXPECT_NEAR(c.b, 1.602304701754486e-02, 1e-9 * c.b);
+  EXPECT_NEAR(c.a, ref::kMfixPfpA, 1e-12 * c.a);
+  EXPECT_NEAR(c.b, ref::kMfixPfpB, 1e-12 * c.b);
+  // The MFiX file's loose constants.
   EXPECT_NEAR(c.a, 0.0401067383, 1e-4 * c.a);
   EXPECT_NEAR(c.b, 0.0160219735, 1e-4 * c.b);
 }
 
-// Seed gap / overlap variants (§8.2 table, the independent Python reference values full digits) →
-// 1e-9 relative.
+// Seed gap / overlap variants (§8.2 table, the reference script's full digits): I, a and b at
+// 1e-12 relative (as above).
 TEST(GasLens, SeedVariantsMatchReferenceScript) {
-  struct Row {
-    double gap, sMin, integral;
-  };
-  const Row rows[] = {{1e-5, 1e-6, 1.828676331275730e-02},   {2e-5, 1e-6, 1.476554955240080e-02},
-                      {1.8e-4, 1e-6, 3.675223767717136e-03}, {-1e-5, 1e-6, 3.509926424950854e-02},
-                      {-1e-5, 4e-10, 7.519425564719893e-02}, {-4e-5, 1e-6, 3.479358596745044e-02},
-                      {-4e-5, 4e-10, 7.451045283921354e-02}};
-  for (const Row& r : rows) {
+  for (const auto& r : ref::kSeedLens) {
     SCOPED_TRACE(r.gap);
     SCOPED_TRACE(r.sMin);
     k::GasLensParams p;
@@ -256,14 +245,13 @@ TEST(GasLens, SeedVariantsMatchReferenceScript) {
     const double l = 1.5e-3 + 1.8e-3 + r.gap;
     const auto in = k::gasLensIntegral(p, 1.5e-3, 1.8e-3, l);
     EXPECT_TRUE(in.converged);
-    EXPECT_NEAR(in.value, r.integral, 1e-9 * r.integral);
+    EXPECT_NEAR(in.value, r.integral, 1e-12 * r.integral);
+    const auto c =
+        v::gasLensCoefficients(3.0e-3, v::musserMaterialA(), 3.6e-3, v::musserMaterialB(), l,
+                               v::kMusserLensGasConductivity, p);
+    EXPECT_NEAR(c.a, r.a, 1e-12 * r.a);
+    EXPECT_NEAR(c.b, r.b, 1e-12 * r.b);
   }
-  // §8.2 table, printed a/b (7 significant digits) for the touching case with s_min = 1e-6.
-  k::GasLensParams p;
-  const auto c = v::gasLensCoefficients(3.0e-3, v::musserMaterialA(), 3.6e-3, v::musserMaterialB(),
-                                        3.3e-3 - 1e-5, v::kMusserLensGasConductivity, p);
-  EXPECT_NEAR(c.a, 0.3830546, 5e-7 * 0.3830546);
-  EXPECT_NEAR(c.b, 0.1530239, 5e-7 * 0.1530239);
 }
 
 // Accuracy target 1e-8 relative (docs/physics.md §3.3): compare against the closed form for equal
@@ -368,42 +356,13 @@ TEST(GasLens, ClippedLimitAndReach) {
 // ---- closed form vs reference quadrature and 40-digit values ------------------------------
 
 // The closed form gasLensIntegral() against 40-digit values (mpmath quadrature of Eq. 24 at the
-// same binary inputs, R_lens = (1.0 + 0.2)·R_L rounded as in the kernel): equal and unequal
-// radii, R_S/R_L from 0.1 to 1, R from 1e-4 to 1e-2 m, overlaps to 5 % of R_S, gaps up to
-// the lens reach, s_min from 1e-10 to 1e-5 m. Observed ≤ 1.3e-15; asserted at the stated bound
-// kGasLensClosedFormRelError = 1e-13.
+// same binary inputs, R_lens = (1.0 + 0.2)·R_L rounded as in the kernel; kLensIntegral of
+// reference/make_thermochem_reference.py): equal and unequal radii, R_S/R_L from 0.1 to 1, R from
+// 1e-4 to 1e-2 m, overlaps to 5 % of R_S, gaps up to the lens reach (the last three rows 1e-6
+// below it, where the adaptive reference loses digits), s_min from 1e-10 to 1e-5 m. Observed
+// ≤ 1.3e-15; asserted at the stated bound kGasLensClosedFormRelError = 1e-13.
 TEST(GasLens, ClosedFormMatchesFortyDigitValues) {
-  struct Row {
-    double big, small, l, sMin, integral;
-  };
-  const Row rows[] = {
-      {0.001, 0.001, 0.0019500000000000001, 1e-10, 0.047518891972462871403},
-      {0.001, 0.001, 0.001999999, 1e-06, 0.019741374890600020929},
-      {0.001, 0.001, 0.0020003, 1e-06, 0.018801428534031667521},
-      {0.001, 0.001, 0.0021, 1e-08, 0.0022678800834538365616},
-      {0.01, 0.001, 0.01095, 1e-05, 0.025598211516973631407},
-      {0.01, 0.001, 0.010999, 1e-10, 0.092659146825969673176},
-      {0.01, 0.001, 0.011002, 1e-09, 0.030532445300712640575},
-      {0.01, 0.001, 0.012499999999999999, 1e-06, 0.0013156704734675914612},
-      {0.0001, 1e-05, 0.0001095, 1e-10, 0.0006338924880155654771},
-      {0.0001, 1.5e-05, 0.000134, 1e-07, 4.1817067721005624817e-6},
-      {0.0001, 5e-05, 0.00014800000000000002, 1e-05, 0.00032345422940312102773},
-      {0.0001, 9.9e-05, 0.000203, 1e-05, 0.0004115085637851585934},
-      {0.002, 0.0012, 0.0031699999999999996, 4e-10, 0.068483554289332297223},
-      {0.005, 0.004, 0.009800000000000001, 1e-07, 0.0032995952118128523533},
-      {0.0018, 0.0015, 0.00331, 1e-06, 0.018286763312759479337},
-      {0.001, 0.0002, 0.00119, 1e-08, 0.010178671753415074056},
-      {0.001, 0.001, 0.002199998, 1e-06, 3.427205954291401435e-8},
-      {0.001, 0.0003, 0.0014998, 1e-09, 1.5083619274701594251e-6},
-      {0.001, 0.0001, 0.0012900000000000001, 1e-10, 0.000028472659311632316984},
-      {0.001, 0.00015, 0.001148, 1e-06, 0.0041959583722470403931},
-      // 1e-6 below the lens reach, where the adaptive reference loses digits:
-      {0.0001, 1.8e-05, 0.00013799998000000002, 1e-06, 9.8345515517039017713e-11},
-      {0.0001, 5e-05, 0.00016999998, 1e-06, 2.2175956202988373946e-10},
-      {0.01, 0.01, 0.021999998, 1e-06, 3.427193383744377616e-8},
-      {0.001, 0.0001, 0.0012999998, 1e-06, 5.7998612655456781066e-10},
-  };
-  for (const Row& r : rows) {
+  for (const auto& r : ref::kLensIntegral) {
     SCOPED_TRACE(::testing::Message()
                  << "R_L " << r.big << " R_S " << r.small << " l " << r.l << " s_min " << r.sMin);
     k::GasLensParams p;
@@ -477,12 +436,22 @@ TEST(GasLens, ClosedFormMatchesAdaptiveReferenceOverDemRange) {
               count, worst, worstAtReach);
 }
 
-// s_min dominates touching particles (§3.3): 1e-6 → 4e-10 m roughly doubles I (0.0351 → 0.0752).
+// s_min dominates touching particles (§3.3): 1e-6 → 4e-10 m roughly doubles I (0.0351 → 0.0752,
+// the seed lens rows of the reference script at 1e-5 m overlap).
 TEST(GasLens, MinimumSeparationControlsTouchingCase) {
   k::GasLensParams coarse;
   k::GasLensParams fine;
   fine.minSeparation = 4e-10;
   const double l = 3.3e-3 - 1e-5;
-  EXPECT_NEAR(k::gasLensIntegral(coarse, 1.5e-3, 1.8e-3, l).value, 0.0351, 5e-5);
-  EXPECT_NEAR(k::gasLensIntegral(fine, 1.5e-3, 1.8e-3, l).value, 0.0752, 5e-5);
+  const auto& r6 = ref::kSeedLens[3];
+  const auto& r10 = ref::kSeedLens[4];
+  ASSERT_EQ(r6.gap, -1e-5);
+  ASSERT_EQ(r6.sMin, 1e-6);
+  ASSERT_EQ(r10.gap, -1e-5);
+  ASSERT_EQ(r10.sMin, 4e-10);
+  const double i6 = k::gasLensIntegral(coarse, 1.5e-3, 1.8e-3, l).value;
+  const double i10 = k::gasLensIntegral(fine, 1.5e-3, 1.8e-3, l).value;
+  EXPECT_NEAR(i6, r6.integral, 1e-12 * i6);
+  EXPECT_NEAR(i10, r10.integral, 1e-12 * i10);
+  EXPECT_GT(i10 / i6, 2.0);
 }

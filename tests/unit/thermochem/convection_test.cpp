@@ -8,8 +8,12 @@
 #include <coredem/dem/kernels/convection.h>
 #include <coredem/dem/verification/analytic.h>
 
+#include "reference/thermochem_reference.h"
+
 namespace k = coredem::dem::kernels;
 namespace v = coredem::dem::verification;
+
+namespace ref = coredem::test::thermochem_ref;
 
 namespace {
 constexpr double kD = 3.6e-3; // particle B
@@ -19,20 +23,27 @@ double cellVoidage() {
 }
 } // namespace
 
-// MFiX-CONV, Ranz–Marshall, Re without ε: Re = 1376.372, Pr = 0.35834, Nu = 17.8107 and
-// coefficient 0.878629815377096 s⁻¹ (MFiX file, 15 digits). Same inputs in SI → agreement to
-// 1e-12 relative (only unit-conversion rounding differs).
+// MFiX-CONV, Ranz–Marshall, Re without ε: Re, Pr, Nu and the coefficient h A/(m c) vs
+// reference/make_thermochem_reference.py (same inputs, 50 digits) at 1e-12 relative (only the
+// unit-conversion and operation rounding differs); and the MFiX file's printed Re = 1376.372,
+// Pr = 0.35834, Nu = 17.8107 and coefficient 0.878629815377096 s⁻¹ (15 digits) at their digits.
 TEST(Convection, MfixRanzMarshallCoefficient) {
   const k::GasState g = v::musserConvectionGas(298.15, 1.0);
   k::ConvectionParams p;
   p.model = k::NusseltModel::RanzMarshall;
   p.reynoldsWithVoidage = false;
   const double re = k::particleReynolds(g.rho, g.mu, kD, 6.0, 1.0, false);
+  EXPECT_NEAR(re, ref::kConvectionReynolds, 1e-12 * re);
+  EXPECT_NEAR(k::prandtl(g.mu, g.cp, g.k), ref::kConvectionPrandtl, 1e-12);
+  EXPECT_NEAR(k::nusselt(p, g, kD, 6.0), ref::kConvectionNusselt, 1e-12 * ref::kConvectionNusselt);
   EXPECT_NEAR(re, 1376.372, 5e-4);
   EXPECT_NEAR(k::prandtl(g.mu, g.cp, g.k), 0.35834, 5e-6);
   EXPECT_NEAR(k::nusselt(p, g, kD, 6.0), 17.8107, 5e-5);
   const double c = v::convectionCoefficient(p, g, kD, v::musserMaterialB(), 6.0);
-  EXPECT_NEAR(c, 0.878629815377096, 1e-12 * 0.878629815377096);
+  EXPECT_NEAR(c, ref::kConvectionCoefficient, 1e-12 * c);
+  EXPECT_NEAR(c, 0.878629815377096, 1e-12 * c);
+  EXPECT_NEAR(v::convectionTemperature(298.15, 373.15, c, 1.0), ref::kConvectionTAt1s, 1e-10);
+  EXPECT_NEAR(v::convectionTemperature(298.15, 373.15, c, 5.0), ref::kConvectionTAt5s, 1e-10);
   // MFiX reference: T(1 s) = 329.3014 K, T(5 s) = 299.0771 K (printed to 1e-4 K).
   EXPECT_NEAR(v::convectionTemperature(298.15, 373.15, c, 1.0), 329.3014, 5e-5);
   EXPECT_NEAR(v::convectionTemperature(298.15, 373.15, c, 5.0), 299.0771, 5e-5);

@@ -1,5 +1,6 @@
 // NASA-7 data, reaction enthalpies and equilibrium constants vs docs/physics.md §3.5 / Appendix A
-// and reference numbers computed independently in Python from the same Burcat/MFiX coefficients.
+// and reference numbers computed independently (mpmath, 50 digits) from the same Burcat/MFiX
+// coefficients by reference/make_thermochem_reference.py (thermochem_reference.h).
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -11,55 +12,24 @@
 #include <coredem/dem/kernels/nasa7.h>
 #include <coredem/dem/kernels/reaction_enthalpy.h>
 
+#include "reference/thermochem_reference.h"
+
 namespace k = coredem::dem::kernels;
 using k::Species;
 
-namespace {
-
-struct Ref {
-  Species s;
-  double t;
-  double h;  // J/mol
-  double cp; // J/(mol K)
-  double s0; // J/(mol K)
-};
-
-// reference/nasa.py H(s,T), Cp(s,T), S(s,T) printed with %.15e.
-const Ref kRefs[] = {
-    {Species::CO, 300.0, -1.104754571058376e+05, 2.914305617896342e+01, 1.978365840221654e+02},
-    {Species::CO, 1173.15, -8.302661507205073e+04, 3.395704366721154e+01, 2.399039378642747e+02},
-    {Species::CO2, 500.0, -3.852073786014339e+05, 4.462034858712661e+01, 2.348796998563710e+02},
-    {Species::CO2, 1500.0, -3.318909695461878e+05, 5.822492870266791e+01, 2.921167703414503e+02},
-    {Species::H2, 300.0, 5.336050519790599e+01, 2.885078499429371e+01, 1.308586887286421e+02},
-    {Species::H2, 1173.15, 2.597975601922082e+04, 3.096876485386089e+01, 1.711158307000313e+02},
-    {Species::H2O, 500.0, -2.348997968798022e+05, 3.521405135799814e+01, 2.065289943489106e+02},
-    {Species::H2O, 1500.0, -1.935853211552782e+05, 4.733367528372539e+01, 2.506847280013882e+02},
-    {Species::N2, 300.0, 5.388085010456956e+01, 2.912538728061013e+01, 1.917887784316625e+02},
-    {Species::N2, 1173.15, 2.719802963623932e+04, 3.352001505643950e+01, 2.334614758613164e+02},
-    {Species::C, 500.0, 2.365541321801280e+03, 1.459203767436161e+01, 1.165752319022243e+01},
-    {Species::C, 1500.0, 2.319015013367180e+04, 2.380191326717621e+01, 3.366195993361097e+01},
-    {Species::Fe2O3, 300.0, -8.240508313859400e+05, 1.042148538537081e+02, 8.804706910378975e+01},
-    {Species::Fe2O3, 1173.15, -6.991191707022114e+05, 1.424389033653509e+02, 2.756711642427959e+02},
-    {Species::Fe3O4, 500.0, -1.083174659704864e+06, 1.932472729815171e+02, 2.353659257748382e+02},
-    {Species::Fe3O4, 1500.0, -8.708183257900418e+05, 1.966929300318852e+02, 4.713896457431098e+02},
-    {Species::Al2O3, 300.0, -1.675543873269881e+06, 7.943262028186017e+01, 5.140982453323183e+01},
-    {Species::Al2O3, 1173.15, -1.575842320512224e+06, 1.271068067273066e+02, 2.004159109101352e+02},
-    {Species::Al2O3, 1500.0, -1.533438444227489e+06, 1.324467335012064e+02, 2.322739416290896e+02},
-};
-
-} // namespace
+namespace ref = coredem::test::thermochem_ref;
 
 // Same polynomials evaluated in a different order (Horner vs term sums): agreement to a few
 // ulp of the largest term. Tolerances: C_p and S 1e-12 relative; H 1e-12 relative to the
 // largest polynomial term R·|a6| (≤ 2e5 R), i.e. ≤ 2e-6 J/mol, because H can be a small
 // difference of large terms (e.g. H2 at 300 K = 53 J/mol).
 TEST(Nasa7, MatchesReferenceScript) {
-  for (const Ref& r : kRefs) {
-    SCOPED_TRACE(static_cast<int>(r.s));
+  for (const auto& r : ref::kNasa7) {
+    SCOPED_TRACE(static_cast<int>(r.species));
     SCOPED_TRACE(r.t);
-    EXPECT_NEAR(k::nasa7CpMolar(r.s, r.t), r.cp, 1e-12 * r.cp);
-    EXPECT_NEAR(k::nasa7EntropyMolar(r.s, r.t), r.s0, 1e-12 * r.s0);
-    EXPECT_NEAR(k::nasa7EnthalpyMolar(r.s, r.t), r.h, 2e-6);
+    EXPECT_NEAR(k::nasa7CpMolar(r.species, r.t), r.cp, 1e-12 * r.cp);
+    EXPECT_NEAR(k::nasa7EntropyMolar(r.species, r.t), r.s, 1e-12 * r.s);
+    EXPECT_NEAR(k::nasa7EnthalpyMolar(r.species, r.t), r.h, 2e-6);
   }
 }
 
@@ -115,30 +85,16 @@ TEST(Nasa7, ContinuousAtTheMidpointForGases) {
   }
 }
 
-// ΔH_r(T) vs reference/nasa.py (printed to 11 significant digits) → 1e-9 relative.
+// ΔH_r(T) vs the reference script (mpmath) → 1e-9 relative (the script's ΔH_r is exact to its
+// 50 digits; the kernel's sum of ν H in double cancels by up to 10× on R4/R5: ≤ 1e-14 observed).
 TEST(ReactionEnthalpy, MatchesReferenceScript) {
-  struct Row {
-    double t;
-    double dh[5];
-  };
-  const Row rows[] = {{298.15,
-                       {1.7244902145e+05, 1.3129525120e+05, -4.1153770249e+04, -4.7001726854e+04,
-                        -5.8479566050e+03}},
-                      {1073.15,
-                       {1.6992109543e+05, 1.3588043422e+05, -3.4040661208e+04, -3.8819141453e+04,
-                        -4.7784802453e+03}},
-                      {1173.15,
-                       {1.6889680007e+05, 1.3580729144e+05, -3.3089508636e+04, -3.9513193113e+04,
-                        -6.4236844773e+03}},
-                      {1223.15,
-                       {1.6836718336e+05, 1.3573825311e+05, -3.2628930257e+04, -4.0141464098e+04,
-                        -7.5125338411e+03}}};
-  for (const Row& r : rows) {
+  for (const auto& r : ref::kReactionEnthalpy) {
+    const double dh[5] = {r.r1, r.r2, r.r3, r.r4, r.r5};
     for (int i = 0; i < 5; ++i) {
       SCOPED_TRACE(r.t);
       SCOPED_TRACE(i);
-      const double dh = k::reactionEnthalpy(static_cast<k::ClgReaction>(i), r.t);
-      EXPECT_NEAR(dh, r.dh[i], 1e-9 * std::fabs(r.dh[i]));
+      EXPECT_NEAR(k::reactionEnthalpy(static_cast<k::ClgReaction>(i), r.t), dh[i],
+                  1e-9 * std::fabs(dh[i]));
     }
   }
   // docs/physics.md §3.5 table (kJ/mol, rounded): R1 +172.45 and R4 −47.0 at 298.15 K.
@@ -146,11 +102,12 @@ TEST(ReactionEnthalpy, MatchesReferenceScript) {
   EXPECT_NEAR(k::reactionEnthalpy(k::ClgReaction::R4, 298.15) / 1e3, -47.0, 0.05);
 }
 
-// Thermodynamic WGS equilibrium constant vs reference/nasa.py ("K_thermo").
+// Thermodynamic WGS equilibrium constant exp(−ΔG/(R T)) vs the reference script: 1e-11 (ΔG/(R T)
+// is a difference of terms ~40 times larger, so double loses ~2 digits).
 TEST(ReactionEnthalpy, WgsEquilibriumConstantFromGibbs) {
   const k::Stoichiometry wgs = k::clgStoichiometry(k::ClgReaction::R3);
-  EXPECT_NEAR(k::equilibriumConstant(wgs, 1000.0), 1.435337193742, 1e-11);
-  EXPECT_NEAR(k::equilibriumConstant(wgs, 1173.15), 0.7854914807524, 1e-11);
+  EXPECT_NEAR(k::equilibriumConstant(wgs, 1000.0), ref::kWgsThermo1000, 1e-11);
+  EXPECT_NEAR(k::equilibriumConstant(wgs, 1173.15), ref::kWgsThermo1173, 1e-11);
 }
 
 // Molar masses from atomic masses: every CLG reaction balances to round-off (a few ulp of

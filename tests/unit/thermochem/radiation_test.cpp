@@ -8,8 +8,11 @@
 #include <coredem/dem/kernels/radiation.h>
 #include <coredem/dem/verification/analytic.h>
 
+#include "reference/thermochem_reference.h"
+
 namespace k = coredem::dem::kernels;
 namespace v = coredem::dem::verification;
+namespace ref = coredem::test::thermochem_ref;
 
 // Eq. 27 in factored form equals e σ A (T_env⁴ − T_p⁴) (1e-14 relative), vanishes at
 // equilibrium and has the right sign.
@@ -38,39 +41,40 @@ TEST(Radiation, EnvironmentTemperature) {
   EXPECT_EQ(k::radiationEnvironmentTemperature(eps, tg, 0.0, 0), tg);
 }
 
-// Constants of §8.4 vs the independent Python reference values: C_A = 2.700186611336668e-10, C_B
-// = 1.553298547852017e-10, ε_g = 0.928581127008392 (1e-12 relative: only the order of
-// multiplications differs).
+// Constants of §8.4 vs reference/make_thermochem_reference.py: C_A, C_B, ε_g (1e-12 relative:
+// only the order of multiplications and the double rounding of the inputs differ).
 TEST(Radiation, MfixCaseConstants) {
   const v::RadiationCase c = v::mfixRadiationCase();
-  EXPECT_NEAR(c.epsG, 9.285811270083920e-01, 1e-13);
-  EXPECT_NEAR(v::radiationConstant(c.m1, c.d1), 2.700186611336668e-10, 1e-12 * 2.7e-10);
-  EXPECT_NEAR(v::radiationConstant(c.m2, c.d2), 1.553298547852017e-10, 1e-12 * 1.55e-10);
+  EXPECT_NEAR(c.epsG, ref::kRadiationVoidage, 1e-13);
+  EXPECT_NEAR(v::radiationConstant(c.m1, c.d1), ref::kRadiationCA, 1e-12 * ref::kRadiationCA);
+  EXPECT_NEAR(v::radiationConstant(c.m2, c.d2), ref::kRadiationCB, 1e-12 * ref::kRadiationCB);
   // MFiX's constants (2.70024635866355e-10, 1.55333291786026e-10) differ by 2.2e-5 relative
   // because MFiX uses a slightly different σ.
   EXPECT_NEAR(v::radiationConstant(c.m1, c.d1) / 2.70024635866355e-10, 1.0, 3e-5);
 }
 
-// RK4, Δt = 1e-3 s, vs the independent Python reference values (printed to 1e-6 K → tolerance 1e-6
-// K) for both T_env variants; and the step is converged (Δt = 1e-3 vs 2e-3 differ by < 1e-8 K).
+// RK4, Δt = 1e-3 s, vs the same scheme in Python floats (reference/make_thermochem_reference.py)
+// for both T_env variants: the two differ only in the rounding of each step (~1e-13 K), which
+// accumulates over up to 3e5 steps → 1e-9 K. And the step is converged (Δt = 1e-3 vs 2e-3
+// differ by < 1e-8 K).
 TEST(Radiation, Rk4ReferenceMatchesScript) {
-  const std::vector<double> times = {10.0, 50.0, 100.0, 200.0, 300.0};
-  const double refA[5][2] = {{338.063746, 432.9536},
-                             {394.964316, 405.973527},
-                             {399.873049, 400.835555},
-                             {400.001314, 400.018021},
-                             {400.000034, 400.000394}};
-  const auto ra = v::radiationReferenceRK4(v::mfixRadiationCase(), times, 1e-3);
-  for (int i = 0; i < 5; ++i) {
-    EXPECT_NEAR(ra[i].t1, refA[i][0], 1e-6) << times[i];
-    EXPECT_NEAR(ra[i].t2, refA[i][1], 1e-6) << times[i];
+  std::vector<double> times;
+  for (const auto& r : ref::kRadiationCellMean) {
+    times.push_back(r.t);
   }
+  const auto ra = v::radiationReferenceRK4(v::mfixRadiationCase(), times, 1e-3);
   const auto rb = v::radiationReferenceRK4(
       v::mfixRadiationCase(k::RadiationEnvironment::NeighbourMeanExcludingSelf), times, 1e-3);
-  EXPECT_NEAR(rb[1].t1, 396.047309, 1e-6);
-  EXPECT_NEAR(rb[1].t2, 405.084005, 1e-6);
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    SCOPED_TRACE(times[i]);
+    EXPECT_NEAR(ra[i].t1, ref::kRadiationCellMean[i].t1, 1e-9);
+    EXPECT_NEAR(ra[i].t2, ref::kRadiationCellMean[i].t2, 1e-9);
+    ASSERT_EQ(ref::kRadiationNeighbours[i].t, times[i]);
+    EXPECT_NEAR(rb[i].t1, ref::kRadiationNeighbours[i].t1, 1e-9);
+    EXPECT_NEAR(rb[i].t2, ref::kRadiationNeighbours[i].t2, 1e-9);
+  }
   const auto coarse = v::radiationReferenceRK4(v::mfixRadiationCase(), times, 2e-3);
-  for (int i = 0; i < 5; ++i) {
+  for (std::size_t i = 0; i < times.size(); ++i) {
     EXPECT_NEAR(coarse[i].t1, ra[i].t1, 1e-8);
     EXPECT_NEAR(coarse[i].t2, ra[i].t2, 1e-8);
   }

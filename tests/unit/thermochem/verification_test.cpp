@@ -1,25 +1,32 @@
 // The analytic solutions of the verification suite (dem-gpu-server/.../verification/analytic.h)
-// vs the numbers of docs/physics.md §8 and the MFiX reference files quoted there.
+// vs reference/make_thermochem_reference.py (thermochem_reference.h), the numbers of
+// docs/physics.md §8 and the MFiX reference files quoted there.
 #include <cmath>
 
 #include <gtest/gtest.h>
 
 #include <coredem/dem/verification/analytic.h>
 
+#include "reference/thermochem_reference.h"
+
 namespace v = coredem::dem::verification;
+namespace ref = coredem::test::thermochem_ref;
 
 // §8.0 property set: masses and heat capacities (m_A C_A = 4.7500e-3, m_B C_B = 1.18906e-2 J/K).
 TEST(Verification, MusserPropertySet) {
   const v::Material a = v::musserMaterialA();
   const v::Material b = v::musserMaterialB();
-  EXPECT_NEAR(v::sphereMass(a, 3.0e-3), 5.937610115284710e-06, 1e-15 * 5.9e-6);
-  EXPECT_NEAR(v::sphereMass(b, 3.6e-3), 2.161968665976809e-04, 1e-15 * 2.2e-4);
+  // The reference script's values (exact decimal inputs): a few ulp of round-off → 1e-15.
+  EXPECT_NEAR(v::sphereMass(a, 3.0e-3), ref::kMassA, 1e-15 * ref::kMassA);
+  EXPECT_NEAR(v::sphereMass(b, 3.6e-3), ref::kMassB, 1e-15 * ref::kMassB);
+  EXPECT_NEAR(v::sphereMass(a, 3.0e-3) * a.cp, ref::kHeatCapacityA, 1e-15 * ref::kHeatCapacityA);
+  EXPECT_NEAR(v::sphereMass(b, 3.6e-3) * b.cp, ref::kHeatCapacityB, 1e-15 * ref::kHeatCapacityB);
+  EXPECT_NEAR(a.k, ref::kConductivityA, 1e-15 * a.k);
+  EXPECT_NEAR(b.k, ref::kConductivityB, 1e-15 * b.k);
+  EXPECT_NEAR(v::kMusserLensGasConductivity, ref::kLensGasConductivity, 1e-17);
   // The table truncates m_A C_A = 4.750073e-3 to 4.7500e-3 → tolerance 1e-7 J/K.
   EXPECT_NEAR(v::sphereMass(a, 3.0e-3) * a.cp, 4.7500e-3, 1e-7);
   EXPECT_NEAR(v::sphereMass(b, 3.6e-3) * b.cp, 1.18906e-2, 5e-7);
-  EXPECT_NEAR(a.k, 55.0, 1e-4);
-  EXPECT_NEAR(b.k, 0.8401, 1e-4);
-  EXPECT_NEAR(v::kMusserLensGasConductivity, 0.051840, 1e-6);
 }
 
 // MFiX-CC analytic column (§8.1): T_A(9.901 s) = 312.85412739, T_A(49.901) = 354.88198678,
@@ -35,9 +42,13 @@ TEST(Verification, MfixContactConductionAnalytic) {
   const auto t50 = v::twoParticleExchange(c.a, c.b, 298.15, 453.15, 49.901);
   EXPECT_NEAR(t50.t1, 354.88198678, 2e-6);
   EXPECT_NEAR(t50.t2, 430.48651583, 2e-6);
-  // the independent Python reference values at 49.901 s (same formula, exact constants):
-  // 354.8819884768602 K.
-  EXPECT_NEAR(t50.t1, 354.8819884768602, 1e-10);
+  // The reference script (same formula, exact constants): 1e-9 K (a, b to 1e-10 relative, see
+  // conduction_test.cpp, move T by ≤ 1e-10 · 150 K).
+  EXPECT_NEAR(v::twoParticleExchange(c.a, c.b, 298.15, 453.15, 9.901).t1, ref::kMfixCcT1At9901ms,
+              1e-9);
+  EXPECT_NEAR(t50.t1, ref::kMfixCcT1At49901ms, 1e-9);
+  EXPECT_NEAR(t50.t2, ref::kMfixCcT2At49901ms, 1e-9);
+  EXPECT_NEAR(v::twoParticleEquilibrium(c.a, c.b, 298.15, 453.15), ref::kMfixCcEquilibrium, 1e-9);
   EXPECT_NEAR(v::twoParticleEquilibrium(c.a, c.b, 298.15, 453.15), 408.9050, 2e-4);
   // t = 0 returns the initial state; t → ∞ the equilibrium; energy m C T is conserved.
   const auto t0 = v::twoParticleExchange(c.a, c.b, 298.15, 453.15, 0.0);
@@ -48,40 +59,34 @@ TEST(Verification, MfixContactConductionAnalytic) {
   EXPECT_NEAR(ma * t50.t1 + mb * t50.t2, ma * 298.15 + mb * 453.15, 1e-14 * (ma + mb) * 453.15);
 }
 
-// MFiX-PFP (§8.2): with the exact integral T_A(49.9 s) = 402.17693, T_B = 411.59297 K; with
-// MFiX's loose constants (a = 0.0401067383, b = 0.0160219735) the file's 402.17567025 K.
+// MFiX-PFP (§8.2): with the exact integral T_A(49.9 s) = 402.17693, T_B = 411.59297 K (the
+// reference script's values at 1e-9 K); with MFiX's loose constants (a = 0.0401067383, b =
+// 0.0160219735) the file's 402.17567025 K.
 TEST(Verification, MfixLensAnalytic) {
   const auto c = v::gasLensCoefficients(3.0e-3, v::musserMaterialA(), 3.6e-3, v::musserMaterialB(),
                                         (1.498 - 1.150) * 1e-2, v::kMusserLensGasConductivity);
   const auto t = v::twoParticleExchange(c.a, c.b, 298.15, 453.15, 49.9);
-  EXPECT_NEAR(t.t1, 402.17693, 5e-6);
-  EXPECT_NEAR(t.t2, 411.59297, 5e-6);
+  EXPECT_NEAR(t.t1, ref::kMfixPfpT1At49900ms, 1e-9);
+  EXPECT_NEAR(t.t2, ref::kMfixPfpT2At49900ms, 1e-9);
   EXPECT_NEAR(v::twoParticleExchange(0.0401067383, 0.0160219735, 298.15, 453.15, 49.9).t1,
               402.17567025, 1e-7);
   EXPECT_NEAR(t.t1, 402.17567025, 1e-2); // §8.2: compare with the MFiX file at ~0.01 K
 }
 
-// §8.5 reaction: t_end = 1.499996 s, m(0.5) = 3.4361167353e-5, m(1.0) = 3.3379417353e-5,
-// m(≥1.5) = 3.2397674240e-5 kg, fractions (the independent Python reference values, 8 decimals).
+// §8.5 reaction vs the reference script: m0, t_end, and m, X_B, X_D, X_I at 0 … 2 s (t_end =
+// 1.499996 s, m(≥1.5 s) = 3.2397674240e-5 kg). Round-off only: 1e-15 relative for masses,
+// 1e-14 for times and fractions.
 TEST(Verification, ReactionAnalytic) {
   const v::ReactionCase c = v::mfixReactionCase();
-  EXPECT_NEAR(c.m0, 3.5342917353e-05, 5e-16);
-  EXPECT_NEAR(v::reactionEndTime(c), 1.499996, 5e-7);
-  struct Row {
-    double t, m, xB, xD, xI;
-  };
-  const Row rows[] = {{0.0, 3.5342917353e-05, 0.5, 0.0, 0.5},
-                      {0.5, 3.4361167353e-05, 0.34285676, 0.14285749, 0.51428575},
-                      {1.0, 3.3379417353e-05, 0.17646979, 0.29411838, 0.52941184},
-                      {1.5, 3.2397674240e-05, 0.0, 0.45454545, 0.54545455},
-                      {2.0, 3.2397674240e-05, 0.0, 0.45454545, 0.54545455}};
-  for (const Row& r : rows) {
+  EXPECT_NEAR(c.m0, ref::kReactionMass0, 1e-15 * ref::kReactionMass0);
+  EXPECT_NEAR(v::reactionEndTime(c), ref::kReactionEndTime, 1e-14);
+  for (const auto& r : ref::kReaction) {
     SCOPED_TRACE(r.t);
     const v::ReactionState s = v::reactionAnalytic(c, r.t);
-    EXPECT_NEAR(s.m, r.m, 5e-16);
-    EXPECT_NEAR(s.xB, r.xB, 5e-9);
-    EXPECT_NEAR(s.xD, r.xD, 5e-9);
-    EXPECT_NEAR(s.xI, r.xI, 5e-9);
+    EXPECT_NEAR(s.m, r.m, 1e-15 * r.m);
+    EXPECT_NEAR(s.xB, r.xB, 1e-14);
+    EXPECT_NEAR(s.xD, r.xD, 1e-14);
+    EXPECT_NEAR(s.xI, r.xI, 1e-14);
     EXPECT_NEAR(s.xB + s.xD + s.xI, 1.0, 1e-15);
   }
   // Final composition X_D = 5/11, X_I = 6/11 exactly (§8.5).
@@ -93,19 +98,26 @@ TEST(Verification, ReactionAnalytic) {
 // Case presets used by the verification suite reproduce the §8 constants.
 TEST(Verification, CasePresets) {
   const auto cc = v::contactConductionCoefficients(v::mfixContactConductionCase());
-  EXPECT_NEAR(cc.a, 0.01027998273952850, 1e-10 * cc.a);
+  EXPECT_NEAR(cc.a, ref::kMfixCcA, 1e-10 * cc.a);
   const auto sv = v::contactConductionCoefficients(v::seedContactConductionCase(2.4e-3, 1e-5));
-  EXPECT_NEAR(sv.a, 8.038552e-02, 5e-7 * sv.a);
-  EXPECT_NEAR(sv.b, 1.083803e-01, 5e-7 * sv.b);
+  const auto& svRef = ref::kSeedContact[0];
+  ASSERT_EQ(svRef.d2, 2.4e-3);
+  ASSERT_EQ(svRef.ov, 1e-5);
+  EXPECT_NEAR(sv.a, svRef.a, 1e-12 * sv.a);
+  EXPECT_NEAR(sv.b, svRef.b, 1e-12 * sv.b);
   const auto pfp = v::gasLensCoefficients(v::mfixLensCase());
-  EXPECT_NEAR(pfp.a, 4.010942558902641e-02, 1e-9 * pfp.a);
+  EXPECT_NEAR(pfp.a, ref::kMfixPfpA, 1e-12 * pfp.a);
   coredem::dem::kernels::GasLensParams fine;
   fine.minSeparation = 4e-10;
   const auto touch = v::gasLensCoefficients(v::seedLensCase(-1e-5), fine);
-  EXPECT_NEAR(touch.a, 8.206299e-01, 5e-7 * touch.a); // §8.2 table
-  EXPECT_NEAR(touch.b, 3.278280e-01, 5e-7 * touch.b);
-  EXPECT_NEAR(v::twoParticleExchange(touch.a, touch.b, 373.15, 278.15, 10.0).t1, 305.2685, 5e-5);
-  EXPECT_NEAR(v::mfixConvectionCellVoidage(), 0.995759, 5e-7);
+  const auto& touchRef = ref::kSeedLens[4];
+  ASSERT_EQ(touchRef.gap, -1e-5);
+  ASSERT_EQ(touchRef.sMin, 4e-10);
+  EXPECT_NEAR(touch.a, touchRef.a, 1e-12 * touch.a);
+  EXPECT_NEAR(touch.b, touchRef.b, 1e-12 * touch.b);
+  EXPECT_NEAR(v::twoParticleExchange(touch.a, touch.b, 373.15, 278.15, 10.0).t1, touchRef.t1At10s,
+              1e-9);
+  EXPECT_NEAR(v::mfixConvectionCellVoidage(), ref::kConvectionCellVoidage, 1e-15);
   // A lens case whose quadrature cannot converge is reported, not silently returned.
   coredem::dem::kernels::GasLensParams impossible;
   impossible.relTol = 1e-30;

@@ -7,20 +7,25 @@
 #include <coredem/dem/kernels/reaction_enthalpy.h>
 #include <coredem/dem/kernels/wgs.h>
 
+#include "reference/thermochem_reference.h"
+
 namespace k = coredem::dem::kernels;
 using k::GasSpecies;
 using k::idx;
 
 // K_eq options: Yoon–Denn 0.0265 e^(3968/T) is 1.40 at 1000 K vs thermodynamic 1.435 (§6.2,
-// within 3 %); the seed's exp(−4.33 + 4577.8/T) = 1.2812036658350723 at 1000 K (nasa.py).
+// within 3 %); the seed's exp(−4.33 + 4577.8/T) and the thermodynamic exp(−ΔG/(R T)) vs
+// reference/make_thermochem_reference.py.
 TEST(Wgs, EquilibriumConstants) {
   k::WgsParams p;
   EXPECT_NEAR(k::wgsEquilibriumConstant(p, 1000.0), 0.0265 * std::exp(3.968), 1e-15);
   EXPECT_NEAR(k::wgsEquilibriumConstant(p, 1000.0), 1.40, 0.005);
   p.equilibrium = k::WgsEquilibrium::Seed;
-  EXPECT_NEAR(k::wgsEquilibriumConstant(p, 1000.0), 1.2812036658350723, 1e-14);
+  EXPECT_NEAR(k::wgsEquilibriumConstant(p, 1000.0), coredem::test::thermochem_ref::kWgsSeed1000,
+              1e-14);
   p.equilibrium = k::WgsEquilibrium::Thermodynamic;
-  EXPECT_NEAR(k::wgsEquilibriumConstant(p, 1000.0), 1.435337193742, 1e-11);
+  EXPECT_NEAR(k::wgsEquilibriumConstant(p, 1000.0), coredem::test::thermochem_ref::kWgsThermo1000,
+              1e-11);
   k::WgsParams yd;
   for (double t : {1000.0, 1100.0, 1173.15, 1223.15}) { // CLG range (5 % off at 900 K)
     EXPECT_NEAR(k::wgsEquilibriumConstant(yd, t) / k::wgsEquilibriumConstant(p, t), 1.0, 0.03) << t;
