@@ -246,9 +246,13 @@ for n in $N_LIST; do
     table+=("$(awk -v c="dem $c" -v n="$n" -v a="$rc" -v b="$rg" 'BEGIN { printf "  %-26s %9d %13.4e %13.4e %9.2fx", c, n, a, b, b / a }')")
     echo "${table[-1]}"
   done
-  echo "== coredem-bench thermochem --particles $n (cpu: $CPU_THREADS threads)"
-  cpu="$(bench "thermochem.$n.cpu" thermochem --particles "$n" --threads "$CPU_THREADS")"
-  gpu="$(bench "thermochem.$n.cuda" thermochem --particles "$n" --backend "$thermo_gpu_backend")"
+  # thermochem times 14 variants (the CLG rates alone are ~5 µs per particle and sub-step on
+  # one core): fewer sub-steps and one repeat from 10^6 particles keep the cpu side short.
+  tsteps=(--steps 10 --warmup 5 --repeat 3)
+  [[ "$n" -ge 1000000 ]] && tsteps=(--steps 4 --warmup 2 --repeat 1)
+  echo "== coredem-bench thermochem --particles $n ${tsteps[*]} (cpu: $CPU_THREADS threads)"
+  cpu="$(bench "thermochem.$n.cpu" thermochem --particles "$n" "${tsteps[@]}" --threads "$CPU_THREADS")"
+  gpu="$(bench "thermochem.$n.cuda" thermochem --particles "$n" "${tsteps[@]}" --backend "$thermo_gpu_backend")"
   for k in whole_step_mechanics whole_step_all_heat; do
     a="$(field "$k" <<<"$cpu")"
     b="$(field "$k" <<<"$gpu")"
