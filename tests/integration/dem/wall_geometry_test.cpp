@@ -268,15 +268,18 @@ TEST(CylinderWall, PackedBedWallForceEqualsWeightPrimitiveAndStl) {
 
 // Discharge of a flat-bottomed cylindrical silo through a central orifice vs Beverloo's
 // correlation W = C ρ_b √g (D_o − k d)^2.5 (Beverloo, Leniger & van de Velde 1961; Nedderman
-// 1992): C = 0.58 and k = 1.5 are the usual values, the band C ∈ [0.55, 0.65], k ∈ [1.3, 2.9]
-// holds the spread of reported fits for cohesionless spheres. 2 mm spheres (k_n = 50 N/m,
-// e_n = 0.5, μ = 0.5 particles and walls), silo radius 15 mm (7.5 d), orifice D_o = 12 mm
-// (6 d), filled by settling a loose lattice on a closed floor, then the floor replaced by the
-// annular plate of the orifice (an analytic cone of zero height would do; the plate here is a
-// frustum 0.1 mm high). ρ_b from the settled bed; W from a linear fit of the discharged mass
-// over 0.1–0.35 s after opening (steady flow: the bed, 4000 spheres ≈ 40 mm, stays higher
-// than the silo is wide).
-TEST(Silo, DischargeRateIsInBeverloosBand) {
+// 1992) with the bed's own measured bulk density ρ_b and the constants fitted for cohesionless
+// spheres, C = 0.58 and k = 1.5. 2 mm spheres (k_n = 50 N/m, e_n = 0.5, μ = 0.5 particles and
+// walls), silo radius 15 mm (7.5 d), orifice D_o = 12 mm (6 d), filled by settling a loose
+// lattice on a closed floor, then the floor replaced by the annular plate of the orifice (an
+// analytic cone of zero height would do; the plate here is a frustum 0.1 mm high). W from a
+// linear fit of the discharged mass over 0.1–0.35 s after opening (steady flow: the bed, 4000
+// spheres ≈ 40 mm, stays higher than the silo is wide).
+// Tolerance ±15 % of the fitted W: the published fits for glass spheres scatter by about ±0.03
+// in C (±5 %) and ±0.2 in k, which at D_o = 6 d moves (D_o − k d)^2.5 by ±11 %; the rate fit
+// over 0.25 s of a 4000-sphere bed adds about ±2 %. (The band of all reported constants, C in
+// [0.55, 0.65] and k in [1.3, 2.9], spans a factor 3.3 here and would not see a rate off by 2×.)
+TEST(Silo, DischargeRateMatchesBeverloo) {
   const double d = 2e-3, R = 15e-3, Do = 12e-3, H = 0.22, rho = 2500.0, g = 9.81;
   auto base = [&] {
     DemConfig c;
@@ -355,16 +358,17 @@ TEST(Silo, DischargeRateIsInBeverloosBand) {
   auto beverloo = [&](double c, double k) {
     return c * rhoB * std::sqrt(g) * std::pow(Do - k * d, 2.5);
   };
-  const double lo = beverloo(0.55, 2.9), mid = beverloo(0.58, 1.5), hi = beverloo(0.65, 1.3);
+  const double mid = beverloo(0.58, 1.5);
+  const double lo = 0.85 * mid, hi = 1.15 * mid;
   EXPECT_GT(rhoB, 0.5 * rho);
   EXPECT_LT(rhoB, 0.66 * rho);
-  EXPECT_GT(w, lo) << "W = " << w << " kg/s, Beverloo " << mid << " (band " << lo << "–" << hi
+  EXPECT_GT(w, lo) << "W = " << w << " kg/s, Beverloo " << mid << " (±15 %: " << lo << "–" << hi
                    << "), rho_b = " << rhoB;
-  EXPECT_LT(w, hi) << "W = " << w << " kg/s, Beverloo " << mid << " (band " << lo << "–" << hi
+  EXPECT_LT(w, hi) << "W = " << w << " kg/s, Beverloo " << mid << " (±15 %: " << lo << "–" << hi
                    << "), rho_b = " << rhoB;
   RecordProperty("discharge_kg_per_s", std::to_string(w));
   RecordProperty("beverloo_kg_per_s", std::to_string(mid));
-  std::printf("silo discharge W = %.5g kg/s, Beverloo (C 0.58, k 1.5) %.5g kg/s, band %.5g-%.5g, "
+  std::printf("silo discharge W = %.5g kg/s, Beverloo (C 0.58, k 1.5) %.5g kg/s, ±15 %% %.5g-%.5g, "
               "rho_b = %.1f kg/m3\n",
               w, mid, lo, hi, rhoB);
 }
