@@ -1,8 +1,8 @@
 // The DEM server's parts on their own (dem-gpu-server/server/src): the coupling fields' bindings
 // to the DEM core's structures, partial-rank combining, session membership and the staggered
 // lag. The whole server is tested through its protocol by the other files of this folder.
+#include <algorithm>
 #include <memory>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -22,20 +22,24 @@ namespace v1 = coredem::v1;
 using namespace coredem::server;
 
 TEST(ServerCouplingFields, EveryTableFieldHasItsOwnMember) {
-  std::set<std::span<const double> coredem::dem::GasFieldsView::*> gas;
+  // Member pointers compare for equality only: a list searched linearly.
+  std::vector<std::span<const double> coredem::dem::GasFieldsView::*> gas;
   for (auto table : {f::gasFields(), f::optionalGasFields()}) {
     for (const auto& spec : table) {
       const auto m = gasFieldMember(spec.name);
       ASSERT_NE(m, nullptr) << spec.name;
-      EXPECT_TRUE(gas.insert(m).second) << spec.name << " shares a member";
+      EXPECT_EQ(std::count(gas.begin(), gas.end(), m), 0) << spec.name << " shares a member";
+      gas.push_back(m);
     }
   }
-  std::set<std::vector<double> coredem::dem::CellSources::*> sources;
+  std::vector<std::vector<double> coredem::dem::CellSources::*> sources;
   for (auto table : {f::sourceFields(), f::optionalSourceFields()}) {
     for (const auto& spec : table) {
       const auto m = sourceFieldMember(spec.name);
       ASSERT_NE(m, nullptr) << spec.name;
-      EXPECT_TRUE(sources.insert(m).second) << spec.name << " shares a member";
+      EXPECT_EQ(std::count(sources.begin(), sources.end(), m), 0)
+          << spec.name << " shares a member";
+      sources.push_back(m);
     }
   }
   EXPECT_EQ(gasFieldMember("no_such_field"), nullptr);
@@ -142,8 +146,9 @@ std::vector<StepReply> repliesOf(const std::vector<proto::Request>& rs) {
 
 TEST(ServerPartialRanks, CombinesVolumeWeightedAndMarksPartlyFluidCells) {
   // Cell 0 is split between the ranks (all fluid), cell 1 is half fluid on rank 1 only.
-  const std::vector<proto::Request> rs{partialRequest({0}, {0.25}, 300.0),
-                                       partialRequest({0, 1}, {0.75, 0.5}, 400.0)};
+  std::vector<proto::Request> rs;
+  rs.push_back(partialRequest({0}, {0.25}, 300.0));
+  rs.push_back(partialRequest({0, 1}, {0.75, 0.5}, 400.0));
   const auto c = combinePartialGasFields(repliesOf(rs), {2, 1}, 1.0, 2);
   ASSERT_TRUE(c.gas.has_value());
   const auto T = c.gas->values<double>(f::kGasTemperature);
@@ -155,8 +160,9 @@ TEST(ServerPartialRanks, CombinesVolumeWeightedAndMarksPartlyFluidCells) {
 }
 
 TEST(ServerPartialRanks, RefusesOverlappingVolumes) {
-  const std::vector<proto::Request> rs{partialRequest({0}, {0.75}, 300.0),
-                                       partialRequest({0}, {0.75}, 300.0)};
+  std::vector<proto::Request> rs;
+  rs.push_back(partialRequest({0}, {0.75}, 300.0));
+  rs.push_back(partialRequest({0}, {0.75}, 300.0));
   const auto c = combinePartialGasFields(repliesOf(rs), {2, 1}, 1.0, 2);
   ASSERT_FALSE(c.gas.has_value());
   EXPECT_EQ(c.failure.kind, CombineFailure::Kind::Volumes);
