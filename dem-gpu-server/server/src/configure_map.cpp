@@ -337,7 +337,7 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   // Model options by name (`models:` in case.yaml), through the model registry (models.h).
   for (const auto& kv : c.options()) {
     if (kv.key() == protocol::fields::kCouplingSchemeOption) {
-      continue; // the server's own option (dem_server.cpp), not a DEM model
+      continue; // the server's own option (session_setup.cpp), not a DEM model
     }
     if (!dem::applyModelOption(cfg, kv.key(), kv.value()) && warnings != nullptr) {
       warnings->push_back(kv.key());

@@ -84,6 +84,7 @@ public:
                                        const GridShape& grid) const;
 
   /// Answers the grant's orchestrator with an Error and drops the grant (the step is not run).
+  /// @pre grant()
   void failGrant(v1::ErrorCode code, const std::string& text);
   /// The step ran: the grant is done.
   void completeGrant() { _grant.reset(); }
@@ -91,10 +92,10 @@ public:
   /// not run (the orchestrator stops the run).
   void failPartialStep(v1::ErrorCode code, const std::string& text);
 
-  /// The connection of a CFD rank (`peer`, rank `rank`, named `who`) closed: its held GasFields
-  /// are dropped.
+  /// The connection `peer` of a CFD rank closed: its held GasFields is dropped (unanswered).
   void dropHeldOf(const protocol::PeerId& peer);
-  /// ... and its partial GasFields; the step in progress fails (the others are answered).
+  /// CFD rank `rank` (named `who` in the texts) left while partial GasFields wait: its own is
+  /// dropped and the step fails (the other ranks and the grant are answered).
   void rankLeft(std::uint32_t rank, const std::string& who, std::int64_t lastStep);
   /// Answers what waited longer than `waitSeconds` (no StepGrant, missing ranks).
   void expire(Clock::time_point now, double waitSeconds);
