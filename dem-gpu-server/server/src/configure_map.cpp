@@ -94,18 +94,17 @@ void addChemistry(const v1::Configure& c, dem::DemConfig& cfg) {
   }
 }
 
-} // namespace
+/// The materials, addressed by id: each id's index in cfg.materials and its density.
+struct MaterialIds {
+  std::map<std::uint32_t, int> index;
+  std::map<std::uint32_t, double> density;
+};
 
-dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* warnings) {
-  dem::DemConfig cfg;
-
-  // Materials, addressed by id.
-  std::map<std::uint32_t, int> materialIndex;
-  std::map<std::uint32_t, double> materialDensity;
+MaterialIds addMaterials(const v1::Configure& c, dem::DemConfig& cfg) {
+  MaterialIds ids;
   cfg.materials.clear();
   for (const auto& m : c.materials()) {
-    COREDEM_CHECK(materialIndex.count(m.id()) == 0, "Configure: material id {} appears twice",
-                  m.id());
+    COREDEM_CHECK(ids.index.count(m.id()) == 0, "Configure: material id {} appears twice", m.id());
     dem::Material d;
     d.name = m.name().empty() ? "material-" + std::to_string(m.id()) : m.name();
     d.kn = m.k_n();
@@ -117,20 +116,18 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
       d.cp = m.cp(); // 0 (unset): the default 840 J/kg/K, as in the case schema
     d.conductivity = m.conductivity();
     d.emissivity = m.emissivity();
-    materialIndex[m.id()] = static_cast<int>(cfg.materials.size());
-    materialDensity[m.id()] = m.density();
+    ids.index[m.id()] = static_cast<int>(cfg.materials.size());
+    ids.density[m.id()] = m.density();
     cfg.materials.push_back(d);
   }
   COREDEM_CHECK(!cfg.materials.empty(), "Configure: no materials; give at least one (k_n, e_n, "
                                         "friction, density)");
+  return ids;
+}
 
-  // Gas species (Y_g / R_species columns).
-  for (const auto& s : c.species()) {
-    cfg.gasSpecies.push_back({s.name(), s.molar_mass()});
-  }
-
-  // Solid species: v1.1 Configure.solid_species when given (chemistry); else the names used in
-  // particle compositions, in order of first appearance.
+/// Solid species: v1.1 Configure.solid_species when given (chemistry); else the names used in
+/// particle compositions, in order of first appearance. Returns their names.
+std::vector<std::string> addSolidSpecies(const v1::Configure& c, dem::DemConfig& cfg) {
   std::vector<std::string> solid;
   for (const auto& s : c.solid_species()) {
     COREDEM_CHECK(std::find(solid.begin(), solid.end(), s.name()) == solid.end(),
@@ -173,76 +170,75 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
     }
     cfg.solidSpecies.push_back({name, molar});
   }
+  return solid;
+}
 
-  // Particle sets. With an initial state file the file's particles replace them after
-  // construction (readState), but they are still built when given: the DEM core derives
-  // dt_dem_max from the sets' materials and sizes.
-  {
-    int index = 0;
-    for (const auto& ps : c.particle_sets()) {
-      const auto it = materialIndex.find(ps.material_id());
-      COREDEM_CHECK(it != materialIndex.end(),
-                    "Configure: particle set {} ('{}') uses material "
-                    "id {}, which is not among the materials",
-                    index, ps.name(), ps.material_id());
-      dem::ParticleSet d;
-      d.name = ps.name().empty() ? "set-" + std::to_string(index) : ps.name();
-      d.material = it->second;
-      switch (ps.packing()) {
-      case v1::PACKING_RANDOM:
-        d.packing = dem::Packing::Random;
-        break;
-      case v1::PACKING_EXPLICIT:
-        d.packing = dem::Packing::Explicit;
-        COREDEM_CHECK(ps.positions_size() > 0 &&
-                          static_cast<std::uint64_t>(ps.positions_size()) == ps.count(),
-                      "Configure: particle set '{}' has explicit packing with {} positions but "
-                      "count {}; give one position per particle",
-                      d.name, ps.positions_size(), ps.count());
-        for (const auto& p : ps.positions()) {
-          d.positions.insert(d.positions.end(), {p.x(), p.y(), p.z()});
-        }
-        break;
-      case v1::PACKING_LATTICE:
-      case v1::PACKING_UNSPECIFIED:
-        d.packing = dem::Packing::Lattice;
-        break;
-      default:
-        COREDEM_CHECK(false,
-                      "Configure: particle set '{}' has an unknown packing {}; use "
-                      "LATTICE, RANDOM or EXPLICIT",
-                      d.name, static_cast<int>(ps.packing()));
+/// Particle sets. With an initial state file the file's particles replace them after
+/// construction (readState), but they are still built when given: the DEM core derives
+/// dt_dem_max from the sets' materials and sizes.
+void addParticleSets(const v1::Configure& c, const MaterialIds& materials,
+                     const std::vector<std::string>& solid, dem::DemConfig& cfg) {
+  int index = 0;
+  for (const auto& ps : c.particle_sets()) {
+    const auto it = materials.index.find(ps.material_id());
+    COREDEM_CHECK(it != materials.index.end(),
+                  "Configure: particle set {} ('{}') uses material "
+                  "id {}, which is not among the materials",
+                  index, ps.name(), ps.material_id());
+    dem::ParticleSet d;
+    d.name = ps.name().empty() ? "set-" + std::to_string(index) : ps.name();
+    d.material = it->second;
+    switch (ps.packing()) {
+    case v1::PACKING_RANDOM:
+      d.packing = dem::Packing::Random;
+      break;
+    case v1::PACKING_EXPLICIT:
+      d.packing = dem::Packing::Explicit;
+      COREDEM_CHECK(ps.positions_size() > 0 &&
+                        static_cast<std::uint64_t>(ps.positions_size()) == ps.count(),
+                    "Configure: particle set '{}' has explicit packing with {} positions but "
+                    "count {}; give one position per particle",
+                    d.name, ps.positions_size(), ps.count());
+      for (const auto& p : ps.positions()) {
+        d.positions.insert(d.positions.end(), {p.x(), p.y(), p.z()});
       }
-      d.regionMin = vec(ps.region_min());
-      d.regionMax = vec(ps.region_max());
-      d.count = static_cast<std::size_t>(ps.count());
-      d.diameter = ps.diameter();
-      d.density = ps.density() > 0.0 ? ps.density() : materialDensity[ps.material_id()];
-      d.temperature = ps.temperature() > 0.0 ? ps.temperature() : d.temperature;
-      // No composition: left empty, the DEM core puts all of the mass in the first solid
-      // species (docs/protocol.md §3).
-      d.composition.assign(ps.composition().empty() ? 0 : solid.size(), 0.0);
-      for (const auto& nv : ps.composition()) {
-        const auto k = std::find(solid.begin(), solid.end(), nv.name()) - solid.begin();
-        d.composition[static_cast<std::size_t>(k)] = nv.value();
-      }
-      d.velocity = vec(ps.initial_velocity());
-      if (ps.seed() != 0) {
-        d.seed = ps.seed();
-      }
-      cfg.particleSets.push_back(std::move(d));
-      ++index;
+      break;
+    case v1::PACKING_LATTICE:
+    case v1::PACKING_UNSPECIFIED:
+      d.packing = dem::Packing::Lattice;
+      break;
+    default:
+      COREDEM_CHECK(false,
+                    "Configure: particle set '{}' has an unknown packing {}; use "
+                    "LATTICE, RANDOM or EXPLICIT",
+                    d.name, static_cast<int>(ps.packing()));
     }
+    d.regionMin = vec(ps.region_min());
+    d.regionMax = vec(ps.region_max());
+    d.count = static_cast<std::size_t>(ps.count());
+    d.diameter = ps.diameter();
+    // The material's density when the set gives none (the id was found above).
+    d.density = ps.density() > 0.0 ? ps.density() : materials.density.at(ps.material_id());
+    d.temperature = ps.temperature() > 0.0 ? ps.temperature() : d.temperature;
+    // No composition: left empty, the DEM core puts all of the mass in the first solid
+    // species (docs/protocol.md §3).
+    d.composition.assign(ps.composition().empty() ? 0 : solid.size(), 0.0);
+    for (const auto& nv : ps.composition()) {
+      const auto k = std::find(solid.begin(), solid.end(), nv.name()) - solid.begin();
+      d.composition[static_cast<std::size_t>(k)] = nv.value();
+    }
+    d.velocity = vec(ps.initial_velocity());
+    if (ps.seed() != 0) {
+      d.seed = ps.seed();
+    }
+    cfg.particleSets.push_back(std::move(d));
+    ++index;
   }
+}
 
-  // Walls.
-  if (c.walls().has_box()) {
-    cfg.addBox(vec(c.walls().box().min()), vec(c.walls().box().max()));
-  }
-  for (const auto& p : c.walls().planes()) {
-    cfg.walls.push_back(dem::Wall::plane(vec(p.point()), vec(p.normal())));
-  }
-  // v1.4: cylinders and cones (their geometry is checked when the system is built), meshes.
+/// Revolved walls (v1.4: cylinders and cones; their geometry is checked when the system is
+/// built).
+void addRevolvedWalls(const v1::Configure& c, dem::DemConfig& cfg) {
   for (int i = 0; i < c.walls().revolved_size(); ++i) {
     const auto& r = c.walls().revolved(i);
     dem::WallSide side = dem::WallSide::Inside;
@@ -271,6 +267,17 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
                  : dem::Wall::cylinder(vec(r.point()), vec(r.axis()), r.radius_start(), start, end,
                                        side, r.cap_start(), r.cap_end()));
   }
+}
+
+/// Walls: box, planes, revolved, meshes; the wall temperature and material; gravity.
+void addWalls(const v1::Configure& c, const MaterialIds& materials, dem::DemConfig& cfg) {
+  if (c.walls().has_box()) {
+    cfg.addBox(vec(c.walls().box().min()), vec(c.walls().box().max()));
+  }
+  for (const auto& p : c.walls().planes()) {
+    cfg.walls.push_back(dem::Wall::plane(vec(p.point()), vec(p.normal())));
+  }
+  addRevolvedWalls(c, cfg);
   for (int i = 0; i < c.walls().meshes_size(); ++i) {
     const auto& m = c.walls().meshes(i);
     COREDEM_CHECK(m.vertices_size() % 3 == 0 && m.triangles_size() % 3 == 0,
@@ -285,16 +292,18 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   }
   cfg.wallTemperature = c.walls().temperature(); // 0 = adiabatic (docs/heat-coupling.md "Walls")
   if (c.walls().temperature() > 0.0) {
-    const auto wm = materialIndex.find(c.walls().material_id());
-    COREDEM_CHECK(wm != materialIndex.end(),
+    const auto wm = materials.index.find(c.walls().material_id());
+    COREDEM_CHECK(wm != materials.index.end(),
                   "Configure: walls use material id {}, which is not "
                   "among the materials",
                   c.walls().material_id());
     cfg.wallMaterial = wm->second;
   }
   cfg.gravity = vec(c.gravity());
+}
 
-  // Coupling grid.
+/// The coupling grid.
+void addGrid(const v1::Configure& c, dem::DemConfig& cfg) {
   if (c.coupling_mesh().has_cartesian()) {
     const auto& g = c.coupling_mesh().cartesian();
     cfg.grid.origin = vec(g.origin());
@@ -306,6 +315,21 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
     cfg.grid.counts = {static_cast<int>(g.counts().x()), static_cast<int>(g.counts().y()),
                        static_cast<int>(g.counts().z())};
   }
+}
+
+} // namespace
+
+dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* warnings) {
+  dem::DemConfig cfg;
+  const MaterialIds materials = addMaterials(c, cfg);
+  // Gas species (Y_g / R_species columns).
+  for (const auto& s : c.species()) {
+    cfg.gasSpecies.push_back({s.name(), s.molar_mass()});
+  }
+  const std::vector<std::string> solid = addSolidSpecies(c, cfg);
+  addParticleSets(c, materials, solid, cfg);
+  addWalls(c, materials, cfg);
+  addGrid(c, cfg);
 
   // Chemistry (v1.1): reactions, CLG models, removal, reaction heat (docs/thermochemistry.md).
   addChemistry(c, cfg);
@@ -313,7 +337,7 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   // Model options by name (`models:` in case.yaml), through the model registry (models.h).
   for (const auto& kv : c.options()) {
     if (kv.key() == protocol::fields::kCouplingSchemeOption) {
-      continue; // the server's own option (dem_server.cpp), not a DEM model
+      continue; // the server's own option (session_setup.cpp), not a DEM model
     }
     if (!dem::applyModelOption(cfg, kv.key(), kv.value()) && warnings != nullptr) {
       warnings->push_back(kv.key());
