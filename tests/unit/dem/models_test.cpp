@@ -161,7 +161,8 @@ TEST(ModelDispatch, DragLaw) {
   const k::DragParams p{k::DragLaw::Gidaspow, k::GidaspowParams{}};
   for (double eps : {0.3, 0.5, 0.8, 0.9, 0.999}) {
     EXPECT_EQ(k::particleDragCoefficient(p, eps, 1.2, 1.8e-5, 1e-3, 5e-10, 0.7),
-              k::gidaspowParticleCoefficient(p.gidaspow, eps, 1.2, 1.8e-5, 1e-3, 5e-10, 0.7));
+              k::gidaspowParticleCoefficient(p.laws.of<k::GidaspowDrag>(), eps, 1.2, 1.8e-5, 1e-3,
+                                             5e-10, 0.7));
   }
 }
 
