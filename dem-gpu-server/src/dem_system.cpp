@@ -14,9 +14,9 @@
 #include "coredem/common/check.h"
 #include "coredem/common/log.h"
 #include "coredem/common/version.h"
-#include "coredem/dem/kernels/collision_time.h"
 #include "coredem/dem/kernels/damping.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
+#include "coredem/dem/models.h"
 #include "coredem/dem/time_handler.h"
 #include "coredem/dem/triangle_mesh.h"
 #include "engine.h"
@@ -239,6 +239,7 @@ void validate(const DemConfig& c) {
                 c.dtFactor);
   COREDEM_CHECK(c.epsMinDrag > 0 && c.epsMinDrag < 1, "epsMinDrag {} must be in (0, 1)",
                 c.epsMinDrag);
+  checkModelParams(c);
   COREDEM_CHECK(c.heat.minSeparation > 0, "heat: s_min = {} m must be > 0", c.heat.minSeparation);
   COREDEM_CHECK(c.heat.lensFraction >= 0, "heat: flpc = {} must be >= 0", c.heat.lensFraction);
   COREDEM_CHECK(c.heat.lensRelTol > 0, "heat: lens_rel_tol = {} must be > 0", c.heat.lensRelTol);
@@ -488,7 +489,8 @@ std::string hashConfig(const DemConfig& c) {
     t += "|drag:";
     num(static_cast<int>(c.drag));
   }
-  if (c.heat.enabled) // heat off keeps the hash of configurations without heat transfer
+  t += modelParamsHashText(c); // "" while every parameter of the chosen models is its default
+  if (c.heat.enabled)          // heat off keeps the hash of configurations without heat transfer
     appendHeatHashText(c.heat, c.wallTemperature, static_cast<int>(c.wallMaterial), t);
   t += chemistryHashText(c); // empty without chemistry
   std::uint64_t h = 0xcbf29ce484222325ull;
@@ -500,38 +502,8 @@ std::string hashConfig(const DemConfig& c) {
 }
 
 PairProps pairProps(const Material& a, const Material& b) {
-  const double kn = 2.0 * a.kn * b.kn / (a.kn + b.kn);
-  const double en = std::min(a.en, b.en);
-  const double ktf = 0.5 * (a.ktFactor + b.ktFactor);
-  const double etf = 0.5 * (a.etatFactor + b.etatFactor);
-  return PairProps{kn, ktf * kn, kernels::dampingFactor(en), etf, std::min(a.mu, b.mu)};
-}
-
-/// Δt_DEM,max = min t_col / dtFactor over present material pairs and walls (Eqs. 12–13),
-/// with the lightest particle of each material (t_col grows with m_eff).
-double dtDemMaxFor(const DemConfig& config, const std::vector<double>& minMass) {
-  const std::size_t nm = config.materials.size();
-  double tcol = std::numeric_limits<double>::infinity();
-  for (std::size_t a = 0; a < nm; ++a) {
-    if (!std::isfinite(minMass[a]))
-      continue;
-    for (std::size_t b = 0; b < nm; ++b) {
-      if (!std::isfinite(minMass[b]))
-        continue;
-      const PairProps pp = pairProps(config.materials[a], config.materials[b]);
-      const double meff = kernels::effectiveMass(minMass[a], minMass[b]);
-      tcol = std::min(tcol,
-                      kernels::collisionTime(pp.kn, meff, pp.dampFactor * std::sqrt(pp.kn * meff)));
-    }
-    if (!config.walls.empty() || !config.meshes.empty()) {
-      const PairProps pp = pairProps(config.materials[a], config.materials[a]);
-      tcol = std::min(tcol, kernels::collisionTime(pp.kn, minMass[a],
-                                                   pp.dampFactor * std::sqrt(pp.kn * minMass[a])));
-    }
-  }
-  if (config.frozenMotion)
-    return std::numeric_limits<double>::max(); // held: no collision limit
-  return std::isfinite(tcol) ? tcol / config.dtFactor : std::numeric_limits<double>::infinity();
+  const MaterialPair m = mixMaterials(a, b);
+  return PairProps{m.kn, m.ktFactor * m.kn, kernels::dampingFactor(m.en), m.etatFactor, m.mu};
 }
 
 /// Mass of particle i for Δt_DEM,max after a restart. With chemistry, the mass at the initial
@@ -628,7 +600,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   m.nParticles = n;
 
   const std::size_t nm = config.materials.size();
-  m.dtMax = dtDemMaxFor(config, minMass);
+  m.dtMax = coredem::dem::dtDemMax(config, minMass);
 
   // Engine set-up.
   EngineSetup& es = m.setup;
@@ -653,7 +625,8 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   }
   es.nGasSpecies = static_cast<int>(config.gasSpecies.size());
   es.drag.law = config.drag;
-  es.drag.gidaspow.epsMin = config.epsMinDrag;
+  es.drag.laws = config.dragLaws;
+  es.drag.epsMin = config.epsMinDrag;
   es.maxRadius = rmax;
   es.skin = config.neighbour.skinFactor * 2.0 * rmax;
   es.historySlots = config.neighbour.historySlots;
@@ -665,16 +638,8 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
     const HeatOptions& h = config.heat;
     HeatSetup& hs = es.heat;
     hs.options = h;
-    hs.enabled = h.enabled;
-    hs.convection = h.convection;
-    hs.contactConduction = h.contactConduction;
-    hs.lensConduction = h.lensConduction && es.coupled;
-    bool anyEmissive = false;
-    for (const Material& mat : config.materials) {
+    for (const Material& mat : config.materials)
       hs.materials.push_back(HeatMaterial{mat.cp, mat.conductivity, mat.emissivity});
-      anyEmissive = anyEmissive || mat.emissivity > 0;
-    }
-    hs.radiation = h.radiation && anyEmissive;
     hs.convectionParams.model = h.nusselt;
     hs.convectionParams.voidageExponent = h.voidageExponent;
     hs.convectionParams.reynoldsWithVoidage = h.reynoldsWithVoidage;
@@ -698,7 +663,8 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
       if (hs.wallParams.lens)
         es.wallReachFactor = 1.0 + h.lensFraction;
     }
-    es.reach = (h.enabled && hs.lensConduction) ? h.lensFraction * rmax : 0.0;
+    es.reach =
+        (h.enabled && HeatTerms::of(hs, es.coupled).lensConduction) ? h.lensFraction * rmax : 0.0;
   }
 
   es.chem = makeChemistrySetup(config); // chemistry (chemistry.h); validates the options
@@ -891,7 +857,7 @@ void DemSystem::readState(const std::string& path) {
     // Built without particle sets: take the neighbour cell size from the file.
     m.setup.maxRadius = rmax;
     m.setup.skin = m.config.neighbour.skinFactor * 2.0 * rmax;
-    if (m.config.heat.enabled && m.setup.heat.lensConduction)
+    if (m.config.heat.enabled && HeatTerms::of(m.setup.heat, m.setup.coupled).lensConduction)
       m.setup.reach = m.config.heat.lensFraction * rmax;
     m.engine.reset();
     m.engine = m.makeEngine();
@@ -901,7 +867,7 @@ void DemSystem::readState(const std::string& path) {
   if (meta.hasChemistry)
     m.engine->restoreChemistryTotals(meta.chemistry);
   m.nParticles = st.n;
-  m.dtMax = dtDemMaxFor(m.config, minMass);
+  m.dtMax = coredem::dem::dtDemMax(m.config, minMass);
   m.time.restore(meta.time, meta.timeCompensation);
   m.step = meta.step;
 }

@@ -81,6 +81,7 @@ public:
 
   void setup(const HeatSetup& h, std::size_t nCells) {
     _h = h;
+    _on = HeatTerms::of(h, nCells > 0);
     _mat.allocate(h.materials.size());
     for (std::size_t k = 0; k < h.materials.size(); ++k)
       _mat.h()[k] = h.materials[k];
@@ -103,7 +104,7 @@ public:
     }
   }
 
-  bool enabled() const { return _h.enabled; }
+  bool enabled() const { return _on.enabled; }
 
   std::size_t bytes() const {
     return _mat.bytes() + _q.bytes() + _g.bytes() + _qrad.bytes() + _cellT.bytes() + _acc.bytes() +
@@ -117,14 +118,14 @@ public:
 
   void beginWindow(StepContext<Exec>& ctx) {
     const std::size_t nCells = ctx.setup.coupled ? ctx.setup.nCells : 0;
-    if (!_h.enabled || nCells == 0)
+    if (!_on.enabled || nCells == 0)
       return;
     double* acc = _acc.d();
     ctx.exec.parallelFor(3 * nCells, [=] DEM_LAMBDA(std::size_t k) { acc[k] = 0.0; });
     _acc.markDeviceModified();
     // The Nusselt factors of every cell (ε frozen, gas fixed for the window): once per window.
     const GasFields<Exec>* gf = ctx.gas;
-    _convFactorsValid = gf != nullptr && _h.convection && gf->has(gf->Tg) && gf->has(gf->kappaG) &&
+    _convFactorsValid = gf != nullptr && _on.convection && gf->has(gf->Tg) && gf->has(gf->kappaG) &&
                         gf->has(gf->cpG);
     if (_convFactorsValid) {
       _convFactors.reserve(nCells);
@@ -148,7 +149,7 @@ public:
   /// Reads pos, vel, radius, temperature, material, the pair lists; writes _q, _g, _qrad,
   /// _acc.
   void sources(StepContext<Exec>& ctx) {
-    if (!_h.enabled)
+    if (!_on.enabled)
       return;
     Exec& exec = ctx.exec;
     ParticleStore<Exec>& p = ctx.particles;
@@ -163,15 +164,15 @@ public:
     const bool hasTg = coupled && gasFields->has(gasFields->Tg);
     const bool hasKappa = coupled && gasFields->has(gasFields->kappaG);
     const bool hasCp = coupled && gasFields->has(gasFields->cpG);
-    const bool conv = coupled && _h.convection && hasTg && hasKappa && hasCp;
+    const bool conv = coupled && _on.convection && hasTg && hasKappa && hasCp;
     if (conv && !_convFactorsValid) {
       backend::raiseUserError("internal: heat sources without the window's Nusselt factors "
                               "(beginWindow was not called after the gas fields were set)");
     }
     const kernels::NusseltFactors* convFactors = conv ? _convFactors.d() : nullptr;
-    const bool rad = coupled && _h.radiation && hasTg;
-    const bool lens = coupled && _h.lensConduction && hasKappa;
-    const bool contact = _h.contactConduction;
+    const bool rad = coupled && _on.radiation && hasTg;
+    const bool lens = coupled && _on.lensConduction && hasKappa;
+    const bool contact = _on.contactConduction;
     const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
     const std::uint32_t* pcell = ctx.cells.pcell();
     const std::uint32_t* perm = ctx.cells.perm();
@@ -466,7 +467,7 @@ public:
   /// After the motion update: T_i += Δt Q_i/(m_i c_p,i) (Eq. 18, explicit Euler).
   /// Reads _q, mass, material; writes temperature.
   void update(StepContext<Exec>& ctx) {
-    if (!_h.enabled)
+    if (!_on.enabled)
       return;
     Exec& exec = ctx.exec;
     ParticleStore<Exec>& p = ctx.particles;
@@ -491,7 +492,7 @@ public:
     const EngineSetup& s = w.setup;
     CellSources& out = w.out;
     const int nSub = w.nSub;
-    if (_h.enabled && _h.walls.enabled) {
+    if (_on.enabled && _h.walls.enabled) {
       _wallAcc.toHost();
       double wall = 0.0;
       for (std::size_t k = 0; k < kWallSlots; ++k) {
@@ -502,7 +503,7 @@ public:
       _wallAcc.toDevice();
       _totals.wall += wall;
     }
-    if (!_h.enabled || !s.coupled)
+    if (!_on.enabled || !s.coupled)
       return;
     _acc.toHost();
     const double* acc = _acc.h();
@@ -525,6 +526,7 @@ public:
 
 private:
   HeatSetup _h;
+  HeatTerms _on; ///< what this run evaluates (from _h.options and the run)
   Dual<HeatMaterial> _mat;
   Dev<double> _q, _g, _qrad; ///< per particle: Q_i (W), G_i (W/K), Q_rad,i (W)
   double _unused = 0.0;      ///< the pair pass's reduction result (cpu slabs), not read

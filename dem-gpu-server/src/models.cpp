@@ -5,21 +5,33 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <mutex>
 #include <optional>
+#include <set>
+#include <utility>
 
 #include "coredem/common/check.h"
+#include "coredem/common/log.h"
 #include "coredem/common/switch.h"
 #include "coredem/dem/dem_system.h"
+#include "coredem/dem/kernels/collision_time.h"
+#include "coredem/dem/kernels/damping.h"
 
 namespace coredem::dem {
 
 // ------------------------------------------------------------------ family registries
 namespace {
 
-constexpr ModelEntry<kernels::DragLaw> kDrag[] = {
-    {"gidaspow", kernels::DragLaw::Gidaspow,
-     "Ergun for ε ≤ 0.8, Wen–Yu above (kernels/drag_gidaspow.h)"},
-};
+/// The registry entries of a family's type list (name, id, doc from each declaration).
+template <class E, class... Ms>
+constexpr std::array<ModelEntry<E>, sizeof...(Ms)> entriesOf(kernels::ModelList<Ms...> list) {
+  return {
+      ModelEntry<E>{Ms::name, static_cast<E>(kernels::modelId<Ms, decltype(list)>), Ms::doc}...};
+}
+
+constexpr auto kDrag = entriesOf<kernels::DragLaw>(kernels::DragLaws{});
 constexpr ModelEntry<kernels::NusseltModel> kNusselt[] = {
     {"li-mason", kernels::NusseltModel::LiMason,
      "Li & Mason (2000), Nu = 2 + 0.6 εⁿ Re^½ Pr^⅓ (Re < 200) …"},
@@ -139,6 +151,38 @@ const ModelFamily<kernels::WgsEquilibrium>& wgsEquilibriumModels() {
   return f;
 }
 
+MaterialPair mixMaterials(const Material& a, const Material& b) {
+  return MaterialPair{2.0 * a.kn * b.kn / (a.kn + b.kn), std::min(a.en, b.en), std::min(a.mu, b.mu),
+                      0.5 * (a.ktFactor + b.ktFactor), 0.5 * (a.etatFactor + b.etatFactor)};
+}
+
+double dtDemMax(const DemConfig& config, std::span<const double> minMass) {
+  const std::size_t nm = config.materials.size();
+  COREDEM_ASSERT(minMass.size() == nm);
+  // t_col of a pair of stiffness kn, restitution en and effective mass meff (Eq. 12, η_n Eq. 13).
+  const auto tcolOf = [](const MaterialPair& p, double meff) {
+    const double kn = p.kn;
+    return kernels::collisionTime(kn, meff, kernels::dampingFactor(p.en) * std::sqrt(kn * meff));
+  };
+  double tcol = std::numeric_limits<double>::infinity();
+  for (std::size_t a = 0; a < nm; ++a) {
+    if (!std::isfinite(minMass[a]))
+      continue;
+    for (std::size_t b = 0; b < nm; ++b) {
+      if (!std::isfinite(minMass[b]))
+        continue;
+      const MaterialPair p = mixMaterials(config.materials[a], config.materials[b]);
+      tcol = std::min(tcol, tcolOf(p, kernels::effectiveMass(minMass[a], minMass[b])));
+    }
+    if (!config.walls.empty() || !config.meshes.empty())
+      tcol = std::min(tcol,
+                      tcolOf(mixMaterials(config.materials[a], config.materials[a]), minMass[a]));
+  }
+  if (config.frozenMotion)
+    return std::numeric_limits<double>::max(); // held: no collision limit
+  return std::isfinite(tcol) ? tcol / config.dtFactor : std::numeric_limits<double>::infinity();
+}
+
 std::string didYouMean(std::string_view word, std::span<const std::string_view> candidates) {
   const std::string w = normalise(word);
   std::size_t best = std::max<std::size_t>(1, w.size() / 3) + 1;
@@ -226,6 +270,64 @@ std::string heatSwitch(DemConfig& c, std::string_view v) {
   return e;
 }
 
+/// "%.17g" (the hash's and the defaults' spelling of a number).
+std::string g17(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.17g", v);
+  return b;
+}
+
+/// The shortest text that reads back as `v` (defaults and ranges as users read them).
+std::string shortest(double v) {
+  char b[40];
+  const auto r = std::to_chars(b, b + sizeof b, v);
+  return std::string(b, r.ptr);
+}
+
+/// The `models:` key of parameter `P` of model `M` in `family`: "<family>.<model>.<parameter>".
+template <class M>
+std::string paramKey(std::string_view family, const char* param) {
+  return coredem::format("{}.{}.{}", family, M::name, param);
+}
+
+/// The range of a declared parameter as users read it, e.g. "number in (0, 1]".
+template <class P>
+std::string rangeText(const kernels::ModelParam<P>& p) {
+  return coredem::format("number in {}{}, {}]", p.loOpen ? "(" : "[", shortest(p.lo),
+                         shortest(p.hi));
+}
+
+/// Parser of parameter `I` of model `M` (its range from the declaration), stored in the
+/// family's ParamPack member `Pack` of DemConfig.
+template <class List, class M, std::size_t I, kernels::ParamPack<List> DemConfig::*Pack>
+std::string applyParam(DemConfig& c, std::string_view v) {
+  constexpr auto params = M::params();
+  constexpr kernels::ModelParam<typename M::Params> p = params[I];
+  std::string e;
+  if (const auto x = number(v, p.lo, p.loOpen, p.hi,
+                            coredem::format("a {} ({}, {})", rangeText(p), p.units,
+                                            shortest(typename M::Params{}.*p.field)),
+                            e))
+    (c.*Pack).template of<M>().*p.field = *x;
+  return e;
+}
+
+/// One `models:` row per declared parameter of every model of `List`.
+template <class List, kernels::ParamPack<List> DemConfig::*Pack>
+void addParamRowsOf(std::vector<ModelOption>& o, std::string_view family) {
+  kernels::forEachModel(List{}, [&]<class M>() {
+    constexpr auto params = M::params();
+    [&]<std::size_t... I>(std::index_sequence<I...>) {
+      (o.push_back({paramKey<M>(family, params[I].key), std::string(family), rangeText(params[I]),
+                    shortest(typename M::Params{}.*params[I].field),
+                    coredem::format("{} ({}), {} only", params[I].doc, params[I].units, M::name),
+                    &applyParam<List, M, I, Pack>}),
+       ...);
+    }
+    (std::make_index_sequence<params.size()>{});
+  });
+}
+
 std::vector<ModelOption> makeOptions() {
   std::vector<ModelOption> o;
   const std::string onOffText = "on, off";
@@ -243,10 +345,11 @@ std::vector<ModelOption> makeOptions() {
       c.epsMinDrag = *x;
     return e;
   };
-  o.push_back({"eps_min_drag", "drag", "number in (0, 1)", "0.35",
+  o.push_back({"dem.eps_min_drag", "drag", "number in (0, 1)", "0.35",
                "lower clip ε_min of ε_g in the drag and the Nusselt correlation", epsMin});
-  o.push_back(
-      {"dem.eps_min_drag", "drag", "number in (0, 1)", "0.35", "same as eps_min_drag", epsMin});
+  o.push_back({"eps_min_drag", "drag", "number in (0, 1)", "0.35",
+               "deprecated spelling of dem.eps_min_drag", epsMin, "dem.eps_min_drag"});
+  addParamRowsOf<kernels::DragLaws, &DemConfig::dragLaws>(o, "drag");
   // --- heat master switch
   o.push_back({"heat", "heat", onOffText, "on", "off: temperatures stay constant, H = H_Tp = 0",
                heatSwitch<&HeatOptions::enabled>});
@@ -342,7 +445,8 @@ std::vector<ModelOption> makeOptions() {
   };
   o.push_back({"dem.dt_factor", "numerics", "number >= 1", "50", "Δt_DEM,max = t_col / dt_factor",
                dtFactor});
-  o.push_back({"dt_factor", "numerics", "number >= 1", "50", "same as dem.dt_factor", dtFactor});
+  o.push_back({"dt_factor", "numerics", "number >= 1", "50", "deprecated spelling of dem.dt_factor",
+               dtFactor, "dem.dt_factor"});
   o.push_back({"dem.skin_factor", "numerics", "number >= 0", "0.1",
                "Verlet skin = skin_factor · d_max (neighbour lists)",
                [](DemConfig& c, std::string_view v) {
@@ -378,13 +482,66 @@ const ModelOption* findModelOption(std::string_view key) {
   return nullptr;
 }
 
+namespace {
+
+/// The warning on an old spelling, once per key and process.
+void warnIfDeprecated(const ModelOption& o) {
+  if (o.deprecatedFor.empty())
+    return;
+  static std::mutex mutex;
+  static std::set<std::string> warned;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (warned.insert(o.key).second)
+    logger("dem.models")
+        ->warn("models: '{}' is deprecated; write '{}' (same meaning)", o.key, o.deprecatedFor);
+}
+
+} // namespace
+
 bool applyModelOption(DemConfig& config, std::string_view key, std::string_view value) {
   const ModelOption* o = findModelOption(key);
   if (o == nullptr)
     return false;
+  warnIfDeprecated(*o);
   const std::string error = o->apply(config, value);
   COREDEM_CHECK(error.empty(), "model option {} = '{}': {}", key, value, error);
   return true;
+}
+
+namespace {
+
+/// Calls f(key, value, default, param) for each declared parameter of the chosen model `id` of
+/// `List` (the family's `family` prefix in the keys).
+template <class List, class F>
+void forChosenParams(const kernels::ParamPack<List>& pack, int id, std::string_view family, F&& f) {
+  kernels::forEachModel(List{}, [&]<class M>() {
+    if (kernels::modelId<M, List> != id)
+      return;
+    for (const auto& p : M::params())
+      f(paramKey<M>(family, p.key), pack.template of<M>().*p.field, typename M::Params{}.*p.field,
+        p);
+  });
+}
+
+} // namespace
+
+std::string modelParamsHashText(const DemConfig& c) {
+  std::string t;
+  forChosenParams(c.dragLaws, static_cast<int>(c.drag), "drag",
+                  [&](const std::string& key, double v, double def, const auto&) {
+                    if (v != def)
+                      t += "|" + key + ":" + g17(v) + ";";
+                  });
+  return t;
+}
+
+void checkModelParams(const DemConfig& c) {
+  forChosenParams(c.dragLaws, static_cast<int>(c.drag), "drag",
+                  [&](const std::string& key, double v, double, const auto& p) {
+                    COREDEM_CHECK(std::isfinite(v) && (p.loOpen ? v > p.lo : v >= p.lo) &&
+                                      v <= p.hi,
+                                  "models: {} = {} is outside its range: {}", key, v, rangeText(p));
+                  });
 }
 
 std::vector<ModelIssue>
@@ -410,6 +567,7 @@ validateModels(std::span<const std::pair<std::string, std::string>> models) {
                            allKeys)});
       continue;
     }
+    warnIfDeprecated(*o);
     std::string error = o->apply(scratch, value);
     if (!error.empty())
       issues.push_back({i, key, false, std::move(error)});

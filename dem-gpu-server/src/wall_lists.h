@@ -124,7 +124,6 @@ public:
 
   int wallCount() const { return _nWalls; }
   const kernels::Wall* walls() const { return _walls.d(); }
-  bool hasMeshes() const { return _nTris > 0; }
   const kernels::MeshTriangle* triangles() const { return _tris.d(); }
   /// Per particle: wall bits (bit k < kNearBits: analytic wall k, all bits when there are more
   /// walls than bits; kMeshBit: mesh candidates).

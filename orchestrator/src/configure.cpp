@@ -3,9 +3,13 @@
 
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <string>
+#include <vector>
 
+#include <coredem/common/check.h>
+#include <coredem/dem/dem_system.h>
+#include <coredem/dem/kernels/pressure_gradient.h>
+#include <coredem/dem/models.h>
 #include <coredem/protocol/coupling_scheme.h>
 
 namespace fs = std::filesystem;
@@ -24,18 +28,49 @@ v1::Vec3 vec(const Vec3& v) {
 
 } // namespace
 
-double estimateDtDemMax(const CaseConfig& c) {
-  double tMin = std::numeric_limits<double>::infinity();
-  for (const auto& p : c.particles) {
-    const auto& m = c.materials[std::size_t(materialIndex(c, p.material))];
-    const double rho = p.density > 0 ? p.density : m.density;
-    const double mass = rho * std::numbers::pi * std::pow(p.diameter, 3) / 6.0;
-    const double le = std::log(m.eN);
-    const double t =
-        std::sqrt(std::numbers::pi * std::numbers::pi + le * le) / std::sqrt(m.kN / (0.5 * mass));
-    tMin = std::min(tMin, t);
+namespace {
+
+/// The case's `models:` applied to `d` as the DEM server applies them (validated with the case by
+/// validateModels; a value it refuses keeps the default here).
+void applyModels(const CaseConfig& c, dem::DemConfig& d) {
+  for (const auto& [key, value] : c.models) {
+    try {
+      dem::applyModelOption(d, key, value);
+    } catch (const UserError&) {
+    }
   }
-  return std::isfinite(tMin) ? tMin / 50.0 : c.dt.dt;
+}
+
+} // namespace
+
+double dtFactorOf(const CaseConfig& c) {
+  dem::DemConfig d;
+  applyModels(c, d);
+  return d.dtFactor;
+}
+
+double estimateDtDemMax(const CaseConfig& c) {
+  // The DEM's own function (coredem/dem/models.h) on the case's materials, lightest particle of
+  // each material and `models:` (dem.dt_factor, motion).
+  dem::DemConfig d;
+  d.materials.clear();
+  for (const MaterialConfig& m : c.materials) {
+    dem::Material dm;
+    dm.name = m.name;
+    dm.kn = m.kN;
+    dm.en = m.eN;
+    dm.mu = m.friction;
+    d.materials.push_back(dm);
+  }
+  std::vector<double> minMass(d.materials.size(), std::numeric_limits<double>::infinity());
+  for (const auto& p : c.particles) {
+    const std::size_t k = std::size_t(materialIndex(c, p.material));
+    const double rho = p.density > 0 ? p.density : c.materials[k].density;
+    minMass[k] = std::min(minMass[k], rho * dem::kernels::sphereVolume(0.5 * p.diameter));
+  }
+  applyModels(c, d);
+  const double dtMax = dem::dtDemMax(d, minMass);
+  return std::isfinite(dtMax) ? dtMax : c.dt.dt;
 }
 
 SubcyclePlan planFor(const CaseConfig& c, double dt, double dtDemMax) {

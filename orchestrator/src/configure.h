@@ -9,10 +9,14 @@
 
 namespace coredem::orchestrator {
 
-/// Smallest collision time over the particle sets / 50 (docs/physics.md Eq. 12, m_eff = m/2 for
-/// equal particles): t_col = sqrt(π² + ln² e_n) / sqrt(k_n / m_eff). Only used for the provisional
-/// plan in Configure; the DEM server's reply is authoritative.
+/// Δt_DEM,max of the case from the DEM's own function (coredem::dem::dtDemMax: min t_col /
+/// dem.dt_factor over the material pairs of the particle sets, docs/physics.md Eq. 12). Only used
+/// for the provisional plan in Configure; the DEM server's reply is authoritative (with an initial
+/// state file its particles may differ from the sets).
 double estimateDtDemMax(const CaseConfig& c);
+
+/// The case's `models: {dem.dt_factor}` (Δt_DEM,max = t_col,min / dt_factor; default 50).
+double dtFactorOf(const CaseConfig& c);
 
 /// The sub-cycling plan of a step: from the forced DEM step time.dt_dem when given (n_sub =
 /// dt/dt_dem; a step shortened to land on time.end gets n_sub = ceil), else from Δt_DEM,max.

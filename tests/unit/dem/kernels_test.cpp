@@ -21,6 +21,29 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 // Patil glass (docs/physics.md §7): d = 1 mm, ρ = 2500, k_n = 1000, e_n = 0.97.
 const double kMass = 2500.0 * kPi / 6.0 * 1e-9;
+
+// Test-only references (the engine uses collisionTime with the pair's η_n, and
+// gidaspowParticleCoefficient).
+
+/// Eq. 12 with η_n from Eq. 13 (restitution e_n).
+double collisionTimeFromRestitution(double kn, double meff, double en) {
+  return collisionTime(kn, meff, normalDamping(kn, meff, en));
+}
+
+/// Gidaspow's interphase momentum exchange coefficient β (kg/m³/s), ε already clipped, written
+/// as the paper does (Ergun below the switch ε of GidaspowParams, Wen–Yu above).
+double gidaspowBeta(double eps, double rhoG, double muG, double dp, double slip) {
+  const double s = 1.0 - eps;
+  if (eps <= GidaspowParams{}.epsSwitch) {
+    return 150.0 * s * s * muG / (eps * dp * dp) + 1.75 * s * rhoG * slip / dp;
+  }
+  const double re = reynoldsParticle(eps, rhoG, dp, slip, muG);
+  if (re <= 0.0) {
+    // Re → 0: C_D ρ_g |Δu| → 24 μ_g/(ε d_p), so β → 18 μ_g (1−ε) ε^−2.65 / d_p² (finite).
+    return 18.0 * muG * s * std::pow(eps, -2.65) / (dp * dp);
+  }
+  return 0.75 * dragCoefficientWenYu(re) * eps * s * rhoG * slip * std::pow(eps, -2.65) / dp;
+}
 } // namespace
 
 TEST(Damping, Eq13MatchesClosedFormAndLimits) {

@@ -212,6 +212,8 @@ struct DemConfig {
   std::vector<Species> gasSpecies;   ///< Y_g and R_species entries
   NeighbourOptions neighbour;
   kernels::DragLaw drag = kernels::DragLaw::Gidaspow; ///< `models: {drag: ...}` (kernels/drag.h)
+  /// Each drag law's parameters (`models: {drag.<law>.<parameter>: ...}`, from its declaration).
+  kernels::ParamPack<kernels::DragLaws> dragLaws{};
   double epsMinDrag = 0.35; ///< ε_min clip in drag (docs/physics.md §1.1 [C])
   double dtFactor = 50.0;   ///< Δt_DEM,max = t_col,min / dtFactor (docs/physics.md Eq. 12)
   HeatOptions heat;         ///< particle heat transfer (docs/heat-coupling.md)

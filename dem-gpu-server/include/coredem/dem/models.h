@@ -13,8 +13,10 @@
 /// This library (target coredem::dem_models) needs neither CUDA nor the protocol nor the engine:
 /// only the plain-data headers dem_system.h and the kernels' enums.
 ///
-/// Adding a drag law: its kernel header, an enumerator + case in kernels/drag.h, one row in
-/// dragModels() (models.cpp), its test (docs/architecture.md).
+/// Adding a drag law: its kernel header (the model's declaration), its name in the type list
+/// kernels::DragLaws (kernels/drag.h), its test and its docs/case-schema.md rows: the family
+/// registry, its `models:` value, the rows of its parameters ("drag.<law>.<parameter>"), their
+/// validation and hashing are generated from the list here (docs/architecture.md).
 
 #include <cstddef>
 #include <span>
@@ -31,6 +33,7 @@
 namespace coredem::dem {
 
 struct DemConfig;
+struct Material;
 
 /// `models: {motion: ...}`.
 enum class MotionModel : int {
@@ -89,6 +92,8 @@ struct ModelOption {
   /// Checks `value` and stores it in `config`. Returns "" when it is allowed, else what is wrong
   /// with it and the allowed values (and a "did you mean" when a close value exists).
   std::string (*apply)(DemConfig& config, std::string_view value) = nullptr;
+  /// Set on an old spelling still accepted: the key to write instead (a warning says so once).
+  std::string_view deprecatedFor = {};
 };
 
 /// Every `models:` key, in documentation order.
@@ -98,7 +103,8 @@ const ModelOption* findModelOption(std::string_view key);
 
 /// Applies one `models:` entry to `config`. Returns false when `key` is not a model key (the
 /// server warns and ignores it); throws coredem::UserError naming the key, the value and the
-/// allowed values when the value is not allowed.
+/// allowed values when the value is not allowed. An old spelling (ModelOption::deprecatedFor)
+/// is applied as its new one, with a warning (once per key and process).
 bool applyModelOption(DemConfig& config, std::string_view key, std::string_view value);
 
 /// A bad entry of a `models:` mapping.
@@ -112,8 +118,33 @@ struct ModelIssue {
 /// Validates a whole `models:` mapping (key, value pairs in file order) with the registry the
 /// DEM server uses. Returns one issue per bad entry (none: the mapping is valid): an unknown key
 /// lists the allowed keys, a bad value the allowed values, each with a "did you mean" when a
-/// close one exists.
+/// close one exists. Old spellings are valid; they are warned about (as applyModelOption).
 std::vector<ModelIssue> validateModels(std::span<const std::pair<std::string, std::string>> models);
+
+/// A material pair's contact parameters from the two materials' values (docs/physics.md §2.1):
+/// k_n the harmonic mean, e_n and μ the smaller, the k_t and η_t factors the mean.
+struct MaterialPair {
+  double kn, en, mu, ktFactor, etatFactor;
+};
+/// The mixing rules of a pair of materials (walls: the pair of their material with itself).
+MaterialPair mixMaterials(const Material& a, const Material& b);
+
+/// The largest stable DEM step Δt_DEM,max = min t_col / `dem.dt_factor` (docs/physics.md Eqs.
+/// 12–13) over the present material pairs (and each material against the walls, if any), with
+/// `minMass[a]` the lightest particle of material a (+inf: none present; t_col grows with m_eff).
+/// The largest finite double with `motion: frozen` (no collision limit); +inf without particles.
+/// The one place this is computed: the DEM server reports it in Configured, the orchestrator's
+/// provisional plan of the first Configure uses it too.
+double dtDemMax(const DemConfig& config, std::span<const double> minMass);
+
+/// The configuration-hash text of the registered models' parameters: "|<key>:<value>;" for each
+/// parameter of the chosen models that differs from its declared default ("" when none does, so
+/// that the hashes of earlier configurations stay).
+std::string modelParamsHashText(const DemConfig& config);
+
+/// Throws coredem::UserError naming the key when a chosen model's parameter is outside its
+/// declared range (a DemConfig filled in code rather than through applyModelOption).
+void checkModelParams(const DemConfig& config);
 
 /// The closest of `candidates` to `word` when it is a plausible typo of it (edit distance at most
 /// max(1, |word|/3), '_' and '-' alike), else "".

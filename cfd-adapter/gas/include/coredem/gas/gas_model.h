@@ -65,7 +65,6 @@ public:
 
   /// Linear interpolation; held constant before the first and after the last point.
   Value at(double t) const;
-  bool isConstant() const { return _times.size() == 1; }
   const std::vector<double>& times() const { return _times; }
 
 private:

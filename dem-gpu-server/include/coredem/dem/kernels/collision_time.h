@@ -2,12 +2,13 @@
 /// @file
 /// LSD collision time — docs/physics.md §2.1, seed Eq. 12 (MFiX check_solids_dem.f):
 ///   t_col = π / √( k_n/m_eff − η_n²/(4 m_eff²) )        (s)
-/// With η_n from Eq. 13 this equals √(m_eff/k_n)·√(π² + ln² e_n); Δt_DEM = t_col,min / 50.
+/// With η_n from Eq. 13 this equals √(m_eff/k_n)·√(π² + ln² e_n). Δt_DEM,max = t_col,min /
+/// dt_factor over the material pairs: coredem::dem::dtDemMax (models.h), the one place it is
+/// computed.
 
 #include <math.h>
 
 #include "coredem/dem/kernels/common.h"
-#include "coredem/dem/kernels/damping.h"
 
 namespace coredem::dem::kernels {
 
@@ -16,11 +17,6 @@ DEM_HD double collisionTime(double kn, double meff, double etan) {
   const double pi = 3.14159265358979323846;
   const double w2 = kn / meff - etan * etan / (4.0 * meff * meff);
   return w2 > 0.0 ? pi / ::sqrt(w2) : HUGE_VAL;
-}
-
-/// Eq. 12 with η_n from Eq. 13 (restitution e_n).
-DEM_HD double collisionTimeFromRestitution(double kn, double meff, double en) {
-  return collisionTime(kn, meff, normalDamping(kn, meff, en));
 }
 
 } // namespace coredem::dem::kernels

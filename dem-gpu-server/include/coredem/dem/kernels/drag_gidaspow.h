@@ -12,12 +12,13 @@
 #include <math.h>
 
 #include "coredem/dem/kernels/common.h"
+#include "coredem/dem/kernels/model_list.h"
 #include "coredem/dem/kernels/vec3.h"
 
 namespace coredem::dem::kernels {
 
 struct GidaspowParams {
-  double epsMin = 0.35;   ///< ε clip (docs/physics.md §1.1 [C])
+  double epsMin = 0.35; ///< ε clip of gidaspowParticleCoefficient (the engine: DragParams::epsMin)
   double epsSwitch = 0.8; ///< Ergun / Wen–Yu switch
 };
 
@@ -35,38 +36,39 @@ DEM_HD double dragCoefficientWenYu(double re) {
   return 24.0 / re * (1.0 + 0.15 * ::pow(re, 0.687));
 }
 
-/// Interphase momentum exchange coefficient β (kg/m³/s), ε already clipped.
-DEM_HD double gidaspowBeta(double eps, double rhoG, double muG, double dp, double slip) {
-  const double s = 1.0 - eps;
-  if (eps <= 0.8) {
-    return 150.0 * s * s * muG / (eps * dp * dp) + 1.75 * s * rhoG * slip / dp;
-  }
-  const double re = reynoldsParticle(eps, rhoG, dp, slip, muG);
-  if (re <= 0.0) {
-    // Re → 0: C_D ρ_g |Δu| → 24 μ_g/(ε d_p), so β → 18 μ_g (1−ε) ε^−2.65 / d_p² (finite).
-    return 18.0 * muG * s * ::pow(eps, -2.65) / (dp * dp);
-  }
-  return 0.75 * dragCoefficientWenYu(re) * eps * s * rhoG * slip * ::pow(eps, -2.65) / dp;
-}
+/// The Gidaspow law as registered in kernels/drag.h (DragLaws): the model declaration.
+struct GidaspowDrag {
+  static constexpr const char* name = "gidaspow";
+  static constexpr const char* doc = "Ergun for ε ≤ 0.8, Wen–Yu above (kernels/drag_gidaspow.h)";
+  using Params = GidaspowParams;
+  static constexpr auto params() { return noParams<Params>(); }
 
-/// Per-particle drag coefficient β V_p/(1−ε) (kg/s) for gas fraction epsCell (clipped).
-/// Near ε = 1 both branches stay finite since β ∝ (1−ε).
+  /// β V_p/(1−ε) (kg/s) for ε already clipped to [ε_min, 1) (kernels/drag.h does that for every
+  /// law). Near ε = 1 both branches stay finite since β ∝ (1−ε).
+  DEM_HD static double coefficient(const Params& p, double eps, double rhoG, double muG, double dp,
+                                   double volume, double slip) {
+    const double s = 1.0 - eps;
+    double betaOverS;
+    if (eps <= p.epsSwitch) {
+      betaOverS = 150.0 * s * muG / (eps * dp * dp) + 1.75 * rhoG * slip / dp;
+    } else {
+      const double re = reynoldsParticle(eps, rhoG, dp, slip, muG);
+      betaOverS =
+          re <= 0.0 ? 18.0 * muG * ::pow(eps, -2.65) / (dp * dp)
+                    : 0.75 * dragCoefficientWenYu(re) * eps * rhoG * slip * ::pow(eps, -2.65) / dp;
+    }
+    return betaOverS * volume;
+  }
+};
+
+/// Per-particle drag coefficient β V_p/(1−ε) (kg/s) for gas fraction epsCell, clipped to
+/// p.epsMin (and below 1: the dilute limit).
 DEM_HD double gidaspowParticleCoefficient(const GidaspowParams& p, double epsCell, double rhoG,
                                           double muG, double dp, double volume, double slip) {
   double eps = epsCell < p.epsMin ? p.epsMin : epsCell;
   if (eps >= 1.0)
     eps = 1.0 - 1e-12; // no particle volume in the cell: dilute limit
-  const double s = 1.0 - eps;
-  double betaOverS;
-  if (eps <= p.epsSwitch) {
-    betaOverS = 150.0 * s * muG / (eps * dp * dp) + 1.75 * rhoG * slip / dp;
-  } else {
-    const double re = reynoldsParticle(eps, rhoG, dp, slip, muG);
-    betaOverS = re <= 0.0
-                    ? 18.0 * muG * ::pow(eps, -2.65) / (dp * dp)
-                    : 0.75 * dragCoefficientWenYu(re) * eps * rhoG * slip * ::pow(eps, -2.65) / dp;
-  }
-  return betaOverS * volume;
+  return GidaspowDrag::coefficient(p, eps, rhoG, muG, dp, volume, slip);
 }
 
 /// f_d = coefficient·(u_g − v) (N).

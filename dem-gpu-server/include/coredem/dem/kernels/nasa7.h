@@ -197,14 +197,4 @@ DEM_HD double nasa7CpMass(Species s, double T) {
   return nasa7CpMolar(s, T) / molarMass(s);
 }
 
-/// Specific enthalpy (formation included), J/kg.
-DEM_HD double nasa7EnthalpyMass(Species s, double T) {
-  return nasa7EnthalpyMolar(s, T) / molarMass(s);
-}
-
-/// Specific sensible enthalpy h(T) − h(T_ref), J/kg.
-DEM_HD double nasa7SensibleEnthalpyMass(Species s, double T) {
-  return (nasa7EnthalpyMolar(s, T) - nasa7EnthalpyMolar(s, kTref)) / molarMass(s);
-}
-
 } // namespace coredem::dem::kernels
