@@ -57,14 +57,19 @@ NVIDIA_SMI="${NVIDIA_SMI:-nvidia-smi}"
 LSPCI="${LSPCI:-lspci}"
 NVIDIA_DEV_GLOB="${NVIDIA_DEV_GLOB:-/dev/nvidia[0-9]*}"
 mkdir -p "$build"
-logs="${LOG_DIR:-$build/gpu-check}"
+# The logs are written under $build/gpu-check/logs; LOG_DIR receives three files only (a folder
+# that comes back from a lent machine may be limited to a few files): summary.txt, bench.jsonl
+# and logs.tar.gz (the logs folder, packed at the end or on a failure).
+logs="$build/gpu-check"
 mkdir -p "$logs/logs"
-summary="$logs/summary.txt"
+out="${LOG_DIR:-$logs}"
+mkdir -p "$out"
+summary="$out/summary.txt"
 : >"$summary"
 started=$SECONDS
 fail() { echo "gpu-check: FAILED: $*" >&2; echo "FAILED: $*" >>"$summary"; pack; exit 1; }
 note() { echo "$*"; echo "$*" >>"$summary"; }
-pack() { tar -C "$logs" -czf "$logs/logs.tar.gz" logs 2>/dev/null || true; }
+pack() { tar -C "$logs" -czf "$out/logs.tar.gz" logs 2>/dev/null || true; }
 
 # ---- 1. configure + build the DEM core alone ----
 if [[ "${GPU_CHECK_SKIP_BUILD:-0}" != 1 ]]; then
@@ -219,7 +224,7 @@ else
 fi
 
 # ---- 3c. benchmarks on both backends ----
-jsonl="$logs/bench.jsonl"
+jsonl="$out/bench.jsonl"
 : >"$jsonl"
 last_json() { grep -E '^\{' | tail -1; }
 field() { sed -n "s/.*\"$1\":\([-0-9.e+]*\).*/\1/p"; }
