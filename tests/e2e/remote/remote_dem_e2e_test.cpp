@@ -25,6 +25,7 @@
 
 #include "coredem_e2e.h"
 #include "netns_link.h"
+#include "relay_trace.h"
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
@@ -157,19 +158,10 @@ std::pair<int, int> expectChunksHeld(const std::string& log, double oneWayMs) {
                            std::chrono::duration<double, std::milli>(oneWayMs))
                            .count();
   std::pair<int, int> n{0, 0};
-  std::istringstream in(log);
-  for (std::string line; std::getline(in, line);) {
-    const auto at = line.find("coredem-relay: chunk ");
-    if (at == std::string::npos) {
-      continue;
-    }
-    std::istringstream w(line.substr(at + 21));
-    std::string connection, direction, word;
-    long long bytes = 0, read = 0, due = 0, written = 0;
-    w >> connection >> direction >> bytes >> word >> word >> read >> word >> due >> word >> written;
-    EXPECT_EQ(due - read, delayNs) << line;
-    EXPECT_GE(written, due) << line;
-    (direction == "up" ? n.first : n.second) += 1;
+  for (const auto& c : coredem::relay::tracedChunks(log)) {
+    EXPECT_EQ(c.due - c.read, delayNs) << c.connection << " " << c.direction << " " << c.bytes;
+    EXPECT_GE(c.written, c.due) << c.connection << " " << c.direction << " " << c.bytes;
+    (c.direction == "up" ? n.first : n.second) += 1;
   }
   return n;
 }

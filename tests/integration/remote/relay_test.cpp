@@ -28,6 +28,8 @@
 
 #include <coredem/common/process.h>
 
+#include "relay_trace.h"
+
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
@@ -204,31 +206,8 @@ private:
   std::string _address;
 };
 
-/// One line of --trace-chunks: "chunk HOST:PORT up|down N bytes read_ns R due_ns D written_ns W".
-struct TracedChunk {
-  std::string connection, direction;
-  long long bytes = 0, read = 0, due = 0, written = 0;
-};
-
-std::vector<TracedChunk> tracedChunks(const std::string& log, const std::string& direction) {
-  std::vector<TracedChunk> out;
-  std::istringstream in(log);
-  for (std::string line; std::getline(in, line);) {
-    const auto at = line.find("coredem-relay: chunk ");
-    if (at == std::string::npos) {
-      continue;
-    }
-    std::istringstream w(line.substr(at + 21));
-    TracedChunk c;
-    std::string word;
-    w >> c.connection >> c.direction >> c.bytes >> word >> word >> c.read >> word >> c.due >>
-        word >> c.written;
-    if (c.direction == direction) {
-      out.push_back(c);
-    }
-  }
-  return out;
-}
+using coredem::relay::TracedChunk;
+using coredem::relay::tracedChunks;
 
 } // namespace
 
