@@ -94,7 +94,7 @@ void checkIdealGas(CaseReading& r) {
   }
   const ParticipantDescriptor& part = participant(c.cfd.participant);
   const Section& g = *r.gasProperties;
-  if (part.caseFolder.empty()) {
+  if (!part.solvesGas) {
     g.fail(g.markOf("model"), "gas_properties.model",
            fmt::format("ideal_gas needs a CFD participant that solves the gas (cfd.participant: "
                        "coredemFoam); {} prescribes the gas from the '{}' section with constant "

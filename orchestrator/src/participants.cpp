@@ -111,6 +111,7 @@ std::vector<ParticipantDescriptor> makeTable() {
     p.caseFolderMarker = "system/controlDict";
     p.caseFolderHint = "give the folder with system/, constant/ and 0/";
     p.openFoamCase = true; // walls.meshes[].from_cfd reads its constant/polyMesh
+    p.solvesGas = true;    // gas_properties.model ideal_gas: a variable-density gas
     p.workDir = "openfoam";
     p.preflight = &checkOpenFoamCase; // gravity, gas model, species and gas state vs case.yaml
     p.generate = &writeGeneratedFoamDictionaries; // ideal_gas: constant/thermophysicalProperties
