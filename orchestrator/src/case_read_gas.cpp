@@ -5,9 +5,9 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <coredem/orchestrator/foam_field.h>
 #include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/participants.h>
-#include <coredem/orchestrator/preflight.h>
 
 #include "case_read.h"
 
