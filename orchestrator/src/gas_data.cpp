@@ -9,8 +9,8 @@
 
 #include <coredem/common/yaml_section.h>
 #include <coredem/dem/kernels/nasa7.h>
+#include <coredem/orchestrator/foam_field.h>
 #include <coredem/orchestrator/gas_data.h>
-#include <coredem/orchestrator/preflight.h>
 
 namespace fs = std::filesystem;
 namespace k = coredem::dem::kernels;

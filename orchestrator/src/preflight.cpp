@@ -1,5 +1,5 @@
-// Pre-flight consistency of a case (preflight.h): geometry, packing, temperatures, and the
-// OpenFOAM participant's gravity and gas properties against case.yaml.
+// Pre-flight consistency of a case (preflight.h): geometry, packing, temperatures, the
+// staggered step; the OpenFOAM case's checks are in preflight_foam.cpp.
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -17,6 +17,8 @@
 #include <coredem/orchestrator/preflight.h>
 #include <coredem/orchestrator/wall_geometry.h>
 
+#include "preflight_locator.h"
+
 namespace fs = std::filesystem;
 
 namespace coredem::orchestrator {
@@ -24,68 +26,13 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// Where in case.yaml a value comes from: the deepest node of `path` that exists.
-class Locator {
-public:
-  explicit Locator(const CaseConfig& c)
-      : _file(c.caseFile.string()) {
-    try {
-      _root = YAML::Load(c.text);
-    } catch (const std::exception&) {
-    }
-  }
-
-  YAML::Mark mark(const std::vector<std::string>& path) const {
-    YAML::Node n;
-    n.reset(_root);
-    YAML::Mark m;
-    for (const auto& key : path) {
-      if (!n || !(n.IsMap() || n.IsSequence())) {
-        break;
-      }
-      const YAML::Node& cn = n; // const access: a missing key is not added
-      if (cn.IsSequence() && std::stoul(key) >= cn.size()) {
-        break;
-      }
-      // Copy-constructed, not assigned: assigning the invalid node of a missing key throws.
-      const YAML::Node next = cn.IsSequence() ? cn[std::stoul(key)] : cn[key];
-      if (!next.IsDefined()) {
-        break;
-      }
-      n.reset(next); // rebind (assignment would overwrite the node's value)
-      m = n.Mark();
-    }
-    return m;
-  }
-
-  [[noreturn]] void fail(const std::vector<std::string>& path, const std::string& key,
-                         const std::string& what) const {
-    yaml::fail(_file, mark(path), key, what);
-  }
-
-  std::string warning(const std::vector<std::string>& path, const std::string& key,
-                      const std::string& what) const {
-    const YAML::Mark m = mark(path);
-    if (m.line >= 0) {
-      return fmt::format("{}:{}:{}: {}: {}", _file, m.line + 1, m.column + 1, key, what);
-    }
-    return fmt::format("{}: {}: {}", _file, key, what);
-  }
-
-  const YAML::Node& root() const { return _root; }
-
-private:
-  std::string _file;
-  YAML::Node _root;
-};
+using preflight::dot;
+using preflight::fmtVec;
+using preflight::Locator;
 
 struct Box {
   Vec3 lo{}, hi{};
 };
-
-std::string fmtVec(const Vec3& v) {
-  return fmt::format("[{:.6g}, {:.6g}, {:.6g}]", v[0], v[1], v[2]);
-}
 
 std::string fmtBox(const Box& b) {
   return fmtVec(b.lo) + " to " + fmtVec(b.hi);
@@ -108,10 +55,6 @@ std::string outside(const Box& inner, const Box& outer, double tol) {
     }
   }
   return {};
-}
-
-double dot(const Vec3& a, const Vec3& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
 /// The space the particles of a set occupy initially (whole particles): the region for lattice
@@ -212,529 +155,23 @@ void checkExplicitOverlaps(const CaseConfig& c, const Locator& at) {
   }
 }
 
-// ------------------------------------------------------------------------- OpenFOAM files
-
-/// A keyword entry "key value;" of an OpenFOAM dictionary file: the value text and its line.
-struct FoamEntry {
-  std::string value;
-  int line = 0;
-};
-
-std::optional<FoamEntry> foamEntry(const fs::path& file, const std::string& key) {
-  std::ifstream in(file);
-  if (!in) {
-    return std::nullopt;
-  }
-  std::string line;
-  int n = 0;
-  const std::regex re("^\\s*" + key + "\\s+([^;]*);");
-  while (std::getline(in, line)) {
-    ++n;
-    std::smatch m;
-    if (std::regex_search(line, m, re)) {
-      return FoamEntry{m[1].str(), n};
-    }
-  }
-  return std::nullopt;
-}
-
-/// The last number of an entry's value ("[0 2 -1 0 0 0 0] 1.5e-05" or "1.5e-05").
-std::optional<double> foamScalar(const std::string& value) {
-  std::istringstream in(
-      value.substr(value.find(']') == std::string::npos ? 0 : value.find(']') + 1));
-  double v = 0.0;
-  std::optional<double> last;
-  while (in >> v) {
-    last = v;
-  }
-  return last;
-}
-
-bool close(double a, double b) {
-  return std::abs(a - b) <= kFoamEqualityRelTol * std::max(std::abs(a), std::abs(b));
-}
-
-/// The bounding box of an OpenFOAM case's mesh points, from constant/polyMesh/points (ASCII) or,
-/// before meshing, from the vertices of system/blockMeshDict (times its scale); the file it came
-/// from. nullopt when neither can be read simply (binary or compressed points, macros, ...).
-struct MeshBounds {
-  Vec3 lo, hi;
-  std::string from;
-};
-
-std::optional<MeshBounds> foamMeshBounds(const fs::path& dir) {
-  auto read = [](const fs::path& file) -> std::optional<std::string> {
-    std::ifstream in(file);
-    if (!in) {
-      return std::nullopt;
-    }
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-  };
-  auto bounds = [](const std::string& list, double scale) -> std::optional<std::pair<Vec3, Vec3>> {
-    static const std::regex point("\\(\\s*([-+0-9.eE]+)\\s+([-+0-9.eE]+)\\s+([-+0-9.eE]+)\\s*\\)");
-    Vec3 lo{1e300, 1e300, 1e300}, hi{-1e300, -1e300, -1e300};
-    std::size_t n = 0;
-    for (std::sregex_iterator it(list.begin(), list.end(), point), end; it != end; ++it, ++n) {
-      for (int d = 0; d < 3; ++d) {
-        const double v = std::strtod((*it)[d + 1].str().c_str(), nullptr) * scale;
-        lo[d] = std::min(lo[d], v);
-        hi[d] = std::max(hi[d], v);
-      }
-    }
-    if (n == 0) {
-      return std::nullopt;
-    }
-    return std::make_pair(lo, hi);
-  };
-  const fs::path pointsFile = dir / "constant" / "polyMesh" / "points";
-  if (const auto text = read(pointsFile)) {
-    if (text->find("binary") != std::string::npos) {
-      return std::nullopt;
-    }
-    const auto open = text->find('(', text->find('}') == std::string::npos ? 0 : text->find('}'));
-    if (open == std::string::npos) {
-      return std::nullopt;
-    }
-    if (const auto b = bounds(text->substr(open + 1), 1.0)) {
-      return MeshBounds{b->first, b->second, pointsFile.string()};
-    }
-    return std::nullopt;
-  }
-  const fs::path dictFile = dir / "system" / "blockMeshDict";
-  const auto text = read(dictFile);
-  if (!text || text->find('$') != std::string::npos ||
-      text->find("#include") != std::string::npos || text->find("#calc") != std::string::npos) {
-    return std::nullopt;
-  }
-  double scale = 1.0;
-  for (const char* key : {"scale", "convertToMeters"}) {
-    if (const auto e = foamEntry(dictFile, key)) {
-      if (const auto v = foamScalar(e->value)) {
-        scale = *v;
-      }
-    }
-  }
-  const auto v = text->find("vertices");
-  const auto open = v == std::string::npos ? v : text->find('(', v);
-  const auto shut = open == std::string::npos ? open : text->find(");", open);
-  if (shut == std::string::npos) {
-    return std::nullopt;
-  }
-  if (const auto b = bounds(text->substr(open + 1, shut - open - 1), scale)) {
-    return MeshBounds{b->first, b->second, dictFile.string()};
-  }
-  return std::nullopt;
-}
-
-/// `text` with // and /* */ comments replaced by spaces (newlines kept, so offsets keep their
-/// lines).
-std::string withoutComments(std::string text) {
-  for (std::size_t i = 0; i + 1 < text.size(); ++i) {
-    if (text[i] == '"') { // a string: skip to its end
-      const auto end = text.find('"', i + 1);
-      i = end == std::string::npos ? text.size() : end;
-      continue;
-    }
-    if (text[i] == '/' && text[i + 1] == '/') {
-      for (; i < text.size() && text[i] != '\n'; ++i) {
-        text[i] = ' ';
-      }
-    } else if (text[i] == '/' && text[i + 1] == '*') {
-      for (; i < text.size() && !(text[i] == '*' && i + 1 < text.size() && text[i + 1] == '/');
-           ++i) {
-        if (text[i] != '\n') {
-          text[i] = ' ';
-        }
-      }
-      if (i + 1 < text.size()) {
-        text[i] = text[i + 1] = ' ';
-      }
-    }
-  }
-  return text;
-}
-
-int lineAt(const std::string& text, std::size_t pos) {
-  return 1 + int(std::count(text.begin(), text.begin() + std::ptrdiff_t(pos), '\n'));
-}
-
-/// The value of "uniform X" when X is one number.
-std::optional<double> uniformScalar(const std::string& value) {
-  std::istringstream in(value);
-  double v = 0.0;
-  std::string rest;
-  if (in >> v && !(in >> rest)) {
-    return v;
-  }
-  return std::nullopt;
-}
-
-std::string readAll(const fs::path& file) {
-  std::ifstream in(file);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-} // namespace
-
-FoamFieldValues readFoamField(const fs::path& file) {
-  FoamFieldValues out;
-  std::ifstream probe(file);
-  if (!fs::is_regular_file(file) || !probe) {
-    return out;
-  }
-  out.found = true;
-  // Scanned by hand, not with std::regex: a nonuniform list can be megabytes long.
-  const std::string text = withoutComments(readAll(file));
-  const auto isWord = [](char ch) {
-    return std::isalnum(static_cast<unsigned char>(ch)) != 0 || ch == '_';
-  };
-  // Position after the whole word `key` at or after `from` (npos: none before `to`).
-  const auto findWord = [&](const std::string& key, std::size_t from, std::size_t to) {
-    for (std::size_t p = text.find(key, from); p != std::string::npos && p < to;
-         p = text.find(key, p + 1)) {
-      const std::size_t e = p + key.size();
-      if ((p == 0 || !isWord(text[p - 1])) && e < text.size() && !isWord(text[e])) {
-        return e;
-      }
-    }
-    return std::string::npos;
-  };
-  const auto skipSpace = [&](std::size_t p) {
-    while (p < text.size() && std::isspace(static_cast<unsigned char>(text[p])) != 0) {
-      ++p;
-    }
-    return p;
-  };
-  // "uniform X;" or "nonuniform ...;" after a keyword ending at `p`: the value and whether it
-  // is a scalar (nullopt: a vector or something else, left out).
-  const auto valueAt = [&](std::size_t p,
-                           const std::string& patch) -> std::optional<FoamFieldValue> {
-    FoamFieldValue v;
-    v.patch = patch;
-    v.line = lineAt(text, p);
-    p = skipSpace(p);
-    std::size_t e = p;
-    while (e < text.size() && isWord(text[e])) {
-      ++e;
-    }
-    const std::string kind = text.substr(p, e - p);
-    if (kind == "nonuniform") {
-      v.uniform = false;
-      return v;
-    }
-    const std::size_t semi = text.find(';', e);
-    if (kind != "uniform" || semi == std::string::npos) {
-      return std::nullopt;
-    }
-    const auto x = uniformScalar(text.substr(e, semi - e));
-    if (!x) {
-      return std::nullopt;
-    }
-    v.value = *x;
-    return v;
-  };
-  const std::size_t internal = findWord("internalField", 0, text.size());
-  const std::size_t head = internal == std::string::npos ? text.size() : internal;
-  if (const std::size_t p = findWord("class", 0, head); p != std::string::npos) {
-    const std::size_t b = skipSpace(p);
-    std::size_t e = b;
-    while (e < text.size() && isWord(text[e])) {
-      ++e;
-    }
-    out.className = text.substr(b, e - b);
-  }
-  if (const std::size_t p = findWord("dimensions", 0, head); p != std::string::npos) {
-    const std::size_t open = text.find('[', p), shut = text.find(']', p);
-    if (open != std::string::npos && shut != std::string::npos && open < shut) {
-      std::istringstream in(text.substr(open + 1, shut - open - 1));
-      std::string word, dims;
-      while (in >> word) {
-        dims += (dims.empty() ? "" : " ") + word;
-      }
-      out.dimensions = dims;
-      out.dimensionsLine = lineAt(text, p);
-    }
-  }
-  if (internal != std::string::npos) {
-    if (const auto v = valueAt(internal, "internalField")) {
-      out.values.push_back(*v);
-    }
-  }
-  // boundaryField { name { ... } ... }: the fixedValue patches.
-  const auto bf = findWord("boundaryField", 0, text.size());
-  const auto open = bf == std::string::npos ? bf : text.find('{', bf);
-  if (open == std::string::npos) {
-    return out;
-  }
-  std::size_t i = open + 1;
-  while (true) {
-    i = skipSpace(i);
-    if (i >= text.size() || text[i] == '}') {
-      break;
-    }
-    const auto brace = text.find('{', i);
-    if (brace == std::string::npos) {
-      break;
-    }
-    std::string name = text.substr(i, brace - i);
-    while (!name.empty() && std::isspace(static_cast<unsigned char>(name.back())) != 0) {
-      name.pop_back();
-    }
-    int depth = 0;
-    std::size_t end = brace;
-    for (; end < text.size(); ++end) {
-      depth += text[end] == '{' ? 1 : text[end] == '}' ? -1 : 0;
-      if (depth == 0) {
-        break;
-      }
-    }
-    const std::size_t type = findWord("type", brace + 1, end);
-    if (type != std::string::npos) {
-      const std::size_t b = skipSpace(type);
-      std::size_t e = b;
-      while (e < end && isWord(text[e])) {
-        ++e;
-      }
-      out.patchTypes.emplace_back(name, text.substr(b, e - b));
-      const std::size_t value = findWord("value", brace + 1, end);
-      if (text.compare(b, e - b, "fixedValue") == 0 && e - b == 10 && value != std::string::npos) {
-        if (const auto v = valueAt(value, name)) {
-          out.values.push_back(*v);
-        }
-      }
-    }
-    i = end + 1;
-  }
-  return out;
-}
-
-bool isZeroGaugeKinematicPressure(const FoamFieldValues& p) {
-  if (!p.found || p.dimensions != kKinematicPressureDimensions || p.values.empty()) {
-    return false;
-  }
-  for (const auto& v : p.values) {
-    if (!v.uniform || v.value != 0.0) {
-      return false;
-    }
-  }
-  static const std::vector<std::string> valueless = {
-      "fixedValue", "fixedFluxPressure", "zeroGradient",  "calculated",
-      "empty",      "symmetry",          "symmetryPlane", "wedge",
-      "cyclic",     "processor",         "cyclicAMI"};
-  for (const auto& [patch, type] : p.patchTypes) {
-    if (std::find(valueless.begin(), valueless.end(), type) == valueless.end()) {
-      return false;
-    }
-  }
-  return true;
-}
-
-namespace {
-
-/// 0/ of the OpenFOAM case: species fields against case.yaml species, and the gas state (T > 0,
-/// mass fractions in [0, 1] summing to 1).
-void checkFoamGasState(const CaseConfig& c, const Locator& at, const fs::path& dir) {
-  auto log = logger("orchestrator");
-  const fs::path zero = dir / "0";
-  // Species fields: each case.yaml species has 0/<name>.
-  for (std::size_t i = 0; i < c.species.size(); ++i) {
-    const fs::path f = zero / c.species[i].name;
-    if (!fs::is_regular_file(f)) {
-      at.fail({"species", std::to_string(i), "name"}, fmt::format("species[{}].name", i),
-              fmt::format("gas species '{}', but the OpenFOAM case has no field {} (its initial "
-                          "and inlet mass fraction); add the field, or remove the species",
-                          c.species[i].name, f.string()));
-    }
-  }
-  // ... and no other mass-fraction field: a dimensionless volScalarField not named alpha* (phase
-  // fractions) or Ydefault (OpenFOAM's field for species without their own).
-  std::vector<std::string> names;
-  for (const auto& s : c.species) {
-    names.push_back(s.name);
-  }
-  if (fs::is_directory(zero)) {
-    std::vector<fs::path> files;
-    for (const auto& e : fs::directory_iterator(zero)) {
-      files.push_back(e.path());
-    }
-    std::sort(files.begin(), files.end());
-    for (const auto& f : files) {
-      const std::string name = f.filename().string();
-      if (!fs::is_regular_file(f) || name.rfind("alpha", 0) == 0 || name == "Ydefault" ||
-          std::find(names.begin(), names.end(), name) != names.end() ||
-          (names.empty() && name == kAirSpecies)) {
-        continue;
-      }
-      const FoamFieldValues v = readFoamField(f);
-      if (v.className == "volScalarField" && v.dimensions == "0 0 0 0 0 0 0") {
-        at.fail({"species"}, "species",
-                fmt::format("{}:{}: {} is a dimensionless field (a mass fraction) of the OpenFOAM "
-                            "case, but case.yaml has no gas species '{}' (species: {}); add it to "
-                            "species, or remove the file",
-                            f.string(), v.dimensionsLine, name, name,
-                            names.empty() ? std::string("none") : yaml::join(names)));
-      }
-    }
-  }
-  // Temperature: every uniform value > 0.
-  const fs::path tFile = zero / "T";
-  const FoamFieldValues T = readFoamField(tFile);
-  for (const auto& v : T.values) {
-    if (!v.uniform) {
-      log->info("{}:{}: {} of T is non-uniform: not checked before start", tFile.string(), v.line,
-                v.patch);
-    } else if (!(v.value > 0.0)) {
-      at.fail({"cfd", "case"}, "cfd.case",
-              fmt::format("{}:{}: {} T = {:.6g} K: the gas temperature must be > 0 K",
-                          tFile.string(), v.line, v.patch, v.value));
-    }
-  }
-  // ideal_gas: the initial temperature of case.yaml is the one of 0/T.
-  if (c.gasProperties.idealGas() && !T.values.empty() && T.values.front().uniform &&
-      T.values.front().patch == "internalField" &&
-      !close(T.values.front().value, c.gasProperties.temperature)) {
-    const bool has = at.root()["gas_properties"] && at.root()["gas_properties"]["temperature"];
-    at.fail({"gas_properties", "temperature"}, "gas_properties.temperature",
-            fmt::format("{:.6g} K{} (the initial gas of the ideal-gas model), but {}:{} gives "
-                        "internalField T = {:.6g} K; give the same value in both (relative "
-                        "tolerance {:.0e})",
-                        c.gasProperties.temperature,
-                        has ? "" : " (the default; no value in case.yaml)", tFile.string(),
-                        T.values.front().line, T.values.front().value, kFoamEqualityRelTol));
-  }
-  // ideal_gas solves p in Pa: a kinematic 0/p (the constant model's) is accepted only as a zero
-  // gauge pressure, which is the same field in Pa (the run's copy gets Pa dimensions).
-  const fs::path pFile = zero / "p";
-  const FoamFieldValues P = readFoamField(pFile);
-  if (c.gasProperties.idealGas() && P.found && P.dimensions == kKinematicPressureDimensions) {
-    if (isZeroGaugeKinematicPressure(P)) {
-      log->info("{}:{}: p is a zero gauge pressure in m2/s2: the run's copy gets dimensions "
-                "[{}] (Pa), which the ideal-gas model solves",
-                pFile.string(), P.dimensionsLine, kPressureDimensions);
-    } else {
-      at.fail({"gas_properties", "model"}, "gas_properties.model",
-              fmt::format("ideal_gas solves p in Pa, but {}:{} is the constant model's kinematic "
-                          "pressure (dimensions [{}], m2/s2) with values or patch types that are "
-                          "not a zero gauge pressure; give 0/p dimensions [{}] and its values in "
-                          "Pa",
-                          pFile.string(), P.dimensionsLine, kKinematicPressureDimensions,
-                          kPressureDimensions));
-    }
-  }
-  if (c.species.empty()) {
-    return;
-  }
-  // Mass fractions: each in [0, 1]; where every species is uniform, they sum to 1.
-  std::vector<FoamFieldValues> Y;
-  for (const auto& s : c.species) {
-    Y.push_back(readFoamField(zero / s.name));
-  }
-  std::vector<std::string> places; // internalField and the patches, in the first file's order
-  for (std::size_t k = 0; k < Y.size(); ++k) {
-    const fs::path f = zero / c.species[k].name;
-    for (const auto& v : Y[k].values) {
-      if (std::find(places.begin(), places.end(), v.patch) == places.end()) {
-        places.push_back(v.patch);
-      }
-      if (!v.uniform) {
-        log->info("{}:{}: {} of {} is non-uniform: not checked before start", f.string(), v.line,
-                  v.patch, c.species[k].name);
-      } else if (!(v.value >= 0.0 && v.value <= 1.0)) {
-        at.fail({"cfd", "case"}, "cfd.case",
-                fmt::format("{}:{}: {} mass fraction {} = {:.10g}: must lie in [0, 1]", f.string(),
-                            v.line, v.patch, c.species[k].name, v.value));
-      }
-    }
-  }
-  for (const auto& place : places) {
-    double sum = 0.0;
-    std::string terms;
-    bool all = true;
-    for (std::size_t k = 0; k < Y.size() && all; ++k) {
-      const auto it = std::find_if(Y[k].values.begin(), Y[k].values.end(),
-                                   [&](const FoamFieldValue& v) { return v.patch == place; });
-      if (it == Y[k].values.end() || !it->uniform) {
-        all = false;
-        break;
-      }
-      sum += it->value;
-      terms += fmt::format("{}{} {:.10g} ({}:{})", k ? " + " : "", c.species[k].name, it->value,
-                           (zero / c.species[k].name).filename().string(), it->line);
-    }
-    if (!all) {
-      if (place != "internalField") {
-        log->info("{}: patch {} is not a uniform fixedValue in every species field: its mass "
-                  "fractions are not summed before start",
-                  zero.string(), place);
-      }
-      continue;
-    }
-    if (std::abs(sum - 1.0) > kMassFractionSumTol) {
-      at.fail({"species"}, "species",
-              fmt::format("the mass fractions of {} in {} sum to {:.12g}, not 1 (tolerance "
-                          "{:.0e}): {}; make them sum to 1",
-                          place, zero.string(), sum, kMassFractionSumTol, terms));
-    }
-  }
-}
-
-/// constant/thermophysicalProperties of the OpenFOAM case: with ideal_gas coredem writes it (a
-/// user's copy must be exactly that one); with constant it must not exist (it would select the
-/// variable-density solver).
-void checkThermophysicalProperties(const CaseConfig& c, const Locator& at, const fs::path& dir) {
-  const fs::path file = dir / kThermophysicalProperties;
-  if (!fs::exists(file)) {
-    return;
-  }
-  const bool has = at.root()["gas_properties"] && at.root()["gas_properties"]["model"];
-  if (!c.gasProperties.idealGas()) {
-    at.fail({"gas_properties", "model"}, "gas_properties.model",
-            fmt::format("constant{} (properties from constant/transportProperties), but {}:1 "
-                        "exists and would select the ideal-gas solver: the gas model is "
-                        "ambiguous; set gas_properties.model: ideal_gas (coredem then writes that "
-                        "file from case.yaml) or remove the file",
-                        has ? "" : " (the default; no model in case.yaml)", file.string()));
-  }
-  const std::string user = readAll(file), generated = thermophysicalPropertiesText(c);
-  if (user == generated) {
-    return;
-  }
-  // The first line that differs, for the message.
-  std::istringstream a(user), b(generated);
-  std::string la, lb;
-  int line = 0;
-  while (true) {
-    ++line;
-    const bool ga = bool(std::getline(a, la)), gb = bool(std::getline(b, lb));
-    if (!ga || !gb || la != lb) {
-      break;
-    }
-  }
-  at.fail({"gas_properties", "model"}, "gas_properties.model",
-          fmt::format("ideal_gas: coredem writes constant/thermophysicalProperties from case.yaml "
-                      "into the run, but the OpenFOAM case has its own ({}:{} reads '{}', coredem "
-                      "would write '{}'), which would be overwritten: remove it; case.yaml "
-                      "defines the gas",
-                      file.string(), line, la, lb));
-}
-
-} // namespace
-
-std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
-  const Locator at(c);
-  std::vector<std::string> warnings;
+/// What the consistency checkers share: the case, where its keys are, the coupling grid's box
+/// with its tolerance, the closed mesh walls' insides, and the warnings so far.
+struct Consistency {
+  const CaseConfig& c;
+  const Locator& at;
   Box grid;
-  double extent = 0.0;
-  for (int d = 0; d < 3; ++d) {
-    grid.lo[d] = c.grid.origin[d];
-    grid.hi[d] = c.grid.origin[d] + c.grid.spacing[d] * double(c.grid.cells[d]);
-    extent = std::max(extent, grid.hi[d] - grid.lo[d]);
-  }
-  const double tol = 1e-9 * extent;
+  double tol = 0.0;
+  std::vector<std::optional<ClosedSurface>> closed;
+  std::vector<std::string> warnings;
+};
 
-  // The walls inside the coupling grid: particles can reach every point within them.
+/// The walls inside the coupling grid: particles can reach every point within them.
+void checkWallsInGrid(Consistency& ck) {
+  const CaseConfig& c = ck.c;
+  const Locator& at = ck.at;
+  const Box& grid = ck.grid;
+  const double tol = ck.tol;
   if (c.walls.box) {
     const Box walls{c.walls.box->first, c.walls.box->second};
     const std::string why = outside(walls, grid, tol);
@@ -784,161 +221,191 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
     }
   }
   // Closed mesh walls hold the particles: their inside, for the test of every set below.
-  std::vector<std::optional<ClosedSurface>> closed(c.walls.meshes.size());
+  ck.closed.resize(c.walls.meshes.size());
   for (std::size_t k = 0; k < c.walls.meshes.size(); ++k) {
     if (c.walls.meshes[k].closed) {
-      closed[k].emplace(c.walls.meshes[k].vertices, c.walls.meshes[k].triangles);
+      ck.closed[k].emplace(c.walls.meshes[k].vertices, c.walls.meshes[k].triangles);
     }
   }
+}
 
-  for (std::size_t i = 0; i < c.particles.size(); ++i) {
-    const auto& p = c.particles[i];
-    const std::string idx = std::to_string(i);
-    const std::vector<std::string> where =
-        p.positions.empty() ? std::vector<std::string>{"particles", idx, "region"}
-                            : std::vector<std::string>{"particles", idx, "positions"};
-    const std::string key = fmt::format("particles[{}].{}", i, where.back());
-    const Box b = occupied(p);
-    // The grid holds the region (lattice, random) or every centre (positions: particles are
-    // coupled to the cell of their centre).
-    const double r = 0.5 * p.diameter;
-    Box coupled = b;
-    if (!p.positions.empty()) {
-      for (int d = 0; d < 3; ++d) {
-        coupled.lo[d] += r;
-        coupled.hi[d] -= r;
-      }
+/// Particle set i inside the grid and every wall that holds it.
+void checkSetInWalls(Consistency& ck, std::size_t i) {
+  const CaseConfig& c = ck.c;
+  const Locator& at = ck.at;
+  const Box& grid = ck.grid;
+  const double tol = ck.tol;
+  const auto& closed = ck.closed;
+  const auto& p = c.particles[i];
+  const std::string idx = std::to_string(i);
+  const std::vector<std::string> where =
+      p.positions.empty() ? std::vector<std::string>{"particles", idx, "region"}
+                          : std::vector<std::string>{"particles", idx, "positions"};
+  const std::string key = fmt::format("particles[{}].{}", i, where.back());
+  const Box b = occupied(p);
+  // The grid holds the region (lattice, random) or every centre (positions: particles are
+  // coupled to the cell of their centre).
+  const double r = 0.5 * p.diameter;
+  Box coupled = b;
+  if (!p.positions.empty()) {
+    for (int d = 0; d < 3; ++d) {
+      coupled.lo[d] += r;
+      coupled.hi[d] -= r;
     }
-    std::string why = outside(coupled, grid, tol);
+  }
+  std::string why = outside(coupled, grid, tol);
+  if (!why.empty()) {
+    at.fail(where, key,
+            fmt::format("{}: the particle {} {}, beyond the coupling grid {} ({}); "
+                        "enlarge grid.cells or grid.origin, or move the particles",
+                        setName(p, i), p.positions.empty() ? "region is" : "centres span",
+                        fmtBox(coupled), fmtBox(grid), why));
+  }
+  if (c.walls.box) {
+    const Box walls{c.walls.box->first, c.walls.box->second};
+    why = outside(b, walls, tol + (p.positions.empty() ? 0.0 : kMaxInitialOverlapFraction * r));
     if (!why.empty()) {
       at.fail(where, key,
-              fmt::format("{}: the particle {} {}, beyond the coupling grid {} ({}); "
-                          "enlarge grid.cells or grid.origin, or move the particles",
-                          setName(p, i), p.positions.empty() ? "region is" : "centres span",
-                          fmtBox(coupled), fmtBox(grid), why));
-    }
-    if (c.walls.box) {
-      const Box walls{c.walls.box->first, c.walls.box->second};
-      why = outside(b, walls, tol + (p.positions.empty() ? 0.0 : kMaxInitialOverlapFraction * r));
-      if (!why.empty()) {
-        at.fail(where, key,
-                fmt::format("{}: the particles occupy {}, outside the walls {} ({}); place "
-                            "them inside walls.box",
-                            setName(p, i), fmtBox(b), fmtBox(walls), why));
-      }
-    }
-    for (std::size_t k = 0; k < c.walls.planes.size(); ++k) {
-      const auto& pl = c.walls.planes[k];
-      const double len = std::sqrt(dot(pl.normal, pl.normal));
-      if (len <= 0.0) {
-        continue;
-      }
-      for (const auto& x : extremeCentres(p)) {
-        const Vec3 rel{x[0] - pl.point[0], x[1] - pl.point[1], x[2] - pl.point[2]};
-        const double dist = dot(rel, pl.normal) / len;
-        if (dist < r * (1.0 - kMaxInitialOverlapFraction) - tol) {
-          at.fail(where, key,
-                  fmt::format("{}: a particle centre at {} is {:.6g} m from the wall "
-                              "walls.planes[{}] (point {}, normal {}) on its inner side, less "
-                              "than the radius {:.6g} m: the particle is behind or inside the "
-                              "wall; move the region to the side the normal points to",
-                              setName(p, i), fmtVec(x), dist, k, fmtVec(pl.point),
-                              fmtVec(pl.normal), r));
-        }
-      }
-    }
-    // Inside every cylinder and cone that holds the particles, where its extent reaches them:
-    // the centres (explicit, or the corners of the region of centres cut to the wall's extent,
-    // which bound the convex excess over the radius) at least a radius from the lateral surface.
-    for (const auto& w : c.walls.revolved) {
-      if (w.side != "inside") {
-        continue;
-      }
-      std::vector<Vec3> centres = p.positions;
-      if (centres.empty()) {
-        Bounds box;
-        for (std::size_t d = 0; d < 3; ++d) {
-          box.lo[d] = std::min(p.regionMin[d] + r, p.regionMax[d] - r);
-          box.hi[d] = std::max(p.regionMax[d] - r, p.regionMin[d] + r);
-        }
-        centres = cornersWithinExtent(box, w);
-      }
-      for (const auto& x : centres) {
-        const std::optional<double> clear = insideClearance(w, x);
-        if (clear && *clear < r * (1.0 - kMaxInitialOverlapFraction) - tol) {
-          at.fail(where, key,
-                  fmt::format("{}: a particle centre at {} (axial coordinate {:.6g} m) is {:.6g} m "
-                              "inside the {} {}, less than the particle radius {:.6g} m: the "
-                              "particles would start in or beyond its wall; move the {} towards "
-                              "the axis (point {}, axis {}), shrink it, or widen the {}",
-                              setName(p, i), fmtVec(x), axialCoordinate(w, x), *clear,
-                              w.cone ? "cone" : "cylinder", w.key(), r,
-                              p.positions.empty() ? "region" : "positions", fmtVec(w.point),
-                              fmtVec(w.axis), w.cone ? "cone" : "cylinder"));
-        }
-      }
-    }
-    // Inside every closed mesh wall: the centres (explicit, or the corners of the region).
-    for (std::size_t k = 0; k < closed.size(); ++k) {
-      if (!closed[k]) {
-        continue;
-      }
-      for (const auto& x : extremeCentres(p)) {
-        if (!closed[k]->contains(x)) {
-          at.fail(where, key,
-                  fmt::format("{}: the particle centre {} lies outside the closed mesh wall "
-                              "walls.meshes[{}] ('{}', spanning {}); move the {} inside the "
-                              "surface, or check the mesh's position and scale",
-                              setName(p, i), fmtVec(x), k, c.walls.meshes[k].name,
-                              fmtBox(Box{meshBounds(c.walls.meshes[k]).lo,
-                                         meshBounds(c.walls.meshes[k]).hi}),
-                              p.positions.empty() ? "region" : "positions"));
-        }
-      }
-    }
-    // Room for the particles.
-    if (p.positions.empty()) {
-      double volume = 1.0;
-      long long sites = 1;
-      for (int d = 0; d < 3; ++d) {
-        const double len = p.regionMax[d] - p.regionMin[d];
-        volume *= len;
-        sites *= static_cast<long long>(std::floor(len / p.diameter + 1e-9));
-      }
-      const double solid = double(p.count) * kPi * p.diameter * p.diameter * p.diameter / 6.0;
-      if (p.packing == "lattice" && sites < static_cast<long long>(p.count)) {
-        at.fail({"particles", idx, "count"}, fmt::format("particles[{}].count", i),
-                fmt::format("{}: the region holds {} lattice sites of diameter {:.6g} m, but "
-                            "count = {}; enlarge the region or reduce the count",
-                            setName(p, i), sites, p.diameter, p.count));
-      }
-      if (p.packing == "random") {
-        const double phi = volume > 0.0 ? solid / volume : 1.0;
-        if (phi > kMaxRandomSolidFraction) {
-          at.fail({"particles", idx, "count"}, fmt::format("particles[{}].count", i),
-                  fmt::format("{}: {} particles of diameter {:.6g} m fill {:.3g} of the region's "
-                              "volume, more than a random packing reaches ({:.2g}); enlarge the "
-                              "region or reduce the count",
-                              setName(p, i), p.count, p.diameter, phi, kMaxRandomSolidFraction));
-        }
-        if (phi > kWarnRandomSolidFraction) {
-          warnings.push_back(at.warning(
-              {"particles", idx, "count"}, fmt::format("particles[{}].count", i),
-              fmt::format("{}: solid fraction {:.3g} of the region (above {:.2g}): random "
-                          "placement without overlap may not find room; use packing: lattice or "
-                          "a larger region",
-                          setName(p, i), phi, kWarnRandomSolidFraction)));
-        }
-      }
-    }
-    if (at.root()["particles"] && at.root()["particles"][i] &&
-        at.root()["particles"][i]["temperature"]) {
-      warnTemperature(at, warnings, {"particles", idx, "temperature"},
-                      fmt::format("particles[{}].temperature", i), p.temperature);
+              fmt::format("{}: the particles occupy {}, outside the walls {} ({}); place "
+                          "them inside walls.box",
+                          setName(p, i), fmtBox(b), fmtBox(walls), why));
     }
   }
-  checkExplicitOverlaps(c, at);
-  // Placed sets whose regions intersect: the DEM places each set on its own.
+  for (std::size_t k = 0; k < c.walls.planes.size(); ++k) {
+    const auto& pl = c.walls.planes[k];
+    const double len = std::sqrt(dot(pl.normal, pl.normal));
+    if (len <= 0.0) {
+      continue;
+    }
+    for (const auto& x : extremeCentres(p)) {
+      const Vec3 rel{x[0] - pl.point[0], x[1] - pl.point[1], x[2] - pl.point[2]};
+      const double dist = dot(rel, pl.normal) / len;
+      if (dist < r * (1.0 - kMaxInitialOverlapFraction) - tol) {
+        at.fail(where, key,
+                fmt::format("{}: a particle centre at {} is {:.6g} m from the wall "
+                            "walls.planes[{}] (point {}, normal {}) on its inner side, less "
+                            "than the radius {:.6g} m: the particle is behind or inside the "
+                            "wall; move the region to the side the normal points to",
+                            setName(p, i), fmtVec(x), dist, k, fmtVec(pl.point), fmtVec(pl.normal),
+                            r));
+      }
+    }
+  }
+  // Inside every cylinder and cone that holds the particles, where its extent reaches them:
+  // the centres (explicit, or the corners of the region of centres cut to the wall's extent,
+  // which bound the convex excess over the radius) at least a radius from the lateral surface.
+  for (const auto& w : c.walls.revolved) {
+    if (w.side != "inside") {
+      continue;
+    }
+    std::vector<Vec3> centres = p.positions;
+    if (centres.empty()) {
+      Bounds box;
+      for (std::size_t d = 0; d < 3; ++d) {
+        box.lo[d] = std::min(p.regionMin[d] + r, p.regionMax[d] - r);
+        box.hi[d] = std::max(p.regionMax[d] - r, p.regionMin[d] + r);
+      }
+      centres = cornersWithinExtent(box, w);
+    }
+    for (const auto& x : centres) {
+      const std::optional<double> clear = insideClearance(w, x);
+      if (clear && *clear < r * (1.0 - kMaxInitialOverlapFraction) - tol) {
+        at.fail(where, key,
+                fmt::format("{}: a particle centre at {} (axial coordinate {:.6g} m) is {:.6g} m "
+                            "inside the {} {}, less than the particle radius {:.6g} m: the "
+                            "particles would start in or beyond its wall; move the {} towards "
+                            "the axis (point {}, axis {}), shrink it, or widen the {}",
+                            setName(p, i), fmtVec(x), axialCoordinate(w, x), *clear,
+                            w.cone ? "cone" : "cylinder", w.key(), r,
+                            p.positions.empty() ? "region" : "positions", fmtVec(w.point),
+                            fmtVec(w.axis), w.cone ? "cone" : "cylinder"));
+      }
+    }
+  }
+  // Inside every closed mesh wall: the centres (explicit, or the corners of the region).
+  for (std::size_t k = 0; k < closed.size(); ++k) {
+    if (!closed[k]) {
+      continue;
+    }
+    for (const auto& x : extremeCentres(p)) {
+      if (!closed[k]->contains(x)) {
+        at.fail(where, key,
+                fmt::format(
+                    "{}: the particle centre {} lies outside the closed mesh wall "
+                    "walls.meshes[{}] ('{}', spanning {}); move the {} inside the "
+                    "surface, or check the mesh's position and scale",
+                    setName(p, i), fmtVec(x), k, c.walls.meshes[k].name,
+                    fmtBox(Box{meshBounds(c.walls.meshes[k]).lo, meshBounds(c.walls.meshes[k]).hi}),
+                    p.positions.empty() ? "region" : "positions"));
+      }
+    }
+  }
+}
+
+/// Room for the particles of set i, and its temperature.
+void checkSetRoom(Consistency& ck, std::size_t i) {
+  const CaseConfig& c = ck.c;
+  const Locator& at = ck.at;
+  const auto& p = c.particles[i];
+  const std::string idx = std::to_string(i);
+  // Room for the particles.
+  if (p.positions.empty()) {
+    double volume = 1.0;
+    long long sites = 1;
+    for (int d = 0; d < 3; ++d) {
+      const double len = p.regionMax[d] - p.regionMin[d];
+      volume *= len;
+      sites *= static_cast<long long>(std::floor(len / p.diameter + 1e-9));
+    }
+    const double solid = double(p.count) * kPi * p.diameter * p.diameter * p.diameter / 6.0;
+    if (p.packing == "lattice" && sites < static_cast<long long>(p.count)) {
+      at.fail({"particles", idx, "count"}, fmt::format("particles[{}].count", i),
+              fmt::format("{}: the region holds {} lattice sites of diameter {:.6g} m, but "
+                          "count = {}; enlarge the region or reduce the count",
+                          setName(p, i), sites, p.diameter, p.count));
+    }
+    if (p.packing == "random") {
+      const double phi = volume > 0.0 ? solid / volume : 1.0;
+      if (phi > kMaxRandomSolidFraction) {
+        at.fail({"particles", idx, "count"}, fmt::format("particles[{}].count", i),
+                fmt::format("{}: {} particles of diameter {:.6g} m fill {:.3g} of the region's "
+                            "volume, more than a random packing reaches ({:.2g}); enlarge the "
+                            "region or reduce the count",
+                            setName(p, i), p.count, p.diameter, phi, kMaxRandomSolidFraction));
+      }
+      if (phi > kWarnRandomSolidFraction) {
+        ck.warnings.push_back(at.warning(
+            {"particles", idx, "count"}, fmt::format("particles[{}].count", i),
+            fmt::format("{}: solid fraction {:.3g} of the region (above {:.2g}): random "
+                        "placement without overlap may not find room; use packing: lattice or "
+                        "a larger region",
+                        setName(p, i), phi, kWarnRandomSolidFraction)));
+      }
+    }
+  }
+  if (at.root()["particles"] && at.root()["particles"][i] &&
+      at.root()["particles"][i]["temperature"]) {
+    warnTemperature(at, ck.warnings, {"particles", idx, "temperature"},
+                    fmt::format("particles[{}].temperature", i), p.temperature);
+  }
+}
+
+void checkParticleSets(Consistency& ck) {
+  for (std::size_t i = 0; i < ck.c.particles.size(); ++i) {
+    checkSetInWalls(ck, i);
+    checkSetRoom(ck, i);
+  }
+}
+
+void checkOverlaps(Consistency& ck) {
+  checkExplicitOverlaps(ck.c, ck.at);
+}
+
+/// Placed sets whose regions intersect: the DEM places each set on its own.
+void warnIntersectingSets(Consistency& ck) {
+  const CaseConfig& c = ck.c;
+  const Locator& at = ck.at;
+  const double tol = ck.tol;
   for (std::size_t i = 0; i < c.particles.size(); ++i) {
     for (std::size_t j = i + 1; j < c.particles.size(); ++j) {
       if (c.particles[i].positions.empty() || c.particles[j].positions.empty()) {
@@ -948,7 +415,7 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
           meet = meet && std::min(a.hi[d], b.hi[d]) - std::max(a.lo[d], b.lo[d]) > tol;
         }
         if (meet) {
-          warnings.push_back(
+          ck.warnings.push_back(
               at.warning({"particles", std::to_string(j)}, fmt::format("particles[{}]", j),
                          fmt::format("{} occupies {}, which intersects {} of {}: sets are placed "
                                      "independently, so their particles may overlap",
@@ -958,15 +425,24 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
       }
     }
   }
+}
 
+void warnTemperatures(Consistency& ck) {
+  const CaseConfig& c = ck.c;
+  const Locator& at = ck.at;
   if (at.root()["gas_properties"] && at.root()["gas_properties"]["temperature"]) {
-    warnTemperature(at, warnings, {"gas_properties", "temperature"}, "gas_properties.temperature",
-                    c.gasProperties.temperature);
+    warnTemperature(at, ck.warnings, {"gas_properties", "temperature"},
+                    "gas_properties.temperature", c.gasProperties.temperature);
   }
   if (c.walls.temperature > 0.0) {
-    warnTemperature(at, warnings, {"walls", "temperature"}, "walls.temperature",
+    warnTemperature(at, ck.warnings, {"walls", "temperature"}, "walls.temperature",
                     c.walls.temperature);
   }
+}
+
+void checkStaggeredStep(Consistency& ck) {
+  const CaseConfig& c = ck.c;
+  const Locator& at = ck.at;
   // Staggered coupling: the drag and heat sources the gas applies are one step old, so the
   // particles must not relax to the gas within one step (docs/coupling-schemes.md "Stability").
   // τ_p,min = ρ_p d_p²/(225 μ_g): the response time of the Ergun/Gidaspow viscous drag at
@@ -1001,7 +477,7 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
                        "<= τ_p (better <= 0.1 τ_p) or coupling.scheme sequential");
       }
       if (dtMax > 0.1 * tau) {
-        warnings.push_back(at.warning(
+        ck.warnings.push_back(at.warning(
             dtPath, dtKey,
             what + fmt::format(": Δt_CFD/τ_p = {:.2g} > 0.1, the one-step lag of the drag and "
                                "heat sources is more than 10 % of a particle relaxation",
@@ -1009,186 +485,53 @@ std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
       }
     }
   }
+}
+
+void warnPrescribedGasTemperature(Consistency& ck) {
+  const CaseConfig& c = ck.c;
+  const Locator& at = ck.at;
   // The prescribed gas temperature (coredem-gas's section), when it is a number.
   const YAML::Node gas = at.root()[c.cfd.gasKey];
   if (gas && gas.IsMap() && gas["T_g"] && gas["T_g"].IsScalar()) {
     try {
-      warnTemperature(at, warnings, {c.cfd.gasKey, "T_g"}, c.cfd.gasKey + ".T_g",
+      warnTemperature(at, ck.warnings, {c.cfd.gasKey, "T_g"}, c.cfd.gasKey + ".T_g",
                       gas["T_g"].as<double>());
     } catch (const YAML::Exception&) {
     }
   }
-  return warnings;
 }
 
-/// Cells of the CFD mesh: the note "nCells:N" of constant/polyMesh/owner, else the product of
-/// the cell counts of every hex block of system/blockMeshDict; nullopt when neither says.
-std::optional<long long> foamCellCount(const fs::path& dir) {
-  std::ifstream owner(dir / "constant" / "polyMesh" / "owner");
-  std::string text((std::istreambuf_iterator<char>(owner)), std::istreambuf_iterator<char>());
-  std::smatch m;
-  const std::string head = text.substr(0, 4096);
-  if (std::regex_search(head, m, std::regex("nCells:\\s*([0-9]+)"))) {
-    return std::stoll(m[1].str());
-  }
-  std::ifstream dict(dir / "system" / "blockMeshDict");
-  text.assign((std::istreambuf_iterator<char>(dict)), std::istreambuf_iterator<char>());
-  const std::regex hex(
-      "hex\\s*\\([^)]*\\)\\s*(?:\\w+\\s*)?\\(\\s*([0-9]+)\\s+([0-9]+)\\s+([0-9]+)\\s*\\)");
-  long long cells = 0;
-  for (auto it = std::sregex_iterator(text.begin(), text.end(), hex); it != std::sregex_iterator();
-       ++it) {
-    cells += std::stoll((*it)[1].str()) * std::stoll((*it)[2].str()) * std::stoll((*it)[3].str());
-  }
-  if (cells > 0) {
-    return cells;
-  }
-  return std::nullopt;
-}
+/// The consistency checkers in the order they run (a case with two errors reports the first).
+struct ConsistencyCheck {
+  const char* what;
+  void (*check)(Consistency&);
+};
+const ConsistencyCheck kConsistencyChecks[] = {
+    {"walls inside the coupling grid", checkWallsInGrid},
+    {"particle sets inside the grid and walls, with room", checkParticleSets},
+    {"explicit positions do not overlap", checkOverlaps},
+    {"placed sets do not intersect", warnIntersectingSets},
+    {"temperatures in kelvin", warnTemperatures},
+    {"the staggered step against the particle response time", checkStaggeredStep},
+    {"the prescribed gas temperature in kelvin", warnPrescribedGasTemperature},
+};
 
-/// cfd.ranks > 1: at most one rank per mesh cell, and a system/decomposeParDict of the case (when
-/// it has one) for the same number of subdomains with a method (coredem writes one, method
-/// simple, when the case has none).
-void checkDecomposition(const CaseConfig& c, const Locator& at, const fs::path& dir) {
-  if (c.cfd.ranks <= 1) {
-    return;
-  }
-  if (const auto cells = foamCellCount(dir); cells && c.cfd.ranks > *cells) {
-    at.fail({"cfd", "ranks"}, "cfd.ranks",
-            fmt::format("{} ranks for a mesh of {} cells ({}): every rank needs cells; use at "
-                        "most {} ranks",
-                        c.cfd.ranks, *cells, dir.string(), *cells));
-  }
-  const fs::path dict = dir / "system" / "decomposeParDict";
-  if (!fs::exists(dict)) {
-    return;
-  }
-  const auto n = foamEntry(dict, "numberOfSubdomains");
-  const auto method = foamEntry(dict, "method");
-  if (!method || method->value.empty()) {
-    at.fail({"cfd", "ranks"}, "cfd.ranks",
-            fmt::format("{} names no decomposition method (method simple with simpleCoeffs, "
-                        "hierarchical, ...): add one, or remove the file and coredem writes one",
-                        dict.string()));
-  }
-  if (!n || std::atoi(n->value.c_str()) != c.cfd.ranks) {
-    at.fail({"cfd", "ranks"}, "cfd.ranks",
-            fmt::format("{} ranks, but {}:{} decomposes into {} subdomains: give the same number "
-                        "in both",
-                        c.cfd.ranks, dict.string(), n ? n->line : 0,
-                        n ? n->value : std::string("(no numberOfSubdomains)")));
-  }
-}
+} // namespace
 
-void checkOpenFoamCase(const CaseConfig& c) {
+std::vector<std::string> checkCaseConsistency(const CaseConfig& c) {
   const Locator at(c);
-  const fs::path dir = c.caseDir / c.cfd.caseFolder;
-  const fs::path gFile = dir / "constant" / "g";
-  if (const auto g = foamEntry(gFile, "value")) {
-    const auto open = g->value.find('('), shut = g->value.find(')');
-    std::istringstream in(open != std::string::npos && shut != std::string::npos
-                              ? g->value.substr(open + 1, shut - open - 1)
-                              : std::string());
-    Vec3 foam{};
-    if (in >> foam[0] >> foam[1] >> foam[2]) {
-      const double norm =
-          std::max(std::sqrt(dot(foam, foam)), std::sqrt(dot(c.gravity, c.gravity)));
-      bool same = true;
-      for (int d = 0; d < 3; ++d) {
-        same = same && std::abs(foam[d] - c.gravity[d]) <= kFoamEqualityRelTol * norm;
-      }
-      if (!same) {
-        at.fail({"gravity"}, "gravity",
-                fmt::format("{} m/s2 (the DEM), but {}:{} gives ({:.6g} {:.6g} {:.6g}) (the "
-                            "gas); give the same vector in both",
-                            fmtVec(c.gravity), gFile.string(), g->line, foam[0], foam[1], foam[2]));
-      }
-    }
+  Consistency ck{c, at, {}, 0.0, {}, {}};
+  double extent = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    ck.grid.lo[d] = c.grid.origin[d];
+    ck.grid.hi[d] = c.grid.origin[d] + c.grid.spacing[d] * double(c.grid.cells[d]);
+    extent = std::max(extent, ck.grid.hi[d] - ck.grid.lo[d]);
   }
-  const fs::path tFile = dir / "constant" / "transportProperties";
-  // With ideal_gas the properties are computed: no constant values to compare.
-  const bool constant = !c.gasProperties.idealGas();
-  auto scalar = [&](const std::string& key) -> std::optional<std::pair<double, int>> {
-    if (!constant) {
-      return std::nullopt;
-    }
-    const auto e = foamEntry(tFile, key);
-    if (!e) {
-      return std::nullopt;
-    }
-    const auto v = foamScalar(e->value);
-    if (!v) {
-      return std::nullopt;
-    }
-    return std::make_pair(*v, e->line);
-  };
-  const auto rho = scalar("rho"), nu = scalar("nu"), cp = scalar("cp"), kappa = scalar("kappa");
-  const auto& gp = c.gasProperties;
-  const bool given = bool(at.root()["gas_properties"]);
-  auto compare = [&](const char* key, double yamlValue, double foamValue, const std::string& what,
-                     int line, const char* unit) {
-    if (close(yamlValue, foamValue)) {
-      return;
-    }
-    const bool has = given && at.root()["gas_properties"][key];
-    at.fail({"gas_properties", key}, fmt::format("gas_properties.{}", key),
-            fmt::format("{:.6g} {}{} (the DEM's drag and heat transfer), but {}:{} gives {} = "
-                        "{:.6g} {} (the gas); give the same value in both (relative tolerance "
-                        "{:.0e})",
-                        yamlValue, unit, has ? "" : " (the default; no value in case.yaml)",
-                        tFile.string(), line, what, foamValue, unit, kFoamEqualityRelTol));
-  };
-  if (rho) {
-    compare("density", gp.density, rho->first, "rho", rho->second, "kg/m3");
+  ck.tol = 1e-9 * extent;
+  for (const ConsistencyCheck& check : kConsistencyChecks) {
+    check.check(ck);
   }
-  if (nu && rho) {
-    compare("viscosity", gp.viscosity, nu->first * rho->first,
-            fmt::format("nu·rho = {:.6g}·{:.6g}", nu->first, rho->first), nu->second, "Pa s");
-  }
-  if (cp) {
-    compare("cp", gp.cp, cp->first, "cp", cp->second, "J/kg/K");
-  }
-  if (kappa) {
-    compare("conductivity", gp.conductivity, kappa->first, "kappa", kappa->second, "W/m/K");
-  }
-  // The coupling grid covers the fluid domain: the mesh's points lie in the grid's box (the grid
-  // is a box, so that is enough; coredemFoam checks every cell's volume again at start). Curved
-  // blockMesh edges can bulge beyond the vertices: coredemFoam catches those.
-  if (const auto mesh = foamMeshBounds(dir)) {
-    for (int d = 0; d < 3; ++d) {
-      const double lo = c.grid.origin[d];
-      const double hi = lo + c.grid.spacing[d] * double(c.grid.cells[d]);
-      const double tol = 1e-6 * c.grid.spacing[d];
-      if (mesh->lo[d] < lo - tol || mesh->hi[d] > hi + tol) {
-        const char* axis[] = {"x", "y", "z"};
-        at.fail({"grid"}, "grid",
-                fmt::format("the coupling grid spans {} = [{:.6g}, {:.6g}] m but the CFD mesh "
-                            "({}) spans [{:.6g}, {:.6g}] m: the coupling grid must cover the "
-                            "fluid domain; enlarge grid.cells or move grid.origin",
-                            axis[d], lo, hi, mesh->from, mesh->lo[d], mesh->hi[d]));
-      }
-    }
-    // The particles' walls inside the CFD domain: particles beyond the mesh would sit in coupling
-    // cells without fluid (the DEM server refuses them at the first step).
-    if (c.walls.box) {
-      for (int d = 0; d < 3; ++d) {
-        const double tol = 1e-6 * c.grid.spacing[d];
-        if (c.walls.box->first[d] < mesh->lo[d] - tol ||
-            c.walls.box->second[d] > mesh->hi[d] + tol) {
-          const char* axis[] = {"x", "y", "z"};
-          at.fail({"walls", "box"}, "walls.box",
-                  fmt::format("the particle walls span {} = [{:.6g}, {:.6g}] m but the CFD mesh "
-                              "({}) spans [{:.6g}, {:.6g}] m: particles beyond the mesh get no "
-                              "gas; shrink walls.box or enlarge the mesh",
-                              axis[d], c.walls.box->first[d], c.walls.box->second[d], mesh->from,
-                              mesh->lo[d], mesh->hi[d]));
-        }
-      }
-    }
-  }
-  checkThermophysicalProperties(c, at, dir);
-  checkFoamGasState(c, at, dir);
-  checkDecomposition(c, at, dir);
+  return std::move(ck.warnings);
 }
 
 } // namespace coredem::orchestrator

@@ -4,8 +4,8 @@
 /// CFD participant only through one row of the participant table: the value of `cfd.participant`
 /// (which is also the program's name), its command template, the environment it reads, the
 /// convention that finds its restart file among its checkpoint files, the input folder it takes
-/// (`cfd.case`), its capabilities (stage timers) and its pre-flight check. Nothing else in the
-/// orchestrator branches on a participant's name.
+/// (`cfd.case`), its capabilities (stage timers, solves the gas, an OpenFOAM case) and its
+/// pre-flight check. Nothing else in the orchestrator branches on a participant's name.
 ///
 /// Adding a participant: a program that links `cfd-adapter/client` plus one row in
 /// participants.cpp (and a line in docs/case-schema.md).
@@ -68,6 +68,10 @@ struct ParticipantDescriptor {
   /// True when `cfd.case` is an OpenFOAM case: walls.meshes[].from_cfd may take the DEM walls
   /// from the patches of its constant/polyMesh.
   bool openFoamCase = false;
+  /// True when the participant solves the gas equations (its gas properties can vary:
+  /// gas_properties.model ideal_gas is allowed); false: it prescribes the gas with constant
+  /// properties.
+  bool solvesGas = false;
   /// Folder of the run folder into which `cfd.case` is copied once before the first start
   /// (a resumed run keeps it); `{work_dir}` names it.
   std::string workDir;

@@ -1,0 +1,164 @@
+// species, gas_properties and the ideal-gas check (docs/case-schema.md, docs/gas-model.md).
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <yaml-cpp/yaml.h>
+
+#include <coredem/orchestrator/foam_field.h>
+#include <coredem/orchestrator/gas_data.h>
+#include <coredem/orchestrator/participants.h>
+
+#include "case_read.h"
+
+namespace coredem::orchestrator::caseread {
+
+using yaml::join;
+
+/// species: the gas species
+void readSpecies(CaseReading& r) {
+  const Section& top = r.top;
+  CaseConfig& c = r.c;
+  if (top.has("species")) {
+    std::set<std::string> seen;
+    r.species = top.list("species", {"name", "molar_mass"}, "gas species");
+    for (const auto& s : r.species) {
+      SpeciesConfig sp;
+      sp.name = s.string("name", std::nullopt, "species name, e.g. CO2");
+      sp.molarMass = s.number("molar_mass", std::nullopt, 0.0, kBig, "kg/mol, > 0", true);
+      if (!seen.insert(sp.name).second) {
+        s.fail(s.markOf("name"), "species", fmt::format("species '{}' is listed twice", sp.name));
+      }
+      c.species.push_back(sp);
+    }
+  }
+}
+
+/// gas_properties: constant or ideal_gas
+void readGasProperties(CaseReading& r) {
+  const Section& top = r.top;
+  CaseConfig& c = r.c;
+  if (top.has("gas_properties")) {
+    const Section& g = r.gasProperties.emplace(
+        top.section("gas_properties", {"model", "density", "viscosity", "conductivity", "cp",
+                                       "temperature", "pressure", "diffusivity", "alphac_min"}));
+    auto& p = c.gasProperties;
+    p.model = g.choice("model", std::string("constant"), {"constant", "ideal_gas"});
+    if (p.idealGas()) {
+      // One source of truth: the ideal-gas model computes these from T, p and the composition.
+      for (const char* key : {"density", "viscosity", "conductivity", "cp"}) {
+        if (g.has(key)) {
+          g.fail(g.markOf(key), g.full(key),
+                 fmt::format("not with model: ideal_gas, which computes the {} from temperature, "
+                             "pressure and composition (perfect gas, NASA-7 cp, Sutherland "
+                             "viscosity); remove the key, or use model: constant",
+                             key == std::string("cp") ? "heat capacity" : key));
+        }
+      }
+      p.diffusivity = g.number("diffusivity", p.diffusivity, 0.0, kBig,
+                               "species diffusivity in m2/s, > 0", true);
+      p.alphacMin = g.number("alphac_min", p.alphacMin, 0.0, 1.0,
+                             "smallest gas fraction the gas equations accept, in (0, 1)", true);
+    } else {
+      for (const char* key : {"diffusivity", "alphac_min"}) {
+        if (g.has(key)) {
+          g.fail(g.markOf(key), g.full(key),
+                 "only with model: ideal_gas (with model constant, the OpenFOAM case's "
+                 "constant/transportProperties gives D and alphacMin)");
+        }
+      }
+      p.density = g.number("density", p.density, 0.0, kBig, "kg/m3, > 0", true);
+      p.viscosity = g.number("viscosity", p.viscosity, 0.0, kBig, "Pa s, > 0", true);
+      p.conductivity = g.number("conductivity", p.conductivity, 0.0, kBig, "W/m/K, > 0", true);
+      p.cp = g.number("cp", p.cp, 0.0, kBig, "J/kg/K, > 0", true);
+    }
+    p.temperature = g.number("temperature", p.temperature, 0.0, kBig, "K, > 0", true);
+    p.pressure = g.number("pressure", p.pressure, 0.0, kBig, "Pa, > 0", true);
+  }
+}
+
+/// gas: the prescribed-gas section (coredem-gas), read by the participant
+void readGasSection(CaseReading& r) {
+  const Section& top = r.top;
+  CaseConfig& c = r.c;
+  c.hasGasSection = top.has("gas");
+}
+
+/// gas_properties.model ideal_gas: a participant that solves the gas (coredemFoam), gas species
+/// with thermo and transport data (gas_data.h) whose molar masses are the table's, and the
+/// initial gas state (density, viscosity, conductivity, cp at temperature and pressure).
+void checkIdealGas(CaseReading& r) {
+  CaseConfig& c = r.c;
+  if (!c.gasProperties.idealGas()) {
+    return;
+  }
+  const ParticipantDescriptor& part = participant(c.cfd.participant);
+  const Section& g = *r.gasProperties;
+  if (!part.solvesGas) {
+    g.fail(g.markOf("model"), "gas_properties.model",
+           fmt::format("ideal_gas needs a CFD participant that solves the gas (cfd.participant: "
+                       "coredemFoam); {} prescribes the gas from the '{}' section with constant "
+                       "properties; use model: constant with it",
+                       c.cfd.participant, c.cfd.gasKey));
+  }
+  std::vector<std::string> names;
+  if (r.top.has("species")) {
+    const auto& list = r.species;
+    for (std::size_t i = 0; i < list.size() && i < c.species.size(); ++i) {
+      const Section& s = list[i];
+      const SpeciesConfig& sp = c.species[i];
+      if (sp.name == kAirSpecies) {
+        s.fail(s.markOf("name"), s.full("name"),
+               "'air' is the gas of a case without species (model ideal_gas): remove 'species' "
+               "for an air case, or list the gas species");
+      }
+      const auto d = gasSpeciesData(sp.name);
+      if (!d) {
+        std::vector<std::string> known = gasSpeciesWithData();
+        known.erase(std::remove(known.begin(), known.end(), std::string(kAirSpecies)), known.end());
+        s.fail(s.markOf("name"), s.full("name"),
+               fmt::format("gas species '{}' has no thermo (NASA-7) or transport (Sutherland) data "
+                           "for gas_properties.model ideal_gas; species with data: {} (a case "
+                           "without species is air)",
+                           sp.name, join(known)));
+      }
+      if (std::abs(sp.molarMass - d->molarMass) > kIdealGasMolarMassRelTol * d->molarMass) {
+        s.fail(s.markOf("molar_mass"), s.full("molar_mass"),
+               fmt::format("{} kg/mol, but the ideal-gas data (the DEM's NASA-7 table) give {:.6g} "
+                           "kg/mol for {}; give the same value (relative tolerance {:.0e})",
+                           sp.molarMass, d->molarMass, sp.name, kIdealGasMolarMassRelTol));
+      }
+      names.push_back(sp.name);
+    }
+  }
+  // The initial gas: air, or the species' uniform initial mass fractions in the OpenFOAM case
+  // (equal fractions when they cannot be read; pre-flight checks them).
+  if (names.empty()) {
+    names.emplace_back(kAirSpecies);
+  }
+  std::vector<double> Y(names.size(), 1.0 / double(names.size()));
+  if (!c.species.empty()) {
+    std::vector<double> read;
+    double sum = 0.0;
+    for (const auto& n : names) {
+      const FoamFieldValues f = readFoamField(c.caseDir / c.cfd.caseFolder / "0" / n);
+      if (!f.found || f.values.empty() || f.values.front().patch != "internalField" ||
+          !f.values.front().uniform || !(f.values.front().value >= 0.0)) {
+        break;
+      }
+      read.push_back(f.values.front().value);
+      sum += read.back();
+    }
+    if (read.size() == names.size() && std::abs(sum - 1.0) <= 1e-9) {
+      Y = read;
+    }
+  }
+  auto& p = c.gasProperties;
+  const GasState s = idealGasState(names, Y, p.temperature, p.pressure);
+  p.density = s.density;
+  p.viscosity = s.viscosity;
+  p.conductivity = s.conductivity;
+  p.cp = s.cp;
+}
+
+} // namespace coredem::orchestrator::caseread

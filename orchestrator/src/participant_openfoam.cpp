@@ -1,0 +1,105 @@
+// The OpenFOAM participant's row of the participant table (participants.h) and what the row
+// points to that is about OpenFOAM alone: the decomposition of its case for a run on K ranks.
+// Its pre-flight is in preflight_foam.cpp, its generated dictionaries in gas_data.cpp, the walls
+// from its mesh's patches in foam_patches.cpp.
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+
+#include <coredem/common/log.h>
+#include <coredem/common/process.h>
+#include <coredem/orchestrator/gas_data.h>
+#include <coredem/orchestrator/preflight.h>
+
+#include "participant_rows.h"
+
+namespace fs = std::filesystem;
+
+namespace coredem::orchestrator {
+namespace {
+
+/// Runs an OpenFOAM utility in `work` (log in logDir/<name>.log); throws naming the log on failure.
+void runFoamUtility(const std::string& name, std::vector<std::string> args, const fs::path& work,
+                    const fs::path& logDir) {
+  const fs::path program = findProgram(name);
+  COREDEM_CHECK(!program.empty(), "{} (OpenFOAM) not found on PATH: install Debian's openfoam",
+                name);
+  args.insert(args.begin(), program.string());
+  args.insert(args.end(), {"-case", work.string()});
+  const char* own = std::getenv("WM_PROJECT_DIR");
+  fs::create_directories(logDir);
+  ChildProcess p(name, args, {{"WM_PROJECT_DIR", own != nullptr ? own : "/usr/share/openfoam"}},
+                 logDir / (name + ".log"));
+  COREDEM_CHECK(p.waitFor(std::chrono::minutes(30)), "{} did not finish within 30 min", name);
+  COREDEM_CHECK(p.exitCode() == 0, "{} -case {} failed ({}; see {}):\n{}", name, work.string(),
+                p.exitReason().value_or("?"), p.logFile().string(), p.logTail());
+}
+
+/// coredemFoam on `ranks` processes: the mesh (blockMesh when the case has none),
+/// system/decomposeParDict (written when the case has none: method simple, `ranks` slabs along x;
+/// Debian's OpenFOAM builds scotch as a dummy library) and decomposePar, unless
+/// processor0 .. processor<ranks-1> exist already (a resumed run keeps its decomposition).
+void decomposeOpenFoamCase(const fs::path& work, int ranks, const fs::path& logDir) {
+  auto log = coredem::logger("orchestrator");
+  const fs::path dict = work / "system" / "decomposeParDict";
+  if (!fs::exists(dict)) {
+    std::ofstream out(dict);
+    out << "FoamFile\n{\n    version 2.0;\n    format ascii;\n    class dictionary;\n"
+        << "    object decomposeParDict;\n}\n\n// written by coredem for cfd.ranks: " << ranks
+        << "\nnumberOfSubdomains " << ranks << ";\n\nmethod simple;\n\nsimpleCoeffs\n{\n    n ("
+        << ranks << " 1 1);\n    delta 0.001;\n}\n";
+    COREDEM_CHECK(out.good(), "cannot write {}", dict.string());
+    log->info("wrote {} (method simple: {} slabs along x)", dict.string(), ranks);
+  }
+  if (fs::is_directory(work / ("processor" + std::to_string(ranks - 1))) &&
+      !fs::exists(work / ("processor" + std::to_string(ranks)))) {
+    return;
+  }
+  if (!fs::exists(work / "constant" / "polyMesh" / "faces") &&
+      fs::exists(work / "system" / "blockMeshDict")) {
+    runFoamUtility("blockMesh", {}, work, logDir);
+  }
+  for (const auto& e : fs::directory_iterator(work)) {
+    if (e.path().filename().string().rfind("processor", 0) == 0) {
+      fs::remove_all(e.path());
+    }
+  }
+  runFoamUtility("decomposePar", {"-force"}, work, logDir);
+  log->info("decomposed {} into {} processor folders (decomposePar)", work.string(), ranks);
+}
+
+} // namespace
+
+ParticipantDescriptor openFoamParticipant() {
+  // The OpenFOAM solver (docs/coredemFoam.md): runs in a copy of the OpenFOAM case inside the
+  // run folder and learns its peers from the environment (docs/client.md). Its restart file
+  // is coredemFoam.restart (the files of its time directory are listed as well).
+  ParticipantDescriptor p;
+  p.name = "coredemFoam";
+  p.summary = "OpenFOAM solver (volume-averaged PIMPLE with the DEM sources)";
+  p.args = {"-case", "{work_dir}"};
+  p.restartArgs = {"-restart", "{restart_file}"};
+  p.timersArgs = {"-timers"}; // writes RUN/timers-cfd.json
+  p.env = {{"COREDEM_CONTROL_ENDPOINT", "{control_endpoint}"},
+           {"COREDEM_DEM_ENDPOINT", "{dem_endpoint}"},
+           {"COREDEM_SESSION", "{session}"},
+           {"COREDEM_TIMEOUT_S", "{timeout_s}"},
+           {"COREDEM_DEM_SERVER_KEY", "{dem_server_key}"},            // remote DEM behind CURVE
+           {"COREDEM_DEM_CLIENT_KEY_FILE", "{dem_client_key_file}"}}; // a path, not the key
+  // OpenFOAM reads its etc tree while its libraries load: Debian's unless set.
+  p.envDefaults = {{"WM_PROJECT_DIR", "/usr/share/openfoam"}};
+  p.restartFile = "coredemFoam.restart";
+  p.caseFolder = "an OpenFOAM case folder";
+  p.caseFolderMarker = "system/controlDict";
+  p.caseFolderHint = "give the folder with system/, constant/ and 0/";
+  p.openFoamCase = true; // walls.meshes[].from_cfd reads its constant/polyMesh
+  p.solvesGas = true;    // gas_properties.model ideal_gas: a variable-density gas
+  p.workDir = "openfoam";
+  p.preflight = &checkOpenFoamCase; // gravity, gas model, species and gas state vs case.yaml
+  p.generate = &writeGeneratedFoamDictionaries; // ideal_gas: constant/thermophysicalProperties
+  p.parallelArgs = {"-parallel"}; // cfd.ranks > 1: mpirun -np K coredemFoam ... -parallel
+  p.decompose = &decomposeOpenFoamCase;
+  return p;
+}
+
+} // namespace coredem::orchestrator
