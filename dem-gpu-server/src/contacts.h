@@ -653,6 +653,8 @@ public:
     _pairs.toDevice();
   }
 
+  static constexpr double StageTimes::*kStage = &StageTimes::contact;
+
   bool enabled() const { return true; }
   std::size_t bytes() const {
     return _pairs.bytes() + _hit.bytes() + _own.bytes() + _hc.bytes() + _hits.bytes() +
@@ -908,7 +910,8 @@ public:
   /// After the sub-step (host): the history slots in use, and their check. A particle keeps
   /// the history of the contacts it owns and of its walls; more of them than slots is an error
   /// (the sub-step's forces lost some contacts' history).
-  void readStatus(const double* status, int K) {
+  void readStatus(const double* status, const ParticleStore<Exec>& p) {
+    const int K = p.K;
     const double maxSlots = status[kStatusHistorySlots];
     _maxUsedSlots = maxSlots < K ? static_cast<int>(maxSlots) : K;
     if (maxSlots > K) {
