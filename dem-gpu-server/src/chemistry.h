@@ -29,6 +29,7 @@
 /// Every loop writes only its own index (gather per cell over sorted segments, no atomics), so
 /// results are bitwise independent of the thread count.
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -44,6 +45,87 @@
 
 namespace coredem::dem {
 
+/// The reaction and enthalpy tables the rates read (device pointers).
+struct ChemRateTables {
+  const kernels::HeterogeneousReaction* reac;  ///< data-defined reactions
+  const kernels::ReactionEnthalpyPoly* dhPoly; ///< their ΔH(T) (n = 0: constant rx.dH)
+  const kernels::ReactionEnthalpyPoly* dhChar; ///< R1/R2 heats; nullptr without reaction heat
+  const kernels::ReactionEnthalpyPoly* dhOc;   ///< R4/R5 heats; nullptr without reaction heat
+  const double* gasM;                          ///< kg/mol per case gas species
+  const double* rhoG;                          ///< per cell; nullptr without the gas state
+  const double* yg;                            ///< per cell and gas species; as rhoG
+};
+
+/// Step 1 for a particle holding reactants, at T_p = tp in PCM cell `cell` (the cell's gas
+/// when `cellGas`, else none: gas-dependent rates are zero): adds the rates of the data-defined
+/// reactions, R1 + R2 and R4 + R5 to solidRate, gasRate (kg/s) and their heat to `heat` (W).
+/// `sm`: the particle's solid species masses (kg), mi their sum; ref: chemRef of particle i.
+DEM_HD_FORCEINLINE void addParticleReactionRates(const ChemParams& cp, const ChemRateTables& t,
+                                                 bool cellGas, std::uint32_t cell, double tp,
+                                                 double mi, const double* sm, const double* ref,
+                                                 std::size_t i, double dt, double* solidRate,
+                                                 double* gasRate, double& heat) {
+  using namespace kernels;
+  const int nG = cp.nGas;
+  const HeterogeneousReaction* reac = t.reac;
+  const ReactionEnthalpyPoly* dhPoly = t.dhPoly;
+  const ReactionEnthalpyPoly* dhChar = t.dhChar;
+  const ReactionEnthalpyPoly* dhOc = t.dhOc;
+  const double* gasM = t.gasM;
+  const double* rhoG = t.rhoG;
+  const double* yg = t.yg;
+  // Gas of the particle's PCM cell (no gas: gas-dependent rates are zero).
+  double conc[kChemMaxGas];
+  double pBar[kGasSpeciesCount];
+  for (int k = 0; k < nG; ++k)
+    conc[k] = 0.0;
+  for (int k = 0; k < kGasSpeciesCount; ++k)
+    pBar[k] = 0.0;
+  if (cellGas) {
+    // The cell's one gas state: c_k = ρ_g Y_k/M_k for the concentration rates (data-
+    // defined reactions, R4/R5), x_k = Y_k M_mix/M_k and P_j = x_j p (bar) with the
+    // case's thermodynamic pressure for the char rates (R1/R2).
+    double x[kChemMaxGas];
+    cellGasState(rhoG[cell], yg + static_cast<std::size_t>(cell) * nG, gasM, nG, x, conc);
+    for (int g = 0; g < kGasSpeciesCount; ++g) {
+      const int k = cp.gasIndex[g];
+      if (k >= 0)
+        pBar[g] = x[k] * cp.pressure * 1.0e-5;
+    }
+  }
+  // Data-defined reactions.
+  for (int a = 0; a < cp.nReactions; ++a) {
+    const HeterogeneousReaction& rx = reac[a];
+    const double w = heterogeneousExtentRate(rx, tp, conc, sm, dt);
+    addHeterogeneousSources(rx, w, solidRate, gasRate);
+    if (w != 0.0)
+      heat -= (dhPoly[a].n > 0 ? reactionEnthalpy(dhPoly[a], tp) : rx.dH) * w;
+  }
+  // R1 + R2 (char).
+  if (cp.charOn && cp.solidC >= 0) {
+    const CharGasificationRates cr =
+        charGasificationHoisted(cp.charParams, dhChar, tp, pBar, sm[cp.solidC], ref[2 * i]);
+    solidRate[cp.solidC] += cr.mdotC;
+    for (int g = 0; g < kGasSpeciesCount; ++g)
+      if (cp.gasIndex[g] >= 0)
+        gasRate[cp.gasIndex[g]] += cr.mdotGas[g];
+    heat += cr.heat;
+  }
+  // R4 + R5 (oxygen carrier).
+  if (cp.ocOn && cp.solidFe2O3 >= 0 && cp.solidFe3O4 >= 0 && mi > 0.0) {
+    const double mf[3] = {sm[cp.solidFe2O3] / mi, sm[cp.solidFe3O4] / mi, 0.0};
+    const int iCO = cp.gasIndex[idx(GasSpecies::CO)], iH2 = cp.gasIndex[idx(GasSpecies::H2)];
+    const OcReductionRates orr = ocReductionHoisted(
+        cp.ocParams, dhOc, tp, mi, mf, iCO >= 0 ? conc[iCO] : 0.0, iH2 >= 0 ? conc[iH2] : 0.0);
+    solidRate[cp.solidFe2O3] += orr.mdotSolid[idx(OcSolid::Fe2O3)];
+    solidRate[cp.solidFe3O4] += orr.mdotSolid[idx(OcSolid::Fe3O4)];
+    for (int g = 0; g < kGasSpeciesCount; ++g)
+      if (cp.gasIndex[g] >= 0)
+        gasRate[cp.gasIndex[g]] += orr.mdotGas[g];
+    heat += orr.heat;
+  }
+}
+
 /// Chemistry of the particles and cells: a StepModule (step_module.h) with the ledger
 /// ChemistryTotals.
 template <class Exec>
@@ -54,6 +136,9 @@ public:
   template <class T>
   using Dev = backend::DeviceArray<T, Exec>;
 
+  static constexpr double StageTimes::*kStage = &StageTimes::chemistry;
+
+  void setup(const EngineSetup& s) { setup(s.chem, s.coupled ? s.nCells : 0); }
   void setup(const ChemistrySetup& c, std::size_t nCells) {
     _c = c;
     _c.params.nReactions = static_cast<int>(c.reactions.size());
@@ -97,7 +182,7 @@ public:
   bool enabled() const { return _c.enabled; }
 
   /// After the sub-step (host): notes a particle below the removal diameter (status array).
-  void readStatus(const double* status) {
+  void readStatus(const double* status, const ParticleStore<Exec>&) {
     if (_c.enabled && status[kStatusBelowRemoval] > 0.0)
       _pending = true;
   }
@@ -138,9 +223,6 @@ public:
     const EngineSetup& s = ctx.setup;
     const double dt = ctx.dt;
     const std::uint32_t* pcell = ctx.cells.pcell();
-    const std::uint32_t* perm = ctx.cells.perm();
-    const std::uint32_t* cStart = ctx.cells.cStart();
-    const std::uint32_t* cEnd = ctx.cells.cEnd();
     const GasFields<Exec>* gasFields = ctx.gas; // nullptr: no gas fields or no coupling grid
     const bool gasPresent = gasFields != nullptr;
     const bool hasRho = gasPresent && gasFields->has(gasFields->rhoG);
@@ -149,7 +231,7 @@ public:
     const bool hasCpG = gasPresent && gasFields->has(gasFields->cpG);
     const std::size_t n = p.n;
     const ChemParams cp = _c.params;
-    const int nG = cp.nGas, nS = cp.nSolid, W = _width;
+    const int nG = cp.nGas, nS = cp.nSolid;
     _gdot.reserve(n * static_cast<std::size_t>(nG > 0 ? nG : 1));
     _dsolid.reserve(n * static_cast<std::size_t>(nS > 0 ? nS : 1));
     _q.reserve(n);
@@ -173,16 +255,15 @@ public:
     const double* cpm = _cp.d();
     const double* tgC = sensGas ? gasFields->Tg.d() : nullptr;
     const double* cpgC = sensGas ? gasFields->cpG.d() : nullptr;
-    const kernels::HeterogeneousReaction* reac = _reactions.d();
     const kernels::ReactionEnthalpyPoly* dhPoly = _dh.d();
     // R1/R2 and R4/R5 heats (none when reaction heat is off: the heat is not used then).
-    const kernels::ReactionEnthalpyPoly* dhChar =
-        cp.reactionHeat ? dhPoly + cp.nReactions : nullptr;
-    const kernels::ReactionEnthalpyPoly* dhOc =
-        cp.reactionHeat ? dhPoly + cp.nReactions + 2 : nullptr;
-    const double* gasM = _gasM.d();
-    const double* rhoG = gas ? gasFields->rhoG.d() : nullptr;
-    const double* yg = gas ? gasFields->Yg.d() : nullptr;
+    const ChemRateTables tables{_reactions.d(),
+                                dhPoly,
+                                cp.reactionHeat ? dhPoly + cp.nReactions : nullptr,
+                                cp.reactionHeat ? dhPoly + cp.nReactions + 2 : nullptr,
+                                _gasM.d(),
+                                gas ? gasFields->rhoG.d() : nullptr,
+                                gas ? gasFields->Yg.d() : nullptr};
 
     exec.reduceMaxInto(
         n,
@@ -207,60 +288,10 @@ public:
                                    (cp.ocOn && cp.solidFe2O3 >= 0 && sm[cp.solidFe2O3] > 0.0);
           const bool active = hasReactant && !(2.0 * r[i] < frac * d0[i]);
           if (active) {
-            const double tp = T[i];
             // Gas of the particle's PCM cell (no gas: gas-dependent rates are zero).
-            double conc[kChemMaxGas];
-            double pBar[kGasSpeciesCount];
-            for (int k = 0; k < nG; ++k)
-              conc[k] = 0.0;
-            for (int k = 0; k < kGasSpeciesCount; ++k)
-              pBar[k] = 0.0;
             const std::uint32_t cell = coupled ? pcell[i] : nCells;
-            if (gas && cell < nCells) {
-              // The cell's one gas state: c_k = ρ_g Y_k/M_k for the concentration rates (data-
-              // defined reactions, R4/R5), x_k = Y_k M_mix/M_k and P_j = x_j p (bar) with the
-              // case's thermodynamic pressure for the char rates (R1/R2).
-              double x[kChemMaxGas];
-              cellGasState(rhoG[cell], yg + static_cast<std::size_t>(cell) * nG, gasM, nG, x, conc);
-              for (int g = 0; g < kGasSpeciesCount; ++g) {
-                const int k = cp.gasIndex[g];
-                if (k >= 0)
-                  pBar[g] = x[k] * cp.pressure * 1.0e-5;
-              }
-            }
-            // Data-defined reactions.
-            for (int a = 0; a < cp.nReactions; ++a) {
-              const HeterogeneousReaction& rx = reac[a];
-              const double w = heterogeneousExtentRate(rx, tp, conc, sm, dt);
-              addHeterogeneousSources(rx, w, solidRate, gasRate);
-              if (w != 0.0)
-                heat -= (dhPoly[a].n > 0 ? reactionEnthalpy(dhPoly[a], tp) : rx.dH) * w;
-            }
-            // R1 + R2 (char).
-            if (cp.charOn && cp.solidC >= 0) {
-              const CharGasificationRates cr = charGasificationHoisted(
-                  cp.charParams, dhChar, tp, pBar, sm[cp.solidC], ref[2 * i]);
-              solidRate[cp.solidC] += cr.mdotC;
-              for (int g = 0; g < kGasSpeciesCount; ++g)
-                if (cp.gasIndex[g] >= 0)
-                  gasRate[cp.gasIndex[g]] += cr.mdotGas[g];
-              heat += cr.heat;
-            }
-            // R4 + R5 (oxygen carrier).
-            if (cp.ocOn && cp.solidFe2O3 >= 0 && cp.solidFe3O4 >= 0 && mi > 0.0) {
-              const double mf[3] = {sm[cp.solidFe2O3] / mi, sm[cp.solidFe3O4] / mi, 0.0};
-              const int iCO = cp.gasIndex[idx(GasSpecies::CO)],
-                        iH2 = cp.gasIndex[idx(GasSpecies::H2)];
-              const OcReductionRates orr =
-                  ocReductionHoisted(cp.ocParams, dhOc, tp, mi, mf, iCO >= 0 ? conc[iCO] : 0.0,
-                                     iH2 >= 0 ? conc[iH2] : 0.0);
-              solidRate[cp.solidFe2O3] += orr.mdotSolid[idx(OcSolid::Fe2O3)];
-              solidRate[cp.solidFe3O4] += orr.mdotSolid[idx(OcSolid::Fe3O4)];
-              for (int g = 0; g < kGasSpeciesCount; ++g)
-                if (cp.gasIndex[g] >= 0)
-                  gasRate[cp.gasIndex[g]] += orr.mdotGas[g];
-              heat += orr.heat;
-            }
+            addParticleReactionRates(cp, tables, gas && cell < nCells, cell, T[i], mi, sm, ref, i,
+                                     dt, solidRate, gasRate, heat);
           }
           // One limiter for the particle: no species below zero, no shrinking below half the
           // removal diameter within the step.
@@ -323,8 +354,28 @@ public:
         },
         0.0, ctx.status + kStatusBelowRemoval);
     p.produced(kMass | kSpecies | kRadius);
+    accumulateWindow(ctx);
+  }
 
-    // Window accumulators per cell (+ one row for particles outside the grid).
+  /// Step 4: the sub-step's sources added to the window accumulators per cell (+ one row for
+  /// particles outside the grid), or, uncoupled, to the window totals. Reads _gdot, _dsolid,
+  /// _q, _sens; writes _acc.
+  void accumulateWindow(StepContext<Exec>& ctx) {
+    Exec& exec = ctx.exec;
+    const EngineSetup& s = ctx.setup;
+    const double dt = ctx.dt;
+    const std::size_t n = ctx.particles.n;
+    const bool coupled = s.coupled;
+    const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
+    const std::uint32_t* pcell = ctx.cells.pcell();
+    const std::uint32_t* perm = ctx.cells.perm();
+    const std::uint32_t* cStart = ctx.cells.cStart();
+    const std::uint32_t* cEnd = ctx.cells.cEnd();
+    const int nG = _c.params.nGas, nS = _c.params.nSolid, W = _width;
+    const double* gdot = _gdot.d();
+    const double* dsol = _dsolid.d();
+    const double* q = _q.d();
+    const double* sens = _sens.d();
     double* acc = _acc.d();
     if (coupled) {
       const std::uint32_t* cs = cStart;
@@ -408,9 +459,17 @@ public:
 
   /// Window end (host): R_species from the particle sources, WGS per cell, ledgers.
   /// out.rSpecies / out.qHom are sized (zeros) by the engine.
+  /// Coupled runs book its time in stage chemistry.
   void endWindow(WindowContext<Exec>& w) {
     if (!_c.enabled)
       return;
+    const auto t0 = std::chrono::steady_clock::now();
+    closeWindow(w);
+    if (w.setup.coupled)
+      w.times.chemistry +=
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  void closeWindow(WindowContext<Exec>& w) {
     const EngineSetup& s = w.setup;
     CellSources& out = w.out;
     const int nSub = w.nSub;

@@ -44,6 +44,96 @@ void needGas(const DemConfig& c, const char* model, std::initializer_list<const 
         model, n, names(c.gasSpecies));
 }
 
+/// Checks one data-defined reaction and adds it (with its NASA-7 stoichiometry for ΔH(T)) to s.
+void addReaction(const DemConfig& c, const ReactionConfig& r,
+                 const decltype(coredem::logger(""))& log, ChemistrySetup& s) {
+  COREDEM_CHECK(
+      !r.terms.empty() && r.terms.size() <= static_cast<std::size_t>(kernels::kMaxReactionTerms),
+      "reaction '{}': {} terms; give 1 to {}", r.name, r.terms.size(), kernels::kMaxReactionTerms);
+  kernels::HeterogeneousReaction h;
+  kernels::Stoichiometry st{0, {}, {}};
+  bool nasaOk = true;
+  h.n = static_cast<int>(r.terms.size());
+  for (int k = 0; k < h.n; ++k) {
+    const ReactionTermConfig& t = r.terms[static_cast<std::size_t>(k)];
+    COREDEM_CHECK(t.nu != 0.0 && std::isfinite(t.nu),
+                  "reaction '{}': species {} has nu = {}; give a nonzero "
+                  "coefficient (< 0 reactant, > 0 product)",
+                  r.name, t.species, t.nu);
+    const int gi = find(c.gasSpecies, t.species);
+    const int si = find(c.solidSpecies, t.species);
+    COREDEM_CHECK(gi >= 0 || si >= 0,
+                  "reaction '{}': unknown species '{}'; gas species: {}; solid species: {}", r.name,
+                  t.species, names(c.gasSpecies), names(c.solidSpecies));
+    COREDEM_CHECK(gi < 0 || si < 0,
+                  "reaction '{}': species '{}' is both a gas and a solid species; rename one",
+                  r.name, t.species);
+    h.phase[k] = gi >= 0 ? kernels::ReactionPhase::Gas : kernels::ReactionPhase::Solid;
+    h.index[k] = gi >= 0 ? gi : si;
+    h.nu[k] = t.nu;
+    h.molarMass[k] = gi >= 0 ? c.gasSpecies[static_cast<std::size_t>(gi)].molarMass
+                             : c.solidSpecies[static_cast<std::size_t>(si)].molarMass;
+    const kernels::Species ns = nasaSpecies(t.species);
+    if (ns == kernels::Species::Count)
+      nasaOk = false;
+    else if (st.n < kernels::kMaxStoichTerms)
+      st.species[st.n] = ns, st.nu[st.n++] = t.nu;
+  }
+  h.law = r.law;
+  COREDEM_CHECK(std::isfinite(r.A) && r.A >= 0.0, "reaction '{}': rate A = {} must be >= 0", r.name,
+                r.A);
+  COREDEM_CHECK(std::isfinite(r.beta) && std::isfinite(r.E) && r.E >= 0.0,
+                "reaction '{}': arrhenius beta = {} and E = {} J/mol must be finite, E >= 0",
+                r.name, r.beta, r.E);
+  h.A = r.A;
+  h.beta = r.beta;
+  h.E = r.E;
+  if (!r.orderSpecies.empty()) {
+    int term = -1;
+    for (int k = 0; k < h.n; ++k)
+      if (r.terms[static_cast<std::size_t>(k)].species == r.orderSpecies)
+        term = k;
+    COREDEM_CHECK(term >= 0 && h.phase[term] == kernels::ReactionPhase::Gas,
+                  "reaction '{}': order_species '{}' must be a gas species among its terms", r.name,
+                  r.orderSpecies);
+    h.orderTerm = term;
+    h.order = r.order;
+  }
+  if (r.heatFromNasa7) {
+    COREDEM_CHECK(nasaOk,
+                  "reaction '{}': heat_of_reaction nasa7 needs NASA-7 data for every species "
+                  "(available: CO, CO2, H2, H2O, N2, C, Fe2O3, Fe3O4, Al2O3); give a number in "
+                  "J/mol instead",
+                  r.name);
+    h.dH = 0.0;
+  } else {
+    COREDEM_CHECK(std::isfinite(r.heatOfReaction), "reaction '{}': heat_of_reaction is not finite",
+                  r.name);
+    h.dH = r.heatOfReaction;
+    st = kernels::Stoichiometry{0, {}, {}};
+  }
+  bool hasSolidReactant = false;
+  for (int k = 0; k < h.n; ++k)
+    hasSolidReactant =
+        hasSolidReactant || (h.phase[k] == kernels::ReactionPhase::Solid && h.nu[k] < 0.0);
+  COREDEM_CHECK(hasSolidReactant,
+                "reaction '{}' has no solid reactant; a heterogeneous reaction consumes a solid "
+                "species (nu < 0) of the particle",
+                r.name);
+  const double imbalance = kernels::heterogeneousMassImbalance(h);
+  double scale = 0.0;
+  for (int k = 0; k < h.n; ++k)
+    scale += std::fabs(h.nu[k] * h.molarMass[k]);
+  if (std::fabs(imbalance) > 1e-9 * scale) {
+    log->warn(
+        "reaction '{}' does not conserve mass: sum nu M = {:.6g} kg/mol ({:.3g} of sum |nu M|); "
+        "mass is created or destroyed at that rate",
+        r.name, imbalance, imbalance / scale);
+  }
+  s.reactions.push_back(h);
+  s.reactionNasa7.push_back(st);
+}
+
 } // namespace
 
 ChemistrySetup makeChemistrySetup(const DemConfig& c) {
@@ -114,94 +204,8 @@ ChemistrySetup makeChemistrySetup(const DemConfig& c) {
   }
 
   auto log = coredem::logger("dem.chemistry");
-  for (const ReactionConfig& r : o.reactions) {
-    COREDEM_CHECK(!r.terms.empty() &&
-                      r.terms.size() <= static_cast<std::size_t>(kernels::kMaxReactionTerms),
-                  "reaction '{}': {} terms; give 1 to {}", r.name, r.terms.size(),
-                  kernels::kMaxReactionTerms);
-    kernels::HeterogeneousReaction h;
-    kernels::Stoichiometry st{0, {}, {}};
-    bool nasaOk = true;
-    h.n = static_cast<int>(r.terms.size());
-    for (int k = 0; k < h.n; ++k) {
-      const ReactionTermConfig& t = r.terms[static_cast<std::size_t>(k)];
-      COREDEM_CHECK(t.nu != 0.0 && std::isfinite(t.nu),
-                    "reaction '{}': species {} has nu = {}; give a nonzero "
-                    "coefficient (< 0 reactant, > 0 product)",
-                    r.name, t.species, t.nu);
-      const int gi = find(c.gasSpecies, t.species);
-      const int si = find(c.solidSpecies, t.species);
-      COREDEM_CHECK(gi >= 0 || si >= 0,
-                    "reaction '{}': unknown species '{}'; gas species: {}; solid species: {}",
-                    r.name, t.species, names(c.gasSpecies), names(c.solidSpecies));
-      COREDEM_CHECK(gi < 0 || si < 0,
-                    "reaction '{}': species '{}' is both a gas and a solid species; rename one",
-                    r.name, t.species);
-      h.phase[k] = gi >= 0 ? kernels::ReactionPhase::Gas : kernels::ReactionPhase::Solid;
-      h.index[k] = gi >= 0 ? gi : si;
-      h.nu[k] = t.nu;
-      h.molarMass[k] = gi >= 0 ? c.gasSpecies[static_cast<std::size_t>(gi)].molarMass
-                               : c.solidSpecies[static_cast<std::size_t>(si)].molarMass;
-      const kernels::Species ns = nasaSpecies(t.species);
-      if (ns == kernels::Species::Count)
-        nasaOk = false;
-      else if (st.n < kernels::kMaxStoichTerms)
-        st.species[st.n] = ns, st.nu[st.n++] = t.nu;
-    }
-    h.law = r.law;
-    COREDEM_CHECK(std::isfinite(r.A) && r.A >= 0.0, "reaction '{}': rate A = {} must be >= 0",
-                  r.name, r.A);
-    COREDEM_CHECK(std::isfinite(r.beta) && std::isfinite(r.E) && r.E >= 0.0,
-                  "reaction '{}': arrhenius beta = {} and E = {} J/mol must be finite, E >= 0",
-                  r.name, r.beta, r.E);
-    h.A = r.A;
-    h.beta = r.beta;
-    h.E = r.E;
-    if (!r.orderSpecies.empty()) {
-      int term = -1;
-      for (int k = 0; k < h.n; ++k)
-        if (r.terms[static_cast<std::size_t>(k)].species == r.orderSpecies)
-          term = k;
-      COREDEM_CHECK(term >= 0 && h.phase[term] == kernels::ReactionPhase::Gas,
-                    "reaction '{}': order_species '{}' must be a gas species among its terms",
-                    r.name, r.orderSpecies);
-      h.orderTerm = term;
-      h.order = r.order;
-    }
-    if (r.heatFromNasa7) {
-      COREDEM_CHECK(nasaOk,
-                    "reaction '{}': heat_of_reaction nasa7 needs NASA-7 data for every species "
-                    "(available: CO, CO2, H2, H2O, N2, C, Fe2O3, Fe3O4, Al2O3); give a number in "
-                    "J/mol instead",
-                    r.name);
-      h.dH = 0.0;
-    } else {
-      COREDEM_CHECK(std::isfinite(r.heatOfReaction),
-                    "reaction '{}': heat_of_reaction is not finite", r.name);
-      h.dH = r.heatOfReaction;
-      st = kernels::Stoichiometry{0, {}, {}};
-    }
-    bool hasSolidReactant = false;
-    for (int k = 0; k < h.n; ++k)
-      hasSolidReactant =
-          hasSolidReactant || (h.phase[k] == kernels::ReactionPhase::Solid && h.nu[k] < 0.0);
-    COREDEM_CHECK(hasSolidReactant,
-                  "reaction '{}' has no solid reactant; a heterogeneous reaction consumes a solid "
-                  "species (nu < 0) of the particle",
-                  r.name);
-    const double imbalance = kernels::heterogeneousMassImbalance(h);
-    double scale = 0.0;
-    for (int k = 0; k < h.n; ++k)
-      scale += std::fabs(h.nu[k] * h.molarMass[k]);
-    if (std::fabs(imbalance) > 1e-9 * scale) {
-      log->warn(
-          "reaction '{}' does not conserve mass: sum nu M = {:.6g} kg/mol ({:.3g} of sum |nu M|); "
-          "mass is created or destroyed at that rate",
-          r.name, imbalance, imbalance / scale);
-    }
-    s.reactions.push_back(h);
-    s.reactionNasa7.push_back(st);
-  }
+  for (const ReactionConfig& r : o.reactions)
+    addReaction(c, r, log, s);
   return s;
 }
 

@@ -43,6 +43,9 @@ public:
     _acc.allocate(s.nCells * 5);
   }
 
+  /// Stage of the second pass (the first ends in stage drag: sources()).
+  static constexpr double StageTimes::*kStage = &StageTimes::coupling;
+
   bool enabled() const { return _enabled; }
   std::size_t bytes() const { return _kcoef.bytes() + _acc.bytes(); }
   DragTotals totals() const { return {}; }
@@ -58,14 +61,17 @@ public:
 
   /// Gas force and PCM cell per particle, then the cell sums of this sub-step.
   /// Reads pos, vel, radius (+ gas fields, ε_g); writes force (the gas force), pcell, the sort.
+  /// The two passes are timed apart: gasForces in stage drag, sortAndDeposit in kStage.
   void sources(StepContext<Exec>& ctx) {
     if (!_enabled)
       return;
     gasForces(ctx);
+    ctx.marks.end(&StageTimes::drag);
     sortAndDeposit(ctx);
   }
 
   void update(StepContext<Exec>&) {}
+  void readStatus(const double*, const ParticleStore<Exec>&) {}
 
   /// ε_g, K_sl, K_sl U_s averaged over the window into out (sized by the engine).
   void endWindow(WindowContext<Exec>& w) {
@@ -87,8 +93,7 @@ public:
   }
 
   // The passes below are public because nvcc refuses extended (device) lambdas in private
-  // member functions. The engine calls the first two itself to time them apart (stages drag and
-  // coupling); together they are sources().
+  // member functions. Together the first two are sources().
 
   /// First pass: PCM cell, drag and −V_p ∇p per particle. The sums are in the order of the former
   /// fused kernel (bitwise the same forces).

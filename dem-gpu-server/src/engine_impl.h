@@ -7,9 +7,9 @@
 /// results are deterministic and independent of the thread count.
 ///
 /// The engine owns the particles, the neighbour lists and the coupling-cell binning
-/// (coupling_cells.h) and drives the sub-step modules through one interface (step_module.h):
-/// drag.h, contacts.h, heat.h, chemistry.h. Sub-step (docs/architecture.md step order, symplectic
-/// Euler):
+/// (coupling_cells.h) and drives the sub-step modules of the list StepModules (step_modules.h:
+/// drag.h, contacts.h, heat.h, chemistry.h) through one interface (step_module.h). Sub-step
+/// (docs/architecture.md step order, symplectic Euler):
 ///   1. neighbour lists rebuilt if a particle moved more than skin/2 since the last build
 ///      (cell keys → stable sort → particles reordered → 27-cell search)
 ///   2. sources of every module, in this order, on the same configuration:
@@ -31,24 +31,22 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "backend/arrays.h"
 #include "backend/exec_common.h"
-#include "chemistry.h"
-#include "contacts.h"
 #include "coredem/dem/kernels/body_force.h"
 #include "coredem/dem/kernels/pcm.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coupling_cells.h"
-#include "drag.h"
 #include "engine.h"
 #include "gas_fields.h"
-#include "heat.h"
 #include "motion.h"
 #include "pair_lists.h"
 #include "particle_store.h"
 #include "step_module.h"
+#include "step_modules.h"
 
 namespace coredem::dem {
 
@@ -73,11 +71,8 @@ public:
           " is out of range; use 1.." + std::to_string(kMaxHistorySlots));
     }
     _cells.setup(_s.coupled ? _s.nCells : 0);
-    _drag.setup(_s);
     _wallLists.setup(_s);
-    _contacts.setup(_s);
-    _heat.setup(_s.heat, _s.coupled ? _s.nCells : 0);
-    _chem.setup(_s.chem, _s.coupled ? _s.nCells : 0);
+    _modules.forEach([&](auto& m) { m.setup(_s); });
     _status.allocate(kStatusSlotCount);
     for (int k = 0; k < kStatusSlotCount; ++k)
       _status.h()[k] = 0.0;
@@ -87,11 +82,20 @@ public:
 
   const char* name() const override { return Exec::name; }
   StageTimes& times() override { return _t; }
-  HeatTotals heatTotals() const override { return _heat.totals(); }
-  void restoreHeatTotals(const HeatTotals& t) override { _heat.restoreTotals(t); }
-  ChemistryTotals chemistryTotals() const override { return _chem.totals(); }
-  void restoreChemistryTotals(const ChemistryTotals& t) override { _chem.restoreTotals(t); }
-  bool takeRemovalRequest() override { return _chem.takeRemovalRequest(); }
+  HeatTotals heatTotals() const override { return heat().totals(); }
+  void restoreHeatTotals(const HeatTotals& t) override { heat().restoreTotals(t); }
+  ChemistryTotals chemistryTotals() const override { return chem().totals(); }
+  void restoreChemistryTotals(const ChemistryTotals& t) override { chem().restoreTotals(t); }
+  bool takeRemovalRequest() override { return chem().takeRemovalRequest(); }
+
+  // The modules the Engine interface reaches by name (ledgers, contact history).
+  ContactModule<Exec>& contacts() { return _modules.template get<ContactModule<Exec>>(); }
+  HeatModule<Exec>& heat() { return _modules.template get<HeatModule<Exec>>(); }
+  const HeatModule<Exec>& heat() const { return _modules.template get<HeatModule<Exec>>(); }
+  ChemistryModule<Exec>& chem() { return _modules.template get<ChemistryModule<Exec>>(); }
+  const ChemistryModule<Exec>& chem() const {
+    return _modules.template get<ChemistryModule<Exec>>();
+  }
 
   // ---------------------------------------------------------------- state transfer
   void setState(const HostState& s) override {
@@ -102,7 +106,7 @@ public:
         arr.h()[k] = vec[k];
     });
     _p.toDevice(kAllFields);
-    _contacts.resetUsedSlots(_p.K);
+    contacts().resetUsedSlots(_p.K);
     _pairLists.invalidate();
     _listValid = s.listValid != 0;
     reserveScratch();
@@ -110,7 +114,7 @@ public:
 
   HostState state() override {
     StepContext<Exec> ctx = stepContext(0.0);
-    _contacts.flushHistory(ctx); // the history slots complete
+    contacts().flushHistory(ctx); // the history slots complete
     _p.toHost(kAllFields);
     HostState s;
     s.n = _p.n;
@@ -165,7 +169,7 @@ public:
       spares += sp->bytes();
     return self._p.bytes() + spares + _keys.bytes() + _perm.bytes() + _cellOffset.bytes() +
            _scratch.bytes() + _cells.bytes() + _pairLists.bytes() + _wallLists.bytes() +
-           _drag.bytes() + _contacts.bytes() + _heat.bytes() + _chem.bytes() + _gas.bytes();
+           _modules.bytes() + _gas.bytes();
   }
 
   // ---------------------------------------------------------------- neighbour search
@@ -365,7 +369,7 @@ public:
     const std::size_t n = _p.n;
     _p.require(kAllFields);
     StepContext<Exec> ctx = stepContext(0.0);
-    _contacts.flushHistory(ctx); // the history follows its particle in the slots
+    contacts().flushHistory(ctx); // the history follows its particle in the slots
     NbGrid g = neighbourGrid();
     computeKeys(g);
     _exec.sortByKey(_keys.d(), n, g.cells, _perm.d());
@@ -373,7 +377,7 @@ public:
     // right after the rebuild (fwall zeroed below), xref is reset and the neighbour lists
     // rebuilt: not moved.)
     // History slots at or beyond the largest count in use are empty in every row: not moved.
-    const int usedSlots = _contacts.usedSlots();
+    const int usedSlots = contacts().usedSlots();
     dropUnusedSpares();
     schema::forEachField(_p, [&](const schema::FieldInfo& f, auto& arr) {
       if (!f.has(schema::kResorted))
@@ -472,7 +476,7 @@ public:
   /// What the modules see this sub-step (dt = 0 at the window boundaries).
   StepContext<Exec> stepContext(double dt) {
     return StepContext<Exec>{_exec,      _p,         _s, gasOrNull(), _cells,
-                             _pairLists, _wallLists, dt, _status.d()};
+                             _pairLists, _wallLists, dt, _status.d(), _marks};
   }
   const GasFields<Exec>* gasOrNull() const { return _hasGas && _s.coupled ? &_gas : nullptr; }
 
@@ -506,50 +510,44 @@ public:
     }
   }
 
-  /// Freezes ε_g (PCM at the current positions) and clears every module's window accumulators.
+  /// Freezes ε_g (PCM at the current positions, coupled runs) and clears every module's window
+  /// accumulators.
   void beginWindow() override {
     StepContext<Exec> ctx = stepContext(0.0);
-    _chem.beginWindow(ctx); // chemistry window accumulators (also uncoupled: ledgers)
-    if (!_s.coupled)
-      return;
     const auto t0 = Clock::now();
-    _p.require(kPos | kRadius);
-    const GasFields<Exec>* gas = gasOrNull();
-    const bool fluid = gas != nullptr && gas->has(gas->fluid);
-    _cells.freeze(_exec, _p, _s.grid, _s.cellVolume, fluid ? gas->fluid.d() : nullptr);
-    if (fluid) {
-      refuseParticlesOutsideTheFluid(*gas);
+    if (_s.coupled) {
+      _p.require(kPos | kRadius);
+      const GasFields<Exec>* gas = gasOrNull();
+      const bool fluid = gas != nullptr && gas->has(gas->fluid);
+      _cells.freeze(_exec, _p, _s.grid, _s.cellVolume, fluid ? gas->fluid.d() : nullptr);
+      if (fluid) {
+        refuseParticlesOutsideTheFluid(*gas);
+      }
     }
-    _drag.beginWindow(ctx);
-    _heat.beginWindow(ctx);
-    Exec::synchronize();
-    _t.coupling += std::chrono::duration<double>(Clock::now() - t0).count();
+    _modules.forEach([&](auto& m) { m.beginWindow(ctx); }); // (uncoupled: chemistry's ledgers)
+    if (_s.coupled) {
+      Exec::synchronize();
+      _t.coupling += std::chrono::duration<double>(Clock::now() - t0).count();
+    }
   }
 
+  /// Sub-step-averaged sources of the window; uncoupled runs only close the modules' ledgers.
   void endWindow(double dtCfd, int nSub, CellSources& out) override {
-    WindowContext<Exec> w{_s, gasOrNull(), _cells, nSub, dtCfd, dtCfd / nSub, out};
+    WindowContext<Exec> w{_s, gasOrNull(), _cells, nSub, dtCfd, dtCfd / nSub, out, _t};
     if (!_s.coupled) {
       out = CellSources{};
-      _chem.endWindow(w); // ledgers only
-      _heat.endWindow(w); // wall heat totals only
-      return;
+    } else {
+      const std::size_t nc = _s.nCells;
+      out.epsG.assign(nc, 1.0);
+      out.kSl.assign(nc, 0.0);
+      out.kSlUs.assign(3 * nc, 0.0);
+      out.heatH.assign(nc, 0.0);
+      out.heatHTp.assign(nc, 0.0);
+      out.rSpecies.assign(nc * static_cast<std::size_t>(_s.nGasSpecies), 0.0);
+      out.qHom.assign(nc, 0.0);
+      out.qRad.assign(nc, 0.0);
     }
-    const std::size_t nc = _s.nCells;
-    out.epsG.assign(nc, 1.0);
-    out.kSl.assign(nc, 0.0);
-    out.kSlUs.assign(3 * nc, 0.0);
-    out.heatH.assign(nc, 0.0);
-    out.heatHTp.assign(nc, 0.0);
-    out.rSpecies.assign(nc * static_cast<std::size_t>(_s.nGasSpecies), 0.0);
-    out.qHom.assign(nc, 0.0);
-    out.qRad.assign(nc, 0.0);
-    _drag.endWindow(w);
-    _heat.endWindow(w);
-    if (_chem.enabled()) { // R_species, WGS, chemistry ledgers (chemistry.h)
-      const auto tc = Clock::now();
-      _chem.endWindow(w);
-      _t.chemistry += std::chrono::duration<double>(Clock::now() - tc).count();
-    }
+    _modules.forEach([&](auto& m) { m.endWindow(w); });
   }
 
   /// Symplectic Euler (motion.h). Reads force, torque, mass, radius; writes pos, vel, omega,
@@ -589,81 +587,46 @@ public:
     _p.produced(kPos | kVel | kOmega);
   }
 
-  /// Runs one module's sources (or update) and marks the end of its stage.
-  template <class Module>
-  void run(Module& stepModule, StepContext<Exec>& ctx, double& stage, bool update = false) {
-    static_assert(StepModule<Module, Exec>);
-    if (!stepModule.enabled())
-      return;
-    if (update) {
-      stepModule.update(ctx);
-    } else {
-      stepModule.sources(ctx);
-    }
-    markStage(stage);
-  }
-
-  /// Stage timing that does not make the host wait for the device: a mark (Exec::Mark: a CUDA
-  /// event on the cuda backend, the host clock otherwise) at the end of each stage, their
-  /// differences booked after the sub-step's status read, when the device has passed them all.
-  void beginMarks() {
-    Exec::mark(_marks[0]);
-    _nMarks = 1;
-  }
-  void markStage(double& stage) {
-    Exec::mark(_marks[_nMarks]);
-    _markStage[_nMarks] = &stage;
-    ++_nMarks;
-  }
-  void bookMarks() {
-    for (int k = 1; k < _nMarks; ++k)
-      *_markStage[k] += Exec::seconds(_marks[k - 1], _marks[k]);
-    _nMarks = 0;
-  }
-
   /// One sub-step. Without a neighbour rebuild the host waits for the device once: the status
   /// read at the end (the values the kernels left in _status; step_module.h StatusSlot).
   void subStep(double dt) override {
     if (_p.n == 0)
       return;
-    beginMarks();
+    _marks.begin();
     if (!_listValid || !_pairLists.valid()) {
       if (!_listValid)
         rebuild();
       _pairLists.ensure(_exec, _p);
-      markStage(_t.neighbour);
+      _marks.end(&StageTimes::neighbour);
     }
     _p.require(kAllFields);
     StepContext<Exec> ctx = stepContext(dt);
-    if (_drag.enabled()) {  // drag.sources() in its two passes, timed apart (stages drag, coupling)
-      _drag.gasForces(ctx); // gas force and PCM cell per particle
-      markStage(_t.drag);
-      _drag.sortAndDeposit(ctx); // particles sorted by cell, K_sl sums
-      markStage(_t.coupling);
-    }
-    run(_contacts, ctx, _t.contact); // + contact forces
-    run(_heat, ctx, _t.heat);        // heat sources on the same configuration
-    run(_chem, ctx, _t.chemistry);   // rates -> mass/diameter, before the motion
+    // Sources of every module on the same configuration, in the list's order (step_modules.h).
+    _modules.forEach([&](auto& m) {
+      if (m.enabled()) {
+        m.sources(ctx);
+        _marks.end(std::remove_reference_t<decltype(m)>::kStage);
+      }
+    });
     integrate(dt);
-    if (_heat.enabled())
-      _heat.update(ctx); // T += Δt Q/(m c_p)
-    if (_chem.enabled())
-      _chem.update(ctx); // + Δt Q_rxn/(m c_p)
-    markStage(_t.integrate);
+    _modules.forEach([&](auto& m) { // heat: T += Δt Q/(m c_p); chemistry: + Δt Q_rxn/(m c_p)
+      if (m.enabled())
+        m.update(ctx);
+    });
+    _marks.end(&StageTimes::integrate);
     _status.markDeviceModified();
     _status.toHost(); // the sub-step's one host round trip
-    bookMarks();
+    _marks.book();
     const double* status = _status.h();
-    _contacts.readStatus(status, _p.K);
-    _chem.readStatus(status);
+    _modules.forEach([&](auto& m) { m.readStatus(status, _p); });
     const double half = 0.5 * _s.skin;
     if (!_s.frozen && status[kStatusMaxDisplacement2] > half * half)
       _listValid = false;
   }
 
-  std::size_t pairContacts() override { return _contacts.pairContacts(_p); }
-  std::size_t wallContacts() override { return _contacts.wallContacts(_p); }
-  std::array<double, 3> wallForce() override { return _contacts.wallForce(_p); }
+  std::size_t pairContacts() override { return contacts().pairContacts(_p); }
+  std::size_t wallContacts() override { return contacts().wallContacts(_p); }
+  std::array<double, 3> wallForce() override { return contacts().wallForce(_p); }
 
 private:
   EngineSetup _s;
@@ -680,15 +643,9 @@ private:
   Dev<unsigned char> _scratch;
   bool _listValid = false;
   StageTimes _t;
-  Dual<double> _status; ///< kStatusSlotCount values per sub-step (step_module.h StatusSlot)
-  static constexpr int kMaxMarks = 10;
-  typename Exec::Mark _marks[kMaxMarks]; ///< stage marks of the sub-step in flight
-  double* _markStage[kMaxMarks] = {};    ///< the StageTimes entry each mark ends
-  int _nMarks = 0;
-  DragModule<Exec> _drag;        ///< gas forces and K_sl (drag.h)
-  ContactModule<Exec> _contacts; ///< contact forces (contacts.h)
-  HeatModule<Exec> _heat;        ///< particle heat transfer (heat.h)
-  ChemistryModule<Exec> _chem;   ///< chemistry (chemistry.h)
+  StageMarks<Exec> _marks{_t}; ///< stage marks of the sub-step in flight
+  Dual<double> _status;        ///< kStatusSlotCount values per sub-step (step_module.h StatusSlot)
+  StepModules<Exec> _modules;  ///< drag, contacts, heat, chemistry (step_modules.h)
 };
 
 } // namespace coredem::dem

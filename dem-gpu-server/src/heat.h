@@ -79,6 +79,9 @@ public:
   template <class T>
   using Dev = backend::DeviceArray<T, Exec>;
 
+  static constexpr double StageTimes::*kStage = &StageTimes::heat;
+
+  void setup(const EngineSetup& s) { setup(s.heat, s.coupled ? s.nCells : 0); }
   void setup(const HeatSetup& h, std::size_t nCells) {
     _h = h;
     _on = HeatTerms::of(h, nCells > 0);
@@ -105,6 +108,7 @@ public:
   }
 
   bool enabled() const { return _on.enabled; }
+  void readStatus(const double*, const ParticleStore<Exec>&) {}
 
   std::size_t bytes() const {
     return _mat.bytes() + _q.bytes() + _g.bytes() + _qrad.bytes() + _cellT.bytes() + _acc.bytes() +
@@ -144,6 +148,25 @@ public:
     }
   }
 
+  /// The terms this sub-step evaluates: the options, and the gas fields the CFD sent.
+  struct ActiveTerms {
+    bool coupled; ///< gas fields present (ctx.gas: set, with a coupling grid)
+    bool hasTg, hasKappa, hasCp;
+    bool conv, rad, lens, contact;
+  };
+  ActiveTerms activeTerms(const GasFields<Exec>* gasFields) const {
+    ActiveTerms a{};
+    a.coupled = gasFields != nullptr;
+    a.hasTg = a.coupled && gasFields->has(gasFields->Tg);
+    a.hasKappa = a.coupled && gasFields->has(gasFields->kappaG);
+    a.hasCp = a.coupled && gasFields->has(gasFields->cpG);
+    a.conv = a.coupled && _on.convection && a.hasTg && a.hasKappa && a.hasCp;
+    a.rad = a.coupled && _on.radiation && a.hasTg;
+    a.lens = a.coupled && _on.lensConduction && a.hasKappa;
+    a.contact = _on.contactConduction;
+    return a;
+  }
+
   /// Heat sources of one sub-step. When coupled, the particles are sorted by PCM cell
   /// (ctx.cells) as the drag module leaves them.
   /// Reads pos, vel, radius, temperature, material, the pair lists; writes _q, _g, _qrad,
@@ -151,217 +174,247 @@ public:
   void sources(StepContext<Exec>& ctx) {
     if (!_on.enabled)
       return;
-    Exec& exec = ctx.exec;
-    ParticleStore<Exec>& p = ctx.particles;
-    const EngineSetup& s = ctx.setup;
-    const double dt = ctx.dt;
-    const std::size_t n = p.n;
+    const std::size_t n = ctx.particles.n;
     _q.reserve(n);
     _g.reserve(n);
     _qrad.reserve(n);
-    const GasFields<Exec>* gasFields = ctx.gas; // nullptr: no gas fields or no coupling grid
-    const bool coupled = gasFields != nullptr;
-    const bool hasTg = coupled && gasFields->has(gasFields->Tg);
-    const bool hasKappa = coupled && gasFields->has(gasFields->kappaG);
-    const bool hasCp = coupled && gasFields->has(gasFields->cpG);
-    const bool conv = coupled && _on.convection && hasTg && hasKappa && hasCp;
-    if (conv && !_convFactorsValid) {
+    const ActiveTerms on = activeTerms(ctx.gas); // ctx.gas nullptr: no gas fields or no grid
+    if (on.conv && !_convFactorsValid) {
       backend::raiseUserError("internal: heat sources without the window's Nusselt factors "
                               "(beginWindow was not called after the gas fields were set)");
     }
-    const kernels::NusseltFactors* convFactors = conv ? _convFactors.d() : nullptr;
-    const bool rad = coupled && _on.radiation && hasTg;
-    const bool lens = coupled && _on.lensConduction && hasKappa;
-    const bool contact = _on.contactConduction;
-    const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
+    if (on.rad)
+      cellTemperatures(ctx);
+    if (_h.walls.enabled) {
+      ctx.walls.ensure(ctx.exec, ctx.particles, ctx.pairs.generation(), ctx.setup.skin);
+      _qw.reserve(n);
+    }
+    if (on.contact || on.lens)
+      pairTerms(ctx, on);
+    particleRates(ctx, on);
+    if (_h.walls.enabled)
+      wallHeat(ctx);
+    if (ctx.setup.coupled)
+      cellSources(ctx);
+  }
+
+  // The passes of sources(), in their order (public: nvcc's extended lambdas may not live in
+  // private member functions).
+
+  /// 1. Σ T_p per cell (radiation environment, variant (a)). Writes _cellT.
+  void cellTemperatures(StepContext<Exec>& ctx) {
+    Exec& exec = ctx.exec;
+    const std::size_t n = ctx.particles.n;
+    const std::uint32_t nCells = static_cast<std::uint32_t>(ctx.setup.nCells);
     const std::uint32_t* pcell = ctx.cells.pcell();
     const std::uint32_t* perm = ctx.cells.perm();
     const std::uint32_t* cStart = ctx.cells.cStart();
     const std::uint32_t* cEnd = ctx.cells.cEnd();
+    double* cellT = _cellT.d();
+    const double* T = ctx.particles.temperature.d();
+    // Occupied cells only (one segment head each); cellT is read only at a particle's cell.
+    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
+      const std::size_t c = pcell[perm[h]];
+      if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c))
+        return;
+      double sum = 0.0;
+      for (std::uint32_t k = cStart[c]; k < cEnd[c]; ++k)
+        sum += T[perm[k]];
+      cellT[c] = sum;
+    });
+  }
+
+  /// 2a. Pair terms, each pair once by its owner (the smaller global id, which is also the
+  ///     canonical "lo" of the pair kernels) over the half lists (pair_lists.h): the owner
+  ///     keeps +Q_ab (heat into lo = G (T_hi − T_lo)) and gives −Q_ab to the partner. Q_ab =
+  ///     −Q_ba exactly. Each particle's pair sums (contact, lens) receive their terms in the
+  ///     order of pair_lists.h "Slabs" (by colour, then by the evaluating particle's index;
+  ///     its own sum at its own index): the cpu backend (scatter) runs the owners slab colour
+  ///     by colour and subtracts Q_ab from the partner's sums directly; the gather backends
+  ///     write Q_ab to the per-candidate scratch at the partner's low-list position (0 when
+  ///     the pair is out of reach) and the owner's sums to qOwn, lOwn, and 2b adds them up in
+  ///     that order.
+  void pairTerms(StepContext<Exec>& ctx, const ActiveTerms& on) {
+    Exec& exec = ctx.exec;
+    ParticleStore<Exec>& p = ctx.particles;
+    const std::size_t n = p.n;
+    const bool lens = on.lens;
+    const bool contact = on.contact;
+    const std::uint32_t nCells = static_cast<std::uint32_t>(ctx.setup.nCells);
+    const std::uint32_t* pcell = ctx.cells.pcell();
+    const double* x = p.pos.d();
+    const double* r = p.radius.d();
+    const double* T = p.temperature.d();
+    const std::int32_t* mat = p.material.d();
+    const HeatMaterial* hm = _mat.d();
+    const double* kap = on.hasKappa ? ctx.gas->kappaG.d() : nullptr;
+    const kernels::GasLensParams lp = _h.lensParams;
+    const double lensFactor = 1.0 + lp.lensFraction;
+    constexpr bool scatter = kScatter<Exec>;
+    PairLists<Exec>& pl = ctx.pairs;
+    const std::uint32_t* hs = pl.halfStart();
+    const std::int32_t* half = pl.half();
+    const std::uint32_t* lowPos = pl.lowPos();
+    static_assert(PairLists<Exec>::kScratchWidth >= 2);
+    double* share = pl.scratch(); // per candidate: Q_ab contact, Q_ab lens (W)
+    double* qOwn = _q.d(); // pair sums, contact and lens (scatter: complete; gather: the owner's)
+    double* lOwn = _g.d(); //   in _q and _g until 2b
+    if constexpr (scatter) {
+      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+        qOwn[i] = 0.0;
+        lOwn[i] = 0.0;
+      });
+    }
+    auto ownerPass = [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
+      using namespace kernels;
+      (void)share, (void)lowPos, (void)qOwn, (void)lOwn; // nvcc: captured outside if constexpr
+      const long long lo = static_cast<long long>(i);
+      const Vec3 xlo = load3(x, lo);
+      const double rlo = r[lo];
+      const double tlo = T[lo];
+      const std::int32_t mlo = mat[lo];
+      const double klo = hm[mlo].k;
+      const std::uint32_t clo = lens ? pcell[lo] : nCells;
+      // The owner's invariants. Partners of the same radius (a monodisperse bed: all) take
+      // the equal-radii kernels (conduction_contact.h: within 2^-52 of the exact contact
+      // radius; conduction_gas_lens.h: within kGasLensEqualRadiiRelDiff of the general lens
+      // form); of the same material, the owner's contact conductivity; in the same PCM cell,
+      // its κ_g (both bitwise as before).
+      const double kcSame = contactConductivity(klo, klo);
+      const bool kSamePos = klo + klo > 0.0;
+      const double kgSame = clo < nCells ? 0.5 * (kap[clo] + kap[clo]) : 0.0;
+      const double reachSame = lens ? lensFactor * rlo + rlo : rlo + rlo;
+      const double reachSame2 = reachSame * reachSame;
+      const double twoR = rlo + rlo;
+      const GasLensEqualRadii lensSame = gasLensEqualRadii(lp, rlo);
+      double qc = 0.0, ql = 0.0;
+      const std::uint32_t qEnd = hs[i + 1];
+      for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
+        const long long hi = half[q];
+        double qcab = 0.0, qlab = 0.0;
+        const Vec3 d = load3(x, hi) - xlo;
+        const double l2 = dot(d, d);
+        const double rhi = r[hi];
+        if (rhi == rlo) {
+          // Same radius: the equal-radii kernels and the owner's reach.
+          if (l2 < reachSame2) {
+            const double l = ::sqrt(l2);
+            const double dT = T[hi] - tlo; // heat into lo = G (T_hi − T_lo)
+            if (contact && l < twoR) {
+              const std::int32_t mhi = mat[hi];
+              const double rc = l >= rlo ? intersectionCircleRadiusEqual(rlo, l)
+                                         : intersectionCircleRadius(rlo, rlo, l);
+              if (mhi == mlo) {
+                if (kSamePos)
+                  qcab = (kcSame * rc) * dT;
+              } else {
+                const double khi = hm[mhi].k;
+                if (klo + khi > 0.0)
+                  qcab = (contactConductivity(klo, khi) * rc) * dT;
+              }
+            }
+            if (lens) {
+              const double kg = pairGasConductivity(kap, clo, pcell[hi], nCells, kgSame);
+              if (kg > 0.0)
+                qlab = kg * gasLensIntegralEqualRadii(lp, lensSame, l) * dT;
+            }
+          }
+        } else {
+          const double big = rlo > rhi ? rlo : rhi;
+          const double small = rlo > rhi ? rhi : rlo;
+          const double reach = lens ? lensFactor * big + small : rlo + rhi;
+          if (l2 < reach * reach) {
+            const double l = ::sqrt(l2);
+            const double dT = T[hi] - tlo;
+            if (contact && l < rlo + rhi) {
+              const double khi = hm[mat[hi]].k;
+              if (klo + khi > 0.0)
+                qcab = contactConductance(klo, khi, rlo, rhi, l) * dT;
+            }
+            if (lens) {
+              const double kg = pairGasConductivity(kap, clo, pcell[hi], nCells, kgSame);
+              if (kg > 0.0)
+                qlab = kg * gasLensIntegral(lp, rlo, rhi, l).value * dT;
+            }
+          }
+        }
+        qc += qcab;
+        ql += qlab;
+        if constexpr (kScatter<Exec>) {
+          qOwn[hi] -= qcab;
+          lOwn[hi] -= qlab;
+        } else {
+          const std::size_t kq = lowPos[q]; // the partner's slot for its share
+          share[2 * kq] = qcab;
+          share[2 * kq + 1] = qlab;
+        }
+      }
+      if constexpr (kScatter<Exec>) { // after the terms of the particles before it
+        qOwn[i] += qc;
+        lOwn[i] += ql;
+      } else {
+        qOwn[i] = qc;
+        lOwn[i] = ql;
+      }
+      return 0.0;
+    };
+    if constexpr (scatter) {
+      exec.reduceMaxOverSlabsWide(pl.slabStart(), pl.slabs(), ownerPass, 0.0, &_unused);
+    } else {
+      exec.parallelFor(n, ownerPass);
+    }
+  }
+
+  /// 2b. Per-particle heat rate: the pair sums of 2a (gather backends: the owner's sums and
+  ///     −Q_ab of the pairs the partners own, in the slab order), convection with the gas of
+  ///     the PCM cell, radiation, walls. Writes _q, _g, _qrad, _qw.
+  void particleRates(StepContext<Exec>& ctx, const ActiveTerms& on) {
+    Exec& exec = ctx.exec;
+    ParticleStore<Exec>& p = ctx.particles;
+    const EngineSetup& s = ctx.setup;
+    const std::size_t n = p.n;
+    const GasFields<Exec>* gasFields = ctx.gas;
+    const bool coupled = on.coupled;
+    const bool conv = on.conv, rad = on.rad, lens = on.lens, contact = on.contact;
+    const kernels::NusseltFactors* convFactors = conv ? _convFactors.d() : nullptr;
+    const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
+    const std::uint32_t* pcell = ctx.cells.pcell();
     const double* epsFrozen = s.coupled ? ctx.cells.epsFrozen() : nullptr;
     const double* ug = coupled ? gasFields->ug.d() : nullptr;
     const double* rhoG = coupled ? gasFields->rhoG.d() : nullptr;
     const double* muG = coupled ? gasFields->muG.d() : nullptr;
-
-    // 1. Σ T_p per cell (radiation environment, variant (a)).
-    double* cellT = _cellT.d();
+    const double* cellT = _cellT.d();
     const double* T = p.temperature.d();
-    if (rad) {
-      // Occupied cells only (one segment head each); cellT is read only at a particle's cell.
-      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
-        const std::size_t c = pcell[perm[h]];
-        if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c))
-          return;
-        double sum = 0.0;
-        for (std::uint32_t k = cStart[c]; k < cEnd[c]; ++k)
-          sum += T[perm[k]];
-        cellT[c] = sum;
-      });
-    }
-
     const double* x = p.pos.d();
     const double* v = p.vel.d();
     const double* r = p.radius.d();
     const std::int32_t* mat = p.material.d();
     const HeatMaterial* hm = _mat.d();
-    const double* tg = hasTg ? gasFields->Tg.d() : nullptr;
-    const double* kap = hasKappa ? gasFields->kappaG.d() : nullptr;
-    const double* cpg = hasCp ? gasFields->cpG.d() : nullptr;
+    const double* tg = on.hasTg ? gasFields->Tg.d() : nullptr;
+    const double* kap = on.hasKappa ? gasFields->kappaG.d() : nullptr;
+    const double* cpg = on.hasCp ? gasFields->cpG.d() : nullptr;
     double* q = _q.d();
     double* gOut = _g.d();
     double* qr = _qrad.d();
     const kernels::ConvectionParams cp = _h.convectionParams;
-    const kernels::GasLensParams lp = _h.lensParams;
-    const std::uint32_t* cs = cStart;
-    const std::uint32_t* ce = cEnd;
-    const double lensFactor = 1.0 + lp.lensFraction;
+    const std::uint32_t* cs = ctx.cells.cStart();
+    const std::uint32_t* ce = ctx.cells.cEnd();
     const bool thermalWalls = _h.walls.enabled;
     const ThermalWalls tw = _h.walls;
-    WallLists<Exec>& wl = ctx.walls;
-    if (thermalWalls)
-      wl.ensure(exec, p, ctx.pairs.generation(), s.skin);
-    const WallView wv = wl.view();
-    const std::uint32_t* wallNear = thermalWalls ? wl.near() : nullptr;
+    const WallView wv = ctx.walls.view();
+    const std::uint32_t* wallNear = thermalWalls ? ctx.walls.near() : nullptr;
     const kernels::WallConductionParams wp = _h.wallParams;
-    const bool wallLens = wp.lens && coupled && hasKappa;
+    const bool wallLens = wp.lens && coupled && on.hasKappa;
     // A wall is reached within R (contact) or (1 + FLPC) R (lens).
     const double wallReach = wallLens ? 1.0 + wp.lensFraction : 1.0;
-    if (thermalWalls)
-      _qw.reserve(n);
     double* qwOut = thermalWalls ? _qw.d() : nullptr;
-
-    // 2a. Pair terms, each pair once by its owner (the smaller global id, which is also the
-    //     canonical "lo" of the pair kernels) over the half lists (pair_lists.h): the owner
-    //     keeps +Q_ab (heat into lo = G (T_hi − T_lo)) and gives −Q_ab to the partner. Q_ab =
-    //     −Q_ba exactly. Each particle's pair sums (contact, lens) receive their terms in the
-    //     order of pair_lists.h "Slabs" (by colour, then by the evaluating particle's index;
-    //     its own sum at its own index): the cpu backend (scatter) runs the owners slab colour
-    //     by colour and subtracts Q_ab from the partner's sums directly; the gather backends
-    //     write Q_ab to the per-candidate scratch at the partner's low-list position (0 when
-    //     the pair is out of reach) and the owner's sums to qOwn, lOwn, and 2b adds them up in
-    //     that order.
-    constexpr bool scatter = kScatter<Exec>;
     PairLists<Exec>& pl = ctx.pairs;
-    const std::uint32_t* hs = pl.halfStart();
-    const std::int32_t* half = pl.half();
     const std::uint32_t* ls = pl.lowStart();
-    const std::uint32_t* lowPos = pl.lowPos();
     const std::uint32_t* lowOwner = pl.lowOwner();
     const std::uint8_t* colour = pl.colour();
-    static_assert(PairLists<Exec>::kScratchWidth >= 2);
-    double* share = pl.scratch(); // per candidate: Q_ab contact, Q_ab lens (W)
-    double* qOwn = _q.d(); // pair sums, contact and lens (scatter: complete; gather: the owner's)
-    double* lOwn = _g.d(); //   in _q and _g until 2b
-    if (contact || lens) {
-      if constexpr (scatter) {
-        exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
-          qOwn[i] = 0.0;
-          lOwn[i] = 0.0;
-        });
-      }
-      auto ownerPass = [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
-        using namespace kernels;
-        (void)share, (void)lowPos, (void)qOwn, (void)lOwn; // nvcc: captured outside if constexpr
-        const long long lo = static_cast<long long>(i);
-        const Vec3 xlo = load3(x, lo);
-        const double rlo = r[lo];
-        const double tlo = T[lo];
-        const std::int32_t mlo = mat[lo];
-        const double klo = hm[mlo].k;
-        const std::uint32_t clo = lens ? pcell[lo] : nCells;
-        // The owner's invariants. Partners of the same radius (a monodisperse bed: all) take
-        // the equal-radii kernels (conduction_contact.h: within 2^-52 of the exact contact
-        // radius; conduction_gas_lens.h: within kGasLensEqualRadiiRelDiff of the general lens
-        // form); of the same material, the owner's contact conductivity; in the same PCM cell,
-        // its κ_g (both bitwise as before).
-        const double kcSame = contactConductivity(klo, klo);
-        const bool kSamePos = klo + klo > 0.0;
-        const double kgSame = clo < nCells ? 0.5 * (kap[clo] + kap[clo]) : 0.0;
-        const double reachSame = lens ? lensFactor * rlo + rlo : rlo + rlo;
-        const double reachSame2 = reachSame * reachSame;
-        const double twoR = rlo + rlo;
-        const GasLensEqualRadii lensSame = gasLensEqualRadii(lp, rlo);
-        double qc = 0.0, ql = 0.0;
-        const std::uint32_t qEnd = hs[i + 1];
-        for (std::uint32_t q = hs[i]; q < qEnd; ++q) {
-          const long long hi = half[q];
-          double qcab = 0.0, qlab = 0.0;
-          const Vec3 d = load3(x, hi) - xlo;
-          const double l2 = dot(d, d);
-          const double rhi = r[hi];
-          if (rhi == rlo) {
-            // Same radius: the equal-radii kernels and the owner's reach.
-            if (l2 < reachSame2) {
-              const double l = ::sqrt(l2);
-              const double dT = T[hi] - tlo; // heat into lo = G (T_hi − T_lo)
-              if (contact && l < twoR) {
-                const std::int32_t mhi = mat[hi];
-                const double rc = l >= rlo ? intersectionCircleRadiusEqual(rlo, l)
-                                           : intersectionCircleRadius(rlo, rlo, l);
-                if (mhi == mlo) {
-                  if (kSamePos)
-                    qcab = (kcSame * rc) * dT;
-                } else {
-                  const double khi = hm[mhi].k;
-                  if (klo + khi > 0.0)
-                    qcab = (contactConductivity(klo, khi) * rc) * dT;
-                }
-              }
-              if (lens) {
-                const double kg = pairGasConductivity(kap, clo, pcell[hi], nCells, kgSame);
-                if (kg > 0.0)
-                  qlab = kg * gasLensIntegralEqualRadii(lp, lensSame, l) * dT;
-              }
-            }
-          } else {
-            const double big = rlo > rhi ? rlo : rhi;
-            const double small = rlo > rhi ? rhi : rlo;
-            const double reach = lens ? lensFactor * big + small : rlo + rhi;
-            if (l2 < reach * reach) {
-              const double l = ::sqrt(l2);
-              const double dT = T[hi] - tlo;
-              if (contact && l < rlo + rhi) {
-                const double khi = hm[mat[hi]].k;
-                if (klo + khi > 0.0)
-                  qcab = contactConductance(klo, khi, rlo, rhi, l) * dT;
-              }
-              if (lens) {
-                const double kg = pairGasConductivity(kap, clo, pcell[hi], nCells, kgSame);
-                if (kg > 0.0)
-                  qlab = kg * gasLensIntegral(lp, rlo, rhi, l).value * dT;
-              }
-            }
-          }
-          qc += qcab;
-          ql += qlab;
-          if constexpr (kScatter<Exec>) {
-            qOwn[hi] -= qcab;
-            lOwn[hi] -= qlab;
-          } else {
-            const std::size_t kq = lowPos[q]; // the partner's slot for its share
-            share[2 * kq] = qcab;
-            share[2 * kq + 1] = qlab;
-          }
-        }
-        if constexpr (kScatter<Exec>) { // after the terms of the particles before it
-          qOwn[i] += qc;
-          lOwn[i] += ql;
-        } else {
-          qOwn[i] = qc;
-          lOwn[i] = ql;
-        }
-        return 0.0;
-      };
-      if constexpr (scatter) {
-        exec.reduceMaxOverSlabsWide(pl.slabStart(), pl.slabs(), ownerPass, 0.0, &_unused);
-      } else {
-        exec.parallelFor(n, ownerPass);
-      }
-    }
-
-    // 2b. Per-particle heat rate: the pair sums of 2a (gather backends: the owner's sums and
-    //     −Q_ab of the pairs the partners own, in the slab order), convection with the gas of
-    //     the PCM cell, radiation, walls.
+    double* share = pl.scratch(); // 2a's per-candidate Q_ab (gather backends)
+    double* qOwn = _q.d();        // 2a's pair sums, contact and lens
+    double* lOwn = _g.d();
     exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) COREDEM_HEAT_INLINE {
       using namespace kernels;
       (void)share, (void)ls, (void)lowOwner, (void)colour, (void)qOwn, (void)lOwn; // nvcc, as 2a
@@ -425,43 +478,57 @@ public:
       gOut[i] = g;
       qr[i] = src.radiation;
     });
+  }
 
-    // Wall heat of this sub-step, in kWallSlots fixed partial sums (J).
-    if (thermalWalls) {
-      double* wa = _wallAcc.d();
-      const double* qwIn = _qw.d();
-      exec.parallelFor(kWallSlots, [=] DEM_LAMBDA(std::size_t sl) {
-        const std::size_t lo = n * sl / kWallSlots, hi = n * (sl + 1) / kWallSlots;
-        double sum = 0.0;
-        for (std::size_t i = lo; i < hi; ++i)
-          sum += qwIn[i];
-        wa[sl] += sum * dt;
-      });
-      _wallAcc.markDeviceModified();
-    }
+  /// Wall heat of this sub-step, in kWallSlots fixed partial sums (J). Writes _wallAcc.
+  void wallHeat(StepContext<Exec>& ctx) {
+    Exec& exec = ctx.exec;
+    const std::size_t n = ctx.particles.n;
+    const double dt = ctx.dt;
+    double* wa = _wallAcc.d();
+    const double* qwIn = _qw.d();
+    exec.parallelFor(kWallSlots, [=] DEM_LAMBDA(std::size_t sl) {
+      const std::size_t lo = n * sl / kWallSlots, hi = n * (sl + 1) / kWallSlots;
+      double sum = 0.0;
+      for (std::size_t i = lo; i < hi; ++i)
+        sum += qwIn[i];
+      wa[sl] += sum * dt;
+    });
+    _wallAcc.markDeviceModified();
+  }
 
-    // 4. Cell sources (gather per cell in the PCM order the drag module sorted).
-    if (s.coupled) {
-      double* acc = _acc.d();
-      const double invVc = 1.0 / s.cellVolume;
-      // Occupied cells only: one segment head each, same order as a loop over all cells.
-      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
-        const std::size_t c = pcell[perm[h]];
-        if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c))
-          return;
-        kernels::ConvectionCellSource cellSrc;
-        double rs = 0.0;
-        for (std::uint32_t k = cs[c]; k < ce[c]; ++k) {
-          const std::uint32_t i = perm[k];
-          kernels::addConvectionToCell(cellSrc, gOut[i], T[i], invVc);
-          rs += qr[i];
-        }
-        acc[3 * c] += cellSrc.H;
-        acc[3 * c + 1] += cellSrc.HTp;
-        acc[3 * c + 2] += rs * invVc;
-      });
-      _acc.markDeviceModified();
-    }
+  /// 4. Cell sources (gather per cell in the PCM order the drag module sorted). Writes _acc.
+  void cellSources(StepContext<Exec>& ctx) {
+    Exec& exec = ctx.exec;
+    const EngineSetup& s = ctx.setup;
+    const std::size_t n = ctx.particles.n;
+    const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
+    const std::uint32_t* pcell = ctx.cells.pcell();
+    const std::uint32_t* perm = ctx.cells.perm();
+    const std::uint32_t* cs = ctx.cells.cStart();
+    const std::uint32_t* ce = ctx.cells.cEnd();
+    const double* T = ctx.particles.temperature.d();
+    const double* gOut = _g.d();
+    const double* qr = _qrad.d();
+    double* acc = _acc.d();
+    const double invVc = 1.0 / s.cellVolume;
+    // Occupied cells only: one segment head each, same order as a loop over all cells.
+    exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
+      const std::size_t c = pcell[perm[h]];
+      if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c))
+        return;
+      kernels::ConvectionCellSource cellSrc;
+      double rs = 0.0;
+      for (std::uint32_t k = cs[c]; k < ce[c]; ++k) {
+        const std::uint32_t i = perm[k];
+        kernels::addConvectionToCell(cellSrc, gOut[i], T[i], invVc);
+        rs += qr[i];
+      }
+      acc[3 * c] += cellSrc.H;
+      acc[3 * c + 1] += cellSrc.HTp;
+      acc[3 * c + 2] += rs * invVc;
+    });
+    _acc.markDeviceModified();
   }
 
   /// After the motion update: T_i += Δt Q_i/(m_i c_p,i) (Eq. 18, explicit Euler).
