@@ -136,12 +136,7 @@ int main(int argc, char* argv[])
             // 3. ledgers (cumulative) and the Courant number of this step.
             #include "updateLedgers.H"
         }
-        scalar CoNum = 0;
-        {
-            const scalarField sumPhi(fvc::surfaceSum(mag(phi))().primitiveField());
-            CoNum = 0.5*gMax(sumPhi/mesh.V().field())*dt;
-        }
-        Info<< "Courant Number max: " << CoNum << endl;
+        #include "couplingCourantNo.H"
 
         // 4. output, checkpoint, StepDone and the wait for the next grant. Output times are the
         // orchestrator's (output in case.yaml): the gas fields are written on the steps whose
@@ -175,29 +170,7 @@ int main(int argc, char* argv[])
         timers.endStep();
     }
 
-    if (timersOn)
-    {
-        Info<< nl << timers.table(nCells, exchange.direct()).c_str() << endl;
-        // Decomposed: rank 0's in timers-cfd.json, the others' in timers-cfd-processorN.json.
-        const fileName file
-        (
-            runTime.globalPath().path()
-           /(
-                Pstream::master()
-              ? word("timers-cfd.json")
-              : word("timers-cfd-processor" + Foam::name(Pstream::myProcNo()) + ".json")
-            )
-        );
-        {
-            std::ofstream out(file.c_str());
-            out << timers.json(nCells, exchange.direct());
-            if (!out)
-            {
-                FatalErrorInFunction << "cannot write " << file << exit(FatalError);
-            }
-        }
-        Info<< "Timers written to " << file << endl;
-    }
+    #include "writeTimers.H"
 
     runTime.writeNow();
     Info<< "Run finished after " << steps << " steps: " << coupling.shutdownReason().c_str()

@@ -40,6 +40,167 @@ double hash01(Foam::label i, Foam::label q)
     return x - std::floor(x);
 }
 
+
+//- The relative errors of the checks, and whether all are within the tolerance.
+struct Checks
+{
+    double tol;
+    bool ok = true;
+
+    void report(const char* name, double err)
+    {
+        Foam::Info<< "check " << name << ": " << err << Foam::endl;
+        if (!(err <= tol)) ok = false;
+    }
+};
+
+//- The mesh's cell shapes and the map's size, printed before the checks.
+void describe(const Foam::fvMesh& mesh, const CoredemGrid& grid, double seconds)
+{
+    using namespace Foam;
+    if (Pstream::parRun())
+    {
+        Pout<< "touched: " << label(grid.touched().size()) << " of " << grid.gridCells()
+            << " grid cells, " << mesh.nCells() << " mesh cells" << endl;
+    }
+    label nPoly = 0;
+    forAll(mesh.cells(), c)
+    {
+        if (mesh.cells()[c].size() != 6 || mesh.cellPoints()[c].size() != 8) ++nPoly;
+    }
+    scalar minWidth = GREAT;
+    forAll(mesh.cells(), c)
+    {
+        const boundBox bb(mesh.points(), mesh.cellPoints()[c], false);
+        minWidth = min(minWidth, cmptMin(bb.span()));
+    }
+    reduce(nPoly, sumOp<label>());
+    reduce(minWidth, minOp<scalar>());
+    Info<< "mesh: " << nPoly << " cells not hexahedra, smallest cell width " << minWidth
+        << " m" << endl;
+    Info<< "map: " << returnReduce(mesh.nCells(), sumOp<label>()) << " mesh cells, "
+        << grid.gridCells() << " grid cells, " << (grid.exact() ? "exact" : "overlap") << ", "
+        << returnReduce(grid.overlapEntries(), sumOp<label>())
+        << " overlaps, " << grid.partialCells() << " partial, " << grid.emptyCells()
+        << " empty, weights in " << seconds << " s" << endl;
+}
+
+//- Sources (3 components): sum_c s_c V_c = sum_g s_g h^3 over the grid cells with fluid.
+void checkSources(const Foam::fvMesh& mesh, const CoredemGrid& grid, Checks& checks)
+{
+    using namespace Foam;
+    const label nCells = mesh.nCells();
+    const label nGrid = grid.gridCells();
+    const scalarField& V = mesh.V().field();
+    const scalar vg = grid.cellVolume();
+    const std::vector<double>& Vf = grid.fluidVolume();
+    std::vector<double> s(std::size_t(nGrid)*3);
+    for (label g = 0; g < nGrid; ++g)
+    {
+        for (label q = 0; q < 3; ++q) s[3*g + q] = (q == 2 ? -1 : 1)*hash01(g, q);
+    }
+    std::vector<double> cell(std::size_t(nCells)*3);
+    grid.scatter(s.data(), 3, cell.data());
+    double worst = 0;
+    for (label q = 0; q < 3; ++q)
+    {
+        double dem = 0, abs = 0, cfd = 0;
+        for (label g = 0; g < nGrid; ++g)
+        {
+            if (Vf[g] > 0)
+            {
+                dem += s[3*g + q]*vg;
+                abs += mag(s[3*g + q])*vg;
+            }
+        }
+        for (label c = 0; c < nCells; ++c) cfd += cell[3*c + q]*V[c];
+        reduce(cfd, sumOp<scalar>());
+        worst = max(worst, mag(cfd - dem)/abs);
+    }
+    checks.report("sources", worst);
+}
+
+//- Gas fraction: random solid volumes, then phi V_f in every grid cell.
+void checkFraction(const Foam::fvMesh& mesh, const CoredemGrid& grid, Checks& checks)
+{
+    using namespace Foam;
+    const label nCells = mesh.nCells();
+    const label nGrid = grid.gridCells();
+    const scalarField& V = mesh.V().field();
+    const scalar vg = grid.cellVolume();
+    const std::vector<double>& Vf = grid.fluidVolume();
+    std::vector<double> eps(nGrid);
+    double solid = 0;
+    for (label g = 0; g < nGrid; ++g)
+    {
+        const double vs = 0.6*hash01(g, 7)*Vf[g];
+        solid += vs;
+        eps[g] = 1 - vs/vg;
+    }
+    scalarField e(nCells);
+    grid.scatter(eps.data(), 1, e.data(), CoredemGrid::Quantity::GasFraction);
+    double cfd = 0;
+    forAll(e, c) cfd += (1 - e[c])*V[c];
+    reduce(cfd, sumOp<scalar>());
+    checks.report("fraction_solid_volume", mag(cfd - solid)/solid);
+    checks.report("fraction_range", (gMin(e) > 0 && gMax(e) <= 1) ? 0 : 1);
+
+    const double phi = 0.4;
+    for (label g = 0; g < nGrid; ++g) eps[g] = 1 - phi*Vf[g]/vg;
+    grid.scatter(eps.data(), 1, e.data(), CoredemGrid::Quantity::GasFraction);
+    checks.report("fraction_uniform", gMax(mag(e - (1 - phi))));
+}
+
+//- Gather (decomposed: the processors' contributions added up, as the DEM server would): a
+//  constant stays constant, and sum_g u_g V_f,g = sum_c u_c V_c for a linear field.
+void checkGather(const Foam::fvMesh& mesh, const CoredemGrid& grid, double vFluid,
+                 Checks& checks)
+{
+    using namespace Foam;
+    const label nCells = mesh.nCells();
+    const label nGrid = grid.gridCells();
+    const scalarField& V = mesh.V().field();
+    const std::vector<double>& Vf = grid.fluidVolume();
+    auto combine = [&](std::vector<double>& out)
+    {
+        if (!Pstream::parRun()) return;
+        List<scalar> sum(label(out.size()));
+        forAll(sum, i) sum[i] = out[i];
+        Pstream::listCombineGather(sum, plusEqOp<scalar>());
+        Pstream::listCombineScatter(sum);
+        forAll(sum, i) out[i] = sum[i];
+    };
+    std::vector<double> u(nCells, 3.5), out;
+    grid.gather(u.data(), 1, out);
+    combine(out);
+    double worst = 0;
+    for (const double v : out) worst = max(worst, mag(v - 3.5)/3.5);
+    checks.report("gather_constant", worst);
+    const vectorField& C = mesh.C().field();
+    double cfd = 0, abs = 0;
+    for (label c = 0; c < nCells; ++c)
+    {
+        u[c] = 1 + 100*C[c].x() - 50*C[c].y() + 20*C[c].z();
+        cfd += u[c]*V[c];
+        abs += mag(u[c])*V[c];
+    }
+    reduce(cfd, sumOp<scalar>());
+    reduce(abs, sumOp<scalar>());
+    grid.gather(u.data(), 1, out);
+    combine(out);
+    double dem = 0, umax = 0;
+    for (label g = 0; g < nGrid; ++g)
+    {
+        dem += out[g]*Vf[g];
+        umax = max(umax, out[g]);
+    }
+    checks.report("gather_conservative", mag(dem - cfd)/abs);
+    // Figures to compare between a serial and a decomposed run of the same mesh.
+    Info<< "figure fluid_volume: " << setprecision(17) << vFluid << nl
+        << "figure gathered_total: " << dem << nl
+        << "figure gathered_max: " << umax << setprecision(6) << endl;
+}
+
 } // namespace
 
 
@@ -65,145 +226,18 @@ int main(int argc, char* argv[])
         mesh, origin, spacing,
         label(counts.x() + 0.5), label(counts.y() + 0.5), label(counts.z() + 0.5)
     );
-    const double seconds = double(std::clock() - t0)/CLOCKS_PER_SEC;
-    const label nCells = mesh.nCells();
-    const label nGrid = grid.gridCells();
-    const scalarField& V = mesh.V().field();
-    const scalar vg = grid.cellVolume();
-    const std::vector<double>& Vf = grid.fluidVolume();
+    describe(mesh, grid, double(std::clock() - t0)/CLOCKS_PER_SEC);
 
-    if (Pstream::parRun())
-    {
-        Pout<< "touched: " << label(grid.touched().size()) << " of " << grid.gridCells()
-            << " grid cells, " << mesh.nCells() << " mesh cells" << endl;
-    }
-    label nPoly = 0;
-    forAll(mesh.cells(), c)
-    {
-        if (mesh.cells()[c].size() != 6 || mesh.cellPoints()[c].size() != 8) ++nPoly;
-    }
-    scalar minWidth = GREAT;
-    forAll(mesh.cells(), c)
-    {
-        const boundBox bb(mesh.points(), mesh.cellPoints()[c], false);
-        minWidth = min(minWidth, cmptMin(bb.span()));
-    }
-    reduce(nPoly, sumOp<label>());
-    reduce(minWidth, minOp<scalar>());
-    Info<< "mesh: " << nPoly << " cells not hexahedra, smallest cell width " << minWidth
-        << " m" << endl;
-    Info<< "map: " << returnReduce(nCells, sumOp<label>()) << " mesh cells, " << nGrid << " grid cells, "
-        << (grid.exact() ? "exact" : "overlap") << ", "
-        << returnReduce(grid.overlapEntries(), sumOp<label>())
-        << " overlaps, " << grid.partialCells() << " partial, " << grid.emptyCells()
-        << " empty, weights in " << seconds << " s" << endl;
-
-    bool ok = true;
-    auto report = [&](const char* name, double err)
-    {
-        Info<< "check " << name << ": " << err << endl;
-        if (!(err <= tol)) ok = false;
-    };
-
+    Checks checks{tol};
     // Volume.
-    double vMesh = gSum(V), vFluid = 0;
-    for (const double v : Vf) vFluid += v;
-    report("volume", mag(vFluid - vMesh)/vMesh);
+    const double vMesh = gSum(mesh.V().field());
+    double vFluid = 0;
+    for (const double v : grid.fluidVolume()) vFluid += v;
+    checks.report("volume", mag(vFluid - vMesh)/vMesh);
+    checkSources(mesh, grid, checks);
+    checkFraction(mesh, grid, checks);
+    checkGather(mesh, grid, vFluid, checks);
 
-    // Sources (3 components).
-    {
-        std::vector<double> s(std::size_t(nGrid)*3);
-        for (label g = 0; g < nGrid; ++g)
-        {
-            for (label q = 0; q < 3; ++q) s[3*g + q] = (q == 2 ? -1 : 1)*hash01(g, q);
-        }
-        std::vector<double> cell(std::size_t(nCells)*3);
-        grid.scatter(s.data(), 3, cell.data());
-        double worst = 0;
-        for (label q = 0; q < 3; ++q)
-        {
-            double dem = 0, abs = 0, cfd = 0;
-            for (label g = 0; g < nGrid; ++g)
-            {
-                if (Vf[g] > 0)
-                {
-                    dem += s[3*g + q]*vg;
-                    abs += mag(s[3*g + q])*vg;
-                }
-            }
-            for (label c = 0; c < nCells; ++c) cfd += cell[3*c + q]*V[c];
-            reduce(cfd, sumOp<scalar>());
-            worst = max(worst, mag(cfd - dem)/abs);
-        }
-        report("sources", worst);
-    }
-
-    // Gas fraction: random solid volumes, then phi V_f in every grid cell.
-    {
-        std::vector<double> eps(nGrid);
-        double solid = 0;
-        for (label g = 0; g < nGrid; ++g)
-        {
-            const double vs = 0.6*hash01(g, 7)*Vf[g];
-            solid += vs;
-            eps[g] = 1 - vs/vg;
-        }
-        scalarField e(nCells);
-        grid.scatter(eps.data(), 1, e.data(), CoredemGrid::Quantity::GasFraction);
-        double cfd = 0;
-        forAll(e, c) cfd += (1 - e[c])*V[c];
-        reduce(cfd, sumOp<scalar>());
-        report("fraction_solid_volume", mag(cfd - solid)/solid);
-        report("fraction_range", (gMin(e) > 0 && gMax(e) <= 1) ? 0 : 1);
-
-        const double phi = 0.4;
-        for (label g = 0; g < nGrid; ++g) eps[g] = 1 - phi*Vf[g]/vg;
-        grid.scatter(eps.data(), 1, e.data(), CoredemGrid::Quantity::GasFraction);
-        report("fraction_uniform", gMax(mag(e - (1 - phi))));
-    }
-
-    // Gather (decomposed: the processors' contributions added up, as the DEM server would).
-    {
-        auto combine = [&](std::vector<double>& out)
-        {
-            if (!Pstream::parRun()) return;
-            List<scalar> sum(label(out.size()));
-            forAll(sum, i) sum[i] = out[i];
-            Pstream::listCombineGather(sum, plusEqOp<scalar>());
-            Pstream::listCombineScatter(sum);
-            forAll(sum, i) out[i] = sum[i];
-        };
-        std::vector<double> u(nCells, 3.5), out;
-        grid.gather(u.data(), 1, out);
-        combine(out);
-        double worst = 0;
-        for (const double v : out) worst = max(worst, mag(v - 3.5)/3.5);
-        report("gather_constant", worst);
-        const vectorField& C = mesh.C().field();
-        double cfd = 0, abs = 0;
-        for (label c = 0; c < nCells; ++c)
-        {
-            u[c] = 1 + 100*C[c].x() - 50*C[c].y() + 20*C[c].z();
-            cfd += u[c]*V[c];
-            abs += mag(u[c])*V[c];
-        }
-        reduce(cfd, sumOp<scalar>());
-        reduce(abs, sumOp<scalar>());
-        grid.gather(u.data(), 1, out);
-        combine(out);
-        double dem = 0, umax = 0;
-        for (label g = 0; g < nGrid; ++g)
-        {
-            dem += out[g]*Vf[g];
-            umax = max(umax, out[g]);
-        }
-        report("gather_conservative", mag(dem - cfd)/abs);
-        // Figures to compare between a serial and a decomposed run of the same mesh.
-        Info<< "figure fluid_volume: " << setprecision(17) << vFluid << nl
-            << "figure gathered_total: " << dem << nl
-            << "figure gathered_max: " << umax << setprecision(6) << endl;
-    }
-
-    Info<< (ok ? "map checks passed" : "map checks FAILED") << nl << "End" << endl;
-    return ok ? 0 : 1;
+    Info<< (checks.ok ? "map checks passed" : "map checks FAILED") << nl << "End" << endl;
+    return checks.ok ? 0 : 1;
 }

@@ -252,6 +252,12 @@ void CoredemGrid::computeOverlaps(const fvMesh& mesh)
         rowStart_[celli + 1] = label(overlapVol_.size());
     }
 
+    sumFluidVolumes();
+}
+
+
+void CoredemGrid::sumFluidVolumes()
+{
     // Fluid volume of every grid cell and the correction of the DEM's per-h^3 values.
     const scalar vg = cellVolume();
     std::fill(fluidVolume_.begin(), fluidVolume_.end(), 0.0);
