@@ -39,10 +39,7 @@ constexpr ModelEntry<MotionModel> kMotion[] = {
     {"frozen", MotionModel::Frozen,
      "particles held in place, velocities zeroed (MFiX verification cases)"},
 };
-constexpr ModelEntry<kernels::RateLaw> kRateLaw[] = {
-    {"constant", kernels::RateLaw::Constant, "ω = A (mol/s)"},
-    {"arrhenius", kernels::RateLaw::Arrhenius, "ω = A T^β exp(−E/(R T)) (× C_g^order)"},
-};
+constexpr auto kRateLaw = entriesOf<kernels::RateLaw>(kernels::RateLaws{});
 constexpr ModelEntry<kernels::WgsEquilibrium> kWgs[] = {
     {"yoon_denn", kernels::WgsEquilibrium::YoonDenn, "K_eq of Yoon & Denn (seed default)"},
     {"seed", kernels::WgsEquilibrium::Seed, "K_eq = exp(−4.33 + 4577.8/T) (seed)"},
