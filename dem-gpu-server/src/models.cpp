@@ -40,11 +40,7 @@ constexpr ModelEntry<MotionModel> kMotion[] = {
      "particles held in place, velocities zeroed (MFiX verification cases)"},
 };
 constexpr auto kRateLaw = entriesOf<kernels::RateLaw>(kernels::RateLaws{});
-constexpr ModelEntry<kernels::WgsEquilibrium> kWgs[] = {
-    {"yoon_denn", kernels::WgsEquilibrium::YoonDenn, "K_eq of Yoon & Denn (seed default)"},
-    {"seed", kernels::WgsEquilibrium::Seed, "K_eq = exp(−4.33 + 4577.8/T) (seed)"},
-    {"thermodynamic", kernels::WgsEquilibrium::Thermodynamic, "K_eq from the NASA-7 data"},
-};
+constexpr auto kWgs = entriesOf<kernels::WgsEquilibrium>(kernels::WgsEquilibria{});
 
 /// '_' as '-' (model names accept either).
 std::string normalise(std::string_view s) {
