@@ -182,6 +182,7 @@ void setUpHeat(const DemConfig& config, double rmax, EngineSetup& es) {
   for (const Material& mat : config.materials)
     hs.materials.push_back(HeatMaterial{mat.cp, mat.conductivity, mat.emissivity});
   hs.convectionParams.model = h.nusselt;
+  hs.convectionParams.models = h.nusseltModels;
   hs.convectionParams.voidageExponent = h.voidageExponent;
   hs.convectionParams.reynoldsWithVoidage = h.reynoldsWithVoidage;
   hs.convectionParams.epsMin = config.epsMinDrag;

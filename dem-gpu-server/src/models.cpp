@@ -18,26 +18,18 @@
 #include "coredem/dem/dem_system.h"
 #include "coredem/dem/kernels/collision_time.h"
 #include "coredem/dem/kernels/damping.h"
+#include "model_registry.h"
 
 namespace coredem::dem {
 
 // ------------------------------------------------------------------ family registries
 namespace {
 
-/// The registry entries of a family's type list (name, id, doc from each declaration).
-template <class E, class... Ms>
-constexpr std::array<ModelEntry<E>, sizeof...(Ms)> entriesOf(kernels::ModelList<Ms...> list) {
-  return {
-      ModelEntry<E>{Ms::name, static_cast<E>(kernels::modelId<Ms, decltype(list)>), Ms::doc}...};
-}
+using registry::entriesOf;
+using registry::number;
 
 constexpr auto kDrag = entriesOf<kernels::DragLaw>(kernels::DragLaws{});
-constexpr ModelEntry<kernels::NusseltModel> kNusselt[] = {
-    {"li-mason", kernels::NusseltModel::LiMason,
-     "Li & Mason (2000), Nu = 2 + 0.6 εⁿ Re^½ Pr^⅓ (Re < 200) …"},
-    {"ranz-marshall", kernels::NusseltModel::RanzMarshall,
-     "Ranz–Marshall, Nu = 2 + 0.6 Re^½ Pr^⅓ (MFiX)"},
-};
+constexpr auto kNusselt = entriesOf<kernels::NusseltModel>(kernels::NusseltModels{});
 constexpr ModelEntry<ReynoldsDefinition> kReynolds[] = {
     {"with-voidage", ReynoldsDefinition::WithVoidage, "Re = ε ρ_g d |Δu|/μ_g, as the drag"},
     {"without-voidage", ReynoldsDefinition::WithoutVoidage, "Re = ρ_g d |Δu|/μ_g"},
@@ -47,15 +39,8 @@ constexpr ModelEntry<MotionModel> kMotion[] = {
     {"frozen", MotionModel::Frozen,
      "particles held in place, velocities zeroed (MFiX verification cases)"},
 };
-constexpr ModelEntry<kernels::RateLaw> kRateLaw[] = {
-    {"constant", kernels::RateLaw::Constant, "ω = A (mol/s)"},
-    {"arrhenius", kernels::RateLaw::Arrhenius, "ω = A T^β exp(−E/(R T)) (× C_g^order)"},
-};
-constexpr ModelEntry<kernels::WgsEquilibrium> kWgs[] = {
-    {"yoon_denn", kernels::WgsEquilibrium::YoonDenn, "K_eq of Yoon & Denn (seed default)"},
-    {"seed", kernels::WgsEquilibrium::Seed, "K_eq = exp(−4.33 + 4577.8/T) (seed)"},
-    {"thermodynamic", kernels::WgsEquilibrium::Thermodynamic, "K_eq from the NASA-7 data"},
-};
+constexpr auto kRateLaw = entriesOf<kernels::RateLaw>(kernels::RateLaws{});
+constexpr auto kWgs = entriesOf<kernels::WgsEquilibrium>(kernels::WgsEquilibria{});
 
 /// '_' as '-' (model names accept either).
 std::string normalise(std::string_view s) {
@@ -232,20 +217,6 @@ std::optional<bool> onOff(std::string_view value, std::string& error) {
   return std::nullopt;
 }
 
-/// A finite number in the range `lo`..`hi` (`loOpen`: lo excluded), described by `what`.
-std::optional<double> number(std::string_view value, double lo, bool loOpen, double hi,
-                             std::string_view what, std::string& error) {
-  double v = 0.0;
-  const char* end = value.data() + value.size();
-  const auto r = std::from_chars(value.data(), end, v);
-  const bool ok = r.ec == std::errc() && r.ptr == end && std::isfinite(v) &&
-                  (loOpen ? v > lo : v >= lo) && v <= hi;
-  if (ok)
-    return v;
-  error = coredem::format("'{}' is not allowed; expected {}", value, what);
-  return std::nullopt;
-}
-
 /// An integer in [lo, hi].
 std::optional<int> integer(std::string_view value, int lo, int hi, std::string_view what,
                            std::string& error) {
@@ -270,62 +241,17 @@ std::string heatSwitch(DemConfig& c, std::string_view v) {
   return e;
 }
 
-/// "%.17g" (the hash's and the defaults' spelling of a number).
-std::string g17(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.17g", v);
-  return b;
-}
-
-/// The shortest text that reads back as `v` (defaults and ranges as users read them).
-std::string shortest(double v) {
-  char b[40];
-  const auto r = std::to_chars(b, b + sizeof b, v);
-  return std::string(b, r.ptr);
-}
-
-/// The `models:` key of parameter `P` of model `M` in `family`: "<family>.<model>.<parameter>".
-template <class M>
-std::string paramKey(std::string_view family, const char* param) {
-  return coredem::format("{}.{}.{}", family, M::name, param);
-}
-
-/// The range of a declared parameter as users read it, e.g. "number in (0, 1]".
-template <class P>
-std::string rangeText(const kernels::ModelParam<P>& p) {
-  return coredem::format("number in {}{}, {}]", p.loOpen ? "(" : "[", shortest(p.lo),
-                         shortest(p.hi));
-}
-
-/// Parser of parameter `I` of model `M` (its range from the declaration), stored in the
-/// family's ParamPack member `Pack` of DemConfig.
-template <class List, class M, std::size_t I, kernels::ParamPack<List> DemConfig::*Pack>
-std::string applyParam(DemConfig& c, std::string_view v) {
-  constexpr auto params = M::params();
-  constexpr kernels::ModelParam<typename M::Params> p = params[I];
-  std::string e;
-  if (const auto x = number(v, p.lo, p.loOpen, p.hi,
-                            coredem::format("a {} ({}, {})", rangeText(p), p.units,
-                                            shortest(typename M::Params{}.*p.field)),
-                            e))
-    (c.*Pack).template of<M>().*p.field = *x;
-  return e;
-}
-
-/// One `models:` row per declared parameter of every model of `List`.
-template <class List, kernels::ParamPack<List> DemConfig::*Pack>
+/// One `models:` row per declared parameter of every model of `List`, stored in the family's
+/// ParamPack std::invoke(Pack, DemConfig&) (a member pointer, or a function for a nested one).
+template <class List, auto Pack>
 void addParamRowsOf(std::vector<ModelOption>& o, std::string_view family) {
-  kernels::forEachModel(List{}, [&]<class M>() {
-    constexpr auto params = M::params();
-    [&]<std::size_t... I>(std::index_sequence<I...>) {
-      (o.push_back({paramKey<M>(family, params[I].key), std::string(family), rangeText(params[I]),
-                    shortest(typename M::Params{}.*params[I].field),
-                    coredem::format("{} ({}), {} only", params[I].doc, params[I].units, M::name),
-                    &applyParam<List, M, I, Pack>}),
-       ...);
-    }
-    (std::make_index_sequence<params.size()>{});
-  });
+  for (registry::ParamRow<DemConfig>& r : registry::paramRowsOf<DemConfig, List, Pack>(family))
+    o.push_back({std::move(r.key), std::move(r.family), std::move(r.values),
+                 std::move(r.defaultValue), std::move(r.doc), r.apply});
+}
+
+kernels::ParamPack<kernels::NusseltModels>& nusseltParamsOf(DemConfig& c) {
+  return c.heat.nusseltModels;
 }
 
 std::vector<ModelOption> makeOptions() {
@@ -382,6 +308,7 @@ std::vector<ModelOption> makeOptions() {
                    c.heat.voidageExponent = *x;
                  return e;
                }});
+  addParamRowsOf<kernels::NusseltModels, &nusseltParamsOf>(o, "convection");
   // --- conduction
   o.push_back({"contact_conduction", "conduction", onOffText, "on",
                "particle–particle conduction through the contact area",
@@ -508,40 +435,15 @@ bool applyModelOption(DemConfig& config, std::string_view key, std::string_view 
   return true;
 }
 
-namespace {
-
-/// Calls f(key, value, default, param) for each declared parameter of the chosen model `id` of
-/// `List` (the family's `family` prefix in the keys).
-template <class List, class F>
-void forChosenParams(const kernels::ParamPack<List>& pack, int id, std::string_view family, F&& f) {
-  kernels::forEachModel(List{}, [&]<class M>() {
-    if (kernels::modelId<M, List> != id)
-      return;
-    for (const auto& p : M::params())
-      f(paramKey<M>(family, p.key), pack.template of<M>().*p.field, typename M::Params{}.*p.field,
-        p);
-  });
-}
-
-} // namespace
-
 std::string modelParamsHashText(const DemConfig& c) {
-  std::string t;
-  forChosenParams(c.dragLaws, static_cast<int>(c.drag), "drag",
-                  [&](const std::string& key, double v, double def, const auto&) {
-                    if (v != def)
-                      t += "|" + key + ":" + g17(v) + ";";
-                  });
-  return t;
+  return registry::paramsHashText(c.dragLaws, static_cast<int>(c.drag), "drag") +
+         registry::paramsHashText(c.heat.nusseltModels, static_cast<int>(c.heat.nusselt),
+                                  "convection");
 }
 
 void checkModelParams(const DemConfig& c) {
-  forChosenParams(c.dragLaws, static_cast<int>(c.drag), "drag",
-                  [&](const std::string& key, double v, double, const auto& p) {
-                    COREDEM_CHECK(std::isfinite(v) && (p.loOpen ? v > p.lo : v >= p.lo) &&
-                                      v <= p.hi,
-                                  "models: {} = {} is outside its range: {}", key, v, rangeText(p));
-                  });
+  registry::checkParams(c.dragLaws, static_cast<int>(c.drag), "drag");
+  registry::checkParams(c.heat.nusseltModels, static_cast<int>(c.heat.nusselt), "convection");
 }
 
 std::vector<ModelIssue>

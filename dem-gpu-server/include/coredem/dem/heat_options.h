@@ -30,6 +30,9 @@ struct HeatOptions {
       true; ///< `wall_conduction: on|off`: contact conduction to fixed-temperature walls
   bool wallLensConduction =
       true; ///< `wall_lens_conduction: on|off`: gas-lens conduction to them (needs κ_g)
+  /// Each Nusselt correlation's parameters, `convection.<model>.<key>` (hashed with the other
+  /// models' parameters: models.h modelParamsHashText).
+  kernels::ParamPack<kernels::NusseltModels> nusseltModels{};
 };
 
 /// Heat the particles received since the system was built (or restarted from a state file

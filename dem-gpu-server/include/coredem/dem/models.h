@@ -3,8 +3,10 @@
 /// Model registries of the DEM server: one table per model family, and the table of the keys of
 /// case.yaml `models:` (= `Configure.options`) that select and parametrise them.
 ///
-/// A family registry lists {name, enum value, one-line doc}; the kernels dispatch on the enum
-/// (e.g. kernels/drag.h on kernels::DragLaw). A `models:` key row holds the key, the family it
+/// A family registry lists {name, id, one-line doc}; the kernels dispatch on the id (e.g.
+/// kernels/drag.h on kernels::DragLaw). The registries of the drag laws, Nusselt correlations,
+/// rate laws and WGS equilibrium constants are generated from their type lists
+/// (kernels/model_list.h; src/model_registry.h). A `models:` key row holds the key, the family it
 /// belongs to, the allowed values and the default as users read them, a one-line doc and the
 /// parser that checks a value and stores it in a DemConfig. The DEM server applies `models:`
 /// with applyModelOption(); `coredem check` / `coredem run` validate the whole mapping with
@@ -13,10 +15,12 @@
 /// This library (target coredem::dem_models) needs neither CUDA nor the protocol nor the engine:
 /// only the plain-data headers dem_system.h and the kernels' enums.
 ///
-/// Adding a drag law: its kernel header (the model's declaration), its name in the type list
-/// kernels::DragLaws (kernels/drag.h), its test and its docs/case-schema.md rows: the family
-/// registry, its `models:` value, the rows of its parameters ("drag.<law>.<parameter>"), their
-/// validation and hashing are generated from the list here (docs/architecture.md).
+/// Adding a drag law (a Nusselt correlation): its kernel header (the model's declaration), its
+/// name in the type list kernels::DragLaws (kernels/drag.h; kernels::NusseltModels,
+/// kernels/convection.h), its test and its docs/case-schema.md rows: the family registry, its
+/// `models:` value, the rows of its parameters ("drag.<law>.<parameter>",
+/// "convection.<model>.<parameter>"), their validation and hashing are generated from the list
+/// here (docs/architecture.md).
 
 #include <cstddef>
 #include <span>
@@ -71,15 +75,17 @@ struct ModelFamily {
 
 /// Drag laws (kernels/drag.h).
 const ModelFamily<kernels::DragLaw>& dragModels();
-/// Nusselt correlations of the particle–gas convection (kernels/convection.h).
+/// Nusselt correlations of the particle–gas convection (kernels::NusseltModels, convection.h).
 const ModelFamily<kernels::NusseltModel>& nusseltModels();
 /// Reynolds number definitions of the Nusselt correlations.
 const ModelFamily<ReynoldsDefinition>& reynoldsModels();
 /// Particle motion.
 const ModelFamily<MotionModel>& motionModels();
-/// Heterogeneous kinetics: rate laws of data-defined reactions (kernels/reaction_generic.h).
+/// Heterogeneous kinetics: rate laws of data-defined reactions (kernels::RateLaws,
+/// kernels/reaction_generic.h).
 const ModelFamily<kernels::RateLaw>& rateLawModels();
-/// Water–gas-shift equilibrium constants (kernels/wgs.h; case.yaml chemistry.clg.wgs_equilibrium).
+/// Water–gas-shift equilibrium constants (kernels::WgsEquilibria, kernels/wgs.h; case.yaml
+/// chemistry.clg.wgs_equilibrium).
 const ModelFamily<kernels::WgsEquilibrium>& wgsEquilibriumModels();
 
 /// One key of `models:`.

@@ -20,21 +20,45 @@
 ///   H_c = Σ_{i∈c} G_i / V_c  (W/(m³ K), implicit coefficient on T_g)
 ///   (H T_p)_c = Σ_{i∈c} G_i T_p,i / V_c  (W/m³, explicit part),
 /// which equals (1/V_c) Σ Q_gp,i exactly when T_g is the cell value (PCM).
+///
+/// Adding a Nusselt correlation: its kernel header (a model struct as nusselt_li_mason.h: name,
+/// doc, Params, params(), `voidageFactor(const Params&, ε, n)`, the part that depends on the gas
+/// state only, and `evaluate(const Params&, Re, Pr^⅓, voidageFactor)` returning Nu), its name in
+/// NusseltModels below (appended: the others' ids, and so earlier configuration hashes, stay),
+/// its test and its docs/case-schema.md rows. Its `models: {convection: …}` value and parameter
+/// keys (`convection.<model>.<key>`), their validation, hashing and copy into the engine come
+/// from the declaration (coredem/dem/models.h).
 
 #include <cmath>
 
 #include <coredem/dem/kernels/common.h>
+#include <coredem/dem/kernels/model_list.h>
+#include <coredem/dem/kernels/nusselt_li_mason.h>
+#include <coredem/dem/kernels/nusselt_ranz_marshall.h>
 
 namespace coredem::dem::kernels {
 
-/// Nusselt correlations; case-file names in the registry (coredem/dem/models.h, nusseltModels()).
+/// The Nusselt correlations, in id order (the registration line).
+using NusseltModels = ModelList<LiMasonNusselt, RanzMarshallNusselt>;
+
+/// A Nusselt correlation's id (its position in NusseltModels; the configuration hash uses it);
+/// case-file names in the registry (coredem/dem/models.h, nusseltModels()). Any correlation's id
+/// is nusseltModel<M>().
 enum class NusseltModel : int { LiMason = 0, RanzMarshall = 1 };
+
+template <class M>
+constexpr NusseltModel nusseltModel() {
+  return static_cast<NusseltModel>(modelId<M, NusseltModels>);
+}
+static_assert(nusseltModel<LiMasonNusselt>() == NusseltModel::LiMason);
+static_assert(nusseltModel<RanzMarshallNusselt>() == NusseltModel::RanzMarshall);
 
 struct ConvectionParams {
   NusseltModel model = NusseltModel::LiMason;
-  double voidageExponent = 3.5;    ///< n in Eq. 21 (Li & Mason: 3.5 dilute, 4.75 dense)
-  bool reynoldsWithVoidage = true; ///< Re_p with ε (default) or without
-  double epsMin = 0.35;            ///< lower clip of ε_g in Re and εⁿ (0 disables)
+  double voidageExponent = 3.5;      ///< n in Eq. 21 (Li & Mason: 3.5 dilute, 4.75 dense)
+  bool reynoldsWithVoidage = true;   ///< Re_p with ε (default) or without
+  double epsMin = 0.35;              ///< lower clip of ε_g in Re and εⁿ (0 disables)
+  ParamPack<NusseltModels> models{}; ///< each correlation's Params (models.of<M>())
 };
 
 /// Gas state seen by a particle (cell of its centroid, PCM), SI.
@@ -59,22 +83,22 @@ DEM_HD double prandtl(double muG, double cpG, double kG) {
   return muG * cpG / kG;
 }
 
-/// Li–Mason Nusselt number (Eq. 21), −.
-DEM_HD double nusseltLiMason(double re, double pr, double eps, double n) {
-  const double en = std::pow(eps, n);
-  if (re < 200.0) {
-    return 2.0 + 0.6 * en * std::sqrt(re) * std::cbrt(pr);
+/// The family's dispatch on the gas-state factor: Dispatch<NusseltVoidageFamily, NusseltModels>.
+struct NusseltVoidageFamily {
+  template <class M>
+  DEM_HD static double evaluate(const ConvectionParams& p, const double& eps) {
+    return M::voidageFactor(p.models.template of<M>(), eps, p.voidageExponent);
   }
-  if (re < 1500.0) {
-    return 2.0 + en * (0.5 * std::sqrt(re) + 0.02 * std::pow(re, 0.8)) * std::cbrt(pr);
-  }
-  return 2.0 + 4.5e-5 * en * std::pow(re, 1.8);
-}
+};
 
-/// Ranz–Marshall Nusselt number, −.
-DEM_HD double nusseltRanzMarshall(double re, double pr) {
-  return 2.0 + 0.6 * std::sqrt(re) * std::cbrt(pr);
-}
+/// The family's dispatch on the Nusselt number: Dispatch<NusseltFamily, NusseltModels>.
+struct NusseltFamily {
+  template <class M>
+  DEM_HD static double evaluate(const ConvectionParams& p, const double& re, const double& pr13,
+                                const double& en) {
+    return M::evaluate(p.models.template of<M>(), re, pr13, en);
+  }
+};
 
 /// The factors of the Nusselt number that depend only on the gas state (constant over a CFD
 /// step in a PCM cell): computed once per cell and step instead of once per particle and
@@ -82,37 +106,28 @@ DEM_HD double nusseltRanzMarshall(double re, double pr) {
 /// of nusseltLiMason()/nusseltRanzMarshall() (same operations in the same order).
 struct NusseltFactors {
   double eps;  ///< ε clipped at epsMin, −
-  double en;   ///< εⁿ (Li–Mason), −
+  double en;   ///< the correlation's voidage factor (Li–Mason: εⁿ), −
   double pr13; ///< Pr^(1/3), −
 };
 
 DEM_HD NusseltFactors nusseltFactors(const ConvectionParams& p, const GasState& g) {
   const double eps = g.eps > p.epsMin ? g.eps : p.epsMin;
-  const double en = p.model == NusseltModel::RanzMarshall ? 1.0 : std::pow(eps, p.voidageExponent);
+  const double en =
+      Dispatch<NusseltVoidageFamily, NusseltModels>::call(static_cast<int>(p.model), p, eps);
   return {eps, en, std::cbrt(prandtl(g.mu, g.cp, g.k))};
 }
 
 /// Nusselt number from the cell factors and the particle Reynolds number, −.
 DEM_HD double nusseltFromFactors(const ConvectionParams& p, const NusseltFactors& f, double re) {
-  if (p.model == NusseltModel::RanzMarshall) {
-    return 2.0 + 0.6 * std::sqrt(re) * f.pr13;
-  }
-  if (re < 200.0) {
-    return 2.0 + 0.6 * f.en * std::sqrt(re) * f.pr13;
-  }
-  if (re < 1500.0) {
-    return 2.0 + f.en * (0.5 * std::sqrt(re) + 0.02 * std::pow(re, 0.8)) * f.pr13;
-  }
-  return 2.0 + 4.5e-5 * f.en * std::pow(re, 1.8);
+  return Dispatch<NusseltFamily, NusseltModels>::call(static_cast<int>(p.model), p, re, f.pr13,
+                                                      f.en);
 }
 
 /// Nusselt number for the chosen model, from the slip speed |u_g − v_p| (m/s).
 DEM_HD double nusselt(const ConvectionParams& p, const GasState& g, double dP, double slip) {
-  const double eps = g.eps > p.epsMin ? g.eps : p.epsMin;
-  const double re = particleReynolds(g.rho, g.mu, dP, slip, eps, p.reynoldsWithVoidage);
-  const double pr = prandtl(g.mu, g.cp, g.k);
-  return p.model == NusseltModel::RanzMarshall ? nusseltRanzMarshall(re, pr)
-                                               : nusseltLiMason(re, pr, eps, p.voidageExponent);
+  const NusseltFactors f = nusseltFactors(p, g);
+  const double re = particleReynolds(g.rho, g.mu, dP, slip, f.eps, p.reynoldsWithVoidage);
+  return nusseltFromFactors(p, f, re);
 }
 
 /// Result of the convection kernel for one particle.

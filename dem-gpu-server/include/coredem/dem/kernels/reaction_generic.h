@@ -15,17 +15,27 @@
 ///   heat into the particle: Q_rxn = −ΔH ω (§3.5), ΔH given in J/mol of reaction.
 ///
 /// Mass is conserved to round-off when Σ ν_k M_k = 0 (checked by heterogeneousMassImbalance).
+///
+/// Rate laws are a model family (kernels/model_list.h) chosen per reaction
+/// (HeterogeneousReaction::law, from `reactions[].rate.law`): a law's coefficients (A, β, E) are
+/// the reaction's data, not `models:` keys, so the laws declare no parameters. Adding one: its
+/// model struct below (name, doc, Params, params(), `evaluate(const Params&, reaction, T_p)`
+/// returning ω before the order and availability factors, mol/s), its name appended to RateLaws
+/// (the others' ids, and so earlier configuration hashes, stay), and its spelling in the
+/// `reactions:` reader and Configure's RateLaw.
 
 #include <cmath>
 
 #include <coredem/dem/kernels/common.h>
+#include <coredem/dem/kernels/model_list.h>
 
 namespace coredem::dem::kernels {
 
 inline constexpr int kMaxReactionTerms = 6;
 
 enum class ReactionPhase : int { Gas = 0, Solid = 1 };
-/// Rate laws; case-file names in the registry (coredem/dem/models.h, rateLawModels()).
+/// A rate law's id (its position in RateLaws; the configuration hash uses it); case-file names
+/// in the registry (coredem/dem/models.h, rateLawModels()).
 enum class RateLaw : int { Constant = 0, Arrhenius = 1 };
 
 struct HeterogeneousReaction {
@@ -43,15 +53,55 @@ struct HeterogeneousReaction {
   double dH = 0.0;    ///< heat of reaction, J per mol of reaction (> 0 endothermic)
 };
 
+/// ω = A (mol/s).
+struct ConstantRate {
+  static constexpr const char* name = "constant";
+  static constexpr const char* doc = "ω = A (mol/s)";
+  struct Params {};
+  static constexpr auto params() { return noParams<Params>(); }
+
+  DEM_HD static double evaluate(const Params&, const HeterogeneousReaction& r, double) {
+    return r.A;
+  }
+};
+
+/// ω = A T_p^β exp(−E/(R T_p)) (mol/s).
+struct ArrheniusRate {
+  static constexpr const char* name = "arrhenius";
+  static constexpr const char* doc = "ω = A T^β exp(−E/(R T)) (× C_g^order)";
+  struct Params {};
+  static constexpr auto params() { return noParams<Params>(); }
+
+  DEM_HD static double evaluate(const Params&, const HeterogeneousReaction& r, double tP) {
+    // T^β exp(−E/(RT)) as one exp() (β = 0: no log).
+    const double arg = -r.E / (8.314462618 * tP);
+    return r.A * std::exp(r.beta == 0.0 ? arg : r.beta * std::log(tP) + arg);
+  }
+};
+
+/// The rate laws, in id order (the registration line).
+using RateLaws = ModelList<ConstantRate, ArrheniusRate>;
+
+template <class Law>
+constexpr RateLaw rateLaw() {
+  return static_cast<RateLaw>(modelId<Law, RateLaws>);
+}
+static_assert(rateLaw<ConstantRate>() == RateLaw::Constant);
+static_assert(rateLaw<ArrheniusRate>() == RateLaw::Arrhenius);
+
+/// The family's dispatch: Dispatch<RateLawFamily, RateLaws> calls the reaction's law (the laws
+/// take their coefficients from the reaction: default Params).
+struct RateLawFamily {
+  template <class Law>
+  DEM_HD static double evaluate(const HeterogeneousReaction& r, const double& tP) {
+    return Law::evaluate(typename Law::Params{}, r, tP);
+  }
+};
+
 /// Rate before availability limits, mol/s. gasConc: cell concentrations (mol/m³) indexed by
 /// the gas-species indices of the terms (may be null when orderTerm < 0).
 DEM_HD double heterogeneousRate(const HeterogeneousReaction& r, double tP, const double* gasConc) {
-  double w = r.A;
-  if (r.law == RateLaw::Arrhenius) {
-    // T^β exp(−E/(RT)) as one exp() (β = 0: no log).
-    const double arg = -r.E / (8.314462618 * tP);
-    w *= std::exp(r.beta == 0.0 ? arg : r.beta * std::log(tP) + arg);
-  }
+  double w = Dispatch<RateLawFamily, RateLaws>::call(static_cast<int>(r.law), r, tP);
   if (r.orderTerm >= 0) {
     const double c = gasConc[r.index[r.orderTerm]];
     w *= c > 0.0 ? (r.order == 1.0 ? c : std::pow(c, r.order)) : 0.0;

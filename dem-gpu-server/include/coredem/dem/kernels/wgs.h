@@ -11,17 +11,68 @@
 ///
 /// The seed's extracted rate is not equilibrium-consistent (docs/physics.md §0.3); this form is.
 /// ω already contains ε_g: do not multiply by ε_g again (§1).
+///
+/// The K_eq correlations are a model family (kernels/model_list.h), chosen by
+/// `chemistry.clg.wgs_equilibrium`. Adding one: its model struct below (name, doc, Params,
+/// params(), `evaluate(const Params&, T)` returning K_eq), its name appended to WgsEquilibria
+/// (the others' ids, and so earlier configuration hashes, stay), and its spelling in the
+/// `chemistry:` reader and Configure's WgsEquilibrium.
 
 #include <cmath>
 
 #include <coredem/dem/kernels/common.h>
+#include <coredem/dem/kernels/model_list.h>
 #include <coredem/dem/kernels/nasa7.h>
 #include <coredem/dem/kernels/reaction_enthalpy.h>
 
 namespace coredem::dem::kernels {
 
-/// K_eq choices; case-file names in the registry (coredem/dem/models.h, wgsEquilibriumModels()).
+/// K_eq = 0.0265 exp(3968/T) (Yoon & Denn; the default [C]).
+struct YoonDennEquilibrium {
+  static constexpr const char* name = "yoon_denn";
+  static constexpr const char* doc = "K_eq of Yoon & Denn (seed default)";
+  struct Params {};
+  static constexpr auto params() { return noParams<Params>(); }
+
+  DEM_HD static double evaluate(const Params&, double t) { return 0.0265 * std::exp(3968.0 / t); }
+};
+
+/// K_eq = exp(−4.33 + 4577.8/T) (the seed's).
+struct SeedEquilibrium {
+  static constexpr const char* name = "seed";
+  static constexpr const char* doc = "K_eq = exp(−4.33 + 4577.8/T) (seed)";
+  struct Params {};
+  static constexpr auto params() { return noParams<Params>(); }
+
+  DEM_HD static double evaluate(const Params&, double t) { return std::exp(-4.33 + 4577.8 / t); }
+};
+
+/// K_eq = exp(−ΔG°/(R T)) of R3 from the NASA-7 data (exactly consistent with ΔH_R3).
+struct ThermodynamicEquilibrium {
+  static constexpr const char* name = "thermodynamic";
+  static constexpr const char* doc = "K_eq from the NASA-7 data";
+  struct Params {};
+  static constexpr auto params() { return noParams<Params>(); }
+
+  DEM_HD static double evaluate(const Params&, double t) {
+    return equilibriumConstant(clgStoichiometry(ClgReaction::R3), t);
+  }
+};
+
+/// The K_eq correlations, in id order (the registration line).
+using WgsEquilibria = ModelList<YoonDennEquilibrium, SeedEquilibrium, ThermodynamicEquilibrium>;
+
+/// A K_eq correlation's id (its position in WgsEquilibria; the configuration hash uses it);
+/// case-file names in the registry (coredem/dem/models.h, wgsEquilibriumModels()).
 enum class WgsEquilibrium : int { YoonDenn = 0, Seed = 1, Thermodynamic = 2 };
+
+template <class M>
+constexpr WgsEquilibrium wgsEquilibrium() {
+  return static_cast<WgsEquilibrium>(modelId<M, WgsEquilibria>);
+}
+static_assert(wgsEquilibrium<YoonDennEquilibrium>() == WgsEquilibrium::YoonDenn);
+static_assert(wgsEquilibrium<SeedEquilibrium>() == WgsEquilibrium::Seed);
+static_assert(wgsEquilibrium<ThermodynamicEquilibrium>() == WgsEquilibrium::Thermodynamic);
 
 struct WgsParams {
   double kf0 = 2.78e-3;    ///< m³/(mol s)
@@ -30,17 +81,18 @@ struct WgsParams {
   bool enabled = true;
 };
 
+/// The family's dispatch: Dispatch<WgsEquilibriumFamily, WgsEquilibria> calls the chosen K_eq
+/// (no correlation has parameters: default Params).
+struct WgsEquilibriumFamily {
+  template <class M>
+  DEM_HD static double evaluate(const double& t) {
+    return M::evaluate(typename M::Params{}, t);
+  }
+};
+
 /// K_eq(T) of CO + H2O ⇌ CO2 + H2, −.
 DEM_HD double wgsEquilibriumConstant(const WgsParams& p, double t) {
-  switch (p.equilibrium) {
-  case WgsEquilibrium::Seed:
-    return std::exp(-4.33 + 4577.8 / t);
-  case WgsEquilibrium::Thermodynamic:
-    return equilibriumConstant(clgStoichiometry(ClgReaction::R3), t);
-  case WgsEquilibrium::YoonDenn:
-  default:
-    return 0.0265 * std::exp(3968.0 / t);
-  }
+  return Dispatch<WgsEquilibriumFamily, WgsEquilibria>::call(static_cast<int>(p.equilibrium), t);
 }
 
 /// Net forward rate ω, mol/(m³ s), from concentrations (mol/m³).
