@@ -5,7 +5,6 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include <coredem/orchestrator/foam_field.h>
 #include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/participants.h>
 
@@ -131,26 +130,16 @@ void checkIdealGas(CaseReading& r) {
       names.push_back(sp.name);
     }
   }
-  // The initial gas: air, or the species' uniform initial mass fractions in the OpenFOAM case
-  // (equal fractions when they cannot be read; pre-flight checks them).
+  // The initial gas: air, or the species' uniform initial mass fractions in the participant's
+  // input (the OpenFOAM case's 0/; equal fractions when they cannot be read; pre-flight checks
+  // them).
   if (names.empty()) {
     names.emplace_back(kAirSpecies);
   }
   std::vector<double> Y(names.size(), 1.0 / double(names.size()));
-  if (!c.species.empty()) {
-    std::vector<double> read;
-    double sum = 0.0;
-    for (const auto& n : names) {
-      const FoamFieldValues f = readFoamField(c.caseDir / c.cfd.caseFolder / "0" / n);
-      if (!f.found || f.values.empty() || f.values.front().patch != "internalField" ||
-          !f.values.front().uniform || !(f.values.front().value >= 0.0)) {
-        break;
-      }
-      read.push_back(f.values.front().value);
-      sum += read.back();
-    }
-    if (read.size() == names.size() && std::abs(sum - 1.0) <= 1e-9) {
-      Y = read;
+  if (!c.species.empty() && part.initialMassFractions != nullptr) {
+    if (auto read = part.initialMassFractions(c, names)) {
+      Y = std::move(*read);
     }
   }
   auto& p = c.gasProperties;

@@ -8,7 +8,6 @@
 #include <yaml-cpp/yaml.h>
 
 #include <coredem/dem/triangle_mesh.h>
-#include <coredem/orchestrator/foam_patches.h>
 #include <coredem/orchestrator/participants.h>
 
 #include "case_read.h"
@@ -151,15 +150,16 @@ std::vector<std::string> patchNames(const Section& s) {
   return names;
 }
 
-/// walls.meshes[i].from_cfd: the wall from patches of the OpenFOAM case's mesh (cfd.case).
+/// walls.meshes[i].from_cfd: the wall from patches of the mesh of cfd.case, read by the CFD
+/// participant's `meshPatches` hook (the OpenFOAM case's constant/polyMesh).
 void meshFromCfd(const Section& s, const CaseConfig& c, bool cfdSection, MeshWallConfig& m) {
   const std::string key = s.full("from_cfd");
   const ParticipantDescriptor& p = participant(c.cfd.participant);
-  if (!p.openFoamCase) {
-    std::vector<std::string> foam;
+  if (p.meshPatches == nullptr) {
+    std::vector<std::string> withMesh;
     for (const auto& q : participantTable()) {
-      if (q.openFoamCase) {
-        foam.push_back(q.name);
+      if (q.meshPatches != nullptr) {
+        withMesh.push_back(q.name);
       }
     }
     s.fail(s.markOf("from_cfd"), key,
@@ -168,19 +168,19 @@ void meshFromCfd(const Section& s, const CaseConfig& c, bool cfdSection, MeshWal
                        "cfd: {{participant: {}, case: <OpenFOAM case folder>}}, or give the wall "
                        "as an STL file (walls.meshes[].file)",
                        p.name, cfdSection ? "cfd.participant" : "the default: no cfd section",
-                       join(foam)));
+                       join(withMesh)));
   }
   m.fromCfd = patchNames(s);
-  const fs::path foamCase = fs::absolute(c.caseDir / c.cfd.caseFolder).lexically_normal();
-  m.path = foamCase / "constant" / "polyMesh";
-  m.name = fmt::format("{}/constant/polyMesh:{}", c.cfd.caseFolder, join(m.fromCfd));
+  const fs::path cfdCase = fs::absolute(c.caseDir / c.cfd.caseFolder).lexically_normal();
+  m.path = cfdCase / p.meshFolder;
+  m.name = fmt::format("{}/{}:{}", c.cfd.caseFolder, p.meshFolder, join(m.fromCfd));
   if (m.name.size() > 200) { // the DEM server's limit on names is 256 bytes
     m.name = fmt::format("{}... ({} patches)", m.name.substr(0, 170), m.fromCfd.size());
   }
-  FoamPatchSurface surface;
+  CfdPatchSurface surface;
   try {
-    surface = readFoamPatches(foamCase, m.fromCfd);
-  } catch (const FoamMeshError& e) {
+    surface = p.meshPatches(cfdCase, m.fromCfd);
+  } catch (const CfdMeshError& e) {
     s.fail(s.markOf("from_cfd"), key, e.what());
   }
   dem::TriangleMesh mesh;

@@ -1,5 +1,5 @@
-// The participant table (participants.h): every CFD participant that `coredem run` can start,
-// one row each, and the generic code that launches, prepares and checks a row.
+// The generic code that launches, prepares and checks a row of the participant table
+// (participants.h; the table is participant_table.cpp).
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -10,71 +10,12 @@
 
 #include <coredem/common/log.h>
 #include <coredem/common/process.h>
-#include <coredem/gas/gas_model.h>
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/preflight.h>
-
-#include "participant_rows.h"
 
 namespace fs = std::filesystem;
 
 namespace coredem::orchestrator {
-namespace {
-
-std::vector<ParticipantDescriptor> makeTable() {
-  std::vector<ParticipantDescriptor> t;
-  {
-    // Prescribed gas from the case file (docs/client.md "coredem-gas"): verification cases,
-    // DEM-only runs, tests. Everything on its command line; its restart file is gas.h5.
-    ParticipantDescriptor p;
-    p.name = "coredem-gas";
-    p.summary = "prescribed gas fields from the case file's gas section";
-    p.args = {"--case",    "{run_case_file}",    "--key",       "{gas_key}",
-              "--control", "{control_endpoint}", "--dem",       "{dem_endpoint}",
-              "--session", "{session}",          "--timeout-s", "{timeout_s}"};
-    p.restartArgs = {"--restart", "{restart_file}"};
-    p.env = {{"COREDEM_DEM_SERVER_KEY", "{dem_server_key}"},
-             {"COREDEM_DEM_CLIENT_KEY_FILE", "{dem_client_key_file}"}};
-    p.restartFile = "*.h5";
-    p.preflight = &checkGasSection;
-    t.push_back(std::move(p));
-  }
-  t.push_back(openFoamParticipant()); // participant_openfoam.cpp
-  return t;
-}
-
-std::string joined(const std::vector<std::string>& items, const char* sep = ", ") {
-  std::string out;
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    out += (i ? sep : "") + items[i];
-  }
-  return out;
-}
-
-} // namespace
-
-const std::vector<ParticipantDescriptor>& participantTable() {
-  static const std::vector<ParticipantDescriptor> table = makeTable();
-  return table;
-}
-
-std::vector<std::string> participantNames() {
-  std::vector<std::string> names;
-  for (const auto& p : participantTable()) {
-    names.push_back(p.name);
-  }
-  return names;
-}
-
-const ParticipantDescriptor& participant(const std::string& name) {
-  for (const auto& p : participantTable()) {
-    if (p.name == name) {
-      return p;
-    }
-  }
-  throw CaseError(fmt::format("unknown CFD participant '{}'; known participants: {}", name,
-                              joined(participantNames())));
-}
 
 std::string expandTemplate(const std::string& text,
                            const std::map<std::string, std::string>& values) {
@@ -193,14 +134,6 @@ void prepareWorkDir(const ParticipantDescriptor& p, const CaseConfig& config,
 bool isRestartFile(const ParticipantDescriptor& p, const fs::path& path) {
   return !p.restartFile.empty() &&
          ::fnmatch(p.restartFile.c_str(), path.filename().c_str(), 0) == 0;
-}
-
-void checkGasSection(const CaseConfig& config) {
-  try {
-    gas::GasModel::fromFile(config.caseFile.string(), config.cfd.gasKey);
-  } catch (const UserError& e) {
-    throw CaseError(e.what());
-  }
 }
 
 void checkParticipantInput(const CaseConfig& config) {

@@ -1,5 +1,6 @@
 // Pre-flight consistency of a case (preflight.h): geometry, packing, temperatures, the
-// staggered step; the OpenFOAM case's checks are in preflight_foam.cpp.
+// staggered step; a participant's own input is checked by its row's pre-flight hook
+// (participants.h; the OpenFOAM case: cfd-adapter/openfoam/participant).
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -13,11 +14,9 @@
 
 #include <coredem/common/log.h>
 #include <coredem/common/yaml_section.h>
-#include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/preflight.h>
+#include <coredem/orchestrator/preflight_locator.h>
 #include <coredem/orchestrator/wall_geometry.h>
-
-#include "preflight_locator.h"
 
 namespace fs = std::filesystem;
 

@@ -11,8 +11,8 @@
 
 #include <coredem/dem/triangle_mesh.h>
 #include <coredem/orchestrator/case_config.h>
-#include <coredem/orchestrator/foam_patches.h>
 #include <coredem/orchestrator/preflight.h>
+#include <coredem/participant/foam_patches.h>
 #include <coredem/v1/configure.pb.h>
 
 #include "admission.h"

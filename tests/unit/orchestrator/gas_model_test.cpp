@@ -17,6 +17,7 @@
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/participants.h>
+#include <coredem/participant/openfoam.h>
 
 #include "case_text.h"
 

@@ -1,4 +1,4 @@
-// Pre-flight of the gas model against the OpenFOAM case (preflight.h checkOpenFoamCase), on a copy
+// Pre-flight of the gas model against the OpenFOAM case (openfoam.h checkOpenFoamCase), on a copy
 // of cases/clg: species fields of 0/ vs case.yaml species, the gas state of 0/ (T > 0, mass
 // fractions in [0, 1] summing to 1), constant/thermophysicalProperties vs the model, and the
 // ideal-gas initial temperature vs 0/T. Each refusal names both files and lines.
@@ -12,6 +12,8 @@
 #include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/preflight.h>
+#include <coredem/participant/foam_field.h>
+#include <coredem/participant/openfoam.h>
 
 #include "case_text.h"
 

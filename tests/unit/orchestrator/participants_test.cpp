@@ -15,6 +15,7 @@
 
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/participants.h>
+#include <coredem/participant/gas.h>
 
 #include "case_text.h"
 

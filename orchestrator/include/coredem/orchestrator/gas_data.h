@@ -1,7 +1,9 @@
 #pragma once
 /// @file
 /// Host-side gas data of the ideal-gas model (`gas_properties.model: ideal_gas`,
-/// docs/case-schema.md) and the OpenFOAM dictionary the orchestrator writes from it.
+/// docs/case-schema.md): read by the case reader (the initial gas state) and by the OpenFOAM
+/// participant's unit, which writes its constant/thermophysicalProperties from it
+/// (coredem/participant/openfoam.h).
 ///
 /// Per gas species: the molar mass and the NASA-7 (janaf) coefficients of the DEM's table
 /// (coredem/dem/kernels/nasa7.h: read from there, never copied), and Sutherland viscosity
@@ -12,7 +14,6 @@
 ///   Sutherland:  mu(T) = As sqrt(T) / (1 + Ts/T)   (Pa s),  As = mu0 (T0 + S) / T0^1.5, Ts = S
 
 #include <array>
-#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -67,24 +68,5 @@ GasState idealGasState(const std::vector<std::string>& species, const std::vecto
 /// The species of the ideal-gas dictionary: the case's gas species in case.yaml order, or
 /// {"air"} when the case has none.
 std::vector<std::string> thermoSpecies(const CaseConfig& config);
-
-/// The text of constant/thermophysicalProperties for a case with gas_properties.model ideal_gas
-/// (docs/case-schema.md "The generated dictionary"). Numbers are written in the shortest form
-/// that reads back to the same double. Throws CaseError naming a species without data.
-std::string thermophysicalPropertiesText(const CaseConfig& config);
-
-/// File name of the generated dictionary inside an OpenFOAM case.
-inline const std::filesystem::path kThermophysicalProperties =
-    std::filesystem::path("constant") / "thermophysicalProperties";
-
-/// The field 0/air of an ideal-gas case without species: mass fraction 1 everywhere (every patch
-/// `calculated`, constraint patches from OpenFOAM's caseDicts/setConstraintTypes).
-std::string airFieldText(const CaseConfig& config);
-
-/// ideal_gas only (no-op for the constant model): writes thermophysicalPropertiesText(config)
-/// into workDir/constant/thermophysicalProperties and, for a case without species whose copy has
-/// neither 0/air nor 0/Ydefault, airFieldText(config) into workDir/0/air (OpenFOAM's mixture
-/// reads a field per species).
-void writeGeneratedFoamDictionaries(const CaseConfig& config, const std::filesystem::path& workDir);
 
 } // namespace coredem::orchestrator

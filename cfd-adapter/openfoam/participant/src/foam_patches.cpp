@@ -14,7 +14,7 @@
 
 #include <fmt/format.h>
 
-#include <coredem/orchestrator/foam_patches.h>
+#include <coredem/participant/foam_patches.h>
 
 namespace fs = std::filesystem;
 

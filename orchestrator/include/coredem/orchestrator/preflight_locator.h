@@ -1,6 +1,8 @@
 #pragma once
-// Shared by the pre-flight checks (preflight.cpp: the case itself; preflight_foam.cpp: the
-// OpenFOAM case): where a key is in case.yaml, and how vectors are written in messages.
+/// @file
+/// Shared by the pre-flight checks (preflight.cpp: the case itself; a participant's pre-flight
+/// hook, e.g. the OpenFOAM case's): where a key is in case.yaml, and how vectors are written in
+/// messages.
 #include <string>
 #include <vector>
 

@@ -1,8 +1,8 @@
 #pragma once
 /// @file
 /// OpenFOAM field files read simply (ASCII, comments ignored, macros and #include not expanded):
-/// what the OpenFOAM participant's pre-flight and the case reader's ideal-gas check read from
-/// 0/<name> of `cfd.case`. Implemented in preflight_foam.cpp.
+/// what the OpenFOAM participant's pre-flight, its generated 0/p and its initial gas composition
+/// (the case reader's ideal-gas check) read from 0/<name> of `cfd.case`.
 
 #include <filesystem>
 #include <string>

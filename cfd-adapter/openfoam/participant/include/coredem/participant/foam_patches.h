@@ -12,13 +12,15 @@
 #include <string>
 #include <vector>
 
+#include <coredem/orchestrator/participant_descriptor.h>
+
 namespace coredem::orchestrator {
 
 /// A mesh that is missing, not in ASCII, malformed, or lacks a patch asked for. The message
 /// names the file (or the patch) and what to do; it carries no case.yaml key.
-class FoamMeshError : public std::runtime_error {
+class FoamMeshError : public CfdMeshError {
 public:
-  using runtime_error::runtime_error;
+  using CfdMeshError::CfdMeshError;
 };
 
 /// One patch of constant/polyMesh/boundary.

@@ -1,17 +1,17 @@
-// The OpenFOAM participant's row of the participant table (participants.h) and what the row
-// points to that is about OpenFOAM alone: the decomposition of its case for a run on K ranks.
-// Its pre-flight is in preflight_foam.cpp, its generated dictionaries in gas_data.cpp, the walls
-// from its mesh's patches in foam_patches.cpp.
+// The OpenFOAM participant's row of the participant table (participants.h) and the hooks of
+// the row that need no file of their own: the decomposition of its case for a run on K ranks,
+// the walls from its mesh's patches and its initial gas composition. Its pre-flight is in
+// preflight_foam.cpp, its generated dictionaries in foam_dictionaries.cpp.
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 
 #include <coredem/common/log.h>
 #include <coredem/common/process.h>
-#include <coredem/orchestrator/gas_data.h>
-#include <coredem/orchestrator/preflight.h>
-
-#include "participant_rows.h"
+#include <coredem/participant/foam_field.h>
+#include <coredem/participant/foam_patches.h>
+#include <coredem/participant/openfoam.h>
 
 namespace fs = std::filesystem;
 
@@ -35,10 +35,8 @@ void runFoamUtility(const std::string& name, std::vector<std::string> args, cons
                 p.exitReason().value_or("?"), p.logFile().string(), p.logTail());
 }
 
-/// coredemFoam on `ranks` processes: the mesh (blockMesh when the case has none),
-/// system/decomposeParDict (written when the case has none: method simple, `ranks` slabs along x;
-/// Debian's OpenFOAM builds scotch as a dummy library) and decomposePar, unless
-/// processor0 .. processor<ranks-1> exist already (a resumed run keeps its decomposition).
+} // namespace
+
 void decomposeOpenFoamCase(const fs::path& work, int ranks, const fs::path& logDir) {
   auto log = coredem::logger("orchestrator");
   const fs::path dict = work / "system" / "decomposeParDict";
@@ -68,7 +66,31 @@ void decomposeOpenFoamCase(const fs::path& work, int ranks, const fs::path& logD
   log->info("decomposed {} into {} processor folders (decomposePar)", work.string(), ranks);
 }
 
-} // namespace
+CfdPatchSurface openFoamMeshPatches(const fs::path& caseFolder,
+                                    const std::vector<std::string>& patches) {
+  FoamPatchSurface s = readFoamPatches(caseFolder, patches);
+  return {std::move(s.vertices), std::move(s.triangles), std::move(s.sourceFace),
+          std::move(s.sourcePatch)};
+}
+
+std::optional<std::vector<double>> openFoamInitialMassFractions(
+    const CaseConfig& config, const std::vector<std::string>& species) {
+  std::vector<double> read;
+  double sum = 0.0;
+  for (const auto& n : species) {
+    const FoamFieldValues f = readFoamField(config.caseDir / config.cfd.caseFolder / "0" / n);
+    if (!f.found || f.values.empty() || f.values.front().patch != "internalField" ||
+        !f.values.front().uniform || !(f.values.front().value >= 0.0)) {
+      break;
+    }
+    read.push_back(f.values.front().value);
+    sum += read.back();
+  }
+  if (read.size() == species.size() && std::abs(sum - 1.0) <= kMassFractionSumTol) {
+    return read;
+  }
+  return std::nullopt;
+}
 
 ParticipantDescriptor openFoamParticipant() {
   // The OpenFOAM solver (docs/coredemFoam.md): runs in a copy of the OpenFOAM case inside the
@@ -92,9 +114,11 @@ ParticipantDescriptor openFoamParticipant() {
   p.caseFolder = "an OpenFOAM case folder";
   p.caseFolderMarker = "system/controlDict";
   p.caseFolderHint = "give the folder with system/, constant/ and 0/";
-  p.openFoamCase = true; // walls.meshes[].from_cfd reads its constant/polyMesh
-  p.solvesGas = true;    // gas_properties.model ideal_gas: a variable-density gas
+  p.solvesGas = true; // gas_properties.model ideal_gas: a variable-density gas
   p.workDir = "openfoam";
+  p.meshPatches = &openFoamMeshPatches; // walls.meshes[].from_cfd reads its constant/polyMesh
+  p.meshFolder = "constant/polyMesh";
+  p.initialMassFractions = &openFoamInitialMassFractions; // ideal_gas: 0/<species>
   p.preflight = &checkOpenFoamCase; // gravity, gas model, species and gas state vs case.yaml
   p.generate = &writeGeneratedFoamDictionaries; // ideal_gas: constant/thermophysicalProperties
   p.parallelArgs = {"-parallel"}; // cfd.ranks > 1: mpirun -np K coredemFoam ... -parallel
