@@ -269,6 +269,10 @@ std::string hashConfig(const DemConfig& c) {
     t += "|drag:";
     num(static_cast<int>(c.drag));
   }
+  if (c.contact != kernels::ContactLaw::LinearSpringDashpot) { // absent for the default law
+    t += "|contact:";
+    num(static_cast<int>(c.contact));
+  }
   t += modelParamsHashText(c); // "" while every parameter of the chosen models is its default
   if (c.heat.enabled)          // heat off keeps the hash of configurations without heat transfer
     appendHeatHashText(c.heat, c.wallTemperature, static_cast<int>(c.wallMaterial), t);

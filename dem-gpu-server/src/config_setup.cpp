@@ -8,7 +8,7 @@
 #include <unordered_map>
 
 #include "coredem/common/check.h"
-#include "coredem/dem/kernels/damping.h"
+#include "coredem/dem/kernels/contact_law.h"
 #include "coredem/dem/kernels/pressure_gradient.h"
 #include "coredem/dem/models.h"
 #include "coredem/dem/triangle_mesh.h"
@@ -159,9 +159,18 @@ std::vector<kernels::MeshTriangle> kernelTriangles(const std::vector<MeshWall>& 
   }
   return out;
 }
-PairProps pairProps(const Material& a, const Material& b) {
-  const MaterialPair m = mixMaterials(a, b);
-  return PairProps{m.kn, m.ktFactor * m.kn, kernels::dampingFactor(m.en), m.etatFactor, m.mu};
+void setUpContacts(const DemConfig& config, EngineSetup& es) {
+  const std::size_t nm = config.materials.size();
+  es.contactLaw = config.contact;
+  es.pairs.clear();
+  kernels::visitModel(kernels::ContactLaws{}, static_cast<int>(config.contact), [&](auto law) {
+    using Law = typename decltype(law)::type;
+    const typename Law::Params& params = config.contactLaws.template of<Law>();
+    for (std::size_t a = 0; a < nm; ++a)
+      for (std::size_t b = 0; b < nm; ++b)
+        es.pairs.push_back(kernels::ContactPair::make<Law>(
+            Law::mix(params, config.materials[a], config.materials[b])));
+  });
 }
 
 /// Mass of particle i for Δt_DEM,max after a restart. With chemistry, the mass at the initial

@@ -39,8 +39,9 @@ std::vector<double> placeParticles(const ParticleSet& s, const std::atomic<bool>
 kernels::Wall kernelWall(const Wall& w);
 /// The mesh walls' triangles with vertex and edge ids unique over all meshes.
 std::vector<kernels::MeshTriangle> kernelTriangles(const std::vector<MeshWall>& meshes);
-/// Contact properties of a material pair.
-PairProps pairProps(const Material& a, const Material& b);
+/// The contact law of the run and its pair table (es.contactLaw, es.pairs): the law's row of
+/// every pair of materials (kernels/contact_law.h, the law's mix()).
+void setUpContacts(const DemConfig& config, EngineSetup& es);
 /// The heat transfer's set-up (es.heat) from the config, and what it widens: the wall candidates'
 /// reach (es.wallReachFactor) and the neighbour reach of the gas lens (es.reach).
 /// @pre es.coupled is set; rmax is the largest particle radius.

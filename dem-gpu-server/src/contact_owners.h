@@ -2,7 +2,7 @@
 /// @file
 /// The contact module's pass 1 (contacts.h, ContactModule::sources): one owner's pairs in
 /// contact and walls (OwnerContacts), and on the cpu backend a slab's owners at a time
-/// (SlabContacts).
+/// (SlabContacts), each for the run's contact law Law (kernels/contact_law.h).
 
 #include <cstddef>
 #include <cstdint>
@@ -10,7 +10,8 @@
 
 #include "backend/exec_common.h"
 #include "contact_pairs.h"
-#include "coredem/dem/kernels/lsd_contact.h"
+#include "coredem/dem/kernels/contact_common.h"
+#include "coredem/dem/kernels/contact_law.h"
 #include "coredem/dem/kernels/mesh_contact.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_contact.h"
@@ -34,9 +35,11 @@ DEM_HD bool zeroBits(kernels::Vec3 v) {
 /// One owner's part of the contact pass (ContactModule::sources, pass 1): its owned pairs in
 /// contact and its walls; returns the history slots it needs (owned contacts + walls). Its
 /// candidates in contact come from its half list (operator(), owner<false>) or, on the cpu
-/// backend, from the list SlabContacts made of its slab's (owner<true>).
-template <class Exec>
+/// backend, from the list SlabContacts made of its slab's (owner<true>). Law: the contact law of
+/// the pairs and the walls.
+template <class Exec, class Law>
 struct OwnerContacts {
+  using Pair = typename Law::Pair;
   const double* x;
   const double* v;
   const double* w;
@@ -54,7 +57,7 @@ struct OwnerContacts {
   const std::uint32_t* hs;
   const std::int32_t* half;
   const std::uint32_t* wallNear;
-  const PairProps* pairs;
+  const kernels::ContactPair* pairs; ///< rows of Law
   WallView wv;
   int nMat;
   int K;
@@ -64,7 +67,7 @@ struct OwnerContacts {
   double* share;      ///< gather backends: per candidate, the partner's share
   double* own;        ///< gather backends: per particle, its own sum
 #if defined(COREDEM_DEM_DOUBLE2)
-  TwoPairArgs two;
+  TwoPairArgs<Law> two;
 #endif
 
   DEM_HD double operator()(std::size_t i) const {
@@ -112,8 +115,9 @@ struct OwnerContacts {
     int slot = 0;
     Vec3 F{0.0, 0.0, 0.0}; // i's own sum: its owned pairs, then its walls
     Vec3 T{0.0, 0.0, 0.0};
-    // Particle–particle LSD (Eqs. 7–13) over the owned candidates. i's velocities, mass and
-    // material are read only if it has some (most particles of a dilute bed do not).
+    // Particle–particle contacts (the law; LSD: Eqs. 7–13) over the owned candidates. i's
+    // velocities, mass and material are read only if it has some (most particles of a dilute
+    // bed do not).
     int owned = 0;
 #if defined(COREDEM_DEM_DOUBLE2)
     std::uint32_t pending[4]; // cpu: candidates in contact not yet evaluated
@@ -172,11 +176,10 @@ struct OwnerContacts {
             continue;
           }
 #endif
-          const PairProps pp = pairs[ai * nMat + mat[j]];
-          const OwnedPair<double> op =
-              ownedPair(d, l2, ri, rj, mi, m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor, pp.mu,
-                        vi, load3(v, j), wi, load3(w, j), load3(hc, q), dt);
-          const LsdResult& res = op.res;
+          const Pair pp = pairs[ai * nMat + mat[j]].template of<Law>();
+          const OwnedPair<double> op = ownedPair<Law, double>(
+              d, l2, ri, rj, mi, m[j], pp, vi, load3(v, j), wi, load3(w, j), load3(hc, q), dt);
+          const ContactResult& res = op.res;
           F += res.force;
           T += res.torque;
           store3(hc, q, res.deltaT);
@@ -196,22 +199,21 @@ struct OwnerContacts {
 #endif
       }
     }
-    // Walls (m_eff = m_i, the particle's material): the analytic walls in ascending order (the
-    // candidate bits of the first kNearBits, most particles have none, then every wall beyond
-    // them), each with its touches in feature order; then the mesh walls' touches.
+    // Walls (the law with m_eff = m_i, the particle's material): the analytic walls in ascending
+    // order (the candidate bits of the first kNearBits, most particles have none, then every wall
+    // beyond them), each with its touches in feature order; then the mesh walls' touches.
     Vec3 FW{0.0, 0.0, 0.0};
     int wallCount = 0;
     const std::uint32_t nearBits = wallNear[i];
     if (nearBits != 0) {
       const int ai = mat[i];
       const double mi = m[i];
-      const PairProps pp = pairs[ai * nMat + ai];
-      const double etan = pp.dampFactor * ::sqrt(pp.kn * mi);
-      const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
+      const Pair pp = pairs[ai * nMat + ai].template of<Law>();
+      const auto lp = Law::contact(pp, mi);
       const Vec3 vi = load3(v, ii);
       const Vec3 wi = load3(w, ii);
       auto touch = [&](double h, Vec3 nw, std::int64_t key, Vec3 history) {
-        const LsdResult res = wallContact(lp, nw, ri - h, vi, wi, ri, history, dt);
+        const ContactResult res = wallContact<Law>(lp, nw, ri - h, vi, wi, ri, history, dt);
         FW += res.force;
         T += res.torque;
         if (slot < K) {
@@ -274,9 +276,9 @@ struct OwnerContacts {
 /// (0 to 5) the processor cannot predict. A dense slab (most candidates in contact: a packed
 /// bed) goes owner by owner (OwnerContacts::operator()), where the contacts are found and
 /// evaluated in one visit. Which of the two is decided per slab from its last sub-step.
-template <class Exec>
+template <class Exec, class Law>
 struct SlabContacts {
-  OwnerContacts<Exec> owners;
+  OwnerContacts<Exec, Law> owners;
   const std::uint32_t* qOwner;    ///< owner of each owned candidate (PairLists::halfOwner)
   std::uint32_t* hits;            ///< per candidate: the slabs' candidates in contact (scratch)
   std::uint32_t* work;            ///< per particle: the slabs' owners with work (scratch)
@@ -299,7 +301,7 @@ struct SlabContacts {
 
   double operator()(int s, std::int64_t lo, std::int64_t hi) const {
     using namespace kernels;
-    const OwnerContacts<Exec>& o = owners;
+    const OwnerContacts<Exec, Law>& o = owners;
     if (s % 3 == 0)
       zeroReach(s);
     const std::uint32_t qa = o.hs[lo], qb = o.hs[hi];

@@ -3,33 +3,36 @@
 /// The contact module's pair kernels (contacts.h): an owned pair in contact evaluated from its
 /// owner (ownedPair, the path of every backend) and the cpu backend's evaluation of two to four
 /// owned pairs at once in SIMD lanes (ownedPairs: kernels::Double2, kernels::Double4 with AVX),
-/// each lane giving the bits of ownedPair<double>.
+/// each lane giving the bits of ownedPair<Law, double>. Every function is written for a contact
+/// law Law (kernels/contact_law.h); ContactModule instantiates them for the run's law.
 
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
 
 #include "backend/exec_common.h"
+#include "coredem/dem/kernels/contact_common.h"
+#include "coredem/dem/kernels/contact_law.h"
 #include "coredem/dem/kernels/damping.h"
-#include "coredem/dem/kernels/lsd_contact.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "engine.h"
 
 namespace coredem::dem {
 
-/// An owned pair in contact seen from its owner i: the LSD law (Eqs. 7–13) and L_ji.
+/// An owned pair in contact seen from its owner i: the contact law's result and L_ji.
 template <class S>
 struct OwnedPair {
-  kernels::LsdResultT<S> res;
+  kernels::ContactResultT<S> res;
   S lji;
 };
 
-/// The pair terms of an owned pair in contact, d = x_j − x_i, l2 = |d|² < (r_i + r_j)². S: the
-/// scalar type (kernels/lanes.h): double, or Double2 for two pairs at once (cpu), each lane
-/// giving the bits of the double evaluation.
-template <class S>
-DEM_HD OwnedPair<S> ownedPair(kernels::Vec3T<S> d, S l2, S ri, S rj, S mi, S mj, S kn, S kt,
-                              S dampFactor, S etatFactor, S mu, kernels::Vec3T<S> vi,
+/// The pair terms of an owned pair in contact, d = x_j − x_i, l2 = |d|² < (r_i + r_j)², with the
+/// pair's row `pair` of contact law Law (LSD: Eqs. 7–13). S: the scalar type (kernels/lanes.h):
+/// double, or Double2 / Double4 for pairs at once (cpu), each lane giving the bits of the double
+/// evaluation.
+template <class Law, class S>
+DEM_HD OwnedPair<S> ownedPair(kernels::Vec3T<S> d, S l2, S ri, S rj, S mi, S mj,
+                              const typename Law::template PairT<S>& pair, kernels::Vec3T<S> vi,
                               kernels::Vec3T<S> vj, kernels::Vec3T<S> wi, kernels::Vec3T<S> wj,
                               kernels::Vec3T<S> hist, double dt) {
   using namespace kernels;
@@ -39,12 +42,11 @@ DEM_HD OwnedPair<S> ownedPair(kernels::Vec3T<S> d, S l2, S ri, S rj, S mi, S mj,
   const Vec3T<S> nrm = invL * d;
   const S deltaN = rsum - l;
   const S meff = effectiveMass(mi, mj);
-  const S etan = dampFactor * laneSqrt(kn * meff);
-  const LsdParamsT<S> lp{kn, kt, etan, etatFactor * etan, mu};
+  const auto contact = Law::contact(pair, meff);
   const S lij = leverArmInv(l, invL, ri, rj);
   const S lji = leverArmInv(l, invL, rj, ri);
   const Vec3T<S> vij = relativeVelocity(vi, vj, wi, wj, lij, lji, nrm);
-  return {lsdContact(lp, nrm, deltaN, vij, lij, hist, dt), lji};
+  return {Law::evaluate(contact, nrm, deltaN, vij, lij, hist, dt), lji};
 }
 
 /// Whether Exec evaluates two owned pairs at once (Exec::PairScalar, cpu: kernels::Double2).
@@ -54,8 +56,10 @@ template <class Exec>
 inline constexpr bool kTwoPairs<Exec, std::void_t<typename Exec::PairScalar>> = true;
 
 #if defined(COREDEM_DEM_DOUBLE2)
-/// What twoOwnedPairs reads and writes (pass 1 of ContactModule::sources).
+/// What twoOwnedPairs reads and writes (pass 1 of ContactModule::sources), for contact law Law.
+template <class Law>
 struct TwoPairArgs {
+  using Pair = typename Law::Pair;
   const double* x;
   const double* v;
   const double* w;
@@ -63,8 +67,8 @@ struct TwoPairArgs {
   const double* m;
   const std::int32_t* mat;
   const std::int32_t* half;
-  const PairProps* pairs;
-  double* hc; ///< tangential history per owned candidate (3 doubles)
+  const kernels::ContactPair* pairs; ///< rows of Law
+  double* hc;                        ///< tangential history per owned candidate (3 doubles)
   double* f;  ///< force: the partners' shares are added to it (scatter, pair_lists.h "Slabs")
   double* tq; ///< torque, likewise
   int nMat;
@@ -73,19 +77,21 @@ struct TwoPairArgs {
 
   /// Properties of the pair (i, j); a one-material run reads no material index (the rows
   /// of a pass's few contacts are otherwise each one more cache line to wait for).
-  DEM_HD const PairProps& props(long long i, long long j) const {
-    return nMat == 1 ? pairs[0] : pairs[mat[i] * nMat + mat[j]];
+  DEM_HD const Pair& props(long long i, long long j) const {
+    return (nMat == 1 ? pairs[0] : pairs[mat[i] * nMat + mat[j]]).template of<Law>();
   }
 };
 
 /// Owned candidates q0 < q1 of particle i, both in contact, evaluated in the two lanes of
-/// Double2 (ownedPair): updates their tangential history (a.hc), adds their partners' shares
+/// Double2 (ownedPair<Law>): updates their tangential history (a.hc), adds their partners' shares
 /// to the partners' force and torque (q0's partner first), and returns force and torque on i of
 /// q0 in out[0..6) and of q1 in out[6..12). Called through twoOwnedPairs.
-DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std::uint32_t q0,
+template <class Law>
+DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs<Law>& a, long long i, std::uint32_t q0,
                                           std::uint32_t q1, double* out) {
   using namespace kernels;
   using D = Double2;
+  using Pair = typename Law::Pair;
   const long long j0 = a.half[q0];
   const long long j1 = a.half[q1];
   auto both = [](double u) { return D{u, u}; };
@@ -98,17 +104,16 @@ DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std
     return Vec3T<D>{both(p[3 * i]), both(p[3 * i + 1]), both(p[3 * i + 2])};
   };
   const Vec3T<D> d = gather3(a.x) - both3(a.x);
-  const PairProps& p0 = a.props(i, j0);
-  const PairProps& p1 = a.props(i, j1);
+  const Pair& p0 = a.props(i, j0);
+  const Pair& p1 = a.props(i, j1);
   const Vec3 h0 = load3(a.hc, q0);
   const Vec3 h1 = load3(a.hc, q1);
-  const OwnedPair<D> op =
-      ownedPair<D>(d, dot(d, d), both(a.r[i]), lanes(a.r[j0], a.r[j1]), both(a.m[i]),
-                   lanes(a.m[j0], a.m[j1]), lanes(p0.kn, p1.kn), lanes(p0.kt, p1.kt),
-                   lanes(p0.dampFactor, p1.dampFactor), lanes(p0.etatFactor, p1.etatFactor),
-                   lanes(p0.mu, p1.mu), both3(a.v), gather3(a.v), both3(a.w), gather3(a.w),
-                   Vec3T<D>{lanes(h0.x, h1.x), lanes(h0.y, h1.y), lanes(h0.z, h1.z)}, a.dt);
-  const LsdResultT<D>& res = op.res;
+  const OwnedPair<D> op = ownedPair<Law, D>(
+      d, dot(d, d), both(a.r[i]), lanes(a.r[j0], a.r[j1]), both(a.m[i]), lanes(a.m[j0], a.m[j1]),
+      Law::template gather<D>([&](auto member) { return lanes(p0.*member, p1.*member); }),
+      both3(a.v), gather3(a.v), both3(a.w), gather3(a.w),
+      Vec3T<D>{lanes(h0.x, h1.x), lanes(h0.y, h1.y), lanes(h0.z, h1.z)}, a.dt);
+  const ContactResultT<D>& res = op.res;
   const Vec3T<D> shareT = op.lji * res.nxft;
   store3(a.hc, q0, Vec3{res.deltaT.x[0], res.deltaT.y[0], res.deltaT.z[0]});
   store3(a.hc, q1, Vec3{res.deltaT.x[1], res.deltaT.y[1], res.deltaT.z[1]});
@@ -130,14 +135,16 @@ DEM_HD_FORCEINLINE void twoOwnedPairsBody(const TwoPairArgs& a, long long i, std
 /// SSE2's two-operand forms (about a quarter of the instructions), and no FMA (not part of AVX),
 /// so the bits are the same. Out of line: the particle loop and this body each get the
 /// registers to themselves.
-[[gnu::noinline, gnu::flatten]] inline void twoOwnedPairsSse2(const TwoPairArgs& a, long long i,
-                                                              std::uint32_t q0, std::uint32_t q1,
-                                                              double* out) {
+template <class Law>
+[[gnu::noinline, gnu::flatten]] inline void twoOwnedPairsSse2(const TwoPairArgs<Law>& a,
+                                                              long long i, std::uint32_t q0,
+                                                              std::uint32_t q1, double* out) {
   twoOwnedPairsBody(a, i, q0, q1, out);
 }
 #if defined(__x86_64__)
+template <class Law>
 [[gnu::noinline, gnu::flatten, gnu::target("avx")]] inline void
-twoOwnedPairsAvx(const TwoPairArgs& a, long long i, std::uint32_t q0, std::uint32_t q1,
+twoOwnedPairsAvx(const TwoPairArgs<Law>& a, long long i, std::uint32_t q0, std::uint32_t q1,
                  double* out) {
   twoOwnedPairsBody(a, i, q0, q1, out);
 }
@@ -145,8 +152,9 @@ twoOwnedPairsAvx(const TwoPairArgs& a, long long i, std::uint32_t q0, std::uint3
 /// twoOwnedPairsAvx if a.avx, else twoOwnedPairsSse2. (Without AVX the group costs 443
 /// instructions per two pairs against 510 for two scalar pairs, about what the call and the
 /// gathers add: pass 1 then counts +0.7 %, not worth a test per pair in the loop.)
-inline void twoOwnedPairs(const TwoPairArgs& a, long long i, std::uint32_t q0, std::uint32_t q1,
-                          double* out) {
+template <class Law>
+inline void twoOwnedPairs(const TwoPairArgs<Law>& a, long long i, std::uint32_t q0,
+                          std::uint32_t q1, double* out) {
 #if defined(__x86_64__)
   if (a.avx) {
     twoOwnedPairsAvx(a, i, q0, q1, out);
@@ -156,18 +164,19 @@ inline void twoOwnedPairs(const TwoPairArgs& a, long long i, std::uint32_t q0, s
   twoOwnedPairsSse2(a, i, q0, q1, out);
 }
 
-/// One owned candidate q of particle i in contact, the scalar evaluation (ownedPair<double>):
-/// updates its history, adds the partner's share to the partner, returns force and torque on i
-/// in out[0..6).
-inline void oneOwnedPair(const TwoPairArgs& a, long long i, std::uint32_t q, double* out) {
+/// One owned candidate q of particle i in contact, the scalar evaluation
+/// (ownedPair<Law, double>): updates its history, adds the partner's share to the partner,
+/// returns force and torque on i in out[0..6).
+template <class Law>
+inline void oneOwnedPair(const TwoPairArgs<Law>& a, long long i, std::uint32_t q, double* out) {
   using namespace kernels;
   const long long j = a.half[q];
   const Vec3 d = load3(a.x, j) - load3(a.x, i);
-  const PairProps& pp = a.props(i, j);
-  const OwnedPair<double> op = ownedPair(
-      d, dot(d, d), a.r[i], a.r[j], a.m[i], a.m[j], pp.kn, pp.kt, pp.dampFactor, pp.etatFactor,
-      pp.mu, load3(a.v, i), load3(a.v, j), load3(a.w, i), load3(a.w, j), load3(a.hc, q), a.dt);
-  const LsdResult& res = op.res;
+  const typename Law::Pair pp = a.props(i, j);
+  const OwnedPair<double> op =
+      ownedPair<Law, double>(d, dot(d, d), a.r[i], a.r[j], a.m[i], a.m[j], pp, load3(a.v, i),
+                             load3(a.v, j), load3(a.w, i), load3(a.w, j), load3(a.hc, q), a.dt);
+  const ContactResult& res = op.res;
   store3(a.hc, q, res.deltaT);
   store3(a.f, j, load3(a.f, j) - res.force);
   store3(a.tq, j, load3(a.tq, j) + op.lji * res.nxft);
@@ -179,13 +188,15 @@ inline void oneOwnedPair(const TwoPairArgs& a, long long i, std::uint32_t q, dou
 /// Three or four owned candidates q[0..count) of particle i, all in contact, in the four lanes
 /// of kernels::Double4 (AVX; with three, the fourth lane repeats the third pair and is
 /// dropped): as twoOwnedPairsBody, pair k's force and torque on i in out[6k..6k+6), the
-/// partners' shares added in the order of q. Every lane gives the bits of ownedPair<double>
-/// (no FMA: not part of AVX).
+/// partners' shares added in the order of q. Every lane gives the bits of
+/// ownedPair<Law, double> (no FMA: not part of AVX).
+template <class Law>
 [[gnu::noinline, gnu::flatten, gnu::target("avx")]] inline void
-fourOwnedPairsAvx(const TwoPairArgs& a, long long i, const std::uint32_t* q, int count,
+fourOwnedPairsAvx(const TwoPairArgs<Law>& a, long long i, const std::uint32_t* q, int count,
                   double* out) {
   using namespace kernels;
   using D = Double4;
+  using Pair = typename Law::Pair;
   const std::uint32_t q3 = q[count > 3 ? 3 : 2];
   const long long j0 = a.half[q[0]], j1 = a.half[q[1]], j2 = a.half[q[2]], j3 = a.half[q3];
   auto both = [](double u) { return D{u, u, u, u}; };
@@ -201,24 +212,22 @@ fourOwnedPairsAvx(const TwoPairArgs& a, long long i, const std::uint32_t* q, int
     return Vec3T<D>{both(p[3 * i]), both(p[3 * i + 1]), both(p[3 * i + 2])};
   };
   const Vec3T<D> d = gather3(a.x) - both3(a.x);
-  // The pair properties in the lanes: one broadcast each in a one-material run (the four
+  // The pair's row in the lanes: one broadcast per member in a one-material run (the four
   // lanes would otherwise load the same row four times), else each lane's row.
-  D props[5];
-  constexpr double PairProps::*kProp[5] = {&PairProps::kn, &PairProps::kt, &PairProps::dampFactor,
-                                           &PairProps::etatFactor, &PairProps::mu};
+  typename Law::template PairT<D> pair;
   if (a.nMat == 1) {
-    for (int k = 0; k < 5; ++k)
-      props[k] = both(a.pairs[0].*kProp[k]);
+    const Pair& p = a.pairs[0].template of<Law>();
+    pair = Law::template gather<D>([&](auto member) { return both(p.*member); });
   } else {
-    const PairProps* pk[4] = {&a.props(i, j0), &a.props(i, j1), &a.props(i, j2), &a.props(i, j3)};
-    for (int k = 0; k < 5; ++k)
-      props[k] = D{pk[0]->*kProp[k], pk[1]->*kProp[k], pk[2]->*kProp[k], pk[3]->*kProp[k]};
+    const Pair* pk[4] = {&a.props(i, j0), &a.props(i, j1), &a.props(i, j2), &a.props(i, j3)};
+    pair = Law::template gather<D>([&](auto member) {
+      return D{pk[0]->*member, pk[1]->*member, pk[2]->*member, pk[3]->*member};
+    });
   }
-  const OwnedPair<D> op =
-      ownedPair<D>(d, dot(d, d), both(a.r[i]), lanes(a.r), both(a.m[i]), lanes(a.m), props[0],
-                   props[1], props[2], props[3], props[4], both3(a.v), gather3(a.v), both3(a.w),
-                   gather3(a.w), rows3(a.hc, q[0], q[1], q[2], q3), a.dt);
-  const LsdResultT<D>& res = op.res;
+  const OwnedPair<D> op = ownedPair<Law, D>(d, dot(d, d), both(a.r[i]), lanes(a.r), both(a.m[i]),
+                                            lanes(a.m), pair, both3(a.v), gather3(a.v), both3(a.w),
+                                            gather3(a.w), rows3(a.hc, q[0], q[1], q[2], q3), a.dt);
+  const ContactResultT<D>& res = op.res;
   const Vec3T<D> shareT = op.lji * res.nxft;
   const long long js[4] = {j0, j1, j2, j3};
   for (int k = 0; k < count; ++k) {
@@ -237,7 +246,8 @@ fourOwnedPairsAvx(const TwoPairArgs& a, long long i, const std::uint32_t* q, int
 /// for three or four (AVX), two lanes for two, the scalar path for one; without AVX, two lanes
 /// at a time and the scalar path for an odd one. Pair k's force and torque on i in
 /// out[6k..6k+6).
-inline void ownedPairs(const TwoPairArgs& a, long long i, const std::uint32_t* q, int count,
+template <class Law>
+inline void ownedPairs(const TwoPairArgs<Law>& a, long long i, const std::uint32_t* q, int count,
                        double* out) {
 #if defined(COREDEM_DEM_DOUBLE4)
   if (a.avx && count >= 3) {

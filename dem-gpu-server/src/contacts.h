@@ -1,7 +1,8 @@
 #pragma once
 /// @file
 /// Particle–particle and particle–wall contact forces in the DEM sub-step (docs/physics.md §2.1,
-/// LSD with tangential history), written once for every backend like engine_impl.h.
+/// the contact law of `models: {contact: …}`, LSD with tangential history by default), written
+/// once for every backend like engine_impl.h.
 ///
 /// Each pair is evaluated once, by its owner: the particle with the smaller global id (gid), a
 /// choice that survives re-sorting, over the engine's half and low lists (pair_lists.h). No
@@ -9,7 +10,7 @@
 /// lists (pair_lists.h "Slabs": by slab colour, then by the index of the evaluating particle),
 /// so the results do not depend on the thread count or the backend:
 ///   cpu (scatter): the owners run slab colour by colour (CpuExec::reduceMaxOverSlabsWide); an
-///     owner i evaluates its owned candidates in contact with the LSD law and adds the
+///     owner i evaluates its owned candidates in contact with the contact law and adds the
 ///     partner's share (−f; torque L_ji n × f_t) straight to the partner's force and torque,
 ///     then its walls, and adds its own sum (f, L_ij n × f_t of its pairs, its walls) to its
 ///     own force and torque, which start at the gas force (or zero) and zero;
@@ -19,9 +20,14 @@
 /// The cpu backend evaluates a particle's owned candidates in contact up to four at once
 /// (ownedPairs): three or four in the lanes of kernels::Double4 where the processor has AVX,
 /// two in the lanes of kernels::Double2 (SSE2, or AVX's encoding of the same operations), one
-/// alone; every lane gives the bits of ownedPair<double>, the other backends' path (no FMA).
-/// The LSD law is mirror-exact (lsd_contact.h): j's share is bitwise what evaluating the pair
-/// from j's side gives. Forces add the gas force of the drag module in coupled runs.
+/// alone; every lane gives the bits of ownedPair<Law, double>, the other backends' path (no
+/// FMA). The LSD law is mirror-exact (lsd_contact.h): j's share is bitwise what evaluating the
+/// pair from j's side gives. Forces add the gas force of the drag module in coupled runs.
+///
+/// Contact laws (kernels/contact_law.h): the pair table holds the rows of the run's law, and
+/// the owners' pass (OwnerContacts, SlabContacts, the pair lanes) is instantiated for every law
+/// of kernels::ContactLaws; sources() picks the run's once per sub-step (kernels::visitModel),
+/// so a pair costs no test of the law (with one law, no test at all).
 ///
 /// Tangential history. Between two neighbour builds the history of a pair lives with its
 /// candidate in the half list (`_hc`, three doubles per owned candidate, in half-list order:
@@ -50,8 +56,8 @@
 #include "backend/exec_common.h"
 #include "contact_owners.h"
 #include "contact_pairs.h"
+#include "coredem/dem/kernels/contact_law.h"
 #include "coredem/dem/kernels/damping.h"
-#include "coredem/dem/kernels/lsd_contact.h"
 #include "coredem/dem/kernels/mesh_contact.h"
 #include "coredem/dem/kernels/vec3.h"
 #include "coredem/dem/kernels/wall_contact.h"
@@ -74,6 +80,7 @@ public:
   using Dev = backend::DeviceArray<T, Exec>;
 
   void setup(const EngineSetup& s) {
+    _law = s.contactLaw;
     _pairs.allocate(s.pairs.size());
     for (std::size_t k = 0; k < s.pairs.size(); ++k)
       _pairs.h()[k] = s.pairs[k];
@@ -242,7 +249,7 @@ public:
     std::int32_t* nwc = p.wallContacts.d();
     const std::uint32_t* hs = pl.halfStart();
     const std::int32_t* half = pl.half();
-    const PairProps* pairs = _pairs.d();
+    const kernels::ContactPair* pairs = _pairs.d();
     const WallView wv = wl.view();
     const int nMat = ctx.setup.nMaterials;
     const int K = p.K;
@@ -271,37 +278,42 @@ public:
       own = _own.d();
     }
 
+    // Pass 1 (per owner): its owned pairs and its walls (OwnerContacts), with the run's contact
+    // law. The largest count of history slots a particle needs goes to the status array.
+    kernels::visitModel(kernels::ContactLaws{}, static_cast<int>(_law), [&](auto law) {
+      using Law = typename decltype(law)::type;
 #if defined(COREDEM_DEM_DOUBLE2)
-    const TwoPairArgs two{x, v, w, r, m, mat, half, pairs, hc, f, tq, nMat, dt, cpuHasAvx()};
+      const TwoPairArgs<Law> two{x, v, w, r, m, mat, half, pairs, hc, f, tq, nMat, dt, cpuHasAvx()};
 #endif
-    // Pass 1 (per owner): its owned pairs and its walls (OwnerContacts). The largest count of
-    // history slots a particle needs goes to the status array.
-    const OwnerContacts<Exec> ownerPass {
-      x, v, w, r, m, mat, hk, hd, hc, f, tq, fw, nc, nwc, hs, half, wallNear, pairs, wv, nMat, K, n,
-          dt, hit, share, own
+      const OwnerContacts<Exec, Law> ownerPass {
+        x, v, w, r, m, mat, hk, hd, hc, f, tq, fw, nc, nwc, hs, half, wallNear, pairs, wv, nMat, K,
+            n, dt, hit, share, own
 #if defined(COREDEM_DEM_DOUBLE2)
-          ,
-          two
+            ,
+            two
 #endif
-    };
-    if constexpr (scatter) {
+      };
+      if constexpr (scatter) {
 #if defined(COREDEM_DEM_DOUBLE2)
-      if (_denseGeneration != pl.generation()) { // new slabs: each starts as a dilute one
-        _dense.assign(static_cast<std::size_t>(pl.slabs()), 0);
-        _denseGeneration = pl.generation();
-      }
-      _hits.reserve(pl.candidates());
-      _work.reserve(n);
-      const SlabContacts<Exec> slabPass{ownerPass,     pl.halfOwner(), _hits.d(),  _work.d(),
-                                        _dense.data(), pl.slabStart(), pl.slabs(), !coupled};
-      ctx.exec.reduceMaxOverSlabRanges(pl.slabStart(), pl.slabs(), slabPass, 0.0,
-                                       ctx.status + kStatusHistorySlots);
+        if (_denseGeneration != pl.generation()) { // new slabs: each starts as a dilute one
+          _dense.assign(static_cast<std::size_t>(pl.slabs()), 0);
+          _denseGeneration = pl.generation();
+        }
+        _hits.reserve(pl.candidates());
+        _work.reserve(n);
+        const SlabContacts<Exec, Law> slabPass{ownerPass,     pl.halfOwner(), _hits.d(),  _work.d(),
+                                               _dense.data(), pl.slabStart(), pl.slabs(), !coupled};
+        ctx.exec.reduceMaxOverSlabRanges(pl.slabStart(), pl.slabs(), slabPass, 0.0,
+                                         ctx.status + kStatusHistorySlots);
 #else
-      ctx.exec.reduceMaxOverSlabsWide(pl.slabStart(), pl.slabs(), ownerPass, 0.0,
-                                      ctx.status + kStatusHistorySlots);
+        ctx.exec.reduceMaxOverSlabsWide(pl.slabStart(), pl.slabs(), ownerPass, 0.0,
+                                        ctx.status + kStatusHistorySlots);
 #endif
-    } else {
-      ctx.exec.reduceMaxInto(n, ownerPass, 0.0, ctx.status + kStatusHistorySlots);
+      } else {
+        ctx.exec.reduceMaxInto(n, ownerPass, 0.0, ctx.status + kStatusHistorySlots);
+      }
+    });
+    if constexpr (!scatter) {
       // Pass 2 (per particle): the gas force (or zero), then the terms in the order the
       // scatter adds them: colour by colour, and within a colour by the evaluating particle's
       // index (its own sum at its own index among the partners of that colour).
@@ -380,8 +392,9 @@ public:
   }
 
 private:
-  Dual<PairProps> _pairs;
-  Dev<unsigned char> _hit;  ///< gather backends, per candidate: in contact this sub-step
+  kernels::ContactLaw _law = kernels::ContactLaw::LinearSpringDashpot; ///< the run's law
+  Dual<kernels::ContactPair> _pairs; ///< rows of _law, [a·nMaterials + b] (walls: [a·n + a])
+  Dev<unsigned char> _hit;           ///< gather backends, per candidate: in contact this sub-step
   Dev<double> _own;         ///< gather backends, per particle: the owner's own force, torque
   Dev<std::uint32_t> _hits; ///< cpu: per owned candidate, scratch of SlabContacts
   Dev<std::uint32_t> _work; ///< cpu: per particle, scratch of SlabContacts

@@ -169,9 +169,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   // Engine set-up.
   EngineSetup& es = m.setup;
   es.nMaterials = static_cast<int>(nm);
-  for (std::size_t a = 0; a < nm; ++a)
-    for (std::size_t b = 0; b < nm; ++b)
-      es.pairs.push_back(pairProps(config.materials[a], config.materials[b]));
+  setUpContacts(config, es); // the contact law and its rows of the material pairs
   for (const Wall& w : config.walls)
     es.walls.push_back(kernelWall(w));
   es.triangles = kernelTriangles(config.meshes);

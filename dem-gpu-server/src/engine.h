@@ -10,6 +10,7 @@
 
 #include "chemistry_setup.h"
 #include "coredem/dem/dem_system.h"
+#include "coredem/dem/kernels/contact_law.h"
 #include "coredem/dem/kernels/drag.h"
 #include "coredem/dem/kernels/mesh_contact.h"
 #include "coredem/dem/kernels/pcm.h"
@@ -20,16 +21,14 @@
 
 namespace coredem::dem {
 
-/// Contact properties of a material pair, with the m_eff-independent damping factor.
-struct PairProps {
-  double kn, kt, dampFactor, etatFactor, mu;
-};
-
 /// Everything the engine needs besides the particles. Plain data.
 struct EngineSetup {
   int nMaterials = 1;
-  std::vector<PairProps> pairs;     ///< nMaterials², [a*nMaterials + b]; walls use [a*n + a]
-  std::vector<kernels::Wall> walls; ///< analytic walls (kernels/wall_contact.h)
+  /// The contact law of particles and walls (kernels/contact_law.h) and its pair table:
+  /// nMaterials² rows of that law, [a*nMaterials + b]; walls use [a*n + a].
+  kernels::ContactLaw contactLaw = kernels::ContactLaw::LinearSpringDashpot;
+  std::vector<kernels::ContactPair> pairs;
+  std::vector<kernels::Wall> walls;             ///< analytic walls (kernels/wall_contact.h)
   std::vector<kernels::MeshTriangle> triangles; ///< mesh walls (kernels/mesh_contact.h)
   double wallReachFactor = 1.0; ///< walls are candidates within f·R + skin/2 (wall_lists.h)
   kernels::Vec3 gravity{0, 0, 0};

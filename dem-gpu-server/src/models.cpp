@@ -16,7 +16,6 @@
 #include "coredem/common/log.h"
 #include "coredem/common/switch.h"
 #include "coredem/dem/dem_system.h"
-#include "coredem/dem/kernels/collision_time.h"
 #include "coredem/dem/kernels/damping.h"
 #include "model_registry.h"
 
@@ -136,33 +135,42 @@ const ModelFamily<kernels::WgsEquilibrium>& wgsEquilibriumModels() {
   return f;
 }
 
-MaterialPair mixMaterials(const Material& a, const Material& b) {
-  return MaterialPair{2.0 * a.kn * b.kn / (a.kn + b.kn), std::min(a.en, b.en), std::min(a.mu, b.mu),
-                      0.5 * (a.ktFactor + b.ktFactor), 0.5 * (a.etatFactor + b.etatFactor)};
+// --- contact laws (kernels/contact_law.h)
+namespace {
+constexpr auto kContact = entriesOf<kernels::ContactLaw>(kernels::ContactLaws{});
+} // namespace
+
+template struct ModelFamily<kernels::ContactLaw>;
+
+const ModelFamily<kernels::ContactLaw>& contactModels() {
+  static const ModelFamily<kernels::ContactLaw> f{"contact", kContact};
+  return f;
 }
 
 double dtDemMax(const DemConfig& config, std::span<const double> minMass) {
   const std::size_t nm = config.materials.size();
   COREDEM_ASSERT(minMass.size() == nm);
-  // t_col of a pair of stiffness kn, restitution en and effective mass meff (Eq. 12, η_n Eq. 13).
-  const auto tcolOf = [](const MaterialPair& p, double meff) {
-    const double kn = p.kn;
-    return kernels::collisionTime(kn, meff, kernels::dampingFactor(p.en) * std::sqrt(kn * meff));
-  };
   double tcol = std::numeric_limits<double>::infinity();
-  for (std::size_t a = 0; a < nm; ++a) {
-    if (!std::isfinite(minMass[a]))
-      continue;
-    for (std::size_t b = 0; b < nm; ++b) {
-      if (!std::isfinite(minMass[b]))
+  kernels::visitModel(kernels::ContactLaws{}, static_cast<int>(config.contact), [&](auto law) {
+    using Law = typename decltype(law)::type;
+    // t_col of the row of materials a and b (the law's mixing) with effective mass meff.
+    const auto tcolOf = [&](std::size_t a, std::size_t b, double meff) {
+      return Law::collisionTime(
+          Law::mix(config.contactLaws.template of<Law>(), config.materials[a], config.materials[b]),
+          meff);
+    };
+    for (std::size_t a = 0; a < nm; ++a) {
+      if (!std::isfinite(minMass[a]))
         continue;
-      const MaterialPair p = mixMaterials(config.materials[a], config.materials[b]);
-      tcol = std::min(tcol, tcolOf(p, kernels::effectiveMass(minMass[a], minMass[b])));
+      for (std::size_t b = 0; b < nm; ++b) {
+        if (!std::isfinite(minMass[b]))
+          continue;
+        tcol = std::min(tcol, tcolOf(a, b, kernels::effectiveMass(minMass[a], minMass[b])));
+      }
+      if (!config.walls.empty() || !config.meshes.empty())
+        tcol = std::min(tcol, tcolOf(a, a, minMass[a]));
     }
-    if (!config.walls.empty() || !config.meshes.empty())
-      tcol = std::min(tcol,
-                      tcolOf(mixMaterials(config.materials[a], config.materials[a]), minMass[a]));
-  }
+  });
   if (config.frozenMotion)
     return std::numeric_limits<double>::max(); // held: no collision limit
   return std::isfinite(tcol) ? tcol / config.dtFactor : std::numeric_limits<double>::infinity();
@@ -362,6 +370,17 @@ std::vector<ModelOption> makeOptions() {
            c.frozenMotion = *m == MotionModel::Frozen;
          return e;
        }});
+  // --- contact law of particles and walls (kernels/contact_law.h)
+  o.push_back({"contact", "contact", contactModels().allowed(),
+               std::string(contactModels().nameOf(kernels::ContactLaw::LinearSpringDashpot)),
+               "contact law of the particle–particle and particle–wall contacts",
+               [](DemConfig& c, std::string_view v) {
+                 std::string e;
+                 if (const auto law = choice(contactModels(), v, e))
+                   c.contact = *law;
+                 return e;
+               }});
+  addParamRowsOf<kernels::ContactLaws, &DemConfig::contactLaws>(o, "contact");
   // --- numerics of the DEM step
   auto dtFactor = [](DemConfig& c, std::string_view v) {
     std::string e;
@@ -438,12 +457,14 @@ bool applyModelOption(DemConfig& config, std::string_view key, std::string_view 
 std::string modelParamsHashText(const DemConfig& c) {
   return registry::paramsHashText(c.dragLaws, static_cast<int>(c.drag), "drag") +
          registry::paramsHashText(c.heat.nusseltModels, static_cast<int>(c.heat.nusselt),
-                                  "convection");
+                                  "convection") +
+         registry::paramsHashText(c.contactLaws, static_cast<int>(c.contact), "contact");
 }
 
 void checkModelParams(const DemConfig& c) {
   registry::checkParams(c.dragLaws, static_cast<int>(c.drag), "drag");
   registry::checkParams(c.heat.nusseltModels, static_cast<int>(c.heat.nusselt), "convection");
+  registry::checkParams(c.contactLaws, static_cast<int>(c.contact), "contact");
 }
 
 std::vector<ModelIssue>

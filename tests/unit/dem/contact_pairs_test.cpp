@@ -23,6 +23,13 @@ using kernels::Vec3;
 
 namespace {
 
+using Lsd = kernels::LinearSpringDashpot;
+
+/// An LSD row of the pair table: {k_n, k_t, dampFactor, etatFactor, μ}.
+kernels::ContactPair lsdRow(double kn, double kt, double damp, double etat, double mu) {
+  return kernels::ContactPair::make<Lsd>(Lsd::Pair{kn, kt, damp, etat, mu});
+}
+
 constexpr int kSlots = 12;
 constexpr double kDiameter = 1e-3;
 constexpr double kPi = 3.14159265358979323846;
@@ -31,9 +38,9 @@ constexpr double kPi = 3.14159265358979323846;
 EngineSetup denseSetup(int threads) {
   EngineSetup s;
   s.nMaterials = 2;
-  const PairProps a{200.0, 100.0, 0.3, 0.5, 0.3};
-  const PairProps b{300.0, 150.0, 0.2, 0.5, 0.5};
-  const PairProps ab{240.0, 120.0, 0.3, 0.5, 0.3};
+  const kernels::ContactPair a = lsdRow(200.0, 100.0, 0.3, 0.5, 0.3);
+  const kernels::ContactPair b = lsdRow(300.0, 150.0, 0.2, 0.5, 0.5);
+  const kernels::ContactPair ab = lsdRow(240.0, 120.0, 0.3, 0.5, 0.3);
   s.pairs = {a, ab, ab, b};
   s.walls = {kernels::planeWall(Vec3{0, 0, 0}, Vec3{0, 0, 1})};
   s.maxRadius = 0.55 * kDiameter;
@@ -159,7 +166,8 @@ TEST(ContactPairs, ForcesMatchAReferenceEvaluatingBothSides) {
         continue;
       ++pairContacts;
       const Vec3 n = (1.0 / l) * d;
-      const PairProps pp = setup.pairs[s0.material[i] * setup.nMaterials + s0.material[j]];
+      const Lsd::Pair pp =
+          setup.pairs[s0.material[i] * setup.nMaterials + s0.material[j]].of<Lsd>();
       const double etan = pp.dampFactor * std::sqrt(pp.kn * effectiveMass(s0.mass[i], s0.mass[j]));
       const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
       const double lij = leverArm(l, ri, rj), lji = leverArm(l, rj, ri);
@@ -195,7 +203,8 @@ TEST(ContactPairs, ForcesMatchAReferenceEvaluatingBothSides) {
       const double dn = ri - dot(xi - w.point, w.normal);
       if (dn <= 0.0)
         continue;
-      const PairProps pp = setup.pairs[s0.material[i] * setup.nMaterials + s0.material[i]];
+      const Lsd::Pair pp =
+          setup.pairs[s0.material[i] * setup.nMaterials + s0.material[i]].of<Lsd>();
       const double etan = pp.dampFactor * std::sqrt(pp.kn * s0.mass[i]);
       const LsdParams lp{pp.kn, pp.kt, etan, pp.etatFactor * etan, pp.mu};
       Vec3 hist{0, 0, 0};
@@ -321,7 +330,7 @@ TEST(ContactPairs, HistoryFollowsItsPairThroughNeighbourRebuilds) {
   st.xref = st.pos;
   fillDefaults(st);
   EngineSetup setup = denseSetup(1);
-  setup.pairs = {PairProps{kn, 0.5 * kn, 0.3, 0.5, 10.0}}; // μ = 10: the contacts stick
+  setup.pairs = {lsdRow(kn, 0.5 * kn, 0.3, 0.5, 10.0)}; // μ = 10: the contacts stick
   setup.nMaterials = 1;
   setup.gravity = Vec3{0.0, 0.0, -g};
   HostState out[2];

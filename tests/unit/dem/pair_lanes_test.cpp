@@ -19,6 +19,13 @@ using kernels::Vec3;
 
 namespace {
 
+using Lsd = kernels::LinearSpringDashpot;
+
+/// An LSD row of the pair table: {k_n, k_t, dampFactor, etatFactor, μ}.
+kernels::ContactPair lsdRow(double kn, double kt, double damp, double etat, double mu) {
+  return kernels::ContactPair::make<Lsd>(Lsd::Pair{kn, kt, damp, etat, mu});
+}
+
 void expectSameBits(double a, double b, const char* what, int c) {
   EXPECT_EQ(std::bit_cast<std::uint64_t>(a), std::bit_cast<std::uint64_t>(b))
       << what << " (case " << c << "): " << a << " vs " << b;
@@ -34,9 +41,9 @@ void expectSameBits(Vec3 a, Vec3 b, const char* what, int c) {
 struct Case {
   std::vector<double> x, v, w, r, m;
   std::vector<std::int32_t> mat{0, 0, 0}, half{1, 2};
-  std::vector<PairProps> pairs{
-      PairProps{200.0, 100.0, 0.3, 0.5, 0.3}, PairProps{240.0, 120.0, 0.25, 0.5, 0.4},
-      PairProps{240.0, 120.0, 0.25, 0.5, 0.4}, PairProps{300.0, 150.0, 0.2, 0.4, 0.5}};
+  std::vector<kernels::ContactPair> pairs{
+      lsdRow(200.0, 100.0, 0.3, 0.5, 0.3), lsdRow(240.0, 120.0, 0.25, 0.5, 0.4),
+      lsdRow(240.0, 120.0, 0.25, 0.5, 0.4), lsdRow(300.0, 150.0, 0.2, 0.4, 0.5)};
   Vec3 h[2];
 };
 
@@ -71,12 +78,12 @@ Case randomCase(std::mt19937_64& rng, bool slide0, bool slide1) {
 }
 
 /// twoOwnedPairs' arguments for a case: hc holds the two candidates' history, two materials.
-TwoPairArgs argsFor(Case& k, std::vector<double>& hc, std::vector<double>& force,
-                    std::vector<double>& torque, double dt, bool avx) {
-  return TwoPairArgs{k.x.data(), k.v.data(),   k.w.data(),    k.r.data(),
-                     k.m.data(), k.mat.data(), k.half.data(), k.pairs.data(),
-                     hc.data(),  force.data(), torque.data(), 2,
-                     dt,         avx};
+TwoPairArgs<Lsd> argsFor(Case& k, std::vector<double>& hc, std::vector<double>& force,
+                         std::vector<double>& torque, double dt, bool avx) {
+  return TwoPairArgs<Lsd>{k.x.data(), k.v.data(),   k.w.data(),    k.r.data(),
+                          k.m.data(), k.mat.data(), k.half.data(), k.pairs.data(),
+                          hc.data(),  force.data(), torque.data(), 2,
+                          dt,         avx};
 }
 
 struct Expected {
@@ -89,11 +96,11 @@ Expected scalarReference(const Case& k, double dt) {
   for (int s = 0; s < 2; ++s) {
     const int j = k.half[s];
     const Vec3 d = kernels::load3(k.x.data(), j) - kernels::load3(k.x.data(), 0);
-    const PairProps& pp = k.pairs[k.mat[0] * 2 + k.mat[j]];
-    const OwnedPair<double> op = ownedPair(
-        d, kernels::dot(d, d), k.r[0], k.r[j], k.m[0], k.m[j], pp.kn, pp.kt, pp.dampFactor,
-        pp.etatFactor, pp.mu, kernels::load3(k.v.data(), 0), kernels::load3(k.v.data(), j),
-        kernels::load3(k.w.data(), 0), kernels::load3(k.w.data(), j), k.h[s], dt);
+    const Lsd::Pair pp = k.pairs[k.mat[0] * 2 + k.mat[j]].of<Lsd>();
+    const OwnedPair<double> op = ownedPair<Lsd, double>(
+        d, kernels::dot(d, d), k.r[0], k.r[j], k.m[0], k.m[j], pp, kernels::load3(k.v.data(), 0),
+        kernels::load3(k.v.data(), j), kernels::load3(k.w.data(), 0), kernels::load3(k.w.data(), j),
+        k.h[s], dt);
     e.force[s] = op.res.force;
     e.torque[s] = op.res.torque;
     e.deltaT[s] = op.res.deltaT;
@@ -120,7 +127,7 @@ void checkGroup(bool avx, int cases) {
       torque[q] = 1e-7 * u(rng);
     }
     const std::vector<double> force0 = force, torque0 = torque;
-    const TwoPairArgs a = argsFor(k, hc, force, torque, dt, avx);
+    const TwoPairArgs<Lsd> a = argsFor(k, hc, force, torque, dt, avx);
     double out[12];
     twoOwnedPairs(a, 0, 0, 1, out);
     for (int s = 0; s < 2; ++s) {
@@ -203,24 +210,23 @@ TEST(PairLanes, FourLanesGiveTheScalarBits) {
       torque[k] = 1e-7 * u(rng);
     }
     const std::vector<double> hc0 = hc, force0 = force, torque0 = torque;
-    std::vector<PairProps> pairs{
-        PairProps{200.0, 100.0, 0.3, 0.5, 0.3}, PairProps{240.0, 120.0, 0.25, 0.5, 0.4},
-        PairProps{240.0, 120.0, 0.25, 0.5, 0.4}, PairProps{300.0, 150.0, 0.2, 0.4, 0.5}};
-    const TwoPairArgs a{x.data(),      v.data(),    w.data(),     r.data(),  m.data(),
-                        mat.data(),    half.data(), pairs.data(), hc.data(), force.data(),
-                        torque.data(), 2,           dt,           avx};
+    std::vector<kernels::ContactPair> pairs{
+        lsdRow(200.0, 100.0, 0.3, 0.5, 0.3), lsdRow(240.0, 120.0, 0.25, 0.5, 0.4),
+        lsdRow(240.0, 120.0, 0.25, 0.5, 0.4), lsdRow(300.0, 150.0, 0.2, 0.4, 0.5)};
+    const TwoPairArgs<Lsd> a{x.data(),      v.data(),    w.data(),     r.data(),  m.data(),
+                             mat.data(),    half.data(), pairs.data(), hc.data(), force.data(),
+                             torque.data(), 2,           dt,           avx};
     const std::uint32_t q[4] = {0, 1, 2, 3};
     double out[24];
     ownedPairs(a, 0, q, count, out);
     for (int k = 0; k < count; ++k) {
       const int j = half[k];
       const Vec3 d = kernels::load3(x.data(), j) - kernels::load3(x.data(), 0);
-      const PairProps& pp = pairs[mat[0] * 2 + mat[j]];
-      const OwnedPair<double> op =
-          ownedPair(d, kernels::dot(d, d), r[0], r[j], m[0], m[j], pp.kn, pp.kt, pp.dampFactor,
-                    pp.etatFactor, pp.mu, kernels::load3(v.data(), 0), kernels::load3(v.data(), j),
-                    kernels::load3(w.data(), 0), kernels::load3(w.data(), j),
-                    kernels::load3(hc0.data(), k), dt);
+      const Lsd::Pair pp = pairs[mat[0] * 2 + mat[j]].of<Lsd>();
+      const OwnedPair<double> op = ownedPair<Lsd, double>(
+          d, kernels::dot(d, d), r[0], r[j], m[0], m[j], pp, kernels::load3(v.data(), 0),
+          kernels::load3(v.data(), j), kernels::load3(w.data(), 0), kernels::load3(w.data(), j),
+          kernels::load3(hc0.data(), k), dt);
       expectSameBits(kernels::load3(out, 2 * k), op.res.force, "force", c);
       expectSameBits(kernels::load3(out, 2 * k + 1), op.res.torque, "torque", c);
       expectSameBits(kernels::load3(hc.data(), k), op.res.deltaT, "history", c);

@@ -25,6 +25,13 @@ namespace sc = coredem::dem::schema;
 
 namespace {
 
+using Lsd = kernels::LinearSpringDashpot;
+
+/// An LSD row of the pair table: {k_n, k_t, dampFactor, etatFactor, μ}.
+kernels::ContactPair lsdRow(double kn, double kt, double damp, double etat, double mu) {
+  return kernels::ContactPair::make<Lsd>(Lsd::Pair{kn, kt, damp, etat, mu});
+}
+
 constexpr int kTestSpecies = 2;
 constexpr int kTestSlots = 3;      // K
 constexpr int kTestNeighbours = 4; // M
@@ -169,7 +176,7 @@ TEST(ParticleSchema, EveryResortedRowFollowsItsParticle) {
   const std::size_t n = 9;
   const HostState before = taggedState(n);
   EngineSetup setup;
-  setup.pairs = {PairProps{1e3, 1e3, 0.0, 0.0, 0.3}};
+  setup.pairs = {lsdRow(1e3, 1e3, 0.0, 0.0, 0.3)};
   setup.maxRadius = 2e-4;
   setup.skin = 1e-4;
   setup.historySlots = kTestSlots;
@@ -344,7 +351,7 @@ TEST(ParticleSchema, SizeMismatchFailsLoudly) {
   HostState s = taggedState(4);
   s.chemRef.pop_back();
   EngineSetup setup;
-  setup.pairs = {PairProps{1e3, 1e3, 0.0, 0.0, 0.3}};
+  setup.pairs = {lsdRow(1e3, 1e3, 0.0, 0.0, 0.3)};
   setup.maxRadius = 2e-4;
   setup.historySlots = kTestSlots;
   auto engine = makeCpuEngine(setup);

@@ -27,6 +27,7 @@
 
 #include "coredem/dem/chemistry_options.h"
 #include "coredem/dem/heat_options.h"
+#include "coredem/dem/kernels/contact_law.h"
 #include "coredem/dem/kernels/drag.h"
 
 namespace coredem::dem {
@@ -212,6 +213,10 @@ struct DemConfig {
   std::vector<Species> gasSpecies;   ///< Y_g and R_species entries
   NeighbourOptions neighbour;
   kernels::DragLaw drag = kernels::DragLaw::Gidaspow; ///< `models: {drag: ...}` (kernels/drag.h)
+  /// `models: {contact: ...}`: the contact law of particles and walls (kernels/contact_law.h).
+  kernels::ContactLaw contact = kernels::ContactLaw::LinearSpringDashpot;
+  /// Each contact law's parameters (`models: {contact.<law>.<parameter>: ...}`).
+  kernels::ParamPack<kernels::ContactLaws> contactLaws{};
   /// Each drag law's parameters (`models: {drag.<law>.<parameter>: ...}`, from its declaration).
   kernels::ParamPack<kernels::DragLaws> dragLaws{};
   double epsMinDrag = 0.35; ///< ε_min clip in drag (docs/physics.md §1.1 [C])

@@ -29,6 +29,7 @@
 #include <utility>
 #include <vector>
 
+#include "coredem/dem/kernels/contact_law.h"
 #include "coredem/dem/kernels/convection.h"
 #include "coredem/dem/kernels/drag.h"
 #include "coredem/dem/kernels/reaction_generic.h"
@@ -127,16 +128,12 @@ struct ModelIssue {
 /// close one exists. Old spellings are valid; they are warned about (as applyModelOption).
 std::vector<ModelIssue> validateModels(std::span<const std::pair<std::string, std::string>> models);
 
-/// A material pair's contact parameters from the two materials' values (docs/physics.md §2.1):
-/// k_n the harmonic mean, e_n and μ the smaller, the k_t and η_t factors the mean.
-struct MaterialPair {
-  double kn, en, mu, ktFactor, etatFactor;
-};
-/// The mixing rules of a pair of materials (walls: the pair of their material with itself).
-MaterialPair mixMaterials(const Material& a, const Material& b);
+/// Contact laws of particles and walls (kernels/contact_law.h).
+const ModelFamily<kernels::ContactLaw>& contactModels();
 
 /// The largest stable DEM step Δt_DEM,max = min t_col / `dem.dt_factor` (docs/physics.md Eqs.
-/// 12–13) over the present material pairs (and each material against the walls, if any), with
+/// 12–13) over the present material pairs (and each material against the walls, if any; the
+/// chosen contact law's mixing rules and collision time), with
 /// `minMass[a]` the lightest particle of material a (+inf: none present; t_col grows with m_eff).
 /// The largest finite double with `motion: frozen` (no collision limit); +inf without particles.
 /// The one place this is computed: the DEM server reports it in Configured, the orchestrator's

@@ -2,11 +2,10 @@
 /// @file
 /// Linear spring–dashpot (LSD) contact, normal + tangential with accumulated tangential
 /// displacement and the Coulomb limit in the MFiX form — docs/physics.md §2.1, seed Eqs. 7–10
-/// (MFiX calc_force_dem.f).
+/// (MFiX calc_force_dem.f): the contact law `linear-spring-dashpot` of kernels/contact_law.h.
 ///
-/// Conventions: n = (x_j − x_i)/|x_j − x_i| points from i to j; δ_n = R_i + R_j − |x_j − x_i|
-/// (> 0 in contact); L_ij = lever arm from the centre of i to the contact point;
-///   v_ij = (v_i − v_j) + (L_ij ω_i + L_ji ω_j) × n,  v_n = (v_ij·n) n,  v_t = v_ij − v_n
+/// Conventions of contact_common.h (n from i to j, δ_n > 0 in contact, lever arm L_ij, v_ij);
+///   v_n = (v_ij·n) n,  v_t = v_ij − v_n
 ///   (9)  f_n = −k_n δ_n n − η_n v_n                                       (N, on i)
 ///   (10) δ_t ← P_n(δ_t) + v_t Δt,  f_t = −k_t δ_t − η_t v_t;
 ///        if |k_t δ_t| > μ|f_n|:  f_t = −μ|f_n| t − η_t v_t,  δ_t ← (μ|f_n|/k_t) t,  t = δ_t/|δ_t|
@@ -15,7 +14,14 @@
 /// the pair from j's side (n → −n, v_ij → −v_ij, δ_t → −δ_t) gives exactly −f and the torque
 /// L_ji n × f_t, so one evaluation per pair (contacts.h) gives both sides bitwise.
 
+#include <math.h>
+
+#include "coredem/dem/kernels/collision_time.h"
 #include "coredem/dem/kernels/common.h"
+#include "coredem/dem/kernels/contact_common.h"
+#include "coredem/dem/kernels/damping.h"
+#include "coredem/dem/kernels/lanes.h"
+#include "coredem/dem/kernels/model_list.h"
 #include "coredem/dem/kernels/vec3.h"
 
 namespace coredem::dem::kernels {
@@ -32,33 +38,10 @@ struct LsdParamsT {
 };
 using LsdParams = LsdParamsT<double>;
 
+/// The result of one LSD evaluation: the family's (contact_common.h).
 template <class S>
-struct LsdResultT {
-  Vec3T<S> force;  ///< f_n + f_t on particle i (N)
-  Vec3T<S> torque; ///< torque on i (N m)
-  Vec3T<S> deltaT; ///< updated accumulated tangential displacement (m), to store
-  Vec3T<S> nxft; ///< n × f_t (N): torque on i = L_ij n × f_t, on j = L_ji n × f_t (mirror-exact)
-};
-using LsdResult = LsdResultT<double>;
-
-/// Contact point velocity difference v_ij (m/s).
-template <class S>
-DEM_HD Vec3T<S> relativeVelocity(Vec3T<S> vi, Vec3T<S> vj, Vec3T<S> wi, Vec3T<S> wj, S lij, S lji,
-                                 Vec3T<S> n) {
-  return (vi - vj) + cross(lij * wi + lji * wj, n);
-}
-
-/// Radical-plane lever arm L_ij = l/2 + (R_i² − R_j²)/(2l) (MFiX), l = centre distance (m).
-DEM_HD double leverArm(double l, double ri, double rj) {
-  return 0.5 * l + (ri * ri - rj * rj) / (2.0 * l);
-}
-
-/// leverArm with 1/l already known (no division); mirror-exact as leverArm is:
-/// leverArmInv(l, 1/l, rj, ri) uses the negated difference of the same squares.
-template <class S>
-DEM_HD S leverArmInv(S l, S invL, S ri, S rj) {
-  return 0.5 * l + (ri * ri - rj * rj) * (0.5 * invL);
-}
+using LsdResultT = ContactResultT<S>;
+using LsdResult = ContactResult;
 
 /// Eqs. 9–10 and 7. @pre deltaN > 0, |n| = 1, p.kt > 0. The Coulomb limit is a lane select:
 /// a lane that does not slide keeps its values bitwise.
@@ -87,5 +70,72 @@ DEM_HD LsdResultT<S> lsdContact(const LsdParamsT<S>& p, Vec3T<S> n, S deltaN, Ve
   r.deltaT = dT;
   return r;
 }
+
+/// The properties of a material pair (a row of the pair table, EngineSetup::pairs): η_n's
+/// factor without m_eff (Eq. 13), so that one row serves every particle mass. S: the scalar type.
+template <class S>
+struct LsdPairT {
+  S kn;         ///< N/m
+  S kt;         ///< N/m
+  S dampFactor; ///< η_n = dampFactor·√(k_n m_eff) (-)
+  S etatFactor; ///< η_t = etatFactor·η_n (-)
+  S mu;         ///< -
+};
+
+/// The `models:` parameters of LSD (none: its parameters are the materials').
+struct LsdModelParams {};
+
+/// The LSD law as registered in kernels/contact_law.h (ContactLaws): the model declaration.
+struct LinearSpringDashpot {
+  static constexpr const char* name = "linear-spring-dashpot";
+  static constexpr const char* doc = "linear spring–dashpot with tangential history and the "
+                                     "Coulomb limit (MFiX; kernels/lsd_contact.h)";
+  using Params = LsdModelParams;
+  static constexpr auto params() { return noParams<Params>(); }
+
+  template <class S>
+  using PairT = LsdPairT<S>;
+  using Pair = PairT<double>;
+  template <class S>
+  using ContactT = LsdParamsT<S>;
+
+  /// The row of materials a and b (walls: a with itself; host): k_n the harmonic mean, e_n and
+  /// μ the smaller, the k_t and η_t factors the mean [C] (docs/physics.md §2.1). Material:
+  /// coredem::dem::Material (kn, en, mu, ktFactor, etatFactor).
+  template <class Material>
+  static Pair mix(const Params&, const Material& a, const Material& b) {
+    const double kn = 2.0 * a.kn * b.kn / (a.kn + b.kn);
+    const double en = b.en < a.en ? b.en : a.en; // std::min(a.en, b.en)
+    const double mu = b.mu < a.mu ? b.mu : a.mu;
+    const double ktFactor = 0.5 * (a.ktFactor + b.ktFactor);
+    return Pair{kn, ktFactor * kn, dampingFactor(en), 0.5 * (a.etatFactor + b.etatFactor), mu};
+  }
+
+  /// Duration of a contact of row p with effective mass meff (Eqs. 12–13; Δt_DEM,max; host).
+  static double collisionTime(const Pair& p, double meff) {
+    return kernels::collisionTime(p.kn, meff, p.dampFactor * ::sqrt(p.kn * meff));
+  }
+
+  /// The row's members in lanes: PairT<S>{load(&Pair::kn), …} (the cpu backend's pair lanes).
+  template <class S, class Load>
+  DEM_HD static PairT<S> gather(const Load& load) {
+    return PairT<S>{load(&Pair::kn), load(&Pair::kt), load(&Pair::dampFactor),
+                    load(&Pair::etatFactor), load(&Pair::mu)};
+  }
+
+  /// The parameters of one contact of row p with effective mass meff (walls: m_i): η_n, η_t.
+  template <class S>
+  DEM_HD static ContactT<S> contact(const PairT<S>& p, S meff) {
+    const S etan = p.dampFactor * laneSqrt(p.kn * meff);
+    return ContactT<S>{p.kn, p.kt, etan, p.etatFactor * etan, p.mu};
+  }
+
+  /// Force, torque and tangential history of contact c (lsdContact).
+  template <class S>
+  DEM_HD static ContactResultT<S> evaluate(const ContactT<S>& c, Vec3T<S> n, S deltaN, Vec3T<S> vij,
+                                           S lij, Vec3T<S> deltaTOld, double dt) {
+    return lsdContact(c, n, deltaN, vij, lij, deltaTOld, dt);
+  }
+};
 
 } // namespace coredem::dem::kernels

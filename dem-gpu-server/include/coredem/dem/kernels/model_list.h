@@ -101,6 +101,28 @@ struct Dispatch<Family, ModelList<M, Rest...>> {
   }
 };
 
+/// The model M as a value: what visitModel passes (`typename decltype(tag)::type`).
+template <class M>
+struct ModelTag {
+  using type = M;
+};
+
+/// Calls f(ModelTag<M>{}) for the model M of id `id` (the last model for an id out of range),
+/// host side: Dispatch's chain of compares once for a whole pass, f then runs code instantiated
+/// for M (e.g. contacts.h: the owners' pass of the chosen contact law, no test per pair). With
+/// one model in the list, f(ModelTag<M>{}) and nothing else.
+template <class M, class... Rest, class F>
+void visitModel(ModelList<M, Rest...>, int id, F&& f) {
+  if constexpr (sizeof...(Rest) == 0) {
+    (void)id;
+    f(ModelTag<M>{});
+  } else if (id == 0) {
+    f(ModelTag<M>{});
+  } else {
+    visitModel(ModelList<Rest...>{}, id - 1, f);
+  }
+}
+
 /// Calls f.template operator()<M>() for every model of the list, in id order (host side:
 /// registries, options, hashing).
 template <class... Ms, class F>

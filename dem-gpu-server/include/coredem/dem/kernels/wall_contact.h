@@ -1,7 +1,7 @@
 #pragma once
 /// @file
 /// Particle–wall contact with a rigid analytic wall (docs/physics.md §2, Eq. 8 with j → wall,
-/// m_eff = m_i): the same LSD law as lsd_contact.h with the wall immobile.
+/// m_eff = m_i): the run's contact law (contact_law.h) with the wall immobile.
 ///
 /// Two kinds of analytic wall:
 /// * a plane (infinite, one-sided): particles live on the side its unit normal n̂_w points to;
@@ -31,6 +31,7 @@
 ///   v_ij = v_i + L ω_i × n.
 
 #include "coredem/dem/kernels/common.h"
+#include "coredem/dem/kernels/contact_common.h"
 #include "coredem/dem/kernels/lsd_contact.h"
 #include "coredem/dem/kernels/vec3.h"
 
@@ -173,13 +174,16 @@ DEM_HD double wallClearance(const Wall& w, Vec3 x) {
 }
 
 /// Force/torque on the particle (radius ri) from a wall touch with overlap deltaN = ri − h > 0
-/// and unit normal nw from the wall towards the centre.
-DEM_HD LsdResult wallContact(const LsdParams& p, Vec3 nw, double deltaN, Vec3 vi, Vec3 wi,
-                             double ri, Vec3 deltaTOld, double dt) {
+/// and unit normal nw from the wall towards the centre, with contact law Law (contact_law.h;
+/// p: Law::contact(row, m_i)).
+template <class Law = LinearSpringDashpot>
+DEM_HD ContactResult wallContact(const typename Law::template ContactT<double>& p, Vec3 nw,
+                                 double deltaN, Vec3 vi, Vec3 wi, double ri, Vec3 deltaTOld,
+                                 double dt) {
   const Vec3 n = -nw;
   const double l = ri - deltaN;
   const Vec3 vij = relativeVelocity(vi, Vec3{0, 0, 0}, wi, Vec3{0, 0, 0}, l, 0.0, n);
-  return lsdContact(p, n, deltaN, vij, l, deltaTOld, dt);
+  return Law::evaluate(p, n, deltaN, vij, l, deltaTOld, dt);
 }
 
 } // namespace coredem::dem::kernels
