@@ -17,6 +17,7 @@
 #include "coredem/common/switch.h"
 #include "coredem/dem/dem_system.h"
 #include "coredem/dem/kernels/damping.h"
+#include "coredem/dem/kernels/pressure_gradient.h"
 #include "model_registry.h"
 
 namespace coredem::dem {
@@ -145,6 +146,10 @@ template struct ModelFamily<kernels::ContactLaw>;
 const ModelFamily<kernels::ContactLaw>& contactModels() {
   static const ModelFamily<kernels::ContactLaw> f{"contact", kContact};
   return f;
+}
+
+double particleMass(double rho, double d) {
+  return rho * kernels::sphereVolume(0.5 * d);
 }
 
 double dtDemMax(const DemConfig& config, std::span<const double> minMass) {

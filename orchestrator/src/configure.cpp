@@ -7,8 +7,7 @@
 #include <vector>
 
 #include <coredem/common/check.h>
-#include <coredem/dem/dem_system.h>
-#include <coredem/dem/kernels/pressure_gradient.h>
+#include <coredem/dem/dem_config.h>
 #include <coredem/dem/models.h>
 #include <coredem/protocol/coupling_scheme.h>
 
@@ -66,7 +65,7 @@ double estimateDtDemMax(const CaseConfig& c) {
   for (const auto& p : c.particles) {
     const std::size_t k = std::size_t(materialIndex(c, p.material));
     const double rho = p.density > 0 ? p.density : c.materials[k].density;
-    minMass[k] = std::min(minMass[k], rho * dem::kernels::sphereVolume(0.5 * p.diameter));
+    minMass[k] = std::min(minMass[k], dem::particleMass(rho, p.diameter));
   }
   applyModels(c, d);
   const double dtMax = dem::dtDemMax(d, minMass);

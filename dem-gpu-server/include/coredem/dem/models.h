@@ -140,6 +140,10 @@ const ModelFamily<kernels::ContactLaw>& contactModels();
 /// provisional plan of the first Configure uses it too.
 double dtDemMax(const DemConfig& config, std::span<const double> minMass);
 
+/// The mass of a particle of density `rho` (kg/m³) and diameter `d` (m), as the DEM computes it
+/// (ρ · 4/3 π (d/2)³): for the `minMass` of dtDemMax.
+double particleMass(double rho, double d);
+
 /// The configuration-hash text of the registered models' parameters: "|<key>:<value>;" for each
 /// parameter of the chosen models that differs from its declared default ("" when none does, so
 /// that the hashes of earlier configurations stay).
