@@ -64,8 +64,21 @@ void ZapHandler::removeDomain(const std::string& domain) {
 }
 
 ZapHandler::ZapHandler() {
-  _stop = true;
-  _thread.join();
+  _socket.set(zmq::sockopt::linger, 0);
+  // Before any CURVE socket of ours accepts. A previous handler's endpoint may take a
+  // moment to be released after its socket closed.
+  for (int attempt = 0;; ++attempt) {
+    try {
+      _socket.bind("inproc://zeromq.zap.01");
+      break;
+    } catch (const zmq::error_t& e) {
+      if (e.num() != EADDRINUSE || attempt >= 50) {
+        rethrowZmq(e, "starting the ZAP handler (client key allow-list)");
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  _thread = std::thread([this] { run(); });
 }
 
 void ZapHandler::run() {
