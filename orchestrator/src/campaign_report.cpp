@@ -38,7 +38,10 @@ std::string csvField(const std::string& v) {
 
 /// A JSON string literal with the common escaper (`status --json` is one line, written here).
 std::string jsonString(const std::string& v) {
-  return "\"" + jsonEscape(v) + "\"";
+  std::string s = "\"";
+  s += jsonEscape(v);
+  s += '"';
+  return s;
 }
 
 std::vector<std::string> splitCsvLine(const std::string& line) {
