@@ -205,6 +205,69 @@ bool wantsWrite(const Direction& d, Clock::time_point now) {
   return !d.queue.empty() && d.queue.front().due <= now;
 }
 
+/// Accepts a client on the listener lfd and connects it to the target: a new connection in
+/// conns, or (when the target cannot be reached) the client closed again.
+void acceptConnection(int lfd, const sockaddr_storage& targetAddr, socklen_t targetLen,
+                      bool traceChunks, std::list<Connection>& conns) {
+  sockaddr_storage peer{};
+  socklen_t peerLen = sizeof peer;
+  const int cfd = ::accept4(lfd, reinterpret_cast<sockaddr*>(&peer), &peerLen, SOCK_CLOEXEC);
+  if (cfd >= 0) {
+    const int tfd = ::socket(targetAddr.ss_family, SOCK_STREAM | SOCK_CLOEXEC, 0);
+    // A blocking connect (the target is meant to be near: the same host or namespace),
+    // bounded so that a target that does not answer cannot stall the other connections.
+    const timeval connectTimeout{5, 0};
+    if (tfd >= 0) {
+      ::setsockopt(tfd, SOL_SOCKET, SO_SNDTIMEO, &connectTimeout, sizeof connectTimeout);
+    }
+    if (tfd < 0 || ::connect(tfd, reinterpret_cast<const sockaddr*>(&targetAddr), targetLen) != 0) {
+      logLine("connection from " + describe(peer) + ": cannot connect to " + describe(targetAddr) +
+              ": " + std::strerror(errno) + "; closed");
+      if (tfd >= 0) {
+        ::close(tfd);
+      }
+      ::close(cfd);
+    } else {
+      const timeval none{0, 0};
+      ::setsockopt(tfd, SOL_SOCKET, SO_SNDTIMEO, &none, sizeof none);
+      setNonBlocking(cfd);
+      setNonBlocking(tfd);
+      setNoDelay(cfd);
+      setNoDelay(tfd);
+      Connection& c = conns.emplace_back();
+      c.client = cfd;
+      c.target = tfd;
+      c.name = describe(peer);
+      c.up.from = cfd;
+      c.up.to = tfd;
+      c.down.from = tfd;
+      c.down.to = cfd;
+      if (traceChunks) {
+        c.up.trace = c.name + " up";
+        c.down.trace = c.name + " down";
+      }
+      logLine("connection from " + c.name + " relayed to " + describe(targetAddr));
+    }
+  }
+}
+
+/// Closes (both sides of) the connections that failed or are done in both directions.
+void closeFinished(std::list<Connection>& conns) {
+  for (auto it = conns.begin(); it != conns.end();) {
+    if (it->failed || (it->up.done() && it->down.done())) {
+      logLine("connection from " + it->name + " closed (" +
+              (it->failed ? std::string("reset or error") : std::string("both sides done")) + ", " +
+              std::to_string(it->up.forwarded) + " bytes up, " +
+              std::to_string(it->down.forwarded) + " bytes down)");
+      ::close(it->client);
+      ::close(it->target);
+      it = conns.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
 int run(const std::string& listenAt, const std::string& targetAt, double delayMs, double mbit,
         double maxQueuedMb, const std::string& portFile, bool traceChunks) {
   Settings s;
@@ -296,46 +359,7 @@ int run(const std::string& listenAt, const std::string& targetAt, double delayMs
       break;
     }
     if (r > 0 && (fds[0].revents & POLLIN)) {
-      sockaddr_storage peer{};
-      socklen_t peerLen = sizeof peer;
-      const int cfd = ::accept4(lfd, reinterpret_cast<sockaddr*>(&peer), &peerLen, SOCK_CLOEXEC);
-      if (cfd >= 0) {
-        const int tfd = ::socket(targetAddr.ss_family, SOCK_STREAM | SOCK_CLOEXEC, 0);
-        // A blocking connect (the target is meant to be near: the same host or namespace),
-        // bounded so that a target that does not answer cannot stall the other connections.
-        const timeval connectTimeout{5, 0};
-        if (tfd >= 0) {
-          ::setsockopt(tfd, SOL_SOCKET, SO_SNDTIMEO, &connectTimeout, sizeof connectTimeout);
-        }
-        if (tfd < 0 || ::connect(tfd, reinterpret_cast<sockaddr*>(&targetAddr), targetLen) != 0) {
-          logLine("connection from " + describe(peer) + ": cannot connect to " +
-                  describe(targetAddr) + ": " + std::strerror(errno) + "; closed");
-          if (tfd >= 0) {
-            ::close(tfd);
-          }
-          ::close(cfd);
-        } else {
-          const timeval none{0, 0};
-          ::setsockopt(tfd, SOL_SOCKET, SO_SNDTIMEO, &none, sizeof none);
-          setNonBlocking(cfd);
-          setNonBlocking(tfd);
-          setNoDelay(cfd);
-          setNoDelay(tfd);
-          Connection& c = conns.emplace_back();
-          c.client = cfd;
-          c.target = tfd;
-          c.name = describe(peer);
-          c.up.from = cfd;
-          c.up.to = tfd;
-          c.down.from = tfd;
-          c.down.to = cfd;
-          if (traceChunks) {
-            c.up.trace = c.name + " up";
-            c.down.trace = c.name + " down";
-          }
-          logLine("connection from " + c.name + " relayed to " + describe(targetAddr));
-        }
-      }
+      acceptConnection(lfd, targetAddr, targetLen, traceChunks, conns);
     }
     // Reads and writes; a connection with a reset or an error is closed on both sides.
     for (std::size_t i = 1; i + 1 < fds.size(); i += 2) {
@@ -356,19 +380,7 @@ int run(const std::string& listenAt, const std::string& targetAt, double delayMs
         c.failed = !(writeSide(c.up) && writeSide(c.down)); // chunks that fell due meanwhile
       }
     }
-    for (auto it = conns.begin(); it != conns.end();) {
-      if (it->failed || (it->up.done() && it->down.done())) {
-        logLine("connection from " + it->name + " closed (" +
-                (it->failed ? std::string("reset or error") : std::string("both sides done")) +
-                ", " + std::to_string(it->up.forwarded) + " bytes up, " +
-                std::to_string(it->down.forwarded) + " bytes down)");
-        ::close(it->client);
-        ::close(it->target);
-        it = conns.erase(it);
-      } else {
-        ++it;
-      }
-    }
+    closeFinished(conns);
   }
   for (Connection& c : conns) {
     ::close(c.client);

@@ -141,6 +141,132 @@ int renderRun(const fs::path& runDir, const std::vector<double>& times, const st
   return kExitOk;
 }
 
+/// The command line: every subcommand's options.
+struct CommandLine {
+  std::string caseDir, out, runDir, file;
+  int autoRestart = 0;
+  std::int64_t stopAfter = -1;
+  bool noPlots = false;
+  double walltime = 0.0;
+  bool timers = false;
+  VerifyOptions verifyOpts;
+  std::vector<std::string> only;
+  std::vector<double> renderTimes;
+  std::string renderField, renderGasField, renderOut;
+  CLI::App *run = nullptr, *resume = nullptr, *inspect = nullptr, *verify = nullptr,
+           *render = nullptr, *check = nullptr;
+};
+
+/// `coredem run` and `coredem resume`.
+void addRunCommands(CLI::App& app, CommandLine& c) {
+  c.run = app.add_subcommand("run", "validate CASE_DIR/case.yaml and run it");
+  c.run->add_option("CASE_DIR", c.caseDir, "case folder with case.yaml (or a case file)")
+      ->required();
+  c.run->add_option("--out", c.out, "run folder (default runs/<name>, timestamped if it exists)");
+  c.run
+      ->add_option("--auto-restart", c.autoRestart,
+                   "after a participant fault, relaunch and resume from the last checkpoint up "
+                   "to N times")
+      ->check(CLI::NonNegativeNumber);
+  c.run->add_option("--stop-after", c.stopAfter,
+                    "stop after this step with a checkpoint (continue with coredem resume)");
+  c.run->add_flag("--no-plots", c.noPlots, "do not make the PNG plots at the end");
+  c.run
+      ->add_option("--walltime", c.walltime,
+                   "stop with a checkpoint before this many seconds of wall time (a batch "
+                   "limit; continue with coredem resume)")
+      ->check(CLI::PositiveNumber);
+  c.run->add_flag("--timers", c.timers,
+                  "per-stage timers in coredem-dem and coredemFoam: RUN/timers-dem.json, "
+                  "RUN/timers-cfd.json and tables in logs/ (docs/performance.md)");
+
+  c.resume = app.add_subcommand(
+      "resume",
+      "continue a run from its latest complete checkpoint (from step 0 when it has none)");
+  c.resume->add_option("RUN_DIR", c.runDir, "run folder created by coredem run")->required();
+  c.resume->add_option("--auto-restart", c.autoRestart, "as for run")
+      ->check(CLI::NonNegativeNumber);
+  c.resume->add_option("--stop-after", c.stopAfter, "as for run");
+  c.resume->add_flag("--no-plots", c.noPlots, "as for run");
+  c.resume->add_option("--walltime", c.walltime, "as for run")->check(CLI::PositiveNumber);
+  c.resume->add_flag("--timers", c.timers, "as for run");
+}
+
+/// `coredem inspect`, `verify`, `render` and `check`.
+void addToolCommands(CLI::App& app, CommandLine& c) {
+  c.inspect = app.add_subcommand("inspect", "summarise a snapshot/state HDF5 file or a checkpoint");
+  c.inspect->add_option("FILE", c.file, "HDF5 file, manifest.json or checkpoint folder")
+      ->required();
+
+  c.verify = app.add_subcommand(
+      "verify", "run the verification cases (docs/physics.md §8) against the analytic solutions");
+  c.verify->add_option("--out", c.verifyOpts.outDir, "output folder (default runs/verify)");
+  c.verify->add_option("--only", c.only, "only these cases (comma-separated names)")
+      ->delimiter(',');
+  c.verify->add_flag("--list", c.verifyOpts.list, "list the cases and exit");
+  c.verify->add_option("--cases", c.verifyOpts.casesDir,
+                       "folder of verification cases (default: the installed or source-tree "
+                       "cases/verification)");
+  c.verify->add_flag("--no-plots", c.noPlots, "do not make the PNG plots");
+  c.verify->add_flag("--verbose", c.verifyOpts.verbose, "keep the runs' info log");
+
+  c.render = app.add_subcommand(
+      "render", "draw the particles (spheres at their radius, coloured by a field) over a slice "
+                "of a gas field at the same instants with ParaView: a PNG per output time and an "
+                "animation (docs/orchestrator.md \"Pictures\")");
+  c.render->add_option("RUN_DIR", c.runDir, "run folder with outputs.csv")->required();
+  c.render
+      ->add_option("--times", c.renderTimes,
+                   "times in s (comma-separated; the nearest output of "
+                   "each is drawn; default: every output)")
+      ->delimiter(',');
+  c.render->add_option("--field", c.renderField,
+                       "particle field to colour by (temperature, velocity, species_<name>, ...)");
+  c.render->add_option("--gas-field", c.renderGasField,
+                       "gas field of the slice (alphac, U, p, T, ...)");
+  c.render->add_option("--out", c.renderOut, "picture folder (default RUN_DIR/render)");
+
+  c.check = app.add_subcommand("check", "validate a case file and exit (0 valid, 2 invalid)");
+  c.check->add_option("CASE_DIR", c.caseDir, "case folder with case.yaml (or a case file)")
+      ->required();
+}
+
+/// `coredem run` (a new run folder) or `coredem resume`: the coupled run and its plots.
+int runOrResume(const CommandLine& c, const std::shared_ptr<spdlog::logger>& log) {
+  RunOptions opts;
+  opts.autoRestart = c.autoRestart;
+  if (c.stopAfter >= 0) {
+    opts.stopAfterStep = c.stopAfter;
+  }
+  opts.tty = ::isatty(STDERR_FILENO) != 0;
+  opts.timers = c.timers;
+  if (c.walltime > 0.0) {
+    opts.walltimeSeconds = c.walltime;
+  }
+  CaseConfig config;
+  if (*c.run) {
+    config = loadCase(c.caseDir);  // throws CaseError: nothing written yet
+    checkParticipantInput(config); // programs, cfd.case, the participant's pre-flight check
+    opts.runDir =
+        prepareRunDir(config, c.out.empty() ? std::nullopt : std::optional<fs::path>(c.out));
+    log->info("run folder {}", opts.runDir.string());
+  } else {
+    opts.runDir = fs::absolute(c.runDir);
+    config = loadRunCase(opts.runDir);
+    opts.resume = true;
+  }
+  const int rc = runSession(config, opts);
+  if (rc == kExitOk) {
+    std::printf("results: %s (timeseries.csv, outputs.csv, particles.xdmf, checkpoints/)\n",
+                opts.runDir.string().c_str());
+  }
+  // An interrupted run (SIGINT/SIGTERM) gets its plots too, up to its last step.
+  if ((rc == kExitOk || rc == kExitInterrupted) && !c.noPlots) {
+    makePlots(opts.runDir, rc == kExitInterrupted);
+  }
+  return rc;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -151,79 +277,10 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("coredem ") + coredem::kVersion);
   app.require_subcommand(1);
 
-  std::string caseDir, out, runDir, file;
-  int autoRestart = 0;
-  std::int64_t stopAfter = -1;
-  bool noPlots = false;
-
-  auto* run = app.add_subcommand("run", "validate CASE_DIR/case.yaml and run it");
-  run->add_option("CASE_DIR", caseDir, "case folder with case.yaml (or a case file)")->required();
-  run->add_option("--out", out, "run folder (default runs/<name>, timestamped if it exists)");
-  run->add_option("--auto-restart", autoRestart,
-                  "after a participant fault, relaunch and resume from the last checkpoint up "
-                  "to N times")
-      ->check(CLI::NonNegativeNumber);
-  run->add_option("--stop-after", stopAfter,
-                  "stop after this step with a checkpoint (continue with coredem resume)");
-  run->add_flag("--no-plots", noPlots, "do not make the PNG plots at the end");
-  double walltime = 0.0;
-  run->add_option("--walltime", walltime,
-                  "stop with a checkpoint before this many seconds of wall time (a batch "
-                  "limit; continue with coredem resume)")
-      ->check(CLI::PositiveNumber);
-  bool timers = false;
-  run->add_flag("--timers", timers,
-                "per-stage timers in coredem-dem and coredemFoam: RUN/timers-dem.json, "
-                "RUN/timers-cfd.json and tables in logs/ (docs/performance.md)");
-
-  auto* resume = app.add_subcommand(
-      "resume",
-      "continue a run from its latest complete checkpoint (from step 0 when it has none)");
-  resume->add_option("RUN_DIR", runDir, "run folder created by coredem run")->required();
-  resume->add_option("--auto-restart", autoRestart, "as for run")->check(CLI::NonNegativeNumber);
-  resume->add_option("--stop-after", stopAfter, "as for run");
-  resume->add_flag("--no-plots", noPlots, "as for run");
-  resume->add_option("--walltime", walltime, "as for run")->check(CLI::PositiveNumber);
-  resume->add_flag("--timers", timers, "as for run");
-
+  CommandLine cmd;
+  addRunCommands(app, cmd);
   app.add_subcommand("campaign", "parameter sweeps: campaign run|resume|status|collect ...");
-  auto* inspect =
-      app.add_subcommand("inspect", "summarise a snapshot/state HDF5 file or a checkpoint");
-  inspect->add_option("FILE", file, "HDF5 file, manifest.json or checkpoint folder")->required();
-
-  VerifyOptions verifyOpts;
-  std::vector<std::string> only;
-  auto* verify = app.add_subcommand(
-      "verify", "run the verification cases (docs/physics.md §8) against the analytic solutions");
-  verify->add_option("--out", verifyOpts.outDir, "output folder (default runs/verify)");
-  verify->add_option("--only", only, "only these cases (comma-separated names)")->delimiter(',');
-  verify->add_flag("--list", verifyOpts.list, "list the cases and exit");
-  verify->add_option("--cases", verifyOpts.casesDir,
-                     "folder of verification cases (default: the installed or source-tree "
-                     "cases/verification)");
-  verify->add_flag("--no-plots", noPlots, "do not make the PNG plots");
-  verify->add_flag("--verbose", verifyOpts.verbose, "keep the runs' info log");
-
-  std::vector<double> renderTimes;
-  std::string renderField, renderGasField, renderOut;
-  auto* render = app.add_subcommand(
-      "render", "draw the particles (spheres at their radius, coloured by a field) over a slice "
-                "of a gas field at the same instants with ParaView: a PNG per output time and an "
-                "animation (docs/orchestrator.md \"Pictures\")");
-  render->add_option("RUN_DIR", runDir, "run folder with outputs.csv")->required();
-  render
-      ->add_option("--times", renderTimes,
-                   "times in s (comma-separated; the nearest output of "
-                   "each is drawn; default: every output)")
-      ->delimiter(',');
-  render->add_option("--field", renderField,
-                     "particle field to colour by (temperature, velocity, species_<name>, ...)");
-  render->add_option("--gas-field", renderGasField,
-                     "gas field of the slice (alphac, U, p, T, ...)");
-  render->add_option("--out", renderOut, "picture folder (default RUN_DIR/render)");
-
-  auto* check = app.add_subcommand("check", "validate a case file and exit (0 valid, 2 invalid)");
-  check->add_option("CASE_DIR", caseDir, "case folder with case.yaml (or a case file)")->required();
+  addToolCommands(app, cmd);
 
   try {
     app.parse(argc, argv);
@@ -233,59 +290,29 @@ int main(int argc, char** argv) {
 
   auto log = coredem::logger("orchestrator");
   try {
-    if (*inspect) {
-      std::cout << inspectSummary(file);
+    if (*cmd.inspect) {
+      std::cout << inspectSummary(cmd.file);
       return kExitOk;
     }
-    if (*render) {
-      return renderRun(fs::absolute(runDir), renderTimes, renderField, renderGasField, renderOut);
+    if (*cmd.render) {
+      return renderRun(fs::absolute(cmd.runDir), cmd.renderTimes, cmd.renderField,
+                       cmd.renderGasField, cmd.renderOut);
     }
-    if (*verify) {
-      verifyOpts.only = only;
-      verifyOpts.plots = !noPlots;
-      if (verifyOpts.outDir.empty()) {
-        verifyOpts.outDir = "runs/verify";
+    if (*cmd.verify) {
+      cmd.verifyOpts.only = cmd.only;
+      cmd.verifyOpts.plots = !cmd.noPlots;
+      if (cmd.verifyOpts.outDir.empty()) {
+        cmd.verifyOpts.outDir = "runs/verify";
       }
-      return runVerify(verifyOpts);
+      return runVerify(cmd.verifyOpts);
     }
-    if (*check) {
-      const CaseConfig c = loadCase(caseDir);
+    if (*cmd.check) {
+      const CaseConfig c = loadCase(cmd.caseDir);
       checkParticipantInput(c);
       std::cout << c.caseFile.string() << ": valid\n";
       return kExitOk;
     }
-    RunOptions opts;
-    opts.autoRestart = autoRestart;
-    if (stopAfter >= 0) {
-      opts.stopAfterStep = stopAfter;
-    }
-    opts.tty = ::isatty(STDERR_FILENO) != 0;
-    opts.timers = timers;
-    if (walltime > 0.0) {
-      opts.walltimeSeconds = walltime;
-    }
-    CaseConfig config;
-    if (*run) {
-      config = loadCase(caseDir);    // throws CaseError: nothing written yet
-      checkParticipantInput(config); // programs, cfd.case, the participant's pre-flight check
-      opts.runDir =
-          prepareRunDir(config, out.empty() ? std::nullopt : std::optional<fs::path>(out));
-      log->info("run folder {}", opts.runDir.string());
-    } else {
-      opts.runDir = fs::absolute(runDir);
-      config = loadRunCase(opts.runDir);
-      opts.resume = true;
-    }
-    const int rc = runSession(config, opts);
-    if (rc == kExitOk) {
-      std::printf("results: %s (timeseries.csv, outputs.csv, particles.xdmf, checkpoints/)\n",
-                  opts.runDir.string().c_str());
-    }
-    // An interrupted run (SIGINT/SIGTERM) gets its plots too, up to its last step.
-    if ((rc == kExitOk || rc == kExitInterrupted) && !noPlots) {
-      makePlots(opts.runDir, rc == kExitInterrupted);
-    }
-    return rc;
+    return runOrResume(cmd, log);
   } catch (const CaseError& e) {
     log->error("{}", e.what());
     return kExitBadInput;

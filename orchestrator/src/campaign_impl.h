@@ -1,6 +1,6 @@
 #pragma once
-// Internal to the campaign library: helpers shared by the local executor (campaign.cpp) and
-// the Slurm executor (campaign_slurm.cpp).
+// Internal to the campaign library: helpers shared by the local executor (campaign.cpp), the
+// reports (campaign_report.cpp) and the Slurm executor (campaign_slurm.cpp).
 #include <atomic>
 #include <filesystem>
 #include <map>
@@ -47,6 +47,14 @@ std::vector<std::string> memberCommand(const MemberRecord& m, std::string& how);
 /// Returns the member's status after the transition.
 std::string finishMember(CampaignDb& db, const std::string& id, const std::string& runDir,
                          int status, int retries);
+
+// --- the reports (campaign_report.cpp)
+
+/// `coredem campaign status DIR [--json]`: prints the members' state. Returns the exit code.
+int status(const std::filesystem::path& dir, bool json);
+/// `coredem campaign collect DIR [--no-plot]`: writes DIR/summary.csv (one row per member, the
+/// sweep's values and collect.scalars) and plots it to DIR/plots/campaign.png.
+int collect(const std::filesystem::path& dir, bool noPlot);
 
 // --- the Slurm executor (campaign_slurm.cpp)
 

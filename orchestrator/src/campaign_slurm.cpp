@@ -456,29 +456,17 @@ int runSlurmCampaign(const fs::path& dir, CampaignDb& db, bool wait) {
   }
 }
 
-int slurmMemberMain(const fs::path& dir, int index) {
-  auto log = logger("campaign");
-  const std::string task = ownTaskId();
-  COREDEM_CHECK(!task.empty(),
-                "coredem campaign member runs inside a Slurm task (DIR/slurm/member.sh); run "
-                "members with coredem campaign run or resume");
-  CampaignDb db(dir / "campaign.db", false);
-  std::optional<MemberRecord> m;
-  for (const auto& r : db.members()) {
-    if (r.index == index) {
-      m = r;
-    }
-  }
-  COREDEM_CHECK(m.has_value(), "{}: no member with index {}", dir.string(), index);
-  const int retries = std::stoi(db.setting("retries", "0"));
-  char host[256] = {0};
-  ::gethostname(host, sizeof host - 1);
+namespace {
 
-  // claim the member
+/// Claims member m for Slurm task `task` on `host` (running, with the task's id): false, with
+/// a note, when it is done, failed, running in a live task or changed meanwhile. Sets the
+/// command that continues it (base) and how ("run" or "resume").
+bool claimMember(CampaignDb& db, const std::optional<MemberRecord>& m, const std::string& task,
+                 const char* host, std::vector<std::string>& base, std::string& how) {
   if (m->status == "done" || m->status == "failed") {
     std::printf("member %s is already %s; task %s has nothing to do\n", m->id.c_str(),
                 m->status.c_str(), task.c_str());
-    return kOk;
+    return false;
   }
   std::string from = m->status;
   if (m->status == "running" && m->jobId != task) {
@@ -487,11 +475,10 @@ int slurmMemberMain(const fs::path& dir, int index) {
     if (it != q.end() && it->second.rfind("RUNNING", 0) == 0) {
       std::printf("member %s runs in Slurm task %s; task %s has nothing to do\n", m->id.c_str(),
                   m->jobId.c_str(), task.c_str());
-      return kOk;
+      return false;
     }
   }
-  std::string how;
-  const std::vector<std::string> base = memberCommand(*m, how);
+  base = memberCommand(*m, how);
   bool claimed = false;
   db.transaction([&] {
     const auto now = db.member(m->id);
@@ -510,12 +497,13 @@ int slurmMemberMain(const fs::path& dir, int index) {
   if (!claimed) {
     std::printf("member %s changed state while task %s started; nothing to do\n", m->id.c_str(),
                 task.c_str());
-    return kOk;
   }
+  return claimed;
+}
 
-  // stop with a checkpoint stop_margin seconds before the task's time limit
-  std::vector<std::string> args = base;
-  const long margin = std::stol(db.setting("slurm.stop_margin", "120"));
+/// Stop with a checkpoint `margin` seconds before the task's time limit: appends --walltime
+/// to args and returns it (0: no limit known).
+long addWalltime(CampaignDb& db, long margin, std::vector<std::string>& args) {
   const char* jobEnv = std::getenv("SLURM_JOB_ID");
   std::optional<long> left = jobEnv ? timeLeft(jobEnv) : std::nullopt;
   if (!left) {
@@ -528,6 +516,141 @@ int slurmMemberMain(const fs::path& dir, int index) {
     args.push_back("--walltime");
     args.push_back(std::to_string(walltime));
   }
+  return walltime;
+}
+
+/// Waits for the member's coredem process `pid`, forwarding a signal to it (once: forwarded)
+/// and recording its newest checkpoint. Returns its waitpid() status (-1: unknown).
+int waitMember(CampaignDb& db, const MemberRecord& m, int pid, bool& forwarded,
+               const std::shared_ptr<spdlog::logger>& log) {
+  int status = 0;
+  std::string lastCkpt = m.lastCheckpoint;
+  auto lastScan = std::chrono::steady_clock::now();
+  while (true) {
+    const pid_t w = ::waitpid(pid, &status, WNOHANG);
+    if (w == pid || (w < 0 && errno != EINTR)) {
+      if (w < 0) {
+        status = -1;
+      }
+      break;
+    }
+    if (gSignal != 0 && !forwarded) {
+      log->warn("member {}: signal {} (time limit, preemption or scancel): stopping with a "
+                "checkpoint",
+                m.id, gSignal.load());
+      ::kill(-pid, SIGTERM);
+      ::kill(-pid, SIGCONT);
+      forwarded = true;
+    }
+    if (std::chrono::steady_clock::now() - lastScan > 1s) {
+      lastScan = std::chrono::steady_clock::now();
+      const std::string c = newestCheckpointName(m.runDir);
+      if (c != lastCkpt) {
+        lastCkpt = c;
+        db.setLastCheckpoint(m.id, c);
+      }
+    }
+    std::this_thread::sleep_for(100ms);
+  }
+  return status;
+}
+
+/// After the member's process ended with `status`: done, failed, or stopped (pending, the
+/// task requeued unless it is ending). Returns the exit code.
+int memberEnded(const fs::path& dir, CampaignDb& db, const MemberRecord& m, const std::string& task,
+                int status, bool forwarded, int retries, long margin,
+                const std::shared_ptr<spdlog::logger>& log) {
+  const bool exitedOk = status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  const bool ok = exitedOk && runReachedEnd(m.runDir, m.caseDir);
+  std::string after;
+  if (ok) {
+    after = finishMember(db, m.id, m.runDir, status, retries);
+    return after == "done" ? kOk : kFault;
+  }
+  // The scheduler's view of this task: still RUNNING after our own wall-time stop or the
+  // time-limit warning (sbatch --signal=B:TERM): requeue it. Anything else (COMPLETING after
+  // scancel, a hard time-limit kill or preemption) means the task is ending: the member stays
+  // pending and the submitting side (campaign run/resume) resubmits it; Slurm requeues a
+  // preempted task itself where PreemptMode=REQUEUE.
+  const std::string jobState = endedTaskState(task);
+  const bool ending = jobState.rfind("RUNNING", 0) != 0;
+  // Stopped, not failed: exit 0 before the end (--walltime), 130 (the forwarded SIGTERM), a
+  // signal to this process, or any end while the task is ending. scancel signals every process
+  // of the task: a participant may stop first and coredem then exits 1 ("the other participant
+  // was shut down") before this process forwards its own signal.
+  const bool stopped = forwarded || gSignal != 0 || (ending && !jobState.empty()) || exitedOk ||
+                       (status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == kInterrupted);
+  if (stopped) {
+    const std::string ckpt = newestCheckpointName(m.runDir);
+    const std::string reason =
+        ending ? fmt::format("its Slurm task ended ({}: scancel, time limit or preemption)",
+                             jobState.empty() ? "state unknown" : jobState)
+        : forwarded
+            ? fmt::format("stopped by Slurm's time-limit warning (signal {})", gSignal.load())
+            : fmt::format("stopped {} s before its time limit", margin);
+    db.transaction([&] {
+      if (db.markInterrupted(m.id, reason)) {
+        db.setLastCheckpoint(m.id, ckpt);
+        db.addEvent(m.id, "stopped",
+                    reason + (ckpt.empty() ? "" : "; continues from checkpoint " + ckpt));
+      }
+    });
+    log->warn("member {}: {}; continues from checkpoint {}", m.id, reason,
+              ckpt.empty() ? "(none: from the start)" : ckpt);
+    after = "pending";
+  } else {
+    after = finishMember(db, m.id, m.runDir, status, retries);
+  }
+  if (after != "pending") {
+    return kFault;
+  }
+  if (ending) {
+    log->info("member {}: coredem campaign resume {} resubmits it", m.id, dir.string());
+    return kOk;
+  }
+  // Continue in a new run of this task (Slurm starts it again after its requeue delay). The
+  // event comes first: the requeue ends this task, and Slurm may kill scontrol (and this
+  // process) before scontrol can report its success.
+  db.transaction([&] { db.addEvent(m.id, "requeued", "Slurm task " + task); });
+  log->info("member {}: requeuing Slurm task {}", m.id, task);
+  const Captured rq = capture({"scontrol", "requeue", task});
+  if (rq.rc > 0) {
+    db.transaction([&] { db.addEvent(m.id, "requeue failed", trim(rq.err + rq.out)); });
+    log->warn("member {}: cannot requeue Slurm task {} ({}); coredem campaign resume {} "
+              "resubmits the member",
+              m.id, task, trim(rq.err + rq.out), dir.string());
+  }
+  return kOk;
+}
+
+} // namespace
+
+int slurmMemberMain(const fs::path& dir, int index) {
+  auto log = logger("campaign");
+  const std::string task = ownTaskId();
+  COREDEM_CHECK(!task.empty(),
+                "coredem campaign member runs inside a Slurm task (DIR/slurm/member.sh); run "
+                "members with coredem campaign run or resume");
+  CampaignDb db(dir / "campaign.db", false);
+  std::optional<MemberRecord> m;
+  for (const auto& r : db.members()) {
+    if (r.index == index) {
+      m = r;
+    }
+  }
+  COREDEM_CHECK(m.has_value(), "{}: no member with index {}", dir.string(), index);
+  const int retries = std::stoi(db.setting("retries", "0"));
+  char host[256] = {0};
+  ::gethostname(host, sizeof host - 1);
+
+  std::string how;
+  std::vector<std::string> base;
+  if (!claimMember(db, m, task, host, base, how)) {
+    return kOk;
+  }
+  std::vector<std::string> args = base;
+  const long margin = std::stol(db.setting("slurm.stop_margin", "120"));
+  const long walltime = addWalltime(db, margin, args);
   const fs::path logFile = fs::path(m->caseDir).parent_path() / "coredem.log";
   const int attempt = m->attempts + 1;
   {
@@ -553,98 +676,9 @@ int slurmMemberMain(const fs::path& dir, int index) {
   log->info("member {}: coredem {} (pid {} on {}, Slurm task {}, attempt {}{})", m->id, how, pid,
             host, task, attempt,
             walltime > 0 ? fmt::format(", stops at {} s wall time", walltime) : "");
-  int status = 0;
   bool forwarded = false;
-  std::string lastCkpt = m->lastCheckpoint;
-  auto lastScan = std::chrono::steady_clock::now();
-  while (true) {
-    const pid_t w = ::waitpid(pid, &status, WNOHANG);
-    if (w == pid || (w < 0 && errno != EINTR)) {
-      if (w < 0) {
-        status = -1;
-      }
-      break;
-    }
-    if (gSignal != 0 && !forwarded) {
-      log->warn("member {}: signal {} (time limit, preemption or scancel): stopping with a "
-                "checkpoint",
-                m->id, gSignal.load());
-      ::kill(-pid, SIGTERM);
-      ::kill(-pid, SIGCONT);
-      forwarded = true;
-    }
-    if (std::chrono::steady_clock::now() - lastScan > 1s) {
-      lastScan = std::chrono::steady_clock::now();
-      const std::string c = newestCheckpointName(m->runDir);
-      if (c != lastCkpt) {
-        lastCkpt = c;
-        db.setLastCheckpoint(m->id, c);
-      }
-    }
-    std::this_thread::sleep_for(100ms);
-  }
-
-  const bool exitedOk = status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
-  const bool ok = exitedOk && runReachedEnd(m->runDir, m->caseDir);
-  std::string after;
-  if (ok) {
-    after = finishMember(db, m->id, m->runDir, status, retries);
-    return after == "done" ? kOk : kFault;
-  }
-  // The scheduler's view of this task: still RUNNING after our own wall-time stop or the
-  // time-limit warning (sbatch --signal=B:TERM): requeue it. Anything else (COMPLETING after
-  // scancel, a hard time-limit kill or preemption) means the task is ending: the member stays
-  // pending and the submitting side (campaign run/resume) resubmits it; Slurm requeues a
-  // preempted task itself where PreemptMode=REQUEUE.
-  const std::string jobState = endedTaskState(task);
-  const bool ending = jobState.rfind("RUNNING", 0) != 0;
-  // Stopped, not failed: exit 0 before the end (--walltime), 130 (the forwarded SIGTERM), a
-  // signal to this process, or any end while the task is ending. scancel signals every process
-  // of the task: a participant may stop first and coredem then exits 1 ("the other participant
-  // was shut down") before this process forwards its own signal.
-  const bool stopped = forwarded || gSignal != 0 || (ending && !jobState.empty()) || exitedOk ||
-                       (status >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == kInterrupted);
-  if (stopped) {
-    const std::string ckpt = newestCheckpointName(m->runDir);
-    const std::string reason =
-        ending ? fmt::format("its Slurm task ended ({}: scancel, time limit or preemption)",
-                             jobState.empty() ? "state unknown" : jobState)
-        : forwarded
-            ? fmt::format("stopped by Slurm's time-limit warning (signal {})", gSignal.load())
-            : fmt::format("stopped {} s before its time limit", margin);
-    db.transaction([&] {
-      if (db.markInterrupted(m->id, reason)) {
-        db.setLastCheckpoint(m->id, ckpt);
-        db.addEvent(m->id, "stopped",
-                    reason + (ckpt.empty() ? "" : "; continues from checkpoint " + ckpt));
-      }
-    });
-    log->warn("member {}: {}; continues from checkpoint {}", m->id, reason,
-              ckpt.empty() ? "(none: from the start)" : ckpt);
-    after = "pending";
-  } else {
-    after = finishMember(db, m->id, m->runDir, status, retries);
-  }
-  if (after != "pending") {
-    return kFault;
-  }
-  if (ending) {
-    log->info("member {}: coredem campaign resume {} resubmits it", m->id, dir.string());
-    return kOk;
-  }
-  // Continue in a new run of this task (Slurm starts it again after its requeue delay). The
-  // event comes first: the requeue ends this task, and Slurm may kill scontrol (and this
-  // process) before scontrol can report its success.
-  db.transaction([&] { db.addEvent(m->id, "requeued", "Slurm task " + task); });
-  log->info("member {}: requeuing Slurm task {}", m->id, task);
-  const Captured rq = capture({"scontrol", "requeue", task});
-  if (rq.rc > 0) {
-    db.transaction([&] { db.addEvent(m->id, "requeue failed", trim(rq.err + rq.out)); });
-    log->warn("member {}: cannot requeue Slurm task {} ({}); coredem campaign resume {} "
-              "resubmits the member",
-              m->id, task, trim(rq.err + rq.out), dir.string());
-  }
-  return kOk;
+  const int status = waitMember(db, *m, pid, forwarded, log);
+  return memberEnded(dir, db, *m, task, status, forwarded, retries, margin, log);
 }
 
 } // namespace coredem::orchestrator::campaign_detail

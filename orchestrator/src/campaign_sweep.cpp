@@ -231,30 +231,11 @@ std::string setCaseKey(const std::string& caseText, const std::string& path,
   return std::string(e.c_str()) + "\n";
 }
 
-Sweep loadSweep(const fs::path& sweepFile) {
-  Sweep sw;
-  sw.file = fs::absolute(sweepFile);
-  SweepReader r{sweepFile.string()};
-  if (!fs::is_regular_file(sw.file)) {
-    throw CaseError(fmt::format("{}: sweep file not found", sweepFile.string()));
-  }
-  sw.text = readFile(sw.file);
-  YAML::Node root;
-  try {
-    root = YAML::Load(sw.text);
-  } catch (const YAML::Exception& e) {
-    const bool flow = e.msg.find("flow") != std::string::npos;
-    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}{}", r.file, e.mark.line + 1,
-                                e.mark.column + 1, e.msg,
-                                flow ? " (a key like particles[0].diameter must be written in "
-                                       "a block mapping, one key per line, not inside { })"
-                                     : ""));
-  }
-  if (!root.IsMap()) {
-    throw CaseError(fmt::format("{}: a sweep file is a mapping with base_case and grid or "
-                                "members (docs/campaigns.md)",
-                                r.file));
-  }
+namespace {
+
+/// The sweep's settings: known top-level keys, base_case, name, executor (with its slurm
+/// section), concurrency and retries.
+void readSettings(const YAML::Node& root, const SweepReader& r, Sweep& sw) {
   for (const auto& kv : root) {
     const std::string k = kv.first.as<std::string>();
     if (!kTopKeys.count(k)) {
@@ -304,8 +285,11 @@ Sweep loadSweep(const fs::path& sweepFile) {
   if (sw.executor == "slurm") {
     sw.slurm = parseSlurmSection(root, r.file);
   }
+}
 
-  // parameters: grid (cartesian product, first key varies slowest) or explicit members
+/// The members: grid (cartesian product, first key varies slowest) or explicit members; ids
+/// m000, m001, ...
+void readMembers(const YAML::Node& root, const SweepReader& r, Sweep& sw) {
   const YAML::Node grid = root["grid"], members = root["members"];
   if (static_cast<bool>(grid) == static_cast<bool>(members)) {
     r.fail(root, grid ? "grid" : "members",
@@ -381,8 +365,11 @@ Sweep loadSweep(const fs::path& sweepFile) {
   for (std::size_t i = 0; i < sw.members.size(); ++i) {
     sw.members[i].id = fmt::format("m{:03d}", i);
   }
+}
 
-  // results
+/// collect: the scalars of summary.csv and the plotted pair (defaults: final mean_T_p against
+/// the first swept key).
+void readCollect(const YAML::Node& root, const SweepReader& r, Sweep& sw) {
   sw.scalars = {{"final", "mean_T_p"}};
   if (const YAML::Node c = root["collect"]) {
     if (!c.IsMap()) {
@@ -446,8 +433,10 @@ Sweep loadSweep(const fs::path& sweepFile) {
   if (sw.plotY.empty()) {
     sw.plotY = sw.scalars.front().label();
   }
+}
 
-  // resolve and validate every member's case (nothing is written)
+/// Resolves and validates every member's case (nothing is written).
+void resolveMembers(const SweepReader& r, Sweep& sw) {
   const fs::path baseFile = sw.baseCase / "case.yaml";
   const std::string baseText = readFile(baseFile);
   for (const auto& mem : sw.members) {
@@ -482,6 +471,38 @@ Sweep loadSweep(const fs::path& sweepFile) {
     }
     sw.resolvedCases.push_back(std::move(text));
   }
+}
+
+} // namespace
+
+Sweep loadSweep(const fs::path& sweepFile) {
+  Sweep sw;
+  sw.file = fs::absolute(sweepFile);
+  SweepReader r{sweepFile.string()};
+  if (!fs::is_regular_file(sw.file)) {
+    throw CaseError(fmt::format("{}: sweep file not found", sweepFile.string()));
+  }
+  sw.text = readFile(sw.file);
+  YAML::Node root;
+  try {
+    root = YAML::Load(sw.text);
+  } catch (const YAML::Exception& e) {
+    const bool flow = e.msg.find("flow") != std::string::npos;
+    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}{}", r.file, e.mark.line + 1,
+                                e.mark.column + 1, e.msg,
+                                flow ? " (a key like particles[0].diameter must be written in "
+                                       "a block mapping, one key per line, not inside { })"
+                                     : ""));
+  }
+  if (!root.IsMap()) {
+    throw CaseError(fmt::format("{}: a sweep file is a mapping with base_case and grid or "
+                                "members (docs/campaigns.md)",
+                                r.file));
+  }
+  readSettings(root, r, sw);
+  readMembers(root, r, sw);
+  readCollect(root, r, sw);
+  resolveMembers(r, sw);
   return sw;
 }
 

@@ -132,6 +132,16 @@ private:
   protocol::Message receiveFromDem(std::chrono::milliseconds timeout, const std::string& awaited);
   // step_loop.cpp
   void stepLoop(std::int64_t startStep);
+  /// Sends the StepGrant of `step` to both participants (the CFD participant's answers its
+  /// pending request): with the checkpoint directory when ckDir is not empty, and to the CFD
+  /// participant the output tag when `output`.
+  void sendStepGrants(std::int64_t step, double tStart, double dt, const SubcyclePlan& plan,
+                      const std::filesystem::path& ckDir, bool output);
+  /// The DEM server's and the CFD participant's StepDone of `step` (other CFD requests are
+  /// answered with an error meanwhile).
+  std::pair<protocol::Message, protocol::Request>
+  awaitStepDone(std::int64_t step, std::chrono::milliseconds demTimeout,
+                std::chrono::milliseconds cfdTimeout);
   // records.cpp
   void writeTimeseriesRow(std::int64_t step, double dt, const SubcyclePlan& plan, double wallStep,
                           const v1::StepDone& dem, const v1::StepDone& cfd);

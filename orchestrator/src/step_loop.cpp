@@ -87,54 +87,10 @@ void Session::stepLoop(std::int64_t startStep) {
       fs::remove_all(ckDir); // a stale, incomplete one from an earlier attempt
       fs::create_directories(ckDir);
     }
-    auto makeGrant = [&](bool cfd) {
-      Message g = protocol::makeStepGrant(step, tStart, dt, std::uint32_t(plan.nSub), plan.dtDem);
-      g.setSessionId(_session);
-      if (checkpoint) {
-        g.envelope().mutable_step_grant()->mutable_checkpoint()->set_directory(ckDir.string());
-      }
-      if (cfd && output) { // the DEM server's part of an output is the snapshot request below
-        g.envelope().mutable_step_grant()->mutable_checkpoint()->set_tag(protocol::kOutputTag);
-      }
-      return g;
-    };
-    _dem->send(makeGrant(false));
-    {
-      Message g = makeGrant(true);
-      g.setSequence(_pendingCfd->message.envelope().sequence());
-      _ctrl->reply(_pendingCfd->peer, std::move(g));
-      _pendingCfd.reset();
-    }
+    sendStepGrants(step, tStart, dt, plan, ckDir, output);
     _overhead.overhead += std::chrono::duration<double>(SteadyClock::now() - afterPrevious).count();
 
-    Message demDone = receiveFromDem(demTimeout, fmt::format("StepDone of step {}", step));
-    if (demDone.type() != v1::MESSAGE_TYPE_STEP_DONE || demDone.envelope().step() != step) {
-      throw ParticipantFault(kDemName,
-                             fmt::format("answered the grant of step {} with {} of step {}", step,
-                                         protocol::messageTypeName(demDone.type()),
-                                         demDone.envelope().step()));
-    }
-    // The scheme the DEM server runs is the one asked for: a server that ignored the Configure
-    // option (an older coredem-dem logs unknown options and runs sequential) reports no lag.
-    if (const std::string why = couplingSchemeMismatch(_c, demDone.envelope().step_done(), step);
-        !why.empty()) {
-      throw ParticipantFault(kDemName, why);
-    }
-    protocol::Request cfdDone;
-    while (true) {
-      cfdDone = receiveFromCfd(cfdTimeout, fmt::format("StepDone of step {}", step));
-      if (cfdDone.message.type() == v1::MESSAGE_TYPE_STEP_DONE &&
-          cfdDone.message.envelope().step() == step) {
-        break;
-      }
-      Message err =
-          protocol::makeError(v1::ERROR_CODE_OUT_OF_ORDER,
-                              fmt::format("expected StepDone of step {}, got {} of step {}", step,
-                                          protocol::messageTypeName(cfdDone.message.type()),
-                                          cfdDone.message.envelope().step()),
-                              cfdDone.message.envelope().sequence(), cfdDone.message.type());
-      _ctrl->reply(cfdDone.peer, std::move(err));
-    }
+    auto [demDone, cfdDone] = awaitStepDone(step, demTimeout, cfdTimeout);
     const auto tDone = SteadyClock::now();
     _time.advance(dt);
     _step = step;
@@ -174,6 +130,62 @@ void Session::stepLoop(std::int64_t startStep) {
   }
   _inStepLoop = false;
   progress.finish(_step, _time.time());
+}
+
+void Session::sendStepGrants(std::int64_t step, double tStart, double dt, const SubcyclePlan& plan,
+                             const fs::path& ckDir, bool output) {
+  const bool checkpoint = !ckDir.empty();
+  auto makeGrant = [&](bool cfd) {
+    Message g = protocol::makeStepGrant(step, tStart, dt, std::uint32_t(plan.nSub), plan.dtDem);
+    g.setSessionId(_session);
+    if (checkpoint) {
+      g.envelope().mutable_step_grant()->mutable_checkpoint()->set_directory(ckDir.string());
+    }
+    if (cfd && output) { // the DEM server's part of an output is the snapshot request below
+      g.envelope().mutable_step_grant()->mutable_checkpoint()->set_tag(protocol::kOutputTag);
+    }
+    return g;
+  };
+  _dem->send(makeGrant(false));
+  {
+    Message g = makeGrant(true);
+    g.setSequence(_pendingCfd->message.envelope().sequence());
+    _ctrl->reply(_pendingCfd->peer, std::move(g));
+    _pendingCfd.reset();
+  }
+}
+
+std::pair<Message, protocol::Request> Session::awaitStepDone(std::int64_t step,
+                                                             std::chrono::milliseconds demTimeout,
+                                                             std::chrono::milliseconds cfdTimeout) {
+  Message demDone = receiveFromDem(demTimeout, fmt::format("StepDone of step {}", step));
+  if (demDone.type() != v1::MESSAGE_TYPE_STEP_DONE || demDone.envelope().step() != step) {
+    throw ParticipantFault(kDemName, fmt::format("answered the grant of step {} with {} of step {}",
+                                                 step, protocol::messageTypeName(demDone.type()),
+                                                 demDone.envelope().step()));
+  }
+  // The scheme the DEM server runs is the one asked for: a server that ignored the Configure
+  // option (an older coredem-dem logs unknown options and runs sequential) reports no lag.
+  if (const std::string why = couplingSchemeMismatch(_c, demDone.envelope().step_done(), step);
+      !why.empty()) {
+    throw ParticipantFault(kDemName, why);
+  }
+  protocol::Request cfdDone;
+  while (true) {
+    cfdDone = receiveFromCfd(cfdTimeout, fmt::format("StepDone of step {}", step));
+    if (cfdDone.message.type() == v1::MESSAGE_TYPE_STEP_DONE &&
+        cfdDone.message.envelope().step() == step) {
+      break;
+    }
+    Message err =
+        protocol::makeError(v1::ERROR_CODE_OUT_OF_ORDER,
+                            fmt::format("expected StepDone of step {}, got {} of step {}", step,
+                                        protocol::messageTypeName(cfdDone.message.type()),
+                                        cfdDone.message.envelope().step()),
+                            cfdDone.message.envelope().sequence(), cfdDone.message.type());
+    _ctrl->reply(cfdDone.peer, std::move(err));
+  }
+  return {std::move(demDone), std::move(cfdDone)};
 }
 
 } // namespace coredem::orchestrator

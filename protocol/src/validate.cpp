@@ -204,10 +204,11 @@ std::uint64_t cellCount(const v1::CouplingMesh& mesh) {
   return xyz;
 }
 
-Status validate(const Message& message, const Expectation& e) {
-  if (Status s = structure(message); !s.ok()) {
-    return s;
-  }
+namespace {
+
+/// The envelope against the expectation: a known type with its body, expected now, of this
+/// session, in sequence and of the expected step.
+Status checkEnvelope(const Message& message, const Expectation& e) {
   const auto& env = message.envelope();
   const v1::MessageType type = env.type();
   if (!v1::MessageType_IsValid(type) || type == v1::MESSAGE_TYPE_UNSPECIFIED) {
@@ -261,99 +262,119 @@ Status validate(const Message& message, const Expectation& e) {
                              " received, step " + std::to_string(*e.step) +
                              " expected; steps are exchanged in order, one per CFD step");
   }
-  if (type == v1::MESSAGE_TYPE_GAS_FIELDS || type == v1::MESSAGE_TYPE_SOURCES) {
-    if (!e.cells || !e.species) {
-      return Status::error(v1::ERROR_CODE_NOT_CONFIGURED,
-                           messageTypeName(type) +
-                               " received before Configure; send Hello and Configure first");
+  return Status::success();
+}
+
+/// A GasFields or Sources message: declared on the configured mesh, its arrays (those of the
+/// listed cells of a partial one) and, of a partial GasFields, the fluid volumes.
+Status checkFields(const Message& message, const Expectation& e) {
+  const auto& env = message.envelope();
+  const v1::MessageType type = env.type();
+  if (!e.cells || !e.species) {
+    return Status::error(v1::ERROR_CODE_NOT_CONFIGURED,
+                         messageTypeName(type) +
+                             " received before Configure; send Hello and Configure first");
+  }
+  std::uint64_t bodyCells = type == v1::MESSAGE_TYPE_GAS_FIELDS ? env.gas_fields().cell_count()
+                                                                : env.sources().cell_count();
+  std::uint64_t bodySpecies = type == v1::MESSAGE_TYPE_GAS_FIELDS ? env.gas_fields().species_count()
+                                                                  : env.sources().species_count();
+  if (bodyCells != *e.cells || bodySpecies != *e.species) {
+    return Status::error(v1::ERROR_CODE_SHAPE,
+                         messageTypeName(type) + " declares " + std::to_string(bodyCells) +
+                             " cells and " + std::to_string(bodySpecies) +
+                             " species but the configured mesh has " + std::to_string(*e.cells) +
+                             " cells and " + std::to_string(*e.species) +
+                             " species; send fields on the configured coupling mesh");
+  }
+  const bool partial =
+      type == v1::MESSAGE_TYPE_GAS_FIELDS ? env.gas_fields().partial() : env.sources().partial();
+  std::uint64_t rows = *e.cells;
+  if (partial) {
+    rows = type == v1::MESSAGE_TYPE_GAS_FIELDS ? env.gas_fields().touched_count()
+                                               : env.sources().touched_count();
+    if (Status p = checkPartial(message, rows, *e.cells); !p.ok()) {
+      return p;
     }
-    std::uint64_t bodyCells = type == v1::MESSAGE_TYPE_GAS_FIELDS ? env.gas_fields().cell_count()
-                                                                  : env.sources().cell_count();
-    std::uint64_t bodySpecies = type == v1::MESSAGE_TYPE_GAS_FIELDS
-                                    ? env.gas_fields().species_count()
-                                    : env.sources().species_count();
-    if (bodyCells != *e.cells || bodySpecies != *e.species) {
-      return Status::error(v1::ERROR_CODE_SHAPE,
-                           messageTypeName(type) + " declares " + std::to_string(bodyCells) +
-                               " cells and " + std::to_string(bodySpecies) +
-                               " species but the configured mesh has " + std::to_string(*e.cells) +
-                               " cells and " + std::to_string(*e.species) +
-                               " species; send fields on the configured coupling mesh");
-    }
-    const bool partial =
-        type == v1::MESSAGE_TYPE_GAS_FIELDS ? env.gas_fields().partial() : env.sources().partial();
-    std::uint64_t rows = *e.cells;
-    if (partial) {
-      rows = type == v1::MESSAGE_TYPE_GAS_FIELDS ? env.gas_fields().touched_count()
-                                                 : env.sources().touched_count();
-      if (Status p = checkPartial(message, rows, *e.cells); !p.ok()) {
-        return p;
-      }
-    }
-    auto required =
-        type == v1::MESSAGE_TYPE_GAS_FIELDS ? fields::gasFields() : fields::sourceFields();
-    Status st = checkArrays(message, required, rows, *e.species, e.requireFinite);
-    if (!st.ok()) {
-      return st;
-    }
-    if (type == v1::MESSAGE_TYPE_SOURCES) {
-      // Optional Sources arrays (v1.3 Q_rad): when present, float64 with one row per cell (or
-      // listed cell of a partial Sources); finiteness was checked with every array above.
-      for (const auto& spec : fields::optionalSourceFields()) {
-        const auto v = message.findArray(spec.name);
-        if (!v) {
-          continue;
-        }
-        const auto expected = fields::shapeOf(spec.extent, rows, *e.species);
-        if (v->dtype() != v1::DTYPE_FLOAT64 || v->shape() != expected) {
-          return Status::error(v1::ERROR_CODE_SHAPE,
-                               "array '" + std::string(spec.name) + "' has dtype " +
-                                   dtypeName(v->dtype()) + " and shape " + shapeString(v->shape()) +
-                                   " but float64 " + shapeString(expected) + " was expected for " +
-                                   std::to_string(rows) + (partial ? " listed" : " configured") +
-                                   " cells");
-        }
-      }
-      return st;
-    }
-    if (type != v1::MESSAGE_TYPE_GAS_FIELDS) {
-      return st;
-    }
-    if (partial) {
-      // The fluid volumes: positive (finite was checked above).
-      const auto fv = message.values<double>(fields::kFluidVolume);
-      for (std::size_t i = 0; i < fv.size(); ++i) {
-        if (!(fv[i] > 0.0)) {
-          return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION,
-                               "partial GasFields: fluid_volume[" + std::to_string(i) +
-                                   "] = " + std::to_string(fv[i]) +
-                                   " m3; list only coupling cells the rank's cells overlap "
-                                   "(fluid volume > 0)");
-        }
-      }
-      if (message.findArray(fields::kFluidFraction)) {
-        return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION,
-                             "partial GasFields carry fluid_volume; fluid_fraction is formed by "
-                             "the DEM server from the ranks' fluid volumes, do not send it");
-      }
-      return st;
-    }
-    // Optional GasFields arrays: when present, the same dtype and shape rules.
-    for (const auto& spec : fields::optionalGasFields()) {
+  }
+  auto required =
+      type == v1::MESSAGE_TYPE_GAS_FIELDS ? fields::gasFields() : fields::sourceFields();
+  Status st = checkArrays(message, required, rows, *e.species, e.requireFinite);
+  if (!st.ok()) {
+    return st;
+  }
+  if (type == v1::MESSAGE_TYPE_SOURCES) {
+    // Optional Sources arrays (v1.3 Q_rad): when present, float64 with one row per cell (or
+    // listed cell of a partial Sources); finiteness was checked with every array above.
+    for (const auto& spec : fields::optionalSourceFields()) {
       const auto v = message.findArray(spec.name);
       if (!v) {
         continue;
       }
-      const auto expected = fields::shapeOf(spec.extent, *e.cells, *e.species);
+      const auto expected = fields::shapeOf(spec.extent, rows, *e.species);
       if (v->dtype() != v1::DTYPE_FLOAT64 || v->shape() != expected) {
         return Status::error(v1::ERROR_CODE_SHAPE,
                              "array '" + std::string(spec.name) + "' has dtype " +
                                  dtypeName(v->dtype()) + " and shape " + shapeString(v->shape()) +
                                  " but float64 " + shapeString(expected) + " was expected for " +
-                                 std::to_string(*e.cells) + " configured cells");
+                                 std::to_string(rows) + (partial ? " listed" : " configured") +
+                                 " cells");
       }
     }
     return st;
+  }
+  if (type != v1::MESSAGE_TYPE_GAS_FIELDS) {
+    return st;
+  }
+  if (partial) {
+    // The fluid volumes: positive (finite was checked above).
+    const auto fv = message.values<double>(fields::kFluidVolume);
+    for (std::size_t i = 0; i < fv.size(); ++i) {
+      if (!(fv[i] > 0.0)) {
+        return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION,
+                             "partial GasFields: fluid_volume[" + std::to_string(i) +
+                                 "] = " + std::to_string(fv[i]) +
+                                 " m3; list only coupling cells the rank's cells overlap "
+                                 "(fluid volume > 0)");
+      }
+    }
+    if (message.findArray(fields::kFluidFraction)) {
+      return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION,
+                           "partial GasFields carry fluid_volume; fluid_fraction is formed by "
+                           "the DEM server from the ranks' fluid volumes, do not send it");
+    }
+    return st;
+  }
+  // Optional GasFields arrays: when present, the same dtype and shape rules.
+  for (const auto& spec : fields::optionalGasFields()) {
+    const auto v = message.findArray(spec.name);
+    if (!v) {
+      continue;
+    }
+    const auto expected = fields::shapeOf(spec.extent, *e.cells, *e.species);
+    if (v->dtype() != v1::DTYPE_FLOAT64 || v->shape() != expected) {
+      return Status::error(v1::ERROR_CODE_SHAPE,
+                           "array '" + std::string(spec.name) + "' has dtype " +
+                               dtypeName(v->dtype()) + " and shape " + shapeString(v->shape()) +
+                               " but float64 " + shapeString(expected) + " was expected for " +
+                               std::to_string(*e.cells) + " configured cells");
+    }
+  }
+  return st;
+}
+
+} // namespace
+
+Status validate(const Message& message, const Expectation& e) {
+  if (Status s = structure(message); !s.ok()) {
+    return s;
+  }
+  if (Status s = checkEnvelope(message, e); !s.ok()) {
+    return s;
+  }
+  const v1::MessageType type = message.envelope().type();
+  if (type == v1::MESSAGE_TYPE_GAS_FIELDS || type == v1::MESSAGE_TYPE_SOURCES) {
+    return checkFields(message, e);
   }
   return checkArrays(message, {}, 0, 0, e.requireFinite);
 }
@@ -460,9 +481,9 @@ bool finite3(const v1::Vec3& v) {
 Status bad(const std::string& msg) {
   return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION, "Configure: " + msg);
 }
-} // namespace
 
-Status validateConfigure(const v1::Configure& c) {
+/// coupling_mesh: a Cartesian grid of at most kMaxCells cells with a finite spacing > 0.
+Status checkMesh(const v1::Configure& c) {
   if (c.coupling_mesh().kind_case() != v1::CouplingMesh::kCartesian) {
     return bad("coupling_mesh must be a CartesianGrid (the only mesh kind of protocol 1.0)");
   }
@@ -480,6 +501,11 @@ Status validateConfigure(const v1::Configure& c) {
   if (!positive(g.spacing()) || !finite3(g.spacing()) || !finite3(g.origin())) {
     return bad("coupling_mesh.cartesian.spacing must be finite and > 0 on every axis");
   }
+  return {};
+}
+
+/// Gas and solid species: unique names, molar masses > 0 (v1.1 chemistry: solid species).
+Status checkSpecies(const v1::Configure& c) {
   std::set<std::string> names;
   for (const auto& s : c.species()) {
     if (s.name().empty() || !names.insert(s.name()).second) {
@@ -491,8 +517,7 @@ Status validateConfigure(const v1::Configure& c) {
                  std::to_string(s.molar_mass()) + " kg/mol; it must be > 0 (e.g. 0.044 for CO2)");
     }
   }
-  // v1.1 chemistry: solid species, reactions, switches (the DEM server checks the species
-  // references and the models' needs when it builds the system).
+  // v1.1 chemistry: solid species, unique among the gas species too.
   for (const auto& s : c.solid_species()) {
     if (s.name().empty() || !names.insert(s.name()).second) {
       return bad("solid_species name '" + printable(s.name()) +
@@ -504,6 +529,12 @@ Status validateConfigure(const v1::Configure& c) {
                  std::to_string(s.molar_mass()) + " kg/mol; it must be > 0");
     }
   }
+  return {};
+}
+
+/// v1.1 chemistry: the reactions' terms and rate laws, the removal fraction (the DEM server
+/// checks the species references and the models' needs when it builds the system).
+Status checkReactions(const v1::Configure& c) {
   for (const auto& r : c.reactions()) {
     if (r.terms_size() < 1 || r.terms_size() > 6) {
       return bad("reaction '" + printable(r.name()) + "' has " + std::to_string(r.terms_size()) +
@@ -534,6 +565,11 @@ Status validateConfigure(const v1::Configure& c) {
     return bad("chemistry.removal_fraction = " + std::to_string(c.chemistry().removal_fraction()) +
                " must be in (0, 1)");
   }
+  return {};
+}
+
+/// sub_cycling: dt_cfd > 0, n_sub >= 1, dt_dem > 0 and dt_dem * n_sub = dt_cfd.
+Status checkSubCycling(const v1::Configure& c) {
   const auto& sc = c.sub_cycling();
   if (!(sc.dt_cfd() > 0) || sc.n_sub() == 0 || !(sc.dt_dem() > 0)) {
     return bad("sub_cycling needs dt_cfd > 0, n_sub >= 1 and dt_dem > 0");
@@ -546,7 +582,11 @@ Status validateConfigure(const v1::Configure& c) {
        << " s (relative tolerance 1e-12); set dt_dem = dt_cfd / n_sub";
     return bad(os.str());
   }
-  std::set<std::uint32_t> materialIds;
+  return {};
+}
+
+/// Materials: unique ids (collected in materialIds) and valid contact parameters.
+Status checkMaterials(const v1::Configure& c, std::set<std::uint32_t>& materialIds) {
   for (const auto& m : c.materials()) {
     if (!materialIds.insert(m.id()).second) {
       return bad("material id " + std::to_string(m.id()) + " is used twice");
@@ -559,47 +599,56 @@ Status validateConfigure(const v1::Configure& c) {
                  "etat_factor >= 0");
     }
   }
-  if (c.initial_state_file().empty()) {
-    for (int i = 0; i < c.particle_sets_size(); ++i) {
-      const auto& p = c.particle_sets(i);
-      std::string which = "particle_sets[" + std::to_string(i) + "]";
-      if (!materialIds.count(p.material_id())) {
-        return bad(which + " refers to material " + std::to_string(p.material_id()) +
-                   ", which is not among materials");
+  return {};
+}
+
+/// Particle sets (of a case without initial_state_file): a known material, valid sizes,
+/// packing and composition.
+Status checkParticleSets(const v1::Configure& c, const std::set<std::uint32_t>& materialIds) {
+  for (int i = 0; i < c.particle_sets_size(); ++i) {
+    const auto& p = c.particle_sets(i);
+    std::string which = "particle_sets[" + std::to_string(i) + "]";
+    if (!materialIds.count(p.material_id())) {
+      return bad(which + " refers to material " + std::to_string(p.material_id()) +
+                 ", which is not among materials");
+    }
+    if (p.count() == 0 || !(p.diameter() > 0) || p.density() < 0 || !(p.temperature() > 0)) {
+      return bad(which + " needs count >= 1, diameter > 0, density >= 0 (0 = material's) "
+                         "and temperature > 0 K");
+    }
+    if (p.packing() == v1::PACKING_EXPLICIT) {
+      if (static_cast<std::uint64_t>(p.positions_size()) != p.count()) {
+        return bad(which + " explicit packing needs one position per particle (count " +
+                   std::to_string(p.count()) + ", positions " + std::to_string(p.positions_size()) +
+                   ")");
       }
-      if (p.count() == 0 || !(p.diameter() > 0) || p.density() < 0 || !(p.temperature() > 0)) {
-        return bad(which + " needs count >= 1, diameter > 0, density >= 0 (0 = material's) "
-                           "and temperature > 0 K");
-      }
-      if (p.packing() == v1::PACKING_EXPLICIT) {
-        if (static_cast<std::uint64_t>(p.positions_size()) != p.count()) {
-          return bad(which + " explicit packing needs one position per particle (count " +
-                     std::to_string(p.count()) + ", positions " +
-                     std::to_string(p.positions_size()) + ")");
+    } else if (!(p.region_min().x() < p.region_max().x() &&
+                 p.region_min().y() < p.region_max().y() &&
+                 p.region_min().z() < p.region_max().z())) {
+      return bad(which + " region_min must be below region_max on every axis");
+    }
+    if (p.packing() == v1::PACKING_UNSPECIFIED) {
+      return bad(which + " packing must be LATTICE, RANDOM or EXPLICIT");
+    }
+    if (p.composition_size() > 0) {
+      double sum = 0;
+      for (const auto& nv : p.composition()) {
+        if (!(nv.value() >= 0)) {
+          return bad(which + " composition '" + printable(nv.name()) + "' is negative");
         }
-      } else if (!(p.region_min().x() < p.region_max().x() &&
-                   p.region_min().y() < p.region_max().y() &&
-                   p.region_min().z() < p.region_max().z())) {
-        return bad(which + " region_min must be below region_max on every axis");
+        sum += nv.value();
       }
-      if (p.packing() == v1::PACKING_UNSPECIFIED) {
-        return bad(which + " packing must be LATTICE, RANDOM or EXPLICIT");
-      }
-      if (p.composition_size() > 0) {
-        double sum = 0;
-        for (const auto& nv : p.composition()) {
-          if (!(nv.value() >= 0)) {
-            return bad(which + " composition '" + printable(nv.name()) + "' is negative");
-          }
-          sum += nv.value();
-        }
-        if (std::abs(sum - 1.0) > 1e-9) {
-          return bad(which + " composition mass fractions sum to " + std::to_string(sum) +
-                     "; they must sum to 1 (tolerance 1e-9)");
-        }
+      if (std::abs(sum - 1.0) > 1e-9) {
+        return bad(which + " composition mass fractions sum to " + std::to_string(sum) +
+                   "; they must sum to 1 (tolerance 1e-9)");
       }
     }
   }
+  return {};
+}
+
+/// Walls: box, planes and (v1.4) cylinders, cones and meshes.
+Status checkWalls(const v1::Configure& c) {
   if (c.walls().has_box()) {
     const auto& b = c.walls().box();
     if (!(b.min().x() < b.max().x() && b.min().y() < b.max().y() && b.min().z() < b.max().z())) {
@@ -652,6 +701,33 @@ Status validateConfigure(const v1::Configure& c) {
     }
   }
   return {};
+}
+
+} // namespace
+
+Status validateConfigure(const v1::Configure& c) {
+  if (Status s = checkMesh(c); !s.ok()) {
+    return s;
+  }
+  if (Status s = checkSpecies(c); !s.ok()) {
+    return s;
+  }
+  if (Status s = checkReactions(c); !s.ok()) {
+    return s;
+  }
+  if (Status s = checkSubCycling(c); !s.ok()) {
+    return s;
+  }
+  std::set<std::uint32_t> materialIds;
+  if (Status s = checkMaterials(c, materialIds); !s.ok()) {
+    return s;
+  }
+  if (c.initial_state_file().empty()) {
+    if (Status s = checkParticleSets(c, materialIds); !s.ok()) {
+      return s;
+    }
+  }
+  return checkWalls(c);
 }
 
 } // namespace coredem::protocol

@@ -225,23 +225,10 @@ void addFieldArrays(Message& m, std::span<const fields::FieldSpec> specs,
   }
 }
 
-} // namespace
+using Golden = std::vector<std::pair<std::string, Message>>;
 
-int main(int argc, char** argv) {
-  if (argc != 2 && argc != 3) {
-    std::fprintf(stderr,
-                 "usage: coredem-golden-gen OUTPUT_DIR [MINOR]   (e.g. protocol/golden/v1.1 1)\n");
-    return 2;
-  }
-  const int minor = argc == 3 ? std::atoi(argv[2]) : 0;
-  if (minor < 0 || minor > 4) {
-    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0, 1, 2, 3 or 4\n");
-    return 2;
-  }
-  std::filesystem::path dir = argv[1];
-  std::filesystem::create_directories(dir);
-  std::vector<std::pair<std::string, Message>> all;
-
+/// Hello, Welcome, Reject, Configure and Configured of protocol 1.minor.
+void addSessionMessages(Golden& all, int minor) {
   {
     v1::FieldManifestEntry e;
     e.set_name("u_g");
@@ -288,6 +275,10 @@ int main(int argc, char** argv) {
     stamp(m, 2);
     all.emplace_back("configured", std::move(m));
   }
+}
+
+/// GasFields and Sources of protocol 1.minor (partial from 1.2, with Q_rad from 1.3).
+void addExchangeMessages(Golden& all, int minor) {
   {
     Message m = makeGasFields(3, 0.25, 1e-4, kCells, kSpecies);
     stamp(m, 3);
@@ -324,6 +315,10 @@ int main(int argc, char** argv) {
     }
     all.emplace_back("sources", std::move(m));
   }
+}
+
+/// StepGrant, StepDone, the checkpoint messages, Heartbeat, Error, Shutdown and Ack.
+void addControlMessages(Golden& all) {
   {
     Message m = makeStepGrant(3, 0.25, 1e-4, 50, 2e-6);
     stamp(m, 4);
@@ -374,6 +369,27 @@ int main(int argc, char** argv) {
     stamp(m, 7);
     all.emplace_back("ack", std::move(m));
   }
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2 && argc != 3) {
+    std::fprintf(stderr,
+                 "usage: coredem-golden-gen OUTPUT_DIR [MINOR]   (e.g. protocol/golden/v1.1 1)\n");
+    return 2;
+  }
+  const int minor = argc == 3 ? std::atoi(argv[2]) : 0;
+  if (minor < 0 || minor > 4) {
+    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0, 1, 2, 3 or 4\n");
+    return 2;
+  }
+  std::filesystem::path dir = argv[1];
+  std::filesystem::create_directories(dir);
+  Golden all;
+  addSessionMessages(all, minor);
+  addExchangeMessages(all, minor);
+  addControlMessages(all);
   // Every row of the message table (message_types.h) has its golden message.
   for (const auto& row : kMessageTypes) {
     const bool found = std::any_of(all.begin(), all.end(),

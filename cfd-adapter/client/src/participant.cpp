@@ -13,18 +13,13 @@
 #include "coredem/common/log.h"
 #include "coredem/common/version.h"
 #include "coredem/protocol/protocol.h"
+#include "participant_impl.h"
 
 namespace coredem::client {
 
-namespace v1 = coredem::v1;
-namespace proto = coredem::protocol;
-
-namespace {
+namespace detail {
 
 const std::string kLibraryVersion = std::string("coredem-client ") + coredem::kVersion;
-constexpr double kDefaultTimeoutS = 60.0;
-/// |dt - granted dt| <= kDtTolerance * granted dt (the DEM sub-cycles exactly the granted dt).
-constexpr double kDtTolerance = 1e-12;
 
 std::string fromEnv(const std::string& given, const char* var) {
   if (!given.empty()) {
@@ -34,7 +29,11 @@ std::string fromEnv(const std::string& given, const char* var) {
   return v != nullptr ? std::string(v) : std::string();
 }
 
-} // namespace
+} // namespace detail
+
+using detail::fromEnv;
+using detail::kDefaultTimeoutS;
+using detail::kLibraryVersion;
 
 const char* stateName(State s) {
   switch (s) {
@@ -85,616 +84,347 @@ std::vector<std::string> Sources::names() const {
   return {n.begin(), n.end()};
 }
 
-struct Participant::Impl {
-  Options opt;
-  State state = State::Created;
-  std::chrono::milliseconds timeout{60000};
-  std::string controlEp, demEp, session;
-  std::unique_ptr<proto::Client> control, dem;
-  std::shared_ptr<spdlog::logger> log = coredem::logger("client");
-
-  Grid grid;
-  std::int64_t startStep = 0;
-  double startTime = 0.0;
-
-  // The current grant.
-  std::int64_t step = 0;
-  double time = 0.0, dt = 0.0, dtDem = 0.0;
-  int nSub = 0;
-  std::string checkpointDir;
-  bool outputRequested = false;
-  std::string shutdownReason;
-
-  Sources sources;
-  ExchangeTimes times;
-  int demMinor = 0; ///< the protocol minor agreed with D
-
-  bool decomposed() const { return opt.rankCount > 1; }
-
-  void require(std::initializer_list<State> allowed, const char* call, const char* hint) const {
-    for (State s : allowed) {
-      if (s == state) {
-        return;
-      }
-    }
-    throw StateError(
-        fmt::format("Participant::{}() called in state {}: {}", call, stateName(state), hint));
-  }
-
-  proto::TransportOptions transport(bool forDem) const {
-    proto::TransportOptions t;
-    t.sender = opt.name + " (" +
-               (opt.softwareVersion.empty() ? kLibraryVersion : opt.softwareVersion) + ")";
-    if (forDem) {
-      const auto key = fromEnv(opt.demServerPublicKey, "COREDEM_DEM_SERVER_KEY");
-      const auto keyFile = fromEnv(opt.demClientKeyFile, "COREDEM_DEM_CLIENT_KEY_FILE");
-      COREDEM_CHECK(!key.empty() || keyFile.empty(),
-                    "{}: a client key ({}) is given but no DEM server public key "
-                    "(COREDEM_DEM_SERVER_KEY): client keys are only used with CURVE",
-                    opt.name, keyFile);
-      if (!key.empty()) {
-        const auto pair =
-            keyFile.empty() ? proto::generateCurveKeyPair() : proto::readClientKeyPair(keyFile);
-        t.curve.serverPublicKey = key;
-        t.curve.clientPublicKey = pair.first;
-        t.curve.clientSecretKey = pair.second;
-      }
-    }
-    return t;
-  }
-
-  /// Takes a grant or Shutdown reply of O.
-  void takeGrantOrShutdown(const proto::Message& reply, std::int64_t expectedStep) {
-    if (reply.type() == v1::MESSAGE_TYPE_SHUTDOWN) {
-      shutdownReason = reply.envelope().shutdown().reason();
-      state = State::Finished;
-      log->info("{}: the orchestrator ended the run ({})", opt.name,
-                shutdownReason.empty() ? "no reason given" : shutdownReason);
-      return;
-    }
-    proto::expectType(reply, v1::MESSAGE_TYPE_STEP_GRANT);
-    proto::Expectation e;
-    e.types = {v1::MESSAGE_TYPE_STEP_GRANT};
-    e.step = expectedStep;
-    if (const auto s = proto::validate(reply, e); !s.ok()) {
-      throw proto::ProtocolError(s.code, "orchestrator " + controlEp +
-                                             " sent a bad StepGrant: " + s.message);
-    }
-    const auto& g = reply.envelope().step_grant();
-    COREDEM_CHECK(g.dt_cfd() > 0.0 && g.n_sub() >= 1,
-                  "orchestrator {} granted step {} with dt_cfd = {} s and n_sub = {}: both must "
-                  "be positive",
-                  controlEp, expectedStep, g.dt_cfd(), g.n_sub());
-    step = reply.envelope().step();
-    time = reply.envelope().time();
-    dt = g.dt_cfd();
-    nSub = static_cast<int>(g.n_sub());
-    dtDem = g.dt_dem() > 0.0 ? g.dt_dem() : dt / nSub;
-    checkpointDir = g.has_checkpoint() ? g.checkpoint().directory() : std::string();
-    outputRequested = g.has_checkpoint() && g.checkpoint().tag() == proto::kOutputTag;
-    state = State::Granted;
-  }
-
-  proto::Message handshake(proto::Client& client, const std::string& peer, bool rank = false) {
-    auto hello = proto::makeHello(v1::ROLE_CFD, opt.softwareVersion.empty() ? kLibraryVersion
-                                                                            : opt.softwareVersion);
-    hello.setSessionId(session);
-    if (rank && decomposed()) {
-      hello.envelope().mutable_hello()->set_rank(static_cast<std::uint32_t>(opt.rank));
-      hello.envelope().mutable_hello()->set_rank_count(static_cast<std::uint32_t>(opt.rankCount));
-    }
-    auto reply = client.request(std::move(hello), timeout);
-    proto::expectType(reply, v1::MESSAGE_TYPE_WELCOME);
-    const auto& w = reply.envelope().welcome();
-    COREDEM_CHECK(w.protocol_major() == proto::kProtocolVersion.major,
-                  "{} at {} speaks protocol {}.{}, this client {}", peer, client.endpoint(),
-                  w.protocol_major(), w.protocol_minor(), proto::kProtocolVersion.toString());
-    log->info("{}: connected to {} at {} (protocol {}.{}, session {})", opt.name, peer,
-              client.endpoint(), w.protocol_major(), w.protocol_minor(), session);
-    return reply;
-  }
-
-  void checkRank() const {
-    COREDEM_CHECK(opt.rankCount >= 0 && opt.rank >= 0 &&
-                      (opt.rankCount <= 1 ? opt.rank == 0 : opt.rank < opt.rankCount),
-                  "{}: rank {} of {} ranks: the rank index must lie in [0, rank count)", opt.name,
-                  opt.rank, opt.rankCount);
-  }
-
-  /// Hello to D (with the rank of a decomposed run); a decomposed run needs protocol 1.2.
-  void connectDem() {
-    dem = std::make_unique<proto::Client>(transport(true));
-    dem->connect(demEp);
-    const auto w = handshake(*dem, "DEM server", true);
-    demMinor = static_cast<int>(w.envelope().welcome().protocol_minor());
-    if (decomposed() && demMinor < static_cast<int>(proto::kMinorDecomposed)) {
-      throw ClientError(ErrorCode::Peer,
-                        fmt::format("{}: the DEM server at {} agreed protocol 1.{}, this client "
-                                    "speaks {}; a decomposed CFD participant ({} ranks) needs "
-                                    "1.{} or later on both sides: update coredem-dem",
-                                    opt.name, demEp, demMinor, proto::kProtocolVersion.toString(),
-                                    opt.rankCount, proto::kMinorDecomposed));
+proto::TransportOptions Participant::Impl::transport(bool forDem) const {
+  proto::TransportOptions t;
+  t.sender =
+      opt.name + " (" + (opt.softwareVersion.empty() ? kLibraryVersion : opt.softwareVersion) + ")";
+  if (forDem) {
+    const auto key = fromEnv(opt.demServerPublicKey, "COREDEM_DEM_SERVER_KEY");
+    const auto keyFile = fromEnv(opt.demClientKeyFile, "COREDEM_DEM_CLIENT_KEY_FILE");
+    COREDEM_CHECK(!key.empty() || keyFile.empty(),
+                  "{}: a client key ({}) is given but no DEM server public key "
+                  "(COREDEM_DEM_SERVER_KEY): client keys are only used with CURVE",
+                  opt.name, keyFile);
+    if (!key.empty()) {
+      const auto pair =
+          keyFile.empty() ? proto::generateCurveKeyPair() : proto::readClientKeyPair(keyFile);
+      t.curve.serverPublicKey = key;
+      t.curve.clientPublicKey = pair.first;
+      t.curve.clientSecretKey = pair.second;
     }
   }
+  return t;
+}
 
-  void readEnvironment() {
-    controlEp = fromEnv(opt.controlEndpoint, "COREDEM_CONTROL_ENDPOINT");
-    demEp = fromEnv(opt.demEndpoint, "COREDEM_DEM_ENDPOINT");
-    session = fromEnv(opt.sessionId, "COREDEM_SESSION");
-    COREDEM_CHECK(!demEp.empty(), "no DEM server endpoint: set COREDEM_DEM_ENDPOINT (or "
-                                  "Options::demEndpoint / --dem), e.g. tcp://127.0.0.1:40125");
-    COREDEM_CHECK(!session.empty(), "no session id: set COREDEM_SESSION (or Options::sessionId / "
-                                    "--session) to the id the orchestrator passes");
-    double t = opt.timeoutSeconds;
-    if (t <= 0.0) {
-      const auto env = fromEnv("", "COREDEM_TIMEOUT_S");
-      t = kDefaultTimeoutS;
-      if (!env.empty()) {
-        char* end = nullptr;
-        t = std::strtod(env.c_str(), &end);
-        COREDEM_CHECK(end != env.c_str() && *end == '\0' && t > 0.0,
-                      "COREDEM_TIMEOUT_S='{}' is not a positive number of seconds", env);
-      }
-    }
-    timeout = std::chrono::milliseconds(static_cast<std::int64_t>(std::ceil(t * 1000.0)));
+void Participant::Impl::takeGrantOrShutdown(const proto::Message& reply,
+                                            std::int64_t expectedStep) {
+  if (reply.type() == v1::MESSAGE_TYPE_SHUTDOWN) {
+    shutdownReason = reply.envelope().shutdown().reason();
+    state = State::Finished;
+    log->info("{}: the orchestrator ended the run ({})", opt.name,
+              shutdownReason.empty() ? "no reason given" : shutdownReason);
+    return;
   }
+  proto::expectType(reply, v1::MESSAGE_TYPE_STEP_GRANT);
+  proto::Expectation e;
+  e.types = {v1::MESSAGE_TYPE_STEP_GRANT};
+  e.step = expectedStep;
+  if (const auto s = proto::validate(reply, e); !s.ok()) {
+    throw proto::ProtocolError(s.code,
+                               "orchestrator " + controlEp + " sent a bad StepGrant: " + s.message);
+  }
+  const auto& g = reply.envelope().step_grant();
+  COREDEM_CHECK(g.dt_cfd() > 0.0 && g.n_sub() >= 1,
+                "orchestrator {} granted step {} with dt_cfd = {} s and n_sub = {}: both must "
+                "be positive",
+                controlEp, expectedStep, g.dt_cfd(), g.n_sub());
+  step = reply.envelope().step();
+  time = reply.envelope().time();
+  dt = g.dt_cfd();
+  nSub = static_cast<int>(g.n_sub());
+  dtDem = g.dt_dem() > 0.0 ? g.dt_dem() : dt / nSub;
+  checkpointDir = g.has_checkpoint() ? g.checkpoint().directory() : std::string();
+  outputRequested = g.has_checkpoint() && g.checkpoint().tag() == proto::kOutputTag;
+  state = State::Granted;
+}
 
-  void initialize() {
-    checkRank();
-    COREDEM_CHECK(opt.rank == 0,
-                  "{}: rank {} of a decomposed run follows rank 0 (Participant::follow) instead of "
-                  "calling initialize()",
-                  opt.name, opt.rank);
-    controlEp = fromEnv(opt.controlEndpoint, "COREDEM_CONTROL_ENDPOINT");
-    COREDEM_CHECK(!controlEp.empty(),
-                  "no orchestrator control endpoint: set COREDEM_CONTROL_ENDPOINT "
-                  "(or Options::controlEndpoint / --control), e.g. tcp://127.0.0.1:40123");
-    readEnvironment();
+proto::Message Participant::Impl::handshake(proto::Client& client, const std::string& peer,
+                                            bool rank) {
+  auto hello = proto::makeHello(v1::ROLE_CFD, opt.softwareVersion.empty() ? kLibraryVersion
+                                                                          : opt.softwareVersion);
+  hello.setSessionId(session);
+  if (rank && decomposed()) {
+    hello.envelope().mutable_hello()->set_rank(static_cast<std::uint32_t>(opt.rank));
+    hello.envelope().mutable_hello()->set_rank_count(static_cast<std::uint32_t>(opt.rankCount));
+  }
+  auto reply = client.request(std::move(hello), timeout);
+  proto::expectType(reply, v1::MESSAGE_TYPE_WELCOME);
+  const auto& w = reply.envelope().welcome();
+  COREDEM_CHECK(w.protocol_major() == proto::kProtocolVersion.major,
+                "{} at {} speaks protocol {}.{}, this client {}", peer, client.endpoint(),
+                w.protocol_major(), w.protocol_minor(), proto::kProtocolVersion.toString());
+  log->info("{}: connected to {} at {} (protocol {}.{}, session {})", opt.name, peer,
+            client.endpoint(), w.protocol_major(), w.protocol_minor(), session);
+  return reply;
+}
 
-    // 1. Hello to O.
-    control = std::make_unique<proto::Client>(transport(false));
-    control->connect(controlEp);
-    handshake(*control, "orchestrator");
+void Participant::Impl::checkRank() const {
+  COREDEM_CHECK(opt.rankCount >= 0 && opt.rank >= 0 &&
+                    (opt.rankCount <= 1 ? opt.rank == 0 : opt.rank < opt.rankCount),
+                "{}: rank {} of {} ranks: the rank index must lie in [0, rank count)", opt.name,
+                opt.rank, opt.rankCount);
+}
 
-    // 2. The case.
-    proto::Message ask(v1::MESSAGE_TYPE_CONFIGURE);
-    ask.setBody(v1::Configure{});
-    ask.setSessionId(session);
-    auto cfg = control->request(std::move(ask), timeout);
-    proto::expectType(cfg, v1::MESSAGE_TYPE_CONFIGURE);
-    const auto& c = cfg.envelope().configure();
-    COREDEM_CHECK(c.coupling_mesh().has_cartesian(),
-                  "orchestrator {} sent a Configure without a Cartesian coupling grid; this "
-                  "client supports coupling_mesh.cartesian only",
-                  controlEp);
-    const auto& g = c.coupling_mesh().cartesian();
-    grid.origin[0] = g.origin().x();
-    grid.origin[1] = g.origin().y();
-    grid.origin[2] = g.origin().z();
-    grid.spacing[0] = g.spacing().x();
-    grid.spacing[1] = g.spacing().y();
-    grid.spacing[2] = g.spacing().z();
-    grid.counts[0] = static_cast<std::int64_t>(g.counts().x());
-    grid.counts[1] = static_cast<std::int64_t>(g.counts().y());
-    grid.counts[2] = static_cast<std::int64_t>(g.counts().z());
-    COREDEM_CHECK(grid.cellCount() > 0,
-                  "orchestrator {} sent an empty coupling grid ({} x {} x {})", controlEp,
-                  grid.counts[0], grid.counts[1], grid.counts[2]);
-    grid.species.clear();
-    grid.molarMasses.clear();
-    for (const auto& s : c.species()) {
-      grid.species.push_back(s.name());
-      grid.molarMasses.push_back(s.molar_mass());
-    }
-    startStep = c.start_step();
-    startTime = c.start_time();
+void Participant::Impl::connectDem() {
+  dem = std::make_unique<proto::Client>(transport(true));
+  dem->connect(demEp);
+  const auto w = handshake(*dem, "DEM server", true);
+  demMinor = static_cast<int>(w.envelope().welcome().protocol_minor());
+  if (decomposed() && demMinor < static_cast<int>(proto::kMinorDecomposed)) {
+    throw ClientError(ErrorCode::Peer,
+                      fmt::format("{}: the DEM server at {} agreed protocol 1.{}, this client "
+                                  "speaks {}; a decomposed CFD participant ({} ranks) needs "
+                                  "1.{} or later on both sides: update coredem-dem",
+                                  opt.name, demEp, demMinor, proto::kProtocolVersion.toString(),
+                                  opt.rankCount, proto::kMinorDecomposed));
+  }
+}
 
-    // 3. Hello to D.
-    connectDem();
-
-    // 4. Ready: the reply is the first grant.
-    auto ready = proto::makeConfigured(static_cast<std::uint64_t>(grid.cellCount()), 0,
-                                       static_cast<std::uint32_t>(grid.species.size()), 0, 0.0);
-    ready.setSessionId(session);
-    ready.setStep(startStep);
-    takeGrantOrShutdown(control->request(std::move(ready), timeout), startStep + 1);
-    if (state == State::Granted) {
-      log->info("{}: coupled on a {} x {} x {} grid with {} species; first grant: step {}, dt {} s",
-                opt.name, grid.counts[0], grid.counts[1], grid.counts[2], grid.species.size(), step,
-                dt);
+void Participant::Impl::readEnvironment() {
+  controlEp = fromEnv(opt.controlEndpoint, "COREDEM_CONTROL_ENDPOINT");
+  demEp = fromEnv(opt.demEndpoint, "COREDEM_DEM_ENDPOINT");
+  session = fromEnv(opt.sessionId, "COREDEM_SESSION");
+  COREDEM_CHECK(!demEp.empty(), "no DEM server endpoint: set COREDEM_DEM_ENDPOINT (or "
+                                "Options::demEndpoint / --dem), e.g. tcp://127.0.0.1:40125");
+  COREDEM_CHECK(!session.empty(), "no session id: set COREDEM_SESSION (or Options::sessionId / "
+                                  "--session) to the id the orchestrator passes");
+  double t = opt.timeoutSeconds;
+  if (t <= 0.0) {
+    const auto env = fromEnv("", "COREDEM_TIMEOUT_S");
+    t = kDefaultTimeoutS;
+    if (!env.empty()) {
+      char* end = nullptr;
+      t = std::strtod(env.c_str(), &end);
+      COREDEM_CHECK(end != env.c_str() && *end == '\0' && t > 0.0,
+                    "COREDEM_TIMEOUT_S='{}' is not a positive number of seconds", env);
     }
   }
+  timeout = std::chrono::milliseconds(static_cast<std::int64_t>(std::ceil(t * 1000.0)));
+}
 
-  /// exchange() of the whole grid (touched == nullptr) or of a rank's cells (exchangePartial).
-  const Sources& exchange(std::int64_t s, double d, const std::vector<NamedField>& fields,
-                          const std::vector<NamedBuffer>& into,
-                          const std::vector<std::int64_t>* touched = nullptr,
-                          ConstView fluidVolume = ConstView()) {
-    using Clock = std::chrono::steady_clock;
-    const auto t0 = Clock::now();
-    COREDEM_CHECK(s == step,
-                  "exchange(step = {}): the granted step is {}; send the fields of the "
-                  "granted step",
-                  s, step);
-    COREDEM_CHECK(std::abs(d - dt) <= kDtTolerance * dt,
-                  "exchange(dt = {:.17g} s): the granted dt of step {} is {:.17g} s; the DEM "
-                  "sub-cycles exactly the granted dt, so advance by dt()",
-                  d, step, dt);
-    const auto gridCells = static_cast<std::uint64_t>(grid.cellCount());
-    // Rows of every array: the grid's cells, or the rank's listed cells.
-    const auto cells = touched != nullptr ? static_cast<std::uint64_t>(touched->size()) : gridCells;
-    const auto ns = static_cast<std::uint64_t>(grid.species.size());
-    const std::string versions = fmt::format("the DEM server at {} agreed protocol 1.{}, this "
-                                             "client speaks {}",
-                                             demEp, demMinor, proto::kProtocolVersion.toString());
-    if (touched != nullptr) {
-      COREDEM_CHECK(demMinor >= static_cast<int>(proto::kMinorDecomposed),
-                    "exchangePartial: {}; partial GasFields need 1.{} or later: update coredem-dem",
-                    versions, proto::kMinorDecomposed);
-      COREDEM_CHECK(fluidVolume.size == touched->size() &&
-                        (touched->empty() || fluidVolume.data != nullptr),
-                    "exchangePartial: {} fluid volumes for {} listed cells", fluidVolume.size,
-                    touched->size());
-      for (std::size_t i = 0; i < touched->size(); ++i) {
-        const std::int64_t g = (*touched)[i];
-        COREDEM_CHECK(g >= 0 && static_cast<std::uint64_t>(g) < gridCells &&
-                          (i == 0 || g > (*touched)[i - 1]),
-                      "exchangePartial: cells[{}] = {}: the list must be strictly ascending "
-                      "coupling cells (0..{})",
-                      i, g, gridCells - 1);
-        COREDEM_CHECK(fluidVolume[i] > 0.0 && std::isfinite(fluidVolume[i]),
-                      "exchangePartial: fluid volume {} m3 of cell {} must be positive",
-                      fluidVolume[i], g);
-      }
-    }
-    std::map<std::string, ConstView> given;
-    for (const auto& f : fields) {
-      const auto named = [&](const auto& spec) { return spec.name == f.name; };
-      COREDEM_CHECK(proto::fields::findField(f.name) != nullptr &&
-                        (std::any_of(proto::fields::gasFields().begin(),
-                                     proto::fields::gasFields().end(), named) ||
-                         std::any_of(proto::fields::optionalGasFields().begin(),
-                                     proto::fields::optionalGasFields().end(), named)),
-                    "exchange: '{}' is not a GasFields array; the names are u_g, grad_p, T_g, "
-                    "rho_g, mu_g, kappa_g, cp_g, Y_g (and optionally fluid_fraction)",
-                    f.name);
-      COREDEM_CHECK(given.emplace(f.name, f.values).second, "exchange: field '{}' given twice",
-                    f.name);
-    }
-    if (given.count(std::string(proto::fields::kFluidFraction)) != 0) {
-      COREDEM_CHECK(touched == nullptr,
-                    "exchangePartial: fluid_fraction is not sent with partial fields (the DEM "
-                    "server forms it from the ranks' fluid volumes)");
-      // A 1.1 server would ignore it silently and run the closures without it.
-      COREDEM_CHECK(demMinor >= static_cast<int>(proto::kMinorDecomposed),
-                    "exchange: {}; fluid_fraction (a mesh that does not fill the coupling grid) "
-                    "needs 1.{} or later: update coredem-dem",
-                    versions, proto::kMinorDecomposed);
-    }
-    std::map<std::string, const NamedBuffer*> dest;
-    for (const auto& b : into) {
-      const auto* spec = proto::fields::findField(b.name);
-      const auto named = [&](const auto& sp) { return sp.name == b.name; };
-      COREDEM_CHECK(spec != nullptr &&
-                        (std::any_of(proto::fields::sourceFields().begin(),
-                                     proto::fields::sourceFields().end(), named) ||
-                         std::any_of(proto::fields::optionalSourceFields().begin(),
-                                     proto::fields::optionalSourceFields().end(), named)),
-                    "exchange: '{}' is not a Sources array; the names are eps_g, K_sl, K_sl_Us, H, "
-                    "H_Tp, R_species, Q_hom, Q_rad",
-                    b.name);
-      const std::uint64_t n = cells * proto::fields::componentsOf(spec->extent, ns);
-      COREDEM_CHECK(b.size == n,
-                    "exchange: the buffer for '{}' holds {} values; the coupling grid "
-                    "has {} cells, so it needs {} ({} per cell)",
-                    b.name, b.size, cells, n, proto::fields::componentsOf(spec->extent, ns));
-      COREDEM_CHECK(n == 0 || b.data != nullptr, "exchange: buffer for '{}' points to null",
-                    b.name);
-      COREDEM_CHECK(dest.emplace(b.name, &b).second, "exchange: buffer for '{}' given twice",
-                    b.name);
-    }
-    auto msg = proto::makeGasFields(step, time, dt, gridCells, static_cast<std::uint32_t>(ns));
-    msg.setSessionId(session);
-    if (touched != nullptr) {
-      msg.envelope().mutable_gas_fields()->set_partial(true);
-      msg.envelope().mutable_gas_fields()->set_touched_count(cells);
-      msg.addArray<std::int64_t>(proto::fields::kTouchedCells,
-                                 std::span<const std::int64_t>(*touched), {cells});
-      msg.addArray<double>(proto::fields::kFluidVolume,
-                           std::span<const double>(fluidVolume.data, fluidVolume.size), {cells});
-    }
-    for (const auto& spec : proto::fields::gasFields()) {
-      const std::string name(spec.name);
-      const auto it = given.find(name);
-      COREDEM_CHECK(it != given.end(), "exchange: the gas field '{}' ({}) is missing", name,
-                    spec.unit);
-      const auto shape = proto::fields::shapeOf(spec.extent, cells, ns);
-      const std::uint64_t n = cells * proto::fields::componentsOf(spec.extent, ns);
-      COREDEM_CHECK(it->second.size == n,
-                    "exchange: '{}' has {} values; the coupling grid has {} cells, so it needs {} "
-                    "({} per cell)",
-                    name, it->second.size, cells, n, proto::fields::componentsOf(spec.extent, ns));
-      COREDEM_CHECK(n == 0 || it->second.data != nullptr, "exchange: '{}' points to null", name);
-      // One copy into the message: zero-copy would leave ZeroMQ pointing into the caller's
-      // arrays after a timed-out request, when the caller may already have freed them.
-      msg.addArray<double>(name, std::span<const double>(it->second.data, it->second.size), shape);
-    }
-    for (const auto& spec : proto::fields::optionalGasFields()) {
-      const std::string name(spec.name);
-      const auto it = given.find(name);
-      if (it == given.end()) {
-        continue;
-      }
-      const std::uint64_t n = cells * proto::fields::componentsOf(spec.extent, ns);
-      COREDEM_CHECK(it->second.size == n && (n == 0 || it->second.data != nullptr),
-                    "exchange: '{}' has {} values; the coupling grid has {} cells, so it needs {}",
-                    name, it->second.size, cells, n);
-      msg.addArray<double>(name, std::span<const double>(it->second.data, it->second.size),
-                           proto::fields::shapeOf(spec.extent, cells, ns));
-    }
-    const auto t1 = Clock::now();
-    const std::string what = "Sources for step " + std::to_string(step);
-    const auto deadline = t1 + timeout;
-    const std::uint64_t seq = dem->send(std::move(msg));
-    const auto t2 = Clock::now();
-    // The reply's frames are kept (no copy): the arrays are viewed in place, or copied once
-    // into the caller's buffers. Replies to earlier, timed-out requests are skipped.
-    std::optional<proto::Message> reply;
-    for (;;) {
-      const auto left =
-          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
-      if (left.count() > 0) {
-        reply = dem->receive(left);
-      }
-      if (!reply) {
-        throw proto::TimeoutError(demEp, what,
-                                  fmt::format("no reply from DEM server {} within {} ms while "
-                                              "awaiting the {}; is it running, reachable and not "
-                                              "stalled?",
-                                              demEp, timeout.count(), what));
-      }
-      const auto& env = reply->envelope();
-      if (env.sequence() == seq ||
-          (env.sequence() == 0 && reply->type() == v1::MESSAGE_TYPE_ERROR)) {
-        break;
-      }
-      log->debug("{}: discarding a stale reply (sequence {}) while awaiting {}", opt.name,
-                 env.sequence(), seq);
-      reply.reset();
-    }
-    const auto t3 = Clock::now();
-    proto::expectType(*reply, v1::MESSAGE_TYPE_SOURCES);
-    proto::Expectation e;
-    e.types = {v1::MESSAGE_TYPE_SOURCES};
-    e.step = step;
-    e.cells = gridCells;
-    e.species = ns;
-    if (const auto st = proto::validate(*reply, e); !st.ok()) {
-      throw proto::ProtocolError(st.code, "DEM server " + demEp + " sent bad Sources for step " +
-                                              std::to_string(step) + ": " + st.message);
-    }
-    // A partial GasFields is answered with the sources of the same cells, in the same order.
-    const bool partialReply = reply->envelope().sources().partial();
-    bool sameCells = partialReply == (touched != nullptr);
-    if (sameCells && touched != nullptr) {
-      const auto back = reply->findArray(proto::fields::kTouchedCells)->as<std::int64_t>();
-      sameCells = std::equal(back.begin(), back.end(), touched->begin(), touched->end());
-    }
-    if (!sameCells) {
-      throw proto::ProtocolError(
-          v1::ERROR_CODE_SHAPE, fmt::format("DEM server {} answered the {} GasFields of step {} "
-                                            "with Sources of {}",
-                                            demEp, touched != nullptr ? "partial" : "whole-grid",
-                                            step, partialReply ? "other cells" : "the whole grid"));
-    }
-    auto kept = std::make_shared<proto::Message>(std::move(*reply));
-    Sources next;
-    std::vector<std::pair<const NamedBuffer*, std::span<const double>>> copies;
-    std::vector<const NamedBuffer*> zeroed; // buffers of optional arrays D did not send
-    std::vector<proto::fields::FieldSpec> received(proto::fields::sourceFields().begin(),
-                                                   proto::fields::sourceFields().end());
-    received.insert(received.end(), proto::fields::optionalSourceFields().begin(),
-                    proto::fields::optionalSourceFields().end());
-    for (const auto& spec : received) {
-      const std::string name(spec.name);
-      if (!kept->findArray(name)) {
-        if (const auto b = dest.find(name); b != dest.end()) {
-          zeroed.push_back(b->second);
-        }
-        continue;
-      }
-      const auto v = kept->values<double>(name);
-      if (const auto b = dest.find(name); b != dest.end()) {
-        if (b->second->size != v.size()) {
-          throw proto::ProtocolError(
-              v1::ERROR_CODE_SHAPE, fmt::format("DEM server {} sent {} values of '{}' for step {}; "
-                                                "the buffer given for it holds {}",
-                                                demEp, v.size(), name, step, b->second->size));
-        }
-        copies.emplace_back(b->second, v);
-      } else {
-        next.views[name] = ConstView(v.data(), v.size());
-      }
-    }
-    for (const auto& [b, v] : copies) { // only after every size was checked
-      if (!v.empty()) {
-        std::memcpy(b->data, v.data(), v.size() * sizeof(double));
-      }
-      next.views[b->name] = ConstView(b->data, b->size);
-    }
-    for (const NamedBuffer* b : zeroed) {
-      std::fill(b->data, b->data + b->size, 0.0);
-    }
-    next.step = step;
-    next.substeps = kept->envelope().sources().substeps();
-    next.storage = std::move(kept);
-    sources = std::move(next);
-    state = State::Exchanged;
-    const auto t4 = Clock::now();
-    auto sec = [](Clock::duration x) { return std::chrono::duration<double>(x).count(); };
-    times = ExchangeTimes{sec(t1 - t0), sec(t2 - t1), sec(t3 - t2), sec(t4 - t3)};
-    return sources;
+void Participant::Impl::initialize() {
+  checkRank();
+  COREDEM_CHECK(opt.rank == 0,
+                "{}: rank {} of a decomposed run follows rank 0 (Participant::follow) instead of "
+                "calling initialize()",
+                opt.name, opt.rank);
+  controlEp = fromEnv(opt.controlEndpoint, "COREDEM_CONTROL_ENDPOINT");
+  COREDEM_CHECK(!controlEp.empty(),
+                "no orchestrator control endpoint: set COREDEM_CONTROL_ENDPOINT "
+                "(or Options::controlEndpoint / --control), e.g. tcp://127.0.0.1:40123");
+  readEnvironment();
+
+  // 1. Hello to O.
+  control = std::make_unique<proto::Client>(transport(false));
+  control->connect(controlEp);
+  handshake(*control, "orchestrator");
+
+  // 2. The case.
+  proto::Message ask(v1::MESSAGE_TYPE_CONFIGURE);
+  ask.setBody(v1::Configure{});
+  ask.setSessionId(session);
+  auto cfg = control->request(std::move(ask), timeout);
+  proto::expectType(cfg, v1::MESSAGE_TYPE_CONFIGURE);
+  const auto& c = cfg.envelope().configure();
+  COREDEM_CHECK(c.coupling_mesh().has_cartesian(),
+                "orchestrator {} sent a Configure without a Cartesian coupling grid; this "
+                "client supports coupling_mesh.cartesian only",
+                controlEp);
+  const auto& g = c.coupling_mesh().cartesian();
+  grid.origin[0] = g.origin().x();
+  grid.origin[1] = g.origin().y();
+  grid.origin[2] = g.origin().z();
+  grid.spacing[0] = g.spacing().x();
+  grid.spacing[1] = g.spacing().y();
+  grid.spacing[2] = g.spacing().z();
+  grid.counts[0] = static_cast<std::int64_t>(g.counts().x());
+  grid.counts[1] = static_cast<std::int64_t>(g.counts().y());
+  grid.counts[2] = static_cast<std::int64_t>(g.counts().z());
+  COREDEM_CHECK(grid.cellCount() > 0, "orchestrator {} sent an empty coupling grid ({} x {} x {})",
+                controlEp, grid.counts[0], grid.counts[1], grid.counts[2]);
+  grid.species.clear();
+  grid.molarMasses.clear();
+  for (const auto& s : c.species()) {
+    grid.species.push_back(s.name());
+    grid.molarMasses.push_back(s.molar_mass());
   }
+  startStep = c.start_step();
+  startTime = c.start_time();
 
-  void advance(double courant, const Ledgers& ledgers, const std::vector<std::string>& files) {
-    COREDEM_CHECK(opt.rank == 0,
-                  "advance: rank {} of a decomposed run follows rank 0's control state "
-                  "(Participant::follow); only rank 0 reports the step to the orchestrator",
-                  opt.rank);
-    COREDEM_CHECK(std::isfinite(courant) && courant >= 0.0,
-                  "advance: the Courant number must be finite and >= 0 (got {})", courant);
-    COREDEM_CHECK(files.empty() || !checkpointDir.empty(),
-                  "advance: checkpoint files given for step {}, but its grant asked for no "
-                  "checkpoint",
-                  step);
-    v1::StepDone body;
-    body.set_cfl(courant);
-    auto fill = [](auto* list, const std::vector<std::pair<std::string, double>>& values) {
-      for (const auto& [name, value] : values) {
-        proto::addNamedValue(list, name, value);
-      }
-    };
-    fill(body.mutable_ledger()->mutable_mass(), ledgers.mass);
-    fill(body.mutable_ledger()->mutable_energy(), ledgers.energy);
-    fill(body.mutable_ledger()->mutable_species(), ledgers.species);
-    fill(body.mutable_diagnostics(), ledgers.diagnostics);
-    if (!checkpointDir.empty()) {
-      body.mutable_checkpoint()->set_directory(checkpointDir);
-      for (const auto& f : files) {
-        body.mutable_checkpoint()->add_files(f);
-      }
-    }
-    auto done = proto::makeStepDone(step, time, body);
-    done.setSessionId(session);
-    takeGrantOrShutdown(control->request(std::move(done), timeout), step + 1);
+  // 3. Hello to D.
+  connectDem();
+
+  // 4. Ready: the reply is the first grant.
+  auto ready = proto::makeConfigured(static_cast<std::uint64_t>(grid.cellCount()), 0,
+                                     static_cast<std::uint32_t>(grid.species.size()), 0, 0.0);
+  ready.setSessionId(session);
+  ready.setStep(startStep);
+  takeGrantOrShutdown(control->request(std::move(ready), timeout), startStep + 1);
+  if (state == State::Granted) {
+    log->info("{}: coupled on a {} x {} x {} grid with {} species; first grant: step {}, dt {} s",
+              opt.name, grid.counts[0], grid.counts[1], grid.counts[2], grid.species.size(), step,
+              dt);
   }
+}
 
-  // ---- decomposed runs: rank 0's control state for the other ranks ----------------------
-  std::string controlState() const {
-    COREDEM_CHECK(state == State::Granted || state == State::Finished,
-                  "controlState() after initialize() or advance() (state {})", stateName(state));
-    std::string out = "coredem-control-state 1\n";
-    const auto str = [&](const std::string& v) { out += fmt::format("{}:{}\n", v.size(), v); };
-    const auto num = [&](double v) { out += fmt::format("{:a}\n", v); }; // exact (hex float)
-    const auto integer = [&](std::int64_t v) { out += fmt::format("{}\n", v); };
-    for (int a = 0; a < 3; ++a) {
-      num(grid.origin[a]);
-      num(grid.spacing[a]);
-      integer(grid.counts[a]);
-    }
-    integer(static_cast<std::int64_t>(grid.species.size()));
-    for (std::size_t k = 0; k < grid.species.size(); ++k) {
-      str(grid.species[k]);
-      num(grid.molarMasses[k]);
-    }
-    integer(startStep);
-    num(startTime);
-    integer(state == State::Finished ? 1 : 0);
-    str(shutdownReason);
-    integer(step);
-    num(time);
-    num(dt);
-    integer(nSub);
-    num(dtDem);
-    str(checkpointDir);
-    integer(outputRequested ? 1 : 0);
-    return out;
-  }
-
-  void follow(const std::string& text) {
-    COREDEM_CHECK(state == State::Created || state == State::Exchanged,
-                  "follow() is called first (instead of initialize()) and after each exchange; "
-                  "state {}",
-                  stateName(state));
-    std::size_t pos = 0;
-    const auto line = [&]() {
-      const auto end = text.find('\n', pos);
-      COREDEM_CHECK(end != std::string::npos, "follow(): truncated control state");
-      std::string l = text.substr(pos, end - pos);
-      pos = end + 1;
-      return l;
-    };
-    const auto str = [&]() {
-      const auto colon = text.find(':', pos);
-      COREDEM_CHECK(colon != std::string::npos, "follow(): malformed control state");
-      const std::size_t n = std::stoull(text.substr(pos, colon - pos));
-      COREDEM_CHECK(colon + 1 + n < text.size() && text[colon + 1 + n] == '\n',
-                    "follow(): malformed control state");
-      std::string v = text.substr(colon + 1, n);
-      pos = colon + 2 + n;
-      return v;
-    };
-    const auto num = [&]() { return std::strtod(line().c_str(), nullptr); };
-    const auto integer = [&]() { return static_cast<std::int64_t>(std::stoll(line())); };
-    COREDEM_CHECK(line() == "coredem-control-state 1",
-                  "follow(): not a control state of this client library version");
-    Grid g;
-    for (int a = 0; a < 3; ++a) {
-      g.origin[a] = num();
-      g.spacing[a] = num();
-      g.counts[a] = integer();
-    }
-    const std::int64_t nSpecies = integer();
-    for (std::int64_t k = 0; k < nSpecies; ++k) {
-      g.species.push_back(str());
-      g.molarMasses.push_back(num());
-    }
-    const std::int64_t start = integer();
-    const double startT = num();
-    const bool finished = integer() != 0;
-    std::string reason = str();
-    const std::int64_t nextStep = integer();
-    const double nextTime = num();
-    const double nextDt = num();
-    const int nextNSub = static_cast<int>(integer());
-    const double nextDtDem = num();
-    std::string dir = str();
-    const bool output = integer() != 0;
-    if (state == State::Created) {
-      checkRank();
-      COREDEM_CHECK(opt.rank > 0 && opt.rankCount > 1,
-                    "{}: follow() is for ranks > 0 of a decomposed run (rank {} of {})", opt.name,
-                    opt.rank, opt.rankCount);
-      readEnvironment();
-      grid = g;
-      startStep = start;
-      startTime = startT;
-      connectDem();
-    } else if (nextStep != step + 1 && !finished) {
-      throw ClientError(ErrorCode::Protocol,
-                        fmt::format("{}: rank {} is at step {} but rank 0's next grant is of step "
-                                    "{}",
-                                    opt.name, opt.rank, step, nextStep));
-    }
-    if (finished) {
-      shutdownReason = std::move(reason);
-      state = State::Finished;
-      return;
-    }
-    step = nextStep;
-    time = nextTime;
-    dt = nextDt;
-    nSub = nextNSub;
-    dtDem = nextDtDem;
-    checkpointDir = std::move(dir);
-    outputRequested = output;
-    state = State::Granted;
-  }
-
-  void finalize() {
-    if (state == State::Finalized) {
-      return;
-    }
-    if (state == State::Granted || state == State::Exchanged) {
-      log->warn("{}: finalize() during step {} before the orchestrator ended the run", opt.name,
+void Participant::Impl::advance(double courant, const Ledgers& ledgers,
+                                const std::vector<std::string>& files) {
+  COREDEM_CHECK(opt.rank == 0,
+                "advance: rank {} of a decomposed run follows rank 0's control state "
+                "(Participant::follow); only rank 0 reports the step to the orchestrator",
+                opt.rank);
+  COREDEM_CHECK(std::isfinite(courant) && courant >= 0.0,
+                "advance: the Courant number must be finite and >= 0 (got {})", courant);
+  COREDEM_CHECK(files.empty() || !checkpointDir.empty(),
+                "advance: checkpoint files given for step {}, but its grant asked for no "
+                "checkpoint",
                 step);
+  v1::StepDone body;
+  body.set_cfl(courant);
+  auto fill = [](auto* list, const std::vector<std::pair<std::string, double>>& values) {
+    for (const auto& [name, value] : values) {
+      proto::addNamedValue(list, name, value);
     }
-    dem.reset();
-    control.reset();
-    sources = Sources();
-    state = State::Finalized;
+  };
+  fill(body.mutable_ledger()->mutable_mass(), ledgers.mass);
+  fill(body.mutable_ledger()->mutable_energy(), ledgers.energy);
+  fill(body.mutable_ledger()->mutable_species(), ledgers.species);
+  fill(body.mutable_diagnostics(), ledgers.diagnostics);
+  if (!checkpointDir.empty()) {
+    body.mutable_checkpoint()->set_directory(checkpointDir);
+    for (const auto& f : files) {
+      body.mutable_checkpoint()->add_files(f);
+    }
   }
-};
+  auto done = proto::makeStepDone(step, time, body);
+  done.setSessionId(session);
+  takeGrantOrShutdown(control->request(std::move(done), timeout), step + 1);
+}
+
+std::string Participant::Impl::controlState() const {
+  COREDEM_CHECK(state == State::Granted || state == State::Finished,
+                "controlState() after initialize() or advance() (state {})", stateName(state));
+  std::string out = "coredem-control-state 1\n";
+  const auto str = [&](const std::string& v) { out += fmt::format("{}:{}\n", v.size(), v); };
+  const auto num = [&](double v) { out += fmt::format("{:a}\n", v); }; // exact (hex float)
+  const auto integer = [&](std::int64_t v) { out += fmt::format("{}\n", v); };
+  for (int a = 0; a < 3; ++a) {
+    num(grid.origin[a]);
+    num(grid.spacing[a]);
+    integer(grid.counts[a]);
+  }
+  integer(static_cast<std::int64_t>(grid.species.size()));
+  for (std::size_t k = 0; k < grid.species.size(); ++k) {
+    str(grid.species[k]);
+    num(grid.molarMasses[k]);
+  }
+  integer(startStep);
+  num(startTime);
+  integer(state == State::Finished ? 1 : 0);
+  str(shutdownReason);
+  integer(step);
+  num(time);
+  num(dt);
+  integer(nSub);
+  num(dtDem);
+  str(checkpointDir);
+  integer(outputRequested ? 1 : 0);
+  return out;
+}
+
+void Participant::Impl::follow(const std::string& text) {
+  COREDEM_CHECK(state == State::Created || state == State::Exchanged,
+                "follow() is called first (instead of initialize()) and after each exchange; "
+                "state {}",
+                stateName(state));
+  std::size_t pos = 0;
+  const auto line = [&]() {
+    const auto end = text.find('\n', pos);
+    COREDEM_CHECK(end != std::string::npos, "follow(): truncated control state");
+    std::string l = text.substr(pos, end - pos);
+    pos = end + 1;
+    return l;
+  };
+  const auto str = [&]() {
+    const auto colon = text.find(':', pos);
+    COREDEM_CHECK(colon != std::string::npos, "follow(): malformed control state");
+    const std::size_t n = std::stoull(text.substr(pos, colon - pos));
+    COREDEM_CHECK(colon + 1 + n < text.size() && text[colon + 1 + n] == '\n',
+                  "follow(): malformed control state");
+    std::string v = text.substr(colon + 1, n);
+    pos = colon + 2 + n;
+    return v;
+  };
+  const auto num = [&]() { return std::strtod(line().c_str(), nullptr); };
+  const auto integer = [&]() { return static_cast<std::int64_t>(std::stoll(line())); };
+  COREDEM_CHECK(line() == "coredem-control-state 1",
+                "follow(): not a control state of this client library version");
+  Grid g;
+  for (int a = 0; a < 3; ++a) {
+    g.origin[a] = num();
+    g.spacing[a] = num();
+    g.counts[a] = integer();
+  }
+  const std::int64_t nSpecies = integer();
+  for (std::int64_t k = 0; k < nSpecies; ++k) {
+    g.species.push_back(str());
+    g.molarMasses.push_back(num());
+  }
+  const std::int64_t start = integer();
+  const double startT = num();
+  const bool finished = integer() != 0;
+  std::string reason = str();
+  const std::int64_t nextStep = integer();
+  const double nextTime = num();
+  const double nextDt = num();
+  const int nextNSub = static_cast<int>(integer());
+  const double nextDtDem = num();
+  std::string dir = str();
+  const bool output = integer() != 0;
+  if (state == State::Created) {
+    checkRank();
+    COREDEM_CHECK(opt.rank > 0 && opt.rankCount > 1,
+                  "{}: follow() is for ranks > 0 of a decomposed run (rank {} of {})", opt.name,
+                  opt.rank, opt.rankCount);
+    readEnvironment();
+    grid = g;
+    startStep = start;
+    startTime = startT;
+    connectDem();
+  } else if (nextStep != step + 1 && !finished) {
+    throw ClientError(ErrorCode::Protocol,
+                      fmt::format("{}: rank {} is at step {} but rank 0's next grant is of step "
+                                  "{}",
+                                  opt.name, opt.rank, step, nextStep));
+  }
+  if (finished) {
+    shutdownReason = std::move(reason);
+    state = State::Finished;
+    return;
+  }
+  step = nextStep;
+  time = nextTime;
+  dt = nextDt;
+  nSub = nextNSub;
+  dtDem = nextDtDem;
+  checkpointDir = std::move(dir);
+  outputRequested = output;
+  state = State::Granted;
+}
+
+void Participant::Impl::finalize() {
+  if (state == State::Finalized) {
+    return;
+  }
+  if (state == State::Granted || state == State::Exchanged) {
+    log->warn("{}: finalize() during step {} before the orchestrator ended the run", opt.name,
+              step);
+  }
+  dem.reset();
+  control.reset();
+  sources = Sources();
+  state = State::Finalized;
+}
 
 namespace {
 

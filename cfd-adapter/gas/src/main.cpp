@@ -85,6 +85,86 @@ private:
   std::vector<coredem::CompensatedSum> _sum;
 };
 
+constexpr const char* kAxes[3] = {"x", "y", "z"};
+
+/// The participant's ledgers: heat, mass and species the particles gave the gas, the momentum
+/// they exchanged with it and their volume.
+Ledgers defineLedgers(const std::vector<std::string>& species) {
+  Ledgers ledgers;
+  ledgers.define("gas.heat_from_particles_J", Kind::Energy);
+  ledgers.define("gas.heat_homogeneous_J", Kind::Energy);
+  // Radiation heat the particles gave the gas, ∫ Σ_c Q_rad V_c dt (protocol 1.3; stays 0 with an
+  // older DEM server, whose particles radiate to an environment outside the system).
+  ledgers.define("gas.heat_radiation_J", Kind::Energy);
+  ledgers.define("gas.mass_from_particles_kg", Kind::Mass);
+  for (const auto& s : species) {
+    ledgers.define("gas.species." + s + "_kg", Kind::Species);
+  }
+  for (const char* a : kAxes) {
+    ledgers.define(std::string("gas.momentum_from_particles_") + a + "_Ns", Kind::Diagnostic);
+  }
+  ledgers.define("gas.solid_volume_m3", Kind::Diagnostic);
+  return ledgers;
+}
+
+/// Adds what the DEM sources s of a step of dt gave the gas (fields f, n cells of volume vc)
+/// to the ledgers.
+void bookSources(Ledgers& ledgers, const client::Sources& s, const gas::GasFieldArrays& f,
+                 const std::vector<std::string>& species, std::size_t n, double vc, double dt) {
+  const std::size_t ns = species.size();
+  const auto eps = s.field("eps_g"), k = s.field("K_sl"), kus = s.field("K_sl_Us"),
+             h = s.field("H"), htp = s.field("H_Tp"), r = s.field("R_species"),
+             q = s.field("Q_hom");
+  const auto qrad = s.radiationHeat(); // empty below protocol 1.3
+  double heat = 0.0, hom = 0.0, solid = 0.0, rad = 0.0;
+  double mom[3] = {0.0, 0.0, 0.0};
+  std::vector<double> spec(ns, 0.0);
+  for (std::size_t c = 0; c < n; ++c) {
+    heat += htp[c] - h[c] * f.T_g[c];
+    hom += q[c];
+    if (qrad.size == n)
+      rad += qrad[c];
+    solid += 1.0 - eps[c];
+    for (int a = 0; a < 3; ++a)
+      mom[a] += kus[3 * c + a] - k[c] * f.u_g[3 * c + a];
+    for (std::size_t j = 0; j < ns; ++j)
+      spec[j] += r[c * ns + j];
+  }
+  ledgers.add("gas.heat_from_particles_J", heat * vc * dt);
+  ledgers.add("gas.heat_homogeneous_J", hom * vc * dt);
+  ledgers.add("gas.heat_radiation_J", rad * vc * dt);
+  double mass = 0.0;
+  for (std::size_t j = 0; j < ns; ++j) {
+    ledgers.add("gas.species." + species[j] + "_kg", spec[j] * vc * dt);
+    mass += spec[j];
+  }
+  ledgers.add("gas.mass_from_particles_kg", mass * vc * dt);
+  for (int a = 0; a < 3; ++a) {
+    ledgers.add(std::string("gas.momentum_from_particles_") + kAxes[a] + "_Ns", mom[a] * vc * dt);
+  }
+  ledgers.set("gas.solid_volume_m3", solid * vc);
+}
+
+/// Writes the checkpoint the grant asks for (gas.h5: the ledgers at t + dt); returns its files.
+std::vector<std::string> writeCheckpoint(client::Participant& p, const std::string& caseKey,
+                                         const Ledgers& ledgers, double t, double dt,
+                                         const std::shared_ptr<spdlog::logger>& log) {
+  std::vector<std::string> files;
+  if (p.requiresCheckpoint()) {
+    const std::string dir = p.checkpointDir();
+    std::filesystem::create_directories(dir);
+    gas::GasState st;
+    st.time = t + dt;
+    st.step = p.step();
+    st.caseKey = caseKey;
+    ledgers.save(st);
+    gas::writeGasState((std::filesystem::path(dir) / "gas.h5").string(), st);
+    files.push_back("gas.h5");
+    log->info("checkpoint of step {} written to {}/gas.h5", p.step(), dir);
+  }
+  return files;
+}
+
 int runParticipant(const std::string& caseFile, const std::string& key, client::Options opts,
                    const std::string& restart) {
   auto log = coredem::logger("gas");
@@ -106,24 +186,9 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
   model.bind(grid, g.species);
   log->info("{}", model.describe());
   const auto n = static_cast<std::size_t>(grid.cellCount());
-  const std::size_t ns = g.species.size();
   const double vc = grid.cellVolume();
 
-  Ledgers ledgers;
-  ledgers.define("gas.heat_from_particles_J", Kind::Energy);
-  ledgers.define("gas.heat_homogeneous_J", Kind::Energy);
-  // Radiation heat the particles gave the gas, ∫ Σ_c Q_rad V_c dt (protocol 1.3; stays 0 with an
-  // older DEM server, whose particles radiate to an environment outside the system).
-  ledgers.define("gas.heat_radiation_J", Kind::Energy);
-  ledgers.define("gas.mass_from_particles_kg", Kind::Mass);
-  for (const auto& s : g.species) {
-    ledgers.define("gas.species." + s + "_kg", Kind::Species);
-  }
-  const char* axes[3] = {"x", "y", "z"};
-  for (const char* a : axes) {
-    ledgers.define(std::string("gas.momentum_from_particles_") + a + "_Ns", Kind::Diagnostic);
-  }
-  ledgers.define("gas.solid_volume_m3", Kind::Diagnostic);
+  Ledgers ledgers = defineLedgers(g.species);
   if (!restart.empty()) {
     const auto s = gas::readGasState(restart);
     COREDEM_CHECK(s.step == p.startStep(),
@@ -179,51 +244,10 @@ int runParticipant(const std::string& caseFile, const std::string& key, client::
     tSplit.wait += x.wait;
     tSplit.receive += x.receive;
     t0 = Clock::now();
-    const auto eps = s.field("eps_g"), k = s.field("K_sl"), kus = s.field("K_sl_Us"),
-               h = s.field("H"), htp = s.field("H_Tp"), r = s.field("R_species"),
-               q = s.field("Q_hom");
-    const auto qrad = s.radiationHeat(); // empty below protocol 1.3
-    double heat = 0.0, hom = 0.0, solid = 0.0, rad = 0.0;
-    double mom[3] = {0.0, 0.0, 0.0};
-    std::vector<double> spec(ns, 0.0);
-    for (std::size_t c = 0; c < n; ++c) {
-      heat += htp[c] - h[c] * f.T_g[c];
-      hom += q[c];
-      if (qrad.size == n)
-        rad += qrad[c];
-      solid += 1.0 - eps[c];
-      for (int a = 0; a < 3; ++a)
-        mom[a] += kus[3 * c + a] - k[c] * f.u_g[3 * c + a];
-      for (std::size_t j = 0; j < ns; ++j)
-        spec[j] += r[c * ns + j];
-    }
-    ledgers.add("gas.heat_from_particles_J", heat * vc * dt);
-    ledgers.add("gas.heat_homogeneous_J", hom * vc * dt);
-    ledgers.add("gas.heat_radiation_J", rad * vc * dt);
-    double mass = 0.0;
-    for (std::size_t j = 0; j < ns; ++j) {
-      ledgers.add("gas.species." + g.species[j] + "_kg", spec[j] * vc * dt);
-      mass += spec[j];
-    }
-    ledgers.add("gas.mass_from_particles_kg", mass * vc * dt);
-    for (int a = 0; a < 3; ++a) {
-      ledgers.add(std::string("gas.momentum_from_particles_") + axes[a] + "_Ns", mom[a] * vc * dt);
-    }
-    ledgers.set("gas.solid_volume_m3", solid * vc);
+    bookSources(ledgers, s, f, g.species, n, vc, dt);
 
-    std::vector<std::string> files;
-    if (p.requiresCheckpoint()) {
-      const std::string dir = p.checkpointDir();
-      std::filesystem::create_directories(dir);
-      gas::GasState st;
-      st.time = t + dt;
-      st.step = p.step();
-      st.caseKey = caseFile + ":" + key;
-      ledgers.save(st);
-      gas::writeGasState((std::filesystem::path(dir) / "gas.h5").string(), st);
-      files.push_back("gas.h5");
-      log->info("checkpoint of step {} written to {}/gas.h5", p.step(), dir);
-    }
+    const std::vector<std::string> files =
+        writeCheckpoint(p, caseFile + ":" + key, ledgers, t, dt, log);
     const double co = courant(f.u_g, dt);
     const auto report = ledgers.report();
     tLedger += since(t0);
