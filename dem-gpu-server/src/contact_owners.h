@@ -75,6 +75,54 @@ struct OwnerContacts {
     return owner<false>(i, nullptr, nullptr, h, 0);
   }
 
+  /// i's wall contacts (the law with m_eff = m_i, the particle's material): their force (returned),
+  /// their torque added to T, their history written from slot `slot` on (`slot` and `wallCount`
+  /// advanced); oldKey/oldD: the first `used` history slots as the last sub-step left them.
+  DEM_HD_FORCEINLINE kernels::Vec3 walls(std::size_t i, kernels::Vec3 xi, double ri, int used,
+                                         const std::int64_t* oldKey, const kernels::Vec3* oldD,
+                                         int& slot, int& wallCount, kernels::Vec3& T) const {
+    using namespace kernels;
+    const long long ii = static_cast<long long>(i);
+    // Walls (the law with m_eff = m_i, the particle's material): the analytic walls in ascending
+    // order (the candidate bits of the first kNearBits, most particles have none, then every wall
+    // beyond them), each with its touches in feature order; then the mesh walls' touches.
+    Vec3 FW{0.0, 0.0, 0.0};
+    const std::uint32_t nearBits = wallNear[i];
+    if (nearBits != 0) {
+      const int ai = mat[i];
+      const double mi = m[i];
+      const Pair pp = pairs[ai * nMat + ai].template of<Law>();
+      const auto lp = Law::contact(pp, mi);
+      const Vec3 vi = load3(v, ii);
+      const Vec3 wi = load3(w, ii);
+      auto touch = [&](double h, Vec3 nw, std::int64_t key, Vec3 history) {
+        const ContactResult res = wallContact<Law>(lp, nw, ri - h, vi, wi, ri, history, dt);
+        FW += res.force;
+        T += res.torque;
+        if (slot < K) {
+          hk[i * K + slot] = key;
+          store3(hd, ii * K + slot, res.deltaT);
+        }
+        ++slot;
+        ++wallCount;
+      };
+      wv.touches(nearBits, i, xi, ri, [&](double h, Vec3 nw, std::int64_t key) {
+        // The history of this feature, else that of a neighbouring one (WallView::continues).
+        int from = -1;
+        for (int s = 0; s < used; ++s) {
+          if (oldKey[s] == key) {
+            from = s;
+            break;
+          }
+          if (from < 0 && wv.continues(key, oldKey[s]))
+            from = s;
+        }
+        touch(h, nw, key, from >= 0 ? oldD[from] : Vec3{0.0, 0.0, 0.0});
+      });
+    }
+    return FW;
+  }
+
   /// kFromHits: i's candidates in contact are hits[h..) while their owner (qOwner) is i; h
   /// ends past them.
   template <bool kFromHits>
@@ -199,44 +247,8 @@ struct OwnerContacts {
 #endif
       }
     }
-    // Walls (the law with m_eff = m_i, the particle's material): the analytic walls in ascending
-    // order (the candidate bits of the first kNearBits, most particles have none, then every wall
-    // beyond them), each with its touches in feature order; then the mesh walls' touches.
-    Vec3 FW{0.0, 0.0, 0.0};
     int wallCount = 0;
-    const std::uint32_t nearBits = wallNear[i];
-    if (nearBits != 0) {
-      const int ai = mat[i];
-      const double mi = m[i];
-      const Pair pp = pairs[ai * nMat + ai].template of<Law>();
-      const auto lp = Law::contact(pp, mi);
-      const Vec3 vi = load3(v, ii);
-      const Vec3 wi = load3(w, ii);
-      auto touch = [&](double h, Vec3 nw, std::int64_t key, Vec3 history) {
-        const ContactResult res = wallContact<Law>(lp, nw, ri - h, vi, wi, ri, history, dt);
-        FW += res.force;
-        T += res.torque;
-        if (slot < K) {
-          hk[i * K + slot] = key;
-          store3(hd, ii * K + slot, res.deltaT);
-        }
-        ++slot;
-        ++wallCount;
-      };
-      wv.touches(nearBits, i, xi, ri, [&](double h, Vec3 nw, std::int64_t key) {
-        // The history of this feature, else that of a neighbouring one (WallView::continues).
-        int from = -1;
-        for (int s = 0; s < used; ++s) {
-          if (oldKey[s] == key) {
-            from = s;
-            break;
-          }
-          if (from < 0 && wv.continues(key, oldKey[s]))
-            from = s;
-        }
-        touch(h, nw, key, from >= 0 ? oldD[from] : Vec3{0.0, 0.0, 0.0});
-      });
-    }
+    const Vec3 FW = walls(i, xi, ri, used, oldKey, oldD, slot, wallCount, T);
     F += FW;
     for (int s = slot; s < used; ++s)
       hk[i * K + s] = -1;

@@ -267,9 +267,8 @@ kernels::ParamPack<kernels::NusseltModels>& nusseltParamsOf(DemConfig& c) {
   return c.heat.nusseltModels;
 }
 
-std::vector<ModelOption> makeOptions() {
-  std::vector<ModelOption> o;
-  const std::string onOffText = "on, off";
+/// The `models:` rows of the drag law, its ε_min clip and its laws' parameters.
+void addDragRows(std::vector<ModelOption>& o) {
   // --- drag
   o.push_back({"drag", "drag", dragModels().allowed(), "gidaspow",
                "drag law of the gas force on the particles", [](DemConfig& c, std::string_view v) {
@@ -289,6 +288,12 @@ std::vector<ModelOption> makeOptions() {
   o.push_back({"eps_min_drag", "drag", "number in (0, 1)", "0.35",
                "deprecated spelling of dem.eps_min_drag", epsMin, "dem.eps_min_drag"});
   addParamRowsOf<kernels::DragLaws, &DemConfig::dragLaws>(o, "drag");
+}
+
+/// The `models:` rows of the heat-transfer switches and parameters: convection, conduction,
+/// radiation.
+void addHeatRows(std::vector<ModelOption>& o) {
+  const std::string onOffText = "on, off";
   // --- heat master switch
   o.push_back({"heat", "heat", onOffText, "on", "off: temperatures stay constant, H = H_Tp = 0",
                heatSwitch<&HeatOptions::enabled>});
@@ -365,6 +370,10 @@ std::vector<ModelOption> makeOptions() {
                "radiation of materials with emissivity > 0 (environment: ε_g T_g + (1 − ε_g) "
                "cell-mean T_p)",
                heatSwitch<&HeatOptions::radiation>});
+}
+
+/// The `models:` rows of particle motion and the contact law with its parameters.
+void addMotionAndContactRows(std::vector<ModelOption>& o) {
   // --- motion
   o.push_back(
       {"motion", "motion", motionModels().allowed(), "free",
@@ -386,6 +395,10 @@ std::vector<ModelOption> makeOptions() {
                  return e;
                }});
   addParamRowsOf<kernels::ContactLaws, &DemConfig::contactLaws>(o, "contact");
+}
+
+/// The `models:` rows of the numerics of the DEM step.
+void addNumericsRows(std::vector<ModelOption>& o) {
   // --- numerics of the DEM step
   auto dtFactor = [](DemConfig& c, std::string_view v) {
     std::string e;
@@ -416,6 +429,14 @@ std::vector<ModelOption> makeOptions() {
            c.neighbour.historySlots = *x;
          return e;
        }});
+}
+
+std::vector<ModelOption> makeOptions() {
+  std::vector<ModelOption> o;
+  addDragRows(o);
+  addHeatRows(o);
+  addMotionAndContactRows(o);
+  addNumericsRows(o);
   return o;
 }
 

@@ -16,8 +16,8 @@
 #include <string>
 #include <vector>
 
-#include "coredem/common/check.h"
 #include "../dem.h"
+#include "coredem/common/check.h"
 
 namespace coredem::bench::hopper {
 
