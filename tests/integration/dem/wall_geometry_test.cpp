@@ -109,6 +109,22 @@ TEST(MeshWall, HeadOnOnATriangulatedPlaneMatchesThePlaneWall) {
   }
 }
 
+// Head-on on triangles much finer than the contact patch (0.05 mm against a 1 mm sphere: about
+// 60 triangles within reach of its centre, more than kMaxMeshTouches): the touches kept are the
+// nearest, so the floor still gives the analytic plane's restitution (to 1e-3), its contact
+// duration (to 2 Δt_DEM) and one contact, on a face, an edge and a vertex.
+TEST(MeshWall, HeadOnOnTrianglesFinerThanTheContactKeepsTheNearestTouches) {
+  const Bounce plane = bounce(0, 0.0, 0.0, 0.0);
+  const double side = 0.05e-3;
+  const std::pair<const char*, std::pair<double, double>> where[] = {
+      {"face", {0.71, 0.23}}, {"diagonal edge", {0.5, 0.5}}, {"vertex", {0.0, 0.0}}};
+  for (const auto& [name, f] : where) {
+    const Bounce m = bounce(40, side, f.first * side, f.second * side);
+    EXPECT_NEAR(m.restitution, plane.restitution, 1e-3) << name;
+    EXPECT_LE(std::abs(m.contactSteps - plane.contactSteps), 2) << name;
+  }
+}
+
 namespace {
 struct Roll {
   double v;         ///< final speed (m/s)

@@ -19,8 +19,9 @@
 /// region, continuous as the sphere slides across edges and vertices (at a region boundary the
 /// face and the edge point coincide), even on a mesh finer than the contact patch; two or more
 /// in a concave valley (one per face), as with analytic walls. Every triangle holding a touched
-/// edge or vertex is itself within reach (it holds a point at the touch's distance), so the
-/// test sees all of them. Triangles are two-sided; h = |x − p| ≥ 0 and the normal points from
+/// edge or vertex is itself within reach (it holds a point at the touch's distance), and no
+/// farther than the touch, so it is among the nearest kMaxMeshTouches kept: the test sees all
+/// of them. Triangles are two-sided; h = |x − p| ≥ 0 and the normal points from
 /// p towards x (the triangle's own normal if x lies on it).
 ///
 /// History key of a touch: −(2 + keyBase + triangle index), the triangle that holds the kept
@@ -84,8 +85,9 @@ DEM_HD double triangleDistance(const MeshTriangle& t, Vec3 x) {
   return ::sqrt(dot(e, e));
 }
 
-/// Most touches of one sphere with the mesh walls considered at once (more within reach are
-/// ignored, farthest in candidate order first: a sphere over a mesh finer than itself).
+/// Most touches of one sphere with the mesh walls considered at once: with more triangles
+/// within reach (a mesh finer than the sphere) the nearest are kept, so the triangles holding
+/// the real contact and its neighbours' features are among them.
 inline constexpr int kMaxMeshTouches = 16;
 
 /// One kept touch of a sphere with a mesh wall.
@@ -109,12 +111,13 @@ DEM_HD bool holdsVertex(const MeshTriangle& t, std::int32_t v) {
 
 /// The touches (h < reach) of a sphere centred at x with the candidate triangles
 /// tris[cand[k]], k < nCand (ascending), one per touched feature as the file comment says;
-/// writes at most kMaxMeshTouches to out and returns their number.
+/// writes at most kMaxMeshTouches (the nearest) to out and returns their number.
 DEM_HD int meshTouches(const MeshTriangle* tris, const std::uint32_t* cand, int nCand, Vec3 x,
                        double reach, MeshTouch* out) {
-  // Pass 1: every triangle within reach, its closest point.
+  // Pass 1: every triangle within reach, its closest point; the nearest kMaxMeshTouches of them,
+  // in candidate order (a touch nearer than the farthest kept one replaces it).
   int raw = 0;
-  for (int k = 0; k < nCand && raw < kMaxMeshTouches; ++k) {
+  for (int k = 0; k < nCand; ++k) {
     const MeshTriangle& t = tris[cand[k]];
     const TrianglePoint cp = closestOnTriangle(t, x);
     const Vec3 e = x - cp.p;
@@ -128,6 +131,17 @@ DEM_HD int meshTouches(const MeshTriangle* tris, const std::uint32_t* cand, int 
     } else {
       const Vec3 c = cross(t.b - t.a, t.c - t.a);
       n = (1.0 / ::sqrt(dot(c, c))) * c;
+    }
+    if (raw == kMaxMeshTouches) {
+      int far = 0;
+      for (int j = 1; j < raw; ++j)
+        if (out[j].h > out[far].h)
+          far = j;
+      if (!(h < out[far].h))
+        continue;
+      for (int j = far; j < raw - 1; ++j)
+        out[j] = out[j + 1];
+      --raw;
     }
     out[raw++] = MeshTouch{h, n, cand[k], cp.region};
   }
