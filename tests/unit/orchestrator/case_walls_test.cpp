@@ -80,6 +80,12 @@ protected:
     dem::writeStl(
         dem::meshRevolved({0, 0, 0}, {0, 0, 1}, {{0.0, 0.055}, {0.31, 0.055}}, 32, false, false),
         dir() / "tube.stl", true);
+    // Floors of 10 cm × 10 cm at z = 1 cm: squares of 5 mm and of 0.5 mm (triangles of 12.5 and
+    // 0.125 mm² under particles of 4 mm: about 0.5 and 44 within a particle's heat reach).
+    for (const auto& [name, quads] : {std::pair{"floor-coarse.stl", 20}, {"floor-fine.stl", 200}})
+      dem::writeStl(
+          dem::meshRectangle({-0.05, -0.05, 0.01}, {0.1, 0, 0}, {0, 0.1, 0}, quads, quads),
+          dir() / name, true);
   }
   static void TearDownTestSuite() { fs::remove_all(dir()); }
   static fs::path& dir() {
@@ -385,4 +391,21 @@ TEST_F(CaseWalls, AServerOlderThanOneDotFourIsRefused) {
   // A case without them still runs with a 1.0 server.
   const std::string plain = std::string(kCase).substr(0, std::string(kCase).find("walls:"));
   EXPECT_EQ(demVersionRefusal(parse(plain), 1, 0), "");
+}
+
+// A mesh wall much finer than the smallest particle is accepted with a warning naming the mesh,
+// the triangles' mean area, the particle diameter and how many triangles a particle reaches; a
+// coarser one gets none.
+TEST_F(CaseWalls, AMeshMuchFinerThanTheParticlesIsWarnedAbout) {
+  const std::string column = "    - file: column.stl\n      closed: true\n";
+  const auto warnings = [&](const char* floor) {
+    return checkCaseConsistency(
+        parse(replace(kCase, column, column + "    - file: " + floor + "\n")));
+  };
+  EXPECT_TRUE(warnings("floor-coarse.stl").empty());
+  const std::vector<std::string> fine = warnings("floor-fine.stl");
+  ASSERT_EQ(fine.size(), 1u);
+  EXPECT_HAS(fine[0], "walls.meshes[1].file: the mesh 'floor-fine.stl' has triangles of 0.125 mm²");
+  EXPECT_HAS(fine[0], "smallest particle (d = 4 mm): about 44 lie within");
+  EXPECT_HAS(fine[0], "the nearest 16 are considered");
 }
