@@ -35,6 +35,14 @@ QUALIFIERS = {"const", "volatile", "noexcept", "override", "final", "&", "&&", "
 ACCESS = {"public", "private", "protected", "signals", "slots"}
 
 
+
+def blank_block_comment(text, i, out):
+    """Appends the /* ... */ comment at i as blanks (newlines kept); returns the index past it."""
+    end = text.find("*/", i + 2)
+    end = len(text) if end < 0 else end + 2
+    out.append(re.sub(r"[^\n]", " ", text[i:end]))
+    return end
+
 def blank(text):
     """Returns text with comments, literals and preprocessor lines replaced by spaces (string
     and character literals by a placeholder), newlines kept."""
@@ -60,10 +68,7 @@ def blank(text):
                     i += 2
                     continue
                 if text.startswith("/*", i):
-                    end = text.find("*/", i + 2)
-                    end = n if end < 0 else end + 2
-                    out.append(re.sub(r"[^\n]", " ", text[i:end]))
-                    i = end
+                    i = blank_block_comment(text, i, out)
                     continue
                 out.append(" ")
                 i += 1
@@ -76,10 +81,7 @@ def blank(text):
             i = end
             continue
         if text.startswith("/*", i):
-            end = text.find("*/", i + 2)
-            end = n if end < 0 else end + 2
-            out.append(re.sub(r"[^\n]", " ", text[i:end]))
-            i = end
+            i = blank_block_comment(text, i, out)
             continue
         if c == '"':
             prefix = re.search(r"(?:^|[^A-Za-z0-9_])((?:u8|u|U|L)?R)$", text[max(0, i - 3):i])
