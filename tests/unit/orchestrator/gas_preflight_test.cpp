@@ -292,3 +292,26 @@ TEST(GasPreflight, KinematicPressureIsAcceptedOnlyAsAZeroGauge) {
   e = failureOf(d);
   EXPECT_TRUE(contains(e, "kinematic pressure")) << e;
 }
+
+// A reacting ideal-gas case with one PIMPLE outer corrector conserves species mass only to O(Δt)
+// of the density change (docs/coredemFoam.md): refused, naming fvSolution's line and the minimum;
+// the constant model (density fixed) is not concerned, and an fvSolution without the entry is
+// OpenFOAM's default, 1.
+TEST(GasPreflight, ReactingIdealGasWithOneOuterCorrectorIsRefused) {
+  const fs::path d = clgCopy("outer");
+  const fs::path sol = d / "openfoam" / "system" / "fvSolution";
+  edit(sol, "nOuterCorrectors 3;", "nOuterCorrectors 1;");
+  EXPECT_EQ(failureOf(d), ""); // model constant
+  makeIdealGas(d);
+  std::string e = failureOf(d);
+  EXPECT_TRUE(contains(e, "gas_properties.model: ideal_gas with reactions needs at least 3 PIMPLE "
+                          "outer correctors, but " +
+                              sol.string() + ":27 gives nOuterCorrectors 1:"))
+      << e;
+  edit(sol, "    nOuterCorrectors 1;\n", "");
+  e = failureOf(d);
+  EXPECT_TRUE(contains(e, "gives nOuterCorrectors 1 (no entry: OpenFOAM's default)")) << e;
+  edit(sol, "PIMPLE\n{\n", "PIMPLE\n{\n    nOuterCorrectors 3;\n");
+  EXPECT_EQ(failureOf(d), "");
+  fs::remove_all(d);
+}

@@ -397,6 +397,34 @@ void checkDecomposition(const CaseConfig& c, const Locator& at, const fs::path& 
   }
 }
 
+/// ideal_gas with chemistry: coredemFoam solves Y and T with the mass flux of the previous outer
+/// iteration, so one outer corrector conserves species mass only to O(Δt) of the density change
+/// (docs/coredemFoam.md "Variable-density gas"); reacting cases need nOuterCorrectors >=
+/// kMinOuterCorrectorsReacting in system/fvSolution (OpenFOAM's default, without the entry, is 1).
+void checkOuterCorrectors(const CaseConfig& c, const Locator& at, const fs::path& dir) {
+  if (!c.gasProperties.idealGas() || !c.usesChemistry() || c.species.empty()) {
+    return;
+  }
+  const fs::path file = dir / "system" / "fvSolution";
+  if (!fs::exists(file)) {
+    return; // coredemFoam refuses a case without fvSolution itself
+  }
+  const auto e = foamEntry(file, "nOuterCorrectors");
+  const int n = e ? std::atoi(e->value.c_str()) : 1;
+  if (n >= kMinOuterCorrectorsReacting) {
+    return;
+  }
+  at.fail({"gas_properties", "model"}, "gas_properties.model",
+          fmt::format("ideal_gas with reactions needs at least {} PIMPLE outer correctors, but "
+                      "{}{} gives nOuterCorrectors {}{}: with fewer, the species and energy "
+                      "equations use the last step's mass flux and species mass is conserved "
+                      "only to O(dt) of the density change; set nOuterCorrectors {} in its PIMPLE "
+                      "dictionary",
+                      kMinOuterCorrectorsReacting, file.string(),
+                      e ? fmt::format(":{}", e->line) : std::string(), n,
+                      e ? "" : " (no entry: OpenFOAM's default)", kMinOuterCorrectorsReacting));
+}
+
 void checkOpenFoamCase(const CaseConfig& c) {
   const Locator at(c);
   const fs::path dir = c.caseDir / c.cfd.caseFolder;
@@ -506,6 +534,7 @@ void checkOpenFoamCase(const CaseConfig& c) {
   checkThermophysicalProperties(c, at, dir);
   checkFoamGasState(c, at, dir);
   checkDecomposition(c, at, dir);
+  checkOuterCorrectors(c, at, dir);
 }
 
 } // namespace coredem::orchestrator

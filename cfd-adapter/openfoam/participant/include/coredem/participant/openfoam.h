@@ -28,6 +28,10 @@ inline constexpr double kFoamEqualityRelTol = 1e-3;
 /// Mass fractions must sum to 1 within this.
 inline constexpr double kMassFractionSumTol = 1e-9;
 
+/// PIMPLE outer correctors a reacting ideal-gas case needs (docs/coredemFoam.md: with fewer,
+/// species mass is conserved only to O(Δt) of the density change).
+inline constexpr int kMinOuterCorrectorsReacting = 3;
+
 /// Pre-flight of the OpenFOAM participant (the row's `preflight`), each failure a CaseError
 /// naming both values and both places (docs/orchestrator.md "One source of truth"):
 /// - gravity of case.yaml equals `cfd.case`/constant/g;
@@ -43,7 +47,9 @@ inline constexpr double kMassFractionSumTol = 1e-9;
 ///   fraction in [0, 1], and where all species are uniform they sum to 1 within
 ///   kMassFractionSumTol (non-uniform values are skipped with an info line);
 /// - the coupling grid covers the mesh, the mesh covers walls.box, and cfd.ranks fits the mesh
-///   and system/decomposeParDict.
+///   and system/decomposeParDict;
+/// - model ideal_gas with reactions: system/fvSolution's nOuterCorrectors is at least
+///   kMinOuterCorrectorsReacting.
 void checkOpenFoamCase(const CaseConfig& config);
 
 // ------------------------------------------------------------------ generated files
