@@ -8,6 +8,7 @@
 #include <iterator>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <regex>
 #include <sstream>
 
@@ -440,49 +441,158 @@ void warnTemperatures(Consistency& ck) {
   }
 }
 
+/// The largest value of a scalar field of the prescribed gas section (a number or a time table
+/// {table: [[t, v], ...]}, at the domain level and in its regions); nullopt when not given.
+std::optional<double> largestPrescribed(const YAML::Node& gas, const char* key) {
+  std::optional<double> best;
+  auto take = [&](const YAML::Node& n) {
+    try {
+      if (n && n.IsScalar()) {
+        best = std::max(best.value_or(-HUGE_VAL), n.as<double>());
+      } else if (n && n.IsMap() && n["table"] && n["table"].IsSequence()) {
+        for (const YAML::Node& row : n["table"]) {
+          if (row.IsSequence() && row.size() == 2 && row[1].IsScalar()) {
+            best = std::max(best.value_or(-HUGE_VAL), row[1].as<double>());
+          }
+        }
+      }
+    } catch (const YAML::Exception&) {
+    }
+  };
+  if (!gas || !gas.IsMap()) {
+    return best;
+  }
+  take(gas[key]);
+  if (gas["regions"] && gas["regions"].IsSequence()) {
+    for (const YAML::Node& r : gas["regions"]) {
+      if (r.IsMap()) {
+        take(r[key]);
+      }
+    }
+  }
+  return best;
+}
+
+/// The largest gas speed the prescribed gas section gives (u_g literals and table rows).
+double largestPrescribedSpeed(const YAML::Node& gas) {
+  double best = 0.0;
+  auto speed = [&](const YAML::Node& v) {
+    try {
+      if (v.IsSequence() && v.size() == 3) {
+        const Vec3 u{v[0].as<double>(), v[1].as<double>(), v[2].as<double>()};
+        best = std::max(best, std::sqrt(dot(u, u)));
+      }
+    } catch (const YAML::Exception&) {
+    }
+  };
+  auto take = [&](const YAML::Node& n) {
+    if (n && n.IsSequence()) {
+      speed(n);
+    } else if (n && n.IsMap() && n["table"] && n["table"].IsSequence()) {
+      for (const YAML::Node& row : n["table"]) {
+        if (row.IsSequence() && row.size() == 2) {
+          speed(row[1]);
+        }
+      }
+    }
+  };
+  if (gas && gas.IsMap()) {
+    take(gas["u_g"]);
+    if (gas["regions"] && gas["regions"].IsSequence()) {
+      for (const YAML::Node& r : gas["regions"]) {
+        if (r.IsMap()) {
+          take(r["u_g"]);
+        }
+      }
+    }
+  }
+  return best;
+}
+
+/// The shortest particle response time of the Ergun/Gidaspow drag at ε_g = 0.4 (ε_s = 0.6):
+/// K_sl = 150 ε_s² μ_g/(ε_g d²) + 1.75 ε_s ρ_g s/d, τ_p = ε_s ρ_p/K_sl, at the slip s = the larger
+/// of the prescribed gas speed and the slip at which the drag carries the bed's buoyant weight,
+/// K_sl(s) s = ε_s (ρ_p − ρ_g) |g| (the slip of a fluidized dense bed).
+struct ResponseTime {
+  double tau = 0.0, slip = 0.0;
+};
+ResponseTime responseTime(double rhoP, double d, double mu, double rhoG, double g, double uGas) {
+  const double es = 0.6, eg = 0.4;
+  const double a = 150.0 * es * es * mu / (eg * d * d), b = 1.75 * es * rhoG / d;
+  const double c = es * std::max(rhoP - rhoG, 0.0) * g;
+  const double sEq = c > 0.0 ? 2.0 * c / (a + std::sqrt(a * a + 4.0 * b * c)) : 0.0;
+  const double s = std::max(sEq, uGas);
+  return {es * rhoP / (a + b * s), s};
+}
+
 void checkStaggeredStep(Consistency& ck) {
   const CaseConfig& c = ck.c;
   const Locator& at = ck.at;
   // Staggered coupling: the drag and heat sources the gas applies are one step old, so the
   // particles must not relax to the gas within one step (docs/coupling-schemes.md "Stability").
-  // τ_p,min = ρ_p d_p²/(225 μ_g): the response time of the Ergun/Gidaspow viscous drag at
-  // ε_g = 0.4 (K_sl = 150 ε_s² μ_g/(ε_g d_p²), τ_p = ε_s ρ_p/K_sl), the shortest of a dense bed.
-  if (c.coupling.staggered()) {
-    const bool adaptive = c.dt.kind == DtPolicyConfig::Kind::Courant;
-    const double dtMax = adaptive ? c.dt.dtMax : c.dt.dt;
-    const std::vector<std::string> dtPath =
-        adaptive ? std::vector<std::string>{"time", "adaptive", "dt_max"}
-                 : std::vector<std::string>{"time", "dt"};
-    const std::string dtKey = adaptive ? "time.adaptive.dt_max" : "time.dt";
-    for (std::size_t i = 0; i < c.particles.size(); ++i) {
-      const ParticleSetConfig& p = c.particles[i];
-      double rho = p.density;
-      if (!(rho > 0.0)) {
-        const int m = materialIndex(c, p.material);
-        rho = m >= 0 ? c.materials[std::size_t(m)].density : 0.0;
-      }
-      const double tau = rho * p.diameter * p.diameter / (225.0 * c.gasProperties.viscosity);
-      if (!(tau > 0.0)) {
-        continue;
-      }
-      const std::string what = fmt::format(
-          "Δt_CFD = {:.4g} s with coupling.scheme staggered and particle set {} (d_p = {:.4g} m, "
-          "ρ_p = {:.4g} kg/m³, μ_g = {:.4g} Pa s): the particle response time τ_p = ρ_p d_p²/(225 "
-          "μ_g) = {:.4g} s",
-          dtMax, setName(p, i), p.diameter, rho, c.gasProperties.viscosity, tau);
-      if (dtMax > tau) {
-        at.fail(dtPath, dtKey,
-                what + " is shorter than one step: the gas would apply drag and heat sources of "
-                       "particles that have since relaxed (lagged sources oscillate). Use Δt_CFD "
-                       "<= τ_p (better <= 0.1 τ_p) or coupling.scheme sequential");
-      }
-      if (dtMax > 0.1 * tau) {
-        ck.warnings.push_back(at.warning(
-            dtPath, dtKey,
-            what + fmt::format(": Δt_CFD/τ_p = {:.2g} > 0.1, the one-step lag of the drag and "
-                               "heat sources is more than 10 % of a particle relaxation",
-                               dtMax / tau)));
-      }
+  if (!c.coupling.staggered()) {
+    return;
+  }
+  const bool adaptive = c.dt.kind == DtPolicyConfig::Kind::Courant;
+  const double dtMax = adaptive ? c.dt.dtMax : c.dt.dt;
+  const std::vector<std::string> dtPath =
+      adaptive ? std::vector<std::string>{"time", "adaptive", "dt_max"}
+               : std::vector<std::string>{"time", "dt"};
+  const std::string dtKey = adaptive ? "time.adaptive.dt_max" : "time.dt";
+  // The gas the particles see: the prescribed gas's largest μ_g, ρ_g and speed where the case
+  // prescribes one, else gas_properties.
+  const YAML::Node gas = at.root()[c.cfd.gasKey];
+  const double mu = largestPrescribed(gas, "mu_g").value_or(c.gasProperties.viscosity);
+  const double rhoG = largestPrescribed(gas, "rho_g").value_or(c.gasProperties.density);
+  const double uGas = largestPrescribedSpeed(gas);
+  const double g = std::sqrt(dot(c.gravity, c.gravity));
+  const double removal = c.chemistry.removalFraction.value_or(0.1);
+  for (std::size_t i = 0; i < c.particles.size(); ++i) {
+    const ParticleSetConfig& p = c.particles[i];
+    double rho = p.density;
+    if (!(rho > 0.0)) {
+      const int m = materialIndex(c, p.material);
+      rho = m >= 0 ? c.materials[std::size_t(m)].density : 0.0;
+    }
+    const ResponseTime r = responseTime(rho, p.diameter, mu, rhoG, g, uGas);
+    if (!(r.tau > 0.0)) {
+      continue;
+    }
+    const std::string what = fmt::format(
+        "Δt_CFD = {:.4g} s with coupling.scheme staggered and particle set {} (d_p = {:.4g} m, "
+        "ρ_p = {:.4g} kg/m³; gas μ_g = {:.4g} Pa s, ρ_g = {:.4g} kg/m³): the particle response "
+        "time of the Ergun drag at ε_g = 0.4 and slip {:.3g} m/s, τ_p = ε_s ρ_p/K_sl = {:.4g} s",
+        dtMax, setName(p, i), p.diameter, rho, mu, rhoG, r.slip, r.tau);
+    if (dtMax > r.tau) {
+      at.fail(dtPath, dtKey,
+              what + " is shorter than one step: the gas would apply drag and heat sources of "
+                     "particles that have since relaxed (lagged sources oscillate). Use Δt_CFD "
+                     "<= τ_p (better <= 0.1 τ_p) or coupling.scheme sequential");
+    }
+    if (dtMax > 0.1 * r.tau) {
+      ck.warnings.push_back(at.warning(
+          dtPath, dtKey,
+          what + fmt::format(": Δt_CFD/τ_p = {:.2g} > 0.1, the one-step lag of the drag and "
+                             "heat sources is more than 10 % of a particle relaxation",
+                             dtMax / r.tau)));
+      continue;
+    }
+    // A set that reacts shrinks down to its removal diameter: its smallest particles relax
+    // faster (few of them, carrying a small share of the exchange: a warning).
+    if (!c.usesChemistry() || p.composition.empty()) {
+      continue;
+    }
+    const double dSmall = removal * p.diameter;
+    const ResponseTime rs = responseTime(rho, dSmall, mu, rhoG, g, uGas);
+    if (dtMax > 0.1 * rs.tau) {
+      ck.warnings.push_back(at.warning(
+          dtPath, dtKey,
+          fmt::format("Δt_CFD = {:.4g} s with coupling.scheme staggered: particle set {} shrinks "
+                      "by reaction down to its removal diameter {:.4g} m (chemistry."
+                      "removal_fraction {:.3g}), where τ_p = {:.4g} s (slip {:.3g} m/s) and "
+                      "Δt_CFD/τ_p = {:.2g} > 0.1; the lag of its smallest particles' drag and "
+                      "heat is more than 10 % of their relaxation",
+                      dtMax, setName(p, i), dSmall, removal, rs.tau, rs.slip, dtMax / rs.tau)));
     }
   }
 }

@@ -130,21 +130,47 @@ TEST(Preflight, RandomPackingTooDenseFailsAndDenseWarns) {
 }
 
 TEST(Preflight, StaggeredSchemeChecksTheStepAgainstTheParticleResponseTime) {
-  // τ_p = ρ_p d_p²/(225 μ_g) with μ_g = 1.81e-5 Pa s (default gas_properties): 10 µm glass beads
-  // τ_p = 6.1e-5 s < Δt = 1e-4 s: refused; 20 µm beads τ_p = 2.5e-4 s, Δt/τ_p = 0.41: a warning;
-  // the 2 mm beads of the base case (τ_p = 2.5 s) pass; the sequential scheme is not checked.
+  // τ_p = ε_s ρ_p/K_sl, Ergun at ε_g = 0.4 with μ_g = 1.81e-5 Pa s, ρ_g = 1.204 kg/m³ (default
+  // gas_properties) and slip 0.1 m/s (the prescribed u_g; larger than the fluidization slip of
+  // these beads): 10 µm glass beads τ_p = 6.136e-5 s < Δt = 1e-4 s: refused; 20 µm beads
+  // τ_p = 2.45e-4 s, Δt/τ_p = 0.41: a warning; the 2 mm beads of the base case (τ_p = 0.45 s)
+  // pass; the sequential scheme is not checked.
   const std::string staggered = std::string(kCase) + "coupling: {scheme: staggered}\n";
   EXPECT_TRUE(checkCaseConsistency(parse(staggered)).empty());
   const std::string e = failureOf(replace(staggered, "diameter: 2.0e-3", "diameter: 1.0e-5"));
   EXPECT_TRUE(contains(e, "case.yaml:2:")) << e;
   EXPECT_TRUE(contains(e, "time.dt:")) << e;
-  EXPECT_TRUE(contains(e, "τ_p = ρ_p d_p²/(225 μ_g) = 6.139e-05 s")) << e;
+  EXPECT_TRUE(contains(e, "slip 0.1 m/s, τ_p = ε_s ρ_p/K_sl = 6.136e-05 s")) << e;
   EXPECT_TRUE(contains(e, "coupling.scheme sequential")) << e;
   const auto w =
       checkCaseConsistency(parse(replace(staggered, "diameter: 2.0e-3", "diameter: 2.0e-5")));
   ASSERT_EQ(w.size(), 1u);
   EXPECT_TRUE(contains(w[0], "Δt_CFD/τ_p = 0.41 > 0.1")) << w[0];
   EXPECT_EQ(failureOf(replace(kCase, "diameter: 2.0e-3", "diameter: 1.0e-5")), "");
+}
+
+TEST(Preflight, StaggeredCheckIncludesTheInertialDragAndThePrescribedGas) {
+  // 1 mm glass beads in air: the viscous term alone gives τ_p = ρ_p d²/(225 μ_g) = 0.614 s; the
+  // bed is carried at a slip of 2.58 m/s (K_sl s = ε_s (ρ_p − ρ_g) g), where the inertial term
+  // more than doubles K_sl: τ_p = 0.263 s < Δt = 0.3 s, refused (the viscous estimate only
+  // warned, Δt/τ_p = 0.49).
+  const std::string staggered = replace(replace(std::string(kCase), "time: {end: 0.01, dt: 1.0e-4}",
+                                                "time: {end: 3.0, dt: 0.3}"),
+                                        "diameter: 2.0e-3", "diameter: 1.0e-3") +
+                                "coupling: {scheme: staggered}\n";
+  const std::string e = failureOf(staggered);
+  EXPECT_TRUE(contains(e, "slip 2.58 m/s, τ_p = ε_s ρ_p/K_sl = 0.263 s is shorter than one step"))
+      << e;
+  // The prescribed gas's largest viscosity (here a region's table reaching 5e-5 Pa s) is the
+  // one checked: 20 µm beads at Δt = 1e-4 s, τ_p = 8.9e-5 s, are refused (2.45e-4 s with the
+  // default 1.81e-5 Pa s: a warning).
+  const std::string hot = replace(std::string(kCase), "diameter: 2.0e-3", "diameter: 2.0e-5") +
+                          "  regions:\n    - box: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}\n"
+                          "      mu_g: {table: [[0.0, 1.81e-5], [0.005, 5.0e-5]]}\n"
+                          "coupling: {scheme: staggered}\n";
+  const std::string h = failureOf(hot);
+  EXPECT_TRUE(contains(h, "μ_g = 5e-05 Pa s")) << h;
+  EXPECT_TRUE(contains(h, "is shorter than one step")) << h;
 }
 
 TEST(Preflight, ExplicitOverlapBeyondTheFractionFails) {
