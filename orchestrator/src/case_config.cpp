@@ -34,13 +34,16 @@ const std::vector<CaseReader>& caseReaders() {
       {"cfd", {}, readCfd},
       {"walls.meshes", {"walls", "grid", "cfd"}, readMeshWalls},
       {"gas", {}, readGasSection},
-      {"ideal_gas", {"species", "gas_properties", "cfd", "gas"}, checkIdealGas},
-      {"coupling", {"gas_properties"}, readCoupling},
-      {"checkpoint", {}, readCheckpoint},
-      {"output", {}, readOutput},
       {"solid_species", {"species", "particles"}, readSolidSpecies},
       {"reactions", {"species", "solid_species"}, readReactions},
       {"chemistry", {"species", "solid_species"}, readChemistry},
+      {"gas_model",
+       {"gas_properties", "particles", "walls", "models", "cfd", "reactions", "chemistry"},
+       resolveGasModel},
+      {"ideal_gas", {"species", "gas_model", "gas"}, checkIdealGas},
+      {"coupling", {"gas_model"}, readCoupling},
+      {"checkpoint", {}, readCheckpoint},
+      {"output", {}, readOutput},
   };
   return readers;
 }

@@ -26,6 +26,7 @@ struct CaseReading {
   std::optional<Section> walls;         ///< the walls mapping, checked once (walls, walls.meshes)
   std::vector<Section> species;         ///< the species entries, checked once (species, ideal gas)
   std::optional<Section> gasProperties; ///< checked once (gas_properties, ideal gas)
+  bool gasModelGiven = false;           ///< gas_properties.model is in the file
 };
 
 /// One part of the case reader: the part (a top-level section, a sub-part such as
@@ -49,6 +50,7 @@ void readGrid(CaseReading& r);
 void readGravity(CaseReading& r);
 void readSpecies(CaseReading& r);
 void readGasProperties(CaseReading& r);
+void resolveGasModel(CaseReading& r);
 void readMaterials(CaseReading& r);
 void readInitialState(CaseReading& r);
 void readParticles(CaseReading& r);

@@ -33,46 +33,107 @@ void readSpecies(CaseReading& r) {
   }
 }
 
-/// gas_properties: constant or ideal_gas
+/// gas_properties: constant or ideal_gas. Without `model`, the model is chosen by
+/// resolveGasModel once the particles, walls, models and chemistry are read; the keys given are
+/// read here and checked against the model there.
 void readGasProperties(CaseReading& r) {
   const Section& top = r.top;
   CaseConfig& c = r.c;
-  if (top.has("gas_properties")) {
-    const Section& g = r.gasProperties.emplace(
-        top.section("gas_properties", {"model", "density", "viscosity", "conductivity", "cp",
-                                       "temperature", "pressure", "diffusivity", "alphac_min"}));
-    auto& p = c.gasProperties;
+  if (!top.has("gas_properties")) {
+    return;
+  }
+  const Section& g = r.gasProperties.emplace(
+      top.section("gas_properties", {"model", "density", "viscosity", "conductivity", "cp",
+                                     "temperature", "pressure", "diffusivity", "alphac_min"}));
+  auto& p = c.gasProperties;
+  if (g.has("model")) {
     p.model = g.choice("model", std::string("constant"), {"constant", "ideal_gas"});
-    if (p.idealGas()) {
-      // One source of truth: the ideal-gas model computes these from T, p and the composition.
-      for (const char* key : {"density", "viscosity", "conductivity", "cp"}) {
-        if (g.has(key)) {
-          g.fail(g.markOf(key), g.full(key),
-                 fmt::format("not with model: ideal_gas, which computes the {} from temperature, "
-                             "pressure and composition (perfect gas, NASA-7 cp, Sutherland "
-                             "viscosity); remove the key, or use model: constant",
-                             key == std::string("cp") ? "heat capacity" : key));
-        }
+    r.gasModelGiven = true;
+  }
+  p.density = g.number("density", p.density, 0.0, kBig, "kg/m3, > 0", true);
+  p.viscosity = g.number("viscosity", p.viscosity, 0.0, kBig, "Pa s, > 0", true);
+  p.conductivity = g.number("conductivity", p.conductivity, 0.0, kBig, "W/m/K, > 0", true);
+  p.cp = g.number("cp", p.cp, 0.0, kBig, "J/kg/K, > 0", true);
+  p.diffusivity =
+      g.number("diffusivity", p.diffusivity, 0.0, kBig, "species diffusivity in m2/s, > 0", true);
+  p.alphacMin = g.number("alphac_min", p.alphacMin, 0.0, 1.0,
+                         "smallest gas fraction the gas equations accept, in (0, 1)", true);
+  p.temperature = g.number("temperature", p.temperature, 0.0, kBig, "K, > 0", true);
+  p.pressure = g.number("pressure", p.pressure, 0.0, kBig, "Pa, > 0", true);
+}
+
+namespace {
+
+/// What the gas exchanges with the particles and walls: the largest temperature difference
+/// of a particle set or fixed-temperature walls to the gas (K, 0 with models.heat off), and
+/// whether the case has reactions.
+struct GasExchange {
+  double dT = 0.0;
+  bool reactions = false;
+};
+
+GasExchange gasExchange(const CaseConfig& c) {
+  const ChemistryConfig& ch = c.chemistry;
+  return {largestGasTemperatureDifference(c),
+          !c.reactions.empty() || ch.charGasification || ch.ocReduction || ch.wgs};
+}
+
+std::string describe(const GasExchange& e) {
+  if (e.dT > 0.0 && e.reactions) {
+    return fmt::format("exchanges heat (up to {:.4g} K from the gas) and reactions", e.dT);
+  }
+  return e.reactions ? std::string("has reactions")
+                     : fmt::format("exchanges heat (up to {:.4g} K from the gas)", e.dT);
+}
+
+} // namespace
+
+/// The gas model: `model` as given; without it, ideal_gas where heat or reactions are exchanged
+/// and the participant solves the gas, constant otherwise. Constant-property keys are refused
+/// with ideal_gas (one source of truth), diffusivity and alphac_min with constant; a constant gas
+/// more than kConstantGasWarnDeltaT from the particles or walls is warned about.
+void resolveGasModel(CaseReading& r) {
+  CaseConfig& c = r.c;
+  auto& p = c.gasProperties;
+  const GasExchange e = gasExchange(c);
+  const bool exchanges = e.dT > 0.0 || e.reactions;
+  const bool solves = participant(c.cfd.participant).solvesGas;
+  if (!r.gasModelGiven) {
+    p.model = exchanges && solves ? "ideal_gas" : "constant";
+  }
+  if (!r.gasProperties) {
+    return;
+  }
+  const Section& g = *r.gasProperties;
+  if (p.idealGas()) {
+    // One source of truth: the ideal-gas model computes these from T, p and the composition.
+    for (const char* key : {"density", "viscosity", "conductivity", "cp"}) {
+      if (!g.has(key)) {
+        continue;
       }
-      p.diffusivity = g.number("diffusivity", p.diffusivity, 0.0, kBig,
-                               "species diffusivity in m2/s, > 0", true);
-      p.alphacMin = g.number("alphac_min", p.alphacMin, 0.0, 1.0,
-                             "smallest gas fraction the gas equations accept, in (0, 1)", true);
-    } else {
-      for (const char* key : {"diffusivity", "alphac_min"}) {
-        if (g.has(key)) {
-          g.fail(g.markOf(key), g.full(key),
-                 "only with model: ideal_gas (with model constant, the OpenFOAM case's "
-                 "constant/transportProperties gives D and alphacMin)");
-        }
+      const std::string what = key == std::string("cp") ? "heat capacity" : key;
+      if (r.gasModelGiven) {
+        g.fail(g.markOf(key), g.full(key),
+               fmt::format("not with model: ideal_gas, which computes the {} from temperature, "
+                           "pressure and composition (perfect gas, NASA-7 cp, Sutherland "
+                           "viscosity); remove the key, or use model: constant",
+                           what));
       }
-      p.density = g.number("density", p.density, 0.0, kBig, "kg/m3, > 0", true);
-      p.viscosity = g.number("viscosity", p.viscosity, 0.0, kBig, "Pa s, > 0", true);
-      p.conductivity = g.number("conductivity", p.conductivity, 0.0, kBig, "W/m/K, > 0", true);
-      p.cp = g.number("cp", p.cp, 0.0, kBig, "J/kg/K, > 0", true);
+      g.fail(g.markOf(key), g.full(key),
+             fmt::format("the case {} with {}, so its gas model is ideal_gas (the default), which "
+                         "computes the {} from temperature, pressure and composition: remove "
+                         "the key, or write gas_properties.model: constant to keep constant "
+                         "properties",
+                         describe(e), c.cfd.participant, what));
     }
-    p.temperature = g.number("temperature", p.temperature, 0.0, kBig, "K, > 0", true);
-    p.pressure = g.number("pressure", p.pressure, 0.0, kBig, "Pa, > 0", true);
+    return;
+  }
+  for (const char* key : {"diffusivity", "alphac_min"}) {
+    if (g.has(key)) {
+      g.fail(g.markOf(key), g.full(key),
+             "only with model: ideal_gas (with model constant, the OpenFOAM case's "
+             "constant/transportProperties gives D and alphacMin)");
+    }
   }
 }
 
@@ -151,3 +212,24 @@ void checkIdealGas(CaseReading& r) {
 }
 
 } // namespace coredem::orchestrator::caseread
+
+namespace coredem::orchestrator {
+
+double largestGasTemperatureDifference(const CaseConfig& c) {
+  for (const auto& [name, value] : c.models) {
+    if (name == "heat" && (value == "off" || value == "false")) {
+      return 0.0;
+    }
+  }
+  const double tg = c.gasProperties.temperature;
+  double dT = 0.0;
+  for (const auto& p : c.particles) {
+    dT = std::max(dT, std::abs(p.temperature - tg));
+  }
+  if (c.walls.temperature > 0.0) {
+    dT = std::max(dT, std::abs(c.walls.temperature - tg));
+  }
+  return dT;
+}
+
+} // namespace coredem::orchestrator

@@ -16,6 +16,7 @@
 
 #include <coredem/common/log.h>
 #include <coredem/common/yaml_section.h>
+#include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/preflight.h>
 #include <coredem/orchestrator/preflight_locator.h>
 #include <coredem/orchestrator/wall_geometry.h>
@@ -597,6 +598,24 @@ void checkStaggeredStep(Consistency& ck) {
   }
 }
 
+/// model constant with a gas the CFD solves, far from the particles' or walls' temperature: the
+/// density, viscosity and heat capacity would follow the temperature (ideal_gas).
+void warnConstantHotGas(Consistency& ck) {
+  const CaseConfig& c = ck.c;
+  if (c.gasProperties.idealGas() || !participant(c.cfd.participant).solvesGas) {
+    return;
+  }
+  const double dT = largestGasTemperatureDifference(c);
+  if (dT > kConstantGasWarnDeltaT) {
+    ck.warnings.push_back(ck.at.warning(
+        {"gas_properties", "model"}, "gas_properties.model",
+        fmt::format("constant gas properties with particles or walls up to {:.4g} K from the gas "
+                    "(more than {:.0f} K): the gas density, viscosity and heat capacity change "
+                    "with its temperature; model: ideal_gas computes them",
+                    dT, kConstantGasWarnDeltaT)));
+  }
+}
+
 void warnPrescribedGasTemperature(Consistency& ck) {
   const CaseConfig& c = ck.c;
   const Locator& at = ck.at;
@@ -674,6 +693,7 @@ const ConsistencyCheck kConsistencyChecks[] = {
     {"temperatures in kelvin", warnTemperatures},
     {"the staggered step against the particle response time", checkStaggeredStep},
     {"the prescribed gas temperature in kelvin", warnPrescribedGasTemperature},
+    {"a constant-property gas near the particles' temperature", warnConstantHotGas},
 };
 
 } // namespace

@@ -38,22 +38,29 @@ void writeText(const fs::path& p, const std::string& text) {
   std::ofstream(p) << text;
 }
 
-/// cases/clg (case.yaml and its OpenFOAM folder) copied to a temp folder.
+/// cases/clg (case.yaml and its OpenFOAM folder) copied to a temp folder, with the
+/// constant-property gas of reduced-constant-gas.yaml (model: constant).
 fs::path clgCopy(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("coredem-gas-preflight-" + name);
   fs::remove_all(d);
   fs::create_directories(d);
   const fs::path src = kSource / "cases" / "clg";
   fs::copy(src / "openfoam", d / "openfoam", fs::copy_options::recursive);
-  fs::copy_file(src / "case.yaml", d / "case.yaml");
+  writeText(d / "case.yaml",
+            replace(readText(src / "case.yaml"),
+                    "  model: ideal_gas\n  temperature: 1173.0\n  pressure: 101325.0\n"
+                    "  diffusivity: 2.0e-4\n",
+                    "  model: constant\n  density: 0.239\n  viscosity: 4.4e-5\n  conductivity: "
+                    "0.085\n  cp: 1650.0\n  temperature: 1173.0\n  pressure: 101325.0\n"));
   return d;
 }
 
-/// The constant properties of cases/clg replaced by model ideal_gas (3 lines fewer).
+/// The constant properties of the copy replaced by model ideal_gas (4 lines fewer).
 void makeIdealGas(const fs::path& d) {
   writeText(d / "case.yaml",
             replace(readText(d / "case.yaml"),
-                    "  density: 0.239\n  viscosity: 4.4e-5\n  conductivity: 0.085\n  cp: 1650.0\n",
+                    "  model: constant\n  density: 0.239\n  viscosity: 4.4e-5\n  conductivity: "
+                    "0.085\n  cp: 1650.0\n",
                     "  model: ideal_gas\n"));
 }
 
@@ -192,7 +199,7 @@ TEST(GasPreflight, ThermophysicalPropertiesWithTheConstantModelIsAmbiguous) {
   const fs::path file = d / "openfoam" / "constant" / "thermophysicalProperties";
   writeText(file, "thermoType { type heRhoThermo; }\n");
   const std::string e = failureOf(d);
-  EXPECT_TRUE(contains(e, "gas_properties.model: constant (the default; no model in case.yaml)"))
+  EXPECT_TRUE(contains(e, "case.yaml:40:10: gas_properties.model: constant (properties from "))
       << e;
   EXPECT_TRUE(contains(e, file.string() + ":1 exists and would select the ideal-gas solver: the "
                                           "gas model is ambiguous"))
@@ -314,4 +321,64 @@ TEST(GasPreflight, ReactingIdealGasWithOneOuterCorrectorIsRefused) {
   edit(sol, "PIMPLE\n{\n", "PIMPLE\n{\n    nOuterCorrectors 3;\n");
   EXPECT_EQ(failureOf(d), "");
   fs::remove_all(d);
+}
+
+// The gas model without gas_properties.model: ideal_gas where heat or reactions are exchanged and
+// the participant solves the gas; constant properties then need model: constant (refused
+// otherwise, naming the key); constant where nothing is exchanged (the isothermal
+// fluidized-bed-small) or the participant prescribes the gas; an explicit constant gas 70 K from
+// the particles is warned about.
+TEST(GasPreflight, TheGasModelDefaultsToTheIdealGasWhereHeatOrReactionsAreExchanged) {
+  const fs::path d = clgCopy("default");
+  const fs::path yaml = d / "case.yaml";
+  // No model, no constant values: the reacting CLG case is an ideal gas.
+  edit(yaml,
+       "  model: constant\n  density: 0.239\n  viscosity: 4.4e-5\n  conductivity: 0.085\n"
+       "  cp: 1650.0\n",
+       "");
+  EXPECT_TRUE(loadCase(yaml).gasProperties.idealGas());
+  EXPECT_EQ(failureOf(d), "");
+  // Constant values without a model: refused, the model is ideal_gas by default.
+  edit(yaml, "  temperature: 1173.0\n", "  density: 0.239\n  temperature: 1173.0\n");
+  try {
+    loadCase(yaml);
+    ADD_FAILURE() << "constant values without a model were accepted";
+  } catch (const CaseError& e) {
+    EXPECT_TRUE(contains(e.what(), "gas_properties.density: the case has reactions with "
+                                   "coredemFoam, so its gas model is ideal_gas (the default)"))
+        << e.what();
+    EXPECT_TRUE(contains(e.what(), "write gas_properties.model: constant")) << e.what();
+  }
+  fs::remove_all(d);
+
+  // Nothing exchanged: an isothermal bed keeps the constant gas without a model key.
+  const CaseConfig iso = loadCase(kSource / "cases" / "fluidized-bed-small" / "case.yaml");
+  EXPECT_FALSE(iso.gasProperties.idealGas());
+  EXPECT_EQ(largestGasTemperatureDifference(iso), 0.0);
+
+  // A heated bed: ideal_gas by default; model: constant is kept and warned about (70 K).
+  const fs::path h = fs::temp_directory_path() / "coredem-gas-default-heated";
+  fs::remove_all(h);
+  fs::create_directories(h);
+  const fs::path src = kSource / "cases" / "fluidized-bed-cooling";
+  fs::copy(src / "openfoam", h / "openfoam", fs::copy_options::recursive);
+  std::string text = readText(src / "case.yaml");
+  writeText(h / "case.yaml", replace(text, "  model: ideal_gas\n", ""));
+  const CaseConfig heated = loadCase(h / "case.yaml");
+  EXPECT_TRUE(heated.gasProperties.idealGas());
+  EXPECT_NEAR(largestGasTemperatureDifference(heated), 363.0 - 293.15, 1e-9);
+  EXPECT_TRUE(checkCaseConsistency(heated).empty());
+  writeText(h / "case.yaml", replace(replace(text, "  diffusivity: 2.0e-5\n", ""),
+                                     "  model: ideal_gas\n", "  model: constant\n"));
+  const auto w = checkCaseConsistency(loadCase(h / "case.yaml"));
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_TRUE(contains(w[0], "gas_properties.model: constant gas properties with particles or "
+                             "walls up to 69.85 K from the gas (more than 20 K)"))
+      << w[0];
+  // models.heat off: nothing is exchanged, the default is constant.
+  writeText(h / "case.yaml",
+            replace(replace(text, "  model: ideal_gas\n", ""), "  diffusivity: 2.0e-5\n", "") +
+                "models: {heat: \"off\"}\n");
+  EXPECT_FALSE(loadCase(h / "case.yaml").gasProperties.idealGas());
+  fs::remove_all(h);
 }

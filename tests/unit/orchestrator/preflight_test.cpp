@@ -252,6 +252,16 @@ void writeText(const fs::path& p, const std::string& text) {
   std::ofstream(p) << text;
 }
 
+/// The copy's gas with constant properties, those of openfoam/constant/transportProperties
+/// (model: constant, air at 20 °C; 3 lines more).
+void makeConstantGas(const fs::path& d) {
+  writeText(d / "case.yaml",
+            replace(readText(d / "case.yaml"), "  model: ideal_gas\n",
+                    "  model: constant\n  density: 1.204\n  viscosity: 1.81e-5\n  conductivity: "
+                    "0.0257\n  cp: 1006.0\n"));
+  writeText(d / "case.yaml", replace(readText(d / "case.yaml"), "  diffusivity: 2.0e-5\n", ""));
+}
+
 /// The pre-flight of the coredemFoam row of the participant table ("" when it passes).
 std::string foamFailureOf(const fs::path& dir) {
   const CaseConfig c = parse(readText(dir / "case.yaml"), dir);
@@ -310,10 +320,11 @@ TEST(PreflightOpenFoam, GravityMismatchNamesBothValues) {
 
 TEST(PreflightOpenFoam, GasPropertyMismatchNamesBothValues) {
   const fs::path d = foamCaseCopy("gas");
+  makeConstantGas(d);
   writeText(d / "case.yaml",
             replace(readText(d / "case.yaml"), "viscosity: 1.81e-5", "viscosity: 1.85e-5"));
   std::string e = foamFailureOf(d);
-  EXPECT_TRUE(contains(e, "case.yaml:23:14: gas_properties.viscosity: 1.85e-05 Pa s")) << e;
+  EXPECT_TRUE(contains(e, "case.yaml:24:14: gas_properties.viscosity: 1.85e-05 Pa s")) << e;
   EXPECT_TRUE(contains(e, "constant/transportProperties:17 gives nu·rho = 1.5033e-05·1.204 = "
                           "1.80997e-05 Pa s"))
       << e;
@@ -324,7 +335,7 @@ TEST(PreflightOpenFoam, GasPropertyMismatchNamesBothValues) {
             replace(readText(d / "openfoam/constant/transportProperties"), "cp              1006;",
                     "cp              1000;"));
   e = foamFailureOf(d);
-  EXPECT_TRUE(contains(e, "case.yaml:25:7: gas_properties.cp: 1006 J/kg/K")) << e;
+  EXPECT_TRUE(contains(e, "case.yaml:26:7: gas_properties.cp: 1006 J/kg/K")) << e;
   EXPECT_TRUE(contains(e, "gives cp = 1000 J/kg/K")) << e;
   fs::remove_all(d);
 }
@@ -352,7 +363,12 @@ TEST(Preflight, EveryShippedCasePasses) {
         p.preflight(c);
       }
       for (const auto& w : checkCaseConsistency(c)) {
-        ADD_FAILURE() << "warning: " << w;
+        // The constant-property twins of the gas-model comparison keep their gas on purpose.
+        const bool twin = name.find("-constant-gas.yaml") != std::string::npos &&
+                          contains(w, "gas_properties.model: constant gas properties");
+        if (!twin) {
+          ADD_FAILURE() << "warning: " << w;
+        }
       }
     });
     ++checked;

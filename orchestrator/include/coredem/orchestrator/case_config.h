@@ -246,6 +246,11 @@ CaseConfig loadCase(const std::filesystem::path& caseDirOrFile);
 CaseConfig parseCase(const std::string& text, const std::filesystem::path& file,
                      const std::filesystem::path& caseDir);
 
+/// The largest temperature difference (K) between the gas (gas_properties.temperature) and a
+/// particle set or fixed-temperature walls; 0 with models.heat off. The gas model defaults to
+/// ideal_gas where it is > 0 (docs/case-schema.md "gas_properties").
+double largestGasTemperatureDifference(const CaseConfig& config);
+
 /// Adds the chemistry of `config` (solid species, reactions, chemistry) to a Configure (v1.1
 /// fields). Defined in case_chemistry.cpp (library coredem::orchestrator, which links the
 /// protocol).

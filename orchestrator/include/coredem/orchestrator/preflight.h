@@ -22,6 +22,10 @@ inline constexpr double kMaxRandomSolidFraction = 0.64;
 inline constexpr double kWarnRandomSolidFraction = 0.35;
 /// Temperatures below this (K) are warned about: probably degrees Celsius.
 inline constexpr double kImplausibleTemperatureK = 200.0;
+/// A constant-property gas solved by the CFD (gas_properties.model: constant) further than this
+/// (K) from a particle set or fixed-temperature walls is warned about: its density and viscosity
+/// would change by more than ~7 % (ideal gas at 300 K).
+inline constexpr double kConstantGasWarnDeltaT = 20.0;
 
 /// The case's geometry and temperatures: the coupling grid covers the particles' initial
 /// region, walls.box, the cylinders and cones with side inside or both, and the mesh walls; the
@@ -29,7 +33,9 @@ inline constexpr double kImplausibleTemperatureK = 200.0;
 /// every side-inside cylinder and cone over the axial extent where it reaches them, and (their
 /// centres) inside every closed mesh wall; lattice regions hold `count` sites, random regions a
 /// solid fraction below kMaxRandomSolidFraction, explicit positions overlap by at most
-/// kMaxInitialOverlapFraction; temperatures below kImplausibleTemperatureK are warned about.
+/// kMaxInitialOverlapFraction; temperatures below kImplausibleTemperatureK are warned about, and
+/// a constant-property gas the CFD solves more than kConstantGasWarnDeltaT from the particles or
+/// walls.
 /// Returns the warnings
 /// ("file:line:col: key: what"); throws CaseError at the first failure.
 std::vector<std::string> checkCaseConsistency(const CaseConfig& config);
