@@ -26,19 +26,16 @@ using coredem::e2e::readAll;
 using coredem::e2e::replaceAll;
 using coredem::e2e::writeAll;
 
-/// cases/fluidized-bed-cooling as an ideal-gas (air) case in `dir/case`, and a stand-in
+/// cases/fluidized-bed-cooling (an ideal-gas air case) in `dir/case`, and a stand-in
 /// coredemFoam in `dir/bin` put first on PATH.
 fs::path idealGasCase(const fs::path& dir) {
   const fs::path src = kSource / "cases" / "fluidized-bed-cooling";
   fs::create_directories(dir / "case");
   fs::copy(src / "openfoam", dir / "case" / "openfoam", fs::copy_options::recursive);
   const std::string yaml = readAll(src / "case.yaml");
-  const std::string ideal = replaceAll(yaml,
-                                       "  density: 1.204\n  viscosity: 1.81e-5\n  conductivity: "
-                                       "0.0257\n  cp: 1006.0\n",
-                                       "  model: ideal_gas\n");
-  EXPECT_NE(ideal, yaml) << "the gas_properties of fluidized-bed-cooling changed";
-  writeAll(dir / "case" / "case.yaml", ideal);
+  EXPECT_NE(yaml.find("  model: ideal_gas\n"), std::string::npos)
+      << "fluidized-bed-cooling is no longer an ideal-gas case";
+  writeAll(dir / "case" / "case.yaml", yaml);
   fs::create_directories(dir / "bin");
   writeAll(dir / "bin" / "coredemFoam", "#!/bin/sh\nexit 3\n");
   ::chmod((dir / "bin" / "coredemFoam").c_str(), 0755);
