@@ -1,6 +1,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include <spdlog/fmt/fmt.h>
 
@@ -55,13 +57,57 @@ void fail(const std::string& file, const YAML::Mark& mark, const std::string& ke
   throw ConfigError(fmt::format("{}: {}: {}", file, key, what));
 }
 
+void checkUniqueKeys(const YAML::Node& node, const std::string& file) {
+  // Iteratively (a deeply nested file must not exhaust the stack): every mapping's scalar keys.
+  std::vector<YAML::Node> todo{node};
+  while (!todo.empty()) {
+    const YAML::Node n = todo.back();
+    todo.pop_back();
+    if (n.IsSequence()) {
+      for (const auto& item : n) {
+        todo.push_back(item);
+      }
+    } else if (n.IsMap()) {
+      std::vector<std::pair<std::string, YAML::Mark>> seen;
+      for (const auto& kv : n) {
+        if (kv.first.IsScalar()) {
+          const std::string& key = kv.first.Scalar();
+          for (const auto& [k, mark] : seen) {
+            if (k == key) {
+              fail(file, kv.first.Mark(), key,
+                   fmt::format("given twice in the same mapping (first at line {}): YAML readers "
+                               "disagree on which one counts; keep one",
+                               mark.line + 1));
+            }
+          }
+          seen.emplace_back(key, kv.first.Mark());
+        }
+        todo.push_back(kv.second);
+      }
+    }
+  }
+}
+
 YAML::Node parse(const std::string& text, const std::string& file) {
+  std::vector<YAML::Node> docs;
   try {
-    return YAML::Load(text);
+    docs = YAML::LoadAll(text);
   } catch (const YAML::ParserException& e) {
     throw ConfigError(fmt::format("{}:{}:{}: not valid YAML: {}", file, e.mark.line + 1,
                                   e.mark.column + 1, e.msg));
   }
+  for (std::size_t i = 1; i < docs.size(); ++i) {
+    if (!docs[i].IsNull()) {
+      fail(file, docs[i].Mark(), "document",
+           "a second YAML document (after '---'): the file is read as one document and the rest "
+           "would be ignored; remove the '---' separator or the second document");
+    }
+  }
+  if (docs.empty()) {
+    return YAML::Node();
+  }
+  checkUniqueKeys(docs.front(), file);
+  return docs.front();
 }
 
 Section::Section(YAML::Node node, std::string file, std::string path,

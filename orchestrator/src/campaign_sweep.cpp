@@ -485,11 +485,10 @@ Sweep loadSweep(const fs::path& sweepFile) {
   sw.text = readFile(sw.file);
   YAML::Node root;
   try {
-    root = YAML::Load(sw.text);
-  } catch (const YAML::Exception& e) {
-    const bool flow = e.msg.find("flow") != std::string::npos;
-    throw CaseError(fmt::format("{}:{}:{}: not valid YAML: {}{}", r.file, e.mark.line + 1,
-                                e.mark.column + 1, e.msg,
+    root = yaml::parse(sw.text, r.file); // also refuses duplicate keys and a second document
+  } catch (const CaseError& e) {
+    const bool flow = std::string(e.what()).find("flow") != std::string::npos;
+    throw CaseError(fmt::format("{}{}", e.what(),
                                 flow ? " (a key like particles[0].diameter must be written in "
                                        "a block mapping, one key per line, not inside { })"
                                      : ""));

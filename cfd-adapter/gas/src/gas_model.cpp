@@ -11,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "coredem/common/check.h"
+#include "coredem/common/yaml_section.h"
 
 namespace coredem::gas {
 
@@ -363,6 +364,7 @@ GasModel GasModel::fromFile(const std::string& file, const std::string& key) {
     COREDEM_CHECK(false, "{}:{}:{}: YAML syntax error: {}", file, e.mark.line + 1,
                   e.mark.column + 1, e.msg);
   }
+  yaml::checkUniqueKeys(root, file); // a key given twice: refused (ConfigError, a UserError)
   YAML::Node node = root;
   std::string done;
   std::stringstream ss(key);

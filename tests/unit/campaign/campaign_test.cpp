@@ -169,3 +169,30 @@ TEST(CampaignSlurm, ShippedSlurmSweepLoads) {
   EXPECT_EQ(sw.slurm.maxConcurrent, 0); // the sweep's concurrency applies
   EXPECT_TRUE(sw.slurm.extra.empty());
 }
+
+// A grid key given twice: the sweep reader took the last, the case reader the first; refused
+// with both lines, as is a second YAML document.
+TEST(CampaignSweep, DuplicateKeysAndASecondDocumentAreRefused) {
+  const fs::path d = tempDir("dup");
+  fs::copy(kCases / "tiny", d / "tiny", fs::copy_options::recursive);
+  const std::string head = "name: dup\nbase_case: tiny\ngrid:\n  gas.T_g: [400.0, 600.0]\n";
+  auto error = [&](const std::string& text) -> std::string {
+    std::ofstream(d / "sweep.yaml") << text;
+    try {
+      (void)loadSweep(d / "sweep.yaml");
+    } catch (const CaseError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error(head), "");
+  const std::string twice = error(head + "  gas.T_g: [500.0]\n");
+  EXPECT_NE(twice.find("sweep.yaml:5:3: gas.T_g: given twice in the same mapping (first at line "
+                       "4)"),
+            std::string::npos)
+      << twice;
+  const std::string second = error(head + "---\nname: other\n");
+  EXPECT_NE(second.find("sweep.yaml:6:1: document: a second YAML document"), std::string::npos)
+      << second;
+  fs::remove_all(d);
+}

@@ -80,3 +80,32 @@ TEST(YamlSection, Vec3) {
 }
 
 } // namespace
+
+// Keys given twice and a second document: YAML readers disagree on which value counts (yaml-cpp's
+// lookup takes the first, an iteration the last), so both are refused with the line.
+TEST(YamlSection, DuplicateKeysAndASecondDocumentAreRefused) {
+  auto error = [](const std::string& text) -> std::string {
+    try {
+      (void)coredem::yaml::parse(text, "dup.yaml");
+    } catch (const coredem::ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  auto contains = [](const std::string& s, const std::string& part) {
+    return s.find(part) != std::string::npos;
+  };
+  EXPECT_EQ(error("a: 1\nb: 2\n"), "");
+  EXPECT_EQ(error("a: 1\n---\n"), ""); // an empty second document holds nothing to ignore
+  EXPECT_EQ(error("a: {x: 1}\nb: {x: 2}\n"), ""); // the same key in two mappings
+  EXPECT_EQ(error("a: 1\nb: 2\na: 3\n"),
+            "dup.yaml:3:1: a: given twice in the same mapping (first at line 1): YAML readers "
+            "disagree on which one counts; keep one");
+  EXPECT_TRUE(contains(error("p:\n  - {d: 1, d: 2}\n"), "dup.yaml:2:12: d: given twice"));
+  EXPECT_TRUE(
+      contains(error("top:\n  inner:\n    k: 1\n    k: 2\n"), "dup.yaml:4:5: k: given twice"));
+  EXPECT_EQ(error("a: 1\n---\nb: 2\n"),
+            "dup.yaml:3:1: document: a second YAML document (after '---'): the file is read as "
+            "one document and the rest would be ignored; remove the '---' separator or the "
+            "second document");
+}

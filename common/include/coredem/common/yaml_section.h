@@ -36,7 +36,11 @@ std::string describe(const YAML::Node& n);
 [[noreturn]] void fail(const std::string& file, const YAML::Mark& mark, const std::string& key,
                        const std::string& what);
 /// Parses YAML text; a syntax error becomes ConfigError "file:line:col: not valid YAML: ...".
+/// Refuses what YAML readers resolve differently: a key given twice in one mapping (naming both
+/// lines) and a second, non-empty document after `---` (naming its line).
 YAML::Node parse(const std::string& text, const std::string& file);
+/// The duplicate-key check of parse() on an already parsed node (ConfigError naming both lines).
+void checkUniqueKeys(const YAML::Node& node, const std::string& file);
 
 /// A mapping with the keys it allows. The constructor refuses unknown keys; every accessor
 /// checks type and range and fails with file:line:col, the full key and the allowed values.
