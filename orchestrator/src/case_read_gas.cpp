@@ -42,6 +42,11 @@ void readGasProperties(CaseReading& r) {
         top.section("gas_properties", {"model", "density", "viscosity", "conductivity", "cp",
                                        "temperature", "pressure", "diffusivity", "alphac_min"}));
     auto& p = c.gasProperties;
+    if (g.has("alphac_min")) {
+      g.fail(g.markOf("alphac_min"), g.full("alphac_min"),
+             "replaced by models: {eps_min: ...}, one clip of the gas fraction for the gas "
+             "equations and the DEM's drag and convection (docs/physics.md §1.1)");
+    }
     p.model = g.choice("model", std::string("constant"), {"constant", "ideal_gas"});
     if (p.idealGas()) {
       // One source of truth: the ideal-gas model computes these from T, p and the composition.
@@ -56,15 +61,11 @@ void readGasProperties(CaseReading& r) {
       }
       p.diffusivity = g.number("diffusivity", p.diffusivity, 0.0, kBig,
                                "species diffusivity in m2/s, > 0", true);
-      p.alphacMin = g.number("alphac_min", p.alphacMin, 0.0, 1.0,
-                             "smallest gas fraction the gas equations accept, in (0, 1)", true);
     } else {
-      for (const char* key : {"diffusivity", "alphac_min"}) {
-        if (g.has(key)) {
-          g.fail(g.markOf(key), g.full(key),
-                 "only with model: ideal_gas (with model constant, the OpenFOAM case's "
-                 "constant/transportProperties gives D and alphacMin)");
-        }
+      if (g.has("diffusivity")) {
+        g.fail(g.markOf("diffusivity"), g.full("diffusivity"),
+               "only with model: ideal_gas (with model constant, the OpenFOAM case's "
+               "constant/transportProperties gives D)");
       }
       p.density = g.number("density", p.density, 0.0, kBig, "kg/m3, > 0", true);
       p.viscosity = g.number("viscosity", p.viscosity, 0.0, kBig, "Pa s, > 0", true);
