@@ -283,10 +283,15 @@ void addDragRows(std::vector<ModelOption>& o) {
       c.epsMinDrag = *x;
     return e;
   };
+  // One clip of ε_g for both sides: the orchestrator also gives it to the CFD participant
+  // (coredemFoam's alphacMin, docs/physics.md §1.1).
+  o.push_back({"eps_min", "drag", "number in (0, 1)", "0.35",
+               "lower clip ε_min of ε_g in the drag, the Nusselt correlation and the gas equations",
+               epsMin});
   o.push_back({"dem.eps_min_drag", "drag", "number in (0, 1)", "0.35",
-               "lower clip ε_min of ε_g in the drag and the Nusselt correlation", epsMin});
-  o.push_back({"eps_min_drag", "drag", "number in (0, 1)", "0.35",
-               "deprecated spelling of dem.eps_min_drag", epsMin, "dem.eps_min_drag"});
+               "deprecated spelling of eps_min", epsMin, "eps_min"});
+  o.push_back({"eps_min_drag", "drag", "number in (0, 1)", "0.35", "deprecated spelling of eps_min",
+               epsMin, "eps_min"});
   addParamRowsOf<kernels::DragLaws, &DemConfig::dragLaws>(o, "drag");
 }
 

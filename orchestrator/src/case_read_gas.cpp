@@ -46,6 +46,11 @@ void readGasProperties(CaseReading& r) {
       top.section("gas_properties", {"model", "density", "viscosity", "conductivity", "cp",
                                      "temperature", "pressure", "diffusivity", "alphac_min"}));
   auto& p = c.gasProperties;
+  if (g.has("alphac_min")) {
+    g.fail(g.markOf("alphac_min"), g.full("alphac_min"),
+           "replaced by models: {eps_min: ...}, one clip of the gas fraction for the gas "
+           "equations and the DEM's drag and convection (docs/physics.md §1.1)");
+  }
   if (g.has("model")) {
     p.model = g.choice("model", std::string("constant"), {"constant", "ideal_gas"});
     r.gasModelGiven = true;
@@ -56,8 +61,6 @@ void readGasProperties(CaseReading& r) {
   p.cp = g.number("cp", p.cp, 0.0, kBig, "J/kg/K, > 0", true);
   p.diffusivity =
       g.number("diffusivity", p.diffusivity, 0.0, kBig, "species diffusivity in m2/s, > 0", true);
-  p.alphacMin = g.number("alphac_min", p.alphacMin, 0.0, 1.0,
-                         "smallest gas fraction the gas equations accept, in (0, 1)", true);
   p.temperature = g.number("temperature", p.temperature, 0.0, kBig, "K, > 0", true);
   p.pressure = g.number("pressure", p.pressure, 0.0, kBig, "Pa, > 0", true);
 }
@@ -90,7 +93,7 @@ std::string describe(const GasExchange& e) {
 
 /// The gas model: `model` as given; without it, ideal_gas where heat or reactions are exchanged
 /// and the participant solves the gas, constant otherwise. Constant-property keys are refused
-/// with ideal_gas (one source of truth), diffusivity and alphac_min with constant; a constant gas
+/// with ideal_gas (one source of truth), diffusivity with constant; a constant gas
 /// more than kConstantGasWarnDeltaT from the particles or walls is warned about.
 void resolveGasModel(CaseReading& r) {
   CaseConfig& c = r.c;
@@ -128,12 +131,10 @@ void resolveGasModel(CaseReading& r) {
     }
     return;
   }
-  for (const char* key : {"diffusivity", "alphac_min"}) {
-    if (g.has(key)) {
-      g.fail(g.markOf(key), g.full(key),
-             "only with model: ideal_gas (with model constant, the OpenFOAM case's "
-             "constant/transportProperties gives D and alphacMin)");
-    }
+  if (g.has("diffusivity")) {
+    g.fail(g.markOf("diffusivity"), g.full("diffusivity"),
+           "only with model: ideal_gas (with model constant, the OpenFOAM case's "
+           "constant/transportProperties gives D)");
   }
 }
 

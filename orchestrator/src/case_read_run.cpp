@@ -5,6 +5,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <coredem/dem/dem_config.h>
 #include <coredem/dem/models.h>
 #include <coredem/orchestrator/participants.h>
 
@@ -125,6 +126,21 @@ void readModels(CaseReading& r) {
       const dem::ModelIssue& bad = issues.front();
       top.fail(bad.unknownKey ? keyMarks[bad.index] : valueMarks[bad.index], "models." + bad.key,
                bad.message);
+    }
+    // The clip of ε_g (one value for the DEM and the CFD): one spelling only.
+    std::size_t clipKeys = 0;
+    dem::DemConfig d;
+    for (std::size_t i = 0; i < c.models.size(); ++i) {
+      const std::string& key = c.models[i].first;
+      if (key != "eps_min" && key != "dem.eps_min_drag" && key != "eps_min_drag") {
+        continue;
+      }
+      if (++clipKeys > 1) {
+        top.fail(keyMarks[i], "models." + key,
+                 "the clip of the gas fraction is given twice: write models: {eps_min: ...} once");
+      }
+      dem::applyModelOption(d, key, c.models[i].second);
+      c.epsMin = d.epsMinDrag;
     }
   }
 }

@@ -52,6 +52,7 @@ LaunchCommand launchCommand(const ParticipantDescriptor& p, const CaseConfig& co
       {"dem_endpoint", in.demEndpoint},
       {"session", in.session},
       {"timeout_s", fmt::format("{}", config.cfd.timeoutSeconds)},
+      {"eps_min", fmt::format("{}", config.epsMin)}, // models: {eps_min}, shortest round trip
       {"dem_server_key", in.demServerKey},
       {"dem_client_key_file", in.demClientKeyFile},
       {"restart_file", in.restartFile.string()}};

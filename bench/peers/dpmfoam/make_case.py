@@ -490,7 +490,6 @@ rho {RHO_G};
 cp 1006;
 kappa 0.0257;
 D 2e-05;
-alphacMin {ALPHAC_MIN};
 pressureDropPatches (inlet outlet);
 """)
     foam(f"{o}/constant/turbulenceProperties", n, "dictionary", "constant",
@@ -573,9 +572,11 @@ boundaryField
         "  backend: cpu",
         "  threads: 2",
     ]
+    # one gas-fraction clip for the gas and the DEM's drag, DPMFoam's 1 - alphaMax
+    lines += ["models:", f"  eps_min: {ALPHAC_MIN}"]
     if not heat:
         # DPMFoam runs without heat transfer (heatTransferModel none): so does the DEM here
-        lines += ["models:", "  heat: \"off\""]
+        lines += ["  heat: \"off\""]
     lines += [
         "checkpoint:",
         "  every_steps: 0",

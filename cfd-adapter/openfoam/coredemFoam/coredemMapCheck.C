@@ -151,6 +151,53 @@ void checkFraction(const Foam::fvMesh& mesh, const CoredemGrid& grid, Checks& ch
     checks.report("fraction_uniform", gMax(mag(e - (1 - phi))));
 }
 
+//- Packed solid (clip epsMin): a bed of solid volume 0.45 min(V_f,g + h^3/4, h^3) in every grid
+//  cell with fluid (more than its fluid volume's share 1 - epsMin in the slivers a wall leaves,
+//  room to spare in the full cells around them), then a domain overfilled everywhere (0.7 V_f,g):
+//  the solid volume the gas sees, plus what is booked as clipped, equals the DEM's deposit, and
+//  only the overfilled domain clips ((0.7 - (1 - epsMin)) sum V_f,g).
+void checkPacked
+(
+    const Foam::fvMesh& mesh, const CoredemGrid& grid, double epsMin, Checks& checks
+)
+{
+    using namespace Foam;
+    const label nGrid = grid.gridCells();
+    const scalarField& V = mesh.V().field();
+    const scalar vg = grid.cellVolume();
+    const std::vector<double>& Vf = grid.fluidVolume();
+    for (const char* which : {"packed", "overfilled"})
+    {
+        const bool packed = which[0] == 'p';
+        std::vector<double> eps(nGrid);
+        double solid = 0, fluid = 0;
+        for (label g = 0; g < nGrid; ++g)
+        {
+            const double vs = Vf[g] > 0
+                ? (packed ? 0.45*min(Vf[g] + 0.25*vg, vg) : 0.7*Vf[g])
+                : 0.0;
+            solid += vs;
+            fluid += Vf[g];
+            eps[g] = 1 - vs/vg;
+        }
+        // coredemFoam's pipeline: the solid limited on the grid (CouplingExchange), the scatter,
+        // the round-off clip of GasFraction::read.
+        const double clipped = grid.limitSolid(eps.data(), nGrid, nullptr, epsMin);
+        scalarField e(mesh.nCells());
+        grid.scatter(eps.data(), 1, e.data(), CoredemGrid::Quantity::GasFraction);
+        checks.report((std::string(which) + "_below_clip").c_str(), max(epsMin - gMin(e), 0.0));
+        e = max(min(e, scalar(1)), epsMin);
+        double seen = 0;
+        forAll(e, c) seen += (1 - e[c])*V[c];
+        reduce(seen, sumOp<scalar>());
+        const std::string name(which);
+        checks.report((name + "_solid_volume").c_str(), mag(seen + clipped - solid)/solid);
+        const double expected = packed ? 0.0 : (0.7 - (1 - epsMin))*fluid;
+        checks.report((name + "_clipped").c_str(), mag(clipped - expected)/solid);
+    }
+}
+
+
 //- Gather (decomposed: the processors' contributions added up, as the DEM server would): a
 //  constant stays constant, and sum_g u_g V_f,g = sum_c u_c V_c for a linear field.
 void checkGather(const Foam::fvMesh& mesh, const CoredemGrid& grid, double vFluid,
@@ -211,6 +258,7 @@ int main(int argc, char* argv[])
     argList::addOption("spacing", "vector", "coupling grid spacing, m");
     argList::addOption("counts", "vector", "coupling grid cells per axis");
     argList::addOption("tol", "scalar", "relative tolerance of every check (default 1e-12)");
+    argList::addOption("epsMin", "scalar", "gas-fraction clip of the packed checks (default 0.35)");
     #include "setRootCase.H"
     #include "createTime.H"
     #include "createMesh.H"
@@ -219,6 +267,7 @@ int main(int argc, char* argv[])
     const vector spacing(args.get<vector>("spacing"));
     const vector counts(args.get<vector>("counts"));
     const scalar tol = args.getOrDefault<scalar>("tol", 1e-12);
+    const scalar epsMin = args.getOrDefault<scalar>("epsMin", 0.35);
 
     const clock_t t0 = std::clock();
     const CoredemGrid grid
@@ -236,6 +285,7 @@ int main(int argc, char* argv[])
     checks.report("volume", mag(vFluid - vMesh)/vMesh);
     checkSources(mesh, grid, checks);
     checkFraction(mesh, grid, checks);
+    checkPacked(mesh, grid, epsMin, checks);
     checkGather(mesh, grid, vFluid, checks);
 
     Info<< (checks.ok ? "map checks passed" : "map checks FAILED") << nl << "End" << endl;

@@ -74,6 +74,26 @@ void CouplingExchange::readZeros(CouplingInput& in)
 }
 
 
+::coredem::client::ConstView CouplingExchange::limited
+(
+    CouplingInput& in,
+    ::coredem::client::ConstView v,
+    double* inPlace,
+    label nRows,
+    const label* rowGrid
+)
+{
+    double* rows = inPlace;
+    if (rows == nullptr)
+    {
+        limited_.assign(v.begin(), v.end());
+        rows = limited_.data();
+    }
+    in.solidClipped(grid_.limitSolid(rows, nRows, rowGrid, in.solidLimit()));
+    return ::coredem::client::ConstView(rows, v.size);
+}
+
+
 void CouplingExchange::exchangePartial(label step, scalar dt)
 {
     using ::coredem::client::ConstView;
@@ -129,12 +149,16 @@ void CouplingExchange::exchangePartial(label step, scalar dt)
             readZeros(*in);
             continue;
         }
-        const ConstView v = src->field(in->name());
+        ConstView v = src->field(in->name());
         if (v.size != touched_.size()*nComp)
         {
             FatalErrorInFunction
                 << "DEM source " << in->name().c_str() << " has " << label(v.size)
                 << " values, expected " << label(touched_.size()*nComp) << exit(FatalError);
+        }
+        if (in->gasFraction())
+        {
+            v = limited(*in, v, nullptr, label(touched_.size()), grid_.touched().data());
         }
         double* storage = in->cellStorage();
         if (storage != nullptr)
@@ -242,7 +266,7 @@ void CouplingExchange::exchange(label step, scalar dt)
             readZeros(*in);
             continue;
         }
-        const ConstView v = src->field(in->name());
+        ConstView v = src->field(in->name());
         if (v.size != std::size_t(grid_.gridCells())*nComp)
         {
             FatalErrorInFunction
@@ -250,6 +274,14 @@ void CouplingExchange::exchange(label step, scalar dt)
                 << " values, expected " << grid_.gridCells()*nComp << exit(FatalError);
         }
         double* storage = in->cellStorage();
+        if (in->gasFraction())
+        {
+            // Received in place (the mesh is the grid in its order): limited there.
+            v = limited
+            (
+                *in, v, v.data == storage ? storage : nullptr, grid_.gridCells(), nullptr
+            );
+        }
         if (storage != nullptr)
         {
             if (v.data != storage) grid_.scatter(v.data, nComp, storage, quantity(*in));

@@ -54,6 +54,21 @@ void GasFraction::read(const double*)
 }
 
 
+void GasFraction::solidClipped(double volume)
+{
+    clipped_ = volume;
+    if (volume > 0 && !warned_)
+    {
+        warned_ = true;
+        Warning
+            << "coupling: " << volume << " m3 of the particles' solid found no room in the fluid "
+            << "(more than 1 - alphacMin = " << 1 - alphacMin_ << " of the fluid volume within 3 "
+            << "coupling cells): the gas does not see it (ledger gas.solid_volume_clipped_m3; "
+            << "first occurrence only)" << endl;
+    }
+}
+
+
 void SpeciesSources::read(const double* r)
 {
     // One field per species from the cell-major (cell, species) values.

@@ -464,6 +464,91 @@ void CoredemGrid::scatterTouched
 }
 
 
+double CoredemGrid::limitSolid
+(
+    double* rowValues,
+    label nRows,
+    const label* rowGrid,
+    const scalar epsMin
+) const
+{
+    // Solid volume of every grid cell (decomposed: of every grid cell a processor touches; each
+    // one receives the DEM server's same value for it).
+    const scalar vg = cellVolume();
+    std::vector<double> vs(std::size_t(nGrid_), 0.0);
+    for (label t = 0; t < nRows; ++t)
+    {
+        vs[rowGrid ? rowGrid[t] : t] = (1 - rowValues[t])*vg;
+    }
+    if (Pstream::parRun())
+    {
+        List<scalar> all(nGrid_);
+        for (label g = 0; g < nGrid_; ++g) all[g] = vs[g];
+        Pstream::listCombineGather(all, maxEqOp<scalar>());
+        Pstream::listCombineScatter(all);
+        for (label g = 0; g < nGrid_; ++g) vs[g] = all[g];
+    }
+    // Room of a grid cell: (1 - epsMin) V_f,g. The excess of a cell goes to the free room of the
+    // grid cells with fluid around it, in cubes of 3^3, 5^3, .. (2 kSpreadReach + 1)^3 cells,
+    // shared in proportion to the free room; cells in ascending order.
+    const double fill = 1 - epsMin;
+    double clipped = 0;
+    // The grid cells whose solid changed (the others keep the DEM's value bit for bit).
+    std::vector<char> moved(std::size_t(nGrid_), 0);
+    for (label g = 0; g < nGrid_; ++g)
+    {
+        const double room = fill*fluidVolume_[g];
+        double excess = vs[g] - room;
+        if (!(excess > 0) || fluidVolume_[g] == 0) continue;
+        const label gi = g % n_[0];
+        const label gj = (g/n_[0]) % n_[1];
+        const label gk = g/(n_[0]*n_[1]);
+        for (label r = 1; r <= kSpreadReach && excess > 0; ++r)
+        {
+            const label lo[3] =
+                {max(gi - r, label(0)), max(gj - r, label(0)), max(gk - r, label(0))};
+            const label hi[3] =
+                {min(gi + r, n_[0] - 1), min(gj + r, n_[1] - 1), min(gk + r, n_[2] - 1)};
+            double freeRoom = 0;
+            for (int pass = 0; pass < 2; ++pass)
+            {
+                const double share = pass == 1 ? min(excess, freeRoom)/freeRoom : 0;
+                for (label k = lo[2]; k <= hi[2]; ++k)
+                {
+                    for (label j = lo[1]; j <= hi[1]; ++j)
+                    {
+                        for (label i = lo[0]; i <= hi[0]; ++i)
+                        {
+                            const label n = i + n_[0]*(j + n_[1]*k);
+                            const double f = fill*fluidVolume_[n] - vs[n];
+                            if (n == g || !(f > 0)) continue;
+                            if (pass == 0) freeRoom += f;
+                            else
+                            {
+                                vs[n] += share*f;
+                                moved[n] = 1;
+                            }
+                        }
+                    }
+                }
+                if (!(freeRoom > 0)) break;
+                if (pass == 1) excess -= min(excess, freeRoom);
+            }
+        }
+        // What finds no room is clipped (booked by the caller).
+        if (excess > 0) clipped += excess;
+        vs[g] = room;
+        moved[g] = 1;
+    }
+    for (label t = 0; t < nRows; ++t)
+    {
+        const label g = rowGrid ? rowGrid[t] : t;
+        if (moved[g]) rowValues[t] = 1 - vs[g]/vg;
+    }
+    return clipped;
+}
+
+
 void CoredemGrid::scatterRows
 (
     const double* rowValues,

@@ -157,6 +157,30 @@ TEST_F(CoredemFoamMap, PartlyFilledCouplingCellsUseTheirFluidVolume) {
   expectConservative(log);
 }
 
+// An inclined wall (x from 9.3 mm at z = 0 to 4.7 mm at z = 10 mm) cuts the coupling cells
+// into slivers of every size. A packed bed that puts more solid into a sliver than its fluid
+// volume's share (1 - eps_min) V_f: the gas sees every m3 of solid the DEM deposited (1e-12
+// relative: the excess goes to the neighbouring cells' free room, sum and order of the
+// additions only) and nothing is clipped; a domain overfilled everywhere (0.7 V_f in every
+// cell, eps_min 0.35) books exactly the 0.05 sum V_f it cannot place as clipped.
+TEST_F(CoredemFoamMap, WallCutCouplingCellsKeepTheirSolid) {
+  const fs::path c = makeMesh("(9 20 10) simpleGrading (1 1 1)",
+                              "(0 0 0) (0.0093 0 0) (0.0093 0.04 0) (0 0.04 0)\n"
+                              "(0 0 0.01) (0.0047 0 0.01) (0.0047 0.04 0.01) (0 0.04 0.01)");
+  const std::string log = run(kBin / "coredemMapCheck",
+                              {"-case", c.string(), "-origin", "(0 0 0)", "-spacing",
+                               "(0.002 0.002 0.002)", "-counts", "(5 20 5)", "-epsMin", "0.35"},
+                              "mapcheck", 0);
+  EXPECT_GT(count(log, "partial"), 100);
+  expectConservative(log);
+  const auto v = checks(log);
+  for (const char* name :
+       {"packed_solid_volume", "packed_clipped", "overfilled_solid_volume", "overfilled_clipped"}) {
+    ASSERT_TRUE(v.count(name)) << name << " missing:\n" << log;
+    EXPECT_LE(v.at(name), 1e-12) << name << "\n" << log;
+  }
+}
+
 // A coupling grid 2 mm short of the mesh (19 cells high for a 40 mm column) is refused naming
 // the first mesh cell it does not cover (exit 2).
 TEST_F(CoredemFoamMap, MeshNotCoveredByTheGridIsRefused) {

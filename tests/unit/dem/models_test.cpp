@@ -97,8 +97,8 @@ TEST(ModelRegistry, EveryRowParsesItsDefault) {
   for (const char* key :
        {"drag", "heat", "convection", "convection_reynolds", "nusselt_exponent",
         "contact_conduction", "lens_conduction", "flpc", "s_min", "lens_rel_tol", "radiation",
-        "wall_conduction", "wall_lens_conduction", "motion", "dem.dt_factor", "dem.eps_min_drag",
-        "dem.skin_factor", "dem.history_slots"})
+        "wall_conduction", "wall_lens_conduction", "motion", "dem.dt_factor", "eps_min",
+        "dem.eps_min_drag", "dem.skin_factor", "dem.history_slots"})
     EXPECT_TRUE(keys.count(key)) << key;
 }
 

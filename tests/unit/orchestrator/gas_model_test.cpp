@@ -13,7 +13,9 @@
 
 #include <gtest/gtest.h>
 
+#include <coredem/dem/dem_config.h>
 #include <coredem/dem/kernels/nasa7.h>
+#include <coredem/dem/models.h>
 #include <coredem/orchestrator/case_config.h>
 #include <coredem/orchestrator/gas_data.h>
 #include <coredem/orchestrator/participants.h>
@@ -232,16 +234,13 @@ TEST(GasModelParse, IdealGasKeysAndDefaults) {
   EXPECT_EQ(c.gasProperties.temperature, 1173.0);
   EXPECT_EQ(c.gasProperties.pressure, 101325.0);
   EXPECT_EQ(c.gasProperties.diffusivity, 2e-5);
-  EXPECT_EQ(c.gasProperties.alphacMin, 0.3);
-  const CaseConfig g =
-      parse(std::string(kIdealGas) + "  diffusivity: 2.0e-4\n  alphac_min: 0.25\n");
+  const CaseConfig g = parse(std::string(kIdealGas) + "  diffusivity: 2.0e-4\n");
   EXPECT_EQ(g.gasProperties.diffusivity, 2e-4);
-  EXPECT_EQ(g.gasProperties.alphacMin, 0.25);
   std::string e = errorOf(std::string(kIdealGas) + "  diffusivity: 0\n");
   EXPECT_TRUE(contains(e, "case.yaml:13:16: gas_properties.diffusivity")) << e;
   EXPECT_TRUE(contains(e, "m2/s, > 0")) << e;
-  e = errorOf(std::string(kIdealGas) + "  alphac_min: 1.5\n");
-  EXPECT_TRUE(contains(e, "case.yaml:13:15: gas_properties.alphac_min")) << e;
+  e = errorOf(std::string(kIdealGas) + "models: {eps_min: 1.5}\n");
+  EXPECT_TRUE(contains(e, "case.yaml:13:19: models.eps_min")) << e;
   EXPECT_TRUE(contains(e, "in (0, 1)")) << e;
 }
 
@@ -258,13 +257,11 @@ TEST(GasModelParse, IdealGasRefusesTheComputedProperties) {
 
 TEST(GasModelParse, ConstantRefusesTheIdealGasKeys) {
   const std::string constant = replace(kIdealGas, "model: ideal_gas", "model: constant");
-  for (const std::string key : {"diffusivity", "alphac_min"}) {
-    const std::string e = errorOf(constant + "  " + key + ": 0.2\n");
-    EXPECT_TRUE(contains(e, "case.yaml:13:" + std::to_string(key.size() + 5) + ": gas_properties." +
-                                key + ": only with model: ideal_gas"))
-        << e;
-    EXPECT_TRUE(contains(e, "constant/transportProperties gives D and alphacMin")) << e;
-  }
+  const std::string e = errorOf(constant + "  diffusivity: 0.2\n");
+  EXPECT_TRUE(
+      contains(e, "case.yaml:13:16: gas_properties.diffusivity: only with model: ideal_gas"))
+      << e;
+  EXPECT_TRUE(contains(e, "constant/transportProperties gives D")) << e;
 }
 
 TEST(GasModelParse, TemperatureAndPressureMustBePositive) {
@@ -488,7 +485,40 @@ TEST(GasModelDictionary, FiveSpeciesReadBackExactly) {
   }
   EXPECT_EQ(t.coredem.at("pRef"), 101325.0);
   EXPECT_EQ(t.coredem.at("D"), 2e-5);
-  EXPECT_EQ(t.coredem.at("alphacMin"), 0.3);
+  EXPECT_EQ(t.coredem.at("alphacMin"), 0.35); // models: {eps_min}, default
+}
+
+// One clip ε_min of the gas fraction for both sides (docs/physics.md §1.1): the DEM's drag and
+// convection clip (its DemConfig after the case's models:, as the server applies them) and the
+// gas's alphacMin (the generated dictionary) are the same number, exactly, by default and for
+// every spelling of the key; two spellings at once and the old gas_properties.alphac_min are
+// refused naming models: {eps_min}.
+TEST(GasModelDictionary, OneGasFractionClipForTheGasAndTheDrag) {
+  auto clips = [](const CaseConfig& c) {
+    coredem::dem::DemConfig d;
+    for (const auto& [key, value] : c.models) {
+      coredem::dem::applyModelOption(d, key, value);
+    }
+    return std::make_pair(d.epsMinDrag,
+                          readBack(thermophysicalPropertiesText(c)).coredem.at("alphacMin"));
+  };
+  const auto byDefault = clips(parse(kIdealGas));
+  EXPECT_EQ(byDefault.first, 0.35);
+  EXPECT_EQ(byDefault.second, byDefault.first) << "the gas clips at another eps_min than the drag";
+  for (const char* key : {"eps_min", "dem.eps_min_drag", "eps_min_drag"}) {
+    SCOPED_TRACE(key);
+    const auto given = clips(parse(std::string(kIdealGas) + "models: {" + key + ": 0.3125}\n"));
+    EXPECT_EQ(given.first, 0.3125);
+    EXPECT_EQ(given.second, 0.3125);
+  }
+  std::string e =
+      errorOf(std::string(kIdealGas) + "models: {eps_min: 0.3, dem.eps_min_drag: 0.3}\n");
+  EXPECT_TRUE(contains(e, "models.dem.eps_min_drag: the clip of the gas fraction is given twice"))
+      << e;
+  e = errorOf(std::string(kIdealGas) + "  alphac_min: 0.3\n");
+  EXPECT_TRUE(contains(e, "case.yaml:13:15: gas_properties.alphac_min: replaced by models: "
+                          "{eps_min: ...}"))
+      << e;
 }
 
 TEST(GasModelDictionary, AirCaseHasOneSpecies) {

@@ -382,3 +382,20 @@ TEST(GasPreflight, TheGasModelDefaultsToTheIdealGasWhereHeatOrReactionsAreExchan
   EXPECT_FALSE(loadCase(h / "case.yaml").gasProperties.idealGas());
   fs::remove_all(h);
 }
+
+// One clip of the gas fraction (models: {eps_min}, coredemFoam -epsMin): an old alphacMin in
+// transportProperties that differs is refused naming both; equal to models: {eps_min} it passes.
+TEST(GasPreflight, TransportPropertiesAlphacMinMustBeTheCaseClip) {
+  const fs::path d = clgCopy("alphacmin");
+  const fs::path file = d / "openfoam" / "constant" / "transportProperties";
+  writeText(file, readText(file) + "alphacMin 0.3;\n");
+  const std::string e = failureOf(d);
+  EXPECT_TRUE(contains(e, "models.eps_min: 0.35 (the clip of the gas fraction for the DEM's drag "
+                          "and the gas), but " +
+                              file.string()))
+      << e;
+  EXPECT_TRUE(contains(e, "gives alphacMin = 0.3: remove alphacMin there")) << e;
+  edit(d / "case.yaml", "\nmodels:\n", "\nmodels:\n  eps_min: 0.3\n");
+  EXPECT_EQ(failureOf(d), "");
+  fs::remove_all(d);
+}

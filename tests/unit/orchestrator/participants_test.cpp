@@ -137,8 +137,9 @@ TEST(Participants, OpenFoamCommandLineAndEnvironment) {
   const auto& p = participant("coredemFoam");
   LaunchInputs in = inputs("/runs/r2");
   LaunchCommand cmd = launchCommand(p, c, in);
+  // -epsMin: the clip of the gas fraction the DEM's drag uses (models: {eps_min}, default 0.35).
   EXPECT_EQ(cmd.argv, (std::vector<std::string>{"/opt/coredem/bin/participant", "-case",
-                                                "/runs/r2/openfoam"}));
+                                                "/runs/r2/openfoam", "-epsMin", "0.35"}));
   const char* wm = std::getenv("WM_PROJECT_DIR");
   EXPECT_EQ(cmd.env, (std::map<std::string, std::string>{
                          {"COREDEM_CONTROL_ENDPOINT", "tcp://127.0.0.1:5001"},
@@ -151,9 +152,10 @@ TEST(Participants, OpenFoamCommandLineAndEnvironment) {
   in.demServerKey = "key";
   in.timers = true;
   cmd = launchCommand(p, c, in);
-  EXPECT_EQ(cmd.argv, (std::vector<std::string>{
-                          "/opt/coredem/bin/participant", "-case", "/runs/r2/openfoam", "-restart",
-                          "/runs/r2/checkpoints/00000004/coredemFoam.restart", "-timers"}));
+  EXPECT_EQ(cmd.argv, (std::vector<std::string>{"/opt/coredem/bin/participant", "-case",
+                                                "/runs/r2/openfoam", "-epsMin", "0.35", "-restart",
+                                                "/runs/r2/checkpoints/00000004/coredemFoam.restart",
+                                                "-timers"}));
   EXPECT_EQ(cmd.env.at("COREDEM_DEM_SERVER_KEY"), "key");
 
   // cfd.timers in the case turns the timers on as `coredem run --timers` does.
@@ -287,7 +289,7 @@ TEST(Participants, DecomposedOpenFoamRunsUnderMpirun) {
   ASSERT_NE(prog, cmd.argv.end());
   EXPECT_EQ(std::vector<std::string>(prog, cmd.argv.end()),
             (std::vector<std::string>{"/opt/coredem/bin/participant", "-case", "/runs/r3/openfoam",
-                                      "-parallel"}));
+                                      "-epsMin", "0.35", "-parallel"}));
   // Every variable of the environment is exported to the ranks.
   for (const char* var : {"COREDEM_CONTROL_ENDPOINT", "COREDEM_DEM_ENDPOINT", "COREDEM_SESSION",
                           "COREDEM_TIMEOUT_S", "WM_PROJECT_DIR"}) {

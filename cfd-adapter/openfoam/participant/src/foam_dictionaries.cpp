@@ -115,12 +115,12 @@ coredem
 {{
     pRef            {};    // Pa: thermodynamic pressure, rho = pRef M_mix/(R T)
     D               {};    // m2/s: species diffusivity
-    alphacMin       {};    // smallest gas fraction the gas equations accept
+    alphacMin       {};    // clip of the gas fraction: case.yaml models: {{eps_min}}
 }}
 
 // ************************************************************************* //
 )",
-                     num(gp.pressure), num(gp.diffusivity), num(gp.alphacMin));
+                     num(gp.pressure), num(gp.diffusivity), num(config.epsMin));
   return out;
 }
 

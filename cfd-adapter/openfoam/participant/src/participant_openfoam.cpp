@@ -99,7 +99,8 @@ ParticipantDescriptor openFoamParticipant() {
   ParticipantDescriptor p;
   p.name = "coredemFoam";
   p.summary = "OpenFOAM solver (volume-averaged PIMPLE with the DEM sources)";
-  p.args = {"-case", "{work_dir}"};
+  // -epsMin: the clip of the gas fraction the DEM's drag uses too (models: {eps_min}).
+  p.args = {"-case", "{work_dir}", "-epsMin", "{eps_min}"};
   p.restartArgs = {"-restart", "{restart_file}"};
   p.timersArgs = {"-timers"}; // writes RUN/timers-cfd.json
   p.env = {{"COREDEM_CONTROL_ENDPOINT", "{control_endpoint}"},

@@ -496,6 +496,15 @@ void checkOpenFoamCase(const CaseConfig& c) {
   if (kappa) {
     compare("conductivity", gp.conductivity, kappa->first, "kappa", kappa->second, "W/m/K");
   }
+  // One clip of the gas fraction (models: {eps_min}, passed as coredemFoam -epsMin): an old
+  // alphacMin of transportProperties must equal it.
+  if (const auto a = scalar("alphacMin"); a && a->first != c.epsMin) {
+    at.fail({"models", "eps_min"}, "models.eps_min",
+            fmt::format("{} (the clip of the gas fraction for the DEM's drag and the gas), but "
+                        "{}:{} gives alphacMin = {}: remove alphacMin there (the case's value "
+                        "reaches coredemFoam) or set models: {{eps_min: {}}}",
+                        c.epsMin, tFile.string(), a->second, a->first, a->first));
+  }
   // The coupling grid covers the fluid domain: the mesh's points lie in the grid's box (the grid
   // is a box, so that is enough; coredemFoam checks every cell's volume again at start). Curved
   // blockMesh edges can bulge beyond the vertices: coredemFoam catches those.

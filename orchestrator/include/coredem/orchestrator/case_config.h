@@ -49,7 +49,6 @@ struct GasPropertiesConfig {
   double density = 1.204, viscosity = 1.81e-5, conductivity = 0.0257, cp = 1005.0,
          temperature = 293.15, pressure = 101325.0;
   double diffusivity = 2e-5; ///< ideal_gas: species diffusivity D, m2/s
-  double alphacMin = 0.3;    ///< ideal_gas: smallest gas fraction the gas equations accept
 };
 
 struct MaterialConfig {
@@ -219,6 +218,9 @@ struct CaseConfig {
   std::filesystem::path initialState; ///< absolute, empty when particle sets are used
   WallsConfig walls;
   std::vector<std::pair<std::string, std::string>> models;
+  /// Clip ε_min of the gas fraction, from models: {eps_min} (or its old spellings): the DEM's
+  /// drag and convection and the CFD's gas equations (coredemFoam -epsMin) use this one value.
+  double epsMin = 0.35;
   DemConfig dem;
   CfdConfig cfd;
   CouplingConfig coupling;
