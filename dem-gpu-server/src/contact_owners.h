@@ -106,19 +106,37 @@ struct OwnerContacts {
         ++slot;
         ++wallCount;
       };
+      // The touches first (at most kMaxHistorySlots: more cannot keep their history, an error
+      // readStatus reports; those are evaluated at once, without history), then each one's
+      // history: its own feature's, else that of a neighbouring feature the sphere no longer
+      // touches (WallView::continues), each old history handed to one new touch at most (a
+      // valley's two faces, a vessel's floor and side: the floor's spring stays the floor's).
+      double th[kMaxHistorySlots];
+      Vec3 tn[kMaxHistorySlots];
+      std::int64_t tk[kMaxHistorySlots];
+      int nt = 0;
       wv.touches(nearBits, i, xi, ri, [&](double h, Vec3 nw, std::int64_t key) {
-        // The history of this feature, else that of a neighbouring one (WallView::continues).
-        int from = -1;
-        for (int s = 0; s < used; ++s) {
-          if (oldKey[s] == key) {
-            from = s;
-            break;
-          }
-          if (from < 0 && wv.continues(key, oldKey[s]))
-            from = s;
+        if (nt == kMaxHistorySlots) {
+          touch(h, nw, key, Vec3{0.0, 0.0, 0.0});
+          return;
         }
-        touch(h, nw, key, from >= 0 ? oldD[from] : Vec3{0.0, 0.0, 0.0});
+        th[nt] = h, tn[nt] = nw, tk[nt] = key;
+        ++nt;
       });
+      int from[kMaxHistorySlots];
+      std::uint32_t taken = 0; // old slots whose history is handed on
+      for (int t = 0; t < nt; ++t) {
+        from[t] = -1;
+        for (int s = 0; s < used && from[t] < 0; ++s)
+          if (oldKey[s] == tk[t])
+            from[t] = s, taken |= 1u << s;
+      }
+      for (int t = 0; t < nt; ++t)
+        for (int s = 0; s < used && from[t] < 0; ++s)
+          if (!(taken >> s & 1u) && wv.continues(tk[t], oldKey[s]))
+            from[t] = s, taken |= 1u << s;
+      for (int t = 0; t < nt; ++t)
+        touch(th[t], tn[t], tk[t], from[t] >= 0 ? oldD[from[t]] : Vec3{0.0, 0.0, 0.0});
     }
     return FW;
   }

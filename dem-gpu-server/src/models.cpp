@@ -155,14 +155,18 @@ double particleMass(double rho, double d) {
 double dtDemMax(const DemConfig& config, std::span<const double> minMass) {
   const std::size_t nm = config.materials.size();
   COREDEM_ASSERT(minMass.size() == nm);
+  // Over the rows present: the smallest contact time scale (resolved in dt_factor steps) and
+  // the smallest stability limit of the integrator (a bound of its own, whatever dt_factor).
   double tcol = std::numeric_limits<double>::infinity();
+  double stable = std::numeric_limits<double>::infinity();
   kernels::visitModel(kernels::ContactLaws{}, static_cast<int>(config.contact), [&](auto law) {
     using Law = typename decltype(law)::type;
-    // t_col of the row of materials a and b (the law's mixing) with effective mass meff.
-    const auto tcolOf = [&](std::size_t a, std::size_t b, double meff) {
-      return Law::collisionTime(
-          Law::mix(config.contactLaws.template of<Law>(), config.materials[a], config.materials[b]),
-          meff);
+    // The row of materials a and b (the law's mixing) with effective mass meff.
+    const auto row = [&](std::size_t a, std::size_t b, double meff) {
+      const auto p =
+          Law::mix(config.contactLaws.template of<Law>(), config.materials[a], config.materials[b]);
+      tcol = std::min(tcol, Law::collisionTime(p, meff));
+      stable = std::min(stable, Law::stableStep(p, meff));
     };
     for (std::size_t a = 0; a < nm; ++a) {
       if (!std::isfinite(minMass[a]))
@@ -170,15 +174,16 @@ double dtDemMax(const DemConfig& config, std::span<const double> minMass) {
       for (std::size_t b = 0; b < nm; ++b) {
         if (!std::isfinite(minMass[b]))
           continue;
-        tcol = std::min(tcol, tcolOf(a, b, kernels::effectiveMass(minMass[a], minMass[b])));
+        row(a, b, kernels::effectiveMass(minMass[a], minMass[b]));
       }
       if (!config.walls.empty() || !config.meshes.empty())
-        tcol = std::min(tcol, tcolOf(a, a, minMass[a]));
+        row(a, a, minMass[a]);
     }
   });
   if (config.frozenMotion)
     return std::numeric_limits<double>::max(); // held: no collision limit
-  return std::isfinite(tcol) ? tcol / config.dtFactor : std::numeric_limits<double>::infinity();
+  return std::isfinite(tcol) ? std::min(tcol / config.dtFactor, stable)
+                             : std::numeric_limits<double>::infinity();
 }
 
 std::string didYouMean(std::string_view word, std::span<const std::string_view> candidates) {

@@ -35,6 +35,11 @@ namespace coredem::dem {
 inline constexpr int kWallNearBits = 31;
 inline constexpr std::uint32_t kWallMeshBit = 1u << 31;
 
+/// Two mesh triangles hand a touch's tangential history on only where their normals are
+/// within 10° (cos 10°): a curved surface faceted at least as finely (an STL cylinder of 36 or
+/// more facets around) keeps it across facets, a corner or valley sharper than that does not.
+inline constexpr double kHistoryBendCos = 0.98480775301220806;
+
 /// The walls as the contact and heat kernels read them (device pointers), and the one order in
 /// which a particle's touches are found: its candidate analytic walls ascending (the bits of the
 /// first kWallNearBits, then every wall beyond them), each wall's touches in feature order, then
@@ -77,9 +82,12 @@ struct WallView {
     }
   }
 
-  /// Whether a touch new to `key` takes over the history of the last sub-step's wall touch
-  /// `old`: another feature of the same analytic wall (a sphere rolling over a rim onto a cap),
-  /// or a triangle sharing a vertex with the new one (sliding across an edge or a vertex).
+  /// Whether a touch new to `key` may take over the history of the last sub-step's wall touch
+  /// `old` (one the sphere no longer touches; contact_owners.h hands each history on once):
+  /// another feature of the same analytic wall (a sphere rolling over a rim onto a cap), or a
+  /// triangle sharing a vertex with the new one and nearly coplanar with it (normals within
+  /// kHistoryBendCos: sliding across an edge or a vertex of a flat or gently curved surface,
+  /// not around a corner or into a valley).
   DEM_HD bool continues(std::int64_t key, std::int64_t old) const {
     const std::int64_t o = -old - 2, k = -key - 2;
     if (o < 0)
@@ -90,10 +98,16 @@ struct WallView {
       return false;
     const kernels::MeshTriangle& t = tris[k - meshKeyBase];
     const kernels::MeshTriangle& u = tris[o - meshKeyBase];
+    bool shared = false;
     for (int a = 0; a < 3; ++a)
-      if (u.v[a] == t.v[0] || u.v[a] == t.v[1] || u.v[a] == t.v[2])
-        return true;
-    return false;
+      shared = shared || u.v[a] == t.v[0] || u.v[a] == t.v[1] || u.v[a] == t.v[2];
+    if (!shared)
+      return false;
+    // |cos| of the angle between the normals (triangles are two-sided), squared: no root.
+    const kernels::Vec3 nt = kernels::cross(t.b - t.a, t.c - t.a);
+    const kernels::Vec3 nu = kernels::cross(u.b - u.a, u.c - u.a);
+    const double c = kernels::dot(nt, nu);
+    return c * c >= kHistoryBendCos * kHistoryBendCos * kernels::dot(nt, nt) * kernels::dot(nu, nu);
   }
 };
 

@@ -16,6 +16,7 @@
 
 #include <coredem/common/log.h>
 #include <coredem/common/yaml_section.h>
+#include <coredem/dem/kernels/mesh_contact.h>
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/preflight.h>
 #include <coredem/orchestrator/preflight_locator.h>
@@ -632,9 +633,9 @@ void warnPrescribedGasTemperature(Consistency& ck) {
 
 /// Mesh walls much finer than the smallest particle: a sphere touching one has about
 /// π ((1.2 R)² − R²) / A of its triangles (mean area A) within its heat reach 1.2 R. The DEM
-/// considers the nearest 16 (kernels/mesh_contact.h: exact on flat and convex parts, whatever
-/// the triangle size); more cost wall search time and, in concave corners finer than that,
-/// may hide a face.
+/// considers the nearest kMaxMeshTouches (kernels/mesh_contact.h: exact on flat and convex
+/// parts, whatever the triangle size); more cost wall search time and, in concave corners finer
+/// than that, may hide a face.
 void warnFineMeshes(Consistency& ck) {
   const CaseConfig& c = ck.c;
   double dMin = std::numeric_limits<double>::infinity();
@@ -645,7 +646,7 @@ void warnFineMeshes(Consistency& ck) {
     return;
   }
   const double r = 0.5 * dMin;
-  constexpr double kConsidered = 16.0; // kernels::kMaxMeshTouches
+  constexpr double kConsidered = coredem::dem::kernels::kMaxMeshTouches;
   for (std::size_t k = 0; k < c.walls.meshes.size(); ++k) {
     const MeshWallConfig& m = c.walls.meshes[k];
     const std::size_t nt = m.triangles.size() / 3;

@@ -52,6 +52,7 @@ struct SpringContact {
   static double collisionTime(const Pair& p, double meff) {
     return 3.14159265358979323846 * std::sqrt(meff / p.kn);
   }
+  static double stableStep(const Pair& p, double meff) { return 2.0 * std::sqrt(meff / p.kn); }
   template <class S, class Load>
   static PairT<S> gather(const Load& load) {
     return PairT<S>{load(&Pair::kn)};
@@ -152,16 +153,45 @@ TEST(ContactLaw, DefaultLawKeepsHashAndRows) {
   expectSameBits(p01.dampFactor, k::dampingFactor(std::min(m0.en, m1.en)), "damping");
   expectSameBits(p01.etatFactor, 0.5 * (m0.etatFactor + m1.etatFactor), "η_t factor");
   expectSameBits(p01.mu, std::min(m0.mu, m1.mu), "μ");
-  // Δt_DEM,max: the smallest t_col of the pairs over dt_factor (Eqs. 12–13).
+  // Δt_DEM,max: the smallest undamped contact duration π √(m_eff/k_n) of the pairs over
+  // dt_factor (docs/physics.md §2.1; the stability limit is far larger at dt_factor 50).
   const double masses[2] = {1e-6, 2e-6};
   double tcol = HUGE_VAL;
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2; ++j) {
       const Lsd::Pair& p = es.pairs[2 * i + j].of<Lsd>();
       const double meff = masses[i] * masses[j] / (masses[i] + masses[j]);
-      tcol = std::min(tcol, k::collisionTime(p.kn, meff, p.dampFactor * std::sqrt(p.kn * meff)));
+      tcol = std::min(tcol, 3.14159265358979323846 * std::sqrt(meff / p.kn));
     }
   expectSameBits(dtDemMax(c, masses), tcol / c.dtFactor, "Δt_DEM,max");
+}
+
+// A tiny restitution does not stretch Δt_DEM,max: the damped t_col = √(m/k)·√(π² + ln² e_n)
+// grows without bound as e_n → 0, the undamped π √(m/k) does not. For e_n = 1e-30 and 1e-10
+// Δt_DEM,max is π √(m/k) / dt_factor to round-off (1e-15), and so is it for e_n = 0.9; with
+// dt_factor 1 the integrator's stability limit Δt_s = 2 (√(1 + ζ²) − ζ)/ω_0 of the stiffest
+// damped oscillator (the tangential one here, ζ_t = 7/4 ζ_n → 1.75) binds instead.
+TEST(DtDem, TinyRestitutionKeepsTheUndampedPeriod) {
+  const double m = 1e-6, kn = 1000.0, t0 = 3.14159265358979323846 * std::sqrt(m / kn);
+  for (double en : {1e-30, 1e-10, 0.9}) {
+    DemConfig c;
+    c.materials[0].kn = kn;
+    c.materials[0].en = en;
+    const double masses[1] = {2 * m}; // m_eff = m
+    const double dt = dtDemMax(c, masses);
+    EXPECT_NEAR(dt, t0 / 50, 1e-15 * t0)
+        << "e_n = " << en << ": Δt_DEM,max / (t_0/50) = " << dt / (t0 / 50);
+  }
+  DemConfig c;
+  c.materials[0].kn = kn;
+  c.materials[0].en = 1e-30;
+  c.dtFactor = 1;
+  const double masses[1] = {2 * m};
+  // ζ_n = c(e_n)/2 (Eq. 13); ζ_t = η_t/(2√(k_t m_t)) with η_t = ½ η_n, k_t = 2/7 k_n and the
+  // contact point's tangential mass m_t = 2/7 m (rotation included): ζ_t = 7/4 ζ_n.
+  const double w0 = std::sqrt(kn / m), zetaT = 1.75 * 0.5 * k::dampingFactor(1e-30);
+  const double limit = 2 * (std::sqrt(1 + zetaT * zetaT) - zetaT) / w0;
+  EXPECT_NEAR(dtDemMax(c, masses), limit, 1e-12 * limit);
 }
 
 // The family mechanism beyond one member: a test list of LSD and the test spring.

@@ -170,7 +170,7 @@ struct DemConfig {
   /// Each drag law's parameters (`models: {drag.<law>.<parameter>: ...}`, from its declaration).
   kernels::ParamPack<kernels::DragLaws> dragLaws{};
   double epsMinDrag = 0.35; ///< ε_min clip in drag (docs/physics.md §1.1 [C])
-  double dtFactor = 50.0;   ///< Δt_DEM,max = t_col,min / dtFactor (docs/physics.md Eq. 12)
+  double dtFactor = 50.0;   ///< Δt_DEM,max = min(t_0,min / dtFactor, Δt_s) (physics.md §2.1)
   HeatOptions heat;         ///< particle heat transfer (docs/heat-coupling.md)
   /// Hold every particle in place (`models: {motion: frozen}`, as MFiX's verification cases do):
   /// forces, torques and gravity do not move it, positions stay fixed, velocities are zeroed

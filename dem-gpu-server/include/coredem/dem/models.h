@@ -131,10 +131,11 @@ std::vector<ModelIssue> validateModels(std::span<const std::pair<std::string, st
 /// Contact laws of particles and walls (kernels/contact_law.h).
 const ModelFamily<kernels::ContactLaw>& contactModels();
 
-/// The largest stable DEM step Δt_DEM,max = min t_col / `dem.dt_factor` (docs/physics.md Eqs.
-/// 12–13) over the present material pairs (and each material against the walls, if any; the
-/// chosen contact law's mixing rules and collision time), with
-/// `minMass[a]` the lightest particle of material a (+inf: none present; t_col grows with m_eff).
+/// The DEM step Δt_DEM,max = min(t_0 / `dem.dt_factor`, Δt_s) (docs/physics.md §2.1): t_0 the
+/// smallest undamped contact duration and Δt_s the smallest stability limit of the integrator
+/// (the contact law's collisionTime and stableStep) over the present material pairs (and each
+/// material against the walls, if any; the chosen contact law's mixing rules), with
+/// `minMass[a]` the lightest particle of material a (+inf: none present; both grow with m_eff).
 /// The largest finite double with `motion: frozen` (no collision limit); +inf without particles.
 /// The one place this is computed: the DEM server reports it in Configured, the orchestrator's
 /// provisional plan of the first Configure uses it too.

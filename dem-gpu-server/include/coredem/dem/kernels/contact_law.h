@@ -13,7 +13,10 @@
 ///   template <class Material> static Pair mix(const Params&, const Material& a, const Material&
 ///   b);
 ///                                         // host: the row of materials a and b (walls: a, a)
-///   static double collisionTime(const Pair&, double meff);   // host: t_col for Δt_DEM,max
+///   static double collisionTime(const Pair&, double meff);   // host: the contact's time
+///                                         //   scale that Δt_DEM,max resolves (dt_factor steps)
+///   static double stableStep(const Pair&, double meff);      // host: the largest Δt the
+///                                         //   integrator keeps the contact stable with
 ///   template <class S, class Load> DEM_HD static PairT<S> gather(const Load& load);
 ///                                         // PairT<S>{load(&Pair::member)…}: rows into lanes
 ///   template <class S> DEM_HD static ContactT<S> contact(const PairT<S>&, S meff);

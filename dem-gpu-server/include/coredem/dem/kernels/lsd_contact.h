@@ -111,9 +111,23 @@ struct LinearSpringDashpot {
     return Pair{kn, ktFactor * kn, dampingFactor(en), 0.5 * (a.etatFactor + b.etatFactor), mu};
   }
 
-  /// Duration of a contact of row p with effective mass meff (Eqs. 12–13; Δt_DEM,max; host).
+  /// Undamped duration of a contact of row p with effective mass meff, π √(m_eff/k_n): the time
+  /// scale Δt_DEM,max resolves (collision_time.h; host).
   static double collisionTime(const Pair& p, double meff) {
-    return kernels::collisionTime(p.kn, meff, p.dampFactor * ::sqrt(p.kn * meff));
+    return undampedCollisionTime(p.kn, meff);
+  }
+
+  /// Largest Δt for which the integrator keeps a contact of row p with effective mass meff
+  /// stable (collision_time.h, Δt_s; host): the normal oscillator (k_n, m_eff, η_n) and the
+  /// tangential one (k_t, η_t, and the mass m_eff/3.5 that the contact point's tangential
+  /// motion has with the spheres' rotation, 1/m_eff + R²/I summed over both sides, I = 2/5 m R²).
+  static double stableStep(const Pair& p, double meff) {
+    const double etan = p.dampFactor * ::sqrt(p.kn * meff);
+    const double normal = dampedStepLimit(p.kn, meff, etan);
+    if (!(p.kt > 0.0))
+      return normal;
+    const double tangential = dampedStepLimit(p.kt, meff / 3.5, p.etatFactor * etan);
+    return tangential < normal ? tangential : normal;
   }
 
   /// The row's members in lanes: PairT<S>{load(&Pair::kn), …} (the cpu backend's pair lanes).
