@@ -40,7 +40,13 @@ std::vector<PathStep> parsePath(const std::string& path) {
     steps.push_back({m[1].str(), -1});
     const std::string idx = m[2].str();
     for (std::sregex_iterator it(idx.begin(), idx.end(), index), end; it != end; ++it) {
-      steps.push_back({"", std::stol((*it)[1].str())});
+      const std::string digits = (*it)[1].str();
+      if (digits.size() > 9) { // beyond any list a case holds (and beyond a long)
+        throw CaseError(fmt::format("'{}': list index {} is out of range (a case file's lists "
+                                    "are far shorter)",
+                                    path, digits));
+      }
+      steps.push_back({"", std::stol(digits)});
     }
   }
   if (!any || path.back() == '.') {

@@ -22,10 +22,24 @@ void readName(CaseReading& r) {
   const Section& top = r.top;
   CaseConfig& c = r.c;
   c.name = top.string("name", std::nullopt, "the case name, used for the run folder");
-  if (c.name.empty() || c.name.find('/') != std::string::npos) {
-    top.fail(top.markOf("name"), "name", "must be a non-empty name without '/'");
+  // The name names the run folder, the logs and HDF5 attributes: printable, one line, a
+  // file name's length.
+  const bool printable = std::all_of(c.name.begin(), c.name.end(), [](char ch) {
+    return static_cast<unsigned char>(ch) >= 0x20 && ch != 0x7f;
+  });
+  if (c.name.empty() || c.name.find('/') != std::string::npos || !printable ||
+      c.name.size() > kMaxCaseNameBytes || c.name == "." || c.name == "..") {
+    top.fail(top.markOf("name"), "name",
+             fmt::format("must be a non-empty name of at most {} bytes, without '/' or control "
+                         "characters (newline, tab, NUL), and not '.' or '..' (got {} bytes)",
+                         kMaxCaseNameBytes, c.name.size()));
   }
   c.description = top.string("description", std::string(), "free text");
+  if (c.description.size() > kMaxCaseDescriptionBytes) {
+    top.fail(top.markOf("description"), "description",
+             fmt::format("{} bytes: at most {} (a line or a paragraph for the run's summary)",
+                         c.description.size(), kMaxCaseDescriptionBytes));
+  }
 }
 
 /// time: end, dt, adaptive (Courant) policy, forced DEM step

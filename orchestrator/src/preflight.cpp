@@ -404,29 +404,66 @@ void checkOverlaps(Consistency& ck) {
   checkExplicitOverlaps(ck.c, ck.at);
 }
 
-/// Placed sets whose regions intersect: the DEM places each set on its own.
+/// Placed sets whose regions intersect are warned about (their particles may overlap), at most
+/// kMaxIntersectionWarnings pairs and one line for the rest; pairs are found by sorting the
+/// boxes along x (sweep and prune), not by testing every pair. Two placed sets with the same
+/// placement (packing, region, count, diameter, and seed for random) would put their particles
+/// on the same centres — coincident spheres, NaN at the first step: refused.
 void warnIntersectingSets(Consistency& ck) {
   const CaseConfig& c = ck.c;
   const Locator& at = ck.at;
   const double tol = ck.tol;
-  for (std::size_t i = 0; i < c.particles.size(); ++i) {
-    for (std::size_t j = i + 1; j < c.particles.size(); ++j) {
-      if (c.particles[i].positions.empty() || c.particles[j].positions.empty()) {
-        const Box a = occupied(c.particles[i]), b = occupied(c.particles[j]);
-        bool meet = true;
-        for (int d = 0; d < 3; ++d) {
-          meet = meet && std::min(a.hi[d], b.hi[d]) - std::max(a.lo[d], b.lo[d]) > tol;
-        }
-        if (meet) {
-          ck.warnings.push_back(
-              at.warning({"particles", std::to_string(j)}, fmt::format("particles[{}]", j),
-                         fmt::format("{} occupies {}, which intersects {} of {}: sets are placed "
-                                     "independently, so their particles may overlap",
-                                     setName(c.particles[j], j), fmtBox(b), fmtBox(a),
-                                     setName(c.particles[i], i))));
-        }
+  // Every set (a placed set may also meet one of explicit positions; two explicit sets are
+  // checkOverlaps' business).
+  std::vector<std::size_t> placed(c.particles.size());
+  std::iota(placed.begin(), placed.end(), std::size_t(0));
+  std::vector<Box> box(c.particles.size());
+  for (std::size_t i : placed) {
+    box[i] = occupied(c.particles[i]);
+  }
+  std::sort(placed.begin(), placed.end(),
+            [&](std::size_t a, std::size_t b) { return box[a].lo[0] < box[b].lo[0]; });
+  std::size_t pairs = 0;
+  for (std::size_t u = 0; u < placed.size(); ++u) {
+    for (std::size_t v = u + 1; v < placed.size(); ++v) {
+      const std::size_t i = std::min(placed[u], placed[v]), j = std::max(placed[u], placed[v]);
+      const Box &a = box[i], &b = box[j];
+      if (box[placed[v]].lo[0] >= box[placed[u]].hi[0] - tol) {
+        break; // sorted by lo.x: no later box reaches this one
+      }
+      const ParticleSetConfig &p = c.particles[i], &q = c.particles[j];
+      bool meet = p.positions.empty() || q.positions.empty();
+      for (int d = 0; d < 3; ++d) {
+        meet = meet && std::min(a.hi[d], b.hi[d]) - std::max(a.lo[d], b.lo[d]) > tol;
+      }
+      if (!meet) {
+        continue;
+      }
+      if (p.positions.empty() && q.positions.empty() && p.packing == q.packing &&
+          p.regionMin == q.regionMin && p.regionMax == q.regionMax && p.count == q.count &&
+          p.diameter == q.diameter && (p.packing != "random" || p.seed == q.seed)) {
+        at.fail({"particles", std::to_string(j)}, fmt::format("particles[{}]", j),
+                fmt::format("{} has the placement of {} ({} packing of {} particles of {} m in "
+                            "{}{}): their particles would sit on the same centres; change one "
+                            "region{}, or merge the sets",
+                            setName(q, j), setName(p, i), p.packing, p.count, p.diameter, fmtBox(a),
+                            p.packing == "random" ? ", same seed" : "",
+                            p.packing == "random" ? " or seed" : ""));
+      }
+      if (++pairs <= kMaxIntersectionWarnings) {
+        ck.warnings.push_back(
+            at.warning({"particles", std::to_string(j)}, fmt::format("particles[{}]", j),
+                       fmt::format("{} occupies {}, which intersects {} of {}: sets are placed "
+                                   "independently, so their particles may overlap",
+                                   setName(q, j), fmtBox(b), fmtBox(a), setName(p, i))));
       }
     }
+  }
+  if (pairs > kMaxIntersectionWarnings) {
+    ck.warnings.push_back(at.warning(
+        {"particles"}, "particles",
+        fmt::format("{} more pairs of placed sets intersect (the first {} are listed above)",
+                    pairs - kMaxIntersectionWarnings, kMaxIntersectionWarnings)));
   }
 }
 

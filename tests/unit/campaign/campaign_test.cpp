@@ -59,6 +59,11 @@ TEST(CampaignKeys, BadPathsNameThePath) {
       << msg("a.b.c");
   EXPECT_NE(msg("a[0]").find("'a[0]': 'a' is not a list"), std::string::npos) << msg("a[0]");
   EXPECT_NE(msg("a..b").find("not a case key path"), std::string::npos) << msg("a..b");
+  // An index beyond a long was an internal error (std::stol); a user error naming it now.
+  const std::string huge = "l[99999999999999999999999]";
+  EXPECT_NE(msg(huge).find("list index 99999999999999999999999 is out of range"), std::string::npos)
+      << msg(huge);
+  EXPECT_NE(msg("l[1000000000]").find("is out of range"), std::string::npos);
 }
 
 TEST(CampaignSweep, GridExpandsWithTheFirstKeySlowest) {

@@ -183,3 +183,19 @@ TEST(CaseConfig, ModelsValidPass) {
                            "lens_conduction: \"off\", s_min: 1e-06, dem.history_slots: 16}\n";
   EXPECT_EQ(errorOf(text), "");
 }
+
+// The name becomes the run folder and log lines: a newline, NUL or 20 MB were accepted.
+TEST(CaseConfig, CaseNamesAreOneShortPrintableLine) {
+  EXPECT_EQ(errorOf(replace(kGood, "name: unit-case", "name: \"two words, ok\"")), "");
+  for (const std::string bad : {std::string("name: \"a\\nb\""), std::string("name: \"a\\0b\""),
+                                std::string("name: \"a\\tb\""), std::string("name: \"..\""),
+                                "name: " + std::string(20u << 20, 'x')}) {
+    const std::string e = errorOf(replace(kGood, "name: unit-case", bad));
+    EXPECT_NE(e.find("cases/x/case.yaml:1:7: name: must be a non-empty name of at most 200 bytes"),
+              std::string::npos)
+        << e.substr(0, 300);
+  }
+  const std::string d =
+      errorOf(replace(kGood, "name: unit-case", "name: d\ndescription: " + std::string(5000, 'y')));
+  EXPECT_NE(d.find("description: 5000 bytes: at most 4096"), std::string::npos) << d.substr(0, 300);
+}

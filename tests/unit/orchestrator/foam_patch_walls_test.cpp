@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <coredem/dem/triangle_mesh.h>
@@ -417,4 +418,43 @@ TEST_F(FoamPatchWalls, ACompactFaceListIsReadToo) {
   const FoamPatchSurface b = readFoamPatches(dir() / "openfoam", {"walls", "inlet", "outlet"});
   EXPECT_EQ(a.triangles, b.triangles);
   EXPECT_EQ(a.vertices, b.vertices);
+}
+
+// Mesh files that cannot be trusted: a FIFO as boundary hung `coredem check`, points linked to
+// /dev/zero grew memory without bound, huge counts ended in std::bad_alloc (an internal error)
+// and a faces list shorter than the boundary's patches was read as if complete. Each is a user
+// error naming the file (and line), before anything is allocated for it.
+TEST_F(FoamPatchWalls, UntrustedMeshFilesAreRefusedBeforeReadingOrAllocating) {
+  const std::string fifo = errorWithCase("fifo", [](const fs::path& foam) {
+    const fs::path b = foam / "constant/polyMesh/boundary";
+    fs::remove(b);
+    ASSERT_EQ(::mkfifo(b.c_str(), 0600), 0);
+  });
+  EXPECT_HAS(fifo, "fifo/constant/polyMesh/boundary is not a regular file (a directory, a FIFO, "
+                   "a device or a broken link)");
+  const std::string zero = errorWithCase("zero", [](const fs::path& foam) {
+    const fs::path p = foam / "constant/polyMesh/points";
+    fs::remove(p);
+    fs::create_symlink("/dev/zero", p);
+  });
+  EXPECT_HAS(zero, "zero/constant/polyMesh/points is not a regular file");
+  const std::string count = errorWithCase("count", [](const fs::path& foam) {
+    write(foam / "constant/polyMesh/points",
+          header("vectorField", "points") + replace(kPoints, "8\n(", "999999999999\n("));
+  });
+  EXPECT_HAS(count, "count/constant/polyMesh/points:");
+  EXPECT_HAS(count, ": a count of 999999999999 items, but only ");
+  const std::string face = errorWithCase("face", [](const fs::path& foam) {
+    write(foam / "constant/polyMesh/faces",
+          header("faceList", "faces") + replace(kFaces, "4(0 4 7 3)", "4000000000(0 4 7 3)"));
+  });
+  EXPECT_HAS(face, "face/constant/polyMesh/faces:");
+  EXPECT_HAS(face, ": a count of 4000000000 vertices, but only ");
+  const std::string shortList = errorWithCase("short", [](const fs::path& foam) {
+    write(foam / "constant/polyMesh/faces",
+          header("faceList", "faces") +
+              replace(replace(kFaces, "6\n(", "5\n("), "4(4 5 6 7)\n", ""));
+  });
+  EXPECT_HAS(shortList, "short/constant/polyMesh/faces:");
+  EXPECT_HAS(shortList, "the list holds 5 faces, but the boundary file's patches end at face 6");
 }

@@ -213,6 +213,38 @@ walls:)");
   EXPECT_TRUE(contains(w[0], "intersects")) << w[0];
 }
 
+// Many intersecting sets: at most 10 warnings and one line for the rest (1,001 sets gave 500,500
+// lines before); a set with the placement of another is refused (coincident centres, NaN at the
+// first step; it only warned before).
+TEST(Preflight, ManyIntersectingSetsWarnBrieflyAndCoincidentSetsAreRefused) {
+  std::string sets;
+  for (int k = 0; k < 1000; ++k) {
+    sets += "  - material: glass\n    count: 1\n    diameter: 2.0e-3\n    packing: random\n"
+            "    seed: " +
+            std::to_string(k + 2) + "\n    region: {min: [0, 0, 0.015], max: [0.01, 0.01, 0.03]}\n";
+  }
+  const auto w = checkCaseConsistency(parse(replace(kCase, "walls:", sets + "walls:")));
+  ASSERT_EQ(w.size(), 11u);
+  EXPECT_TRUE(contains(w[10], "500490 more pairs of placed sets intersect (the first 10 are "
+                              "listed above)"))
+      << w[10];
+  const std::string twin = replace(kCase, "walls:", R"(  - material: glass
+    count: 10
+    diameter: 2.0e-3
+    temperature: 300.0
+    packing: random
+    region: {min: [0, 0, 0.01], max: [0.02, 0.02, 0.02]}
+walls:)");
+  const std::string e = failureOf(twin);
+  EXPECT_TRUE(contains(e, "particles[1]: particles[1] (set1) has the placement of particles[0] "
+                          "(set0) (random packing of 10 particles"))
+      << e;
+  EXPECT_TRUE(contains(e, "same seed): their particles would sit on the same centres")) << e;
+  EXPECT_EQ(failureOf(replace(twin, "    packing: random\n    region: {min: [0, 0, 0.01]",
+                              "    packing: random\n    seed: 7\n    region: {min: [0, 0, 0.01]")),
+            "");
+}
+
 TEST(Preflight, CelsiusTemperaturesWarn) {
   std::string t = replace(kCase, "temperature: 300.0", "temperature: 90.0");
   t = replace(t, "T_g: 500.0", "T_g: 20.0");

@@ -68,6 +68,21 @@ std::string readMeshFile(const fs::path& foamCase, const std::string& name) {
     }
     notMeshed(foamCase, file);
   }
+  // A FIFO, a device (a link to /dev/zero) or a directory would hang or grow without bound.
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) {
+    throw FoamMeshError(fmt::format("{} is not a regular file (a directory, a FIFO, a device or "
+                                    "a broken link): from_cfd reads the mesh files OpenFOAM "
+                                    "wrote",
+                                    file.string()));
+  }
+  const auto bytes = fs::file_size(file, ec);
+  if (ec || bytes > kMaxFoamMeshFileBytes) {
+    throw FoamMeshError(fmt::format("{}: {} bytes, more than the {} GiB from_cfd reads (an ASCII "
+                                    "mesh of ~10^8 faces); use an STL of the wall instead",
+                                    file.string(), ec ? std::string("unknown size, ") : std::to_string(bytes),
+                                    kMaxFoamMeshFileBytes >> 30));
+  }
   std::ifstream in(file, std::ios::binary);
   std::string text(std::istreambuf_iterator<char>(in), {});
   if (!in.good() && !in.eof()) {
@@ -241,17 +256,29 @@ public:
     return cls == entries.end() ? std::string() : cls->second;
   }
 
-  /// The start of a list: "N (" or "(" (count -1); the '(' is read.
-  std::int64_t listStart() {
+  /// The start of a list: "N (" or "(" (count -1); the '(' is read. A count the rest of the file
+  /// cannot hold (each item takes at least minItemBytes characters) fails before anything is
+  /// allocated for it.
+  std::int64_t listStart(std::size_t minItemBytes = 2) {
     std::int64_t n = -1;
     if (std::isdigit(static_cast<unsigned char>(peek()))) {
       n = label();
       if (peek() == '{') {
         fail("a uniform list N{...} is not a mesh list");
       }
+      checkCount(n, minItemBytes, "items");
     }
     expect('(');
     return n;
+  }
+
+  /// Fails when `n` items of at least minItemBytes characters each cannot fit in the rest of
+  /// the file.
+  void checkCount(std::int64_t n, std::size_t minItemBytes, const char* what) const {
+    const std::size_t left = _text.size() - std::min(_pos, _text.size());
+    if (n < 0 || std::uint64_t(n) > left / minItemBytes) {
+      fail(fmt::format("a count of {} {}, but only {} bytes of the file follow", n, what, left));
+    }
   }
 
   /// True at the ')' that ends a list of `n` items (n < 0: unknown) after `read` items; fails
@@ -292,7 +319,7 @@ std::vector<Point> readPoints(const fs::path& foamCase) {
   FoamParser p(readMeshFile(foamCase, "points"), file, foamCase);
   (void)p.header();
   std::vector<Point> points;
-  const std::int64_t n = p.listStart();
+  const std::int64_t n = p.listStart(7); // "(0 0 0)"
   if (n > 0) {
     points.reserve(std::size_t(n));
   }
@@ -336,13 +363,18 @@ std::vector<std::vector<std::int64_t>> readFaces(const fs::path& foamCase, std::
     }
     return faces;
   }
-  const std::int64_t n = p.listStart();
+  const std::int64_t n = p.listStart(8); // "3(0 1 2)"
+  if (n >= 0 && n < needed) {
+    p.fail(fmt::format("the list holds {} faces, but the boundary file's patches end at face {}",
+                       n, needed));
+  }
   faces.reserve(std::size_t(std::max<std::int64_t>(0, std::min(needed, n < 0 ? needed : n))));
   while (std::int64_t(faces.size()) < needed && !p.listEnd(n, std::int64_t(faces.size()))) {
     const std::int64_t k = p.label();
     if (k < 0) {
       p.fail(fmt::format("face {} has {} vertices", faces.size(), k));
     }
+    p.checkCount(k, 2, "vertices");
     std::vector<std::int64_t> face(std::size_t(k), 0);
     p.expect('(');
     for (auto& v : face) {

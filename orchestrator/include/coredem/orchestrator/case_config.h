@@ -25,6 +25,11 @@ namespace coredem::orchestrator {
 /// A case file that does not follow the schema (or a file it names that is missing).
 using CaseError = ConfigError;
 
+/// Longest case name (bytes): the run folder's name (a file name of most file systems).
+inline constexpr std::size_t kMaxCaseNameBytes = 200;
+/// Longest case description (bytes).
+inline constexpr std::size_t kMaxCaseDescriptionBytes = 4096;
+
 using Vec3 = std::array<double, 3>;
 
 struct GridConfig {

@@ -20,6 +20,8 @@ inline constexpr double kMaxInitialOverlapFraction = 0.05;
 inline constexpr double kMaxRandomSolidFraction = 0.64;
 /// Solid fraction above which random placement may not find room (warning).
 inline constexpr double kWarnRandomSolidFraction = 0.35;
+/// Intersecting placed sets listed one warning each, up to this many pairs (then one line).
+inline constexpr std::size_t kMaxIntersectionWarnings = 10;
 /// Temperatures below this (K) are warned about: probably degrees Celsius.
 inline constexpr double kImplausibleTemperatureK = 200.0;
 /// A constant-property gas solved by the CFD (gas_properties.model: constant) further than this

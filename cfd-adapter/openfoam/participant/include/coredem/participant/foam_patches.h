@@ -18,6 +18,9 @@ namespace coredem::orchestrator {
 
 /// A mesh that is missing, not in ASCII, malformed, or lacks a patch asked for. The message
 /// names the file (or the patch) and what to do; it carries no case.yaml key.
+/// Largest constant/polyMesh file from_cfd reads (an ASCII mesh of ~10^8 faces).
+inline constexpr std::uintmax_t kMaxFoamMeshFileBytes = std::uintmax_t(2) << 30;
+
 class FoamMeshError : public CfdMeshError {
 public:
   using CfdMeshError::CfdMeshError;
