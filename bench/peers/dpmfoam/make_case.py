@@ -27,7 +27,7 @@ The mapping chosen here:
     one (t_col = pi / sqrt(k/m - eta^2/4m^2)); pair and wall separately (the wall contact of
     the linear model has m_eff = m, so it lasts sqrt(2) times longer);
   * collisionResolutionSteps so that DPMFoam's collision sub-step equals CoReDEM's
-    dt_DEM = t_col/50 when its fastest particle moves at the design speed U_SUB (default
+    dt_DEM = pi sqrt(m_eff/k_n)/50 when its fastest particle moves at the design speed U_SUB (default
     0.025 m/s, about the speed of the 0.01 s benchmark runs; --substep-velocity). OpenFOAM
     1912 estimates the sub-step every CFD step as
     5.429675 R (rho/(E* sqrt(U)))^0.4 / collisionResolutionSteps with, for the pair model,
@@ -68,7 +68,7 @@ V_REF = 0.5                      # m/s, impact velocity at which the contact tim
 # as U^(1/5), so a factor 1.5 off U costs < 9 %. A bubbling bed needs about V_REF.
 # report.py checks every run's counts.
 U_SUB = 0.025
-DT_FACTOR = 50                   # CoReDEM: dt_DEM = t_col / 50 (docs/physics.md Eq. 12)
+DT_FACTOR = 50                   # CoReDEM: dt_DEM = pi sqrt(m_eff/k_n) / 50 (docs/physics.md)
 LATTICE_FAC = 1.05               # start lattice spacing / d_p
 JITTER_FAC = 0.02                # +- jitter of each start position / d_p (< (fac - 1)/2)
 ALPHAC_MIN = 0.3                 # smallest gas fraction in the gas equations (both codes)
@@ -161,7 +161,7 @@ def parameters(u_sub=U_SUB):
     m_pp, m_pw = 0.5 * m, m
     tcol_pp = linear_tcol(K_N, m_pp, E_N)
     tcol_pw = linear_tcol(K_N, m_pw, E_N)
-    dt_dem = tcol_pp / DT_FACTOR
+    dt_dem = math.pi * math.sqrt(m_pp / K_N) / DT_FACTOR  # CoReDEM: undamped duration / 50
     alpha = alpha_for_restitution(E_N)
     r_pp, r_pw = D_P / 4.0, D_P / 2.0            # OpenFOAM's effective radii
     estar_pp = hertz_estar_for_tcol(tcol_pp, r_pp, m_pp, alpha, V_REF)
