@@ -33,6 +33,7 @@
 #include "processorFvPatch.H"
 #include "fvOptions.H"
 #include "rhoReactionThermo.H"
+#include "multivariateScheme.H"
 
 #include "checkpoint.H"
 #include "couplingExchange.H"
@@ -78,6 +79,11 @@ int main(int argc, char* argv[])
     scalar cumulativeContErr = 0;
     label steps = 0;
 
+    // Simulated time as the orchestrator sums it (compensated, common/compensated_sum.h), so that
+    // the step it shortens to land on time.end or an output time ends there exactly: OpenFOAM's
+    // own t += dt drifts (4.999999999999981 for 5 after 279 adaptive steps).
+    ::coredem::CompensatedSum timeSum(runTime.value());
+
     Info<< "\nStarting time loop\n" << endl;
 
     while (coupling.isRunning())
@@ -91,6 +97,8 @@ int main(int argc, char* argv[])
 
         runTime.setDeltaT(dt, false);
         ++runTime;
+        timeSum.add(dt);
+        runTime.setTime(timeSum.value(), runTime.timeIndex());
         Info<< "Step " << step << "  Time = " << runTime.timeName() << "  deltaT = " << dt
             << nl << endl;
 

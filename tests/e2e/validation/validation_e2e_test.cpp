@@ -65,8 +65,8 @@ std::string tail(const fs::path& p) {
 /// A finished Patil run: end time reached, the particle heat balance
 ///   ΔΣ m c T = Q_gas + Q_rad + Q_wall
 /// closes to 1e-10 of Σ m c T at every row (E0 = M c_p 363.15 K exactly: all beads start there),
-/// the gas's own enthalpy ledger closes (Δ enthalpy = Δ inflow + Δ heat from particles, to 1e-7
-/// of its enthalpy), walls give heat only when they are cold, and the run plot exists.
+/// the gas's own enthalpy ledger closes (below), walls give heat only when they are cold, and the
+/// run plot exists.
 void checkPatilRun(const fs::path& run, double end, bool coldWalls) {
   auto ts = readTimeseries(run);
   ASSERT_FALSE(ts["t"].empty());
@@ -90,12 +90,20 @@ void checkPatilRun(const fs::path& run, double end, bool coldWalls) {
   if (coldWalls) {
     EXPECT_LT(qw.back(), 0.0); // and so do walls at 20 °C
   }
-  const auto& h = ts["gas.enthalpy_J"];
-  const double dh = h.back() - h.front();
-  const double inflow = ts["gas.enthalpy_inflow_J"].back() - ts["gas.enthalpy_inflow_J"].front();
-  const double fromP =
-      ts["gas.heat_from_particles_J"].back() - ts["gas.heat_from_particles_J"].front();
-  EXPECT_NEAR(dh, inflow + fromP, 1e-7 * h.back());
+  // The gas's own ledger (sensible enthalpy, issue 38 item 3): Δ enthalpy = Δ inflow + Δ heat
+  // from particles + Δ enthalpy of released mass + Δ enthalpy of the mass-balance residual, to
+  // 1e-7 of the heat exchanged (measured 1.3e-8; the T form with the cell's c_p missed 0.2-3 %).
+  // The residual term is the energy error of the unconverged continuity of nOuterCorrectors 1:
+  // at most 1 % of the heat exchanged (measured 0.16 %).
+  const auto delta = [&](const char* k) { return ts[k].back() - ts[k].front(); };
+  const double dh = delta("gas.enthalpy_J");
+  const double fromP = delta("gas.heat_from_particles_J");
+  const double residual = delta("gas.enthalpy_mass_residual_J");
+  EXPECT_NEAR(dh,
+              delta("gas.enthalpy_inflow_J") + fromP + delta("gas.enthalpy_from_particle_mass_J") +
+                  residual,
+              1e-7 * std::fabs(fromP));
+  EXPECT_LT(std::fabs(residual), 0.01 * std::fabs(fromP));
   EXPECT_TRUE(fs::exists(run / "plots" / "timeseries.png")) << run;
 }
 
