@@ -579,9 +579,11 @@ particles:
 // identical (the gas it was sent is the same initial field); later steps agree within the linear
 // solvers' tolerance, not bit for bit: the decomposed PCG/DIC pressure solve (preconditioner cut at
 // the processor boundary, relTol 0.01 in the non-final correctors) converges to other iterates,
-// measured 2e-5 relative on the pressure drop, and the coupling sums are regrouped by rank
-// (round-off, 1e-16). Bounds: pressure drop 1e-4 relative, bed height 1e-6 relative, solid volume
-// 1e-12 relative (the map is conservative on any decomposition).
+// measured 4e-5 relative on the pressure drop, and the coupling sums are regrouped by rank
+// (round-off, 1e-16). The bed's contacts amplify that difference about 30-fold per step (bed
+// height: 1e-9, 3.5e-8, 1.2e-6 relative at steps 2-4 with the contact-duration step of issue 38
+// item 11). Bounds: pressure drop 1e-4 relative, bed height 1e-5 relative, solid volume 1e-12
+// relative (the map is conservative on any decomposition).
 TEST_F(CoredemFoamE2E, PackedBedOnTwoAndFourRanksAgreesWithOneRank) {
   const std::string bed = R"(time: {end: 0.004, dt: 1.0e-3}
 materials:
@@ -610,7 +612,7 @@ particles:
     for (std::size_t i = 0; i < 4; ++i) {
       EXPECT_LE(rel(one["gas.pressure_drop_Pa"][i], many["gas.pressure_drop_Pa"][i]), 1e-4)
           << ranks << " ranks, step " << i + 1;
-      EXPECT_LE(rel(one["bed_height_m"][i], many["bed_height_m"][i]), 1e-6)
+      EXPECT_LE(rel(one["bed_height_m"][i], many["bed_height_m"][i]), 1e-5)
           << ranks << " ranks, step " << i + 1;
       EXPECT_LE(rel(one["gas.solid_volume_m3"][i], many["gas.solid_volume_m3"][i]), 1e-12)
           << ranks << " ranks, step " << i + 1;
