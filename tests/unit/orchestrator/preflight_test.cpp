@@ -325,10 +325,26 @@ TEST(PreflightOpenFoam, GridNotCoveringTheMeshNamesTheAxis) {
   EXPECT_TRUE(contains(e, "grid: the coupling grid spans y = [0, 0.058] m but the CFD mesh")) << e;
   EXPECT_TRUE(contains(e, "blockMeshDict) spans [0, 0.06] m")) << e;
   EXPECT_TRUE(contains(e, "must cover the fluid domain")) << e;
-  // A grid larger than the mesh is fine (coupling cells without fluid).
+  // A grid up to one cell larger than the mesh is fine (coupling cells without fluid).
   writeText(d / "case.yaml",
             replace(readText(d / "case.yaml"), "cells: [10, 29, 2]", "cells: [10, 31, 3]"));
   EXPECT_EQ(foamFailureOf(d), "");
+  // More is not (issue 39 item 1): a spacing 20 % too large, or 2^31 m, ran before and left
+  // hundreds of coupling cells outside the fluid.
+  const std::string fitting = readText(d / "case.yaml");
+  const auto sp = fitting.find("spacing: [");
+  ASSERT_NE(sp, std::string::npos) << fitting;
+  const std::string spacing = fitting.substr(sp, fitting.find(']', sp) - sp + 1);
+  writeText(d / "case.yaml", replace(fitting, spacing, "spacing: [0.0024, 0.0024, 0.0024]"));
+  std::string big = foamFailureOf(d);
+  EXPECT_TRUE(contains(big, "grid: the coupling grid spans x = [0, 0.024] m, more than one grid "
+                            "cell (0.0024 m) beyond the CFD mesh"))
+      << big;
+  EXPECT_TRUE(contains(big, "fit grid.spacing, grid.cells and grid.origin to the mesh")) << big;
+  writeText(d / "case.yaml", replace(fitting, spacing, "spacing: [2147483648, 0.002, 0.002]"));
+  big = foamFailureOf(d);
+  EXPECT_TRUE(contains(big, "more than one grid cell (2.14748e+09 m) beyond the CFD mesh")) << big;
+  writeText(d / "case.yaml", fitting);
   // Particle walls beyond the mesh are not: particles there would get no gas.
   const std::string yaml = readText(d / "case.yaml");
   const auto box = yaml.find("max: [0.02, 0.06, 0.004]");

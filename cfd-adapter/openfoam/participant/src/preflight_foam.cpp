@@ -75,6 +75,8 @@ bool close(double a, double b) {
 struct MeshBounds {
   Vec3 lo, hi;
   std::string from;
+  /// False for a blockMeshDict with curved edges: its vertices bound the mesh from inside only.
+  bool exact = true;
 };
 
 std::optional<MeshBounds> foamMeshBounds(const fs::path& dir) {
@@ -138,7 +140,9 @@ std::optional<MeshBounds> foamMeshBounds(const fs::path& dir) {
     return std::nullopt;
   }
   if (const auto b = bounds(text->substr(open + 1, shut - open - 1), scale)) {
-    return MeshBounds{b->first, b->second, dictFile.string()};
+    static const std::regex curved(R"(\b(arc|spline|simpleSpline|polyLine|BSpline|project)\b)");
+    return MeshBounds{b->first, b->second, dictFile.string(),
+                      !std::regex_search(*text, curved)};
   }
   return std::nullopt;
 }
@@ -520,6 +524,19 @@ void checkOpenFoamCase(const CaseConfig& c) {
                             "({}) spans [{:.6g}, {:.6g}] m: the coupling grid must cover the "
                             "fluid domain; enlarge grid.cells or move grid.origin",
                             axis[d], lo, hi, mesh->from, mesh->lo[d], mesh->hi[d]));
+      } else if (mesh->exact && (mesh->lo[d] - lo > c.grid.spacing[d] + tol ||
+                                 hi - mesh->hi[d] > c.grid.spacing[d] + tol)) {
+        // A grid rounded up to whole cells may overhang the mesh by up to one cell; more is a
+        // spacing, count or origin that does not fit the mesh (20 % too coarse, or 2^31 m).
+        const char* axis[] = {"x", "y", "z"};
+        at.fail({"grid"}, "grid",
+                fmt::format("the coupling grid spans {} = [{:.6g}, {:.6g}] m, more than one grid "
+                            "cell ({:.6g} m) beyond the CFD mesh ({}), which spans [{:.6g}, {:.6g}] "
+                            "m: its coupling cells outside the fluid would map the particles' "
+                            "sources onto too few gas cells; fit grid.spacing, grid.cells and "
+                            "grid.origin to the mesh",
+                            axis[d], lo, hi, c.grid.spacing[d], mesh->from, mesh->lo[d],
+                            mesh->hi[d]));
       }
     }
     // The particles' walls inside the CFD domain: particles beyond the mesh would sit in coupling
