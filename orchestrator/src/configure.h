@@ -7,20 +7,9 @@
 #include <coredem/orchestrator/time_handler.h>
 #include <coredem/protocol/protocol.h>
 
+#include "dem_step.h"
+
 namespace coredem::orchestrator {
-
-/// Δt_DEM,max of the case from the DEM's own function (coredem::dem::dtDemMax: min t_col /
-/// dem.dt_factor over the material pairs of the particle sets, docs/physics.md Eq. 12). Only used
-/// for the provisional plan in Configure; the DEM server's reply is authoritative (with an initial
-/// state file its particles may differ from the sets).
-double estimateDtDemMax(const CaseConfig& c);
-
-/// The case's `models: {dem.dt_factor}` (Δt_DEM,max = t_col,min / dt_factor; default 50).
-double dtFactorOf(const CaseConfig& c);
-
-/// The sub-cycling plan of a step: from the forced DEM step time.dt_dem when given (n_sub =
-/// dt/dt_dem; a step shortened to land on time.end gets n_sub = ceil), else from Δt_DEM,max.
-SubcyclePlan planFor(const CaseConfig& c, double dt, double dtDemMax);
 
 /// Configure of the case (grid, species, gas properties, materials, particle sets, walls,
 /// gravity, models, chemistry, output folder) with the given first Δt_CFD and plan.

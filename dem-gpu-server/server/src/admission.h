@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <string>
 
+#include <coredem/common/limits.h>
+
 #include "coredem/v1/configure.pb.h"
 
 namespace coredem::server {
@@ -27,23 +29,12 @@ struct MemoryModel {
   static constexpr std::uint64_t kMeshTriangle = 512;
 };
 
-struct Limits {
-  std::uint64_t memoryBytes = 0;  ///< the budget (--max-memory)
-  std::uint64_t particles = 0;    ///< derived: budget / bytes per particle
-  std::uint64_t cells = 0;        ///< derived: budget / bytes per cell (and <= kMaxCells)
-  std::uint64_t materials = 1024; ///< pair table <= 64 MiB
-  std::uint64_t species = 256;    ///< gas species (columns of Y_g, R_species)
-  std::uint64_t solidSpecies = 256;
-  std::uint64_t particleSets = 4096;
-  std::uint64_t reactions = 1024;
-  std::uint64_t options = 256;        ///< Configure.options entries
-  std::uint64_t revolvedWalls = 4096; ///< Configure.walls.revolved (cylinders, cones)
-  std::uint64_t meshWalls = 256;      ///< Configure.walls.meshes
-  /// Triangles and vertices over all mesh walls (a 10^6-triangle STL is 1-3·10^6 vertices).
-  std::uint64_t meshTriangles = std::uint64_t{1} << 24;
-  std::uint64_t meshVertices = std::uint64_t{3} << 24;
-  std::uint64_t subSteps = 100000; ///< n_sub of a StepGrant (--max-sub-steps)
-  std::uint64_t nameBytes = 256;   ///< any name or option key/value
+/// The count limits of the project's one table (coredem/common/limits.h, which `coredem check`
+/// applies too) and the memory-derived ones of this server's budget.
+struct Limits : coredem::CountLimits {
+  std::uint64_t memoryBytes = 0; ///< the budget (--max-memory)
+  std::uint64_t particles = 0;   ///< derived: budget / bytes per particle
+  std::uint64_t cells = 0;       ///< derived: budget / bytes per cell (and <= kMaxCells)
 };
 
 /// Half of the physical memory (sysconf), at least 1 GiB.

@@ -154,10 +154,14 @@ TEST(Preflight, StaggeredCheckIncludesTheInertialDragAndThePrescribedGas) {
   // bed is carried at a slip of 2.58 m/s (K_sl s = ε_s (ρ_p − ρ_g) g), where the inertial term
   // more than doubles K_sl: τ_p = 0.263 s < Δt = 0.3 s, refused (the viscous estimate only
   // warned, Δt/τ_p = 0.49).
-  const std::string staggered = replace(replace(std::string(kCase), "time: {end: 0.01, dt: 1.0e-4}",
-                                                "time: {end: 3.0, dt: 0.3}"),
-                                        "diameter: 2.0e-3", "diameter: 1.0e-3") +
-                                "coupling: {scheme: staggered}\n";
+  // (k_n 10 N/m: 0.3 s is 18,663 DEM sub-steps, within the server's 100,000; τ_p does not
+  // depend on k_n.)
+  const std::string staggered =
+      replace(replace(replace(std::string(kCase), "time: {end: 0.01, dt: 1.0e-4}",
+                              "time: {end: 3.0, dt: 0.3}"),
+                      "diameter: 2.0e-3", "diameter: 1.0e-3"),
+              "k_n: 1000,", "k_n: 10,") +
+      "coupling: {scheme: staggered}\n";
   const std::string e = failureOf(staggered);
   EXPECT_TRUE(contains(e, "slip 2.58 m/s, τ_p = ε_s ρ_p/K_sl = 0.263 s is shorter than one step"))
       << e;
@@ -171,6 +175,30 @@ TEST(Preflight, StaggeredCheckIncludesTheInertialDragAndThePrescribedGas) {
   const std::string h = failureOf(hot);
   EXPECT_TRUE(contains(h, "μ_g = 5e-05 Pa s")) << h;
   EXPECT_TRUE(contains(h, "is shorter than one step")) << h;
+}
+
+// What the DEM server and the participants refuse is refused by pre-flight, from the same table
+// (coredem/common/limits.h; issue 39 item 2): each of these passed `coredem check` before and
+// the run then failed.
+TEST(Preflight, TheServersLimitsAreCheckedBeforeTheRun) {
+  // k_n 2e21 N/m: Δt_DEM = π √(m/2/k_n)/50 = 1.4e-13 s, ~7e8 sub-steps of Δt = 1e-4 s.
+  std::string e = failureOf(replace(kCase, "k_n: 1000,", "k_n: 2.0e21,"));
+  EXPECT_TRUE(contains(e, "case.yaml:2:")) << e;
+  EXPECT_TRUE(contains(e, "DEM sub-steps of")) << e;
+  EXPECT_TRUE(contains(e, "grants at most 100000 per CFD step")) << e;
+  EXPECT_EQ(failureOf(kCase), "");
+  // 1025 materials (the server's admission limit is 1024).
+  std::string many = "materials:\n  - {name: glass, density: 2500, k_n: 1000, e_n: 0.9}\n";
+  for (int i = 0; i < 1024; ++i) {
+    many += "  - {name: m" + std::to_string(i) + ", density: 2500, k_n: 1000, e_n: 0.9}\n";
+  }
+  e = failureOf(
+      replace(kCase, "materials:\n  - {name: glass, density: 2500, k_n: 1000, e_n: 0.9}\n", many));
+  EXPECT_TRUE(contains(e, "materials: 1025 materials: the DEM server admits at most 1024")) << e;
+  // A constant gas viscosity of 1e-320 Pa s (the DEM refuses mu_g outside [1e-7, 1] Pa s).
+  e = failureOf(std::string(kCase) + "gas_properties: {model: constant, viscosity: 1.0e-320}\n");
+  EXPECT_TRUE(contains(e, "Pa s is outside [1e-07, 1] Pa s")) << e;
+  EXPECT_TRUE(contains(e, "gas_properties.viscosity: ")) << e;
 }
 
 TEST(Preflight, ExplicitOverlapBeyondTheFractionFails) {

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include <coredem/common/limits.h>
 #include <coredem/protocol/message.h>
 #include <coredem/protocol/status.h>
 #include <coredem/v1/configure.pb.h>
@@ -56,21 +57,8 @@ Status validate(const Message& message, const Expectation& expectation);
 /// friction >= 0, density > 0).
 Status validateConfigure(const v1::Configure& configure);
 
-/// Physically plausible ranges of the received gas fields (docs/protocol.md §3, "Ranges").
-/// Wide enough for any gas (and most liquids) a CFD-DEM run couples; a value outside is a
-/// sender bug (wrong units, divergence, uninitialised memory), refused before it reaches the
-/// DEM core, where it would turn every later Sources into NaN.
-struct GasRanges {
-  double temperatureMin = 100.0, temperatureMax = 6000.0; ///< T_g, K
-  double densityMin = 1e-4, densityMax = 2e4;             ///< rho_g, kg/m3
-  double viscosityMin = 1e-7, viscosityMax = 1.0;         ///< mu_g, Pa s
-  double conductivityMin = 1e-4, conductivityMax = 1e3;   ///< kappa_g, W/m/K
-  double heatCapacityMin = 100.0, heatCapacityMax = 1e5;  ///< cp_g, J/kg/K
-  double speedMax = 1e4;                                  ///< |u_g|, m/s
-  double pressureGradientMax = 1e12;                      ///< |grad_p|, Pa/m
-  double massFractionTolerance = 1e-3;                    ///< Y_k in [-tol, 1 + tol]
-  double massFractionSumTolerance = 0.05;                 ///< |sum_k Y_k - 1| (n_species >= 1)
-};
+/// The ranges of the received gas fields: the project's one table (coredem/common/limits.h).
+using GasRanges = coredem::GasRanges;
 
 /// Checks a (validated) GasFields message's values against `ranges`: the first value outside
 /// is refused (INVALID_CONFIGURATION) naming the array, the cell, the value and the range.
