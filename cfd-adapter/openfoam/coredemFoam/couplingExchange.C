@@ -144,6 +144,10 @@ void CouplingExchange::exchangePartial(label step, scalar dt)
             in->read(nullptr);
             continue;
         }
+        if (in->optional())
+        {
+            in->present(src->has(in->name()));
+        }
         if (in->optional() && !src->has(in->name()))
         {
             readZeros(*in);
@@ -260,6 +264,10 @@ void CouplingExchange::exchange(label step, scalar dt)
         {
             in->read(nullptr);
             continue;
+        }
+        if (in->optional())
+        {
+            in->present(src->has(in->name()));
         }
         if (in->optional() && !src->has(in->name()))
         {
