@@ -89,7 +89,7 @@ struct BenchGas {
     cp.assign(cells, 1005.0);
   }
   coredem::dem::GasFieldsView view() const {
-    return coredem::dem::GasFieldsView{ug, gradP, Tg, rho, mu, kappa, cp, {}, {}};
+    return coredem::dem::GasFieldsView{ug, gradP, Tg, rho, mu, kappa, cp, {}, {}, {}};
   }
 };
 

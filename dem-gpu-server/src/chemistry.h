@@ -16,12 +16,14 @@
 ///   4. per cell (segment heads of the PCM order): Σ ṁ_gas Δt, Σ Δm_solid, Σ Q_rxn Δt, the sensible
 ///      heat of the transferred gas Σ ṁ_gas,i c_p,g (T_p,i − T_g) Δt (gas enters at T_p, not T_g;
 ///      c_p,g, T_g of the cell from the frozen gas; 0 outside the grid or without gas fields) and
-///      the particle-side Σ Δm_i c_p,i T_p,i (J) added to the window accumulators (row nCells:
-///      particles outside the grid, ledgers only)
+///      the particle-side Σ Δm_i c_p,i T_p,i (J) and the momentum of the released gas Σ ṁ_gas,i u_i
+///      Δt (N s; the gas leaves at the particle's velocity u_i of the sub-step, before the motion
+///      update) added to the window accumulators (row nCells: particles outside the grid, ledgers
+///      only)
 ///   5. after the heat module's temperature update: T += Δt Q_rxn/(m c_p) (when reaction heat is
 ///   on)
 /// At the window end R_species = Σ ṁ Δt/(V_c t_window), Q_hom = Σ ṁ_gas c_p,g (T_p − T_g) Δt/(V_c
-/// t_window) and the WGS (R3) of every cell is added
+/// t_window), mom_p = Σ ṁ_gas u Δt/(V_c t_window) and the WGS (R3) of every cell is added
 /// from the frozen gas (host, once per CFD step). A particle whose diameter fell below
 /// removalFraction·d_0 stops reacting and is reported (takeRemovalRequest) so that DemSystem
 /// removes it at the CFD-step boundary.
@@ -167,7 +169,7 @@ public:
     put(_dh, dh);
     put(_gasM, c.gasMolarMass);
     put(_cp, c.materialCp);
-    _width = c.params.nGas + c.params.nSolid + 3;
+    _width = c.params.nGas + c.params.nSolid + kExtraColumns;
     _acc.allocate((nCells + 1) * static_cast<std::size_t>(_width));
     for (std::size_t k = 0; k < _acc.size(); ++k)
       _acc.h()[k] = 0.0;
@@ -359,7 +361,7 @@ public:
 
   /// Step 4: the sub-step's sources added to the window accumulators per cell (+ one row for
   /// particles outside the grid), or, uncoupled, to the window totals. Reads _gdot, _dsolid,
-  /// _q, _sens; writes _acc.
+  /// _q, _sens, velocity; writes _acc.
   void accumulateWindow(StepContext<Exec>& ctx) {
     Exec& exec = ctx.exec;
     const EngineSetup& s = ctx.setup;
@@ -376,7 +378,9 @@ public:
     const double* dsol = _dsolid.d();
     const double* q = _q.d();
     const double* sens = _sens.d();
+    const double* vel = ctx.particles.vel.d();
     double* acc = _acc.d();
+    const int mom = nG + nS + 3; // first of the three momentum columns
     if (coupled) {
       const std::uint32_t* cs = cStart;
       const std::uint32_t* ce = cEnd;
@@ -397,6 +401,13 @@ public:
           acc[row + nG + nS] += q[i] * dt;
           acc[row + nG + nS + 1] += sens[2 * static_cast<std::size_t>(i)] * dt;
           acc[row + nG + nS + 2] += sens[2 * static_cast<std::size_t>(i) + 1];
+          // The released gas leaves at the particle's velocity: Σ_k ṁ_k u Δt.
+          double mGas = 0.0;
+          for (int g = 0; g < nG; ++g)
+            mGas += gdot[static_cast<std::size_t>(i) * nG + g];
+          if (mGas != 0.0)
+            for (int a = 0; a < 3; ++a)
+              acc[row + mom + a] += mGas * vel[3 * static_cast<std::size_t>(i) + a] * dt;
         }
       });
     } else {
@@ -422,8 +433,15 @@ public:
             sum += q[i] * dt;
           else if (k == nG + nS + 1)
             sum += sens[2 * i] * dt;
-          else
+          else if (k == nG + nS + 2)
             sum += sens[2 * i + 1];
+          else { // the momentum of the released gas (column k − mom)
+            double mGas = 0.0;
+            for (int g = 0; g < nG; ++g)
+              mGas += gdot[i * nG + g];
+            if (mGas != 0.0)
+              sum += mGas * vel[3 * i + static_cast<std::size_t>(k - mom)] * dt;
+          }
         }
         part[t] = sum;
       });
@@ -482,6 +500,8 @@ public:
     std::vector<double> gasSum(static_cast<std::size_t>(nG), 0.0),
         solidSum(static_cast<std::size_t>(nS), 0.0);
     double heatSum = 0.0, gasSensSum = 0.0, massSensSum = 0.0;
+    double momSum[3] = {0.0, 0.0, 0.0};
+    const int mom = nG + nS + 3;
     for (std::size_t c = 0; c <= nc; ++c) {
       const double* row = acc + c * W;
       for (int g = 0; g < nG; ++g) {
@@ -496,6 +516,11 @@ public:
       massSensSum += row[nG + nS + 2];
       if (c < nc && window > 0.0 && row[nG + nS + 1] != 0.0)
         out.qHom[c] += row[nG + nS + 1] / (s.cellVolume * window);
+      for (int a = 0; a < 3; ++a) {
+        momSum[a] += row[mom + a];
+        if (c < nc && window > 0.0)
+          out.momP[3 * c + a] += row[mom + a] / (s.cellVolume * window);
+      }
     }
     for (int g = 0; g < nG; ++g)
       _totals.gasProduced[g] += gasSum[g];
@@ -504,6 +529,8 @@ public:
     _totals.reactionHeat += heatSum;
     _totals.gasSensibleHeat += gasSensSum;
     _totals.sensibleMassEnthalpy += massSensSum;
+    for (int a = 0; a < 3; ++a)
+      _totals.releasedMomentum[a] += momSum[a];
 
     // R3, homogeneous water–gas shift: once per CFD step per cell from the frozen gas.
     const GasFields<Exec>* gf = w.gas;
@@ -560,10 +587,12 @@ private:
   Dev<double> _blockSums; ///< uncoupled totals: per block of kTotalsBlock particles and column
   static constexpr std::size_t kTotalsBlock = 256;
   Dev<double> _sens; ///< per particle: ṁ_gas c_p,g (T_p − T_g) (W), Δm c_p T_p (J); N*2
-  Dual<double>
-      _acc; ///< (nCells+1)*W: Σ gas kg, Σ solid kg, Σ Q_rxn J, Σ gas sensible J, Σ Δm c T J
-  int _width = 0;        ///< W = nGas + nSolid + 3
-  bool _pending = false; ///< a particle is below the removal diameter
+  /// (nCells+1)*W: Σ gas kg, Σ solid kg, Σ Q_rxn J, Σ gas sensible J, Σ Δm c T J, Σ ṁ_gas u Δt
+  /// N s (3)
+  Dual<double> _acc;
+  static constexpr int kExtraColumns = 6; ///< the columns after the gas and solid species
+  int _width = 0;                         ///< W = nGas + nSolid + kExtraColumns
+  bool _pending = false;                  ///< a particle is below the removal diameter
   ChemistryTotals _totals;
 };
 

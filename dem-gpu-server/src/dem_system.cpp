@@ -93,6 +93,7 @@ struct DemSystem::Impl {
   std::size_t nParticles = 0;
   const std::atomic<bool>* interrupt = nullptr; ///< setInterruptFlag
   BackendKind kind = BackendKind::Cpu;
+  bool warnedUnassignedSplit = false; ///< the warning about heat split to no particle was logged
   std::unique_ptr<Engine> makeEngine() const {
 #if defined(COREDEM_CUDA_ENABLED)
     if (kind == BackendKind::Cuda)
@@ -261,6 +262,7 @@ void DemSystem::setGasFields(const GasFieldsView& gas) {
   g.cpG = check(gas.cpG, nc, "cp_g", true, true);
   g.Yg = check(gas.Yg, nc * ns, "Y_g", true, false);
   g.fluidFraction = check(gas.fluidFraction, nc, "fluid_fraction", true, false);
+  g.heatToParticles = check(gas.heatToParticles, nc, "Q_split", true, false);
   for (std::size_t k = 0; k < g.fluidFraction.size(); ++k) {
     COREDEM_CHECK(g.fluidFraction[k] >= 0.0 && g.fluidFraction[k] <= 1.0,
                   "setGasFields: fluid_fraction[{}] = {} must lie in [0, 1]", k,
@@ -281,6 +283,14 @@ const CellSources& DemSystem::advance(double dtCfd, int nSub) {
       "nSub >= {} (TimeHandler::subStepsFor)",
       dt, m.dtMax, m.config.dtFactor, TimeHandler::subStepsFor(dtCfd, m.dtMax));
   m.engine->beginWindow();
+  const HeatSplitBooking split = m.engine->giveHeatSplit();
+  if (split.unassignedCells > 0 && !m.warnedUnassignedSplit) {
+    m.warnedUnassignedSplit = true;
+    m.log->warn("t = {:.6g} s: {:.6g} J of the heat split the gas sent (Q_split) fell in {} "
+                "coupling cell(s) without particles, first cell {}: booked as "
+                "dem.heat_split_unassigned_J, given to no particle (first occurrence only)",
+                m.time.time(), split.unassigned, split.unassignedCells, split.firstUnassignedCell);
+  }
   for (int s = 0; s < nSub; ++s) {
     if (m.interrupt != nullptr && m.interrupt->load(std::memory_order_relaxed)) {
       throw Interrupted(coredem::format("interrupted after {} of {} sub-steps", s, nSub));

@@ -87,7 +87,16 @@ void compactParticles(HostState& s, const std::vector<std::size_t>& keep);
 /// Host copies of the gas fields (per cell).
 struct GasArrays {
   std::vector<double> ug, gradP, Tg, rhoG, muG, kappaG, cpG, Yg;
-  std::vector<double> fluidFraction; ///< empty: every cell all fluid
+  std::vector<double> fluidFraction;   ///< empty: every cell all fluid
+  std::vector<double> heatToParticles; ///< J/m³ of V_c per cell (Q_split); empty: none
+};
+
+/// What Engine::giveHeatSplit() did with the heat split of the gas fields (J).
+struct HeatSplitBooking {
+  double given = 0.0;      ///< to the particles (booked in HeatTotals::convection)
+  double unassigned = 0.0; ///< of cells without particles (HeatTotals::splitUnassigned)
+  std::int64_t firstUnassignedCell = -1; ///< the first such cell (-1: none)
+  std::size_t unassignedCells = 0;       ///< how many
 };
 
 class Engine {
@@ -100,6 +109,9 @@ public:
   virtual void setGas(const GasArrays& g) = 0;
   /// Freezes ε_g (PCM at the current positions) and clears the source accumulators.
   virtual void beginWindow() = 0;
+  /// After beginWindow(): gives the heat split of the gas fields set last (GasArrays::
+  /// heatToParticles) to the particles of each cell, once per setGas (heat.h giveHeatSplit).
+  virtual HeatSplitBooking giveHeatSplit() = 0;
   /// One DEM sub-step of length dt (rebuild if needed, forces, sources, motion).
   virtual void subStep(double dt) = 0;
   /// Sub-step-averaged sources after nSub sub-steps of dtCfd/nSub each.

@@ -152,6 +152,24 @@ public:
   void setGas(const GasArrays& g) override {
     _gas.set(g);
     _hasGas = true;
+    _splitPending = !g.heatToParticles.empty();
+  }
+
+  /// The heat split of the gas fields set last, once (heat.h giveHeatSplit): after beginWindow,
+  /// on the frozen cells and the window's Nusselt factors.
+  HeatSplitBooking giveHeatSplit() override {
+    if (!_splitPending)
+      return {};
+    _splitPending = false;
+    const GasFields<Exec>* gas = gasOrNull();
+    if (gas == nullptr)
+      return {};
+    const auto t0 = Clock::now();
+    _p.require(kPos | kVel | kRadius | kMass | kMaterial | kTemperature);
+    StepContext<Exec> ctx = stepContext(0.0);
+    const HeatSplitBooking b = heat().giveHeatSplit(ctx);
+    _t.heat += std::chrono::duration<double>(Clock::now() - t0).count();
+    return b;
   }
 
   void reserveScratch() {
@@ -546,6 +564,7 @@ public:
       out.rSpecies.assign(nc * static_cast<std::size_t>(_s.nGasSpecies), 0.0);
       out.qHom.assign(nc, 0.0);
       out.qRad.assign(nc, 0.0);
+      out.momP.assign(3 * nc, 0.0);
     }
     _modules.forEach([&](auto& m) { m.endWindow(w); });
   }
@@ -636,6 +655,7 @@ private:
   std::vector<std::unique_ptr<Dual<unsigned char>>> _spares;
   GasFields<Exec> _gas; ///< per-cell gas fields of the CFD step, read by the modules
   bool _hasGas = false;
+  bool _splitPending = false; ///< _gas holds a heat split not given yet (giveHeatSplit)
   CouplingCells<Exec> _cells; ///< PCM cell binning and frozen ε_g, read by the modules
   PairLists<Exec> _pairLists; ///< half and low lists of the neighbour lists (pair_lists.h)
   WallLists<Exec> _wallLists; ///< walls and wall candidates per particle (wall_lists.h)

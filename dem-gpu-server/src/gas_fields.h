@@ -17,7 +17,8 @@ struct GasFields {
   using Arr = backend::DualArray<double, Exec>;
 
   Arr ug, gradP, Tg, rhoG, muG, kappaG, cpG, Yg;
-  Arr fluid; ///< φ_f per cell (empty: 1 everywhere)
+  Arr fluid;     ///< φ_f per cell (empty: 1 everywhere)
+  Arr heatSplit; ///< Q_split per cell, J/m³ of V_c (empty: none; heat.h giveHeatSplit)
 
   static bool has(const Arr& a) { return a.size() > 0; }
 
@@ -32,11 +33,12 @@ struct GasFields {
     upload(cpG, g.cpG);
     upload(Yg, g.Yg);
     upload(fluid, g.fluidFraction);
+    upload(heatSplit, g.heatToParticles);
   }
 
   std::size_t bytes() const {
     std::size_t b = 0;
-    for (const Arr* a : {&ug, &gradP, &Tg, &rhoG, &muG, &kappaG, &cpG, &Yg, &fluid})
+    for (const Arr* a : {&ug, &gradP, &Tg, &rhoG, &muG, &kappaG, &cpG, &Yg, &fluid, &heatSplit})
       b += a->bytes();
     return b;
   }

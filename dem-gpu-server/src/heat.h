@@ -12,6 +12,11 @@
 ///      to the window accumulators (averaged over the sub-steps at the window end; the radiation
 ///      sum, negated, is the Sources array Q_rad: the heat the gas receives with protocol 1.3)
 ///   4. after the motion update: T_i += Δt Q_i/(m_i c_p,i) (explicit Euler, Eq. 18)
+/// At the start of a window whose gas fields carry a heat split (protocol 1.5 Q_split, J/m³ of
+/// V_c: what the gas removed in its last step beyond what the DEM booked), giveHeatSplit() gives
+/// R_c = Q_split[c] V_c to the particles of cell c in proportion to their gas conductance G_i of
+/// the window start (all zero: to m_i c_p,i), T_i += R_i/(m_i c_p,i); R_c of an occupied cell is
+/// booked in HeatTotals::convection, of an empty one in HeatTotals::splitUnassigned.
 /// Fixed-temperature walls (HeatSetup::walls, kernels/wall_conduction.h) add their contact and
 /// gas-lens conduction to Q_i in step 2; their heat Σ_i Q_w,i Δt is summed in kWallSlots fixed
 /// slots per sub-step (deterministic) and booked in HeatTotals::wall at the window end.
@@ -98,6 +103,7 @@ public:
       _wallAcc.toDevice();
     }
     if (nCells > 0) {
+      _splitGiven.allocate(nCells);
       _acc.allocate(3 * nCells);
       for (std::size_t k = 0; k < 3 * nCells; ++k)
         _acc.h()[k] = 0.0;
@@ -112,7 +118,7 @@ public:
 
   std::size_t bytes() const {
     return _mat.bytes() + _q.bytes() + _g.bytes() + _qrad.bytes() + _cellT.bytes() + _acc.bytes() +
-           _qw.bytes() + _wallAcc.bytes() + _convFactors.bytes();
+           _qw.bytes() + _wallAcc.bytes() + _convFactors.bytes() + _splitGiven.bytes();
   }
 
   /// Heat the particles received since construction (or the restored totals).
@@ -146,6 +152,121 @@ public:
         nf[c] = kernels::nusseltFactors(cp, gs);
       });
     }
+  }
+
+  /// The heat split of the window's gas fields (GasFields::heatSplit, J/m³ of V_c) into the
+  /// particles, after beginWindow (cells frozen and sorted, Nusselt factors of the window): per
+  /// occupied cell c (one segment head each, its particles in the sorted order) R_c =
+  /// Q_split[c] V_c, split in proportion to G_i = h_i A_i of the window start (convection with
+  /// the window's gas and the particle's slip; 0 when convection is off or lacks its fields) or,
+  /// when every G_i of the cell is 0, to m_i c_p,i; T_i += R_i/(m_i c_p,i). Each particle is
+  /// written by its cell's head only: deterministic on every backend. Books the totals (host).
+  /// Writes _g (G_i), temperature, _splitGiven.
+  HeatSplitBooking giveHeatSplit(StepContext<Exec>& ctx) {
+    HeatSplitBooking b;
+    const GasFields<Exec>* gf = ctx.gas;
+    const EngineSetup& s = ctx.setup;
+    if (!s.coupled || gf == nullptr || !gf->has(gf->heatSplit))
+      return b;
+    Exec& exec = ctx.exec;
+    ParticleStore<Exec>& p = ctx.particles;
+    const std::size_t n = p.n;
+    const std::uint32_t nCells = static_cast<std::uint32_t>(s.nCells);
+    double* given = _splitGiven.d();
+    exec.parallelFor(s.nCells, [=] DEM_LAMBDA(std::size_t c) { given[c] = 0.0; });
+    if (n > 0) {
+      _g.reserve(n);
+      const ActiveTerms on = activeTerms(gf);
+      splitConductances(ctx, on.conv && _convFactorsValid);
+      const std::uint32_t* pcell = ctx.cells.pcell();
+      const std::uint32_t* perm = ctx.cells.perm();
+      const std::uint32_t* cs = ctx.cells.cStart();
+      const std::uint32_t* ce = ctx.cells.cEnd();
+      const double* qs = gf->heatSplit.d();
+      const double* g = _g.d();
+      const double* m = p.mass.d();
+      const std::int32_t* mat = p.material.d();
+      const HeatMaterial* hm = _mat.d();
+      double* T = p.temperature.d();
+      const double vc = s.cellVolume;
+      exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t h) {
+        const std::uint32_t c = pcell[perm[h]];
+        if (c >= nCells || (h > 0 && pcell[perm[h - 1]] == c))
+          return;
+        const double rc = qs[c] * vc;
+        given[c] = rc;
+        if (rc == 0.0)
+          return;
+        double sumG = 0.0, sumC = 0.0;
+        for (std::uint32_t k = cs[c]; k < ce[c]; ++k) {
+          const std::uint32_t i = perm[k];
+          sumG += g[i];
+          sumC += m[i] * hm[mat[i]].cp;
+        }
+        const bool byConductance = sumG > 0.0;
+        for (std::uint32_t k = cs[c]; k < ce[c]; ++k) {
+          const std::uint32_t i = perm[k];
+          const double mc = m[i] * hm[mat[i]].cp;
+          const double share = byConductance ? g[i] / sumG : mc / sumC;
+          T[i] = T[i] + (rc * share) / mc;
+        }
+      });
+      p.produced(kTemperature);
+    }
+    _splitGiven.markDeviceModified();
+    _splitGiven.toHost();
+    const double* givenH = _splitGiven.h();
+    const double* qH = gf->heatSplit.h();
+    for (std::size_t c = 0; c < s.nCells; ++c) {
+      if (givenH[c] != 0.0) {
+        b.given += givenH[c];
+      } else if (qH[c] != 0.0) {
+        b.unassigned += qH[c] * s.cellVolume;
+        if (b.firstUnassignedCell < 0)
+          b.firstUnassignedCell = static_cast<std::int64_t>(c);
+        ++b.unassignedCells;
+      }
+    }
+    _totals.convection += b.given;
+    _totals.splitUnassigned += b.unassigned;
+    return b;
+  }
+
+  /// giveHeatSplit's G_i = h_i A_i of every particle in a cell (0 outside the grid and when
+  /// `conv` is false), as particleRates() evaluates it. Writes _g.
+  void splitConductances(StepContext<Exec>& ctx, bool conv) {
+    const std::size_t n = ctx.particles.n;
+    double* gOut = _g.d();
+    if (!conv) {
+      ctx.exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) { gOut[i] = 0.0; });
+      return;
+    }
+    const GasFields<Exec>* gf = ctx.gas;
+    const std::uint32_t nCells = static_cast<std::uint32_t>(ctx.setup.nCells);
+    const std::uint32_t* pcell = ctx.cells.pcell();
+    const double* eps = ctx.cells.epsFrozen();
+    const kernels::NusseltFactors* nf = _convFactors.d();
+    const kernels::ConvectionParams cp = _h.convectionParams;
+    const double* ug = gf->ug.d();
+    const double* rhoG = gf->rhoG.d();
+    const double* muG = gf->muG.d();
+    const double* kap = gf->kappaG.d();
+    const double* cpg = gf->cpG.d();
+    const double* tg = gf->Tg.d();
+    const double* v = ctx.particles.vel.d();
+    const double* r = ctx.particles.radius.d();
+    const double* T = ctx.particles.temperature.d();
+    ctx.exec.parallelFor(n, [=] DEM_LAMBDA(std::size_t i) {
+      using namespace kernels;
+      const std::uint32_t c = pcell[i];
+      if (c >= nCells) {
+        gOut[i] = 0.0;
+        return;
+      }
+      const double slip = norm(load3(ug, c) - load3(v, static_cast<long long>(i)));
+      const GasState gs{rhoG[c], muG[c], kap[c], cpg[c], tg[c], eps[c]};
+      gOut[i] = convectionFromFactors(cp, nf[c], gs, 2.0 * r[i], slip, T[i]).conductance;
+    });
   }
 
   /// The terms this sub-step evaluates: the options, and the gas fields the CFD sent.
@@ -602,6 +723,7 @@ private:
   Dev<double> _qw;           ///< per particle: Q_wall,i (W)
   Dual<double> _wallAcc;     ///< kWallSlots partial sums of Σ_sub Σ_i Q_wall,i Δt (J)
   Dev<kernels::NusseltFactors> _convFactors; ///< per cell: Nusselt factors of the window
+  Dual<double> _splitGiven; ///< per cell: R_c given to its particles (0: none) (giveHeatSplit)
   bool _convFactorsValid = false;
   HeatTotals _totals;
 };

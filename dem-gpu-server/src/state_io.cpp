@@ -33,6 +33,10 @@ T optionalAttribute(hid_t loc, const std::string& name, T fallback, const std::s
   return h5::hasAttribute(loc, name) ? h5::readAttribute<T>(loc, name, what) : fallback;
 }
 
+/// /chemistry attributes of ChemistryTotals::releasedMomentum.
+constexpr const char* kReleasedMomentumAttributes[3] = {
+    "released_momentum_x_Ns", "released_momentum_y_Ns", "released_momentum_z_Ns"};
+
 } // namespace
 
 void writeStateFile(const std::string& path, const HostState& s, const StateMeta& meta) {
@@ -61,6 +65,8 @@ void writeStateFile(const std::string& path, const HostState& s, const StateMeta
     h5::writeAttribute(g, "gas_sensible_heat_J", c.gasSensibleHeat);
     h5::writeAttribute(g, "sensible_mass_enthalpy_J", c.sensibleMassEnthalpy);
     h5::writeAttribute(g, "removed_count", static_cast<std::uint64_t>(c.removedCount));
+    for (int a = 0; a < 3; ++a)
+      h5::writeAttribute(g, kReleasedMomentumAttributes[a], c.releasedMomentum[a]);
   }
   h5::Handle g = h5::createGroup(file, "meta");
   h5::writeAttribute(g, "format_version", static_cast<std::int32_t>(schema::kFormatVersion));
@@ -154,6 +160,9 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
     c.gasSensibleHeat = optionalAttribute(gc, "gas_sensible_heat_J", 0.0, what);
     c.sensibleMassEnthalpy = optionalAttribute(gc, "sensible_mass_enthalpy_J", 0.0, what);
     c.removedCount = h5::readAttribute<std::uint64_t>(gc, "removed_count", what);
+    // Files written before protocol 1.5's released momentum: it starts at 0.
+    for (int a = 0; a < 3; ++a)
+      c.releasedMomentum[a] = optionalAttribute(gc, kReleasedMomentumAttributes[a], 0.0, what);
   }
 }
 

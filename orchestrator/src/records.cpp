@@ -159,9 +159,14 @@ void Session::writeTimeseriesRow(std::int64_t step, double dt, const SubcyclePla
   // (gas.heat_in_flight_J, docs/coredemFoam.md): taken off the same way.
   const auto inFlight = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_in_flight_J");
   const auto gasInFlight = protocol::findNamedValue(cd.ledger().energy(), "gas.heat_in_flight_J");
+  // The heat split the gas sent (protocol 1.5 Q_split) for coupling cells without particles is
+  // given to nobody: the DEM books it apart (dem.heat_split_unassigned_J), on its side.
+  const auto unassigned =
+      protocol::findNamedValue(dd.ledger().energy(), "dem.heat_split_unassigned_J");
   if (demHeat && gasHeat) {
-    row.emplace_back("balance.heat_residual_J",
-                     *demHeat + *gasHeat - inFlight.value_or(0.0) - gasInFlight.value_or(0.0));
+    row.emplace_back("balance.heat_residual_J", *demHeat + unassigned.value_or(0.0) + *gasHeat -
+                                                    inFlight.value_or(0.0) -
+                                                    gasInFlight.value_or(0.0));
   }
   // Radiation (protocol 1.3): what the particles radiated is what the gas received.
   const auto demRad = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_radiation_J");

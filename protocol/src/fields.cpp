@@ -17,8 +17,10 @@ constexpr std::array<FieldSpec, 8> kGasFields{{
     {kGasMassFractions, v1::EXTENT_SPECIES, "-", "gas species mass fractions"},
 }};
 
-constexpr std::array<FieldSpec, 1> kOptionalGasFields{{
+constexpr std::array<FieldSpec, 2> kOptionalGasFields{{
     {kFluidFraction, v1::EXTENT_SCALAR, "-", "fluid fraction of the coupling cell's volume"},
+    {kHeatToParticles, v1::EXTENT_SCALAR, "J/m3",
+     "heat the gas removed beyond what the DEM booked, for the cell's particles (extensive)"},
 }};
 
 constexpr std::array<FieldSpec, 7> kSourceFields{{
@@ -31,8 +33,10 @@ constexpr std::array<FieldSpec, 7> kSourceFields{{
     {kHomogeneousHeat, v1::EXTENT_SCALAR, "W/m3", "homogeneous reaction heat release"},
 }};
 
-constexpr std::array<FieldSpec, 1> kOptionalSourceFields{{
+constexpr std::array<FieldSpec, 2> kOptionalSourceFields{{
     {kRadiationHeat, v1::EXTENT_SCALAR, "W/m3", "radiation heat the particles gave the gas"},
+    {kReleasedMomentum, v1::EXTENT_VECTOR3, "N/m3",
+     "momentum of the mass the particles give the gas (released mass rate times u_p)"},
 }};
 } // namespace
 

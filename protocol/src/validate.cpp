@@ -303,30 +303,7 @@ Status checkFields(const Message& message, const Expectation& e) {
   if (!st.ok()) {
     return st;
   }
-  if (type == v1::MESSAGE_TYPE_SOURCES) {
-    // Optional Sources arrays (v1.3 Q_rad): when present, float64 with one row per cell (or
-    // listed cell of a partial Sources); finiteness was checked with every array above.
-    for (const auto& spec : fields::optionalSourceFields()) {
-      const auto v = message.findArray(spec.name);
-      if (!v) {
-        continue;
-      }
-      const auto expected = fields::shapeOf(spec.extent, rows, *e.species);
-      if (v->dtype() != v1::DTYPE_FLOAT64 || v->shape() != expected) {
-        return Status::error(v1::ERROR_CODE_SHAPE,
-                             "array '" + std::string(spec.name) + "' has dtype " +
-                                 dtypeName(v->dtype()) + " and shape " + shapeString(v->shape()) +
-                                 " but float64 " + shapeString(expected) + " was expected for " +
-                                 std::to_string(rows) + (partial ? " listed" : " configured") +
-                                 " cells");
-      }
-    }
-    return st;
-  }
-  if (type != v1::MESSAGE_TYPE_GAS_FIELDS) {
-    return st;
-  }
-  if (partial) {
+  if (type == v1::MESSAGE_TYPE_GAS_FIELDS && partial) {
     // The fluid volumes: positive (finite was checked above).
     const auto fv = message.values<double>(fields::kFluidVolume);
     for (std::size_t i = 0; i < fv.size(); ++i) {
@@ -338,26 +315,30 @@ Status checkFields(const Message& message, const Expectation& e) {
                                  "(fluid volume > 0)");
       }
     }
-    if (message.findArray(fields::kFluidFraction)) {
-      return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION,
-                           "partial GasFields carry fluid_volume; fluid_fraction is formed by "
-                           "the DEM server from the ranks' fluid volumes, do not send it");
-    }
-    return st;
   }
-  // Optional GasFields arrays: when present, the same dtype and shape rules.
-  for (const auto& spec : fields::optionalGasFields()) {
+  // Optional arrays (Sources: v1.3 Q_rad, v1.5 mom_p; GasFields: fluid_fraction, v1.5 Q_split):
+  // when present, float64 with one row per cell (or listed cell of a partial message);
+  // finiteness was checked with every array above.
+  const auto optional = type == v1::MESSAGE_TYPE_SOURCES ? fields::optionalSourceFields()
+                                                         : fields::optionalGasFields();
+  for (const auto& spec : optional) {
     const auto v = message.findArray(spec.name);
     if (!v) {
       continue;
     }
-    const auto expected = fields::shapeOf(spec.extent, *e.cells, *e.species);
+    if (partial && spec.name == fields::kFluidFraction) {
+      return Status::error(v1::ERROR_CODE_INVALID_CONFIGURATION,
+                           "partial GasFields carry fluid_volume; fluid_fraction is formed by "
+                           "the DEM server from the ranks' fluid volumes, do not send it");
+    }
+    const auto expected = fields::shapeOf(spec.extent, rows, *e.species);
     if (v->dtype() != v1::DTYPE_FLOAT64 || v->shape() != expected) {
       return Status::error(v1::ERROR_CODE_SHAPE,
                            "array '" + std::string(spec.name) + "' has dtype " +
                                dtypeName(v->dtype()) + " and shape " + shapeString(v->shape()) +
                                " but float64 " + shapeString(expected) + " was expected for " +
-                               std::to_string(*e.cells) + " configured cells");
+                               std::to_string(rows) + (partial ? " listed" : " configured") +
+                               " cells");
     }
   }
   return st;

@@ -12,6 +12,9 @@
 // also carrying Q_rad (the radiation heat the particles gave the gas) for its one cell.
 // v1.4 (MINOR 4): the v1.3 messages with minor 4 in Hello/Welcome/Reject and a Configure whose
 // walls also hold a capped cylinder, a cone and a two-triangle mesh (walls.revolved, .meshes).
+// v1.5 (MINOR 5): the v1.4 messages with minor 5 in Hello/Welcome/Reject, the partial GasFields
+// also carrying Q_split (heat for the cell's particles, J/m3, extensive) and the partial Sources
+// also carrying mom_p (momentum of the released mass, N/m3) for its one cell.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -277,7 +280,8 @@ void addSessionMessages(Golden& all, int minor) {
   }
 }
 
-/// GasFields and Sources of protocol 1.minor (partial from 1.2, with Q_rad from 1.3).
+/// GasFields and Sources of protocol 1.minor (partial from 1.2, with Q_rad from 1.3, with Q_split
+/// and mom_p from 1.5).
 void addExchangeMessages(Golden& all, int minor) {
   {
     Message m = makeGasFields(3, 0.25, 1e-4, kCells, kSpecies);
@@ -289,6 +293,10 @@ void addExchangeMessages(Golden& all, int minor) {
       m.addArray<std::int64_t>(fields::kTouchedCells, std::vector<std::int64_t>{1}, {kTouched});
       m.addArray<double>(fields::kFluidVolume, std::vector<double>{0.125}, {kTouched});
       addFieldArrays(m, fields::gasFields(), kTouched);
+      if (minor >= 5) { // v1.5: heat for the cell's particles, J/m3 (field index 8; negative)
+        m.addArray<double>(fields::kHeatToParticles, std::vector<double>{-goldenValue(8, 0)},
+                           fields::shapeOf(fields::kHeatToParticles, kTouched, kSpecies));
+      }
     } else {
       addFieldArrays(m, fields::gasFields());
     }
@@ -309,6 +317,12 @@ void addExchangeMessages(Golden& all, int minor) {
       if (minor >= 3) { // v1.3: the radiation heat to the gas, W/m3 (field index 7)
         m.addArray<double>(fields::kRadiationHeat, std::vector<double>{goldenValue(7, 0)},
                            fields::shapeOf(fields::kRadiationHeat, kTouched, kSpecies));
+      }
+      if (minor >= 5) { // v1.5: the momentum of the released mass, N/m3 (field index 8)
+        m.addArray<double>(
+            fields::kReleasedMomentum,
+            std::vector<double>{goldenValue(8, 0), goldenValue(8, 1), goldenValue(8, 2)},
+            fields::shapeOf(fields::kReleasedMomentum, kTouched, kSpecies));
       }
     } else {
       addFieldArrays(m, fields::sourceFields());
@@ -380,8 +394,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int minor = argc == 3 ? std::atoi(argv[2]) : 0;
-  if (minor < 0 || minor > 4) {
-    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0, 1, 2, 3 or 4\n");
+  if (minor < 0 || minor > 5) {
+    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0, 1, 2, 3, 4 or 5\n");
     return 2;
   }
   std::filesystem::path dir = argv[1];

@@ -267,6 +267,27 @@ coredem_status coredem_client_radiation_heat(const coredem_client* cc, const dou
   });
 }
 
+coredem_status coredem_client_released_momentum(const coredem_client* cc, const double** values,
+                                                size_t* size) {
+  auto* c = const_cast<coredem_client*>(cc);
+  return call(c, "coredem_client_released_momentum", [&] {
+    argCheck(values != nullptr && size != nullptr,
+             "coredem_client_released_momentum: values and size must not be NULL");
+    const auto v = participant(c).sources().releasedMomentum();
+    *values = v.size > 0 ? v.data : nullptr;
+    *size = v.size;
+  });
+}
+
+coredem_status coredem_client_set_heat_to_particles(coredem_client* c, const double* values,
+                                                    size_t size) {
+  return call(c, "coredem_client_set_heat_to_particles", [&] {
+    argCheck(size == 0 || values != nullptr,
+             "coredem_client_set_heat_to_particles: values must not be NULL");
+    participant(c).setHeatToParticles(coredem::client::ConstView(values, size));
+  });
+}
+
 coredem_status coredem_client_advance(coredem_client* c, double courant, int32_t n_ledgers,
                                       const char* const* ledger_names, const double* ledger_values,
                                       int32_t n_files, const char* const* checkpoint_files) {

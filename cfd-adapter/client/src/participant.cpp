@@ -71,6 +71,11 @@ ConstView Sources::radiationHeat() const {
   return has(name) ? field(name) : ConstView();
 }
 
+ConstView Sources::releasedMomentum() const {
+  const std::string name(proto::fields::kReleasedMomentum);
+  return has(name) ? field(name) : ConstView();
+}
+
 bool Sources::has(const std::string& name) const {
   return views.count(name) == 1 || arrays.count(name) == 1;
 }
@@ -560,6 +565,32 @@ void Participant::follow(const std::string& controlState) {
 
 int Participant::demProtocolMinor() const {
   return _impl->demMinor;
+}
+
+void Participant::setHeatToParticles(ConstView values) {
+  _impl->require({State::Granted}, "setHeatToParticles",
+                 "set Q_split after a grant, before that step's exchange()");
+  guarded("setHeatToParticles", [&] {
+    Impl& m = *_impl;
+    COREDEM_CHECK(m.demMinor >= static_cast<int>(proto::kMinorHeatToParticles),
+                  "setHeatToParticles: {}; Q_split needs 1.{} or later (an older DEM server "
+                  "would drop the heat): update coredem-dem, or keep the split in the gas",
+                  m.versionsAgreed(), proto::kMinorHeatToParticles);
+    COREDEM_CHECK(values.size == 0 || values.data != nullptr,
+                  "setHeatToParticles: {} values at a null pointer", values.size);
+    for (std::size_t i = 0; i < values.size; ++i) {
+      COREDEM_CHECK(std::isfinite(values[i]),
+                    "setHeatToParticles: Q_split[{}] = {} J/m3 is not finite; check the gas "
+                    "solution of that cell",
+                    i, values[i]);
+    }
+    m.heatToParticles.assign(values.begin(), values.end());
+    m.hasHeatToParticles = true;
+  });
+}
+
+bool Participant::takesHeatToParticles() const {
+  return _impl->demMinor >= static_cast<int>(proto::kMinorHeatToParticles);
 }
 
 ExchangeTimes Participant::lastExchangeTimes() const {

@@ -24,12 +24,21 @@ const Sources& Participant::Impl::exchange(std::int64_t s, double d,
   // Rows of every array: the grid's cells, or the rank's listed cells.
   const auto cells = touched != nullptr ? static_cast<std::uint64_t>(touched->size())
                                         : static_cast<std::uint64_t>(grid.cellCount());
-  const auto given = givenGasFields(fields, touched != nullptr);
+  auto given = givenGasFields(fields, touched != nullptr);
+  if (hasHeatToParticles) { // setHeatToParticles(): Q_split with these fields
+    COREDEM_CHECK(given
+                      .emplace(std::string(proto::fields::kHeatToParticles),
+                               ConstView(heatToParticles.data(), heatToParticles.size()))
+                      .second,
+                  "exchange: Q_split given both as a field and with setHeatToParticles()");
+  }
   const auto dest = sourceBuffers(into, cells);
   auto msg = gasFieldsMessage(given, touched, fluidVolume);
   const auto t1 = Clock::now();
   const auto deadline = t1 + timeout;
   const std::uint64_t seq = dem->send(std::move(msg));
+  heatToParticles.clear(); // sent: one exchange only
+  hasHeatToParticles = false;
   const auto t2 = Clock::now();
   auto reply = awaitReply(seq, deadline);
   const auto t3 = Clock::now();
@@ -92,7 +101,7 @@ Participant::Impl::givenGasFields(const std::vector<NamedField>& fields, bool pa
                        std::any_of(proto::fields::optionalGasFields().begin(),
                                    proto::fields::optionalGasFields().end(), named)),
                   "exchange: '{}' is not a GasFields array; the names are u_g, grad_p, T_g, "
-                  "rho_g, mu_g, kappa_g, cp_g, Y_g (and optionally fluid_fraction)",
+                  "rho_g, mu_g, kappa_g, cp_g, Y_g (and optionally fluid_fraction, Q_split)",
                   f.name);
     COREDEM_CHECK(given.emplace(f.name, f.values).second, "exchange: field '{}' given twice",
                   f.name);
@@ -106,6 +115,13 @@ Participant::Impl::givenGasFields(const std::vector<NamedField>& fields, bool pa
                   "exchange: {}; fluid_fraction (a mesh that does not fill the coupling grid) "
                   "needs 1.{} or later: update coredem-dem",
                   versionsAgreed(), proto::kMinorDecomposed);
+  }
+  if (given.count(std::string(proto::fields::kHeatToParticles)) != 0) {
+    // An older server would ignore it and the heat would be lost.
+    COREDEM_CHECK(demMinor >= static_cast<int>(proto::kMinorHeatToParticles),
+                  "exchange: {}; Q_split (heat for the particles) needs 1.{} or later: update "
+                  "coredem-dem",
+                  versionsAgreed(), proto::kMinorHeatToParticles);
   }
   return given;
 }
@@ -123,7 +139,7 @@ Participant::Impl::sourceBuffers(const std::vector<NamedBuffer>& into, std::uint
                        std::any_of(proto::fields::optionalSourceFields().begin(),
                                    proto::fields::optionalSourceFields().end(), named)),
                   "exchange: '{}' is not a Sources array; the names are eps_g, K_sl, K_sl_Us, H, "
-                  "H_Tp, R_species, Q_hom, Q_rad",
+                  "H_Tp, R_species, Q_hom, Q_rad, mom_p",
                   b.name);
     const std::uint64_t n = cells * proto::fields::componentsOf(spec->extent, ns);
     COREDEM_CHECK(b.size == n,
@@ -176,7 +192,8 @@ proto::Message Participant::Impl::gasFieldsMessage(const std::map<std::string, C
     }
     const std::uint64_t n = cells * proto::fields::componentsOf(spec.extent, ns);
     COREDEM_CHECK(it->second.size == n && (n == 0 || it->second.data != nullptr),
-                  "exchange: '{}' has {} values; the coupling grid has {} cells, so it needs {}",
+                  "exchange: '{}' has {} values; the coupling grid (or the rank's list) has {} "
+                  "cells, so it needs {}",
                   name, it->second.size, cells, n);
     msg.addArray<double>(name, std::span<const double>(it->second.data, it->second.size),
                          proto::fields::shapeOf(spec.extent, cells, ns));

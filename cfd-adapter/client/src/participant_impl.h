@@ -54,6 +54,9 @@ struct Participant::Impl {
   Sources sources;
   ExchangeTimes times;
   int demMinor = 0; ///< the protocol minor agreed with D
+  /// setHeatToParticles(): the Q_split values for the next exchange (sent once, then cleared)
+  std::vector<double> heatToParticles;
+  bool hasHeatToParticles = false;
 
   bool decomposed() const { return opt.rankCount > 1; }
 

@@ -103,6 +103,11 @@ Ledgers defineLedgers(const std::vector<std::string>& species) {
   for (const char* a : kAxes) {
     ledgers.define(std::string("gas.momentum_from_particles_") + a + "_Ns", Kind::Diagnostic);
   }
+  // The momentum of the mass the particles released, ∫ Σ_c mom_p V_c dt (protocol 1.5; stays 0
+  // with an older DEM server), also inside gas.momentum_from_particles_*.
+  for (const char* a : kAxes) {
+    ledgers.define(std::string("gas.momentum_released_") + a + "_Ns", Kind::Diagnostic);
+  }
   ledgers.define("gas.solid_volume_m3", Kind::Diagnostic);
   return ledgers;
 }
@@ -115,9 +120,10 @@ void bookSources(Ledgers& ledgers, const client::Sources& s, const gas::GasField
   const auto eps = s.field("eps_g"), k = s.field("K_sl"), kus = s.field("K_sl_Us"),
              h = s.field("H"), htp = s.field("H_Tp"), r = s.field("R_species"),
              q = s.field("Q_hom");
-  const auto qrad = s.radiationHeat(); // empty below protocol 1.3
+  const auto qrad = s.radiationHeat();    // empty below protocol 1.3
+  const auto momP = s.releasedMomentum(); // empty below protocol 1.5
   double heat = 0.0, hom = 0.0, solid = 0.0, rad = 0.0;
-  double mom[3] = {0.0, 0.0, 0.0};
+  double mom[3] = {0.0, 0.0, 0.0}, released[3] = {0.0, 0.0, 0.0};
   std::vector<double> spec(ns, 0.0);
   for (std::size_t c = 0; c < n; ++c) {
     heat += htp[c] - h[c] * f.T_g[c];
@@ -125,8 +131,13 @@ void bookSources(Ledgers& ledgers, const client::Sources& s, const gas::GasField
     if (qrad.size == n)
       rad += qrad[c];
     solid += 1.0 - eps[c];
-    for (int a = 0; a < 3; ++a)
+    for (int a = 0; a < 3; ++a) {
       mom[a] += kus[3 * c + a] - k[c] * f.u_g[3 * c + a];
+      if (momP.size == 3 * n) {
+        mom[a] += momP[3 * c + a];
+        released[a] += momP[3 * c + a];
+      }
+    }
     for (std::size_t j = 0; j < ns; ++j)
       spec[j] += r[c * ns + j];
   }
@@ -141,6 +152,7 @@ void bookSources(Ledgers& ledgers, const client::Sources& s, const gas::GasField
   ledgers.add("gas.mass_from_particles_kg", mass * vc * dt);
   for (int a = 0; a < 3; ++a) {
     ledgers.add(std::string("gas.momentum_from_particles_") + kAxes[a] + "_Ns", mom[a] * vc * dt);
+    ledgers.add(std::string("gas.momentum_released_") + kAxes[a] + "_Ns", released[a] * vc * dt);
   }
   ledgers.set("gas.solid_volume_m3", solid * vc);
 }

@@ -94,6 +94,47 @@ void CouplingExchange::readZeros(CouplingInput& in)
 }
 
 
+void CouplingExchange::packHeatToParticles(label step)
+{
+    if (heatToParticles_ == nullptr) return;
+    if (!coupling_.takesHeatToParticles())
+    {
+        FatalErrorInFunction
+            << "coupling, step " << step << ": the variable-density gas gives the particles the "
+            << "heat of its implicit exchange (Q_split, protocol 1.5), which this DEM server "
+            << "does not take: run a coredem-dem of protocol 1.5 or later" << exit(FatalError);
+    }
+    using ::coredem::client::ConstView;
+    const scalarField& q = heatToParticles_->primitiveField();
+    const double h3 = grid_.cellVolume();
+    if (partial_)
+    {
+        // This processor's part: sum_{c here} A(c, g) q_c / h^3 per touched cell (the server
+        // adds the processors' parts).
+        grid_.sumTouched(q.cdata(), 1, splitTouched_);
+        for (double& v : splitTouched_) v /= h3;
+        coupling_.setHeatToParticles(ConstView(splitTouched_));
+        return;
+    }
+    if (grid_.exact())
+    {
+        if (direct_)
+        {
+            coupling_.setHeatToParticles(ConstView(q.cdata(), std::size_t(q.size())));
+            return;
+        }
+        grid_.gather(q.cdata(), 1, split_); // the exact map copies
+        coupling_.setHeatToParticles(ConstView(split_));
+        return;
+    }
+    grid_.sumTouched(q.cdata(), 1, splitTouched_);
+    split_.assign(std::size_t(grid_.gridCells()), 0.0);
+    const std::vector<label>& t = grid_.touched();
+    for (std::size_t k = 0; k < t.size(); ++k) split_[std::size_t(t[k])] = splitTouched_[k]/h3;
+    coupling_.setHeatToParticles(ConstView(split_));
+}
+
+
 void CouplingExchange::exchangePartial(label step, scalar dt)
 {
     using ::coredem::client::ConstView;
@@ -110,6 +151,7 @@ void CouplingExchange::exchangePartial(label step, scalar dt)
         grid_.sumTouched(v.data, out.nComponents(), gathered_[i]);
         fields.push_back({out.name(), gathered_[i]});
     }
+    packHeatToParticles(step);
     timers_.toc(StageTimers::Pack);
 
     const ::coredem::client::Sources* src = nullptr;
@@ -143,6 +185,10 @@ void CouplingExchange::exchangePartial(label step, scalar dt)
         {
             in->read(nullptr);
             continue;
+        }
+        if (in->optional())
+        {
+            in->present(src->has(in->name()));
         }
         if (in->optional() && !src->has(in->name()))
         {
@@ -216,6 +262,7 @@ void CouplingExchange::exchange(label step, scalar dt)
         }
         fields.push_back({out.name(), v});
     }
+    packHeatToParticles(step);
     timers_.toc(StageTimers::Pack);
 
     // Sources received straight into the fields (in place) or viewed in the received frames
@@ -260,6 +307,10 @@ void CouplingExchange::exchange(label step, scalar dt)
         {
             in->read(nullptr);
             continue;
+        }
+        if (in->optional())
+        {
+            in->present(src->has(in->name()));
         }
         if (in->optional() && !src->has(in->name()))
         {

@@ -109,6 +109,16 @@ void ConfiguredSession::addDiagnostics(v1::StepDone& done, const dem::ParticleDa
   proto::addNamedValue(d, "dem_time_s", system->time());
   proto::addNamedValue(d, "bed_height_m",
                        dem::bedHeight(p.position, p.radius, p.count, system->config().gravity));
+  // The momentum the particles' released gas carried away (cumulative, N s; protocol 1.5 sends
+  // it to the gas as mom_p): the gas's gas.momentum_released_*_Ns receives the same.
+  if (system->config().chemistry.active()) {
+    const dem::ChemistryTotals c = system->chemistryTotals();
+    const char* names[3] = {"dem.momentum_released_x_Ns", "dem.momentum_released_y_Ns",
+                            "dem.momentum_released_z_Ns"};
+    for (int a = 0; a < 3; ++a) {
+      proto::addNamedValue(d, names[a], c.releasedMomentum[a]);
+    }
+  }
 }
 
 std::vector<std::string> ConfiguredSession::writeCheckpoint(const std::string& dir,

@@ -15,7 +15,7 @@ struct GasBinding {
   std::span<const double> dem::GasFieldsView::*member;
 };
 
-constexpr std::array<GasBinding, 9> kGasBindings{{
+constexpr std::array<GasBinding, 10> kGasBindings{{
     {f::kGasVelocity, &dem::GasFieldsView::ug},
     {f::kPressureGradient, &dem::GasFieldsView::gradP},
     {f::kGasTemperature, &dem::GasFieldsView::Tg},
@@ -25,6 +25,7 @@ constexpr std::array<GasBinding, 9> kGasBindings{{
     {f::kGasHeatCapacity, &dem::GasFieldsView::cpG},
     {f::kGasMassFractions, &dem::GasFieldsView::Yg},
     {f::kFluidFraction, &dem::GasFieldsView::fluidFraction},
+    {f::kHeatToParticles, &dem::GasFieldsView::heatToParticles},
 }};
 
 struct SourceBinding {
@@ -32,7 +33,7 @@ struct SourceBinding {
   std::vector<double> dem::CellSources::*member;
 };
 
-constexpr std::array<SourceBinding, 8> kSourceBindings{{
+constexpr std::array<SourceBinding, 9> kSourceBindings{{
     {f::kVoidFraction, &dem::CellSources::epsG},
     {f::kDragCoefficient, &dem::CellSources::kSl},
     {f::kDragCoefficientTimesUs, &dem::CellSources::kSlUs},
@@ -41,6 +42,7 @@ constexpr std::array<SourceBinding, 8> kSourceBindings{{
     {f::kSpeciesSources, &dem::CellSources::rSpecies},
     {f::kHomogeneousHeat, &dem::CellSources::qHom},
     {f::kRadiationHeat, &dem::CellSources::qRad},
+    {f::kReleasedMomentum, &dem::CellSources::momP},
 }};
 
 std::span<const double> dem::GasFieldsView::*boundGasMember(std::string_view name) {

@@ -82,6 +82,25 @@ Combined combinePartialGasFields(const std::vector<StepReply>& to, const GridSha
   if (partFluid) {
     gas.addArray<double>(f::kFluidFraction, std::span<const double>(fraction), {cells});
   }
+  // Q_split (v1.5) is extensive: each rank sends its own contribution per coupling-cell volume,
+  // and a cell's heat is the sum of the ranks' (in rank order), not a fluid-volume average.
+  // Sent on when any rank sent it.
+  std::vector<double> split(n, 0.0);
+  bool anySplit = false;
+  for (const StepReply& t : to) {
+    const auto q = t.request->message.findArray(f::kHeatToParticles);
+    if (!q) {
+      continue;
+    }
+    anySplit = true;
+    const auto v = q->as<double>();
+    for (std::size_t i = 0; i < t.cells.size(); ++i) {
+      split[static_cast<std::size_t>(t.cells[i])] += v[i];
+    }
+  }
+  if (anySplit) {
+    gas.addArray<double>(f::kHeatToParticles, std::span<const double>(split), {cells});
+  }
   if (const auto st = proto::validateGasRanges(gas); !st.ok()) {
     out.failure = {CombineFailure::Kind::Ranges, st.code,
                    "the combined GasFields of the CFD ranks: " + st.message, std::string()};

@@ -38,7 +38,8 @@ struct Combined {
 /// Combines the partial GasFields `to` (in rank order, independent of their arrival order) of a
 /// grid of `grid.cells` cells of volume `cellVolume`: V_g = sum_r V_r,g, f_g = sum_r S_r,g / V_g,
 /// fluid fraction V_g / V_c (exactly 1 within 1e-12 of V_c, 0 for cells no rank touches, whose gas
-/// is the volume-weighted average of all cells; sent only when some cell is not all fluid).
+/// is the volume-weighted average of all cells; sent only when some cell is not all fluid). The
+/// extensive Q_split (v1.5) of a cell is the sum of the ranks' values (sent when any rank sent it).
 /// `rankCount` names the ranks in a failure's text.
 Combined combinePartialGasFields(const std::vector<StepReply>& to, const GridShape& grid,
                                  double cellVolume, std::uint32_t rankCount);

@@ -90,11 +90,15 @@ void Replies::sendSources(const std::vector<StepReply>& to, const proto::Message
       add(spec.name, sourceValues(s, spec.name));
     }
     // v1.3: the radiation heat of the particles goes to the gas; an older peer never sees it
-    // (the heat then stays with the particles' environment, as before 1.3).
-    if (const int r = _members.rankOf(t.request->peer);
-        r >= 0 && _members.rankMinor(static_cast<std::size_t>(r)) >= proto::kMinorRadiation &&
-        s.qRad.size() == n) {
+    // (the heat then stays with the particles' environment, as before 1.3). v1.5: the momentum of
+    // the released mass; an older peer never sees it (the mass enters at the gas velocity).
+    const int r = _members.rankOf(t.request->peer);
+    const std::uint32_t minor = r >= 0 ? _members.rankMinor(static_cast<std::size_t>(r)) : 0;
+    if (r >= 0 && minor >= proto::kMinorRadiation && s.qRad.size() == n) {
       add(f::kRadiationHeat, sourceValues(s, f::kRadiationHeat));
+    }
+    if (r >= 0 && minor >= proto::kMinorReleasedMomentum && s.momP.size() == 3 * n) {
+      add(f::kReleasedMomentum, sourceValues(s, f::kReleasedMomentum));
     }
     *src.envelope().mutable_sources()->mutable_ledger() = ledger;
     send(t.request->peer, std::move(src), req.sequence(), env.step());

@@ -15,10 +15,10 @@ const dem::CellSources& StaggeredLag::apply(double dt, std::span<const double> T
                                             double cellVolume, std::vector<double>& speciesToGas) {
   dem::CellSources& p = _state.pending;
   const std::size_t n = cells;
-  // The released mass and its heat (R_species, Q_hom) are amounts over the step that computed
-  // them: with a different Δt now (adaptive Δt_CFD) the rates are rescaled so that the gas gets
-  // exactly what the particles released. The coefficients (ε_g, K_sl, K_sl U_s, H, H T_p)
-  // describe the particles and are sent as they are.
+  // The released mass, its heat and its momentum (R_species, Q_hom, Q_rad, mom_p) are amounts
+  // over the step that computed them: with a different Δt now (adaptive Δt_CFD) the rates are
+  // rescaled so that the gas gets exactly what the particles released. The coefficients (ε_g, K_sl,
+  // K_sl U_s, H, H T_p) describe the particles and are sent as they are.
   if (_state.pendingDt > 0.0 && _state.pendingDt != dt) {
     const double scale = _state.pendingDt / dt;
     for (double& v : p.rSpecies) {
@@ -28,6 +28,9 @@ const dem::CellSources& StaggeredLag::apply(double dt, std::span<const double> T
       v *= scale;
     }
     for (double& v : p.qRad) {
+      v *= scale;
+    }
+    for (double& v : p.momP) {
       v *= scale;
     }
   }

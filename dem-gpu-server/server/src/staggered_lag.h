@@ -40,7 +40,7 @@ public:
   /// core throws.
   void evaluateInitial(dem::DemSystem& system, double dtSub);
   /// The pending sources as the gas applies them in a step of `dt` with temperatures `Tg`: the
-  /// amounts R_species, Q_hom and Q_rad rescaled from the Δt that computed them, booked as
+  /// amounts R_species, Q_hom, Q_rad and mom_p rescaled from the Δt that computed them, booked as
   /// applied (heat, and the species into `speciesToGas`). Sent, then markSent().
   const dem::CellSources& apply(double dt, std::span<const double> Tg, std::size_t cells,
                                 std::uint32_t species, double cellVolume,

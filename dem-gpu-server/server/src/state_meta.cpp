@@ -48,6 +48,7 @@ void forEachPending(F&& f, dem::CellSources& p) {
   f("R_species", p.rSpecies, 0); // 0: one column per gas species
   f("Q_hom", p.qHom, 1);
   f("Q_rad", p.qRad, -1); // -1: one per cell, absent from files written before protocol 1.3
+  f("mom_p", p.momP, -3); // -3: three per cell, absent from files written before protocol 1.5
 }
 } // namespace
 
@@ -83,8 +84,8 @@ StaggeredState readStaggeredState(const std::string& path, std::uint64_t cells, 
     forEachPending(
         [&](const char* name, std::vector<double>& v, int width) {
           const std::string dataset = std::string("pending_") + name;
-          if (width < 0 && !h5::exists(group, dataset)) { // optional (Q_rad): zeros
-            v.assign(static_cast<std::size_t>(cells), 0.0);
+          if (width < 0 && !h5::exists(group, dataset)) { // optional (Q_rad, mom_p): zeros
+            v.assign(static_cast<std::size_t>(cells) * static_cast<std::size_t>(-width), 0.0);
             return;
           }
           const auto n = static_cast<std::int64_t>(cells) *

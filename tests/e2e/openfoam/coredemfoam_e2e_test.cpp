@@ -810,8 +810,8 @@ TEST_F(CoredemFoamE2E, StaggeredRestartContinuesWithTheSameFieldsAndDemState) {
   for (const auto& name : compared) {
     pending += name.rfind("server/staggered/pending_", 0) == 0 ? 1 : 0;
   }
-  // The seven arrays of every Sources and Q_rad (a 1.3 peer).
-  EXPECT_EQ(pending, 8u) << "the checkpoint does not hold every pending source";
+  // The seven arrays of every Sources, Q_rad (a 1.3 peer) and mom_p (a 1.5 peer).
+  EXPECT_EQ(pending, 9u) << "the checkpoint does not hold every pending source";
   auto ta = readTimeseries(a), tb = readTimeseries(b);
   ASSERT_EQ(ta["gas.pressure_drop_Pa"].size(), 24u);
   ASSERT_EQ(tb["gas.pressure_drop_Pa"].size(), 24u);

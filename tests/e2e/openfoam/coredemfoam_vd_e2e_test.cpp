@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <regex>
@@ -344,6 +345,53 @@ TEST_F(CoredemFoamVdE2E, ParticleHeatReachesTheGasExactlyWithTheBookedSplit) {
   EXPECT_GT(std::abs(inFlight.back()), 1e-6 * dem.back());
 }
 
+// (c1) The split given to the particles (issue 38 item 2): N2 at 400 K at rest around a bed at
+// 293.15 K filling the column above its floor, no gravity, motion frozen, Δt = 0.025 s: the
+// exchange's λ = H Δt/(α ρ c_p) is ~10 (H = 6 (1 - ε) h/d with Nu = 2). Booking the split to the
+// gas in the next step, as before protocol 1.5, made every bed cell follow (1+λ) e^{n+1} =
+// (1+λ) e^n - λ e^{n-1}, an oscillation about the particles' temperature (|z| ≈ 0.95 per step);
+// given to the particles, the gas cools monotonically (its enthalpy falls at every step; the
+// particles, which took the exchange at the start temperature, give back the split of step 1 in
+// step 2) and the heat balance closes to round-off.
+TEST_F(CoredemFoamVdE2E, StiffExchangeCoolsTheGasMonotonically) {
+  VdCase v;
+  v.uIn = 0.0;
+  v.tIn = 400.0;
+  v.t0 = 400.0;
+  v.gravity = 0.0;
+  v.body = R"(time: {end: 0.5, dt: 0.025}
+materials:
+  - {name: glass, density: 2500.0, k_n: 10.0, e_n: 0.5, friction: 0.3, cp: 840.0}
+particles:
+  - {name: bed, material: glass, count: 3600, diameter: 1.0e-3, packing: lattice,
+     temperature: 293.15, region: {min: [0.0, 0.004, 0.0], max: [0.01, 0.040, 0.01]}}
+models: {motion: frozen, radiation: "off"}
+)";
+  const fs::path c = makeVdCase(dir, v);
+  const fs::path run = dir / "run";
+  ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, dir / "coredem.log"), 0)
+      << readAll(dir / "coredem.log") << logTail(run);
+  auto ts = readTimeseries(run);
+  const auto& gas = ts["gas.enthalpy_J"];
+  const auto& particles = ts["dem.thermal_energy_J"];
+  const auto& residual = ts["balance.heat_residual_J"];
+  const auto& conv = ts["dem.heat_from_gas_J"];
+  ASSERT_EQ(gas.size(), 20u);
+  ASSERT_EQ(particles.size(), 20u);
+  ASSERT_GT(conv.back(), 1e-4) << "the particles were not heated";
+  // Row 0 is after step 1: the particles' energy at the start is row 0's less what they got.
+  EXPECT_GT(particles.back(), particles.front() - conv.front());
+  for (std::size_t i = 1; i < gas.size(); ++i) {
+    EXPECT_LT(gas[i], gas[i - 1]) << "the gas enthalpy rose at step " << i + 1;
+  }
+  for (std::size_t i = 0; i < residual.size(); ++i) {
+    EXPECT_LT(std::abs(residual[i]), 1e-9 * std::abs(conv[i]) + 1e-18) << "row " << i;
+  }
+  std::cout << "stiff exchange: gas enthalpy " << gas.front() << " -> " << gas.back()
+            << " J, particles gained " << conv.back() << " J, residual " << residual.back()
+            << " J\n";
+}
+
 // (c2) A hot bed in cold gas, every heat path on: 1600 beads at 600 K (emissivity 0.9, radiation
 // to the cell's environment) cooled by N2 entering at 300 K, 20 steps. The coupled energy ledger
 // closes at every step:
@@ -354,13 +402,12 @@ TEST_F(CoredemFoamVdE2E, ParticleHeatReachesTheGasExactlyWithTheBookedSplit) {
 //    exchanged;
 //  * radiation (protocol 1.3): what the particles radiated is what the gas received
 //    (balance.radiation_residual_J) within 1e-12 of it;
-//  * the gas's own ledger: its enthalpy change (sum V alpha rho cp T) is the enthalpy advected and
-//    conducted in plus the heat received from the particles, within 10 % of that heat. Not
-//    round-off, and not the issue's 0.1 %: the energy equation is in T form with the cell's cp
-//    (exact where cp is uniform), and here the cold gas entering the 600 K bed warms by up to
-//    ~300 K in one step while N2's cp grows 3 %; sum V alpha rho cp T then misses the cp change
-//    (observed 6.6 % after the first step, 1-3 % later; a sensible-enthalpy form of the equation
-//    would close it: docs/coredemFoam.md, limits).
+//  * the gas's own ledger: its enthalpy change (sum V alpha rho h_s) is the enthalpy advected and
+//    conducted in plus the heat received from the particles plus the enthalpy of its mass-balance
+//    residual (gas.enthalpy_mass_residual_J), within 1e-6 of that heat (issue 38 item 3). The
+//    temperature form with the cell's cp used before missed 6.6 % after the first step, 1-3 %
+//    later (the cold gas entering the 600 K bed warms by ~300 K in one step while N2's cp grows
+//    3 %), and this test allowed 10 %.
 TEST_F(CoredemFoamVdE2E, HotBedInColdGasClosesTheCoupledEnergyLedger) {
   VdCase v;
   v.uIn = 0.3;
@@ -390,6 +437,8 @@ particles:
   const auto& gasConv = ts["gas.heat_from_particles_J"];
   const auto& gasRad = ts["gas.heat_radiation_J"];
   const auto& gasHom = ts["gas.heat_homogeneous_J"];
+  const auto& gasMassResidual = ts["gas.enthalpy_mass_residual_J"];
+  ASSERT_EQ(gasMassResidual.size(), 20u);
   ASSERT_EQ(energy.size(), 20u);
   for (const auto* column : {&conv, &rad, &wall, &heatResidual, &radResidual, &gasContent,
                              &gasInflow, &gasConv, &gasRad, &gasHom}) {
@@ -408,10 +457,10 @@ particles:
     if (i > 0) {
       const double received =
           (gasConv[i] - gasConv[0]) + (gasRad[i] - gasRad[0]) + (gasHom[i] - gasHom[0]);
-      const double gasResidual =
-          (gasContent[i] - gasContent[0]) - (gasInflow[i] - gasInflow[0]) - received;
+      const double gasResidual = (gasContent[i] - gasContent[0]) - (gasInflow[i] - gasInflow[0]) -
+                                 received - (gasMassResidual[i] - gasMassResidual[0]);
       worstGas = std::max(worstGas, std::abs(gasResidual) / std::abs(received));
-      EXPECT_LT(std::abs(gasResidual), 0.1 * std::abs(received)) << "row " << i;
+      EXPECT_LT(std::abs(gasResidual), 1e-6 * std::abs(received)) << "row " << i;
     }
   }
   std::cout << "hot bed in cold gas: particles gave the gas " << -conv.back() << " J by "
@@ -703,15 +752,22 @@ models: {heat: "off", motion: frozen, radiation: "off"}
   const double carbonGas =
       co + co2 -
       (ts["gas.species.CO_kg"].front() / 0.028010 + ts["gas.species.CO2_kg"].front() / 0.044009);
-  EXPECT_NEAR(carbonGas, carbonLost, 1e-10 * co) << "carbon";
+  // The carbon lost is a difference of particle-mass sums whose 500 terms are each rounded at
+  // every sub-step: 100 ulps of the solid mass on top (measured 30).
+  const double massUlps = 100.0 * std::numeric_limits<double>::epsilon() * solid.front() / 0.012011;
+  EXPECT_NEAR(carbonGas, carbonLost, 1e-10 * co + massUlps) << "carbon";
   EXPECT_NEAR(co + 2.0 * co2 + h2o, 0.0, 1e-10 * co) << "oxygen";
   EXPECT_NEAR(2.0 * h2 + 2.0 * h2o, 0.0, 1e-10 * co) << "hydrogen";
 }
 
 // (g) Decomposed: the hot bed of (c) on 1 and 2 ranks, 8 steps. The pressure drop, the gas
 // ledgers (heat from the particles, heat in flight, enthalpy, inflow) and the DEM's heat agree
-// within 1e-4 of each column's largest magnitude (not bitwise: the decomposed solves stop at their
-// relative tolerances at other iterates, as for the constant-property gas).
+// within 1e-4 of each column's largest magnitude, 5e-4 for the heat exchanged (not bitwise: the
+// decomposed solves stop at their relative tolerances at other iterates, as for the
+// constant-property gas). The heat columns rest on the split H (T_x - T_start), a difference of
+// two close temperatures that the decomposed enthalpy solve perturbs most: measured 1.4e-4
+// (heat from the particles), 2.4e-4 (in flight) at step 8, with the heat balance of each run
+// closed to round-off (balance.heat_residual_J < 1e-18 J).
 TEST_F(CoredemFoamVdE2E, HotBedOnTwoRanksAgreesWithOneRank) {
   std::map<int, std::map<std::string, std::vector<double>>> series;
   for (int ranks : {1, 2}) {
@@ -735,8 +791,9 @@ TEST_F(CoredemFoamVdE2E, HotBedOnTwoRanksAgreesWithOneRank) {
       scale = std::max(scale, std::abs(x));
     }
     ASSERT_GT(scale, 0.0) << key;
+    const double bound = std::string(key).find("heat") != std::string::npos ? 5e-4 : 1e-4;
     for (std::size_t i = 0; i < 8; ++i) {
-      EXPECT_LE(std::abs(one[i] - two[i]), 1e-4 * scale) << key << ", step " << i + 1;
+      EXPECT_LE(std::abs(one[i] - two[i]), bound * scale) << key << ", step " << i + 1;
     }
   }
 }

@@ -77,7 +77,7 @@ struct Gas {
       Y.insert(Y.end(), y.begin(), y.end());
   }
   void apply(DemSystem& s) const {
-    s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, Y, {}});
+    s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, Y, {}, {}});
   }
 };
 

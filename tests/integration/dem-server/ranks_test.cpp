@@ -6,6 +6,7 @@
 // (arrival order: bitwise; 1 vs 2 ranks: within round-off, see kRegrouped); rank count mismatch,
 // duplicate rank index, rank index out of range, a silent rank and a rank that leaves are refused
 // with errors naming the rank, never a hang.
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -35,6 +36,7 @@ constexpr double kRegrouped = 1e-11;
 /// The gas of coupling cell c (varies per cell so that a wrong cell order shows).
 struct Gas {
   std::vector<double> u, gradP, T, rho, mu, kappa, cp, Y;
+  std::vector<double> split; ///< Q_split per cell (J/m3 of V_c), v1.5; empty: not sent
   Gas() {
     for (std::size_t c = 0; c < kCells; ++c) {
       u.insert(u.end(), {0.01 * double(c % 3), 0.0, 0.3 + 0.01 * double(c)});
@@ -59,6 +61,9 @@ struct Gas {
     m.setSessionId(session);
     for (const auto& [name, v] : arrays()) {
       m.addArray<double>(name, *v, f::shapeOf(name, kCells, 1));
+    }
+    if (!split.empty()) {
+      m.addArray<double>(f::kHeatToParticles, split, {kCells});
     }
     return m;
   }
@@ -88,6 +93,15 @@ struct Gas {
         }
       }
       m.addArray<double>(name, sums, f::shapeOf(name, cells.size(), 1));
+    }
+    if (!split.empty()) {
+      // Extensive: each rank its own part of a cell's heat (of the shared cell 13, in proportion
+      // to its fluid volume), per coupling-cell volume; the server sums them.
+      std::vector<double> q;
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        q.push_back(split[std::size_t(cells[i])] * volume[i] / v);
+      }
+      m.addArray<double>(f::kHeatToParticles, q, {cells.size()});
     }
     return m;
   }
@@ -158,20 +172,61 @@ struct RunResult {
   /// Σ over the steps and cells of Q_rad V_c Δt (J): the radiation heat the gas received.
   double radiationToGas = 0.0;
   int stepsWithQrad = 0; ///< steps whose Sources carried Q_rad
+  /// Σ over the steps and cells of mom_p V_c Δt (N s): the momentum the released mass brought.
+  std::array<double, 3> momentumToGas{0.0, 0.0, 0.0};
+  int stepsWithMomP = 0; ///< steps whose Sources carried mom_p
 };
+
+/// What a run adds to the base case (protocol 1.5).
+struct Extras {
+  bool reacting = false; ///< the beads hold B, which burns to the gas N2 (mom_p)
+  bool split = false;    ///< the CFD sends Q_split every step
+};
+
+/// The base case; reacting: half of every bead is B (M = 0.028), B -> N2 at a constant rate.
+v1::Configure rankCase(double hotT, const Extras& x) {
+  v1::Configure cfg = smallCase(kParticles, kD, kBox, kCellsPerAxis);
+  if (hotT > 0.0) {
+    cfg.mutable_particle_sets(0)->set_temperature(hotT);
+  }
+  if (x.reacting) {
+    for (auto [name, molar] : {std::pair{"B", 0.028}, {"I", 0.020}}) {
+      auto* s = cfg.add_solid_species();
+      s->set_name(name);
+      s->set_molar_mass(molar);
+    }
+    for (auto [name, frac] : {std::pair{"B", 0.5}, {"I", 0.5}}) {
+      auto* nv = cfg.mutable_particle_sets(0)->add_composition();
+      nv->set_name(name);
+      nv->set_value(frac);
+    }
+    auto* r = cfg.add_reactions();
+    r->set_name("burn");
+    for (auto [sp, nu] : {std::pair{"B", -1.0}, {"N2", 1.0}}) {
+      auto* t = r->add_terms();
+      t->set_species(sp);
+      t->set_nu(nu);
+    }
+    r->mutable_rate()->set_law(v1::RATE_LAW_CONSTANT);
+    r->mutable_rate()->set_a(1e-6); // mol/s per bead: 2.8e-8 kg/s of its 6.5e-7 kg of B
+    r->set_heat_of_reaction(0.0);
+  }
+  return cfg;
+}
 
 /// Three steps with 1 whole-grid participant (ranks 0) or 2 ranks sending in `order`; `hotT` > 0:
 /// the particles start at that temperature (radiation to the 300 K gas); `minor`: the protocol
 /// minor the CFD ranks say in Hello.
 RunResult run(int ranks, std::vector<int> order = {0, 1}, double hotT = 0.0,
-              std::uint32_t minor = proto::kProtocolVersion.minor) {
+              std::uint32_t minor = proto::kProtocolVersion.minor, Extras extras = {}) {
   ServerThread server;
-  v1::Configure cfg = smallCase(kParticles, kD, kBox, kCellsPerAxis);
-  if (hotT > 0.0) {
-    cfg.mutable_particle_sets(0)->set_temperature(hotT);
-  }
-  MiniOrchestrator o(server.endpoint(), cfg);
+  MiniOrchestrator o(server.endpoint(), rankCase(hotT, extras));
   Gas gas;
+  if (extras.split) {
+    for (std::size_t c = 0; c < kCells; ++c) {
+      gas.split.push_back(2e5 * (1.0 + 0.1 * double(c)) * (c % 2 == 0 ? 1.0 : -0.5));
+    }
+  }
   const double dt = 2e-4;
   const auto nSub = static_cast<std::uint32_t>(std::ceil(dt / o.dtDemMax()));
   std::vector<proto::Client> c;
@@ -214,6 +269,13 @@ RunResult run(int ranks, std::vector<int> order = {0, 1}, double hotT = 0.0,
         sum += v * kH * kH * kH * dt;
       }
       result.radiationToGas += sum;
+    }
+    if (const auto m = result.sources.find(std::string(f::kReleasedMomentum));
+        m != result.sources.end()) {
+      ++result.stepsWithMomP;
+      for (std::size_t k = 0; k < m->second.size(); ++k) {
+        result.momentumToGas[k % 3] += m->second[k] * kH * kH * kH * dt;
+      }
     }
   }
   return result;
@@ -373,4 +435,73 @@ TEST(DemServerRanks, APeerOfProtocol12ReceivesNoRadiationHeat) {
   // A decomposed 1.2 run gets no Q_rad either.
   const RunResult oldTwo = run(2, {0, 1}, 900.0, 2);
   EXPECT_EQ(oldTwo.stepsWithQrad, 0);
+}
+
+// Protocol 1.5: mom_p, the momentum of the mass the particles release (burning beads moving in
+// the gas). Σ mom_p V_c Δt over cells and steps equals the DEM's dem.momentum_released_*_Ns to
+// 1e-12, whole grid or 2 ranks (partial Sources); a 1.4 peer, whole or decomposed, receives none.
+TEST(DemServerRanks, ReleasedMomentumReachesPeersOfProtocol15Only) {
+  const Extras burning{.reacting = true};
+  const RunResult one = run(0, {0, 1}, 0.0, proto::kProtocolVersion.minor, burning);
+  const RunResult two = run(2, {0, 1}, 0.0, proto::kProtocolVersion.minor, burning);
+  EXPECT_EQ(one.stepsWithMomP, 3);
+  EXPECT_EQ(two.stepsWithMomP, 3);
+  const char* names[3] = {"dem.momentum_released_x_Ns", "dem.momentum_released_y_Ns",
+                          "dem.momentum_released_z_Ns"};
+  double size = 0.0;
+  for (int a = 0; a < 3; ++a) {
+    const double dem = named(one.demDone.diagnostics(), names[a]);
+    size = std::max(size, std::abs(dem));
+    EXPECT_NEAR(one.momentumToGas[a], dem, 1e-12 * std::abs(dem)) << names[a];
+    const double demTwo = named(two.demDone.diagnostics(), names[a]);
+    EXPECT_NEAR(two.momentumToGas[a], demTwo, 1e-12 * std::abs(demTwo)) << names[a];
+  }
+  EXPECT_GT(size, 0.0); // the beads move (settling) while they burn
+  std::printf("released momentum to the gas %.6g %.6g %.6g N s\n", one.momentumToGas[0],
+              one.momentumToGas[1], one.momentumToGas[2]);
+  for (std::uint32_t ranks : {0u, 2u}) {
+    const RunResult old = run(int(ranks), {0, 1}, 0.0, proto::kMinorReleasedMomentum - 1, burning);
+    EXPECT_EQ(old.stepsWithMomP, 0) << ranks << " ranks";
+    EXPECT_EQ(old.sources.count(std::string(f::kReleasedMomentum)), 0u);
+    EXPECT_EQ(old.stepsWithQrad, 3); // a 1.4 peer still gets Q_rad
+  }
+}
+
+// Protocol 1.5: Q_split of a decomposed CFD is extensive: 2 ranks each send their own part of a
+// cell's heat (the shared cell 13 split 0.375/0.625) and the server sums them, so the particles
+// get what one whole-grid participant sending the whole heat gives them (to round-off). Given
+// plus unassigned is, per step, Σ_c Q_split V_c (up to the window's convective response).
+TEST(DemServerRanks, HeatSplitFromTwoRanksIsSummedPerCell) {
+  const Extras split{.split = true};
+  const RunResult one = run(0, {0, 1}, 0.0, proto::kProtocolVersion.minor, split);
+  const RunResult two = run(2, {1, 0}, 0.0, proto::kProtocolVersion.minor, split);
+  const RunResult none = run(0);
+  const auto energy = [](const RunResult& r, const char* name) {
+    return named(r.demDone.ledger().energy(), name);
+  };
+  const double booked =
+      energy(one, "dem.heat_from_gas_J") + energy(one, "dem.heat_split_unassigned_J");
+  const double bookedTwo =
+      energy(two, "dem.heat_from_gas_J") + energy(two, "dem.heat_split_unassigned_J");
+  EXPECT_LE(relDiff(booked, bookedTwo), kRegrouped) << booked << " vs " << bookedTwo;
+  EXPECT_LE(relDiff(named(one.demDone.diagnostics(), "mean_T_p"),
+                    named(two.demDone.diagnostics(), "mean_T_p")),
+            kRegrouped);
+  double sent = 0.0;
+  for (std::size_t c = 0; c < kCells; ++c) {
+    sent += 3 * 2e5 * (1.0 + 0.1 * double(c)) * (c % 2 == 0 ? 1.0 : -0.5) * kH * kH * kH;
+  }
+  const double delta = booked - energy(none, "dem.heat_from_gas_J");
+  std::printf("split sent %.9g J, booked %.9g J (unassigned %.6g J)\n", sent, delta,
+              energy(one, "dem.heat_split_unassigned_J"));
+  EXPECT_NEAR(delta, sent, 1e-3 * std::abs(sent));
+  EXPECT_NE(named(one.demDone.diagnostics(), "mean_T_p"),
+            named(none.demDone.diagnostics(), "mean_T_p"));
+  // The particles' energy balance closes with the split booked as heat from the gas.
+  const double thermal0 = energy(none, "dem.thermal_energy_J") -
+                          energy(none, "dem.heat_from_gas_J") -
+                          energy(none, "dem.heat_radiation_J") - energy(none, "dem.heat_wall_J");
+  const double thermal = energy(one, "dem.thermal_energy_J") - energy(one, "dem.heat_from_gas_J") -
+                         energy(one, "dem.heat_radiation_J") - energy(one, "dem.heat_wall_J");
+  EXPECT_NEAR(thermal, thermal0, 1e-9 * std::abs(thermal0));
 }

@@ -26,7 +26,7 @@ TEST(Coupling, GasFractionSumsToParticleVolume) {
   std::vector<double> ug(3 * nc), gp(3 * nc, 0.0), rho(nc, 1.2), mu(nc, 1.8e-5);
   for (std::size_t k = 0; k < nc; ++k)
     ug[3 * k + 2] = 0.5 + 0.01 * k;
-  sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}, {}});
+  sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}, {}, {}});
   const auto& cfg = sys.config().grid;
   const double vc = cfg.spacing[0] * cfg.spacing[1] * cfg.spacing[2];
   const ParticleData p = sys.particles();
@@ -65,7 +65,7 @@ TEST(Coupling, SourcesOfAParticleAtRestMatchTheDragLaw) {
   c.particleSets.push_back(s);
   DemSystem sys(c, BackendKind::Cpu, 1);
   const std::vector<double> ug{0, 0, 0, 0, 0, 1.0}, gp(6, 0.0), rho{1.2, 1.2}, mu{1.8e-5, 1.8e-5};
-  sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}, {}});
+  sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}, {}, {}});
   const CellSources& src = sys.advance(sys.dtDemMax(), 1);
   const double vc = 64e-9, vp = kPi / 6 * 1e-9, eps = 1 - vp / vc;
   const double re = eps * 1.2 * 1e-3 * 1.0 / 1.8e-5;
@@ -82,14 +82,14 @@ TEST(Coupling, RejectsBadGasFields) {
   DemSystem sys(coupledBox(8), BackendKind::Cpu, 1);
   std::vector<double> ug(3 * 36, 0.0), gp(3 * 36, 0.0), rho(36, 1.2), mu(36, 1.8e-5),
       shortv(5, 1.0);
-  EXPECT_THROW(sys.setGasFields(GasFieldsView{shortv, gp, {}, rho, mu, {}, {}, {}, {}}),
+  EXPECT_THROW(sys.setGasFields(GasFieldsView{shortv, gp, {}, rho, mu, {}, {}, {}, {}, {}}),
                coredem::UserError);
   rho[3] = -1;
-  EXPECT_THROW(sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}, {}}),
+  EXPECT_THROW(sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}, {}, {}}),
                coredem::UserError);
   rho[3] = 1.2;
   ug[7] = NAN;
-  EXPECT_THROW(sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}, {}}),
+  EXPECT_THROW(sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}, {}, {}}),
                coredem::UserError);
   EXPECT_THROW(sys.advance(10 * sys.dtDemMax(), 1), coredem::UserError); // Δt too large
 }
@@ -110,7 +110,7 @@ TEST(Coupling, FluidFractionGivesTheGasFractionOfTheFluidVolume) {
   DemSystem sys(c, BackendKind::Cpu, 1);
   const std::vector<double> ug{0, 0, 0, 0, 0, 1.0}, gp(6, 0.0), rho{1.2, 1.2}, mu{1.8e-5, 1.8e-5},
       fluid{1.0, 0.5};
-  GasFieldsView view{ug, gp, {}, rho, mu, {}, {}, {}, {}};
+  GasFieldsView view{ug, gp, {}, rho, mu, {}, {}, {}, {}, {}};
   view.fluidFraction = fluid;
   sys.setGasFields(view);
   const CellSources& src = sys.advance(sys.dtDemMax(), 1);
@@ -136,7 +136,7 @@ TEST(Coupling, ParticleInACellWithoutFluidIsRefusedNamingIt) {
   c.particleSets.push_back(s);
   DemSystem sys(c, BackendKind::Cpu, 1);
   const std::vector<double> ug(6, 0.0), gp(6, 0.0), rho{1.2, 1.2}, mu{1.8e-5, 1.8e-5};
-  GasFieldsView view{ug, gp, {}, rho, mu, {}, {}, {}, {}};
+  GasFieldsView view{ug, gp, {}, rho, mu, {}, {}, {}, {}, {}};
   const std::vector<double> bad{1.0, 1.5};
   view.fluidFraction = bad;
   EXPECT_THROW(sys.setGasFields(view), coredem::UserError);

@@ -29,7 +29,7 @@ void setGas(DemSystem& sys) {
     ug[3 * k + 2] = 0.8;
     gp[3 * k + 2] = -11.8;
   }
-  sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}, {}});
+  sys.setGasFields(GasFieldsView{ug, gp, {}, rho, mu, {}, {}, {}, {}, {}});
 }
 
 void run(DemSystem& sys, int windows, std::vector<double>* lastSources = nullptr) {

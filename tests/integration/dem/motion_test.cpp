@@ -69,7 +69,7 @@ TEST(Drag, SingleSphereSettlesAtGidaspowTerminalVelocity) {
   DemSystem sys(c, BackendKind::Cpu, 1);
   // Quiescent gas with hydrostatic pressure: ∇p = ρ_g g gives the buoyancy −V_p ∇p.
   const std::vector<double> ug{0, 0, 0}, gradP{0, 0, -rhoG * g}, rho{rhoG}, muv{mu};
-  sys.setGasFields(GasFieldsView{ug, gradP, {}, rho, muv, {}, {}, {}, {}});
+  sys.setGasFields(GasFieldsView{ug, gradP, {}, rho, muv, {}, {}, {}, {}, {}});
   const double vp = kPi / 6 * d * d * d;
   const double eps = 1 - vp / (0.1 * 0.1 * 11);
   const double vt = terminalVelocity(rhoP, rhoG, mu, d, eps, g);

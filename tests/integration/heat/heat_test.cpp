@@ -69,7 +69,7 @@ struct Gas {
       , kappa(n, kG)
       , cp(n, cpG) {}
   void apply(DemSystem& s) const {
-    s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, {}, {}});
+    s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, {}, {}, {}});
   }
 };
 

@@ -137,7 +137,7 @@ TEST(WallHeat, CoupledWallLensAddsToContact) {
   const double kg = 0.0257;
   std::vector<double> u(3, 0.0), gp(3, 0.0), tg(1, kT0), rho(1, 1.204), mu(1, 1.81e-5),
       kappa(1, kg), cp(1, 1006.0);
-  sys.setGasFields(GasFieldsView{u, gp, tg, rho, mu, kappa, cp, {}, {}});
+  sys.setGasFields(GasFieldsView{u, gp, tg, rho, mu, kappa, cp, {}, {}, {}});
   k::WallConductionParams wp;
   const double h = 0.5 * kD - kDelta;
   const double g =
@@ -196,7 +196,7 @@ TEST(WallHeat, CylinderAndTriangleWallsConductAsThePlane) {
     DemSystem sys(cfg, BackendKind::Cpu, 1);
     std::vector<double> u(3, 0.0), gp(3, 0.0), tg(1, kT0), rho(1, 1.204), mu(1, 1.81e-5),
         kappa(1, kg), cp(1, 1006.0);
-    sys.setGasFields(GasFieldsView{u, gp, tg, rho, mu, kappa, cp, {}, {}});
+    sys.setGasFields(GasFieldsView{u, gp, tg, rho, mu, kappa, cp, {}, {}, {}});
     const double e0 = sys.thermalEnergy();
     sys.advance(100 * dt, 100);
     EXPECT_NEAR(onlyTemperature(sys), want, 1e-10) << "variant " << variant;

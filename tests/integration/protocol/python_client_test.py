@@ -3,7 +3,7 @@
 talks to the C++ loopback server and decodes the C++ golden files.
 
 usage: python_client_test.py PROTOC PROTO_DIR GOLDEN_DIR LOOPBACK_BINARY
-Checks: every golden v1.0, v1.1, v1.2 and v1.3 file decodes with Python's protobuf and has the type its name says;
+Checks: every golden v1.0 to v1.5 file decodes with Python's protobuf and has the type its name says;
 the golden GasFields arrays hold 0.25 (f+1) + 0.125 i; over tcp loopback a Python DEALER
 handshakes, configures a 4x3x2 grid, sends GasFields built from numpy arrays and receives
 Sources (eps_g = 1, other sources 0, checksums equal to sequential sums of what was sent);
@@ -101,6 +101,21 @@ def main():
         hello.ParseFromString(read_cdmf(os.path.join(golden_dir, "v1.3", "hello.cdmf"))[0])
         assert hello.hello.protocol_minor == 3
         print("python: decoded the golden v1.3 Sources with Q_rad")
+        # v1.5: the partial GasFields also carry Q_split [1], the partial Sources mom_p [1, 3].
+        for name, array, shape, values in (("gas_fields", "Q_split", [1], [-2.25]),
+                                           ("sources", "mom_p", [1, 3], [2.25, 2.375, 2.5])):
+            frames = read_cdmf(os.path.join(golden_dir, "v1.5", name + ".cdmf"))
+            env = pb.Envelope()
+            env.ParseFromString(frames[0])
+            assert env.WhichOneof("body") == name
+            arrays = {d.name: (d, raw) for d, raw in zip(env.arrays, frames[1:])}
+            d, raw = arrays[array]
+            assert d.dtype == common.DTYPE_FLOAT64 and list(d.shape) == shape, d
+            assert np.frombuffer(raw, dtype="<f8").tolist() == values
+        hello = pb.Envelope()
+        hello.ParseFromString(read_cdmf(os.path.join(golden_dir, "v1.5", "hello.cdmf"))[0])
+        assert hello.hello.protocol_minor == 5
+        print("python: decoded the golden v1.5 GasFields with Q_split and Sources with mom_p")
         # v1.1 Configure: explicit positions and chemistry, read by Python's protobuf.
         env = pb.Envelope()
         env.ParseFromString(read_cdmf(os.path.join(golden_dir, "v1.1", "configure.cdmf"))[0])
@@ -151,7 +166,7 @@ def main():
             hello.hello.role = common.ROLE_CFD
             welcome, _ = request(hello)
             assert welcome.type == common.MESSAGE_TYPE_WELCOME
-            assert welcome.welcome.protocol_minor == 4  # min(server 1.4, client 1.7)
+            assert welcome.welcome.protocol_minor == 5  # min(server 1.5, client 1.7)
             session = welcome.welcome.session_id
 
             nx, ny, nz, ns = 4, 3, 2, 2

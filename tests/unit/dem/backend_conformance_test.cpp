@@ -130,15 +130,20 @@ void expectSameSources(const CellSources& a, const CellSources& b, const Toleran
   expectCloseRel(a.heatHTp, b.heatHTp, t.sources, "heatHTp");
   expectCloseRel(a.rSpecies, b.rSpecies, t.sources, "rSpecies");
   expectCloseRel(a.qHom, b.qHom, t.sources, "qHom");
+  expectCloseRel(a.qRad, b.qRad, t.sources, "qRad");
+  expectCloseRel(a.momP, b.momP, t.sources, "momP");
 }
 
 void expectSameTotals(const HeatTotals& a, const HeatTotals& b, const ChemistryTotals& ca,
                       const ChemistryTotals& cb, const Tolerances& t) {
-  expectCloseRel({a.convection, a.radiation, a.wall}, {b.convection, b.radiation, b.wall}, t.totals,
-                 "heat totals");
+  expectCloseRel({a.convection, a.radiation, a.wall, a.splitUnassigned},
+                 {b.convection, b.radiation, b.wall, b.splitUnassigned}, t.totals, "heat totals");
   expectCloseRel(ca.gasProduced, cb.gasProduced, t.totals, "gasProduced");
   expectCloseRel(ca.solidChange, cb.solidChange, t.totals, "solidChange");
   expectCloseRel(ca.removedSolid, cb.removedSolid, t.totals, "removedSolid");
+  expectCloseRel({ca.releasedMomentum.begin(), ca.releasedMomentum.end()},
+                 {cb.releasedMomentum.begin(), cb.releasedMomentum.end()}, t.totals,
+                 "releasedMomentum");
   expectCloseRel({ca.reactionHeat, ca.homogeneousHeat, ca.gasSensibleHeat, ca.sensibleMassEnthalpy},
                  {cb.reactionHeat, cb.homogeneousHeat, cb.gasSensibleHeat, cb.sensibleMassEnthalpy},
                  t.totals, "chemistry heat totals");
@@ -162,7 +167,7 @@ struct Gas {
     }
   }
   void apply(DemSystem& s) const {
-    s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, Y, {}});
+    s.setGasFields(GasFieldsView{u, gp, T, rho, mu, kappa, cp, Y, {}, {}});
   }
 };
 

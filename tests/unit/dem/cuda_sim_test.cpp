@@ -193,7 +193,7 @@ TEST(CudaSim, OneHostRoundTripPerSubStepWithDragAndHeat) {
     cp.push_back(1100.0);
   }
   DemSystem sim(c, BackendKind::CudaSim, 1);
-  const GasFieldsView gas{u, gp, T, rho, mu, kappa, cp, {}, {}};
+  const GasFieldsView gas{u, gp, T, rho, mu, kappa, cp, {}, {}, {}};
   sim.setGasFields(gas);
   const double dt = 1e-5; // frozen: no contact time step limit (dtDemMax is infinite)
   sim.advance(dt, 1);

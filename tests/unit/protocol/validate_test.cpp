@@ -608,3 +608,89 @@ TEST(ValidateSources, RadiationHeatRoundTripsBitwise) {
   EXPECT_NE(fields::findField(fields::kRadiationHeat), nullptr);
   EXPECT_EQ(fields::findField(fields::kRadiationHeat)->unit, "W/m3");
 }
+
+// Q_split (v1.5): optional in GasFields, whole grid or partial; when present float64, one row per
+// cell (or listed cell) and finite, of either sign.
+TEST(ValidateGasFields, HeatToParticlesIsOptionalOnePerCellFiniteOfEitherSign) {
+  const Expectation e = partialExpectation(); // 4 cells, 1 species
+  const auto whole = [](std::vector<double> q, std::vector<std::uint64_t> shape) {
+    Message m = makeGasFields(1, 0.0, 1e-3, 4, 1);
+    for (const auto& spec : fields::gasFields()) {
+      std::vector<double> v(4 * fields::componentsOf(spec.extent, 1), 1.0);
+      m.addArray<double>(spec.name, v, fields::shapeOf(spec.extent, 4, 1));
+    }
+    if (!shape.empty()) {
+      m.addArray<double>(fields::kHeatToParticles, q, shape);
+    }
+    return m;
+  };
+  EXPECT_TRUE(validate(whole({}, {}), e).ok()); // a v1.4 GasFields: no Q_split
+  Status s = validate(whole({1.5, -2.0, 0.0, 3e6}, {4}), e);
+  EXPECT_TRUE(s.ok()) << s.toString();
+  // Partial (a rank's own contribution): one value per listed cell.
+  Message p = partialGas({0, 3}, {0.5, 1.0}, 2);
+  p.addArray<double>(fields::kHeatToParticles, std::vector<double>{-4.0, 2.5}, {2});
+  s = validate(p, e);
+  EXPECT_TRUE(s.ok()) << s.toString();
+  Message pBad = partialGas({0, 3}, {0.5, 1.0}, 2);
+  pBad.addArray<double>(fields::kHeatToParticles, std::vector<double>{-4.0, 2.5, 1.0, 1.0}, {4});
+  s = validate(pBad, e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  EXPECT_NE(s.message.find("'Q_split'"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("listed"), std::string::npos) << s.message;
+  // Wrong count or shape on the whole grid.
+  s = validate(whole({1.0, 2.0, 3.0}, {3}), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  EXPECT_NE(s.message.find("'Q_split'"), std::string::npos) << s.message;
+  s = validate(whole({1.0, 2.0, 3.0, 4.0}, {4, 1}), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  // NaN and Inf are refused, naming the array and the index (whole grid and partial).
+  s = validate(whole({1.0, std::nan(""), 3.0, 4.0}, {4}), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_NON_FINITE);
+  EXPECT_NE(s.message.find("Q_split"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("flat index 1"), std::string::npos) << s.message;
+  Message pNan = partialGas({0, 3}, {0.5, 1.0}, 2);
+  pNan.addArray<double>(fields::kHeatToParticles,
+                        std::vector<double>{-std::numeric_limits<double>::infinity(), 2.5}, {2});
+  s = validate(pNan, e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_NON_FINITE);
+  EXPECT_NE(s.message.find("Q_split"), std::string::npos) << s.message;
+  // float32 is refused like every coupling array.
+  Message f32 = whole({}, {});
+  f32.addArray<float>(fields::kHeatToParticles, std::vector<float>{1, 2, 3, 4}, {4});
+  EXPECT_EQ(validate(f32, e).code, v1::ERROR_CODE_SHAPE);
+  // No physical range: any finite value passes the gas ranges.
+  const auto* spec = fields::findField(fields::kHeatToParticles);
+  ASSERT_NE(spec, nullptr);
+  EXPECT_EQ(spec->unit, "J/m3");
+  EXPECT_EQ(spec->extent, v1::EXTENT_SCALAR);
+}
+
+// mom_p (v1.5): optional in Sources; when present float64 [rows, 3], finite.
+TEST(ValidateSources, ReleasedMomentumIsOptionalThreePerCell) {
+  const Expectation e = sourcesExpectation(); // 4 cells, 1 species
+  const auto with = [](std::uint64_t rows, bool partial, std::vector<double> mom,
+                       std::vector<std::uint64_t> shape) {
+    Message m = sourcesWith(rows, partial, {}, {});
+    m.addArray<double>(fields::kReleasedMomentum, mom, shape);
+    return m;
+  };
+  std::vector<double> twelve(12, 0.25);
+  twelve[5] = -3.5;
+  Status s = validate(with(4, false, twelve, {4, 3}), e);
+  EXPECT_TRUE(s.ok()) << s.toString();
+  s = validate(with(2, true, {1, 2, 3, -4, -5, -6}, {2, 3}), e); // partial: listed cells
+  EXPECT_TRUE(s.ok()) << s.toString();
+  s = validate(with(4, false, twelve, {12}), e); // flat: refused
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  EXPECT_NE(s.message.find("'mom_p'"), std::string::npos) << s.message;
+  s = validate(with(2, true, twelve, {4, 3}), e); // whole-grid rows in a partial Sources
+  EXPECT_EQ(s.code, v1::ERROR_CODE_SHAPE);
+  twelve[7] = std::nan("");
+  s = validate(with(4, false, twelve, {4, 3}), e);
+  EXPECT_EQ(s.code, v1::ERROR_CODE_NON_FINITE);
+  EXPECT_NE(s.message.find("mom_p"), std::string::npos) << s.message;
+  EXPECT_NE(s.message.find("row 2, column 1"), std::string::npos) << s.message;
+  EXPECT_EQ(fields::findField(fields::kReleasedMomentum)->unit, "N/m3");
+  EXPECT_EQ(fields::shapeOf(fields::kReleasedMomentum, 5, 2), (std::vector<std::uint64_t>{5, 3}));
+}

@@ -7,6 +7,7 @@
 /// `Configure.chemistry` (case.yaml `reactions:` / `chemistry:`) by the server. Species are named
 /// by the gas and solid species lists of DemConfig.
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -90,7 +91,10 @@ struct ChemistryTotals {
   /// them at T_p; Δ Σ m c_p T = Q_gas + Q_rad + Q_wall + reactionHeat + this (+ removed particles)
   double sensibleMassEnthalpy = 0.0;
   std::vector<double> homogeneousSource; ///< kg per gas species produced by WGS (sums to ~0)
-  std::uint64_t removedCount = 0;        ///< particles removed
+  /// N s: Σ ṁ_gas,i u_i Δt, the momentum the gas the particles released carried away (their
+  /// velocity; negative ṁ: gas taken up), all particles (also outside the coupling grid)
+  std::array<double, 3> releasedMomentum{0.0, 0.0, 0.0};
+  std::uint64_t removedCount = 0; ///< particles removed
   double removedMass() const {
     double s = 0.0;
     for (double v : removedSolid)

@@ -83,6 +83,14 @@ struct GasFieldsView {
   /// PCM then takes ε_g = 1 − V_s/(φ_f V_c) for the closures (drag, heat, WGS) and a particle
   /// in a cell with φ_f = 0 is an error naming it; the sources stay per V_c.
   std::span<const double> fluidFraction;
+  /// Optional heat for the particles, N (J per m³ of coupling cell, either sign; empty: none):
+  /// the heat the gas removed from each cell in its last step beyond what the DEM booked
+  /// (protocol 1.5 Q_split). The next advance() gives Q_split[c]·V_c to the particles of cell c at
+  /// its start, in proportion to their gas conductance G_i = h_i A_i (all G_i zero: to m_i c_p,i),
+  /// ΔT_i = R_i/(m_i c_p,i), booked in HeatTotals::convection; a cell without particles books it
+  /// in HeatTotals::splitUnassigned (a warning names the first such cell, once). Given once: a
+  /// second advance() without new gas fields does not give it again; evaluateSources() never.
+  std::span<const double> heatToParticles;
 };
 
 /// Per-cell sources for the CFD, averaged over the sub-steps of one advance() (docs/physics.md
@@ -103,6 +111,12 @@ struct CellSources {
   /// Q_rad,i⟩. Σ_c qRad V_c Δt_CFD = −Δ HeatTotals::radiation of the window (round-off). Sent as
   /// the Sources array Q_rad to a CFD peer of protocol 1.3 or later (docs/heat-coupling.md).
   std::vector<double> qRad;
+  /// Momentum of the mass the particles give the gas, per V_c, averaged over the sub-steps like
+  /// rSpecies (N/m³, N*3): (1/V_c) ⟨Σ_i ṁ_i u_i⟩ with ṁ_i the net gas mass particle i releases
+  /// (kg/s, Σ_k of its species rates; negative when it takes gas) and u_i its velocity in the
+  /// sub-step: the mass leaves the particle at the particle's velocity. Sent as the Sources array
+  /// mom_p to a CFD peer of protocol 1.5 or later (docs/physics.md §1.1).
+  std::vector<double> momP;
 };
 
 /// Host copy of the particle state (for tests, snapshots and the server), in the system's

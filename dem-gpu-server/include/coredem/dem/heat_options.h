@@ -39,9 +39,14 @@ struct HeatOptions {
 /// written by it), J. Conduction between particles moves heat between particles only and is
 /// not listed; conduction from fixed-temperature walls is (`wall`).
 struct HeatTotals {
-  double convection = 0.0; ///< from the gas (Σ_c (H T_g − H_Tp) V_c Δt), the gas loses the same
-  double radiation = 0.0;  ///< from the radiative environment (Eq. 27)
-  double wall = 0.0;       ///< from fixed-temperature walls (kernels/wall_conduction.h)
+  /// From the gas: Σ_c (H T_g − H_Tp) V_c Δt (the gas loses the same) plus the heat split the gas
+  /// sent (protocol 1.5 Q_split, GasFieldsView::heatToParticles) given to the particles
+  double convection = 0.0;
+  double radiation = 0.0; ///< from the radiative environment (Eq. 27)
+  double wall = 0.0;      ///< from fixed-temperature walls (kernels/wall_conduction.h)
+  /// Heat split the gas sent for coupling cells without particles: given to nobody (the gas
+  /// removed it), booked here so that the ledgers close
+  double splitUnassigned = 0.0;
 };
 
 /// One entry of the heat ledger: how the DEM server reports it (StepDone ledger, energy, J) and
@@ -58,6 +63,7 @@ inline constexpr HeatLedgerEntry kHeatLedger[] = {
     {"dem.heat_from_gas_J", &HeatTotals::convection, "heat_convection_J"},
     {"dem.heat_radiation_J", &HeatTotals::radiation, "heat_radiation_J"},
     {"dem.heat_wall_J", &HeatTotals::wall, "heat_wall_J"},
+    {"dem.heat_split_unassigned_J", &HeatTotals::splitUnassigned, "heat_split_unassigned_J"},
 };
 
 /// The heat options' part of the configuration hash (a restart with other options is refused),

@@ -37,6 +37,19 @@ inline constexpr std::string_view kGasMassFractions = "Y_g";    ///< [N,n_specie
 /// closures (drag, heat, WGS) and refuses a particle in a cell without fluid. Its Sources stay
 /// per coupling-cell volume V_c (the CFD side divides by φ_f).
 inline constexpr std::string_view kFluidFraction = "fluid_fraction"; ///< [N] -
+/// Optional (v1.5, fields::optionalGasFields()): the heat the gas removed from each coupling cell
+/// in its last step beyond what the DEM booked, per coupling-cell volume (J/m3 of V_c, NOT of the
+/// fluid volume), to be given to the cell's particles at the start of the DEM window that
+/// receives it (either sign; absent = 0; a prescribed-gas participant never sends it). The DEM
+/// server gives Q_split V_c to the particles of the cell in proportion to their gas conductance
+/// h_i A_i (all zero: to m_i c_p,i) and books it in dem.heat_from_gas_J; in a cell without
+/// particles it is booked as unassigned (dem.heat_split_unassigned_J). Sent only to a DEM server
+/// of agreed minor >= kMinorHeatToParticles.
+/// EXTENSIVE in a partial GasFields (v1.2, decomposed CFD): each rank sends its OWN contribution,
+/// still in J per m3 of the coupling cell's volume V_c (not fluid-volume weighted like the
+/// intensive fields above), and the server SUMS the ranks' values of a cell (it does not divide
+/// by the fluid volume).
+inline constexpr std::string_view kHeatToParticles = "Q_split"; ///< [N] J/m3
 
 // Partial GasFields / Sources (v1.2, one rank of a decomposed CFD participant; body.partial):
 // every array above has M = body.touched_count rows instead of N, one per listed coupling cell.
@@ -59,6 +72,14 @@ inline constexpr std::string_view kHomogeneousHeat = "Q_hom";          ///< [N] 
 /// like H and H_Tp (positive = heat to the gas). Σ_c Q_rad V_c Δt_CFD is the radiation heat the
 /// particles lost in the step. Sent only to a CFD peer of agreed minor >= kMinorRadiation.
 inline constexpr std::string_view kRadiationHeat = "Q_rad"; ///< [N] W/m3
+/// Optional (v1.5, fields::optionalSourceFields()): the momentum of the mass the particles of each
+/// coupling cell give the gas, Σ_i ṁ_i u_i / V_c (ṁ_i: the net gas mass particle i releases, kg/s,
+/// negative when it takes gas; u_i its velocity), averaged over the sub-steps like R_species:
+/// released mass leaves a particle at the particle's velocity. The gas adds mom_p − S_m U to its
+/// momentum equation (S_m = Σ_k R_species; the mass then enters with the particles' momentum
+/// instead of at the gas velocity). Sent only to a CFD peer of agreed minor >=
+/// kMinorReleasedMomentum.
+inline constexpr std::string_view kReleasedMomentum = "mom_p"; ///< [N,3] N/m3
 
 /// One coupling field.
 struct FieldSpec {
@@ -70,12 +91,12 @@ struct FieldSpec {
 
 /// The arrays a GasFields message must carry, in the canonical order.
 std::span<const FieldSpec> gasFields();
-/// The arrays a GasFields message may carry besides (fluid_fraction).
+/// The arrays a GasFields message may carry besides (fluid_fraction; v1.5: Q_split).
 std::span<const FieldSpec> optionalGasFields();
 /// The arrays a Sources message must carry, in the canonical order.
 std::span<const FieldSpec> sourceFields();
-/// The arrays a Sources message may carry besides (v1.3: Q_rad); validated like the required
-/// ones (dtype float64, one row per cell or listed cell, finite) when present.
+/// The arrays a Sources message may carry besides (v1.3: Q_rad; v1.5: mom_p); validated like the
+/// required ones (dtype float64, one row per cell or listed cell, finite) when present.
 std::span<const FieldSpec> optionalSourceFields();
 /// The spec of a GasFields or Sources field by name; nullptr if the name is not one of them.
 const FieldSpec* findField(std::string_view name);

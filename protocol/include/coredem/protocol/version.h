@@ -19,7 +19,7 @@ struct Version {
 };
 
 /// The version this build speaks.
-inline constexpr Version kProtocolVersion{1, 4};
+inline constexpr Version kProtocolVersion{1, 5};
 
 /// First minor version with the fluid_fraction array and the decomposed (M:1) exchange: rank
 /// identity in Hello, partial GasFields/Sources (docs/protocol.md "Decomposed CFD").
@@ -34,6 +34,17 @@ inline constexpr std::uint32_t kMinorRadiation = 3;
 /// .meshes). An older server ignores them, so the orchestrator refuses to send a case with such
 /// walls to a DEM server whose agreed minor is below this.
 inline constexpr std::uint32_t kMinorWallShapes = 4;
+
+/// First minor version with the Sources array mom_p (the momentum of the mass the particles give
+/// the gas, fields::kReleasedMomentum): the DEM server sends it only to a CFD peer whose agreed
+/// minor is at least this; below, the released mass enters the gas at the gas velocity as before.
+inline constexpr std::uint32_t kMinorReleasedMomentum = 5;
+
+/// First minor version with the GasFields array Q_split (heat the gas removed from a cell beyond
+/// what the DEM booked, to be given to the cell's particles, fields::kHeatToParticles). An older
+/// DEM server would ignore it (the heat would be lost), so the coupling client refuses to send it
+/// to a DEM server whose agreed minor is below this.
+inline constexpr std::uint32_t kMinorHeatToParticles = 5;
 
 /// Outcome of a handshake.
 struct Negotiation {

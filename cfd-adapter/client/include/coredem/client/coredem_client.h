@@ -120,6 +120,17 @@ coredem_status coredem_client_source(const coredem_client* c, const char* name,
  * server did not send it (protocol below 1.3). */
 coredem_status coredem_client_radiation_heat(const coredem_client* c, const double** values,
                                              size_t* size);
+/* mom_p of the last exchange: the momentum of the mass the particles gave the gas, N/m3 of
+ * coupling cell, 3 values per cell (x, y, z). *values NULL and *size 0 when the DEM server did not
+ * send it (protocol below 1.5). */
+coredem_status coredem_client_released_momentum(const coredem_client* c, const double** values,
+                                                size_t* size);
+/* Q_split for the next exchange (protocol 1.5): the heat the gas removed beyond what the DEM
+ * booked, J/m3 of coupling cell, one value per cell (exchange_partial: per listed cell, this rank's
+ * own contribution). Copied; sent once. COREDEM_ERROR_ARGUMENT when a value is not finite or the
+ * DEM server agreed a protocol below 1.5. After a grant, before that step's exchange. */
+coredem_status coredem_client_set_heat_to_particles(coredem_client* c, const double* values,
+                                                    size_t size);
 
 /* StepDone to O: Courant number, energy ledgers (name/value pairs, J) and the checkpoint files
  * written for this step; then waits for the next grant or Shutdown. */

@@ -156,8 +156,9 @@ struct Grid {
 };
 
 /// Sources of the last exchange (sub-step averages over the CFD step), valid until the next
-/// exchange() or finalize(). Names: eps_g, K_sl, K_sl_Us, H, H_Tp, R_species, Q_hom, and with a
-/// DEM server of protocol 1.3 or later Q_rad (radiationHeat()).
+/// exchange() or finalize(). Names: eps_g, K_sl, K_sl_Us, H, H_Tp, R_species, Q_hom, with a
+/// DEM server of protocol 1.3 or later Q_rad (radiationHeat()) and of 1.5 or later mom_p
+/// (releasedMomentum()).
 /// Arrays are not copied on receipt: field() views the received frames (kept alive by
 /// `storage`), or the caller's NamedBuffer the array was received into.
 class Sources {
@@ -170,6 +171,13 @@ public:
   /// source. Empty (size 0) when the DEM server did not send it (agreed protocol below 1.3: the
   /// radiation heat then leaves the system, as before 1.3).
   ConstView radiationHeat() const;
+  /// mom_p: the momentum of the mass the particles of each cell give the gas, N per m3 of
+  /// coupling cell (sum of released mass rate times particle velocity / V_c, sub-step averaged
+  /// like R_species; 3 values per cell, x y z, or per listed cell after exchangePartial()). The gas
+  /// adds mom_p - S_m U to its momentum equation (S_m = sum of R_species): the released mass then
+  /// carries the particles' momentum instead of entering at the gas velocity. Empty (size 0) when
+  /// the DEM server did not send it (agreed protocol below 1.5).
+  ConstView releasedMomentum() const;
   bool has(const std::string& name) const;
   std::vector<std::string> names() const;
   std::int64_t step = 0;
@@ -264,6 +272,20 @@ public:
 
   /// The protocol minor agreed with the DEM server (valid after initialize()/follow()).
   int demProtocolMinor() const;
+
+  /// Q_split (protocol 1.5): the heat the gas removed from each coupling cell in its last step
+  /// beyond what the DEM booked, J per m3 of coupling-cell volume (either sign), for the DEM server
+  /// to give to the cell's particles at the start of its next window. Sent with the next
+  /// exchange() (one value per coupling cell, grid().cellCount()) or exchangePartial() (one per
+  /// listed cell: this rank's OWN contribution, still per m3 of coupling cell, not fluid-volume
+  /// weighted; the DEM server sums the ranks'), then forgotten: call it before every exchange
+  /// that has a split to send. The values are copied. Throws ClientError(Argument) when a value
+  /// is not finite or when the DEM server agreed a protocol below 1.5 (it would drop the heat;
+  /// check takesHeatToParticles() first); the size is checked by the exchange.
+  /// @pre state() == Granted
+  void setHeatToParticles(ConstView joulesPerCubicMetre);
+  /// True when the DEM server takes Q_split (agreed protocol 1.5 or later).
+  bool takesHeatToParticles() const;
 
   /// Where the last exchange() spent its time (zeros before the first).
   ExchangeTimes lastExchangeTimes() const;
