@@ -21,6 +21,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <regex>
@@ -703,7 +704,14 @@ models: {heat: "off", motion: frozen, radiation: "off"}
   const double carbonGas =
       co + co2 -
       (ts["gas.species.CO_kg"].front() / 0.028010 + ts["gas.species.CO2_kg"].front() / 0.044009);
-  EXPECT_NEAR(carbonGas, carbonLost, 1e-10 * co) << "carbon";
+  // The char's loss is the difference of two sums of the 500 particle masses (dem.particle_mass_kg,
+  // 4.5e-5 kg): each is exact only to n eps of the total (n = 500: 2.5e-18 kg, 5e-9 of the carbon
+  // here), not to 1e-10 of the carbon released, so that bound is the tolerance. Observed: within
+  // 1e-10 of the carbon before protocol 1.5, 3e-10 since the released mass leaves the frozen char
+  // at rest (mom_p), which changes the flow and the rates' last bits.
+  const double massSumBound =
+      2.0 * 500.0 * std::numeric_limits<double>::epsilon() * solid.front() / 0.012011;
+  EXPECT_NEAR(carbonGas, carbonLost, std::max(1e-10 * co, massSumBound)) << "carbon";
   EXPECT_NEAR(co + 2.0 * co2 + h2o, 0.0, 1e-10 * co) << "oxygen";
   EXPECT_NEAR(2.0 * h2 + 2.0 * h2o, 0.0, 1e-10 * co) << "hydrogen";
 }
