@@ -9,6 +9,7 @@
 #include <coredem/common/yaml_section.h>
 #include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/case_config.h>
+#include <coredem/orchestrator/preflight.h>
 
 namespace coredem::orchestrator {
 
@@ -466,7 +467,11 @@ void resolveMembers(const SweepReader& r, Sweep& sw) {
     text = header + text;
     try {
       // named as the file it becomes, so that line numbers match
-      parseCase(text, fs::path("members") / mem.id / "case" / "case.yaml", sw.baseCase);
+      // and pre-flighted as `coredem check` does (what every member's run would refuse is
+      // refused here, once, before anything is launched)
+      const CaseConfig member =
+          parseCase(text, fs::path("members") / mem.id / "case" / "case.yaml", sw.baseCase);
+      (void)checkCaseConsistency(member);
     } catch (const CaseError& e) {
       std::string vals;
       for (const auto& [path, value] : mem.values) {

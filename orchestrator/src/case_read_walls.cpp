@@ -17,6 +17,15 @@ namespace fs = std::filesystem;
 namespace coredem::orchestrator::caseread {
 namespace {
 
+/// The range of walls.meshes[].scale: a length unit from µm to km (1e-30 was accepted before
+/// and made a micro-mesh no particle can touch).
+constexpr double kMinStlScale = 1e-6;
+constexpr double kMaxStlScale = 1e3;
+
+} // namespace
+
+namespace {
+
 using yaml::describe;
 using yaml::join;
 
@@ -258,14 +267,35 @@ void parseMeshWalls(const Section& w, CaseConfig& c, bool cfdSection) {
     m.name = m.file;
     m.scale = s.number("scale", 1.0, 0.0, kBig,
                        "factor to metres, > 0 (1: file in m, 0.001: file in mm)", true);
+    if (m.scale < kMinStlScale || m.scale > kMaxStlScale) {
+      s.fail(s.markOf("scale"), s.full("scale"),
+             fmt::format("{:g} is not a length unit: give the factor from the file's unit to "
+                         "metres, from {:g} (µm) to {:g} (km), e.g. 0.001 for mm, 0.0254 for in",
+                         m.scale, kMinStlScale, kMaxStlScale));
+    }
     // Relative to the case folder, like initial_state and cfd.case: a resumed run finds the file
     // through run.json's case_dir, a campaign member through the links to the base case's files.
     m.path = fs::absolute(c.caseDir / m.file);
-    if (!fs::is_regular_file(m.path)) {
+    std::error_code ec;
+    const fs::file_status st = fs::status(m.path, ec);
+    if (!fs::exists(st)) {
       s.fail(s.markOf("file"), s.full("file"),
              fmt::format("file '{}' not found (looked for {}); give an STL file (ASCII or binary) "
                          "relative to the case folder",
                          m.file, m.path.string()));
+    }
+    if (!fs::is_regular_file(st)) {
+      // A directory, FIFO, socket or device (a link to /dev/zero): never opened, so that nothing
+      // blocks or reads without end.
+      s.fail(s.markOf("file"), s.full("file"),
+             fmt::format("'{}' ({}) is {}, not a regular file; give an STL file (ASCII or binary) "
+                         "relative to the case folder",
+                         m.file, m.path.string(),
+                         fs::is_directory(st)                                 ? "a directory"
+                         : fs::is_fifo(st)                                    ? "a FIFO"
+                         : fs::is_socket(st)                                  ? "a socket"
+                         : fs::is_character_file(st) || fs::is_block_file(st) ? "a device"
+                                                                              : "not a file"));
     }
     try {
       dem::TriangleMesh mesh = dem::readStl(m.path, dem::StlOptions{m.scale});

@@ -154,9 +154,10 @@ void Session::writeTimeseriesRow(std::int64_t step, double dt, const SubcyclePla
   // sources; docs/coupling-schemes.md) is reported by the DEM server and taken off.
   const auto demHeat = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_from_gas_J");
   const auto gasHeat = protocol::findNamedValue(cd.ledger().energy(), "gas.heat_from_particles_J");
-  // The variable-density gas books the part of the exchange it takes at the end of the step that
-  // the particles saw at its start, and gives it to the gas in the next step
-  // (gas.heat_in_flight_J, docs/coredemFoam.md): taken off the same way.
+  // The variable-density gas takes the exchange at the end of the step, the particles saw it at
+  // its start: the difference goes to the particles with the next step (Q_split, protocol 1.5)
+  // and is reported meanwhile as gas.heat_in_flight_J (docs/coredemFoam.md): taken off the same
+  // way.
   const auto inFlight = protocol::findNamedValue(dd.ledger().energy(), "dem.heat_in_flight_J");
   const auto gasInFlight = protocol::findNamedValue(cd.ledger().energy(), "gas.heat_in_flight_J");
   // The heat split the gas sent (protocol 1.5 Q_split) for coupling cells without particles is

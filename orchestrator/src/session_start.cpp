@@ -222,13 +222,15 @@ void Session::configureDem(std::int64_t startStep, double startTime, const fs::p
   }
   const auto& cd = reply.envelope().configured();
   COREDEM_CHECK(cd.n_sub() >= 1 && cd.dt_dem() > 0, "DEM server replied an invalid plan");
-  // Configured.dt_dem is D's Δt_DEM,max = t_col,min/dt_factor (its n_sub is for the first
+  // Configured.dt_dem is D's Δt_DEM,max = min(π √(m/k)/dt_factor, the integrator's stability
+  // limit) over the material pairs (its n_sub is for the first
   // Δt_CFD); every later plan is n_sub = ceil(Δt_CFD/Δt_DEM,max).
   _dtDemMax = cd.dt_dem();
   if (_c.dtDem > _dtDemMax * (1.0 + 1e-12)) {
     throw CaseError(fmt::format(
         "time.dt_dem = {:.6g} s exceeds the DEM server's stable step dt_dem_max = {:.6g} s "
-        "(t_col/{:g}, models: dem.dt_factor); use time.dt_dem <= {:.6g} s, or hold the particles "
+        "(the undamped contact duration over {:g}, models: dem.dt_factor, or the integrator's "
+        "stability limit); use time.dt_dem <= {:.6g} s, or hold the particles "
         "with models: {{motion: frozen}}",
         _c.dtDem, _dtDemMax, dtFactorOf(_c), _dtDemMax));
   }

@@ -201,3 +201,24 @@ TEST(CampaignSweep, DuplicateKeysAndASecondDocumentAreRefused) {
       << second;
   fs::remove_all(d);
 }
+
+// A member the run would refuse is refused when the sweep is loaded (issue 39 item 2): each
+// member's case is pre-flighted as `coredem check` does. k_n = 2e21 N/m needs ~10^10 DEM
+// sub-steps per CFD step; before, the sweep loaded and that member exited 2 at its start.
+TEST(CampaignSweep, AMemberTheRunWouldRefuseIsRefusedAtLoad) {
+  const fs::path d = tempDir("preflight");
+  fs::copy(kCases / "tiny", d / "tiny", fs::copy_options::recursive);
+  std::ofstream(d / "sweep.yaml")
+      << "name: stiff\nbase_case: tiny\ngrid:\n  materials[0].k_n: [20.0, 2.0e21]\n";
+  std::string e;
+  try {
+    (void)loadSweep(d / "sweep.yaml");
+  } catch (const CaseError& err) {
+    e = err.what();
+  }
+  EXPECT_NE(e.find("member m001 (materials[0].k_n = 2.0e21) gives an invalid case"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("DEM sub-steps"), std::string::npos) << e;
+  fs::remove_all(d);
+}

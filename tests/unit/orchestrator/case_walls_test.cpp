@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <coredem/dem/dem_system.h>
@@ -181,6 +182,19 @@ TEST_F(CaseWalls, BadInputsAreRefusedNamingTheKey) {
   const std::string missing = errorOf(replace(kCase, "file: column.stl", "file: hopper.stl"));
   EXPECT_HAS(missing, "walls.meshes[0].file: file 'hopper.stl' not found");
   EXPECT_HAS(missing, (dir() / "hopper.stl").string());
+  // not a regular file (issue 39 item 5: reported as "not found" before, and a FIFO would block)
+  fs::create_directories(dir() / "adir.stl");
+  EXPECT_HAS(errorOf(replace(kCase, "file: column.stl", "file: adir.stl")),
+             "is a directory, not a regular file");
+  ASSERT_EQ(::mkfifo((dir() / "pipe.stl").c_str(), 0600), 0);
+  EXPECT_HAS(errorOf(replace(kCase, "file: column.stl", "file: pipe.stl")),
+             "is a FIFO, not a regular file");
+  fs::create_symlink("/dev/zero", dir() / "zero.stl");
+  EXPECT_HAS(errorOf(replace(kCase, "file: column.stl", "file: zero.stl")),
+             "is a device, not a regular file");
+  // a scale that is no length unit
+  EXPECT_HAS(errorOf(replace(kCase, "file: column.stl", "file: column.stl\n      scale: 1.0e-30")),
+             "walls.meshes[0].scale: 1e-30 is not a length unit");
   // an STL in mm without scale, and with it
   const std::string mm = errorOf(replace(kCase, "file: column.stl", "file: column-mm.stl"));
   EXPECT_HAS(mm, "walls.meshes[0].file: column-mm.stl: the STL is probably in millimetres");
