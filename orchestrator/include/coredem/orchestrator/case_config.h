@@ -213,7 +213,8 @@ struct CaseConfig {
   std::string description;
   double endTime = 0.0;
   DtPolicyConfig dt;
-  double dtDem = 0.0; ///< time.dt_dem: forced Δt_DEM (s), n_sub = dt/dt_dem; 0 = the DEM's Δt_DEM,max
+  double dtDem =
+      0.0; ///< time.dt_dem: forced Δt_DEM (s), n_sub = dt/dt_dem; 0 = the DEM's Δt_DEM,max
   GridConfig grid;
   Vec3 gravity{0.0, 0.0, -9.81};
   std::vector<SpeciesConfig> species;
