@@ -486,30 +486,8 @@ void warnTemperatures(Consistency& ck) {
 /// {table: [[t, v], ...]}, at the domain level and in its regions); nullopt when not given.
 std::optional<double> largestPrescribed(const YAML::Node& gas, const char* key) {
   std::optional<double> best;
-  auto take = [&](const YAML::Node& n) {
-    try {
-      if (n && n.IsScalar()) {
-        best = std::max(best.value_or(-HUGE_VAL), n.as<double>());
-      } else if (n && n.IsMap() && n["table"] && n["table"].IsSequence()) {
-        for (const YAML::Node& row : n["table"]) {
-          if (row.IsSequence() && row.size() == 2 && row[1].IsScalar()) {
-            best = std::max(best.value_or(-HUGE_VAL), row[1].as<double>());
-          }
-        }
-      }
-    } catch (const YAML::Exception&) {
-    }
-  };
-  if (!gas || !gas.IsMap()) {
-    return best;
-  }
-  take(gas[key]);
-  if (gas["regions"] && gas["regions"].IsSequence()) {
-    for (const YAML::Node& r : gas["regions"]) {
-      if (r.IsMap()) {
-        take(r[key]);
-      }
-    }
+  for (const PrescribedValue& v : prescribedValues(gas, key)) {
+    best = std::max(best.value_or(-HUGE_VAL), v.value);
   }
   return best;
 }

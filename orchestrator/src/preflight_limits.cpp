@@ -1,6 +1,7 @@
 // Pre-flight: the limits of the DEM server and the participants (preflight_limits.h).
 #include "preflight_limits.h"
 
+#include <cctype>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -11,6 +12,43 @@
 #include "dem_step.h"
 
 namespace coredem::orchestrator {
+
+std::vector<PrescribedValue> prescribedValues(const YAML::Node& gas, const char* key) {
+  std::vector<PrescribedValue> out;
+  auto take = [&](const YAML::Node& n, std::vector<std::string> path) {
+    try {
+      if (n && n.IsScalar()) {
+        out.push_back({n.as<double>(), path});
+      } else if (n && n.IsMap() && n["table"] && n["table"].IsSequence()) {
+        std::size_t i = 0;
+        for (const YAML::Node& row : n["table"]) {
+          if (row.IsSequence() && row.size() == 2 && row[1].IsScalar()) {
+            std::vector<std::string> p = path;
+            p.insert(p.end(), {"table", std::to_string(i), "1"});
+            out.push_back({row[1].as<double>(), p});
+          }
+          ++i;
+        }
+      }
+    } catch (const YAML::Exception&) {
+      // not a number: the participant's own reader names it
+    }
+  };
+  if (!gas || !gas.IsMap()) {
+    return out;
+  }
+  take(gas[key], {key});
+  if (gas["regions"] && gas["regions"].IsSequence()) {
+    std::size_t i = 0;
+    for (const YAML::Node& r : gas["regions"]) {
+      if (r.IsMap()) {
+        take(r[key], {"regions", std::to_string(i), key});
+      }
+      ++i;
+    }
+  }
+  return out;
+}
 
 /// What the DEM server and the participants would refuse, from the same table
 /// (coredem/common/limits.h): the counts of coredem-dem's admission control, the sub-steps per
@@ -49,6 +87,41 @@ void checkServerLimits(const CaseConfig& c, const preflight::Locator& at) {
                           "DEM server grants at most {} per CFD step: shorten the CFD step or "
                           "soften k_n",
                           dtMax, nSub, dtDem, limits.subSteps));
+    }
+  }
+  // A prescribed gas (coredem-gas) is sent as given too: every literal and table value of its
+  // section and regions in the DEM's ranges (μ_g = 1e-320 Pa s ran until the first exchange).
+  {
+    const YAML::Node gas = at.root()[c.cfd.gasKey];
+    const GasRanges r;
+    struct Range {
+      const char* key;
+      double lo, hi;
+      const char* unit;
+    };
+    // (T_g is warned about below 200 K by warnPrescribedGasTemperature, not refused here yet:
+    // the campaign e2e tests use a member with T_g = -5 K that must fail at its start.)
+    const Range ranges[] = {{"rho_g", r.densityMin, r.densityMax, "kg/m3"},
+                            {"mu_g", r.viscosityMin, r.viscosityMax, "Pa s"},
+                            {"kappa_g", r.conductivityMin, r.conductivityMax, "W/m/K"},
+                            {"cp_g", r.heatCapacityMin, r.heatCapacityMax, "J/kg/K"}};
+    for (const Range& g : ranges) {
+      for (const PrescribedValue& v : prescribedValues(gas, g.key)) {
+        if (!(v.value >= g.lo && v.value <= g.hi)) {
+          std::vector<std::string> path = {c.cfd.gasKey};
+          path.insert(path.end(), v.path.begin(), v.path.end());
+          std::string key = c.cfd.gasKey;
+          for (const std::string& part : v.path) {
+            key +=
+                (std::isdigit(static_cast<unsigned char>(part[0])) ? "[" + part + "]" : "." + part);
+          }
+          at.fail(path, key,
+                  fmt::format("{:.6g} {} is outside [{:g}, {:g}] {}, the range of the gas state "
+                              "the DEM server accepts (docs/protocol.md §3 'Ranges'); check the "
+                              "units",
+                              v.value, g.unit, g.lo, g.hi, g.unit));
+        }
+      }
     }
   }
   // A constant-property gas is sent as given: its values must lie in the DEM's ranges.

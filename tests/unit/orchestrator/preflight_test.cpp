@@ -199,6 +199,14 @@ TEST(Preflight, TheServersLimitsAreCheckedBeforeTheRun) {
   e = failureOf(std::string(kCase) + "gas_properties: {model: constant, viscosity: 1.0e-320}\n");
   EXPECT_TRUE(contains(e, "Pa s is outside [1e-07, 1] Pa s")) << e;
   EXPECT_TRUE(contains(e, "gas_properties.viscosity: ")) << e;
+  // The same in the prescribed gas (coredem-gas sends it as given), in a region's table too.
+  e = failureOf(std::string(kCase) + "  mu_g: 1.0e-320\n");
+  EXPECT_TRUE(contains(e, "gas.mu_g: ")) << e;
+  EXPECT_TRUE(contains(e, "is outside [1e-07, 1] Pa s")) << e;
+  e = failureOf(std::string(kCase) +
+                "  regions:\n    - box: {min: [0, 0, 0], max: [0.02, 0.02, 0.02]}\n"
+                "      rho_g: {table: [[0.0, 1.2], [0.005, 1.0e9]]}\n");
+  EXPECT_TRUE(contains(e, "gas.regions[0].rho_g.table[1][1]: 1e+09 kg/m3 is outside")) << e;
 }
 
 TEST(Preflight, ExplicitOverlapBeyondTheFractionFails) {
