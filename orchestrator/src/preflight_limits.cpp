@@ -50,18 +50,26 @@ std::vector<PrescribedValue> prescribedValues(const YAML::Node& gas, const char*
   return out;
 }
 
-/// What the DEM server and the participants would refuse, from the same table
-/// (coredem/common/limits.h): the counts of coredem-dem's admission control, the sub-steps per
-/// CFD step of the plan it will grant, and the gas properties outside the ranges of the gas
-/// fields it receives (a constant-property gas sends them as they are given).
-void checkServerLimits(const CaseConfig& c, const preflight::Locator& at) {
-  const CountLimits limits;
+namespace {
+
+/// "time.adaptive.dt_max", "gas.regions[0].mu_g" for messages from a case path.
+std::string keyOf(const std::vector<std::string>& path) {
+  std::string key;
+  for (const std::string& part : path) {
+    const bool index = !part.empty() && std::isdigit(static_cast<unsigned char>(part[0]));
+    key += index ? "[" + part + "]" : (key.empty() ? "" : ".") + part;
+  }
+  return key;
+}
+
+/// The counts of coredem-dem's admission control.
+void checkCounts(const CaseConfig& c, const preflight::Locator& at, const CountLimits& limits) {
   const auto count = [&](const char* key, std::size_t n, std::uint64_t limit, const char* what) {
     if (n > limit) {
       at.fail({key}, key,
-              fmt::format("{} {}: the DEM server admits at most {} ({}); split the case or merge "
-                          "entries",
-                          n, what, limit, "coredem-dem's admission control"));
+              fmt::format("{} {}: the DEM server admits at most {} (coredem-dem's admission "
+                          "control); split the case or merge entries",
+                          n, what, limit));
     }
   };
   count("materials", c.materials.size(), limits.materials, "materials");
@@ -70,77 +78,86 @@ void checkServerLimits(const CaseConfig& c, const preflight::Locator& at) {
   count("particles", c.particles.size(), limits.particleSets, "particle sets");
   count("reactions", c.reactions.size(), limits.reactions, "reactions");
   count("models", c.models.size(), limits.options, "model options");
-  // Sub-steps of the largest CFD step (the DEM server refuses a grant of more).
+}
+
+/// The sub-steps of the largest CFD step (the DEM server refuses a grant of more).
+void checkSubSteps(const CaseConfig& c, const preflight::Locator& at, const CountLimits& limits) {
   const bool adaptive = c.dt.kind == DtPolicyConfig::Kind::Courant;
   const double dtMax = adaptive ? c.dt.dtMax : c.dt.dt;
-  if (dtMax > 0.0 && std::isfinite(dtMax)) {
-    const double dtDem = c.dtDem > 0.0 ? c.dtDem : estimateDtDemMax(c);
-    const double nSub = std::ceil(dtMax / dtDem * (1.0 - 1e-12));
-    if (!(nSub <= double(limits.subSteps))) {
-      const std::vector<std::string> path =
-          c.dtDem > 0.0 ? std::vector<std::string>{"time", "dt_dem"}
-          : adaptive    ? std::vector<std::string>{"time", "adaptive", "dt_max"}
-                        : std::vector<std::string>{"time", "dt"};
-      at.fail(path, adaptive ? "time.adaptive.dt_max" : "time.dt",
-              fmt::format("{:.6g} s needs {:.6g} DEM sub-steps of {:.6g} s (the contact time of "
-                          "the stiffest material pair over dem.dt_factor, or time.dt_dem); the "
-                          "DEM server grants at most {} per CFD step: shorten the CFD step or "
-                          "soften k_n",
-                          dtMax, nSub, dtDem, limits.subSteps));
-    }
+  if (!(dtMax > 0.0 && std::isfinite(dtMax))) {
+    return;
   }
-  // A prescribed gas (coredem-gas) is sent as given too: every literal and table value of its
-  // section and regions in the DEM's ranges (μ_g = 1e-320 Pa s ran until the first exchange).
-  {
-    const YAML::Node gas = at.root()[c.cfd.gasKey];
-    const GasRanges r;
-    struct Range {
-      const char* key;
-      double lo, hi;
-      const char* unit;
-    };
-    // (T_g is warned about below 200 K by warnPrescribedGasTemperature, not refused here yet:
-    // the campaign e2e tests use a member with T_g = -5 K that must fail at its start.)
-    const Range ranges[] = {{"rho_g", r.densityMin, r.densityMax, "kg/m3"},
-                            {"mu_g", r.viscosityMin, r.viscosityMax, "Pa s"},
-                            {"kappa_g", r.conductivityMin, r.conductivityMax, "W/m/K"},
-                            {"cp_g", r.heatCapacityMin, r.heatCapacityMax, "J/kg/K"}};
-    for (const Range& g : ranges) {
-      for (const PrescribedValue& v : prescribedValues(gas, g.key)) {
-        if (!(v.value >= g.lo && v.value <= g.hi)) {
-          std::vector<std::string> path = {c.cfd.gasKey};
-          path.insert(path.end(), v.path.begin(), v.path.end());
-          std::string key = c.cfd.gasKey;
-          for (const std::string& part : v.path) {
-            key +=
-                (std::isdigit(static_cast<unsigned char>(part[0])) ? "[" + part + "]" : "." + part);
-          }
-          at.fail(path, key,
-                  fmt::format("{:.6g} {} is outside [{:g}, {:g}] {}, the range of the gas state "
-                              "the DEM server accepts (docs/protocol.md §3 'Ranges'); check the "
-                              "units",
-                              v.value, g.unit, g.lo, g.hi, g.unit));
-        }
-      }
-    }
+  const double dtDem = c.dtDem > 0.0 ? c.dtDem : estimateDtDemMax(c);
+  const double nSub = std::ceil(dtMax / dtDem * (1.0 - 1e-12));
+  if (nSub <= double(limits.subSteps)) {
+    return;
   }
-  // A constant-property gas is sent as given: its values must lie in the DEM's ranges.
+  const std::vector<std::string> path = c.dtDem > 0.0 ? std::vector<std::string>{"time", "dt_dem"}
+                                        : adaptive
+                                            ? std::vector<std::string>{"time", "adaptive", "dt_max"}
+                                            : std::vector<std::string>{"time", "dt"};
+  at.fail(path, keyOf(path),
+          fmt::format("{:.6g} s needs {:.6g} DEM sub-steps of {:.6g} s (the contact time of the "
+                      "stiffest material pair over dem.dt_factor, or time.dt_dem); the DEM server "
+                      "grants at most {} per CFD step: shorten the CFD step or soften k_n",
+                      dtMax, nSub, dtDem, limits.subSteps));
+}
+
+/// A gas value the DEM receives as given: the prescribed gas's field and the constant-property
+/// gas's property, with the range of the one table.
+struct GasRange {
+  const char* field;    ///< the prescribed gas section's key (GasFields array)
+  const char* property; ///< gas_properties' key
+  double GasPropertiesConfig::*value;
+  double GasRanges::*lo;
+  double GasRanges::*hi;
+  const char* unit;
+};
+// (T_g is warned about below 200 K by warnPrescribedGasTemperature, not refused here yet: the
+// campaign e2e tests use a member with T_g = -5 K that must fail at its start.)
+constexpr GasRange kGasRanges[] = {
+    {"rho_g", "density", &GasPropertiesConfig::density, &GasRanges::densityMin,
+     &GasRanges::densityMax, "kg/m3"},
+    {"mu_g", "viscosity", &GasPropertiesConfig::viscosity, &GasRanges::viscosityMin,
+     &GasRanges::viscosityMax, "Pa s"},
+    {"kappa_g", "conductivity", &GasPropertiesConfig::conductivity, &GasRanges::conductivityMin,
+     &GasRanges::conductivityMax, "W/m/K"},
+    {"cp_g", "cp", &GasPropertiesConfig::cp, &GasRanges::heatCapacityMin,
+     &GasRanges::heatCapacityMax, "J/kg/K"}};
+
+/// The gas values the DEM receives as given inside its ranges: every literal and table value of
+/// the prescribed gas (coredem-gas; μ_g = 1e-320 Pa s ran until the first exchange) and the
+/// properties of a constant-property gas.
+void checkGasRanges(const CaseConfig& c, const preflight::Locator& at) {
   const GasRanges r;
-  const GasPropertiesConfig& g = c.gasProperties;
-  const auto range = [&](const char* key, double v, double lo, double hi, const char* unit) {
-    if (!(v >= lo && v <= hi)) {
-      at.fail({"gas_properties", key}, fmt::format("gas_properties.{}", key),
+  const YAML::Node gas = at.root()[c.cfd.gasKey];
+  const auto inside = [&](const GasRange& g, double v, const std::vector<std::string>& path) {
+    if (!(v >= r.*g.lo && v <= r.*g.hi)) {
+      at.fail(path, keyOf(path),
               fmt::format("{:.6g} {} is outside [{:g}, {:g}] {}, the range of the gas state the "
                           "DEM server accepts (docs/protocol.md §3 'Ranges'); check the units",
-                          v, unit, lo, hi, unit));
+                          v, g.unit, r.*g.lo, r.*g.hi, g.unit));
     }
   };
-  if (g.model != "ideal_gas") {
-    range("density", g.density, r.densityMin, r.densityMax, "kg/m3");
-    range("viscosity", g.viscosity, r.viscosityMin, r.viscosityMax, "Pa s");
-    range("conductivity", g.conductivity, r.conductivityMin, r.conductivityMax, "W/m/K");
-    range("cp", g.cp, r.heatCapacityMin, r.heatCapacityMax, "J/kg/K");
+  for (const GasRange& g : kGasRanges) {
+    for (const PrescribedValue& v : prescribedValues(gas, g.field)) {
+      std::vector<std::string> path = {c.cfd.gasKey};
+      path.insert(path.end(), v.path.begin(), v.path.end());
+      inside(g, v.value, path);
+    }
+    if (c.gasProperties.model != "ideal_gas") {
+      inside(g, c.gasProperties.*g.value, {"gas_properties", g.property});
+    }
   }
+}
+
+} // namespace
+
+void checkServerLimits(const CaseConfig& c, const preflight::Locator& at) {
+  const CountLimits limits;
+  checkCounts(c, at, limits);
+  checkSubSteps(c, at, limits);
+  checkGasRanges(c, at);
 }
 
 } // namespace coredem::orchestrator

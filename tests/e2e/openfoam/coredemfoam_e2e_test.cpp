@@ -46,6 +46,7 @@ const fs::path kTemplate = COREDEM_FOAM_E2E_TEMPLATE;
 
 using coredem::e2e::readAll;
 using coredem::e2e::readTimeseries;
+using coredem::e2e::foam::copyColumnTemplate;
 using coredem::e2e::foam::logTail;
 using coredem::e2e::foam::runCoredem;
 using coredem::e2e::foam::runOnRanks;
@@ -66,15 +67,7 @@ using coredem::e2e::replaceAll;
 fs::path makeCase(const fs::path& dir, double uIn, double tIn, const std::string& body) {
   const fs::path c = dir / "case";
   fs::create_directories(c);
-  fs::copy(kTemplate, c / "openfoam", fs::copy_options::recursive);
-  for (const auto& e : fs::recursive_directory_iterator(c / "openfoam")) {
-    if (e.is_regular_file()) {
-      std::string s = readAll(e.path());
-      s = replaceAll(s, "@U_IN@", std::to_string(uIn));
-      s = replaceAll(s, "@T_IN@", std::to_string(tIn));
-      writeAll(e.path(), s);
-    }
-  }
+  copyColumnTemplate(kTemplate, c / "openfoam", uIn, tIn);
   writeAll(c / "case.yaml", std::string(R"(name: column
 grid: {origin: [0, 0, 0], spacing: [0.002, 0.002, 0.002], cells: [5, 20, 5]}
 gravity: [0.0, -9.81, 0.0]

@@ -27,6 +27,7 @@ using coredem::e2e::readAll;
 using coredem::e2e::readTimeseries;
 using coredem::e2e::replaceAll;
 using coredem::e2e::writeAll;
+using coredem::e2e::foam::copyColumnTemplate;
 using coredem::e2e::foam::logTail;
 using coredem::e2e::foam::runCoredem;
 
@@ -37,15 +38,7 @@ fs::path makeCase(const fs::path& dir, const std::string& body) {
   const fs::path c = dir / "case";
   const fs::path of = c / "openfoam";
   fs::create_directories(c);
-  fs::copy(kTemplate, of, fs::copy_options::recursive);
-  for (const auto& e : fs::recursive_directory_iterator(of)) {
-    if (e.is_regular_file()) {
-      std::string s = readAll(e.path());
-      s = replaceAll(s, "@U_IN@", "0");
-      s = replaceAll(s, "@T_IN@", "293.15");
-      writeAll(e.path(), s);
-    }
-  }
+  copyColumnTemplate(kTemplate, of, 0.0, 293.15);
   writeAll(of / "constant" / "g",
            replaceAll(readAll(of / "constant" / "g"), "(0 -9.81 0)", "(0 0 0)"));
   writeAll(of / "0" / "N2", R"(FoamFile

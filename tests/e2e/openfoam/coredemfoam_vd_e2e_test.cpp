@@ -46,6 +46,7 @@ using coredem::e2e::readAll;
 using coredem::e2e::readTimeseries;
 using coredem::e2e::replaceAll;
 using coredem::e2e::writeAll;
+using coredem::e2e::foam::copyColumnTemplate;
 using coredem::e2e::foam::logTail;
 using coredem::e2e::foam::runCoredem;
 using coredem::e2e::foam::runOnRanks;
@@ -97,15 +98,7 @@ fs::path makeVdCase(const fs::path& dir, const VdCase& v) {
   const fs::path c = dir / "case";
   const fs::path of = c / "openfoam";
   fs::create_directories(c);
-  fs::copy(kTemplate, of, fs::copy_options::recursive);
-  for (const auto& e : fs::recursive_directory_iterator(of)) {
-    if (e.is_regular_file()) {
-      std::string s = readAll(e.path());
-      s = replaceAll(s, "@U_IN@", std::to_string(v.uIn));
-      s = replaceAll(s, "@T_IN@", std::to_string(v.tIn));
-      writeAll(e.path(), s);
-    }
-  }
+  copyColumnTemplate(kTemplate, of, v.uIn, v.tIn);
   // p in Pa, the outlet at pRef.
   std::string p = readAll(of / "0" / "p");
   p = replaceAll(p, "[0 2 -2 0 0 0 0]", "[1 -1 -2 0 0 0 0]");
@@ -598,15 +591,7 @@ TEST_F(CoredemFoamVdE2E, RestartContinuesBitwise) {
 TEST_F(CoredemFoamVdE2E, ConstantPropertySolverGivesTheFiguresItGaveBefore) {
   const fs::path c = dir / "case";
   fs::create_directories(c);
-  fs::copy(kTemplate, c / "openfoam", fs::copy_options::recursive);
-  for (const auto& e : fs::recursive_directory_iterator(c / "openfoam")) {
-    if (e.is_regular_file()) {
-      std::string s = readAll(e.path());
-      s = replaceAll(s, "@U_IN@", std::to_string(0.3));
-      s = replaceAll(s, "@T_IN@", std::to_string(400.0));
-      writeAll(e.path(), s);
-    }
-  }
+  copyColumnTemplate(kTemplate, c / "openfoam", 0.3, 400.0);
   writeAll(c / "case.yaml", R"(name: column
 grid: {origin: [0, 0, 0], spacing: [0.002, 0.002, 0.002], cells: [5, 20, 5]}
 gravity: [0.0, -9.81, 0.0]

@@ -1,9 +1,9 @@
 #pragma once
 /// @file
-/// What the coredemFoam end-to-end tests share: running `coredem` on a case (with a deadline, no
-/// plots), the tail of coredemFoam's log for failure messages, a run straight through against
-/// the same run stopped and resumed, and a case run on K decomposed CFD ranks. Needs
-/// COREDEM_BIN_DIR (the build's bin folder).
+/// What the coredemFoam end-to-end tests share: the column template filled in, running `coredem` on
+/// a case (with a deadline, no plots), the tail of coredemFoam's log for failure messages, a run
+/// straight through against the same run stopped and resumed, and a case run on K decomposed CFD
+/// ranks. Needs COREDEM_BIN_DIR (the build's bin folder).
 
 #include <chrono>
 #include <filesystem>
@@ -20,6 +20,20 @@ namespace coredem::e2e::foam {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
+
+/// Copies the column template folder `from` to `to` with its inlet velocity (m/s) and
+/// temperature (K) filled in (@U_IN@, @T_IN@).
+inline void copyColumnTemplate(const fs::path& from, const fs::path& to, double uIn, double tIn) {
+  fs::copy(from, to, fs::copy_options::recursive);
+  for (const auto& e : fs::recursive_directory_iterator(to)) {
+    if (e.is_regular_file()) {
+      std::string s = readAll(e.path());
+      s = replaceAll(s, "@U_IN@", std::to_string(uIn));
+      s = replaceAll(s, "@T_IN@", std::to_string(tIn));
+      writeAll(e.path(), s);
+    }
+  }
+}
 
 /// Runs `coredem args... --no-plots` with output into `log`, with a deadline; returns the exit
 /// code.
