@@ -697,8 +697,11 @@ models: {heat: "off", motion: frozen, radiation: "off"}
   for (std::size_t i = 1; i < dt.size(); ++i) {
     double out = 0;
     for (const auto& [name, m] : molarMass) {
-      out += (ts["gas.outflow." + name + "_kg_per_s"][i] - ts["gas.inflow." + name + "_kg_per_s"][i]) / m;
-      produced += (ts["gas.species." + name + "_kg"][i] - ts["gas.species." + name + "_kg"][i - 1]) / m;
+      out +=
+          (ts["gas.outflow." + name + "_kg_per_s"][i] - ts["gas.inflow." + name + "_kg_per_s"][i]) /
+          m;
+      produced +=
+          (ts["gas.species." + name + "_kg"][i] - ts["gas.species." + name + "_kg"][i - 1]) / m;
       stored += (ts["gas.mass." + name + "_kg"][i] - ts["gas.mass." + name + "_kg"][i - 1]) / m;
     }
     netOut += dt[i] * out;
@@ -748,10 +751,11 @@ models: {heat: "off", motion: frozen, radiation: "off"}
 // (h) A tall column at rest: the column of (a) scaled 250x (10 m of N2 at 293.15 K in 5 x 20 x 5
 // cells of 0.5 m, closed at the bottom, the outlet at p_ref on top, one frozen bead), gravity
 // 9.81 m/s2, 3 s. The gas settles into the isothermal atmosphere: the density follows the local
-// absolute pressure, rho(y) = rho_top exp(g (H - y) M/(R T)), 1.13e-3 higher at the bottom than at the top (issue
-// 38 item 4: with rho = psi p_ref everywhere it was uniform). Checked per cell row within 2e-7 of
-// rho (the discrete hydrostatic balance and the outlet's half cell: observed ~4e-8), the gas at
-// rest (|u| < 1e-6 m/s), and p - p_ref = the weight of the gas above over the area (1e-4).
+// absolute pressure, rho(y) = rho_top exp(g (H - y) M/(R T)), 1.13e-3 higher at the bottom than at
+// the top (issue 38 item 4: with rho = psi p_ref everywhere it was uniform). Checked per cell row
+// within 2e-7 of rho (the discrete hydrostatic balance and the outlet's half cell: observed ~4e-8),
+// the gas at rest (|u| < 1e-6 m/s), and p - p_ref = the weight of the gas above over the area
+// (1e-4).
 TEST_F(CoredemFoamVdE2E, TallColumnAtRestHasTheDensityOfItsHydrostaticPressure) {
   VdCase v;
   v.uIn = 0.0;
@@ -799,9 +803,9 @@ TEST_F(CoredemFoamVdE2E, TallColumnAtRestHasTheDensityOfItsHydrostaticPressure) 
   // The weight of the gas column above the bottom cell's centre, per area.
   const double weight = rhoTop / k * (std::exp(k * (h - 0.5 * dy)) - 1.0) * g;
   std::cout << "tall column: rho bottom/top " << bottom / top << " (exp(k dy (ny-1)) "
-            << std::exp(k * dy * (ny - 1)) << "), worst relative error " << worst
-            << ", |u| max " << uMax << " m/s, p bottom - p_ref " << p[0] - kPRef << " Pa (weight "
-            << weight << " Pa)\n";
+            << std::exp(k * dy * (ny - 1)) << "), worst relative error " << worst << ", |u| max "
+            << uMax << " m/s, p bottom - p_ref " << p[0] - kPRef << " Pa (weight " << weight
+            << " Pa)\n";
   EXPECT_LT(worst, 2e-7);
   EXPECT_NEAR(bottom / top, std::exp(k * dy * (ny - 1)), 2e-7);
   EXPECT_LT(uMax, 1e-6) << "the gas has not settled";
