@@ -104,6 +104,8 @@ struct DemSystem::Impl {
     return makeCpuEngine(setup);
   }
   std::shared_ptr<coredem::Logger> log = coredem::logger("dem.system");
+  /// The particles of state `st` (read from `path`) as this system's: checks, engine, Δt_DEM,max.
+  void adoptState(const std::string& path, HostState& st);
 };
 
 DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
@@ -363,6 +365,8 @@ void DemSystem::writeState(const std::string& path, const std::string& protocolV
   meta.heat = m.engine->heatTotals();
   meta.hasChemistry = m.config.chemistry.active();
   meta.chemistry = m.engine->chemistryTotals();
+  for (const Material& mat : m.config.materials)
+    meta.materialNames.push_back(mat.name);
   writeStateFile(path, m.engine->state(), meta);
 }
 
@@ -374,11 +378,78 @@ void DemSystem::readState(const std::string& path) {
   COREDEM_CHECK(
       meta.configHash == m.hash,
       "state file '{}' was written with config hash {} but this system's is {}: restart with "
-      "the same materials, walls, gravity, grid, species and options",
+      "the same materials, walls, gravity, grid, species and options (a new start from another "
+      "run's state with a different configuration: case.yaml initial_state)",
       path, meta.configHash, m.hash);
+  m.adoptState(path, st);
+  m.engine->restoreHeatTotals(meta.heat);
+  if (meta.hasChemistry)
+    m.engine->restoreChemistryTotals(meta.chemistry);
+  m.time.restore(meta.time, meta.timeCompensation);
+  m.step = meta.step;
+}
+
+namespace {
+
+/// A new start keeps the tangential history of particle pairs (partners by global id) and
+/// drops the walls' (the new configuration's walls may differ): the first wallContacts slots
+/// of each particle's row, the rest moved forward.
+void dropWallHistory(HostState& st) {
+  const std::size_t h = static_cast<std::size_t>(st.historySlots);
+  for (std::size_t i = 0; i < st.n; ++i) {
+    const std::size_t w = static_cast<std::size_t>(std::max(0, st.wallContacts[i]));
+    const std::size_t row = i * h;
+    for (std::size_t s = 0; s < h; ++s) {
+      const bool kept = s + w < h && st.histKey[row + s + w] >= 0;
+      st.histKey[row + s] = kept ? st.histKey[row + s + w] : -1;
+      for (std::size_t a = 0; a < 3; ++a)
+        st.histDisp[3 * (row + s) + a] = kept ? st.histDisp[3 * (row + s + w) + a] : 0.0;
+    }
+    st.wallContacts[i] = 0;
+  }
+  st.listValid = 0;
+}
+
+} // namespace
+
+void DemSystem::startFromState(const std::string& path) {
+  Impl& m = *_impl;
+  HostState st;
+  StateMeta meta;
+  readStateFile(path, st, meta);
+  // Materials by name where the file names them.
+  const auto& materials = m.config.materials;
+  if (!meta.materialNames.empty()) {
+    std::vector<int> to(meta.materialNames.size(), -1);
+    for (std::size_t k = 0; k < to.size(); ++k) {
+      for (std::size_t j = 0; j < materials.size(); ++j) {
+        if (materials[j].name == meta.materialNames[k])
+          to[k] = static_cast<int>(j);
+      }
+    }
+    for (std::size_t i = 0; i < st.n; ++i) {
+      const int k = st.material[i];
+      COREDEM_CHECK(k >= 0 && static_cast<std::size_t>(k) < to.size(),
+                    "state file '{}': particle {} has material index {}, the file names {}", path,
+                    i, k, to.size());
+      COREDEM_CHECK(to[k] >= 0,
+                    "state file '{}': its particles of material '{}' have no material of that "
+                    "name in this case: add it to materials (the particles keep their sizes, "
+                    "masses and temperatures; the material gives the contact and heat properties)",
+                    path, meta.materialNames[k]);
+      st.material[i] = to[k];
+    }
+  }
+  dropWallHistory(st);
+  m.adoptState(path, st);
+}
+
+void DemSystem::Impl::adoptState(const std::string& path, HostState& st) {
+  Impl& m = *this;
   COREDEM_CHECK(st.nSpecies == static_cast<int>(m.config.solidSpecies.size()),
-                "state file '{}' has {} solid species, the config {}", path, st.nSpecies,
-                m.config.solidSpecies.size());
+                "state file '{}' has {} solid species, the config {}: the particles keep their "
+                "compositions, so solid_species must be the same",
+                path, st.nSpecies, m.config.solidSpecies.size());
   COREDEM_CHECK(st.historySlots >= 1, "state file '{}': bad history_slots", path);
   double rmax = 0;
   std::vector<double> minMass(m.config.materials.size(), std::numeric_limits<double>::infinity());
@@ -403,13 +474,8 @@ void DemSystem::readState(const std::string& path) {
     m.engine = m.makeEngine();
   }
   m.engine->setState(st);
-  m.engine->restoreHeatTotals(meta.heat);
-  if (meta.hasChemistry)
-    m.engine->restoreChemistryTotals(meta.chemistry);
   m.nParticles = st.n;
   m.dtMax = coredem::dem::dtDemMax(m.config, minMass);
-  m.time.restore(meta.time, meta.timeCompensation);
-  m.step = meta.step;
 }
 
 double DemSystem::time() const {

@@ -3,6 +3,7 @@
 // [N,3], [N,K], [N,K,3]); /meta carries the scalars as attributes, /chemistry the ledgers.
 #include "state_io.h"
 
+#include <sstream>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -82,6 +83,13 @@ void writeStateFile(const std::string& path, const HostState& s, const StateMeta
   h5::writeAttribute(g, "history_slots", static_cast<std::int32_t>(s.historySlots));
   h5::writeAttribute(g, "neighbour_slots", static_cast<std::int32_t>(s.neighbourSlots));
   h5::writeAttribute(g, "neighbour_list_valid", static_cast<std::int32_t>(s.listValid));
+  {
+    std::string names;
+    for (const std::string& n : meta.materialNames)
+      names += (names.empty() ? "" : "\n") + n;
+    if (!names.empty())
+      h5::writeAttribute(g, "material_names", names);
+  }
   for (const HeatLedgerEntry& e : kHeatLedger)
     h5::writeAttribute(g, e.stateAttribute, meta.heat.*e.value);
   COREDEM_CHECK(H5Fflush(file, H5F_SCOPE_GLOBAL) >= 0, "cannot flush state file '{}'", path);
@@ -116,6 +124,11 @@ void readStateFile(const std::string& path, HostState& s, StateMeta& meta) {
   s.historySlots = h5::readAttribute<std::int32_t>(gm, "history_slots", what);
   s.neighbourSlots = h5::readAttribute<std::int32_t>(gm, "neighbour_slots", what);
   s.listValid = h5::readAttribute<std::int32_t>(gm, "neighbour_list_valid", what);
+  if (h5::hasAttribute(gm, "material_names")) {
+    std::istringstream names(h5::readStringAttribute(gm, "material_names", what));
+    for (std::string n; std::getline(names, n);)
+      meta.materialNames.push_back(n);
+  }
   // Heat totals: absent in files written before heat transfer was integrated (or the term).
   for (const HeatLedgerEntry& e : kHeatLedger)
     meta.heat.*e.value = optionalAttribute(gm, e.stateAttribute, 0.0, what);

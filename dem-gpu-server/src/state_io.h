@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "engine.h"
 
@@ -22,8 +23,11 @@ struct StateMeta {
   std::string softwareVersion;
   std::string protocolVersion; ///< coupling protocol of the writing server ("none" without one)
   HeatTotals heat;             ///< the heat ledger (kHeatLedger rows; 0 when a file lacks one)
-  bool hasChemistry = false;   ///< write/read the chemistry ledgers (/chemistry)
-  ChemistryTotals chemistry;   ///< ledgers; read only when the file has /chemistry
+  /// The materials' names in index order (/meta `material_names`, one per line; empty in files
+  /// written before it: a new start then maps the particles' materials by index)
+  std::vector<std::string> materialNames;
+  bool hasChemistry = false; ///< write/read the chemistry ledgers (/chemistry)
+  ChemistryTotals chemistry; ///< ledgers; read only when the file has /chemistry
 };
 
 /// Writes every checkpointed schema field and `meta`. Throws InternalError when a field of `s`

@@ -1,5 +1,6 @@
 // materials, initial_state, particles (docs/case-schema.md).
 #include <cmath>
+#include <fstream>
 #include <limits>
 
 #include <yaml-cpp/yaml.h>
@@ -48,19 +49,75 @@ void readMaterials(CaseReading& r) {
   }
 }
 
-/// initial_state: an HDF5 state file relative to the case folder
+namespace {
+
+/// The state file a new start takes from `path`: the file itself; a checkpoint folder's dem.h5;
+/// a run folder's last snapshot (snapshots/index.csv: the run's end), else its newest
+/// checkpoint. Empty, with `why`, when there is none.
+fs::path initialStateFile(const fs::path& path, std::string& why) {
+  if (fs::is_regular_file(path)) {
+    return path;
+  }
+  if (!fs::is_directory(path)) {
+    why = "not found";
+    return {};
+  }
+  if (fs::is_regular_file(path / "dem.h5")) {
+    return path / "dem.h5"; // a checkpoint folder
+  }
+  if (std::ifstream index{path / "snapshots" / "index.csv"}) {
+    std::string line, last;
+    while (std::getline(index, line)) {
+      if (!line.empty()) {
+        last = line;
+      }
+    }
+    const auto comma = last.rfind(',');
+    if (comma != std::string::npos && last.rfind("step,", 0) != 0) {
+      const fs::path snapshot = path / last.substr(comma + 1);
+      if (fs::is_regular_file(snapshot)) {
+        return snapshot;
+      }
+    }
+  }
+  fs::path newest;
+  if (fs::is_directory(path / "checkpoints")) {
+    for (const auto& e : fs::directory_iterator(path / "checkpoints")) {
+      if (fs::is_regular_file(e.path() / "manifest.json") &&
+          fs::is_regular_file(e.path() / "dem.h5") && e.path() > newest) {
+        newest = e.path();
+      }
+    }
+  }
+  if (newest.empty()) {
+    why = "is a folder without a DEM state (neither a run folder with snapshots or complete "
+          "checkpoints nor a checkpoint folder with dem.h5)";
+    return {};
+  }
+  return newest / "dem.h5";
+}
+
+} // namespace
+
+/// initial_state: the particles of another run to start from (a state file, a checkpoint
+/// folder or a run folder), relative to the case folder
 void readInitialState(CaseReading& r) {
   const Section& top = r.top;
   CaseConfig& c = r.c;
   if (top.has("initial_state")) {
-    const std::string rel =
-        top.string("initial_state", std::nullopt, "HDF5 state file, relative to the case folder");
-    c.initialState = fs::absolute(c.caseDir / rel);
-    if (!fs::is_regular_file(c.initialState)) {
+    const std::string rel = top.string("initial_state", std::nullopt,
+                                       "another run's DEM state: an HDF5 state file (a snapshot "
+                                       "or a checkpoint's dem.h5), a checkpoint folder or a run "
+                                       "folder, relative to the case folder");
+    const fs::path given = fs::absolute(c.caseDir / rel);
+    std::string why;
+    c.initialState = initialStateFile(given, why);
+    if (c.initialState.empty()) {
       top.fail(top.markOf("initial_state"), "initial_state",
-               fmt::format("file '{}' not found (looked for {}); give an HDF5 state file relative "
-                           "to the case folder",
-                           rel, c.initialState.string()));
+               fmt::format("{}'{}' {} (looked for {}); give a DEM state file (a run's "
+                           "snapshots/particles_<step>.h5 or checkpoints/<step>/dem.h5), a "
+                           "checkpoint folder or a run folder, relative to the case folder",
+                           why == "not found" ? "file " : "", rel, why, given.string()));
     }
   }
 }

@@ -10,6 +10,7 @@
 #include <coredem/dem/dem_config.h>
 #include <coredem/dem/models.h>
 #include <coredem/protocol/coupling_scheme.h>
+#include <coredem/protocol/initial_state.h>
 
 namespace fs = std::filesystem;
 namespace v1 = coredem::v1;
@@ -130,7 +131,11 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
   walls->set_temperature(c.walls.temperature);
   *cfg.mutable_gravity() = vec(c.gravity);
   if (!c.initialState.empty()) {
+    // A new start from another run's particles (any configuration; protocol/initial_state.h).
     cfg.set_initial_state_file(c.initialState.string());
+    auto* kv = cfg.add_options();
+    kv->set_key(std::string(protocol::fields::kInitialStateOption));
+    kv->set_value(std::string(protocol::fields::kInitialStateStart));
   }
   cfg.mutable_sub_cycling()->set_dt_cfd(dtCfd);
   cfg.mutable_sub_cycling()->set_n_sub(std::uint32_t(plan.nSub));

@@ -5,6 +5,7 @@
 #include <thread>
 
 #include <coredem/common/version.h>
+#include <coredem/protocol/initial_state.h>
 
 #include "configure.h"
 #include "session_impl.h"
@@ -200,7 +201,13 @@ void Session::configureDem(std::int64_t startStep, double startTime, const fs::p
   _configure.set_start_step(startStep);
   _configure.set_start_time(startTime);
   if (!initialState.empty()) {
+    // A resume: this run's own checkpoint, read bit for bit (the server checks its hash), not
+    // the new start from case.yaml's initial_state.
     _configure.set_initial_state_file(fs::absolute(initialState).string());
+    auto& options = *_configure.mutable_options();
+    for (auto it = options.begin(); it != options.end();) {
+      it = it->key() == protocol::fields::kInitialStateOption ? options.erase(it) : it + 1;
+    }
   }
   // A Configure with large mesh walls may exceed the server's message limit: the server started
   // here has the default limit; one at dem.endpoint may have been given a larger one.

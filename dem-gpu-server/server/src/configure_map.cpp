@@ -9,6 +9,7 @@
 #include "coredem/dem/kernels/nasa7.h"
 #include "coredem/dem/models.h"
 #include "coredem/protocol/coupling_scheme.h"
+#include "coredem/protocol/initial_state.h"
 
 namespace coredem::server {
 
@@ -336,8 +337,9 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
 
   // Model options by name (`models:` in case.yaml), through the model registry (models.h).
   for (const auto& kv : c.options()) {
-    if (kv.key() == protocol::fields::kCouplingSchemeOption) {
-      continue; // the server's own option (session_setup.cpp), not a DEM model
+    if (kv.key() == protocol::fields::kCouplingSchemeOption ||
+        kv.key() == protocol::fields::kInitialStateOption) {
+      continue; // the server's own options (session_setup.cpp), not DEM models
     }
     if (!dem::applyModelOption(cfg, kv.key(), kv.value()) && warnings != nullptr) {
       warnings->push_back(kv.key());

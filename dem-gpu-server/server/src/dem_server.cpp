@@ -293,7 +293,10 @@ struct DemServer::Impl {
     log->info("session {}: configured by '{}': {} particles{}, grid {} x {} x {}, {} gas species, "
               "backend {}, dt_dem_max {:.4g} s, start step {}",
               sessionId(), members.orchestratorName(), system.particleCount(),
-              c.initial_state_file().empty() ? "" : " from " + safe(c.initial_state_file(), 200),
+              c.initial_state_file().empty()
+                  ? ""
+                  : (s.newStart ? " (a new start) from " : " (a restart) from ") +
+                        safe(c.initial_state_file(), 200),
               g.counts().x(), g.counts().y(), g.counts().z(), session.grid.species,
               system.backendName(), dtMax, session.lastStep);
     auto m = proto::makeConfigured(session.grid.cells, system.particleCount(), session.grid.species,

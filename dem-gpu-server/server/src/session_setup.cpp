@@ -10,6 +10,7 @@
 #include "coredem/common/check.h"
 #include "coredem/dem/time_handler.h"
 #include "coredem/protocol/coupling_scheme.h"
+#include "coredem/protocol/initial_state.h"
 #include "coredem/protocol/protocol.h"
 
 namespace coredem::server {
@@ -38,9 +39,29 @@ std::optional<Refusal> readCouplingScheme(const v1::Configure& c, bool& staggere
   return std::nullopt;
 }
 
+/// How Configure.initial_state_file is read (protocol/initial_state.h): a new start from another
+/// run's particles, or (absent, "resume") a checkpoint of this run. Another value is refused.
+std::optional<Refusal> readInitialStateMode(const v1::Configure& c, bool& newStart) {
+  newStart = false;
+  for (const auto& kv : c.options()) {
+    if (kv.key() == proto::fields::kInitialStateOption) {
+      if (kv.value() == proto::fields::kInitialStateStart) {
+        newStart = true;
+      } else if (kv.value() != "resume") {
+        return Refusal{v1::ERROR_CODE_INVALID_CONFIGURATION,
+                       fmt::format("Configure option {} = '{}': this server reads 'start' or "
+                                   "'resume'",
+                                   proto::fields::kInitialStateOption, safe(kv.value(), 64))};
+      }
+    }
+  }
+  return std::nullopt;
+}
+
 /// The DEM system of `c` with its restart state (throws what the DEM core throws).
 void build(const v1::Configure& c, const ServerOptions& options, std::atomic<bool>* stopFlag,
            SessionSetup& s) {
+  const bool newStart = s.newStart;
   COREDEM_CHECK(c.coupling_mesh().has_cartesian(), "Configure has no Cartesian coupling grid");
   auto cfg = toDemConfig(c, &s.ignoredOptions);
   cfg.interrupt = stopFlag; // SIGINT/SIGTERM stop a long placement
@@ -49,9 +70,14 @@ void build(const v1::Configure& c, const ServerOptions& options, std::atomic<boo
   if (!c.initial_state_file().empty()) {
     COREDEM_CHECK(fs::exists(c.initial_state_file()), "initial state file '{}' does not exist",
                   c.initial_state_file());
-    s.system->readState(c.initial_state_file());
-    s.ledgers = readServerLedgers(c.initial_state_file(), c.species_size());
-    if (s.staggered) {
+    if (newStart) {
+      // Another run's particles: time, ledgers and the staggered lag start afresh.
+      s.system->startFromState(c.initial_state_file());
+    } else {
+      s.system->readState(c.initial_state_file());
+      s.ledgers = readServerLedgers(c.initial_state_file(), c.species_size());
+    }
+    if (s.staggered && !newStart) {
       s.lag = readStaggeredState(c.initial_state_file(), proto::cellCount(c.coupling_mesh()),
                                  c.species_size());
     }
@@ -81,6 +107,9 @@ std::variant<SessionSetup, SetupRefusal> setUpSession(const v1::Configure& c,
   }
   SessionSetup s;
   if (auto no = readCouplingScheme(c, s.staggered)) {
+    return SetupRefusal{std::move(*no), std::string()};
+  }
+  if (auto no = readInitialStateMode(c, s.newStart)) {
     return SetupRefusal{std::move(*no), std::string()};
   }
   s.lag.speciesComputed.assign(static_cast<std::size_t>(c.species_size()), 0.0);

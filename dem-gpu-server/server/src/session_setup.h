@@ -22,6 +22,7 @@ struct SessionSetup {
   std::unique_ptr<dem::DemSystem> system;
   std::uint32_t nSub = 0; ///< the sub-steps of Configure's dt_cfd (0: none given)
   bool staggered = false;
+  bool newStart = false; ///< initial_state_file is another run's particles (initial_state.h)
   ServerLedgers ledgers;
   StaggeredState lag;
   std::vector<std::string> ignoredOptions; ///< Configure options that are not the DEM's

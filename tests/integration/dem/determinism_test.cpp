@@ -121,3 +121,66 @@ TEST(Restart, WriteReadContinueIsBitwiseIdentical) {
   EXPECT_THROW(wrong.readState((dir / "missing.h5").string()), coredem::UserError);
   std::filesystem::remove_all(dir);
 }
+
+// A new start from another run's state (DemSystem::startFromState; case.yaml initial_state):
+// time, step and ledgers start at 0 and the pairs' tangential history is kept, so that without
+// wall contacts continuing from it is bitwise the restart's continuation (only the clock
+// differs, which no force here depends on); materials are matched by name, and a particle whose
+// material the new configuration lacks is refused naming it.
+TEST(NewStart, KeepsParticlesAndPairHistoryAndMatchesMaterialsByName) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("coredem_dem_new_start_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string file = (dir / "state.h5").string();
+  DemConfig c = agitatedDeck(729, false, 11); // no walls: only pair contacts
+  c.grid.counts = {3, 3, 3};
+  for (int d = 0; d < 3; ++d)
+    c.grid.spacing[d] = c.particleSets[0].regionMax[d] / 3;
+  DemSystem first(c, BackendKind::Cpu, 1);
+  setGas(first);
+  run(first, 8);
+  first.writeState(file);
+  const ParticleData atWrite = first.particles();
+
+  DemConfig noSets = c;
+  noSets.particleSets.clear();
+  DemSystem restarted(noSets, BackendKind::Cpu, 1);
+  restarted.readState(file);
+  DemSystem started(noSets, BackendKind::Cpu, 1);
+  started.startFromState(file);
+  EXPECT_EQ(started.time(), 0.0);
+  EXPECT_EQ(started.step(), 0u);
+  expectBitwiseEqual(atWrite, started.particles());
+  for (DemSystem* s : {&restarted, &started}) {
+    setGas(*s);
+    run(*s, 8);
+  }
+  expectBitwiseEqual(restarted.particles(), started.particles());
+  EXPECT_GT(restarted.time(), started.time());
+
+  // Materials by name: "default" is material 1 behind a new "steel".
+  DemConfig renamed = noSets;
+  Material steel = renamed.materials[0];
+  steel.name = "steel";
+  steel.kn *= 3.0;
+  renamed.materials.insert(renamed.materials.begin(), steel);
+  renamed.materials[1].mu = 0.5; // another configuration: the hash differs
+  DemSystem moved(renamed, BackendKind::Cpu, 1);
+  EXPECT_THROW(moved.readState(file), coredem::UserError);
+  moved.startFromState(file);
+  for (const std::int32_t m : moved.particles().material)
+    EXPECT_EQ(m, 1);
+
+  DemConfig missing = noSets;
+  missing.materials[0].name = "sand";
+  DemSystem refused(missing, BackendKind::Cpu, 1);
+  try {
+    refused.startFromState(file);
+    ADD_FAILURE() << "a state whose material is missing was accepted";
+  } catch (const coredem::UserError& e) {
+    EXPECT_NE(std::string(e.what()).find("material 'default' have no material of that name"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}

@@ -204,6 +204,15 @@ public:
   /// particle sets takes all particles from the file; Δt_DEM,max is recomputed from them.
   /// @pre written by a system with the same config hash (else UserError naming both).
   void readState(const std::string& path);
+  /// A new start from the particles of another run's state file (a checkpoint or a snapshot,
+  /// any configuration): positions, velocities, angular velocities, radii, masses, densities,
+  /// temperatures, compositions, initial diameters and the tangential history of particle
+  /// pairs; the time, step and ledgers start at 0, the walls' history is dropped (the walls
+  /// may differ) and each particle takes the material of the same name in this configuration
+  /// (by index for files that do not name them). Δt_DEM,max is recomputed from the particles.
+  /// @pre the file's solid species count is this configuration's (else UserError); every
+  /// particle's material exists here (else UserError naming it).
+  void startFromState(const std::string& path);
 
   double time() const;        ///< simulated time (s)
   std::uint64_t step() const; ///< DEM sub-steps taken
