@@ -1,5 +1,6 @@
 // coredem: the CoReDEM orchestrator CLI (docs/orchestrator.md).
 //   coredem run CASE_DIR [--out RUN_DIR] [--auto-restart N] [--stop-after STEP] [--walltime S]
+//                        (a staged case: one run per stage, RUN_DIR/stages/NN-name/run)
 //   coredem resume RUN_DIR [--auto-restart N] [--stop-after STEP] [--walltime S]
 //   coredem inspect FILE
 //   coredem render RUN_DIR [--times T,...] [--field F] [--gas-field G] [--out DIR]
@@ -22,12 +23,32 @@
 #include <coredem/orchestrator/outputs.h>
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/session.h>
+#include <coredem/orchestrator/stages.h>
 #include <coredem/orchestrator/verify.h>
 
 using namespace coredem::orchestrator;
 namespace fs = std::filesystem;
 
 namespace {
+
+/// The case file of a CASE_DIR argument (a folder with case.yaml, or a case file).
+fs::path caseFileOf(const std::string& caseDir) {
+  fs::path file = caseDir;
+  if (fs::is_directory(file)) {
+    file /= "case.yaml";
+  }
+  return file;
+}
+
+std::string readAll(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+/// Whether `file` is a staged case (case.yaml `stages`; a missing file is left to loadCase).
+bool isStaged(const fs::path& file) {
+  return fs::is_regular_file(file) && !readStages(file).empty();
+}
 
 /// Runs scripts/plot/plot_run.py with the Python that CMake found (COREDEM_PYTHON); a failure
 /// is a warning, never an error of the run.
@@ -243,6 +264,34 @@ int runOrResume(const CommandLine& c, const std::shared_ptr<spdlog::logger>& log
   if (c.walltime > 0.0) {
     opts.walltimeSeconds = c.walltime;
   }
+  const auto plots = [&](const fs::path& runDir, int rc) {
+    if (rc == kExitOk) {
+      std::printf("results: %s (timeseries.csv, outputs.csv, particles.xdmf, checkpoints/)\n",
+                  runDir.string().c_str());
+    }
+    // An interrupted run (SIGINT/SIGTERM) gets its plots too, up to its last step.
+    if ((rc == kExitOk || rc == kExitInterrupted) && !c.noPlots) {
+      makePlots(runDir, rc == kExitInterrupted);
+    }
+  };
+  // A staged case (case.yaml `stages`): one run per stage in one run folder.
+  const fs::path given = *c.run ? caseFileOf(c.caseDir) : fs::path(c.runDir) / "staged.yaml";
+  if (*c.run ? isStaged(given) : fs::is_regular_file(given)) {
+    std::vector<Stage> stages = readStages(given);
+    fs::path runDir;
+    if (!*c.run) {
+      runDir = fs::absolute(c.runDir);
+    } else {
+      checkStages(given, checkParticipantInput); // every stage before anything is written
+      const CaseConfig first = parseCase(
+          stageCaseText(readAll(given), fs::absolute(given).parent_path(), stages, 0, false), given,
+          fs::absolute(given).parent_path());
+      runDir = fs::absolute(
+          chooseRunDir(first.name, c.out.empty() ? std::nullopt : std::optional<fs::path>(c.out)));
+      log->info("run folder {} ({} stages)", runDir.string(), stages.size());
+    }
+    return runStages(given, runDir, !*c.run, opts, checkParticipantInput, plots);
+  }
   CaseConfig config;
   if (*c.run) {
     config = loadCase(c.caseDir);  // throws CaseError: nothing written yet
@@ -256,14 +305,7 @@ int runOrResume(const CommandLine& c, const std::shared_ptr<spdlog::logger>& log
     opts.resume = true;
   }
   const int rc = runSession(config, opts);
-  if (rc == kExitOk) {
-    std::printf("results: %s (timeseries.csv, outputs.csv, particles.xdmf, checkpoints/)\n",
-                opts.runDir.string().c_str());
-  }
-  // An interrupted run (SIGINT/SIGTERM) gets its plots too, up to its last step.
-  if ((rc == kExitOk || rc == kExitInterrupted) && !c.noPlots) {
-    makePlots(opts.runDir, rc == kExitInterrupted);
-  }
+  plots(opts.runDir, rc);
   return rc;
 }
 
@@ -307,6 +349,11 @@ int main(int argc, char** argv) {
       return runVerify(cmd.verifyOpts);
     }
     if (*cmd.check) {
+      if (const fs::path file = caseFileOf(cmd.caseDir); isStaged(file)) {
+        checkStages(file, checkParticipantInput);
+        std::cout << file.string() << ": valid (" << readStages(file).size() << " stages)\n";
+        return kExitOk;
+      }
       const CaseConfig c = loadCase(cmd.caseDir);
       checkParticipantInput(c);
       std::cout << c.caseFile.string() << ": valid\n";

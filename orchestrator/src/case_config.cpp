@@ -87,6 +87,13 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   c.text = text;
   c.configHash = sha256Hex(text);
 
+  if (root.IsMap() && root["stages"]) {
+    const YAML::Mark m = root["stages"].Mark();
+    throw CaseError(fmt::format("{}:{}:{}: stages: a staged case runs with 'coredem run' or "
+                                "'coredem check' on its folder, one case per stage; it cannot be "
+                                "loaded as one case here (e.g. as a campaign's base case)",
+                                fileName, m.line + 1, m.column + 1));
+  }
   const yaml::Section top(
       root, fileName, "",
       {"name",       "description",    "time",          "grid",      "gravity",

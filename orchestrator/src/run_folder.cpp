@@ -15,30 +15,35 @@ namespace fs = std::filesystem;
 
 namespace coredem::orchestrator {
 
-fs::path prepareRunDir(const CaseConfig& config, const std::optional<fs::path>& out) {
+fs::path chooseRunDir(const std::string& name, const std::optional<fs::path>& out) {
   fs::path dir;
   if (out) {
     dir = *out;
-    if (fs::exists(dir / "case.yaml")) {
+    if (fs::exists(dir / "case.yaml") || fs::exists(dir / "staged.yaml")) {
       throw CaseError(fmt::format("{} already holds a run; continue it with 'coredem resume {}' "
                                   "(from its latest complete checkpoint, or from step 0 when it "
                                   "has none) or choose another --out",
                                   dir.string(), dir.string()));
     }
   } else {
-    dir = fs::path("runs") / config.name;
+    dir = fs::path("runs") / name;
     if (fs::exists(dir)) {
       const std::time_t now = std::time(nullptr);
       std::tm tm{};
       ::localtime_r(&now, &tm);
       char buf[32];
       std::strftime(buf, sizeof buf, "%Y%m%d-%H%M%S", &tm);
-      dir = fs::path("runs") / (config.name + "-" + buf);
+      dir = fs::path("runs") / (name + "-" + buf);
       for (int i = 2; fs::exists(dir); ++i) {
-        dir = fs::path("runs") / fmt::format("{}-{}-{}", config.name, buf, i);
+        dir = fs::path("runs") / fmt::format("{}-{}-{}", name, buf, i);
       }
     }
   }
+  return dir;
+}
+
+fs::path prepareRunDir(const CaseConfig& config, const std::optional<fs::path>& out) {
+  const fs::path dir = chooseRunDir(config.name, out);
   fs::create_directories(dir / "logs");
   writeFileAtomic(dir / "case.yaml", config.text);
   JsonWriter run;

@@ -87,18 +87,17 @@ std::string secondCase(const std::string& from) {
 TEST(NewStartE2E, SettledBedStartsARunWithAnotherConfiguration) {
   const fs::path d = coredem::e2e::tempDir("coredem-e2e", "new-start");
   const fs::path settle = d / "settle";
-  ASSERT_EQ(runCoredem({"run", (kCases / "restart").string(), "--out", settle.string(),
-                        "--no-plots"},
-                       d / "settle.log"),
-            0)
+  ASSERT_EQ(
+      runCoredem({"run", (kCases / "restart").string(), "--out", settle.string(), "--no-plots"},
+                 d / "settle.log"),
+      0)
       << readAll(d / "settle.log");
   const fs::path second = d / "second";
   fs::create_directories(second);
   writeAll(second / "case.yaml", secondCase("../settle")); // the run folder: its last snapshot
   const fs::path run = d / "run";
-  ASSERT_EQ(runCoredem({"run", second.string(), "--out", run.string(), "--no-plots"},
-                       d / "run.log"),
-            0)
+  ASSERT_EQ(
+      runCoredem({"run", second.string(), "--out", run.string(), "--no-plots"}, d / "run.log"), 0)
       << readAll(d / "run.log");
 
   const fs::path end = lastSnapshot(settle);
@@ -108,9 +107,9 @@ TEST(NewStartE2E, SettledBedStartsARunWithAnotherConfiguration) {
   EXPECT_EQ(metaTime(start), 0.0) << "a new start begins at t = 0";
   const auto a = datasetsOf(end);
   const auto b = datasetsOf(start);
-  for (const char* field : {"particles/position", "particles/velocity",
-                            "particles/angular_velocity", "particles/radius",
-                            "particles/temperature", "particles/global_id"}) {
+  for (const char* field :
+       {"particles/position", "particles/velocity", "particles/angular_velocity",
+        "particles/radius", "particles/temperature", "particles/global_id"}) {
     ASSERT_TRUE(a.count(field) && b.count(field)) << field;
     EXPECT_EQ(a.at(field), b.at(field)) << field << " differs from the settled run's end";
   }
@@ -156,11 +155,12 @@ TEST(NewStartE2E, StartWithoutAStateOrWithAMissingMaterialIsRefusedNamingIt) {
            replaceAll(secondCase("../settle/snapshots/particles_00000000.h5"), "- name: glass",
                       "- name: sand"));
   const fs::path run = d / "run";
-  EXPECT_NE(runCoredem({"run", (d / "c2").string(), "--out", run.string(), "--no-plots"},
-                       d / "c2.log"),
-            0);
-  EXPECT_NE(readAll(d / "c2.log").find("particles of material 'glass' have no material of that "
-                                       "name in this case"),
+  EXPECT_NE(
+      runCoredem({"run", (d / "c2").string(), "--out", run.string(), "--no-plots"}, d / "c2.log"),
+      0);
+  EXPECT_NE(readAll(d / "c2.log")
+                .find("particles of material 'glass' have no material of that "
+                      "name in this case"),
             std::string::npos)
       << readAll(d / "c2.log");
   if (!HasFailure()) {

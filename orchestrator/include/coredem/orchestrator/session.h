@@ -72,6 +72,11 @@ enum ExitCode : int {
   kExitInterrupted = 130,
 };
 
+/// The folder of a new run: `out` (which must not hold a run yet: case.yaml, or staged.yaml of
+/// a staged run), else `runs/<name>` or a timestamped sibling when that exists. Creates nothing.
+std::filesystem::path chooseRunDir(const std::string& name,
+                                   const std::optional<std::filesystem::path>& out);
+
 /// Creates the run folder for a new run (`runs/<name>` or a timestamped sibling when that
 /// exists, or `out` which must not contain a run yet) and copies the case file into it.
 std::filesystem::path prepareRunDir(const CaseConfig& config,
