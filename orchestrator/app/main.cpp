@@ -4,16 +4,19 @@
 //   coredem inspect FILE
 //   coredem render RUN_DIR [--times T,...] [--field F] [--gas-field G] [--out DIR]
 //   coredem check CASE_DIR
+//   coredem stats RUN_DIR [--from T] [--to T] [--json] [--no-fields]
 //   coredem verify [--out DIR] [--only NAME[,NAME]] [--list] [--cases DIR] [--no-plots]
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <coredem/common/files.h>
 #include <coredem/common/log.h>
 #include <coredem/common/process.h>
 #include <coredem/common/version.h>
@@ -22,6 +25,7 @@
 #include <coredem/orchestrator/outputs.h>
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/session.h>
+#include <coredem/orchestrator/stats.h>
 #include <coredem/orchestrator/verify.h>
 
 using namespace coredem::orchestrator;
@@ -153,8 +157,12 @@ struct CommandLine {
   std::vector<std::string> only;
   std::vector<double> renderTimes;
   std::string renderField, renderGasField, renderOut;
+  std::vector<std::string> renderExtra; ///< --slice, --particles, ... passed to the script
+  double statsFrom = 0.0, statsTo = 0.0;
+  CLI::Option *statsFromOpt = nullptr, *statsToOpt = nullptr;
+  bool statsJson = false, statsNoFields = false;
   CLI::App *run = nullptr, *resume = nullptr, *inspect = nullptr, *verify = nullptr,
-           *render = nullptr, *check = nullptr;
+           *render = nullptr, *check = nullptr, *stats = nullptr;
 };
 
 /// `coredem run` and `coredem resume`.
@@ -226,9 +234,62 @@ void addToolCommands(CLI::App& app, CommandLine& c) {
                        "gas field of the slice (alphac, U, p, T, ...)");
   c.render->add_option("--out", c.renderOut, "picture folder (default RUN_DIR/render)");
 
+  c.stats = app.add_subcommand(
+      "stats", "time-averaged results of a run: mean, std, min, max of every timeseries.csv "
+               "column over a window, and time-averaged coupling-cell fields from the snapshots "
+               "(RUN_DIR/stats/; docs/orchestrator.md \"Time-averaged results\")");
+  c.stats->add_option("RUN_DIR", c.runDir, "run folder created by coredem run")->required();
+  c.statsFromOpt = c.stats->add_option("--from", c.statsFrom,
+                      "start of the window in s (exclude the start-up transient; default: the "
+                      "run's start)");
+  c.statsToOpt = c.stats->add_option("--to", c.statsTo, "end of the window in s (default: the run's last row)");
+  c.stats->add_flag("--json", c.statsJson, "print the JSON document instead of the table");
+  c.stats->add_flag("--no-fields", c.statsNoFields,
+                    "only the timeseries statistics (no averaged fields from the snapshots)");
+
   c.check = app.add_subcommand("check", "validate a case file and exit (0 valid, 2 invalid)");
   c.check->add_option("CASE_DIR", c.caseDir, "case folder with case.yaml (or a case file)")
       ->required();
+}
+
+/// `coredem stats`: RUN/stats/stats.json (+ averages.h5/.xdmf) and the table (or the JSON).
+int runStats(const CommandLine& c) {
+  const fs::path runDir = fs::absolute(c.runDir);
+  TimeWindow window;
+  if (c.statsFromOpt->count() > 0) {
+    window.from = c.statsFrom;
+  }
+  if (c.statsToOpt->count() > 0) {
+    window.to = c.statsTo;
+  }
+  const TimeseriesStats s = timeseriesStats(runDir, window);
+  std::optional<FieldAverages> fields;
+  const fs::path outDir = runDir / "stats";
+  fs::create_directories(outDir);
+  std::string note;
+  if (!c.statsNoFields) {
+    const CaseConfig config = loadRunCase(runDir);
+    fields = fieldAverages(runDir, config.grid, s.from, s.to);
+    if (fields) {
+      writeFieldAverages(*fields, outDir / "averages.h5", outDir / "averages.xdmf");
+      note = fmt::format("fields: {} (ParaView; {} snapshots at t = {:.6g} .. {:.6g} s)\n",
+                         (outDir / "averages.xdmf").string(), fields->times.size(),
+                         fields->times.front(), fields->times.back());
+    } else {
+      note = fmt::format("fields: none (no particle snapshot in t = [{:.6g}, {:.6g}] s: "
+                         "outputs.csv lists the snapshots; set output.every or "
+                         "output.every_seconds in case.yaml)\n",
+                         s.from, s.to);
+    }
+  }
+  const std::string json = statsJson(s, fields, fields ? "averages.xdmf" : "");
+  writeFileAtomic(outDir / "stats.json", json);
+  if (c.statsJson) {
+    std::cout << json;
+  } else {
+    std::cout << statsTable(s) << note << "json: " << (outDir / "stats.json").string() << "\n";
+  }
+  return kExitOk;
 }
 
 /// `coredem run` (a new run folder) or `coredem resume`: the coupled run and its plots.
@@ -297,6 +358,9 @@ int main(int argc, char** argv) {
     if (*cmd.render) {
       return renderRun(fs::absolute(cmd.runDir), cmd.renderTimes, cmd.renderField,
                        cmd.renderGasField, cmd.renderOut);
+    }
+    if (*cmd.stats) {
+      return runStats(cmd);
     }
     if (*cmd.verify) {
       cmd.verifyOpts.only = cmd.only;
