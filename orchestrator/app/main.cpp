@@ -253,7 +253,7 @@ void addToolCommands(CLI::App& app, CommandLine& c) {
 }
 
 /// `coredem stats`: RUN/stats/stats.json (+ averages.h5/.xdmf) and the table (or the JSON).
-int runStats(const CommandLine& c) {
+int statsOf(const CommandLine& c) {
   const fs::path runDir = fs::absolute(c.runDir);
   TimeWindow window;
   if (c.statsFromOpt->count() > 0) {
@@ -283,13 +283,23 @@ int runStats(const CommandLine& c) {
     }
   }
   const std::string json = statsJson(s, fields, fields ? "averages.xdmf" : "");
-  writeFileAtomic(outDir / "stats.json", json);
+  coredem::writeFileAtomic(outDir / "stats.json", json);
   if (c.statsJson) {
     std::cout << json;
   } else {
     std::cout << statsTable(s) << note << "json: " << (outDir / "stats.json").string() << "\n";
   }
   return kExitOk;
+}
+
+/// `coredem stats` with bad input (exit 2) told apart from a fault.
+int runStats(const CommandLine& c) {
+  try {
+    return statsOf(c);
+  } catch (const coredem::UserError& e) { // a window outside the run, a folder without a run
+    coredem::logger("orchestrator")->error("{}", e.what());
+    return kExitBadInput;
+  }
 }
 
 /// `coredem run` (a new run folder) or `coredem resume`: the coupled run and its plots.
