@@ -2,7 +2,8 @@
 //   coredem run CASE_DIR [--out RUN_DIR] [--auto-restart N] [--stop-after STEP] [--walltime S]
 //   coredem resume RUN_DIR [--auto-restart N] [--stop-after STEP] [--walltime S]
 //   coredem inspect FILE
-//   coredem render RUN_DIR [--times T,...] [--field F] [--gas-field G] [--out DIR]
+//   coredem render RUN_DIR [--times T,...] [--field F] [--gas-field G] [--out DIR] [--slice F]
+//                          [--particles all|none] [--particle-opacity A] [--particle-scale S]
 //   coredem check CASE_DIR
 //   coredem stats RUN_DIR [--from T] [--to T] [--json] [--no-fields]
 //   coredem verify [--out DIR] [--only NAME[,NAME]] [--list] [--cases DIR] [--no-plots]
@@ -62,7 +63,8 @@ void makePlots(const fs::path& runDir, bool interrupted) {
 /// `coredem render`: scripts/render/render_run.py under ParaView's pvbatch (found at configure
 /// time or on PATH), on a private Xvfb when there is no display.
 int renderRun(const fs::path& runDir, const std::vector<double>& times, const std::string& field,
-              const std::string& gasField, const std::string& outDir) {
+              const std::string& gasField, const std::string& outDir,
+              const std::vector<std::pair<std::string, std::string>>& extra) {
   auto log = coredem::logger("orchestrator");
   fs::path pvbatch = COREDEM_PVBATCH;
   if (pvbatch.empty() || !fs::exists(pvbatch)) {
@@ -111,6 +113,11 @@ int renderRun(const fs::path& runDir, const std::vector<double>& times, const st
   if (!gasField.empty()) {
     args.insert(args.end(), {"--gas-field", gasField});
   }
+  for (const auto& [flag, value] : extra) { // --slice, --particles, ... when given
+    if (!value.empty()) {
+      args.insert(args.end(), {flag, value});
+    }
+  }
   const fs::path out = outDir.empty() ? runDir / "render" : fs::absolute(outDir);
   args.insert(args.end(), {"--out", out.string()});
   fs::create_directories(out);
@@ -157,7 +164,7 @@ struct CommandLine {
   std::vector<std::string> only;
   std::vector<double> renderTimes;
   std::string renderField, renderGasField, renderOut;
-  std::vector<std::string> renderExtra; ///< --slice, --particles, ... passed to the script
+  std::string renderSlice, renderParticles, renderOpacity, renderScale; ///< passed on as given
   double statsFrom = 0.0, statsTo = 0.0;
   CLI::Option *statsFromOpt = nullptr, *statsToOpt = nullptr;
   bool statsJson = false, statsNoFields = false;
@@ -233,6 +240,19 @@ void addToolCommands(CLI::App& app, CommandLine& c) {
   c.render->add_option("--gas-field", c.renderGasField,
                        "gas field of the slice (alphac, U, p, T, ...)");
   c.render->add_option("--out", c.renderOut, "picture folder (default RUN_DIR/render)");
+  c.render->add_option("--slice", c.renderSlice,
+                       "gas slice position along the viewing axis, a fraction of the domain depth "
+                       "(0 front .. 1 back; default 0.5)")
+      ->check(CLI::Range(0.0, 1.0));
+  c.render->add_option("--particles", c.renderParticles,
+                       "all (default) or none: the gas slice alone, which the particles of a bed "
+                       "one cell deep hide")
+      ->check(CLI::IsMember({"all", "none"}));
+  c.render->add_option("--particle-opacity", c.renderOpacity, "particle opacity 0..1 (default 1)")
+      ->check(CLI::Range(0.0, 1.0));
+  c.render->add_option("--particle-scale", c.renderScale,
+                       "sphere size as a fraction of the particle diameter (0..1], default 1")
+      ->check(CLI::Range(0.0, 1.0));
 
   c.stats = app.add_subcommand(
       "stats", "time-averaged results of a run: mean, std, min, max of every timeseries.csv "
@@ -367,7 +387,11 @@ int main(int argc, char** argv) {
     }
     if (*cmd.render) {
       return renderRun(fs::absolute(cmd.runDir), cmd.renderTimes, cmd.renderField,
-                       cmd.renderGasField, cmd.renderOut);
+                       cmd.renderGasField, cmd.renderOut,
+                       {{"--slice", cmd.renderSlice},
+                        {"--particles", cmd.renderParticles},
+                        {"--particle-opacity", cmd.renderOpacity},
+                        {"--particle-scale", cmd.renderScale}});
     }
     if (*cmd.stats) {
       return runStats(cmd);

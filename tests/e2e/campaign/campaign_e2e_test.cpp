@@ -265,16 +265,14 @@ TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
     while (std::getline(w, l)) {
       const std::string id = l.substr(0, l.find(','));
       const auto ts = coredem::e2e::readTimeseries(dir / "members" / id / "run");
-      double mx = -HUGE_VAL, mxAll = -HUGE_VAL;
+      double mx = -HUGE_VAL;
       for (std::size_t i = 0; i < ts.at("t").size(); ++i) {
         const double e = ts.at("dem.kinetic_energy_J")[i];
-        mxAll = std::max(mxAll, e);
         if (ts.at("t")[i] > 0.01 + 1e-12) {
           mx = std::max(mx, e);
         }
       }
       EXPECT_EQ(std::stod(l.substr(l.rfind(',') + 1)), mx) << l;
-      EXPECT_LT(mx, mxAll) << id; // the window left the fall's peak out
     }
   }
   // a window beyond the members' end is refused with the reason
