@@ -12,7 +12,9 @@ DIR/<field>.mp4 is made when ffmpeg is on PATH, else DIR/<field>.gif when Pillow
 
 --field: a particle array (temperature, velocity, diameter, species_<name>, ...; vectors are
 coloured by magnitude; default temperature when it varies, else velocity). --gas-field: an
-OpenFOAM field of the gas folder (default alphac when present, else U, else p). --times: decimal
+OpenFOAM field of the gas folder (default alphac when present, else U, else p), or p_Pa: the
+pressure in Pa (coredemFoam's constant-property gas writes the kinematic p = p/rho_g in m^2/s^2;
+p_Pa is rho_g * p from case.yaml's gas_properties.density; the ideal gas's p is already in Pa). --times: decimal
 times in seconds (the nearest output of each is drawn), default every output.
 
 Every picture carries its time stamp (t and step), a colour legend for the particles and one for
@@ -29,7 +31,7 @@ import shutil
 import subprocess
 import sys
 
-from paraview.simple import (ColorBy, CreateView, GetColorTransferFunction, GetScalarBar,
+from paraview.simple import (Calculator, ColorBy, CreateView, GetColorTransferFunction, GetScalarBar,
                              GetDisplayProperties, Glyph, OpenFOAMReader, Render, Ruler,
                              SaveScreenshot, Show, Slice, Text, UpdatePipeline, XDMFReader)
 from paraview import servermanager as sm
@@ -114,6 +116,22 @@ def gravity_axis(run_dir):
         return 1
 
 
+def pressure_factor(run_dir):
+    """(factor, note): p_Pa = factor * p. coredemFoam's constant-property gas solves the kinematic
+    pressure p/rho_g (m^2/s^2), its ideal gas p in Pa (docs/coredemFoam.md)."""
+    try:
+        import yaml
+
+        with open(os.path.join(run_dir, "case.yaml")) as f:
+            gp = (yaml.safe_load(f) or {}).get("gas_properties") or {}
+    except Exception:  # no case file or no PyYAML: the documented default (constant, air)
+        gp = {}
+    if gp.get("model", "constant") == "ideal_gas":
+        return 1.0, "p is in Pa (ideal gas)"
+    rho = float(gp.get("density", 1.204))
+    return rho, f"p is kinematic (m^2/s^2): p_Pa = {rho:g} kg/m^3 * p"
+
+
 def array_info(proxy, name):
     """(number of components, range) of a point array, or None when absent."""
     info = proxy.GetDataInformation().GetPointDataInformation().GetArrayInformation(name)
@@ -181,6 +199,14 @@ def main():
         gas.MeshRegions = ["internalMesh"]
         gas.UpdatePipelineInformation()
         UpdatePipeline(time=t0, proxy=gas)
+        if a.gas_field == "p_Pa" and cell_array_info(gas, "p_Pa") is None:
+            factor, note = pressure_factor(run_dir)
+            gas = Calculator(Input=gas)
+            gas.AttributeType = "Cell Data"
+            gas.ResultArrayName = "p_Pa"
+            gas.Function = f"p*{factor!r}"
+            UpdatePipeline(time=t0, proxy=gas)
+            print(f"p_Pa: {note}", flush=True)
 
     up = gravity_axis(run_dir)
     bounds = particles.GetDataInformation().GetBounds()
@@ -233,7 +259,8 @@ def main():
             lut = GetColorTransferFunction(gas_field)
             lut.ApplyPreset("Cool to Warm", True)
             bar = GetScalarBar(lut, view)
-            bar.Title = f"gas {gas_field}"
+            bar.Title = f"gas {gas_field}" + (" [m2/s2, kinematic]" if gas_field == "p" and
+                                               pressure_factor(run_dir)[0] != 1.0 else "")
             bar.ComponentTitle = ""
             bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
             bar.WindowLocation = "Any Location"
