@@ -240,18 +240,21 @@ void addToolCommands(CLI::App& app, CommandLine& c) {
   c.render->add_option("--gas-field", c.renderGasField,
                        "gas field of the slice (alphac, U, p, T, ...)");
   c.render->add_option("--out", c.renderOut, "picture folder (default RUN_DIR/render)");
-  c.render->add_option("--slice", c.renderSlice,
-                       "gas slice position along the viewing axis, a fraction of the domain depth "
-                       "(0 front .. 1 back; default 0.5)")
+  c.render
+      ->add_option("--slice", c.renderSlice,
+                   "gas slice position along the viewing axis, a fraction of the domain depth "
+                   "(0 front .. 1 back; default 0.5)")
       ->check(CLI::Range(0.0, 1.0));
-  c.render->add_option("--particles", c.renderParticles,
-                       "all (default) or none: the gas slice alone, which the particles of a bed "
-                       "one cell deep hide")
+  c.render
+      ->add_option("--particles", c.renderParticles,
+                   "all (default) or none: the gas slice alone, which the particles of a bed "
+                   "one cell deep hide")
       ->check(CLI::IsMember({"all", "none"}));
   c.render->add_option("--particle-opacity", c.renderOpacity, "particle opacity 0..1 (default 1)")
       ->check(CLI::Range(0.0, 1.0));
-  c.render->add_option("--particle-scale", c.renderScale,
-                       "sphere size as a fraction of the particle diameter (0..1], default 1")
+  c.render
+      ->add_option("--particle-scale", c.renderScale,
+                   "sphere size as a fraction of the particle diameter (0..1], default 1")
       ->check(CLI::Range(0.0, 1.0));
 
   c.stats = app.add_subcommand(
@@ -259,10 +262,12 @@ void addToolCommands(CLI::App& app, CommandLine& c) {
                "column over a window, and time-averaged coupling-cell fields from the snapshots "
                "(RUN_DIR/stats/; docs/orchestrator.md \"Time-averaged results\")");
   c.stats->add_option("RUN_DIR", c.runDir, "run folder created by coredem run")->required();
-  c.statsFromOpt = c.stats->add_option("--from", c.statsFrom,
-                      "start of the window in s (exclude the start-up transient; default: the "
-                      "run's start)");
-  c.statsToOpt = c.stats->add_option("--to", c.statsTo, "end of the window in s (default: the run's last row)");
+  c.statsFromOpt =
+      c.stats->add_option("--from", c.statsFrom,
+                          "start of the window in s (exclude the start-up transient; default: the "
+                          "run's start)");
+  c.statsToOpt = c.stats->add_option("--to", c.statsTo,
+                                     "end of the window in s (default: the run's last row)");
   c.stats->add_flag("--json", c.statsJson, "print the JSON document instead of the table");
   c.stats->add_flag("--no-fields", c.statsNoFields,
                     "only the timeseries statistics (no averaged fields from the snapshots)");

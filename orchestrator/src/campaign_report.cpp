@@ -161,8 +161,7 @@ std::string whenOf(const std::vector<MemberRecord>& members, const ScalarSpec& s
     return fmt::format("final value at t = {} s", span(lo1, hi1));
   }
   const std::string from = spec.from ? fmt::format("{:.6g}", *spec.from) : span(lo0, hi0);
-  const std::string to = spec.to ? fmt::format("{:.6g}", std::min(*spec.to, hi1))
-                                 : span(lo1, hi1);
+  const std::string to = spec.to ? fmt::format("{:.6g}", std::min(*spec.to, hi1)) : span(lo1, hi1);
   return fmt::format("{} over t = {} to {} s{}", spec.reduce, from, to,
                      spec.from ? " (start-up excluded)" : "");
 }
@@ -342,9 +341,8 @@ int collect(const fs::path& dir, bool noPlot, const CollectWindow& window) {
   }
   const std::string cmd = fmt::format(
       "'{}' '{}' '{}' --x '{}' --y '{}'{}{} --title '{}' --when '{}' --out '{}' > '{}' 2>&1",
-      python.string(), script.string(), (dir / "summary.csv").string(), db.setting("plot_x"),
-      plotY, groups, units, db.setting("name"), when, png.string(),
-      (dir / "plots" / "plot.log").string());
+      python.string(), script.string(), (dir / "summary.csv").string(), db.setting("plot_x"), plotY,
+      groups, units, db.setting("name"), when, png.string(), (dir / "plots" / "plot.log").string());
   const int rc = std::system(cmd.c_str());
   if (rc != 0) {
     logger("campaign")->warn("plot script failed (see {})", (dir / "plots" / "plot.log").string());

@@ -449,9 +449,8 @@ ScalarSpec scalarOfMapping(const YAML::Node& v) {
   if (text.empty()) {
     throw CaseError("a scalar mapping needs one of final, max, min, mean: {mean: COLUMN}");
   }
-  ScalarSpec spec = parseScalarLabel(text.find("@..:") != std::string::npos
-                                         ? text.replace(text.find("@..:"), 4, ":")
-                                         : text);
+  ScalarSpec spec = parseScalarLabel(
+      text.find("@..:") != std::string::npos ? text.replace(text.find("@..:"), 4, ":") : text);
   return spec;
 }
 
@@ -479,7 +478,8 @@ void readCollect(const YAML::Node& root, const SweepReader& r, Sweep& sw) {
       sw.scalars.clear();
       for (const auto& v : s) {
         try {
-          sw.scalars.push_back(v.IsMap() ? scalarOfMapping(v) : parseScalarLabel(v.as<std::string>()));
+          sw.scalars.push_back(v.IsMap() ? scalarOfMapping(v)
+                                         : parseScalarLabel(v.as<std::string>()));
         } catch (const CaseError& e) {
           r.fail(v, "collect.scalars", e.what());
         } catch (const YAML::Exception& e) {
@@ -489,8 +489,9 @@ void readCollect(const YAML::Node& root, const SweepReader& r, Sweep& sw) {
     }
     if (const YAML::Node u = c["units"]) {
       if (!u.IsMap()) {
-        r.fail(u, "collect.units", "expected a mapping {swept key or column: unit}, e.g. "
-                                   "{param.U_in: m/s}");
+        r.fail(u, "collect.units",
+               "expected a mapping {swept key or column: unit}, e.g. "
+               "{param.U_in: m/s}");
       }
       for (const auto& kv : u) {
         sw.units.emplace_back(kv.first.as<std::string>(), kv.second.as<std::string>());

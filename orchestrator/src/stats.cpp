@@ -53,8 +53,10 @@ struct Table {
 
 Table readTable(const fs::path& file) {
   std::ifstream in(file);
-  COREDEM_CHECK(in.good(), "{}: no such file: give a run folder written by coredem run (it holds "
-                "timeseries.csv)", file.string());
+  COREDEM_CHECK(in.good(),
+                "{}: no such file: give a run folder written by coredem run (it holds "
+                "timeseries.csv)",
+                file.string());
   Table t;
   std::string line;
   COREDEM_CHECK(std::getline(in, line) && !line.empty(),
@@ -149,8 +151,10 @@ ColumnStats columnStats(const Table& t, std::size_t c, const std::vector<double>
 
 TimeseriesStats timeseriesStats(const fs::path& runDir, const TimeWindow& window) {
   const fs::path file = runDir / "timeseries.csv";
-  COREDEM_CHECK(fs::is_directory(runDir), "{}: not a folder: give a run folder written by "
-                "coredem run", runDir.string());
+  COREDEM_CHECK(fs::is_directory(runDir),
+                "{}: not a folder: give a run folder written by "
+                "coredem run",
+                runDir.string());
   const Table t = readTable(file);
   const std::size_t ct = columnIndex(t, "t", file);
   const std::size_t cdt = columnIndex(t, "dt", file);
@@ -160,13 +164,16 @@ TimeseriesStats timeseriesStats(const fs::path& runDir, const TimeWindow& window
   s.runEnd = t.rows.back()[ct];
   s.from = window.from.value_or(s.runStart);
   s.to = window.to.value_or(s.runEnd);
-  const std::string range = fmt::format("the run covers t = {:.6g} to {:.6g} s", s.runStart,
-                                        s.runEnd);
+  const std::string range =
+      fmt::format("the run covers t = {:.6g} to {:.6g} s", s.runStart, s.runEnd);
   COREDEM_CHECK(std::isfinite(s.from) && std::isfinite(s.to),
                 "--from and --to must be finite times in s ({})", range);
-  COREDEM_CHECK(s.to > s.from, "--to {:.6g} s is not after --from {:.6g} s: give a window with "
-                "from < to ({})", s.to, s.from, range);
-  COREDEM_CHECK(s.from < s.runEnd, "--from {:.6g} s is at or beyond the run's last row ({}); "
+  COREDEM_CHECK(s.to > s.from,
+                "--to {:.6g} s is not after --from {:.6g} s: give a window with "
+                "from < to ({})",
+                s.to, s.from, range);
+  COREDEM_CHECK(s.from < s.runEnd,
+                "--from {:.6g} s is at or beyond the run's last row ({}); "
                 "choose an earlier --from, or continue the run (coredem resume) first",
                 s.from, range);
   const std::vector<double> w = rowWeights(t, ct, cdt, s.from, s.to);
@@ -343,8 +350,7 @@ struct CellField {
 std::vector<CellField> cellFields(const FieldAverages& a) {
   return {
       {"eps_g", "-", "time-averaged gas fraction (PCM, geometric cell volume)", &a.epsG, 1},
-      {"eps_g_std", "-", "standard deviation of the gas fraction over the samples", &a.epsGStd,
-       1},
+      {"eps_g_std", "-", "standard deviation of the gas fraction over the samples", &a.epsGStd, 1},
       {"U_p", "m/s", "mass-weighted time-averaged particle velocity", &a.up, 3},
       {"theta", "m^2/s^2", "mass-weighted time-averaged granular temperature", &a.theta, 1},
       {"T_p", "K", "mass-weighted time-averaged particle temperature", &a.tp, 1},
@@ -377,8 +383,7 @@ void writeFieldAverages(const FieldAverages& a, const fs::path& h5Path, const fs
       h5::writeAttribute(ds, "description", fld.description);
     }
     h5::writeAttribute(g, "origin_xyz", fmt::format("{:.17g}", fmt::join(a.grid.origin, " ")));
-    h5::writeAttribute(g, "spacing_xyz",
-                       fmt::format("{:.17g}", fmt::join(a.grid.spacing, " ")));
+    h5::writeAttribute(g, "spacing_xyz", fmt::format("{:.17g}", fmt::join(a.grid.spacing, " ")));
   }
   fs::rename(h5Path.string() + ".tmp", h5Path);
   const std::string file = h5Path.filename().string();

@@ -146,7 +146,8 @@ protected:
 TEST_F(StatsE2E, TimeseriesStatisticsOverAWindowMatchTheRows) {
   ASSERT_EQ(rc, 0) << readAll(dir / "run.log");
   const double from = 0.0075;
-  ASSERT_EQ(runCoredem({"stats", run.string(), "--from", "0.0075", "--no-fields"}, dir / "s.log"), 0)
+  ASSERT_EQ(runCoredem({"stats", run.string(), "--from", "0.0075", "--no-fields"}, dir / "s.log"),
+            0)
       << readAll(dir / "s.log");
   const std::string table = readAll(dir / "s.log");
   EXPECT_NE(table.find("mean_T_p"), std::string::npos) << table;

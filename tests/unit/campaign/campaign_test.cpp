@@ -115,8 +115,8 @@ TEST(CampaignSweep, ScalarWindowsReadAndWriteTheirLabels) {
   EXPECT_EQ(parseScalarLabel("min@0.1..0.2:x").label(), "min@0.1..0.2:x");
   EXPECT_EQ(parseScalarLabel("mean_T_p").label(), "mean_T_p");
   EXPECT_EQ(parseScalarLabel("max:x").baseLabel(), "max:x");
-  for (const char* bad : {"final@0.1..:x", "mean@0.1:x", "mean@a..:x", "mean@0.2..0.1:x",
-                          "median:x", "mean:"}) {
+  for (const char* bad :
+       {"final@0.1..:x", "mean@0.1:x", "mean@a..:x", "mean@0.2..0.1:x", "median:x", "mean:"}) {
     EXPECT_THROW(parseScalarLabel(bad), CaseError) << bad;
   }
 }

@@ -30,7 +30,7 @@ struct ColumnStats {
 };
 
 struct TimeseriesStats {
-  double from = 0, to = 0;        ///< the window used (s)
+  double from = 0, to = 0;          ///< the window used (s)
   double firstRow = 0, lastRow = 0; ///< t of the first and last row in it
   std::size_t rows = 0;             ///< rows in the window
   double runStart = 0, runEnd = 0;  ///< t of the first and last row of the file (s)
