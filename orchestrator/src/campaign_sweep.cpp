@@ -457,7 +457,7 @@ ScalarSpec scalarOfMapping(const YAML::Node& v) {
 /// collect: the scalars of summary.csv and the plotted pair (defaults: final mean_T_p against
 /// the first swept key).
 void readCollect(const YAML::Node& root, const SweepReader& r, Sweep& sw) {
-  sw.scalars = {{"final", "mean_T_p"}};
+  sw.scalars = {parseScalarLabel("mean_T_p")};
   if (const YAML::Node c = root["collect"]) {
     if (!c.IsMap()) {
       r.fail(c, "collect", "expected a mapping with scalars and plot");
