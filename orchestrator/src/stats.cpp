@@ -168,14 +168,14 @@ TimeseriesStats timeseriesStats(const fs::path& runDir, const TimeWindow& window
       fmt::format("the run covers t = {:.6g} to {:.6g} s", s.runStart, s.runEnd);
   COREDEM_CHECK(std::isfinite(s.from) && std::isfinite(s.to),
                 "--from and --to must be finite times in s ({})", range);
-  COREDEM_CHECK(s.to > s.from,
-                "--to {:.6g} s is not after --from {:.6g} s: give a window with "
-                "from < to ({})",
-                s.to, s.from, range);
   COREDEM_CHECK(s.from < s.runEnd,
                 "--from {:.6g} s is at or beyond the run's last row ({}); "
                 "choose an earlier --from, or continue the run (coredem resume) first",
                 s.from, range);
+  COREDEM_CHECK(s.to > s.from,
+                "--to {:.6g} s is not after --from {:.6g} s: give a window with "
+                "from < to ({})",
+                s.to, s.from, range);
   const std::vector<double> w = rowWeights(t, ct, cdt, s.from, s.to);
   for (std::size_t i = 0; i < t.rows.size(); ++i) {
     if (w[i] >= 0.0) {
