@@ -144,6 +144,10 @@ ColumnStats columnStats(const Table& t, std::size_t c, const std::vector<double>
     }
   }
   s.std = std::sqrt(var / total);
+  if (s.min == s.max) { // a constant column: no round-off of the weights in mean and std
+    s.mean = s.min;
+    s.std = 0.0;
+  }
   return s;
 }
 
