@@ -226,6 +226,27 @@ TEST_F(StatsE2E, AveragedFieldsMatchTheSnapshotsInTheWindow) {
   EXPECT_EQ(j["fields"]["samples"].as<int>(), 3);
 }
 
+TEST_F(StatsE2E, JsonOnStdoutWithTheDefaultStartAndAnEnd) {
+  ASSERT_EQ(rc, 0) << readAll(dir / "run.log");
+  ASSERT_EQ(
+      runCoredem({"stats", run.string(), "--to", "0.01", "--json", "--no-fields"}, dir / "j.log"),
+      0)
+      << readAll(dir / "j.log");
+  const YAML::Node j = YAML::Load(readAll(dir / "j.log")); // stdout is the JSON document
+  EXPECT_DOUBLE_EQ(j["window"]["from"].as<double>(), 0.0); // the run's start: t_1 - dt_1
+  EXPECT_EQ(j["rows"].as<int>(), 20);
+  // the rows of steps 1..20: the particle count, constant
+  EXPECT_EQ(j["columns"]["particles"]["mean"].as<double>(), 64.0);
+  EXPECT_EQ(j["columns"]["particles"]["std"].as<double>(), 0.0);
+  const auto ts = coredem::e2e::readTimeseries(run);
+  double sum = 0;
+  for (int i = 0; i < 20; ++i) {
+    sum += ts.at("dem.kinetic_energy_J")[std::size_t(i)];
+  }
+  EXPECT_NEAR(j["columns"]["dem.kinetic_energy_J"]["mean"].as<double>(), sum / 20,
+              1e-12 * sum / 20);
+}
+
 TEST_F(StatsE2E, BadWindowsAndFoldersAreRefusedWithTheReason) {
   ASSERT_EQ(rc, 0) << readAll(dir / "run.log");
   EXPECT_EQ(runCoredem({"stats", run.string(), "--from", "0.5"}, dir / "b1.log"), 2);
