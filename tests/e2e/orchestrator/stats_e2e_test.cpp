@@ -247,6 +247,26 @@ TEST_F(StatsE2E, JsonOnStdoutWithTheDefaultStartAndAnEnd) {
               1e-12 * sum / 20);
 }
 
+// Issue 41 item 5: with a forced time.dt_dem the log gives the n_sub that runs (0.5 ms / 10 us =
+// 50), not the DEM server's own plan for its stable step (44 sub-steps of 11.4 us).
+TEST(ForcedDemStepLog, TheLoggedNSubIsTheOneThatRuns) {
+  const fs::path d = coredem::e2e::tempDir("coredem-e2e", "forced-nsub");
+  std::string text = readAll(kCases / "stats" / "case.yaml");
+  text = coredem::e2e::replaceAll(text, "  end: 0.02\n", "  end: 0.001\n  dt_dem: 1.0e-5\n");
+  fs::create_directories(d / "case");
+  coredem::e2e::writeAll(d / "case" / "case.yaml", text);
+  ASSERT_EQ(runCoredem({"run", (d / "case").string(), "--out", (d / "run").string(), "--no-plots"},
+                       d / "log"),
+            0)
+      << readAll(d / "log");
+  const std::string log = readAll(d / "log");
+  EXPECT_NE(log.find("n_sub = 50 for dt_CFD = 0.0005 s, forced by time.dt_dem"), std::string::npos)
+      << log;
+  const auto ts = coredem::e2e::readTimeseries(d / "run");
+  EXPECT_EQ(ts.at("n_sub").front(), 50.0);
+  fs::remove_all(d);
+}
+
 TEST_F(StatsE2E, BadWindowsAndFoldersAreRefusedWithTheReason) {
   ASSERT_EQ(rc, 0) << readAll(dir / "run.log");
   EXPECT_EQ(runCoredem({"stats", run.string(), "--from", "0.5"}, dir / "b1.log"), 2);
