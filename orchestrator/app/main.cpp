@@ -3,18 +3,22 @@
 //                        (a staged case: one run per stage, RUN_DIR/stages/NN-name/run)
 //   coredem resume RUN_DIR [--auto-restart N] [--stop-after STEP] [--walltime S]
 //   coredem inspect FILE
-//   coredem render RUN_DIR [--times T,...] [--field F] [--gas-field G] [--out DIR]
+//   coredem render RUN_DIR [--times T,...] [--field F] [--gas-field G] [--out DIR] [--slice F]
+//                          [--particles all|none] [--particle-opacity A] [--particle-scale S]
 //   coredem check CASE_DIR
+//   coredem stats RUN_DIR [--from T] [--to T] [--json] [--no-fields]
 //   coredem verify [--out DIR] [--only NAME[,NAME]] [--list] [--cases DIR] [--no-plots]
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <optional>
 
 #include <CLI/CLI.hpp>
 #include <unistd.h>
 
+#include <coredem/common/files.h>
 #include <coredem/common/log.h>
 #include <coredem/common/process.h>
 #include <coredem/common/version.h>
@@ -24,6 +28,7 @@
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/session.h>
 #include <coredem/orchestrator/stages.h>
+#include <coredem/orchestrator/stats.h>
 #include <coredem/orchestrator/verify.h>
 
 using namespace coredem::orchestrator;
@@ -79,7 +84,8 @@ void makePlots(const fs::path& runDir, bool interrupted) {
 /// `coredem render`: scripts/render/render_run.py under ParaView's pvbatch (found at configure
 /// time or on PATH), on a private Xvfb when there is no display.
 int renderRun(const fs::path& runDir, const std::vector<double>& times, const std::string& field,
-              const std::string& gasField, const std::string& outDir) {
+              const std::string& gasField, const std::string& outDir,
+              const std::vector<std::pair<std::string, std::string>>& extra) {
   auto log = coredem::logger("orchestrator");
   fs::path pvbatch = COREDEM_PVBATCH;
   if (pvbatch.empty() || !fs::exists(pvbatch)) {
@@ -128,6 +134,11 @@ int renderRun(const fs::path& runDir, const std::vector<double>& times, const st
   if (!gasField.empty()) {
     args.insert(args.end(), {"--gas-field", gasField});
   }
+  for (const auto& [flag, value] : extra) { // --slice, --particles, ... when given
+    if (!value.empty()) {
+      args.insert(args.end(), {flag, value});
+    }
+  }
   const fs::path out = outDir.empty() ? runDir / "render" : fs::absolute(outDir);
   args.insert(args.end(), {"--out", out.string()});
   fs::create_directories(out);
@@ -174,8 +185,12 @@ struct CommandLine {
   std::vector<std::string> only;
   std::vector<double> renderTimes;
   std::string renderField, renderGasField, renderOut;
+  std::string renderSlice, renderParticles, renderOpacity, renderScale; ///< passed on as given
+  double statsFrom = 0.0, statsTo = 0.0;
+  CLI::Option *statsFromOpt = nullptr, *statsToOpt = nullptr;
+  bool statsJson = false, statsNoFields = false;
   CLI::App *run = nullptr, *resume = nullptr, *inspect = nullptr, *verify = nullptr,
-           *render = nullptr, *check = nullptr;
+           *render = nullptr, *check = nullptr, *stats = nullptr;
 };
 
 /// `coredem run` and `coredem resume`.
@@ -246,10 +261,91 @@ void addToolCommands(CLI::App& app, CommandLine& c) {
   c.render->add_option("--gas-field", c.renderGasField,
                        "gas field of the slice (alphac, U, p, T, ...)");
   c.render->add_option("--out", c.renderOut, "picture folder (default RUN_DIR/render)");
+  c.render
+      ->add_option("--slice", c.renderSlice,
+                   "gas slice position along the viewing axis, a fraction of the domain depth "
+                   "(0 front .. 1 back; default 0.5)")
+      ->check(CLI::Range(0.0, 1.0));
+  c.render
+      ->add_option("--particles", c.renderParticles,
+                   "all (default) or none: the gas slice alone, which the particles of a bed "
+                   "one cell deep hide")
+      ->check(CLI::IsMember({"all", "none"}));
+  c.render->add_option("--particle-opacity", c.renderOpacity, "particle opacity 0..1 (default 1)")
+      ->check(CLI::Range(0.0, 1.0));
+  c.render
+      ->add_option("--particle-scale", c.renderScale,
+                   "sphere size as a fraction of the particle diameter (0..1], default 1")
+      ->check(CLI::Range(0.0, 1.0));
+
+  c.stats = app.add_subcommand(
+      "stats", "time-averaged results of a run: mean, std, min, max of every timeseries.csv "
+               "column over a window, and time-averaged coupling-cell fields from the snapshots "
+               "(RUN_DIR/stats/; docs/orchestrator.md \"Time-averaged results\")");
+  c.stats->add_option("RUN_DIR", c.runDir, "run folder created by coredem run")->required();
+  c.statsFromOpt =
+      c.stats->add_option("--from", c.statsFrom,
+                          "start of the window in s (exclude the start-up transient; default: the "
+                          "run's start)");
+  c.statsToOpt = c.stats->add_option("--to", c.statsTo,
+                                     "end of the window in s (default: the run's last row)");
+  c.stats->add_flag("--json", c.statsJson, "print the JSON document instead of the table");
+  c.stats->add_flag("--no-fields", c.statsNoFields,
+                    "only the timeseries statistics (no averaged fields from the snapshots)");
 
   c.check = app.add_subcommand("check", "validate a case file and exit (0 valid, 2 invalid)");
   c.check->add_option("CASE_DIR", c.caseDir, "case folder with case.yaml (or a case file)")
       ->required();
+}
+
+/// `coredem stats`: RUN/stats/stats.json (+ averages.h5/.xdmf) and the table (or the JSON).
+int statsOf(const CommandLine& c) {
+  const fs::path runDir = fs::absolute(c.runDir);
+  TimeWindow window;
+  if (c.statsFromOpt->count() > 0) {
+    window.from = c.statsFrom;
+  }
+  if (c.statsToOpt->count() > 0) {
+    window.to = c.statsTo;
+  }
+  const TimeseriesStats s = timeseriesStats(runDir, window);
+  std::optional<FieldAverages> fields;
+  const fs::path outDir = runDir / "stats";
+  fs::create_directories(outDir);
+  std::string note;
+  if (!c.statsNoFields) {
+    const CaseConfig config = loadRunCase(runDir);
+    fields = fieldAverages(runDir, config.grid, s.from, s.to);
+    if (fields) {
+      writeFieldAverages(*fields, outDir / "averages.h5", outDir / "averages.xdmf");
+      note = fmt::format("fields: {} (ParaView; {} snapshots at t = {:.6g} .. {:.6g} s)\n",
+                         (outDir / "averages.xdmf").string(), fields->times.size(),
+                         fields->times.front(), fields->times.back());
+    } else {
+      note = fmt::format("fields: none (no particle snapshot in t = [{:.6g}, {:.6g}] s: "
+                         "outputs.csv lists the snapshots; set output.every or "
+                         "output.every_seconds in case.yaml)\n",
+                         s.from, s.to);
+    }
+  }
+  const std::string json = statsJson(s, fields, fields ? "averages.xdmf" : "");
+  coredem::writeFileAtomic(outDir / "stats.json", json);
+  if (c.statsJson) {
+    std::cout << json;
+  } else {
+    std::cout << statsTable(s) << note << "json: " << (outDir / "stats.json").string() << "\n";
+  }
+  return kExitOk;
+}
+
+/// `coredem stats` with bad input (exit 2) told apart from a fault.
+int runStats(const CommandLine& c) {
+  try {
+    return statsOf(c);
+  } catch (const coredem::UserError& e) { // a window outside the run, a folder without a run
+    coredem::logger("orchestrator")->error("{}", e.what());
+    return kExitBadInput;
+  }
 }
 
 /// `coredem run` (a new run folder) or `coredem resume`: the coupled run and its plots.
@@ -338,7 +434,14 @@ int main(int argc, char** argv) {
     }
     if (*cmd.render) {
       return renderRun(fs::absolute(cmd.runDir), cmd.renderTimes, cmd.renderField,
-                       cmd.renderGasField, cmd.renderOut);
+                       cmd.renderGasField, cmd.renderOut,
+                       {{"--slice", cmd.renderSlice},
+                        {"--particles", cmd.renderParticles},
+                        {"--particle-opacity", cmd.renderOpacity},
+                        {"--particle-scale", cmd.renderScale}});
+    }
+    if (*cmd.stats) {
+      return runStats(cmd);
     }
     if (*cmd.verify) {
       cmd.verifyOpts.only = cmd.only;

@@ -455,6 +455,11 @@ void createCampaign(const Sweep& sw, const fs::path& dir) {
       db.setSetting("scalars", scalars);
       db.setSetting("plot_x", sw.plotX);
       db.setSetting("plot_y", sw.plotY);
+      std::string units;
+      for (const auto& [key, unit] : sw.units) {
+        units += (units.empty() ? "" : "\n") + key + "=" + unit;
+      }
+      db.setSetting("units", units);
       for (std::size_t i = 0; i < sw.members.size(); ++i) {
         const auto& mem = sw.members[i];
         const fs::path mdir = dir / "members" / mem.id;
@@ -546,6 +551,11 @@ int campaignMain(int argc, char** argv) {
   auto* col = app.add_subcommand("collect", "write DIR/summary.csv and DIR/plots/campaign.png");
   col->add_option("DIR", dir, "campaign folder")->required();
   col->add_flag("--no-plot", noPlot, "summary.csv only");
+  CollectWindow window;
+  auto* fromOpt = col->add_option("--from", window.from,
+                                  "window start in s for every max/min/mean scalar without a "
+                                  "window of its own (exclude the start-up transient)");
+  auto* toOpt = col->add_option("--to", window.to, "window end in s (as --from)");
   auto* mem = app.add_subcommand(
       "member", "run one member inside its Slurm array task (called by DIR/slurm/member.sh)");
   mem->add_option("DIR", dir, "campaign folder")->required();
@@ -578,7 +588,9 @@ int campaignMain(int argc, char** argv) {
     if (*st) {
       return status(fs::absolute(dir), json);
     }
-    return collect(fs::absolute(dir), noPlot);
+    window.hasFrom = fromOpt->count() > 0;
+    window.hasTo = toOpt->count() > 0;
+    return collect(fs::absolute(dir), noPlot, window);
   } catch (const CaseError& e) {
     log->error("{}", e.what());
     return kBadInput;

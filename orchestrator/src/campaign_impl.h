@@ -54,7 +54,12 @@ std::string finishMember(CampaignDb& db, const std::string& id, const std::strin
 int status(const std::filesystem::path& dir, bool json);
 /// `coredem campaign collect DIR [--no-plot]`: writes DIR/summary.csv (one row per member, the
 /// sweep's values and collect.scalars) and plots it to DIR/plots/campaign.png.
-int collect(const std::filesystem::path& dir, bool noPlot);
+/// `--from`/`--to` apply to every max/min/mean scalar that has no window of its own.
+struct CollectWindow {
+  double from = 0.0, to = 0.0;
+  bool hasFrom = false, hasTo = false;
+};
+int collect(const std::filesystem::path& dir, bool noPlot, const CollectWindow& window = {});
 
 // --- the Slurm executor (campaign_slurm.cpp)
 

@@ -16,6 +16,7 @@
 #include <coredem/common/log.h>
 #include <coredem/orchestrator/campaign.h>
 #include <coredem/orchestrator/campaign_db.h>
+#include <coredem/orchestrator/stats.h>
 
 #include "campaign_impl.h"
 
@@ -65,7 +66,9 @@ std::string valuesText(const MemberRecord& m) {
   return s;
 }
 
-/// One scalar of a member's timeseries.csv; "" when the run has no rows yet.
+/// One scalar of a member's timeseries.csv; "" when the run has no rows yet. max, min and mean
+/// come from the same statistics as `coredem stats` (over the scalar's window; the mean
+/// time-weighted).
 std::string scalarOf(const fs::path& timeseries, const ScalarSpec& spec) {
   std::ifstream in(timeseries);
   std::string header;
@@ -78,7 +81,6 @@ std::string scalarOf(const fs::path& timeseries, const ScalarSpec& spec) {
                 timeseries.string(), spec.column, fmt::join(cols, ", "));
   const std::size_t c = static_cast<std::size_t>(at - cols.begin());
   std::string line, last;
-  double sum = 0.0, mx = -HUGE_VAL, mn = HUGE_VAL;
   std::size_t n = 0;
   while (std::getline(in, line)) {
     const auto f = splitCsvLine(line);
@@ -86,10 +88,6 @@ std::string scalarOf(const fs::path& timeseries, const ScalarSpec& spec) {
       continue;
     }
     last = f[c];
-    const double v = std::strtod(f[c].c_str(), nullptr);
-    sum += v;
-    mx = std::max(mx, v);
-    mn = std::min(mn, v);
     ++n;
   }
   if (n == 0) {
@@ -98,8 +96,19 @@ std::string scalarOf(const fs::path& timeseries, const ScalarSpec& spec) {
   if (spec.reduce == "final") {
     return last;
   }
-  const double v = spec.reduce == "max" ? mx : spec.reduce == "min" ? mn : sum / n;
-  return fmt::format("{:.17g}", v);
+  TimeseriesStats st;
+  try {
+    st = timeseriesStats(timeseries.parent_path(), {spec.from, spec.to});
+  } catch (const UserError& e) {
+    throw UserError(fmt::format("collect.scalars '{}': {}", spec.label(), e.what()));
+  }
+  for (const auto& cs : st.columns) {
+    if (cs.name == spec.column) {
+      const double v = spec.reduce == "max" ? cs.max : spec.reduce == "min" ? cs.min : cs.mean;
+      return cs.rows == 0 ? "" : fmt::format("{:.17g}", v);
+    }
+  }
+  return "";
 }
 
 /// First and last simulated time (column t) of a timeseries.csv; nullopt without rows.
@@ -151,7 +160,10 @@ std::string whenOf(const std::vector<MemberRecord>& members, const ScalarSpec& s
   if (spec.reduce == "final") {
     return fmt::format("final value at t = {} s", span(lo1, hi1));
   }
-  return fmt::format("{} over t = {} to {} s", spec.reduce, span(lo0, hi0), span(lo1, hi1));
+  const std::string from = spec.from ? fmt::format("{:.6g}", *spec.from) : span(lo0, hi0);
+  const std::string to = spec.to ? fmt::format("{:.6g}", std::min(*spec.to, hi1)) : span(lo1, hi1);
+  return fmt::format("{} over t = {} to {} s{}", spec.reduce, from, to,
+                     spec.from ? " (start-up excluded)" : "");
 }
 
 } // namespace
@@ -233,18 +245,28 @@ int status(const fs::path& dir, bool json) {
   return kOk;
 }
 
-int collect(const fs::path& dir, bool noPlot) {
+int collect(const fs::path& dir, bool noPlot, const CollectWindow& window) {
   CampaignDb db(dir / "campaign.db", false);
   const auto members = db.members();
+  if (window.hasFrom && window.hasTo && !(window.to > window.from)) {
+    throw CaseError(fmt::format("--to {} s is not after --from {} s", window.to, window.from));
+  }
   std::vector<ScalarSpec> scalars;
+  std::string plotY = db.setting("plot_y");
   {
     std::stringstream ss(db.setting("scalars", "mean_T_p"));
     std::string t;
     while (std::getline(ss, t)) {
-      const auto colon = t.find(':');
-      scalars.push_back(colon == std::string::npos
-                            ? ScalarSpec{"final", t}
-                            : ScalarSpec{t.substr(0, colon), t.substr(colon + 1)});
+      ScalarSpec spec = parseScalarLabel(t);
+      // --from/--to: for the reductions without a window of their own
+      if (spec.reduce != "final" && !spec.from && !spec.to) {
+        spec.from = window.hasFrom ? std::optional<double>(window.from) : std::nullopt;
+        spec.to = window.hasTo ? std::optional<double>(window.to) : std::nullopt;
+        if (t == plotY) {
+          plotY = spec.label();
+        }
+      }
+      scalars.push_back(spec);
     }
   }
   std::ostringstream csv;
@@ -265,9 +287,15 @@ int collect(const fs::path& dir, bool noPlot) {
       csv << "," << csvField(value);
     }
     for (const auto& s : scalars) {
-      csv << ","
-          << (m.status == "done" ? csvField(scalarOf(fs::path(m.runDir) / "timeseries.csv", s))
-                                 : "");
+      std::string v;
+      if (m.status == "done") {
+        try {
+          v = scalarOf(fs::path(m.runDir) / "timeseries.csv", s);
+        } catch (const UserError& e) {
+          throw CaseError(fmt::format("member {}: {}", m.id, e.what())); // bad input: exit 2
+        }
+      }
+      csv << "," << csvField(v);
     }
     csv << "\n";
     done += m.status == "done";
@@ -297,15 +325,24 @@ int collect(const fs::path& dir, bool noPlot) {
   }
   std::string when;
   for (const auto& sc : scalars) {
-    if (sc.label() == db.setting("plot_y")) {
+    if (sc.label() == plotY) {
       when = whenOf(members, sc);
     }
   }
+  // collect.units: the axis unit of a key or column that units.py does not know (param.U_in)
+  std::string units;
+  {
+    std::stringstream ss(db.setting("units"));
+    for (std::string t; std::getline(ss, t);) {
+      if (!t.empty()) {
+        units += fmt::format(" --unit '{}'", t);
+      }
+    }
+  }
   const std::string cmd = fmt::format(
-      "'{}' '{}' '{}' --x '{}' --y '{}'{} --title '{}' --when '{}' --out '{}' > '{}' 2>&1",
-      python.string(), script.string(), (dir / "summary.csv").string(), db.setting("plot_x"),
-      db.setting("plot_y"), groups, db.setting("name"), when, png.string(),
-      (dir / "plots" / "plot.log").string());
+      "'{}' '{}' '{}' --x '{}' --y '{}'{}{} --title '{}' --when '{}' --out '{}' > '{}' 2>&1",
+      python.string(), script.string(), (dir / "summary.csv").string(), db.setting("plot_x"), plotY,
+      groups, units, db.setting("name"), when, png.string(), (dir / "plots" / "plot.log").string());
   const int rc = std::system(cmd.c_str());
   if (rc != 0) {
     logger("campaign")->warn("plot script failed (see {})", (dir / "plots" / "plot.log").string());

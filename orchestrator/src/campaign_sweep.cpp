@@ -1,5 +1,8 @@
 // Sweep files: parsing, validation, member expansion and case-key substitution (campaign.h).
+#include <cmath>
+#include <cstdlib>
 #include <fstream>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -188,6 +191,57 @@ std::optional<long> parseSlurmTime(const std::string& text) {
   return std::nullopt;
 }
 
+std::string ScalarSpec::label() const {
+  if (reduce == "final" || (!from && !to)) {
+    return baseLabel();
+  }
+  return fmt::format("{}@{}..{}:{}", reduce, from ? fmt::format("{}", *from) : "",
+                     to ? fmt::format("{}", *to) : "", column);
+}
+
+ScalarSpec parseScalarLabel(const std::string& text) {
+  ScalarSpec spec;
+  const auto colon = text.find(':');
+  spec.column = colon == std::string::npos ? text : text.substr(colon + 1);
+  std::string reduce = colon == std::string::npos ? "final" : text.substr(0, colon);
+  const auto at = reduce.find('@');
+  const std::string usage =
+      fmt::format("'{}': write COLUMN, REDUCE:COLUMN or REDUCE@FROM..TO:COLUMN with REDUCE one "
+                  "of final, max, min, mean and a window of simulated time in s (either end may "
+                  "be left out, e.g. mean@0.5..:dp; not for final); COLUMN from timeseries.csv",
+                  text);
+  if (at != std::string::npos) {
+    const std::string window = reduce.substr(at + 1);
+    reduce = reduce.substr(0, at);
+    const auto dots = window.find("..");
+    if (dots == std::string::npos || reduce == "final") {
+      throw CaseError(usage);
+    }
+    auto number = [&](const std::string& t) -> std::optional<double> {
+      if (t.empty()) {
+        return std::nullopt;
+      }
+      char* end = nullptr;
+      const double v = std::strtod(t.c_str(), &end);
+      if (end == nullptr || *end != '\0' || !std::isfinite(v)) {
+        throw CaseError(usage);
+      }
+      return v;
+    };
+    spec.from = number(window.substr(0, dots));
+    spec.to = number(window.substr(dots + 2));
+    if (spec.from && spec.to && !(*spec.to > *spec.from)) {
+      throw CaseError(fmt::format("'{}': the window's end {} s is not after its start {} s", text,
+                                  *spec.to, *spec.from));
+    }
+  }
+  spec.reduce = reduce;
+  if (!kReduces.count(spec.reduce) || spec.column.empty()) {
+    throw CaseError(usage);
+  }
+  return spec;
+}
+
 std::string setCaseKey(const std::string& caseText, const std::string& path,
                        const std::string& valueYaml) {
   const auto steps = parsePath(path);
@@ -374,38 +428,73 @@ void readMembers(const YAML::Node& root, const SweepReader& r, Sweep& sw) {
   }
 }
 
+/// A scalar written as a mapping: {mean: column, from: T, to: T} (one reduction key).
+ScalarSpec scalarOfMapping(const YAML::Node& v) {
+  std::string text;
+  std::string window;
+  for (const auto& kv : v) {
+    const std::string k = kv.first.as<std::string>();
+    if (k == "from" || k == "to") {
+      continue;
+    }
+    if (!text.empty() || !kReduces.count(k)) {
+      throw CaseError(fmt::format("'{}': a scalar mapping has one of final, max, min, mean "
+                                  "(the column) and optionally from, to (s), e.g. {{mean: dp, "
+                                  "from: 0.5}}",
+                                  k));
+    }
+    text = k + "@" + (v["from"] ? v["from"].as<std::string>() : "") + ".." +
+           (v["to"] ? v["to"].as<std::string>() : "") + ":" + kv.second.as<std::string>();
+  }
+  if (text.empty()) {
+    throw CaseError("a scalar mapping needs one of final, max, min, mean: {mean: COLUMN}");
+  }
+  ScalarSpec spec = parseScalarLabel(
+      text.find("@..:") != std::string::npos ? text.replace(text.find("@..:"), 4, ":") : text);
+  return spec;
+}
+
 /// collect: the scalars of summary.csv and the plotted pair (defaults: final mean_T_p against
 /// the first swept key).
 void readCollect(const YAML::Node& root, const SweepReader& r, Sweep& sw) {
-  sw.scalars = {{"final", "mean_T_p"}};
+  sw.scalars = {parseScalarLabel("mean_T_p")};
   if (const YAML::Node c = root["collect"]) {
     if (!c.IsMap()) {
       r.fail(c, "collect", "expected a mapping with scalars and plot");
     }
     for (const auto& kv : c) {
       const std::string k = kv.first.as<std::string>();
-      if (k != "scalars" && k != "plot") {
-        r.fail(kv.first, "collect." + k, "unknown key; allowed keys in 'collect': scalars, plot");
+      if (k != "scalars" && k != "plot" && k != "units") {
+        r.fail(kv.first, "collect." + k,
+               "unknown key; allowed keys in 'collect': scalars, plot, units");
       }
     }
     if (const YAML::Node s = c["scalars"]) {
       if (!s.IsSequence() || s.size() == 0) {
-        r.fail(s, "collect.scalars", "expected a list like [mean_T_p, max:dem.kinetic_energy_J]");
+        r.fail(s, "collect.scalars",
+               "expected a list like [mean_T_p, max:dem.kinetic_energy_J, {mean: "
+               "gas.pressure_drop_Pa, from: 0.5}]");
       }
       sw.scalars.clear();
       for (const auto& v : s) {
-        const std::string t = v.as<std::string>();
-        ScalarSpec spec;
-        const auto colon = t.find(':');
-        spec.column = colon == std::string::npos ? t : t.substr(colon + 1);
-        spec.reduce = colon == std::string::npos ? "final" : t.substr(0, colon);
-        if (!kReduces.count(spec.reduce) || spec.column.empty()) {
-          r.fail(v, "collect.scalars",
-                 fmt::format("'{}': write COLUMN or REDUCE:COLUMN with REDUCE one of final, "
-                             "max, min, mean (COLUMN from timeseries.csv)",
-                             t));
+        try {
+          sw.scalars.push_back(v.IsMap() ? scalarOfMapping(v)
+                                         : parseScalarLabel(v.as<std::string>()));
+        } catch (const CaseError& e) {
+          r.fail(v, "collect.scalars", e.what());
+        } catch (const YAML::Exception& e) {
+          r.fail(v, "collect.scalars", e.what());
         }
-        sw.scalars.push_back(spec);
+      }
+    }
+    if (const YAML::Node u = c["units"]) {
+      if (!u.IsMap()) {
+        r.fail(u, "collect.units",
+               "expected a mapping {swept key or column: unit}, e.g. "
+               "{param.U_in: m/s}");
+      }
+      for (const auto& kv : u) {
+        sw.units.emplace_back(kv.first.as<std::string>(), kv.second.as<std::string>());
       }
     }
     if (const YAML::Node p = c["plot"]) {
@@ -425,7 +514,10 @@ void readCollect(const YAML::Node& root, const SweepReader& r, Sweep& sw) {
         sw.plotY = p["y"].as<std::string>();
         bool found = false;
         for (const auto& s : sw.scalars) {
-          found = found || s.label() == sw.plotY;
+          if (!found && (s.label() == sw.plotY || s.baseLabel() == sw.plotY)) {
+            found = true;
+            sw.plotY = s.label();
+          }
         }
         if (!found) {
           r.fail(p["y"], "collect.plot.y",
@@ -449,6 +541,9 @@ void resolveMembers(const SweepReader& r, Sweep& sw) {
   for (const auto& mem : sw.members) {
     std::string text = baseText;
     for (const auto& [path, value] : mem.values) {
+      if (path.rfind(kParamPrefix, 0) == 0) {
+        continue; // a recorded parameter, not a case key
+      }
       try {
         text = setCaseKey(text, path, value);
       } catch (const CaseError& e) {

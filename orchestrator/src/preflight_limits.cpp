@@ -99,7 +99,8 @@ void checkSubSteps(const CaseConfig& c, const preflight::Locator& at, const Coun
   at.fail(path, keyOf(path),
           fmt::format("{:.6g} s needs {:.6g} DEM sub-steps of {:.6g} s (the contact time of the "
                       "stiffest material pair over dem.dt_factor, or time.dt_dem); the DEM server "
-                      "grants at most {} per CFD step: shorten the CFD step or soften k_n",
+                      "grants at most {} per CFD step: shorten the CFD step, soften the contact "
+                      "(materials[].k_n), lower dem.dt_factor or raise time.dt_dem",
                       dtMax, nSub, dtDem, limits.subSteps));
 }
 

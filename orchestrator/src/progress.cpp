@@ -45,22 +45,43 @@ void Progress::setSink(std::function<void(const std::string&, bool)> sink) {
   _sink = std::move(sink);
 }
 
+Progress::Sample Progress::rateAnchor(Clock::time_point now) const {
+  for (const Sample& s : _samples) {
+    if (std::chrono::duration<double>(now - s.wall).count() <= kRateWindowSeconds) {
+      return s;
+    }
+  }
+  return _samples.empty() ? Sample{_start, _t0, _step0} : _samples.back();
+}
+
 std::string Progress::line(std::int64_t step, double time, Clock::time_point now) const {
-  const double wall = std::chrono::duration<double>(now - _start).count();
-  const double steps = double(step - _step0);
-  const double rate = wall > 0.0 ? steps / wall : 0.0;
-  const double span = _tEnd - _t0;
-  const double done = span > 0.0 ? (time - _t0) / span : 1.0;
+  // The recent rate: from the anchor (at most kRateWindowSeconds ago) to now.
+  Sample a = rateAnchor(now);
+  if (a.step >= step || !(now > a.wall)) {
+    a = Sample{_start, _t0, _step0};
+  }
+  const double wall = std::chrono::duration<double>(now - a.wall).count();
+  const double rate = wall > 0.0 ? double(step - a.step) / wall : 0.0;
+  const double simRate = wall > 0.0 ? (time - a.time) / wall : 0.0; // simulated s per wall s
   const double pct = 100.0 * std::clamp((time - 0.0) / (_tEnd > 0.0 ? _tEnd : 1.0), 0.0, 1.0);
   std::string eta = "?";
-  if (done > 0.0 && wall > 0.0) {
-    eta = formatDuration(wall * (1.0 - done) / done);
+  if (simRate > 0.0) {
+    eta = formatDuration(std::max(0.0, _tEnd - time) / simRate);
   }
   return fmt::format("step {}  t = {:.4e} / {:.4e} s ({:.1f}%)  {:.1f} steps/s  ETA {}", step, time,
                      _tEnd, pct, rate, eta);
 }
 
 void Progress::update(std::int64_t step, double time, Clock::time_point now) {
+  if (_samples.empty() ||
+      std::chrono::duration<double>(now - _samples.back().wall).count() >= 0.5) {
+    _samples.push_back({now, time, step});
+    // keep one sample older than the window (the anchor until a newer one is old enough)
+    while (_samples.size() > 2 &&
+           std::chrono::duration<double>(now - _samples[1].wall).count() > kRateWindowSeconds) {
+      _samples.pop_front();
+    }
+  }
   const double since = std::chrono::duration<double>(now - _lastPrint).count();
   const double due = _tty ? 0.2 : _interval;
   if (_printedOnce && since < due) {

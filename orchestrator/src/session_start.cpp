@@ -235,19 +235,25 @@ void Session::configureDem(std::int64_t startStep, double startTime, const fs::p
   _dtDemMax = cd.dt_dem();
   if (_c.dtDem > _dtDemMax * (1.0 + 1e-12)) {
     throw CaseError(fmt::format(
-        "time.dt_dem = {:.6g} s exceeds the DEM server's stable step dt_dem_max = {:.6g} s "
-        "(the undamped contact duration over {:g}, models: dem.dt_factor, or the integrator's "
-        "stability limit); use time.dt_dem <= {:.6g} s, or hold the particles "
-        "with models: {{motion: frozen}}",
+        "time.dt_dem = {:.6g} s exceeds the DEM server's stable step dt_dem_max = {:.6g} s (the "
+        "undamped contact duration pi*sqrt(m_eff/k_n) of the stiffest material pair over "
+        "dem.dt_factor = {:g}, or the integrator's stability limit). Any one of: use "
+        "time.dt_dem <= {:.6g} s (or remove it: the DEM then picks its own step); lower "
+        "dem.dt_factor (Δt_DEM,max = t_col/dt_factor; docs/case-schema.md); soften the contact "
+        "(a smaller materials[].k_n, or another contact law: models: {{contact: ...}}); "
+        "or hold the particles with models: {{motion: frozen}}",
         _c.dtDem, _dtDemMax, dtFactorOf(_c), _dtDemMax));
   }
   _cells = cd.cell_count();
   _species = cd.species_count();
   _configure.mutable_sub_cycling()->set_n_sub(cd.n_sub());
   _configure.mutable_sub_cycling()->set_dt_dem(cd.dt_dem());
+  // The plan that runs: a forced time.dt_dem sets n_sub = dt_CFD/dt_dem, not D's own n_sub.
+  const SubcyclePlan runs = planFor(_c, dt0, _dtDemMax);
   _log->info("DEM configured: {} particles, {} coupling cells, dt_DEM = {:.4g} s (n_sub = {} for "
-             "dt_CFD = {:.4g} s)",
-             cd.particle_count(), cd.cell_count(), cd.dt_dem(), cd.n_sub(), dt0);
+             "dt_CFD = {:.4g} s{}; the DEM's stable step dt_dem_max = {:.4g} s)",
+             cd.particle_count(), cd.cell_count(), runs.dtDem, runs.nSub, dt0,
+             _c.dtDem > 0.0 ? ", forced by time.dt_dem" : "", _dtDemMax);
 }
 
 void Session::startCfd(const fs::path& cfdRestart) {

@@ -6,8 +6,10 @@
 
 Reads summary.csv written by `coredem campaign collect`; members that are not done (empty
 result) are left out. When more than one key was swept, one line per combination of the
-other keys. Axes carry units (units.py: from the column or key name; [?] when unknown) and the
-title the time the plotted value refers to (--when, given by `coredem campaign collect`).
+other keys. Axes carry units (--unit KEY=UNIT from the sweep's collect.units, else units.py: from
+the column or key name; [?] when unknown) and the title the time the plotted value refers to
+(--when, given by `coredem campaign collect`). An x key whose values are all numbers (a swept
+number, or a recorded param.* value) gives a numeric axis; other values a categorical one.
 """
 import argparse
 import csv
@@ -40,7 +42,14 @@ def main():
     ap.add_argument("--when", default="", help="the time the y value refers to (title)")
     ap.add_argument("--group", action="append", default=[],
                     help="another swept key: one line per value (repeatable)")
+    ap.add_argument("--unit", action="append", default=[],
+                    help="KEY=UNIT: the unit of a key or column (collect.units; repeatable)")
     a = ap.parse_args()
+    units = dict(u.split("=", 1) for u in a.unit if "=" in u)
+
+    def axis_label(name):
+        base = name.split(":")[-1]
+        return unit_label(name, units.get(name, units.get(base)))
 
     with open(a.summary, newline="") as f:
         rows = list(csv.DictReader(f))
@@ -52,8 +61,11 @@ def main():
     for g in a.group:
         if g not in rows[0]:
             sys.exit(f"{a.summary}: no column '{g}' (--group)")
-    # keys with a single value in the whole campaign do not split the lines
-    a.group = [g for g in a.group if len({r[g] for r in rows}) > 1]
+    # keys with a single value in the whole campaign, or fixed by the x value (a cfd.case folder
+    # that goes with each param.U_in), do not split the lines
+    xs_all = {r[a.x] for r in rows}
+    a.group = [g for g in a.group if len({r[g] for r in rows}) > 1
+               and len({(r[a.x], r[g]) for r in rows}) > len(xs_all)]
     groups = {}
     for r in rows:
         y = number(r[a.y])
@@ -69,8 +81,8 @@ def main():
         pts.sort(key=lambda p: p[0] if numeric else str(p[0]))  # noqa: E501
         xs = [p[0] for p in pts] if numeric else [str(p[0]) for p in pts]
         ax.plot(xs, [p[1] for p in pts], "o-", label=label or None)
-    ax.set_xlabel(unit_label(a.x))
-    ax.set_ylabel(unit_label(a.y))
+    ax.set_xlabel(axis_label(a.x))
+    ax.set_ylabel(axis_label(a.y))
     title = f"{a.title}: {a.y} vs {a.x}"
     if a.when:
         title += f"\n({a.when})"
@@ -80,7 +92,10 @@ def main():
         ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(a.out, dpi=120)
-    print(f"x axis: {unit_label(a.x)}; y axis: {unit_label(a.y)}; title: {title}".replace("\n", " "))
+    kind = "numeric" if all(all(isinstance(p[0], float) for p in pts) for pts in groups.values()) \
+        else "categorical"
+    print(f"x axis: {axis_label(a.x)} ({kind}); y axis: {axis_label(a.y)}; title: {title}"
+          .replace("\n", " "))
     print(f"wrote {a.out}")
 
 

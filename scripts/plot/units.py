@@ -4,7 +4,7 @@ campaign_plot.py). The column names carry their unit as a suffix (docs/orchestra
 
 # Suffix of a column or key name -> unit (the longest suffix wins).
 SUFFIXES = {
-    "_kg_per_s": "kg/s", "_J": "J", "_kg": "kg", "_Pa": "Pa", "_m": "m", "_s": "s", "_K": "K",
+    "_kg_per_s": "kg/s", "_m_per_s": "m/s", "_J": "J", "_kg": "kg", "_Pa": "Pa", "_m": "m", "_s": "s", "_K": "K",
     "_W": "W", "_mol": "mol",
 }
 # Whole names (the last component of a key path such as particles[0].diameter) -> unit.

@@ -3,7 +3,8 @@ a slice of a gas field at the same instant. Run by `coredem render` with ParaVie
 (docs/orchestrator.md "Pictures"); it can also be run directly:
 
     pvbatch render_run.py RUN_DIR [--times T,T,...] [--field NAME] [--gas-field NAME]
-                                  [--out DIR] [--size W,H]
+                                  [--out DIR] [--size W,H] [--slice F] [--particles all|none]
+                                  [--particle-opacity A] [--particle-scale S]
 
 RUN_DIR/outputs.csv lists the synchronized outputs (step, time_s, particles, gas); each chosen
 time gives DIR/<field>_<step>.png (DIR defaults to RUN_DIR/render). With more than one time,
@@ -11,8 +12,16 @@ DIR/<field>.mp4 is made when ffmpeg is on PATH, else DIR/<field>.gif when Pillow
 
 --field: a particle array (temperature, velocity, diameter, species_<name>, ...; vectors are
 coloured by magnitude; default temperature when it varies, else velocity). --gas-field: an
-OpenFOAM field of the gas folder (default alphac when present, else U, else p). --times: decimal
+OpenFOAM field of the gas folder (default alphac when present, else U, else p), or p_Pa: the
+pressure in Pa (coredemFoam's constant-property gas writes the kinematic p = p/rho_g in m^2/s^2;
+p_Pa is rho_g * p from case.yaml's gas_properties.density; the ideal gas's p is already in Pa). --times: decimal
 times in seconds (the nearest output of each is drawn), default every output.
+
+Every picture carries its time stamp (t and step), a colour legend for the particles and one for
+the gas slice, and a scale bar (a ruler of a round length in mm under the domain). --slice: where
+the gas slice cuts the viewing axis, as a fraction of the domain's depth (0 front .. 1 back;
+default 0.5). In a bed one cell deep the particles hide the slice: --particles none draws the gas
+alone, --particle-opacity (0..1) makes them see-through, --particle-scale (0..1) shrinks them.
 """
 import argparse
 import csv
@@ -22,9 +31,9 @@ import shutil
 import subprocess
 import sys
 
-from paraview.simple import (ColorBy, CreateView, GetColorTransferFunction, GetScalarBar,
-                             GetDisplayProperties, Glyph, OpenFOAMReader, Render,
-                             SaveScreenshot, Show, Slice, UpdatePipeline, XDMFReader)
+from paraview.simple import (Calculator, ColorBy, CreateView, GetColorTransferFunction, GetScalarBar,
+                             GetDisplayProperties, Glyph, OpenFOAMReader, Render, Ruler,
+                             SaveScreenshot, Show, Slice, Text, UpdatePipeline, XDMFReader)
 from paraview import servermanager as sm
 
 
@@ -36,7 +45,40 @@ def parse_args():
     ap.add_argument("--gas-field", default="", help="gas field of the slice")
     ap.add_argument("--out", default="", help="output folder (default RUN_DIR/render)")
     ap.add_argument("--size", default="", help="image size W,H in pixels (default: fit)")
-    return ap.parse_args()
+    ap.add_argument("--slice", type=float, default=0.5,
+                    help="slice position along the viewing axis, fraction of the depth (0..1)")
+    ap.add_argument("--particles", choices=("all", "none"), default="all",
+                    help="draw the particles (all) or the gas slice alone (none)")
+    ap.add_argument("--particle-opacity", type=float, default=1.0,
+                    help="particle opacity 0..1 (see the gas slice through them)")
+    ap.add_argument("--particle-scale", type=float, default=1.0,
+                    help="sphere diameter as a fraction of the particle diameter (0..1]")
+    a = ap.parse_args()
+    if not 0.0 <= a.slice <= 1.0:
+        ap.error(f"--slice {a.slice}: give a fraction of the domain depth between 0 and 1")
+    if not 0.0 <= a.particle_opacity <= 1.0:
+        ap.error(f"--particle-opacity {a.particle_opacity}: give a value between 0 and 1")
+    if not 0.0 < a.particle_scale <= 1.0:
+        ap.error(f"--particle-scale {a.particle_scale}: give a value in (0, 1]")
+    return a
+
+
+def nice_length(span):
+    """A round length (1, 2 or 5 times a power of ten) of about a fifth of span."""
+    target = max(span, 1e-30) / 5.0
+    p = 10.0 ** math.floor(math.log10(target))
+    for m in (5.0, 2.0, 1.0):
+        if m * p <= target:
+            return m * p
+    return p
+
+
+def set_location(prop, where, old):
+    """WindowLocation names changed between ParaView versions ('Upper Center' / 'UpperCenter')."""
+    try:
+        prop.WindowLocation = where
+    except (ValueError, AttributeError):
+        prop.WindowLocation = old
 
 
 def read_outputs(run_dir):
@@ -72,6 +114,22 @@ def gravity_axis(run_dir):
         return max(range(3), key=lambda i: abs(float(g[i])))
     except Exception:  # no case file or no PyYAML
         return 1
+
+
+def pressure_factor(run_dir):
+    """(factor, note): p_Pa = factor * p. coredemFoam's constant-property gas solves the kinematic
+    pressure p/rho_g (m^2/s^2), its ideal gas p in Pa (docs/coredemFoam.md)."""
+    try:
+        import yaml
+
+        with open(os.path.join(run_dir, "case.yaml")) as f:
+            gp = (yaml.safe_load(f) or {}).get("gas_properties") or {}
+    except Exception:  # no case file or no PyYAML: the documented default (constant, air)
+        gp = {}
+    if gp.get("model", "constant") == "ideal_gas":
+        return 1.0, "p is in Pa (ideal gas)"
+    rho = float(gp.get("density", 1.204))
+    return rho, f"p is kinematic (m^2/s^2): p_Pa = {rho:g} kg/m^3 * p"
 
 
 def array_info(proxy, name):
@@ -116,7 +174,7 @@ def main():
         sys.exit(f"no particle array '{field}'; the snapshots have: {', '.join(sorted(names))}")
     spheres = Glyph(Input=particles, GlyphType="Sphere")
     spheres.ScaleArray = ["POINTS", "diameter" if array_info(particles, "diameter") else "radius"]
-    spheres.ScaleFactor = 1.0 if array_info(particles, "diameter") else 2.0
+    spheres.ScaleFactor = (1.0 if array_info(particles, "diameter") else 2.0) * a.particle_scale
     spheres.GlyphMode = "All Points"
     spheres.GlyphType.Radius = 0.5
     spheres.GlyphType.ThetaResolution = 12
@@ -141,6 +199,14 @@ def main():
         gas.MeshRegions = ["internalMesh"]
         gas.UpdatePipelineInformation()
         UpdatePipeline(time=t0, proxy=gas)
+        if a.gas_field == "p_Pa" and cell_array_info(gas, "p_Pa") is None:
+            factor, note = pressure_factor(run_dir)
+            gas = Calculator(Input=gas)
+            gas.AttributeType = "Cell Data"
+            gas.ResultArrayName = "p_Pa"
+            gas.Function = f"p*{factor!r}"
+            UpdatePipeline(time=t0, proxy=gas)
+            print(f"p_Pa: {note}", flush=True)
 
     up = gravity_axis(run_dir)
     bounds = particles.GetDataInformation().GetBounds()
@@ -170,7 +236,10 @@ def main():
         cut.SliceType = "Plane"
         normal = [0.0, 0.0, 0.0]
         normal[depth] = 1.0
-        cut.SliceType.Origin = centre
+        origin = list(centre)
+        # --slice: 0 the front face (towards the camera), 1 the back face
+        origin[depth] = bounds[2 * depth + 1] - a.slice * extent[depth]
+        cut.SliceType.Origin = origin
         cut.SliceType.Normal = normal
         UpdatePipeline(time=t0, proxy=cut)
         if not gas_field:
@@ -183,14 +252,15 @@ def main():
         cut_display = Show(cut, view)
         # Drawn behind every particle: the slice's display moves to the back of the domain.
         shift = [0.0, 0.0, 0.0]
-        shift[depth] = -(0.5 * extent[depth] + 0.01 * max(extent))
+        shift[depth] = -(origin[depth] - bounds[2 * depth] + 0.01 * max(extent))
         cut_display.Position = shift
         if gas_field:
             ColorBy(cut_display, ("CELLS", gas_field, "Magnitude"))
             lut = GetColorTransferFunction(gas_field)
             lut.ApplyPreset("Cool to Warm", True)
             bar = GetScalarBar(lut, view)
-            bar.Title = f"gas {gas_field}"
+            bar.Title = f"gas {gas_field}" + (" [m2/s2, kinematic]" if gas_field == "p" and
+                                               pressure_factor(run_dir)[0] != 1.0 else "")
             bar.ComponentTitle = ""
             bar.TitleColor = bar.LabelColor = [0.0, 0.0, 0.0]
             bar.WindowLocation = "Any Location"
@@ -198,6 +268,8 @@ def main():
             cut_display.SetScalarBarVisibility(view, True)
 
     sphere_display = Show(spheres, view)
+    sphere_display.Visibility = 1 if a.particles == "all" else 0
+    sphere_display.Opacity = a.particle_opacity
     ColorBy(sphere_display, ("POINTS", field, "Magnitude"))
     plut = GetColorTransferFunction(field)
     plut.ApplyPreset("Inferno (matplotlib)", True)
@@ -207,7 +279,31 @@ def main():
     pbar.TitleColor = pbar.LabelColor = [0.0, 0.0, 0.0]
     pbar.WindowLocation = "Any Location"
     pbar.Position = [0.76, 0.1]
-    sphere_display.SetScalarBarVisibility(view, True)
+    sphere_display.SetScalarBarVisibility(view, a.particles == "all")
+
+    # Time stamp (updated per picture) and a scale bar: a ruler of a round length under the domain.
+    stamp = Text(Text="")
+    stamp_display = Show(stamp, view)
+    stamp_display.Color = [0.0, 0.0, 0.0]
+    stamp_display.FontSize = 14
+    set_location(stamp_display, "Upper Center", "UpperCenter")
+    across = [i for i in range(3) if i not in (up, depth)][0]
+    length = nice_length(extent[across])
+    p1 = [bounds[0], bounds[2], bounds[4]]
+    p1[depth] = bounds[2 * depth + 1]  # the front face: never behind the particles
+    p1[up] = bounds[2 * up] - 0.04 * extent[up]
+    p2 = list(p1)
+    p2[across] += length
+    ruler = Ruler(Point1=p1, Point2=p2)
+    ruler_display = Show(ruler, view)
+    for prop, value in (("AxisColor", [0.0, 0.0, 0.0]), ("Color", [0.0, 0.0, 0.0]),
+                        ("Scale", 1000.0), ("LabelFormat", "%-#.3g mm"), ("NumberOfTicks", 2)):
+        try:  # the label in mm (Scale 1000), not the default metres; names vary by version
+            setattr(ruler_display, prop, value)
+        except (AttributeError, ValueError):
+            pass
+    print(f"scale bar: {length * 1e3:g} mm; slice at {a.slice:g} of the depth; particles "
+          f"{a.particles} (opacity {a.particle_opacity:g}, scale {a.particle_scale:g})", flush=True)
 
     # Camera: along the depth axis, the vertical axis up, the whole domain in view.
     view.CameraFocalPoint = centre
@@ -239,6 +335,7 @@ def main():
                 if ghi - glo <= 1e-12 * max(1.0, abs(ghi)):
                     glo, ghi = glo - 1.0, ghi + 1.0
                 GetColorTransferFunction(gas_field).RescaleTransferFunction(glo, ghi)
+        stamp.Text = f"t = {t:.6g} s   (step {int(r['step'])})"
         view.ResetCamera()
         Render(view)
         png = os.path.join(out, f"{field}_{int(r['step']):08d}.png")

@@ -4,7 +4,9 @@
 // resume` finishes every member exactly once with results identical to an uninterrupted
 // campaign; a deterministically failing member ends failed after the retry limit while the
 // others finish; malformed sweep files are refused (exit 2, naming the key, nothing written).
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -247,6 +249,39 @@ TEST(CampaignE2E, FourMemberSweepCompletesAndCollects) {
   EXPECT_NE(plotLog.find("x axis: particles[0].diameter [m]"), std::string::npos) << plotLog;
   EXPECT_NE(plotLog.find("y axis: dem.kinetic_energy_J [J]"), std::string::npos) << plotLog;
   EXPECT_NE(plotLog.find("(final value at t = "), std::string::npos) << plotLog;
+
+  // collect --from: the max/min/mean scalars over t in (0.01, end], labelled with the window,
+  // against each member's own rows
+  ASSERT_EQ(runCoredem({"campaign", "collect", dir.string(), "--no-plot", "--from", "0.01"},
+                       d / "collect-from.txt"),
+            0)
+      << readAll(d / "collect-from.txt");
+  {
+    std::ifstream w(dir / "summary.csv");
+    std::string h, l;
+    std::getline(w, h);
+    EXPECT_EQ(h, "member,status,gas.T_g,particles[0].diameter,mean_T_p,"
+                 "dem.kinetic_energy_J,max@0.01..:dem.kinetic_energy_J");
+    while (std::getline(w, l)) {
+      const std::string id = l.substr(0, l.find(','));
+      const auto ts = coredem::e2e::readTimeseries(dir / "members" / id / "run");
+      double mx = -HUGE_VAL;
+      for (std::size_t i = 0; i < ts.at("t").size(); ++i) {
+        const double e = ts.at("dem.kinetic_energy_J")[i];
+        if (ts.at("t")[i] > 0.01 + 1e-12) {
+          mx = std::max(mx, e);
+        }
+      }
+      EXPECT_EQ(std::stod(l.substr(l.rfind(',') + 1)), mx) << l;
+    }
+  }
+  // a window beyond the members' end is refused with the reason
+  EXPECT_EQ(runCoredem({"campaign", "collect", dir.string(), "--no-plot", "--from", "0.5"},
+                       d / "collect-late.txt"),
+            2);
+  EXPECT_NE(readAll(d / "collect-late.txt").find("at or beyond the run's last row"),
+            std::string::npos)
+      << readAll(d / "collect-late.txt");
 
   // a member re-runs alone from its case folder with the same result
   ASSERT_EQ(runCoredem({"run", (dir / "members/m001/case").string(), "--out",

@@ -361,6 +361,33 @@ TEST_F(ClgRun, RenderDrawsOneTime) {
   EXPECT_GT(std::stoi(readAll(count)), 50) << "the picture is (nearly) a single colour";
 }
 
+// Issue 41 item 5: the pictures carry a time stamp and a scale bar, and the gas can be drawn
+// alone (a bed whose particles hide the slice), at another slice position, in Pa.
+TEST_F(ClgRun, RenderGasAloneInPascalWithStampAndScaleBar) {
+  const Pvbatch pv = findPvbatch();
+  if (COREDEM_PARAVIEW_OPTED_OUT) {
+    GTEST_SKIP() << "opted out (COREDEM_TEST_OPT_OUT=paraview)";
+  }
+  ASSERT_TRUE(pv.missing.empty()) << pv.missing << kParaviewOptOut;
+  const fs::path out = dir_ / "render-p";
+  const fs::path log = dir_ / "render-p-cli.log";
+  ASSERT_EQ(runProgram(kBin / "coredem",
+                       {"render", run_.string(), "--times", "0.0004", "--gas-field", "p_Pa",
+                        "--particles", "none", "--slice", "0.25", "--out", out.string()},
+                       log),
+            0)
+      << tail(log) << tail(out / "render.log");
+  const std::string r = readAll(out / "render.log");
+  EXPECT_NE(r.find("p_Pa: p is"), std::string::npos) << r;
+  EXPECT_NE(r.find("scale bar: "), std::string::npos) << r;
+  EXPECT_NE(r.find("slice at 0.25 of the depth; particles none"), std::string::npos) << r;
+  // a bad option value is refused before ParaView starts
+  EXPECT_EQ(runProgram(kBin / "coredem", {"render", run_.string(), "--slice", "2"},
+                       dir_ / "render-bad.log"),
+            2)
+      << readAll(dir_ / "render-bad.log");
+}
+
 // docs/tutorial.md, as written: its ```bash blocks run in order, in one bash (set -euo pipefail),
 // in a folder that looks like the repository root (docs/, cases/, build/bin). With the paraview
 // test group opted out the render block is left out (and the test says so by skipping).

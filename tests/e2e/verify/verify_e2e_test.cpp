@@ -157,4 +157,8 @@ TEST_F(VerifyE2E, ForcedDemStepAboveTheStableStepIsRefused) {
             std::string::npos)
       << log;
   EXPECT_NE(log.find("models: {motion: frozen}"), std::string::npos) << log;
+  // every lever is named (issue 41): the forced step, dt_factor, the stiffness / contact law
+  for (const char* lever : {"time.dt_dem <=", "dem.dt_factor", "materials[].k_n", "contact law"}) {
+    EXPECT_NE(log.find(lever), std::string::npos) << lever << "\n" << log;
+  }
 }

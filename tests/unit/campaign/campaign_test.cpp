@@ -101,6 +101,54 @@ TEST(CampaignSweep, ExplicitMembers) {
   EXPECT_EQ(sw.scalars.at(0).column, "mean_T_p"); // default result
 }
 
+TEST(CampaignSweep, ScalarWindowsReadAndWriteTheirLabels) {
+  const ScalarSpec a = parseScalarLabel("mean@0.5..:gas.pressure_drop_Pa");
+  EXPECT_EQ(a.reduce, "mean");
+  EXPECT_EQ(a.column, "gas.pressure_drop_Pa");
+  ASSERT_TRUE(a.from.has_value());
+  EXPECT_EQ(*a.from, 0.5);
+  EXPECT_FALSE(a.to.has_value());
+  EXPECT_EQ(a.label(), "mean@0.5..:gas.pressure_drop_Pa");
+  const ScalarSpec b = parseScalarLabel("max@..0.25:bed_height_m");
+  EXPECT_EQ(*b.to, 0.25);
+  EXPECT_FALSE(b.from.has_value());
+  EXPECT_EQ(parseScalarLabel("min@0.1..0.2:x").label(), "min@0.1..0.2:x");
+  EXPECT_EQ(parseScalarLabel("mean_T_p").label(), "mean_T_p");
+  EXPECT_EQ(parseScalarLabel("max:x").baseLabel(), "max:x");
+  for (const char* bad :
+       {"final@0.1..:x", "mean@0.1:x", "mean@a..:x", "mean@0.2..0.1:x", "median:x", "mean:"}) {
+    EXPECT_THROW(parseScalarLabel(bad), CaseError) << bad;
+  }
+}
+
+TEST(CampaignSweep, MappingScalarsParamKeysAndUnits) {
+  const fs::path d = tempDir("param");
+  fs::create_directory_symlink(fs::absolute(kCases / "tiny"), d / "tiny");
+  std::ofstream(d / "sweep.yaml") << "base_case: tiny\n"
+                                     "members:\n"
+                                     "  - {gas.T_g: 400.0, param.U_in: 0.1}\n"
+                                     "  - {gas.T_g: 500.0, param.U_in: 0.2}\n"
+                                     "collect:\n"
+                                     "  scalars: [{mean: mean_T_p, from: 0.01}, "
+                                     "{max: dem.kinetic_energy_J, from: 0.005, to: 0.015}]\n"
+                                     "  units: {param.U_in: m/s}\n"
+                                     "  plot: {x: param.U_in, y: \"mean:mean_T_p\"}\n";
+  const Sweep sw = loadSweep(d / "sweep.yaml");
+  ASSERT_EQ(sw.scalars.size(), 2u);
+  EXPECT_EQ(sw.scalars[0].label(), "mean@0.01..:mean_T_p");
+  EXPECT_EQ(sw.scalars[1].label(), "max@0.005..0.015:dem.kinetic_energy_J");
+  EXPECT_EQ(sw.plotY, "mean@0.01..:mean_T_p"); // found by the label without its window
+  EXPECT_EQ(sw.plotX, "param.U_in");
+  ASSERT_EQ(sw.units.size(), 1u);
+  EXPECT_EQ(sw.units[0], (std::pair<std::string, std::string>{"param.U_in", "m/s"}));
+  // a param. key is recorded with the member but never written into its case
+  EXPECT_EQ(sw.members[1].values.at(1), (std::pair<std::string, std::string>{"param.U_in", "0.2"}));
+  const YAML::Node c = YAML::Load(sw.resolvedCases[1]);
+  EXPECT_FALSE(c["param"]);
+  EXPECT_EQ(c["gas"]["T_g"].as<double>(), 500.0);
+  fs::remove_all(d);
+}
+
 TEST(CampaignDbTest, TransitionsAreCountedExactly) {
   const fs::path d = tempDir("db");
   CampaignDb db(d / "campaign.db", true);

@@ -204,3 +204,26 @@ TEST(Progress, LineHasTimeRateAndEta) {
   EXPECT_EQ(formatDuration(3725), "1h02m");
   EXPECT_EQ(formatDuration(185), "3m05s");
 }
+
+TEST(Progress, EtaFollowsTheRecentRateNotTheAverageSinceTheStart) {
+  // 20 % of the run in the first 10 s, then 10x slower: 1 % every 5 s (0.002 per s).
+  Progress p(0.0, 1.0, 0, false, 1e9);
+  p.setSink([](const std::string&, bool) {});
+  const auto t0 = Progress::Clock::now();
+  double t = 0.0;
+  std::int64_t step = 0;
+  for (int s = 1; s <= 100; ++s) { // one report a wall second
+    t += s <= 10 ? 0.02 : 0.002;
+    step += s <= 10 ? 20 : 2;
+    p.update(step, t, t0 + std::chrono::seconds(s));
+  }
+  // t = 0.38 after 100 s; the last 30 s ran at 0.002 per s -> ETA (1 - 0.38)/0.002 = 310 s.
+  // The average since the start (0.0038 per s) would say 163 s.
+  const std::string l = p.line(step, t, t0 + std::chrono::seconds(100));
+  EXPECT_TRUE(std::regex_search(l, std::regex("ETA 5m(09|10)s"))) << l; // round-off of 310 s
+  EXPECT_NE(l.find("2.0 steps/s"), std::string::npos) << l;
+}
+
+TEST(Progress, FormatDuration) {
+  EXPECT_EQ(formatDuration(185), "3m05s");
+}

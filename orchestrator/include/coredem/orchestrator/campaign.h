@@ -12,13 +12,28 @@
 namespace coredem::orchestrator {
 
 /// One scalar result per member, taken from its timeseries.csv: `final` (last row), `max`,
-/// `min` or `mean` of a column. Written as "reduce:column" in the sweep file ("column" alone
-/// means final).
+/// `min` or `mean` of a column, the last three optionally over a window of simulated time
+/// (from, to] (the mean time-weighted, as `coredem stats`). Written as "reduce:column" or
+/// "reduce@from..to:column" (either end may be left out) in the sweep file, or as a mapping
+/// {mean: column, from: T, to: T}; "column" alone means final.
 struct ScalarSpec {
   std::string reduce = "final";
   std::string column;
-  std::string label() const { return reduce == "final" ? column : reduce + ":" + column; }
+  std::optional<double> from, to; ///< s
+  /// The summary.csv column: "column", "mean:column", "mean@0.5..:column", "max@0.1..0.2:column".
+  std::string label() const;
+  /// The same scalar without its window ("mean:column").
+  std::string baseLabel() const { return reduce == "final" ? column : reduce + ":" + column; }
 };
+
+/// Reads a label written by ScalarSpec::label(). Throws CaseError naming the text when it is
+/// not one (an unknown reduction, a window on `final`, a window that is not two numbers).
+ScalarSpec parseScalarLabel(const std::string& text);
+
+/// Sweep keys with this prefix (`param.U_in`) are not case keys: the value is only recorded
+/// with the member (a summary.csv column, a plot axis), e.g. the inlet velocity of a member
+/// whose swept key is a whole `cfd.case` folder.
+inline constexpr const char* kParamPrefix = "param.";
 
 /// One member: the value (YAML text, flow style) of every varied key, in sweep order.
 struct SweepMember {
@@ -54,6 +69,8 @@ struct Sweep {
   std::vector<SweepMember> members;
   std::vector<ScalarSpec> scalars;
   std::string plotX, plotY; ///< summary columns of the plot (default: first key, first scalar)
+  /// collect.units: the unit of a swept key or a scalar's column for the plot's axis labels
+  std::vector<std::pair<std::string, std::string>> units;
   std::vector<std::string> resolvedCases; ///< case.yaml text of every member (validated)
 };
 
