@@ -263,4 +263,32 @@ TEST_F(CoredemFoamMap, DecomposedMapsAddUpToTheSerialMap) {
   }
 }
 
+// Pre-flight of the DEM's revolved walls against the CFD mesh (issue 41 item 4): the cylindrical
+// bed's O-grid has 32 flat wall faces around; its DEM cylinder and cone at the inscribed radii
+// R cos(π/32) pass `coredem check`; the full radius R (0.072 mm outside the flat faces at their
+// middles) is refused naming the wall and the boundary's distance from the axis.
+TEST_F(CoredemFoamMap, DemCylinderOutsideAFacetedCfdWallIsRefused) {
+  const fs::path c = dir / "bed";
+  fs::copy(fs::path(COREDEM_SOURCE_DIR) / "cases" / "cylindrical-bed", c,
+           fs::copy_options::recursive);
+  run(kFoamBin / "blockMesh", {"-case", (c / "openfoam").string()}, "blockMesh", 0);
+  run(kBin / "coredem", {"check", c.string()}, "check-inscribed", 0);
+  std::string yaml = readAll(c / "case.yaml");
+  yaml = replaceAll(yaml, "radius: 0.0149277709, from: 0.015", "radius: 0.015, from: 0.015");
+  writeAll(c / "case.yaml", yaml);
+  const std::string log = run(kBin / "coredem", {"check", c.string()}, "check-outside", 2);
+  EXPECT_NE(log.find("walls.cylinders[0]: radius 0.015 m"), std::string::npos) << log;
+  const std::smatch m = [&] {
+    std::smatch r;
+    std::regex_search(log, r, std::regex("is ([0-9.e-]+) m from the axis"));
+    return r;
+  }();
+  ASSERT_EQ(m.size(), 2u) << log;
+  // The nearest boundary along the sampled rays: the inscribed radius 14.928 mm, or a little
+  // more between the face centres (1/cos of at most π/64).
+  const double inscribed = 0.015 * std::cos(M_PI / 32.0);
+  EXPECT_GE(std::stod(m[1].str()), inscribed * (1 - 1e-6)) << log;
+  EXPECT_LE(std::stod(m[1].str()), inscribed / std::cos(M_PI / 64.0)) << log;
+}
+
 } // namespace

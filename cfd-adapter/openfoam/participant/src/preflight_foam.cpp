@@ -557,6 +557,7 @@ void checkOpenFoamCase(const CaseConfig& c) {
       }
     }
   }
+  checkRevolvedWallsInsideFoamMesh(c, at, dir);
   checkThermophysicalProperties(c, at, dir);
   checkFoamGasState(c, at, dir);
   checkDecomposition(c, at, dir);

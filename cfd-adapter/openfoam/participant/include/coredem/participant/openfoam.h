@@ -52,6 +52,16 @@ inline constexpr int kMinOuterCorrectorsReacting = 3;
 ///   kMinOuterCorrectorsReacting.
 void checkOpenFoamCase(const CaseConfig& config);
 
+namespace preflight {
+class Locator;
+}
+/// Part of checkOpenFoamCase: every finite DEM cylinder and cone with side inside lies within the
+/// boundary of the mesh in `dir`/constant/polyMesh (its wall and patch patches), sampled by rays
+/// from the axis; fails naming the wall, its radius and the boundary's distance (a faceted CFD
+/// wall's inscribed radius). Skipped without a readable mesh (made at the run).
+void checkRevolvedWallsInsideFoamMesh(const CaseConfig& config, const preflight::Locator& at,
+                                      const std::filesystem::path& dir);
+
 // ------------------------------------------------------------------ generated files
 
 /// The text of constant/thermophysicalProperties for a case with gas_properties.model ideal_gas
