@@ -99,6 +99,45 @@ void checkWall(const Wall& w, std::size_t k) {
   }
 }
 
+/// The contact law's material properties, the material pairs and the walls' materials.
+void validateContactMaterials(const DemConfig& c) {
+  const int nm = static_cast<int>(c.materials.size());
+  if (c.contact == kernels::ContactLaw::HertzMindlin) {
+    for (const Material& mat : c.materials) {
+      COREDEM_CHECK(mat.youngsModulus > 0 && std::isfinite(mat.youngsModulus),
+                    "material '{}': the contact law hertz-mindlin needs youngs_modulus > 0 Pa "
+                    "(got {})",
+                    mat.name, mat.youngsModulus);
+      COREDEM_CHECK(mat.poissonRatio > -1.0 && mat.poissonRatio < 0.5,
+                    "material '{}': poisson_ratio = {} must be in (-1, 0.5)", mat.name,
+                    mat.poissonRatio);
+    }
+  }
+  for (std::size_t k = 0; k < c.materialPairs.size(); ++k) {
+    const MaterialPair& p = c.materialPairs[k];
+    COREDEM_CHECK(p.a >= 0 && p.a < nm && p.b >= 0 && p.b < nm,
+                  "material pair {}: material indices {}, {} are not in 0..{}", k + 1, p.a, p.b,
+                  nm - 1);
+    COREDEM_CHECK(std::isnan(p.en) || (p.en > 0 && p.en <= 1),
+                  "material pair {}: en = {} must be in (0, 1]", k + 1, p.en);
+    COREDEM_CHECK(std::isnan(p.mu) || (p.mu >= 0 && std::isfinite(p.mu)),
+                  "material pair {}: mu = {} must be >= 0", k + 1, p.mu);
+    for (std::size_t q = 0; q < k; ++q) {
+      const MaterialPair& o = c.materialPairs[q];
+      COREDEM_CHECK(!((o.a == p.a && o.b == p.b) || (o.a == p.b && o.b == p.a)),
+                    "material pairs {} and {} name the same pair of materials", q + 1, k + 1);
+    }
+  }
+  for (std::size_t k = 0; k < c.walls.size(); ++k)
+    COREDEM_CHECK(c.walls[k].material >= -1 && c.walls[k].material < nm,
+                  "wall {}: material index {} is not in 0..{} (or -1)", k + 1, c.walls[k].material,
+                  nm - 1);
+  for (const MeshWall& m : c.meshes)
+    COREDEM_CHECK(m.material >= -1 && m.material < nm,
+                  "mesh wall '{}': material index {} is not in 0..{} (or -1)", m.name, m.material,
+                  nm - 1);
+}
+
 } // namespace
 
 namespace cfg {
@@ -107,7 +146,9 @@ void validate(const DemConfig& c) {
   COREDEM_CHECK(!c.materials.empty(), "DemConfig.materials is empty; define at least one material");
   for (std::size_t m = 0; m < c.materials.size(); ++m) {
     const Material& mat = c.materials[m];
-    COREDEM_CHECK(mat.kn > 0 && std::isfinite(mat.kn), "material '{}': kn = {} must be > 0",
+    COREDEM_CHECK(c.contact != kernels::ContactLaw::LinearSpringDashpot ||
+                      (mat.kn > 0 && std::isfinite(mat.kn)),
+                  "material '{}': the contact law linear-spring-dashpot needs kn > 0 N/m (got {})",
                   mat.name, mat.kn);
     COREDEM_CHECK(mat.en > 0 && mat.en <= 1, "material '{}': en = {} must be in (0, 1]", mat.name,
                   mat.en);
@@ -124,6 +165,7 @@ void validate(const DemConfig& c) {
     COREDEM_CHECK(mat.emissivity >= 0 && mat.emissivity <= 1,
                   "material '{}': emissivity = {} must be in [0, 1]", mat.name, mat.emissivity);
   }
+  validateContactMaterials(c);
   for (const ParticleSet& s : c.particleSets) {
     COREDEM_CHECK(s.material >= 0 && s.material < static_cast<int>(c.materials.size()),
                   "particle set '{}': material index {} is not in 0..{}", s.name, s.material,
@@ -225,6 +267,8 @@ std::string hashConfig(const DemConfig& c) {
     t += m.name + ":";
     for (double v : {m.kn, m.en, m.mu, m.ktFactor, m.etatFactor})
       num(v);
+    if (c.contact == kernels::ContactLaw::HertzMindlin) // absent for LSD: earlier hashes stay
+      t += "E", num(m.youngsModulus), num(m.poissonRatio);
     if (c.heat.enabled)
       num(m.cp), num(m.conductivity), num(m.emissivity);
   }
@@ -240,6 +284,8 @@ std::string hashConfig(const DemConfig& c) {
       t += w.capStart ? 'S' : '-';
       t += w.capEnd ? 'E' : '-';
     }
+    if (w.material >= 0) // absent for the default (the particle's own): earlier hashes stay
+      t += "m", num(w.material);
   }
   for (const MeshWall& m : c.meshes) {
     t += "|mesh:" + m.name + ":";
@@ -247,7 +293,11 @@ std::string hashConfig(const DemConfig& c) {
       num(v);
     for (std::int32_t i : m.triangles)
       t += std::to_string(i) + ",";
+    if (m.material >= 0)
+      t += "m", num(m.material);
   }
+  for (const MaterialPair& p : c.materialPairs) // none: earlier hashes stay
+    t += "|pair:", num(p.a), num(p.b), num(p.en), num(p.mu);
   t += "|g:";
   for (double v : c.gravity)
     num(v);

@@ -108,9 +108,13 @@ kernels::Wall kernelWall(const Wall& w) {
   const double l = std::hypot(w.normal[0], w.normal[1], w.normal[2]);
   const kernels::Vec3 p{w.point[0], w.point[1], w.point[2]};
   const kernels::Vec3 n{w.normal[0] / l, w.normal[1] / l, w.normal[2] / l};
-  if (w.shape == WallShape::Plane)
-    return kernels::planeWall(p, n);
+  if (w.shape == WallShape::Plane) {
+    kernels::Wall k = kernels::planeWall(p, n);
+    k.material = w.material;
+    return k;
+  }
   kernels::Wall k{};
+  k.material = w.material;
   k.point = p;
   k.normal = n;
   k.kind = kernels::kWallRevolved;
@@ -145,6 +149,7 @@ std::vector<kernels::MeshTriangle> kernelTriangles(const std::vector<MeshWall>& 
     const std::size_t nt = m.triangles.size() / 3;
     for (std::size_t t = 0; t < nt; ++t) {
       kernels::MeshTriangle k{};
+      k.material = m.material;
       kernels::Vec3* corner[3] = {&k.a, &k.b, &k.c};
       for (int c = 0; c < 3; ++c) {
         const std::int32_t v = m.triangles[3 * t + c];
@@ -167,9 +172,10 @@ void setUpContacts(const DemConfig& config, EngineSetup& es) {
     using Law = typename decltype(law)::type;
     const typename Law::Params& params = config.contactLaws.template of<Law>();
     for (std::size_t a = 0; a < nm; ++a)
-      for (std::size_t b = 0; b < nm; ++b)
-        es.pairs.push_back(kernels::ContactPair::make<Law>(
-            Law::mix(params, config.materials[a], config.materials[b])));
+      for (std::size_t b = 0; b < nm; ++b) {
+        const auto [ma, mb] = pairMaterials(config, a, b); // material_pairs overrides
+        es.pairs.push_back(kernels::ContactPair::make<Law>(Law::mix(params, ma, mb)));
+      }
   });
 }
 

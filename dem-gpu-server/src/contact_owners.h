@@ -75,9 +75,10 @@ struct OwnerContacts {
     return owner<false>(i, nullptr, nullptr, h, 0);
   }
 
-  /// i's wall contacts (the law with m_eff = m_i, the particle's material): their force (returned),
-  /// their torque added to T, their history written from slot `slot` on (`slot` and `wallCount`
-  /// advanced); oldKey/oldD: the first `used` history slots as the last sub-step left them.
+  /// i's wall contacts (the law with m_eff = m_i, R* = R_i, the particle's and the wall's
+  /// material): their force (returned), their torque added to T, their history written from slot
+  /// `slot` on (`slot` and `wallCount` advanced); oldKey/oldD: the first `used` history slots as
+  /// the last sub-step left them.
   DEM_HD_FORCEINLINE kernels::Vec3 walls(std::size_t i, kernels::Vec3 xi, double ri, int used,
                                          const std::int64_t* oldKey, const kernels::Vec3* oldD,
                                          int& slot, int& wallCount, kernels::Vec3& T) const {
@@ -91,11 +92,13 @@ struct OwnerContacts {
     if (nearBits != 0) {
       const int ai = mat[i];
       const double mi = m[i];
-      const Pair pp = pairs[ai * nMat + ai].template of<Law>();
-      const auto lp = Law::contact(pp, mi);
       const Vec3 vi = load3(v, ii);
       const Vec3 wi = load3(w, ii);
       auto touch = [&](double h, Vec3 nw, std::int64_t key, Vec3 history) {
+        // The row of i's material and the wall's (a wall without one: i's material with itself).
+        const int wm = wv.materialOf(key);
+        const Pair pp = pairs[ai * nMat + (wm < 0 ? ai : wm)].template of<Law>();
+        const auto lp = Law::contact(pp, mi, ri);
         const ContactResult res = wallContact<Law>(lp, nw, ri - h, vi, wi, ri, history, dt);
         FW += res.force;
         T += res.torque;

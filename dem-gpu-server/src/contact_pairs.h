@@ -42,7 +42,7 @@ DEM_HD OwnedPair<S> ownedPair(kernels::Vec3T<S> d, S l2, S ri, S rj, S mi, S mj,
   const Vec3T<S> nrm = invL * d;
   const S deltaN = rsum - l;
   const S meff = effectiveMass(mi, mj);
-  const auto contact = Law::contact(pair, meff);
+  const auto contact = Law::contact(pair, meff, effectiveMass(ri, rj)); // R* as m*
   const S lij = leverArmInv(l, invL, ri, rj);
   const S lji = leverArmInv(l, invL, rj, ri);
   const Vec3T<S> vij = relativeVelocity(vi, vj, wi, wj, lij, lji, nrm);

@@ -125,6 +125,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   st.neighbourSlots = config.neighbour.initialNeighbourSlots;
   double rmax = 0;
   std::vector<double> minMass(config.materials.size(), std::numeric_limits<double>::infinity());
+  std::vector<double> minRadius(config.materials.size(), 1.0); // of the lightest (dtDemMax)
   std::int64_t nextId = 0;
   for (const ParticleSet& s : config.particleSets) {
     const std::vector<double> p = placeParticles(s, config.interrupt);
@@ -133,7 +134,10 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
     const double r = 0.5 * s.diameter;
     const double mass = s.density * kernels::sphereVolume(r);
     rmax = std::max(rmax, r);
-    minMass[s.material] = std::min(minMass[s.material], mass);
+    if (mass < minMass[s.material]) {
+      minMass[s.material] = mass;
+      minRadius[s.material] = r;
+    }
     for (std::size_t k = 0; k < n; ++k) {
       for (int d = 0; d < 3; ++d) {
         st.pos.push_back(p[3 * k + d]);
@@ -167,7 +171,7 @@ DemSystem::DemSystem(const DemConfig& config, BackendKind backend, int threads)
   m.nParticles = n;
 
   const std::size_t nm = config.materials.size();
-  m.dtMax = coredem::dem::dtDemMax(config, minMass);
+  m.dtMax = coredem::dem::dtDemMax(config, minMass, minRadius);
 
   // Engine set-up.
   EngineSetup& es = m.setup;
@@ -453,10 +457,17 @@ void DemSystem::Impl::adoptState(const std::string& path, HostState& st) {
   COREDEM_CHECK(st.historySlots >= 1, "state file '{}': bad history_slots", path);
   double rmax = 0;
   std::vector<double> minMass(m.config.materials.size(), std::numeric_limits<double>::infinity());
+  std::vector<double> minRadius(m.config.materials.size(), 1.0); // of the lightest (dtDemMax)
   for (std::size_t i = 0; i < st.n; ++i) {
     rmax = std::max(rmax, st.radius[i]);
-    if (st.material[i] >= 0 && st.material[i] < static_cast<int>(minMass.size()))
-      minMass[st.material[i]] = std::min(minMass[st.material[i]], restartMass(m.config, st, i));
+    if (st.material[i] >= 0 && st.material[i] < static_cast<int>(minMass.size())) {
+      const double mi = restartMass(m.config, st, i);
+      if (mi < minMass[st.material[i]]) {
+        minMass[st.material[i]] = mi;
+        // the radius of that mass (with chemistry: the initial one, as restartMass)
+        minRadius[st.material[i]] = std::cbrt(mi / (st.density[i] * kernels::sphereVolume(1.0)));
+      }
+    }
     COREDEM_CHECK(
         st.material[i] >= 0 && st.material[i] < static_cast<int>(m.config.materials.size()),
         "state file '{}': particle {} has material {} not in the config", path, i, st.material[i]);
@@ -475,7 +486,7 @@ void DemSystem::Impl::adoptState(const std::string& path, HostState& st) {
   }
   m.engine->setState(st);
   m.nParticles = st.n;
-  m.dtMax = coredem::dem::dtDemMax(m.config, minMass);
+  m.dtMax = coredem::dem::dtDemMax(m.config, minMass, minRadius);
 }
 
 double DemSystem::time() const {

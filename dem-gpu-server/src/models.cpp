@@ -152,21 +152,54 @@ double particleMass(double rho, double d) {
   return rho * kernels::sphereVolume(0.5 * d);
 }
 
-double dtDemMax(const DemConfig& config, std::span<const double> minMass) {
+std::pair<Material, Material> pairMaterials(const DemConfig& config, std::size_t a, std::size_t b) {
+  std::pair<Material, Material> m{config.materials[a], config.materials[b]};
+  for (const MaterialPair& p : config.materialPairs) {
+    const auto ia = static_cast<std::size_t>(p.a), ib = static_cast<std::size_t>(p.b);
+    if (!((ia == a && ib == b) || (ia == b && ib == a)))
+      continue;
+    if (!std::isnan(p.en))
+      m.first.en = m.second.en = p.en;
+    if (!std::isnan(p.mu))
+      m.first.mu = m.second.mu = p.mu;
+  }
+  return m;
+}
+
+std::vector<int> wallMaterialsOf(const DemConfig& config, int a) {
+  std::vector<int> out;
+  auto add = [&](int w) {
+    const int k = w < 0 ? a : w;
+    if (std::find(out.begin(), out.end(), k) == out.end())
+      out.push_back(k);
+  };
+  for (const Wall& w : config.walls)
+    add(w.material);
+  for (const MeshWall& w : config.meshes)
+    add(w.material);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+double dtDemMax(const DemConfig& config, std::span<const double> minMass,
+                std::span<const double> minRadius) {
   const std::size_t nm = config.materials.size();
   COREDEM_ASSERT(minMass.size() == nm);
+  COREDEM_ASSERT(minRadius.empty() || minRadius.size() == nm);
+  const auto radius = [&](std::size_t a) { return minRadius.empty() ? 1.0 : minRadius[a]; };
   // Over the rows present: the smallest contact time scale (resolved in dt_factor steps) and
   // the smallest stability limit of the integrator (a bound of its own, whatever dt_factor).
   double tcol = std::numeric_limits<double>::infinity();
   double stable = std::numeric_limits<double>::infinity();
   kernels::visitModel(kernels::ContactLaws{}, static_cast<int>(config.contact), [&](auto law) {
     using Law = typename decltype(law)::type;
-    // The row of materials a and b (the law's mixing) with effective mass meff.
-    const auto row = [&](std::size_t a, std::size_t b, double meff) {
-      const auto p =
-          Law::mix(config.contactLaws.template of<Law>(), config.materials[a], config.materials[b]);
-      tcol = std::min(tcol, Law::collisionTime(p, meff));
-      stable = std::min(stable, Law::stableStep(p, meff));
+    const typename Law::Params& params = config.contactLaws.template of<Law>();
+    // The row of materials a and b (the law's mixing) with effective mass meff, radius reff.
+    const auto row = [&](std::size_t a, std::size_t b, double meff, double reff) {
+      const auto [ma, mb] = pairMaterials(config, a, b);
+      const auto p = Law::mix(params, ma, mb);
+      tcol = std::min(tcol, Law::collisionTime(params, p, meff, reff));
+      stable = std::min(stable, Law::stableStep(params, p, meff, reff));
     };
     for (std::size_t a = 0; a < nm; ++a) {
       if (!std::isfinite(minMass[a]))
@@ -174,10 +207,11 @@ double dtDemMax(const DemConfig& config, std::span<const double> minMass) {
       for (std::size_t b = 0; b < nm; ++b) {
         if (!std::isfinite(minMass[b]))
           continue;
-        row(a, b, kernels::effectiveMass(minMass[a], minMass[b]));
+        row(a, b, kernels::effectiveMass(minMass[a], minMass[b]),
+            kernels::effectiveMass(radius(a), radius(b)));
       }
-      if (!config.walls.empty() || !config.meshes.empty())
-        row(a, a, minMass[a]);
+      for (const int w : wallMaterialsOf(config, static_cast<int>(a)))
+        row(a, static_cast<std::size_t>(w), minMass[a], radius(a));
     }
   });
   if (config.frozenMotion)

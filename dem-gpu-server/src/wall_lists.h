@@ -82,6 +82,13 @@ struct WallView {
     }
   }
 
+  /// The material of the wall a touch with history key `key` belongs to (kernels::Wall::material,
+  /// kernels::MeshTriangle::material): −1 for the particle's own (the default).
+  DEM_HD int materialOf(std::int64_t key) const {
+    const std::int64_t k = -key - 2;
+    return k < meshKeyBase ? walls[k % nWalls].material : tris[k - meshKeyBase].material;
+  }
+
   /// Whether a touch new to `key` may take over the history of the last sub-step's wall touch
   /// `old` (one the sphere no longer touches; contact_owners.h hands each history on once):
   /// another feature of the same analytic wall (a sphere rolling over a rim onto a cap), or a

@@ -30,6 +30,8 @@ const std::vector<CaseReader>& caseReaders() {
       {"particles", {"materials", "initial_state"}, readParticles},
       {"walls", {"materials"}, readWalls},
       {"models", {}, readModels},
+      {"material_pairs", {"materials"}, readMaterialPairs},
+      {"contact_materials", {"materials", "models"}, checkContactMaterials},
       {"dem", {}, readDem},
       {"cfd", {}, readCfd},
       {"walls.meshes", {"walls", "grid", "cfd"}, readMeshWalls},
@@ -100,7 +102,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
        "species",    "gas_properties", "materials",     "particles", "initial_state",
        "walls",      "models",         "dem",           "cfd",       "gas",
        "checkpoint", "output",         "solid_species", "reactions", "chemistry",
-       "coupling"},
+       "coupling",   "material_pairs"},
       YAML::Mark());
   caseread::CaseReading reading{top, c, std::nullopt, {}, std::nullopt};
   for (const caseread::CaseReader& reader : caseread::caseReaders()) {

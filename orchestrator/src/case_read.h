@@ -52,6 +52,8 @@ void readSpecies(CaseReading& r);
 void readGasProperties(CaseReading& r);
 void resolveGasModel(CaseReading& r);
 void readMaterials(CaseReading& r);
+void readMaterialPairs(CaseReading& r);
+void checkContactMaterials(CaseReading& r);
 void readInitialState(CaseReading& r);
 void readParticles(CaseReading& r);
 void readWalls(CaseReading& r);

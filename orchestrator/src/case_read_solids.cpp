@@ -19,14 +19,31 @@ void readMaterials(CaseReading& r) {
   const Section& top = r.top;
   CaseConfig& c = r.c;
   top.require("materials", "a list of solid materials");
-  for (const auto& m : top.list("materials",
-                                {"name", "density", "k_n", "e_n", "friction", "kt_factor",
-                                 "etat_factor", "cp", "conductivity", "emissivity"},
-                                "solid materials")) {
+  for (const auto& m :
+       top.list("materials",
+                {"name", "density", "k_n", "e_n", "friction", "kt_factor", "etat_factor",
+                 "youngs_modulus", "poisson_ratio", "cp", "conductivity", "emissivity"},
+                "solid materials")) {
     MaterialConfig mc;
     mc.name = m.string("name", std::nullopt, "material name");
     mc.density = m.number("density", std::nullopt, 0.0, kBig, "kg/m3, > 0", true);
-    mc.kN = m.number("k_n", std::nullopt, 0.0, kBig, "normal spring stiffness in N/m, > 0", true);
+    // k_n: required by the linear spring–dashpot law, E and ν by Hertz–Mindlin
+    // (checkContactMaterials, once `models` is read).
+    if (m.has("k_n")) {
+      mc.kN = m.number("k_n", std::nullopt, 0.0, kBig, "normal spring stiffness in N/m, > 0", true);
+    }
+    if (m.has("youngs_modulus")) {
+      mc.youngsModulus =
+          m.number("youngs_modulus", std::nullopt, 0.0, kBig, "Young's modulus in Pa, > 0", true);
+    }
+    if (m.has("poisson_ratio")) {
+      mc.poissonRatio =
+          m.number("poisson_ratio", std::nullopt, -1.0, 0.5, "Poisson's ratio in (-1, 0.5)", true);
+      if (*mc.poissonRatio >= 0.5) {
+        m.fail(m.markOf("poisson_ratio"), m.full("poisson_ratio"),
+               fmt::format("{} is outside (-1, 0.5)", *mc.poissonRatio));
+      }
+    }
     mc.eN =
         m.number("e_n", std::nullopt, 0.0, 1.0, "normal restitution coefficient in (0, 1]", true);
     mc.friction = m.number("friction", 0.3, 0.0, kBig, "Coulomb friction coefficient, >= 0");

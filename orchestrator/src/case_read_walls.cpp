@@ -97,11 +97,24 @@ void wallExtent(const Section& s, RevolvedWallConfig& r) {
   }
 }
 
+/// A wall's `material:` (protocol v1.6): a material name, or "" (absent: each particle meets the
+/// wall with its own material).
+std::string wallMaterial(const Section& s, const CaseConfig& c) {
+  if (!s.has("material")) {
+    return {};
+  }
+  const std::string name = s.string("material", std::nullopt, "contact material of the wall");
+  if (materialIndex(c, name) < 0) {
+    s.fail(s.markOf("material"), s.full("material"), fmt::format("unknown material '{}'", name));
+  }
+  return name;
+}
+
 /// walls.cylinders, walls.cones (protocol v1.4; docs/case-schema.md "walls").
 void parseWallShapes(const Section& w, CaseConfig& c) {
   if (w.has("cylinders")) {
     for (const auto& s :
-         w.list("cylinders", {"point", "axis", "radius", "from", "to", "side", "caps"},
+         w.list("cylinders", {"point", "axis", "radius", "from", "to", "side", "caps", "material"},
                 "cylinder walls")) {
       RevolvedWallConfig r;
       r.index = c.walls.revolved.size();
@@ -110,14 +123,16 @@ void parseWallShapes(const Section& w, CaseConfig& c) {
       r.radiusFrom = r.radiusTo = s.number("radius", std::nullopt, 0.0, kBig, "m, > 0", true);
       wallExtent(s, r);
       wallSideAndCaps(s, r);
+      r.material = wallMaterial(s, c);
       c.walls.revolved.push_back(r);
     }
   }
   if (w.has("cones")) {
     std::size_t index = 0;
-    for (const auto& s : w.list(
-             "cones", {"point", "axis", "from", "to", "radius_from", "radius_to", "side", "caps"},
-             "cone (frustum) walls")) {
+    for (const auto& s : w.list("cones",
+                                {"point", "axis", "from", "to", "radius_from", "radius_to", "side",
+                                 "caps", "material"},
+                                "cone (frustum) walls")) {
       RevolvedWallConfig r;
       r.cone = true;
       r.index = index++;
@@ -131,6 +146,7 @@ void parseWallShapes(const Section& w, CaseConfig& c) {
                "a cone needs a radius > 0 at one end at least (radius_from or radius_to)");
       }
       wallSideAndCaps(s, r);
+      r.material = wallMaterial(s, c);
       c.walls.revolved.push_back(r);
     }
   }
@@ -244,9 +260,10 @@ void parseMeshWalls(const Section& w, CaseConfig& c, bool cfdSection) {
         c.grid.origin[std::size_t(d)] +
         c.grid.spacing[std::size_t(d)] * double(c.grid.cells[std::size_t(d)]);
   }
-  for (const auto& s :
-       w.list("meshes", {"file", "from_cfd", "scale", "closed"}, "triangle-mesh walls")) {
+  for (const auto& s : w.list("meshes", {"file", "from_cfd", "scale", "closed", "material"},
+                              "triangle-mesh walls")) {
     MeshWallConfig m;
+    m.material = wallMaterial(s, c);
     m.closed = s.onOff("closed", false);
     if (s.has("file") && s.has("from_cfd")) {
       s.fail(s.markOf("from_cfd"), s.full("from_cfd"),
@@ -326,14 +343,16 @@ void readWalls(CaseReading& r) {
       r.walls.emplace(r.top.section("walls", {"box", "planes", "cylinders", "cones", "meshes",
                                               "material", "thermal", "temperature"}));
   if (w.has("box")) {
-    const Section b = w.section("box", {"min", "max"});
+    const Section b = w.section("box", {"min", "max", "material"});
     c.walls.box =
         std::make_pair(b.vec3("min", std::nullopt, "m"), b.vec3("max", std::nullopt, "m"));
+    c.walls.boxMaterial = wallMaterial(b, c);
   }
   if (w.has("planes")) {
-    for (const auto& pl : w.list("planes", {"point", "normal"}, "planar walls")) {
+    for (const auto& pl : w.list("planes", {"point", "normal", "material"}, "planar walls")) {
       c.walls.planes.push_back({pl.vec3("point", std::nullopt, "m"),
-                                pl.vec3("normal", std::nullopt, "into the domain")});
+                                pl.vec3("normal", std::nullopt, "into the domain"),
+                                wallMaterial(pl, c)});
     }
   }
   parseWallShapes(w, c);

@@ -68,6 +68,23 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
     mat->set_cp(m.cp);
     mat->set_conductivity(m.conductivity);
     mat->set_emissivity(m.emissivity);
+    if (m.youngsModulus) { // v1.6
+      mat->set_youngs_modulus(*m.youngsModulus);
+    }
+    if (m.poissonRatio) {
+      mat->set_poisson_ratio(*m.poissonRatio);
+    }
+  }
+  for (const auto& p : c.materialPairs) { // v1.6
+    auto* mp = cfg.add_material_pairs();
+    mp->set_material_a(std::uint32_t(materialIndex(c, p.a)));
+    mp->set_material_b(std::uint32_t(materialIndex(c, p.b)));
+    if (p.eN) {
+      mp->set_e_n(*p.eN);
+    }
+    if (p.friction) {
+      mp->set_friction(*p.friction);
+    }
   }
   for (const auto& p : c.particles) {
     auto* ps = cfg.add_particle_sets();
@@ -93,14 +110,22 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
     *ps->mutable_initial_velocity() = vec(p.velocity);
   }
   auto* walls = cfg.mutable_walls();
+  // v1.6: a wall's contact material when it names one (unset: each particle's own).
+  const auto wallMaterial = [&](const std::string& name, auto* w) {
+    if (!name.empty()) {
+      w->set_material_id(std::uint32_t(materialIndex(c, name)));
+    }
+  };
   if (c.walls.box) {
     *walls->mutable_box()->mutable_min() = vec(c.walls.box->first);
     *walls->mutable_box()->mutable_max() = vec(c.walls.box->second);
+    wallMaterial(c.walls.boxMaterial, walls->mutable_box());
   }
   for (const auto& pl : c.walls.planes) {
     auto* p = walls->add_planes();
     *p->mutable_point() = vec(pl.point);
     *p->mutable_normal() = vec(pl.normal);
+    wallMaterial(pl.material, p);
   }
   // v1.4: cylinders and cones, triangle meshes (the session refuses a server below 1.4 first).
   for (const auto& r : c.walls.revolved) {
@@ -120,12 +145,14 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
                     : (r.side == "both" ? v1::WALL_SIDE_BOTH : v1::WALL_SIDE_INSIDE));
     w->set_cap_start(r.capStart);
     w->set_cap_end(r.capEnd);
+    wallMaterial(r.material, w);
   }
   for (const auto& m : c.walls.meshes) {
     auto* w = walls->add_meshes();
     w->set_name(m.name); // from case.yaml: part of the DEM's config hash, stable across restarts
     w->mutable_vertices()->Add(m.vertices.begin(), m.vertices.end());
     w->mutable_triangles()->Add(m.triangles.begin(), m.triangles.end());
+    wallMaterial(m.material, w);
   }
   walls->set_material_id(std::uint32_t(std::max(0, materialIndex(c, c.walls.material))));
   walls->set_temperature(c.walls.temperature);
@@ -188,6 +215,16 @@ std::string demVersionRefusal(const CaseConfig& c, std::uint32_t agreedMajor,
                        "a coredem-dem built from this release, or give the walls as walls.box and "
                        "walls.planes",
                        agreedMajor, agreedMinor, what, protocol::kMinorWallShapes,
+                       protocol::kProtocolVersion.toString());
+  }
+  // Material pairs, wall materials and the Hertz–Mindlin properties travel in fields of v1.6:
+  // an older server would run with the mixed properties instead.
+  const std::string contact = c.contactMaterialsUsed();
+  if (!contact.empty() && agreedMinor < protocol::kMinorContactMaterials) {
+    return fmt::format("the DEM server speaks protocol {}.{}, but this case uses contact "
+                       "materials ({}), which need protocol 1.{} (this coredem speaks {}); an "
+                       "older server would ignore them. Use a coredem-dem built from this release",
+                       agreedMajor, agreedMinor, contact, protocol::kMinorContactMaterials,
                        protocol::kProtocolVersion.toString());
   }
   return {};

@@ -18,7 +18,8 @@ v1::Configure buildConfigure(const CaseConfig& c, const std::filesystem::path& r
 
 /// Why this case cannot be sent to a DEM server that agreed protocol `agreedMajor`.`agreedMinor`
 /// (a Configure field it would ignore), or "" when it can: chemistry needs 1.1, cylinder, cone
-/// and mesh walls need 1.4 (protocol::kMinorWallShapes). The text names both versions, what needs
+/// and mesh walls need 1.4 (protocol::kMinorWallShapes), material pairs, wall materials and
+/// Hertz–Mindlin 1.6 (protocol::kMinorContactMaterials). The text names both versions, what needs
 /// the newer one and what to do.
 std::string demVersionRefusal(const CaseConfig& c, std::uint32_t agreedMajor,
                               std::uint32_t agreedMinor);

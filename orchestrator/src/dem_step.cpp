@@ -32,6 +32,41 @@ double dtFactorOf(const CaseConfig& c) {
   return d.dtFactor;
 }
 
+namespace {
+
+/// What of the walls the DEM's Δt_DEM,max reads: the material pairs, and one wall per contact
+/// material the walls have (−1: a wall without one, each particle's own material).
+void addContactWalls(const CaseConfig& c, dem::DemConfig& d) {
+  for (const auto& p : c.materialPairs) {
+    dem::MaterialPair mp;
+    mp.a = materialIndex(c, p.a);
+    mp.b = materialIndex(c, p.b);
+    mp.en = p.eN.value_or(mp.en);
+    mp.mu = p.friction.value_or(mp.mu);
+    d.materialPairs.push_back(mp);
+  }
+  std::vector<std::string> names;
+  if (c.walls.box) {
+    names.push_back(c.walls.boxMaterial);
+  }
+  for (const auto& p : c.walls.planes) {
+    names.push_back(p.material);
+  }
+  for (const auto& w : c.walls.revolved) {
+    names.push_back(w.material);
+  }
+  for (const auto& w : c.walls.meshes) {
+    names.push_back(w.material);
+  }
+  for (const std::string& n : names) {
+    dem::Wall w;
+    w.material = n.empty() ? -1 : materialIndex(c, n);
+    d.walls.push_back(w);
+  }
+}
+
+} // namespace
+
 double estimateDtDemMax(const CaseConfig& c) {
   // The DEM's own function (coredem/dem/models.h) on the case's materials, lightest particle of
   // each material and `models:` (dem.dt_factor, motion).
@@ -43,16 +78,26 @@ double estimateDtDemMax(const CaseConfig& c) {
     dm.kn = m.kN;
     dm.en = m.eN;
     dm.mu = m.friction;
+    dm.ktFactor = m.ktFactor.value_or(dm.ktFactor);
+    dm.etatFactor = m.etatFactor.value_or(dm.etatFactor);
+    dm.youngsModulus = m.youngsModulus.value_or(dm.youngsModulus);
+    dm.poissonRatio = m.poissonRatio.value_or(dm.poissonRatio);
     d.materials.push_back(dm);
   }
+  addContactWalls(c, d);
   std::vector<double> minMass(d.materials.size(), std::numeric_limits<double>::infinity());
+  std::vector<double> minRadius(d.materials.size(), 1.0); // of the lightest particle
   for (const auto& p : c.particles) {
     const std::size_t k = std::size_t(materialIndex(c, p.material));
     const double rho = p.density > 0 ? p.density : c.materials[k].density;
-    minMass[k] = std::min(minMass[k], dem::particleMass(rho, p.diameter));
+    const double mass = dem::particleMass(rho, p.diameter);
+    if (mass < minMass[k]) {
+      minMass[k] = mass;
+      minRadius[k] = 0.5 * p.diameter;
+    }
   }
   applyModels(c, d);
-  const double dtMax = dem::dtDemMax(d, minMass);
+  const double dtMax = dem::dtDemMax(d, minMass, minRadius);
   return std::isfinite(dtMax) ? dtMax : c.dt.dt;
 }
 

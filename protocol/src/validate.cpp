@@ -572,12 +572,68 @@ Status checkMaterials(const v1::Configure& c, std::set<std::uint32_t>& materialI
     if (!materialIds.insert(m.id()).second) {
       return bad("material id " + std::to_string(m.id()) + " is used twice");
     }
-    if (!(m.density() > 0) || !(m.k_n() > 0) || !(m.e_n() > 0 && m.e_n() <= 1) ||
+    // k_n: 0 = not given (v1.6: a hertz-mindlin material; the DEM refuses it for the linear
+    // spring-dashpot law, naming the law).
+    if (!(m.density() > 0) || !(m.k_n() >= 0) || !(m.e_n() > 0 && m.e_n() <= 1) ||
         !(m.friction() >= 0) || (m.has_kt_factor() && !(m.kt_factor() > 0)) ||
-        (m.has_etat_factor() && !(m.etat_factor() >= 0))) {
+        (m.has_etat_factor() && !(m.etat_factor() >= 0)) ||
+        (m.has_youngs_modulus() &&
+         !(m.youngs_modulus() > 0 && std::isfinite(m.youngs_modulus()))) ||
+        (m.has_poisson_ratio() && !(m.poisson_ratio() > -1 && m.poisson_ratio() < 0.5))) {
       return bad("material " + std::to_string(m.id()) + " ('" + printable(m.name()) +
-                 "') needs density > 0, k_n > 0, 0 < e_n <= 1, friction >= 0, kt_factor > 0, "
-                 "etat_factor >= 0");
+                 "') needs density > 0, k_n >= 0, 0 < e_n <= 1, friction >= 0, kt_factor > 0, "
+                 "etat_factor >= 0, youngs_modulus > 0, -1 < poisson_ratio < 0.5");
+    }
+  }
+  return {};
+}
+
+/// v1.6: material pairs and the walls' contact materials name known materials, valid values.
+Status checkContactMaterials(const v1::Configure& c, const std::set<std::uint32_t>& materialIds) {
+  for (int i = 0; i < c.material_pairs_size(); ++i) {
+    const auto& p = c.material_pairs(i);
+    const std::string which = "material_pairs[" + std::to_string(i) + "]";
+    if (!materialIds.count(p.material_a()) || !materialIds.count(p.material_b())) {
+      return bad(which + " refers to a material id that is not among materials");
+    }
+    if ((p.has_e_n() && !(p.e_n() > 0 && p.e_n() <= 1)) ||
+        (p.has_friction() && !(p.friction() >= 0 && std::isfinite(p.friction())))) {
+      return bad(which + " needs 0 < e_n <= 1, friction >= 0");
+    }
+  }
+  const auto wall = [&](bool has, std::uint32_t id, const std::string& which) -> Status {
+    if (has && !materialIds.count(id)) {
+      return bad(which + " has material_id " + std::to_string(id) +
+                 ", which is not among materials");
+    }
+    return {};
+  };
+  const auto& w = c.walls();
+  if (Status s = wall(w.box().has_material_id(), w.box().material_id(), "walls.box"); !s.ok()) {
+    return s;
+  }
+  for (int i = 0; i < w.planes_size(); ++i) {
+    const auto& p = w.planes(i);
+    if (Status s =
+            wall(p.has_material_id(), p.material_id(), "walls.planes[" + std::to_string(i) + "]");
+        !s.ok()) {
+      return s;
+    }
+  }
+  for (int i = 0; i < w.revolved_size(); ++i) {
+    const auto& r = w.revolved(i);
+    if (Status s =
+            wall(r.has_material_id(), r.material_id(), "walls.revolved[" + std::to_string(i) + "]");
+        !s.ok()) {
+      return s;
+    }
+  }
+  for (int i = 0; i < w.meshes_size(); ++i) {
+    const auto& m = w.meshes(i);
+    if (Status s =
+            wall(m.has_material_id(), m.material_id(), "walls.meshes[" + std::to_string(i) + "]");
+        !s.ok()) {
+      return s;
     }
   }
   return {};
@@ -701,6 +757,9 @@ Status validateConfigure(const v1::Configure& c) {
   }
   std::set<std::uint32_t> materialIds;
   if (Status s = checkMaterials(c, materialIds); !s.ok()) {
+    return s;
+  }
+  if (Status s = checkContactMaterials(c, materialIds); !s.ok()) {
     return s;
   }
   if (c.initial_state_file().empty()) {

@@ -15,6 +15,9 @@
 // v1.5 (MINOR 5): the v1.4 messages with minor 5 in Hello/Welcome/Reject, the partial GasFields
 // also carrying Q_split (heat for the cell's particles, J/m3, extensive) and the partial Sources
 // also carrying mom_p (momentum of the released mass, N/m3) for its one cell.
+// v1.6 (MINOR 6): the v1.5 messages with minor 6 in Hello/Welcome/Reject and a Configure whose
+// material also has Young's modulus and Poisson's ratio, with a second material, a material pair
+// and contact materials on the box, the plane, the cylinder and the mesh (the cone without one).
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -215,6 +218,30 @@ void addV14(v1::Configure& c) {
   }
 }
 
+/// v1.6 additions to the golden Configure (tests/unit/protocol/golden_v1_6_test.cpp checks
+/// them): the Hertz–Mindlin properties, a second material, a material pair, wall materials.
+void addV16(v1::Configure& c) {
+  c.mutable_materials(0)->set_youngs_modulus(1.5e8);
+  c.mutable_materials(0)->set_poisson_ratio(0.25);
+  auto* steel = c.add_materials();
+  steel->set_id(2);
+  steel->set_name("steel");
+  steel->set_density(7800.0);
+  steel->set_k_n(4000.0);
+  steel->set_e_n(0.8);
+  steel->set_friction(0.0);
+  steel->set_youngs_modulus(2e11); // poisson_ratio left unset (default 0.3)
+  auto* pair = c.add_material_pairs();
+  pair->set_material_a(1);
+  pair->set_material_b(2);
+  pair->set_e_n(0.5); // friction left unset (the mixed value)
+  auto* w = c.mutable_walls();
+  w->mutable_box()->set_material_id(2);
+  w->mutable_planes(0)->set_material_id(1);
+  w->mutable_revolved(0)->set_material_id(2);
+  w->mutable_meshes(0)->set_material_id(1);
+}
+
 void addFieldArrays(Message& m, std::span<const fields::FieldSpec> specs,
                     std::uint64_t rows = kCells) {
   std::size_t f = 0;
@@ -268,6 +295,9 @@ void addSessionMessages(Golden& all, int minor) {
     }
     if (minor >= 4) {
       addV14(c);
+    }
+    if (minor >= 6) {
+      addV16(c);
     }
     Message m = makeConfigure(c);
     stamp(m, 2);
@@ -394,8 +424,8 @@ int main(int argc, char** argv) {
     return 2;
   }
   const int minor = argc == 3 ? std::atoi(argv[2]) : 0;
-  if (minor < 0 || minor > 5) {
-    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0, 1, 2, 3, 4 or 5\n");
+  if (minor < 0 || minor > 6) {
+    std::fprintf(stderr, "coredem-golden-gen: MINOR must be 0 to 6\n");
     return 2;
   }
   std::filesystem::path dir = argv[1];

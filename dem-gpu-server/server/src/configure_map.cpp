@@ -117,6 +117,10 @@ MaterialIds addMaterials(const v1::Configure& c, dem::DemConfig& cfg) {
       d.cp = m.cp(); // 0 (unset): the default 840 J/kg/K, as in the case schema
     d.conductivity = m.conductivity();
     d.emissivity = m.emissivity();
+    if (m.has_youngs_modulus()) // v1.6 (unset: not given, needed by hertz-mindlin only)
+      d.youngsModulus = m.youngs_modulus();
+    if (m.has_poisson_ratio())
+      d.poissonRatio = m.poisson_ratio();
     ids.index[m.id()] = static_cast<int>(cfg.materials.size());
     ids.density[m.id()] = m.density();
     cfg.materials.push_back(d);
@@ -124,6 +128,14 @@ MaterialIds addMaterials(const v1::Configure& c, dem::DemConfig& cfg) {
   COREDEM_CHECK(!cfg.materials.empty(), "Configure: no materials; give at least one (k_n, e_n, "
                                         "friction, density)");
   return ids;
+}
+
+/// The index of material id `id` of a wall or a material pair (v1.6), named `what` in the error.
+int materialIndexOf(const MaterialIds& materials, std::uint32_t id, const std::string& what) {
+  const auto it = materials.index.find(id);
+  COREDEM_CHECK(it != materials.index.end(),
+                "Configure: {} uses material id {}, which is not among the materials", what, id);
+  return it->second;
 }
 
 /// Solid species: v1.1 Configure.solid_species when given (chemistry); else the names used in
@@ -239,7 +251,7 @@ void addParticleSets(const v1::Configure& c, const MaterialIds& materials,
 
 /// Revolved walls (v1.4: cylinders and cones; their geometry is checked when the system is
 /// built).
-void addRevolvedWalls(const v1::Configure& c, dem::DemConfig& cfg) {
+void addRevolvedWalls(const v1::Configure& c, const MaterialIds& materials, dem::DemConfig& cfg) {
   for (int i = 0; i < c.walls().revolved_size(); ++i) {
     const auto& r = c.walls().revolved(i);
     dem::WallSide side = dem::WallSide::Inside;
@@ -267,18 +279,50 @@ void addRevolvedWalls(const v1::Configure& c, dem::DemConfig& cfg) {
                                    r.radius_end(), side, r.cap_start(), r.cap_end())
                  : dem::Wall::cylinder(vec(r.point()), vec(r.axis()), r.radius_start(), start, end,
                                        side, r.cap_start(), r.cap_end()));
+    if (r.has_material_id()) // v1.6; unset: the particle's own
+      cfg.walls.back().material =
+          materialIndexOf(materials, r.material_id(), "walls.revolved[" + std::to_string(i) + "]");
   }
 }
 
-/// Walls: box, planes, revolved, meshes; the wall temperature and material; gravity.
+/// Material pairs (v1.6): e_n and friction of a pair of materials replacing the mixing.
+void addMaterialPairs(const v1::Configure& c, const MaterialIds& materials, dem::DemConfig& cfg) {
+  cfg.materialPairs.clear();
+  for (int i = 0; i < c.material_pairs_size(); ++i) {
+    const auto& p = c.material_pairs(i);
+    const std::string what = "material_pairs[" + std::to_string(i) + "]";
+    dem::MaterialPair d;
+    d.a = materialIndexOf(materials, p.material_a(), what);
+    d.b = materialIndexOf(materials, p.material_b(), what);
+    if (p.has_e_n())
+      d.en = p.e_n();
+    if (p.has_friction())
+      d.mu = p.friction();
+    cfg.materialPairs.push_back(d);
+  }
+}
+
+/// Walls: box, planes, revolved, meshes (each with its contact material, v1.6); the wall
+/// temperature and material; gravity.
 void addWalls(const v1::Configure& c, const MaterialIds& materials, dem::DemConfig& cfg) {
+  // A wall's contact material (v1.6): unset, the particle's own (−1).
+  auto wallMaterial = [&](bool has, std::uint32_t id, const std::string& what) {
+    return has ? materialIndexOf(materials, id, what) : -1;
+  };
   if (c.walls().has_box()) {
-    cfg.addBox(vec(c.walls().box().min()), vec(c.walls().box().max()));
+    const auto& b = c.walls().box();
+    cfg.addBox(vec(b.min()), vec(b.max()));
+    const int m = wallMaterial(b.has_material_id(), b.material_id(), "walls.box");
+    for (std::size_t k = cfg.walls.size() - 6; k < cfg.walls.size(); ++k)
+      cfg.walls[k].material = m;
   }
-  for (const auto& p : c.walls().planes()) {
+  for (int i = 0; i < c.walls().planes_size(); ++i) {
+    const auto& p = c.walls().planes(i);
     cfg.walls.push_back(dem::Wall::plane(vec(p.point()), vec(p.normal())));
+    cfg.walls.back().material = wallMaterial(p.has_material_id(), p.material_id(),
+                                             "walls.planes[" + std::to_string(i) + "]");
   }
-  addRevolvedWalls(c, cfg);
+  addRevolvedWalls(c, materials, cfg);
   for (int i = 0; i < c.walls().meshes_size(); ++i) {
     const auto& m = c.walls().meshes(i);
     COREDEM_CHECK(m.vertices_size() % 3 == 0 && m.triangles_size() % 3 == 0,
@@ -289,6 +333,9 @@ void addWalls(const v1::Configure& c, const MaterialIds& materials, dem::DemConf
     d.name = m.name().empty() ? "mesh-" + std::to_string(i) : m.name();
     d.vertices.assign(m.vertices().begin(), m.vertices().end());
     d.triangles.assign(m.triangles().begin(), m.triangles().end());
+    if (m.has_material_id()) // v1.6; unset: the particle's own
+      d.material =
+          materialIndexOf(materials, m.material_id(), "walls.meshes[" + std::to_string(i) + "]");
     cfg.meshes.push_back(std::move(d));
   }
   cfg.wallTemperature = c.walls().temperature(); // 0 = adiabatic (docs/heat-coupling.md "Walls")
@@ -330,6 +377,7 @@ dem::DemConfig toDemConfig(const v1::Configure& c, std::vector<std::string>* war
   const std::vector<std::string> solid = addSolidSpecies(c, cfg);
   addParticleSets(c, materials, solid, cfg);
   addWalls(c, materials, cfg);
+  addMaterialPairs(c, materials, cfg);
   addGrid(c, cfg);
 
   // Chemistry (v1.1): reactions, CLG models, removal, reaction heat (docs/thermochemistry.md).

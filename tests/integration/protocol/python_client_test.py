@@ -3,7 +3,7 @@
 talks to the C++ loopback server and decodes the C++ golden files.
 
 usage: python_client_test.py PROTOC PROTO_DIR GOLDEN_DIR LOOPBACK_BINARY
-Checks: every golden v1.0 to v1.5 file decodes with Python's protobuf and has the type its name says;
+Checks: every golden v1.0 to v1.6 file decodes with Python's protobuf and has the type its name says;
 the golden GasFields arrays hold 0.25 (f+1) + 0.125 i; over tcp loopback a Python DEALER
 handshakes, configures a 4x3x2 grid, sends GasFields built from numpy arrays and receives
 Sources (eps_g = 1, other sources 0, checksums equal to sequential sums of what was sent);
@@ -116,6 +116,18 @@ def main():
         hello.ParseFromString(read_cdmf(os.path.join(golden_dir, "v1.5", "hello.cdmf"))[0])
         assert hello.hello.protocol_minor == 5
         print("python: decoded the golden v1.5 GasFields with Q_split and Sources with mom_p")
+        # v1.6 Configure: Hertz-Mindlin properties, a material pair, wall materials.
+        env = pb.Envelope()
+        env.ParseFromString(read_cdmf(os.path.join(golden_dir, "v1.6", "configure.cdmf"))[0])
+        c = env.configure
+        assert c.materials[0].youngs_modulus == 1.5e8 and c.materials[0].poisson_ratio == 0.25
+        assert not c.materials[1].HasField("poisson_ratio")
+        p = c.material_pairs[0]
+        assert (p.material_a, p.material_b, p.e_n) == (1, 2, 0.5) and not p.HasField("friction")
+        assert c.walls.box.material_id == 2 and c.walls.planes[0].material_id == 1
+        assert c.walls.revolved[0].material_id == 2 and not c.walls.revolved[1].HasField("material_id")
+        assert c.walls.meshes[0].material_id == 1
+        print("python: decoded the golden v1.6 Configure with contact materials")
         # v1.1 Configure: explicit positions and chemistry, read by Python's protobuf.
         env = pb.Envelope()
         env.ParseFromString(read_cdmf(os.path.join(golden_dir, "v1.1", "configure.cdmf"))[0])
@@ -166,7 +178,7 @@ def main():
             hello.hello.role = common.ROLE_CFD
             welcome, _ = request(hello)
             assert welcome.type == common.MESSAGE_TYPE_WELCOME
-            assert welcome.welcome.protocol_minor == 5  # min(server 1.5, client 1.7)
+            assert welcome.welcome.protocol_minor == 6  # min(server 1.6, client 1.7)
             session = welcome.welcome.session_id
 
             nx, ny, nz, ns = 4, 3, 2, 2

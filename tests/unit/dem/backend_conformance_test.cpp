@@ -259,6 +259,36 @@ DemConfig denseBox() {
   return c;
 }
 
+/// denseBox with the Hertz–Mindlin law (kernels/hertz_mindlin_contact.h), two materials, a
+/// material pair's restitution and friction, walls of their own materials (a frictionless one)
+/// and others with the particles' own: every row kind of the pair table, in the pair lanes too.
+DemConfig hertzBox() {
+  DemConfig c = denseBox();
+  c.contact = coredem::dem::kernels::ContactLaw::HertzMindlin;
+  Material glass;
+  glass.name = "glass";
+  glass.youngsModulus = 5e6, glass.poissonRatio = 0.25, glass.en = 0.8, glass.mu = 0.4;
+  Material steel = glass;
+  steel.name = "steel";
+  steel.youngsModulus = 2e7, steel.poissonRatio = 0.3, steel.en = 0.9, steel.mu = 0.2;
+  Material slick = steel;
+  slick.name = "slick";
+  slick.mu = 0.0;
+  c.materials = {glass, steel, slick};
+  ParticleSet top = c.particleSets[0];
+  c.particleSets[0].count = 196; // the lower four layers glass, the upper three steel
+  c.particleSets[0].regionMax[2] = 4 * 1.05e-3;
+  top.material = 1;
+  top.count = 147;
+  top.regionMin[2] = 4 * 1.05e-3;
+  top.seed = 6;
+  c.particleSets.push_back(top);
+  c.materialPairs.push_back(MaterialPair{0, 1, 0.5, 0.6});
+  c.walls[0].material = 2; // x = 0: frictionless
+  c.walls[4].material = 1; // the floor: steel
+  return c;
+}
+
 /// A settling heated bed on a coupling grid: drag, PCM, every heat term, hot walls. `scale`
 /// multiplies the box edges (and the particle count by scale³).
 DemConfig heatedBed(int scale = 1) {
@@ -367,6 +397,16 @@ TYPED_TEST(StageConformance, NeighbourSearchWithListGrowthContactsAndWalls) {
   EXPECT_GT(ref.contacts.back(), ref.pairContacts.back()); // wall contacts present
   EXPECT_GT(ref.pairContacts.back(), 0u);
   EXPECT_EQ(ref.rebuilds, r.rebuilds);
+  expectSameRun(ref, r, this->tol, this->kind != BackendKind::Cuda);
+}
+
+TYPED_TEST(StageConformance, HertzMindlinWithMaterialPairsAndWallMaterials) {
+  const DemConfig cfg = hertzBox();
+  const double dt = DemSystem(cfg, BackendKind::Cpu, 1).dtDemMax();
+  const Run ref = run(cfg, BackendKind::Cpu, 6, 25, 25 * dt);
+  const Run r = run(cfg, this->kind, 6, 25, 25 * dt);
+  EXPECT_GT(ref.contacts.back(), ref.pairContacts.back()); // wall contacts present
+  EXPECT_GT(ref.pairContacts.back(), 0u);
   expectSameRun(ref, r, this->tol, this->kind != BackendKind::Cuda);
 }
 

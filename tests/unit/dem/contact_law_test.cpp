@@ -49,16 +49,18 @@ struct SpringContact {
   static Pair mix(const Params&, const Material& a, const Material& b) {
     return Pair{0.5 * (a.kn + b.kn)};
   }
-  static double collisionTime(const Pair& p, double meff) {
+  static double collisionTime(const Params&, const Pair& p, double meff, double) {
     return 3.14159265358979323846 * std::sqrt(meff / p.kn);
   }
-  static double stableStep(const Pair& p, double meff) { return 2.0 * std::sqrt(meff / p.kn); }
+  static double stableStep(const Params&, const Pair& p, double meff, double) {
+    return 2.0 * std::sqrt(meff / p.kn);
+  }
   template <class S, class Load>
   static PairT<S> gather(const Load& load) {
     return PairT<S>{load(&Pair::kn)};
   }
   template <class S>
-  static ContactT<S> contact(const PairT<S>& p, S) {
+  static ContactT<S> contact(const PairT<S>& p, S, S) {
     return p;
   }
   template <class S>
@@ -114,7 +116,9 @@ TEST(ContactLaw, ModelsKeyIsValidated) {
   DemConfig c;
   EXPECT_TRUE(applyModelOption(c, "contact", "linear_spring_dashpot"));
   EXPECT_EQ(c.contact, k::ContactLaw::LinearSpringDashpot);
-  EXPECT_THROW(applyModelOption(c, "contact", "hertz-mindlin"), coredem::UserError);
+  EXPECT_THROW(applyModelOption(c, "contact", "hertz"), coredem::UserError);
+  EXPECT_TRUE(applyModelOption(c, "contact", "hertz_mindlin"));
+  EXPECT_EQ(c.contact, k::ContactLaw::HertzMindlin);
   const std::vector<std::pair<std::string, std::string>> models = {
       {"contact", "linear-spring-dashpot"}, {"contact", "linear-spring-dashpt"}, {"contact", "x"}};
   const std::vector<ModelIssue> issues = validateModels(models);
@@ -238,7 +242,7 @@ TEST(ContactLaw, SecondLawDispatches) {
 
   // The wall kernel for the spring: a floor, overlap 2e-5 m.
   const k::ContactResult w = k::wallContact<SpringContact>(
-      SpringContact::contact(rows[1].of<SpringContact>(), 1e-6), Vec3{0.0, 0.0, 1.0}, 2e-5,
+      SpringContact::contact(rows[1].of<SpringContact>(), 1e-6, ri), Vec3{0.0, 0.0, 1.0}, 2e-5,
       Vec3{0.0, 0.0, -0.1}, zero, ri, zero, 1e-6);
   EXPECT_NEAR(w.force.z, kn * 2e-5, 1e-12 * kn * 2e-5);
 

@@ -2,8 +2,8 @@
 # compares each file with the committed one byte for byte. -DGEN=... -DGOLDEN=... -DOUT=...
 file(GLOB versions RELATIVE ${GOLDEN} ${GOLDEN}/v1.*)
 list(LENGTH versions count)
-if(count LESS 6)
-  message(FATAL_ERROR "expected golden folders v1.0 .. v1.5 in ${GOLDEN}, found: ${versions}")
+if(count LESS 7)
+  message(FATAL_ERROR "expected golden folders v1.0 .. v1.6 in ${GOLDEN}, found: ${versions}")
 endif()
 foreach(v IN LISTS versions)
   string(REGEX REPLACE "^v1\\." "" minor ${v})

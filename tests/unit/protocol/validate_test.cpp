@@ -279,6 +279,48 @@ TEST(ValidateConfigure, RejectsInconsistentCases) {
   EXPECT_TRUE(validateConfigure(c).ok());
 }
 
+// v1.6: the Hertz–Mindlin properties, material pairs and wall materials; k_n 0 (not given) is
+// the DEM's to refuse for the law that needs it.
+TEST(ValidateConfigure, ChecksTheContactMaterialsOfV16) {
+  auto expectBad = [](const v1::Configure& c, const std::string& needle) {
+    const Status s = validateConfigure(c);
+    EXPECT_EQ(s.code, v1::ERROR_CODE_INVALID_CONFIGURATION) << needle;
+    EXPECT_NE(s.message.find(needle), std::string::npos) << s.message;
+  };
+  v1::Configure c = validConfigure();
+  const std::uint32_t id = c.materials(0).id();
+  c.mutable_materials(0)->set_k_n(0.0);
+  c.mutable_materials(0)->set_youngs_modulus(1e8);
+  c.mutable_materials(0)->set_poisson_ratio(0.3);
+  auto* pair = c.add_material_pairs();
+  pair->set_material_a(id);
+  pair->set_material_b(id);
+  pair->set_friction(0.0);
+  auto* plane = c.mutable_walls()->add_planes();
+  plane->mutable_normal()->set_z(1.0);
+  plane->set_material_id(id);
+  EXPECT_TRUE(validateConfigure(c).ok()) << validateConfigure(c).toString();
+
+  v1::Configure b = c;
+  b.mutable_materials(0)->set_poisson_ratio(0.5);
+  expectBad(b, "poisson_ratio");
+  b = c;
+  b.mutable_materials(0)->set_youngs_modulus(0.0);
+  expectBad(b, "youngs_modulus");
+  b = c;
+  b.mutable_material_pairs(0)->set_material_b(id + 7);
+  expectBad(b, "material_pairs[0]");
+  b = c;
+  b.mutable_material_pairs(0)->set_e_n(0.0);
+  expectBad(b, "material_pairs[0] needs");
+  b = c;
+  b.mutable_walls()->mutable_planes(0)->set_material_id(id + 7);
+  expectBad(b, "walls.planes[0] has material_id");
+  b = c;
+  b.mutable_walls()->mutable_box()->set_material_id(id + 7);
+  expectBad(b, "walls.box");
+}
+
 TEST(ValidateConfigure, ChecksTheChemistryFieldsOfV11) {
   auto withReaction = [] {
     v1::Configure c = validConfigure();

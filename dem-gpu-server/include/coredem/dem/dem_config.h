@@ -22,12 +22,16 @@
 namespace coredem::dem {
 
 /// Contact properties of one solid material (docs/physics.md §2.1, Eqs. 9–13).
-/// Pairs of different materials use k_n = 2 k_a k_b/(k_a+k_b), e_n = min(e_a, e_b),
-/// μ = min(μ_a, μ_b) [C]; particle–wall contacts use the particle's material with
-/// m_eff = m_i (the wall is rigid, immobile, and has the particle's properties).
+/// Pairs of different materials use the contact law's mixing (linear spring–dashpot:
+/// k_n = 2 k_a k_b/(k_a+k_b); Hertz–Mindlin: E*, G*; both: e_n = min(e_a, e_b),
+/// μ = min(μ_a, μ_b) [C]) unless DemConfig::materialPairs names the pair; particle–wall contacts
+/// use the particle's material and the wall's (Wall::material; by default the particle's own)
+/// with m_eff = m_i (the wall is rigid and immobile).
 struct Material {
   std::string name = "default";
-  double kn = 1000.0;          ///< normal spring stiffness k_n (N/m)
+  double kn = 1000.0;          ///< normal spring stiffness k_n (N/m), linear spring–dashpot
+  double youngsModulus = 0.0;  ///< Young's modulus E (Pa), Hertz–Mindlin (0: not given)
+  double poissonRatio = 0.3;   ///< Poisson's ratio ν (-), in (−1, 0.5), Hertz–Mindlin
   double en = 0.97;            ///< normal restitution coefficient e_n (-), 0 < e_n <= 1
   double mu = 0.1;             ///< Coulomb friction coefficient μ (-)
   double ktFactor = 2.0 / 7.0; ///< k_t = ktFactor·k_n (MFiX KT_FAC)
@@ -100,6 +104,9 @@ struct Wall {
   WallSide side = WallSide::Inside;
   bool capStart = false; ///< a flat disc closes the `start` end
   bool capEnd = false;   ///< a flat disc closes the `end` end
+  /// Index into DemConfig::materials of the wall's contact material; −1 (the default): each
+  /// particle meets it with its own material (the behaviour before walls had materials).
+  int material = -1;
 
   /// A plane through `point` with normal `normal` towards the particles.
   static Wall plane(const std::array<double, 3>& point, const std::array<double, 3>& normal);
@@ -119,6 +126,15 @@ struct MeshWall {
   std::string name;                    ///< where it came from (messages)
   std::vector<double> vertices;        ///< x0,y0,z0,... (m)
   std::vector<std::int32_t> triangles; ///< 3 vertex indices per triangle
+  int material = -1; ///< contact material (index into DemConfig::materials); −1 as Wall::material
+};
+
+/// The contact properties of one pair of materials that override the contact law's mixing
+/// (docs/case-schema.md `material_pairs`): NaN keeps the mixed value.
+struct MaterialPair {
+  int a = 0, b = 0;                                     ///< indices into DemConfig::materials
+  double en = std::numeric_limits<double>::quiet_NaN(); ///< restitution e_n (-), (0, 1]
+  double mu = std::numeric_limits<double>::quiet_NaN(); ///< friction μ (-), ≥ 0
 };
 
 /// Uniform Cartesian coupling grid (PCM cells): cell = i + nx*(j + ny*k). counts = 0: no coupling.
@@ -154,6 +170,7 @@ struct NeighbourOptions {
 /// `models:` keys of a case (Configure.options) are applied by applyModelOption (models.h).
 struct DemConfig {
   std::vector<Material> materials{Material{}};
+  std::vector<MaterialPair> materialPairs; ///< per-pair overrides of e_n and μ (at most one a pair)
   std::vector<ParticleSet> particleSets;
   std::vector<Wall> walls;
   std::vector<MeshWall> meshes; ///< triangle-mesh walls (two-sided), besides `walls`

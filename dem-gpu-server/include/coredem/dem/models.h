@@ -135,11 +135,22 @@ const ModelFamily<kernels::ContactLaw>& contactModels();
 /// smallest undamped contact duration and Δt_s the smallest stability limit of the integrator
 /// (the contact law's collisionTime and stableStep) over the present material pairs (and each
 /// material against the walls, if any; the chosen contact law's mixing rules), with
-/// `minMass[a]` the lightest particle of material a (+inf: none present; both grow with m_eff).
+/// `minMass[a]` the lightest particle of material a (+inf: none present; both grow with m_eff)
+/// and `minRadius[a]` its radius (the Hertz time scales grow with m*²/R*; empty: not needed by
+/// the law, e.g. linear spring–dashpot; a law that needs it then uses 1 m).
 /// The largest finite double with `motion: frozen` (no collision limit); +inf without particles.
 /// The one place this is computed: the DEM server reports it in Configured, the orchestrator's
 /// provisional plan of the first Configure uses it too.
-double dtDemMax(const DemConfig& config, std::span<const double> minMass);
+double dtDemMax(const DemConfig& config, std::span<const double> minMass,
+                std::span<const double> minRadius = {});
+
+/// Materials a and b as the contact law's mix() sees them: with a `materialPairs` entry of the
+/// pair, its e_n and μ replace both materials' (the laws take the smaller of the two).
+std::pair<Material, Material> pairMaterials(const DemConfig& config, std::size_t a, std::size_t b);
+
+/// The material indices the walls (analytic and mesh) meet particles of material a with: each
+/// wall's own, or a for a wall without one, each once, ascending.
+std::vector<int> wallMaterialsOf(const DemConfig& config, int a);
 
 /// The mass of a particle of density `rho` (kg/m³) and diameter `d` (m), as the DEM computes it
 /// (ρ · 4/3 π (d/2)³): for the `minMass` of dtDemMax.

@@ -58,9 +58,18 @@ struct GasPropertiesConfig {
 
 struct MaterialConfig {
   std::string name;
-  double density = 0.0, kN = 0.0, eN = 0.0, friction = 0.0;
+  double density = 0.0, kN = 0.0, eN = 0.0, friction = 0.0; ///< kN 0: not given (Hertz–Mindlin)
   std::optional<double> ktFactor, etatFactor;
   double cp = 0.0, conductivity = 0.0, emissivity = 0.0;
+  /// Hertz–Mindlin (protocol v1.6): Young's modulus (Pa) and Poisson's ratio (-).
+  std::optional<double> youngsModulus, poissonRatio;
+};
+
+/// material_pairs[]: contact properties of one pair of materials replacing the law's mixing
+/// (protocol v1.6).
+struct MaterialPairConfig {
+  std::string a, b;                   ///< material names (may be the same)
+  std::optional<double> eN, friction; ///< unset: the mixed value
 };
 
 struct ParticleSetConfig {
@@ -78,6 +87,7 @@ struct ParticleSetConfig {
 
 struct PlaneConfig {
   Vec3 point{}, normal{};
+  std::string material; ///< contact material (v1.6); empty: each particle's own
 };
 
 /// A cylinder or cone wall about an axis (walls.cylinders[], walls.cones[]; protocol v1.4).
@@ -92,6 +102,7 @@ struct RevolvedWallConfig {
   double from = 0.0, to = 0.0;           ///< m along the axis from `point`, from < to (when finite)
   std::string side = "inside";           ///< inside | outside | both
   bool capStart = false, capEnd = false; ///< flat discs closing `from` / `to`
+  std::string material;                  ///< contact material (v1.6); empty: each particle's own
   /// "walls.cylinders[0]" (messages)
   std::string key() const;
 };
@@ -111,12 +122,14 @@ struct MeshWallConfig {
   bool closed = false;          ///< a closed surface is required (and particles must be inside)
   std::vector<double> vertices; ///< m, x0,y0,z0,x1,... (welded, scaled)
   std::vector<std::int32_t> triangles; ///< 3 vertex indices per triangle
+  std::string material;                ///< contact material (v1.6); empty: each particle's own
   /// The key of case.yaml the wall comes from: "file" or "from_cfd" (messages).
   const char* sourceKey() const { return fromCfd.empty() ? "file" : "from_cfd"; }
 };
 
 struct WallsConfig {
   std::optional<std::pair<Vec3, Vec3>> box;
+  std::string boxMaterial; ///< contact material of the box's faces (v1.6); empty: the particle's
   std::vector<PlaneConfig> planes;
   std::vector<RevolvedWallConfig> revolved; ///< cylinders then cones, in case.yaml order
   std::vector<MeshWallConfig> meshes;
@@ -220,6 +233,7 @@ struct CaseConfig {
   std::vector<SpeciesConfig> species;
   GasPropertiesConfig gasProperties;
   std::vector<MaterialConfig> materials;
+  std::vector<MaterialPairConfig> materialPairs; ///< material_pairs (protocol v1.6)
   std::vector<ParticleSetConfig> particles;
   std::filesystem::path initialState; ///< absolute, empty when particle sets are used
   WallsConfig walls;
@@ -245,6 +259,9 @@ struct CaseConfig {
   /// True when the case has cylinder, cone or mesh walls: needs a v1.4 server
   /// (protocol::kMinorWallShapes).
   bool usesWallShapes() const { return !walls.revolved.empty() || !walls.meshes.empty(); }
+  /// What of the contact materials of protocol v1.6 the case uses ("" when none): material
+  /// pairs, wall materials, the hertz-mindlin law (the Configure fields a v1.5 server ignores).
+  std::string contactMaterialsUsed() const;
 };
 
 /// Loads and validates CASE_DIR/case.yaml (or a file path). Throws CaseError.

@@ -19,7 +19,7 @@ struct Version {
 };
 
 /// The version this build speaks.
-inline constexpr Version kProtocolVersion{1, 5};
+inline constexpr Version kProtocolVersion{1, 6};
 
 /// First minor version with the fluid_fraction array and the decomposed (M:1) exchange: rank
 /// identity in Hello, partial GasFields/Sources (docs/protocol.md "Decomposed CFD").
@@ -45,6 +45,13 @@ inline constexpr std::uint32_t kMinorReleasedMomentum = 5;
 /// DEM server would ignore it (the heat would be lost), so the coupling client refuses to send it
 /// to a DEM server whose agreed minor is below this.
 inline constexpr std::uint32_t kMinorHeatToParticles = 5;
+
+/// First minor version with the contact materials: Material.youngs_modulus and .poisson_ratio
+/// (the Hertz–Mindlin law), Configure.material_pairs and the walls' material_id (Box, Plane,
+/// RevolvedWall, MeshWall). An older DEM server ignores them, so the orchestrator refuses to send
+/// a case with material pairs, wall materials or the hertz-mindlin law to a DEM server whose
+/// agreed minor is below this.
+inline constexpr std::uint32_t kMinorContactMaterials = 6;
 
 /// Outcome of a handshake.
 struct Negotiation {

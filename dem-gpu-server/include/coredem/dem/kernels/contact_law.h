@@ -13,14 +13,17 @@
 ///   template <class Material> static Pair mix(const Params&, const Material& a, const Material&
 ///   b);
 ///                                         // host: the row of materials a and b (walls: a, a)
-///   static double collisionTime(const Pair&, double meff);   // host: the contact's time
-///                                         //   scale that Δt_DEM,max resolves (dt_factor steps)
-///   static double stableStep(const Pair&, double meff);      // host: the largest Δt the
-///                                         //   integrator keeps the contact stable with
+///   static double collisionTime(const Params&, const Pair&, double meff, double reff);
+///                                         // host: the contact's time scale that Δt_DEM,max
+///                                         //   resolves (dt_factor steps)
+///   static double stableStep(const Params&, const Pair&, double meff, double reff);
+///                                         // host: the largest Δt the integrator keeps the
+///                                         //   contact stable with
 ///   template <class S, class Load> DEM_HD static PairT<S> gather(const Load& load);
 ///                                         // PairT<S>{load(&Pair::member)…}: rows into lanes
-///   template <class S> DEM_HD static ContactT<S> contact(const PairT<S>&, S meff);
-///                                         // per contact (walls: meff = m_i, once per particle)
+///   template <class S> DEM_HD static ContactT<S> contact(const PairT<S>&, S meff, S reff);
+///                                         // per contact: m* = m_i m_j/(m_i + m_j),
+///                                         //   R* = R_i R_j/(R_i + R_j) (walls: m_i, R_i)
 ///   template <class S> DEM_HD static ContactResultT<S> evaluate(const ContactT<S>&, Vec3T<S> n,
 ///       S deltaN, Vec3T<S> vij, S lij, Vec3T<S> deltaTOld, double dt);
 ///                                         // force on i, torque on i, new δ_t, n × f_t
@@ -42,18 +45,20 @@
 
 #include "coredem/dem/kernels/common.h"
 #include "coredem/dem/kernels/contact_common.h"
+#include "coredem/dem/kernels/hertz_mindlin_contact.h"
 #include "coredem/dem/kernels/lsd_contact.h"
 #include "coredem/dem/kernels/model_list.h"
 
 namespace coredem::dem::kernels {
 
 /// The contact laws, in id order (the registration line).
-using ContactLaws = ModelList<LinearSpringDashpot>;
+using ContactLaws = ModelList<LinearSpringDashpot, HertzMindlin>;
 
 /// A contact law's id (its position in ContactLaws; the configuration hash uses it). The default
 /// has a name; any law's id is contactLaw<Law>().
 enum class ContactLaw : int {
-  LinearSpringDashpot = 0 ///< kernels/lsd_contact.h, the default
+  LinearSpringDashpot = 0, ///< kernels/lsd_contact.h, the default
+  HertzMindlin = 1         ///< kernels/hertz_mindlin_contact.h
 };
 
 template <class Law>
@@ -61,6 +66,7 @@ constexpr ContactLaw contactLaw() {
   return static_cast<ContactLaw>(modelId<Law, ContactLaws>);
 }
 static_assert(contactLaw<LinearSpringDashpot>() == ContactLaw::LinearSpringDashpot);
+static_assert(contactLaw<HertzMindlin>() == ContactLaw::HertzMindlin);
 
 /// A row of the pair table for the laws of List: the Pair of one of them (a union: as large as
 /// the largest, so that a law's rows do not grow with the others). Plain data, copied to the

@@ -113,7 +113,7 @@ struct LinearSpringDashpot {
 
   /// Undamped duration of a contact of row p with effective mass meff, π √(m_eff/k_n): the time
   /// scale Δt_DEM,max resolves (collision_time.h; host).
-  static double collisionTime(const Pair& p, double meff) {
+  static double collisionTime(const Params&, const Pair& p, double meff, double /*reff*/) {
     return undampedCollisionTime(p.kn, meff);
   }
 
@@ -121,7 +121,7 @@ struct LinearSpringDashpot {
   /// stable (collision_time.h, Δt_s; host): the normal oscillator (k_n, m_eff, η_n) and the
   /// tangential one (k_t, η_t, and the mass m_eff/3.5 that the contact point's tangential
   /// motion has with the spheres' rotation, 1/m_eff + R²/I summed over both sides, I = 2/5 m R²).
-  static double stableStep(const Pair& p, double meff) {
+  static double stableStep(const Params&, const Pair& p, double meff, double /*reff*/) {
     const double etan = p.dampFactor * ::sqrt(p.kn * meff);
     const double normal = dampedStepLimit(p.kn, meff, etan);
     if (!(p.kt > 0.0))
@@ -137,9 +137,10 @@ struct LinearSpringDashpot {
                     load(&Pair::etatFactor), load(&Pair::mu)};
   }
 
-  /// The parameters of one contact of row p with effective mass meff (walls: m_i): η_n, η_t.
+  /// The parameters of one contact of row p with effective mass meff (walls: m_i): η_n, η_t
+  /// (the radius does not enter).
   template <class S>
-  DEM_HD static ContactT<S> contact(const PairT<S>& p, S meff) {
+  DEM_HD static ContactT<S> contact(const PairT<S>& p, S meff, S /*reff*/) {
     const S etan = p.dampFactor * laneSqrt(p.kn * meff);
     return ContactT<S>{p.kn, p.kt, etan, p.etatFactor * etan, p.mu};
   }

@@ -37,8 +37,9 @@ namespace coredem::dem::kernels {
 /// One triangle of a mesh wall with its topology (ids unique over all meshes of a run).
 struct MeshTriangle {
   Vec3 a, b, c;
-  std::int32_t v[3]; ///< vertex ids of a, b, c
-  std::int32_t e[3]; ///< edge ids: e[0] = ab, e[1] = bc, e[2] = ca
+  std::int32_t v[3];          ///< vertex ids of a, b, c
+  std::int32_t e[3];          ///< edge ids: e[0] = ab, e[1] = bc, e[2] = ca
+  std::int32_t material = -1; ///< material index of the mesh; −1: the particle's own
 };
 
 /// Region of a triangle's closest point: kRegionFace, kRegionEdge + k (edge k), kRegionVertex + k.

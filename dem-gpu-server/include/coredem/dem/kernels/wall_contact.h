@@ -61,6 +61,7 @@ struct Wall {
   int points;                  ///< revolved: profile points, 2..kMaxProfilePoints
   int side;                    ///< revolved: +1, −1 or 0 (both sides), see the file comment
   int infinite;                ///< revolved: 1 = one infinite cylinder r = r[0]
+  int material = -1;           ///< material index of the wall; −1: the particle's own
 };
 
 /// A plane wall through `point` with inward normal `normal` (unit).
