@@ -2,6 +2,7 @@
 """Mutation fuzz of the input files `coredem check` reads (docs/security.md "Input files").
 
     bench/fuzz/inputs.py COREDEM [--per-kind N] [--seed S] [--timeout T] [--work DIR]
+                         [--kinds case,stl,polymesh,stages]
 
 Starts from valid inputs (cases/fluidized-bed-cooling with its blockMesh-generated polyMesh, a
 small ASCII and binary STL floor) and writes N mutants of each kind:
@@ -13,6 +14,7 @@ small ASCII and binary STL floor) and writes N mutants of each kind:
            triangle count set to huge values, truncated, numbers replaced;
   polymesh constant/polyMesh/{points,faces,owner,boundary} of walls.meshes[0].from_cfd: counts
            and numbers replaced, lines deleted, truncated;
+  stages   the `stages` list of a staged case (two stages) mutated as case.yaml is;
 
 plus fixed special files (a FIFO as the STL and as boundary, points linked to /dev/zero, a
 directory as the STL). Each mutant is checked with `COREDEM check` under a T-second timeout and a
@@ -140,6 +142,8 @@ def main():
     ap.add_argument("--seed", type=int, default=20261204)
     ap.add_argument("--timeout", type=float, default=20.0)
     ap.add_argument("--work", default=None)
+    ap.add_argument("--kinds", default="case,stl,polymesh,stages",
+                    help="comma-separated kinds to mutate (default: all)")
     a = ap.parse_args()
     rng = random.Random(a.seed)
     work = a.work or tempfile.mkdtemp(prefix="coredem-fuzz-inputs-")
@@ -187,6 +191,13 @@ def main():
             return d
         mutants.append(("polymesh", "polymesh-%d" % k, polymesh))
 
+    # Staged cases (case.yaml `stages`): the stage list mutated, each stage checked.
+    staged_case = case_text + (b"stages:\n  - {name: settle, time.end: 0.01, models.heat: 'off'}\n"
+                               b"  - name: blow\n    time.end: 0.02\n")
+    for k in range(a.per_kind):
+        mutants.append(("stages", "stages-%d" % k, lambda k=k: fresh(
+            "m", staged_case[:len(case_text)] + mutate_text(rng, staged_case[len(case_text):]))))
+
     def special(kind, what):
         def make():
             d = fresh("m", stl_case if kind == "stl" else cfd_case)
@@ -208,6 +219,8 @@ def main():
                        ("polymesh", "zero-points")):
         mutants.append((kind, what, special(kind, what)))
 
+    kinds = set(a.kinds.split(","))
+    mutants = [m for m in mutants if m[0] in kinds]
     counts = {}
     bad = []
     for kind, label, make in mutants:
@@ -223,7 +236,7 @@ def main():
         shutil.rmtree(d, ignore_errors=True)
     outcomes = ["accepted", "refused", "unnamed", "internal", "hang"]
     print("%-9s %6s " % ("kind", "total") + " ".join("%9s" % o for o in outcomes))
-    for kind in ("case", "stl", "polymesh"):
+    for kind in ("case", "stl", "polymesh", "stages"):
         c = counts.get(kind, {})
         print("%-9s %6d " % (kind, sum(c.values())) + " ".join("%9d" % c.get(o, 0)
                                                              for o in outcomes))

@@ -100,6 +100,13 @@ std::vector<Stage> readStages(const fs::path& file) {
     throw CaseError(at(file, list.Mark(), "stages",
                        "expected a list of stages, each {name: ..., <dotted key>: value, ...}"));
   }
+  // The case without `stages`: each stage's values are tried on it here, so that a key path
+  // that does not fit the case is refused with its line.
+  YAML::Node base = YAML::Clone(root);
+  base.remove("stages");
+  YAML::Emitter emitted;
+  emitted << base;
+  const std::string baseText = std::string(emitted.c_str()) + "\n";
   const std::regex nameRule("[A-Za-z0-9_-]{1,64}");
   std::set<std::string> names;
   for (std::size_t i = 0; i < list.size(); ++i) {
@@ -117,6 +124,10 @@ std::vector<Stage> readStages(const fs::path& file) {
              fmt::format("'{}': stage names are unique, 1-64 letters, digits, _ or -", st.name)));
     }
     for (const auto& kv : s) {
+      if (!kv.first.IsScalar()) {
+        throw CaseError(at(file, kv.first.Mark(), key,
+                           "expected dotted keys (e.g. time.end: 0.5) besides name"));
+      }
       const std::string k = kv.first.as<std::string>();
       if (k == "name") {
         continue;
@@ -128,6 +139,11 @@ std::vector<Stage> readStages(const fs::path& file) {
                                            "particles; only the first stage may set them"));
       }
       st.values.emplace_back(k, flow(kv.second));
+      try {
+        setCaseKey(baseText, k, st.values.back().second);
+      } catch (const CaseError& e) {
+        throw CaseError(at(file, kv.first.Mark(), key + "." + k, e.what()));
+      }
     }
     stages.push_back(std::move(st));
   }
