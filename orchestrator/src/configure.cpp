@@ -26,6 +26,27 @@ v1::Vec3 vec(const Vec3& v) {
   return out;
 }
 
+/// Configure.options: the `models:` choices by name, and the server's own options: the coupling
+/// scheme (sequential sends nothing: its Configure stays as before) and, for a case.yaml
+/// `initial_state`, a new start from another run's particles (protocol/initial_state.h).
+void addOptions(const CaseConfig& c, v1::Configure& cfg) {
+  const auto add = [&](std::string key, std::string value) {
+    auto* kv = cfg.add_options();
+    kv->set_key(std::move(key));
+    kv->set_value(std::move(value));
+  };
+  for (const auto& [k, v] : c.models) {
+    add(k, v);
+  }
+  if (c.coupling.staggered()) {
+    add(std::string(protocol::fields::kCouplingSchemeOption), "staggered");
+  }
+  if (!c.initialState.empty()) {
+    add(std::string(protocol::fields::kInitialStateOption),
+        std::string(protocol::fields::kInitialStateStart));
+  }
+}
+
 } // namespace
 
 v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double dtCfd,
@@ -158,25 +179,12 @@ v1::Configure buildConfigure(const CaseConfig& c, const fs::path& runDir, double
   walls->set_temperature(c.walls.temperature);
   *cfg.mutable_gravity() = vec(c.gravity);
   if (!c.initialState.empty()) {
-    // A new start from another run's particles (any configuration; protocol/initial_state.h).
     cfg.set_initial_state_file(c.initialState.string());
-    auto* kv = cfg.add_options();
-    kv->set_key(std::string(protocol::fields::kInitialStateOption));
-    kv->set_value(std::string(protocol::fields::kInitialStateStart));
   }
   cfg.mutable_sub_cycling()->set_dt_cfd(dtCfd);
   cfg.mutable_sub_cycling()->set_n_sub(std::uint32_t(plan.nSub));
   cfg.mutable_sub_cycling()->set_dt_dem(plan.dtDem);
-  for (const auto& [k, v] : c.models) {
-    auto* kv = cfg.add_options();
-    kv->set_key(k);
-    kv->set_value(v);
-  }
-  if (c.coupling.staggered()) { // sequential sends nothing: its Configure stays as before
-    auto* kv = cfg.add_options();
-    kv->set_key(std::string(protocol::fields::kCouplingSchemeOption));
-    kv->set_value("staggered");
-  }
+  addOptions(c, cfg);
   cfg.set_output_directory(fs::absolute(runDir).string());
   addChemistryToConfigure(c, cfg); // v1.1: solid species, reactions, chemistry
   return cfg;
