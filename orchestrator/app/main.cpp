@@ -36,20 +36,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// The case file of a CASE_DIR argument (a folder with case.yaml, or a case file).
-fs::path caseFileOf(const std::string& caseDir) {
-  fs::path file = caseDir;
-  if (fs::is_directory(file)) {
-    file /= "case.yaml";
-  }
-  return file;
-}
-
-std::string readAll(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 /// Whether `file` is a staged case (case.yaml `stages`; a missing file is left to loadCase).
 bool isStaged(const fs::path& file) {
   return fs::is_regular_file(file) && !readStages(file).empty();
@@ -379,9 +365,7 @@ int runOrResume(const CommandLine& c, const std::shared_ptr<spdlog::logger>& log
       runDir = fs::absolute(c.runDir);
     } else {
       checkStages(given, checkParticipantInput); // every stage before anything is written
-      const CaseConfig first = parseCase(
-          stageCaseText(readAll(given), fs::absolute(given).parent_path(), stages, 0, false), given,
-          fs::absolute(given).parent_path());
+      const CaseConfig first = firstStageCase(given);
       runDir = fs::absolute(
           chooseRunDir(first.name, c.out.empty() ? std::nullopt : std::optional<fs::path>(c.out)));
       log->info("run folder {} ({} stages)", runDir.string(), stages.size());

@@ -111,11 +111,12 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
   return c;
 }
 
+fs::path caseFileOf(const fs::path& caseDirOrFile) {
+  return fs::is_directory(caseDirOrFile) ? caseDirOrFile / "case.yaml" : caseDirOrFile;
+}
+
 CaseConfig loadCase(const fs::path& caseDirOrFile) {
-  fs::path file = caseDirOrFile;
-  if (fs::is_directory(file)) {
-    file /= "case.yaml";
-  }
+  const fs::path file = caseFileOf(caseDirOrFile);
   if (!fs::is_regular_file(file)) {
     throw CaseError(fmt::format("{}: case file not found; give a case folder that contains "
                                 "case.yaml (or the path of a case file)",

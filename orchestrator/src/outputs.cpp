@@ -18,9 +18,8 @@
 namespace fs = std::filesystem;
 
 namespace coredem::orchestrator {
-namespace {
 
-std::vector<std::string> splitCsv(const std::string& line) {
+std::vector<std::string> csvFields(const std::string& line) {
   std::vector<std::string> out;
   std::string cur;
   for (char c : line) {
@@ -35,8 +34,6 @@ std::vector<std::string> splitCsv(const std::string& line) {
   return out;
 }
 
-} // namespace
-
 TimeseriesWriter::TimeseriesWriter(fs::path path, std::int64_t resumeAfterStep)
     : _path(std::move(path)) {
   if (resumeAfterStep >= 0 && fs::is_regular_file(_path)) {
@@ -47,7 +44,7 @@ TimeseriesWriter::TimeseriesWriter(fs::path path, std::int64_t resumeAfterStep)
     bool header = true;
     while (std::getline(in, line)) {
       if (header) {
-        _columns = splitCsv(line);
+        _columns = csvFields(line);
         kept += line + "\n";
         header = false;
         continue;
@@ -55,7 +52,7 @@ TimeseriesWriter::TimeseriesWriter(fs::path path, std::int64_t resumeAfterStep)
       if (line.empty()) {
         continue;
       }
-      const auto cells = splitCsv(line);
+      const auto cells = csvFields(line);
       if (cells.size() != _columns.size()) {
         break; // a torn last line from a crash
       }

@@ -16,6 +16,7 @@
 
 #include "coredem/orchestrator/campaign.h"
 #include "coredem/orchestrator/case_config.h"
+#include "coredem/orchestrator/stats.h"
 
 namespace fs = std::filesystem;
 
@@ -51,26 +52,13 @@ bool namesParticles(const std::string& key) {
   return key.rfind("particles", 0) == 0 || key.rfind("initial_state", 0) == 0;
 }
 
-/// The last t of a run folder's timeseries.csv (-1: none).
+/// The last t of a run folder's timeseries.csv (-1: none yet).
 double lastTime(const fs::path& runDir) {
-  std::ifstream in(runDir / "timeseries.csv");
-  std::string header, line, last;
-  if (!std::getline(in, header)) {
-    return -1;
+  try {
+    return timeseriesStats(runDir, {}).runEnd;
+  } catch (const UserError&) {
+    return -1; // no rows: the stage stopped before its first step
   }
-  while (std::getline(in, line)) {
-    if (!line.empty()) {
-      last = line;
-    }
-  }
-  std::istringstream h(header), v(last);
-  std::string name, value;
-  while (std::getline(h, name, ',') && std::getline(v, value, ',')) {
-    if (name == "t") {
-      return value.empty() ? -1 : std::stod(value);
-    }
-  }
-  return -1;
 }
 
 /// The stage's case folder: its case.yaml and links to the case folder's other entries (the CFD
@@ -177,6 +165,12 @@ std::string stageCaseText(const std::string& text, const fs::path& caseDir,
   return fmt::format("# stage {} of {} ('{}') of a staged case, written by coredem\n", i + 1,
                      stages.size(), stages[i].name) +
          out;
+}
+
+CaseConfig firstStageCase(const fs::path& file) {
+  const fs::path caseDir = fs::absolute(file).parent_path();
+  return parseCase(stageCaseText(readText(file), caseDir, readStages(file), 0, false), file,
+                   caseDir);
 }
 
 void checkStages(const fs::path& file, const std::function<void(const CaseConfig&)>& check) {

@@ -12,6 +12,7 @@
 #include <coredem/common/hdf5.h>
 #include <coredem/common/json.h>
 #include <coredem/dem/kernels/pcm.h>
+#include <coredem/orchestrator/outputs.h>
 #include <coredem/orchestrator/stats.h>
 
 namespace fs = std::filesystem;
@@ -20,21 +21,6 @@ namespace coredem::orchestrator {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-std::vector<std::string> splitLine(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cur;
-  for (char c : line) {
-    if (c == ',') {
-      out.push_back(cur);
-      cur.clear();
-    } else if (c != '\r') {
-      cur += c;
-    }
-  }
-  out.push_back(cur);
-  return out;
-}
 
 /// A cell of a CSV row as a number; NaN when empty or not a number.
 double numberOf(const std::string& text) {
@@ -61,12 +47,12 @@ Table readTable(const fs::path& file) {
   std::string line;
   COREDEM_CHECK(std::getline(in, line) && !line.empty(),
                 "{}: empty file: the run has not finished a step yet", file.string());
-  t.columns = splitLine(line);
+  t.columns = csvFields(line);
   while (std::getline(in, line)) {
     if (line.empty()) {
       continue;
     }
-    const auto cells = splitLine(line);
+    const auto cells = csvFields(line);
     if (cells.size() != t.columns.size()) {
       continue; // a torn last line of a crashed run
     }
@@ -222,7 +208,7 @@ std::vector<SnapshotRef> snapshotsOf(const fs::path& runDir) {
     return out;
   }
   while (std::getline(in, line)) {
-    const auto cells = splitLine(line);
+    const auto cells = csvFields(line);
     if (cells.size() >= 3 && !cells[2].empty()) {
       out.push_back({std::stoll(cells[0]), numberOf(cells[1]), cells[2]});
     }

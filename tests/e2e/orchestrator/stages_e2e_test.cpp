@@ -22,21 +22,13 @@ const fs::path kBin = COREDEM_BIN_DIR;
 const fs::path kCases = COREDEM_E2E_CASES;
 
 using coredem::e2e::datasetsOf;
+using coredem::e2e::lastSnapshot;
 using coredem::e2e::readAll;
 using coredem::e2e::replaceAll;
 using coredem::e2e::writeAll;
 
 int runCoredem(const std::vector<std::string>& args, const fs::path& log) {
   return coredem::e2e::waitExit(coredem::e2e::startProgram(kBin / "coredem", args, log), 120s);
-}
-
-/// The last file of a run's snapshots/index.csv.
-fs::path lastSnapshot(const fs::path& run) {
-  const std::string index = readAll(run / "snapshots" / "index.csv");
-  const auto end = index.find_last_not_of('\n');
-  const auto start = index.rfind('\n', end);
-  const std::string line = index.substr(start + 1, end - start);
-  return run / line.substr(line.rfind(',') + 1);
 }
 
 /// The restart case (64 beads in a box, prescribed gas) with two stages.

@@ -65,6 +65,15 @@ inline std::map<std::string, std::vector<double>> readTimeseries(const fs::path&
   return out;
 }
 
+/// The file of the last line of a run's snapshots/index.csv (the run's end).
+inline fs::path lastSnapshot(const fs::path& runDir) {
+  const std::string index = readAll(runDir / "snapshots" / "index.csv");
+  const auto end = index.find_last_not_of('\n');
+  const auto start = index.rfind('\n', end);
+  const std::string line = index.substr(start + 1, end - start);
+  return runDir / line.substr(line.rfind(',') + 1);
+}
+
 inline void writeAll(const fs::path& p, const std::string& text) {
   std::ofstream out(p, std::ios::binary);
   out << text;

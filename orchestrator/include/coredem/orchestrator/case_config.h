@@ -266,6 +266,8 @@ struct CaseConfig {
 
 /// Loads and validates CASE_DIR/case.yaml (or a file path). Throws CaseError.
 CaseConfig loadCase(const std::filesystem::path& caseDirOrFile);
+/// The case file of a case folder (its case.yaml) or of a case file (itself).
+std::filesystem::path caseFileOf(const std::filesystem::path& caseDirOrFile);
 
 /// Parses case text as if read from `file` (relative paths resolve against `caseDir`).
 CaseConfig parseCase(const std::string& text, const std::filesystem::path& file,

@@ -47,6 +47,10 @@ struct AttributeInfo {
   std::string value; ///< as text
 };
 
+/// The comma-separated fields of one line of the run's CSV files (timeseries.csv, outputs.csv:
+/// no quoting), a trailing '\r' dropped; an empty line is one empty field.
+std::vector<std::string> csvFields(const std::string& line);
+
 /// Every dataset (recursively) and attribute of an HDF5 file, with statistics.
 /// Throws UserError if the file cannot be opened as HDF5.
 void scanHdf5(const std::filesystem::path& file, std::vector<DatasetInfo>& datasets,

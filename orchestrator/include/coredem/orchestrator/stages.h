@@ -44,6 +44,9 @@ std::string stageCaseText(const std::string& text, const std::filesystem::path& 
 /// The folder name of stage i: "01-settle".
 std::string stageFolder(const std::vector<Stage>& stages, std::size_t i);
 
+/// The first stage's case of the staged case `file` (its name names the run folder).
+CaseConfig firstStageCase(const std::filesystem::path& file);
+
 /// `coredem check` of a staged case: every stage's case is loaded and checked (`check`), the
 /// later stages with the case's own particles (their start does not exist yet).
 void checkStages(const std::filesystem::path& file,
