@@ -7,18 +7,24 @@ Reads each run's timeseries.csv and writes to DIR (default docs/img/validation):
   patil_temperature.png  mean particle temperature (°C) vs time for every run, the seed's
                          reported trends (90 − 3.0 t °C for 75 g, 90 − 2.5 t °C for 125 g,
                          ±3 °C) and the adiabatic energy-balance bound
-                         T̄ = T_in + (T0 − T_in) exp(−t/τ), τ = M c_p,p / (ρ_g U A c_p,g)
-                         of each run's inventory and cross-section
+                         M c_p,p dT̄/dt = −ṁ_g (h_g(T̄) − h_g(T_in)) (the gas leaves at the
+                         mean bed temperature), ṁ_g = ρ_g,in U A, of each run's inventory and
+                         cross-section; with a constant-property gas h_g = c_p,g (T − T_in) and
+                         T̄ = T_in + (T0 − T_in) exp(−t/τ), τ = M c_p,p / (ρ_g U A c_p,g); with the
+                         ideal gas h_g is the NASA-7 enthalpy and ρ_g,in = p M/(R T_in) of the
+                         run's own constant/thermophysicalProperties (p: pRef plus the run's
+                         mean gas.pressure_drop_Pa, the inlet's absolute pressure), and τ is
+                         the initial time constant M c_p,p (T0 − T_in) / (ṁ_g (h_g(T0) − h_g(T_in))))
   patil_ledger.png       energy-ledger closure of every run: particle side
                          |ΔΣ m c T − (Q_gas + Q_rad + Q_wall)| and gas side
                          |balance.heat_residual_J| relative to the heat removed
 The run label must start with the inventory ('75g' or '125g'); the cross-section A is read from
-the run's case file (walls.box, x and z extents) and U, T_in, ρ_g, c_p,g from it as well.
+the run's case file (walls.box, x and z extents), U from the run's openfoam/0/U, T_in and (constant
+gas) ρ_g, c_p,g from its case file.
 --summary writes a Markdown table of the end values (mean T, bound, ledger residuals).
 Interpreter: COREDEM_PYTHON (/usr/bin/python3 with numpy, matplotlib, yaml-free parsing).
 """
 import argparse
-import math
 import os
 import re
 import sys
@@ -51,15 +57,65 @@ def case_numbers(run_dir):
 
     def gas(key):
         m = re.search(r"gas_properties:.*?\n\s+" + key + r":\s*([0-9.eE+-]+)", text, re.S)
-        return float(m.group(1))
+        return float(m.group(1)) if m else None
 
     u = None
     ufile = os.path.join(run_dir, "openfoam", "0", "U")
     if os.path.exists(ufile):
         m = re.search(r"inlet\s*\{[^}]*uniform \(0 ([0-9.eE+-]+) 0\)", open(ufile).read())
         u = float(m.group(1)) if m else None
-    return {"area": area, "u": u if u is not None else 1.54, "rho": gas("density"),
-            "cpg": gas("cp"), "tin": gas("temperature")}
+    out = {"area": area, "u": u if u is not None else 1.54, "tin": gas("temperature")}
+    thermo = os.path.join(run_dir, "openfoam", "constant", "thermophysicalProperties")
+    if re.search(r"gas_properties:[^\n]*\n(\s+[^\n]*\n)*?\s+model:\s*ideal_gas", text) and \
+            os.path.exists(thermo):
+        out.update(ideal_gas_numbers(open(thermo).read(), thermo))
+    else:
+        cp, rho = gas("cp"), gas("density")
+        out.update({"rho": rho, "h": lambda T: cp * T})
+    return out
+
+
+def ideal_gas_numbers(text, path):
+    """Molar mass, pRef and the sensible enthalpy h(T) [J/kg] of the run's one-species ideal gas."""
+    species = re.search(r"species\s*\(\s*(\w+)\s*\)", text)
+    if species is None:
+        raise SystemExit(f"{path}: the Patil plots expect a gas of one species (air)")
+    mw = float(re.search(r"molWeight\s+([0-9.eE+-]+)", text).group(1)) * 1e-3
+    tcommon = float(re.search(r"Tcommon\s+([0-9.eE+-]+)", text).group(1))
+    lo = [float(v) for v in re.search(r"lowCpCoeffs\s*\(([^)]*)\)", text).group(1).split()]
+    hi = [float(v) for v in re.search(r"highCpCoeffs\s*\(([^)]*)\)", text).group(1).split()]
+    pref = float(re.search(r"pRef\s+([0-9.eE+-]+)", text).group(1))
+    r_gas = 8.314462618  # J/mol/K
+
+    def h(T):
+        a = lo if T <= tcommon else hi
+        return r_gas / mw * T * (a[0] + T * (a[1] / 2 + T * (a[2] / 3 + T * (a[3] / 4 + T * a[4] / 5))) +
+                                 a[5] / T)
+
+    return {"h": h, "molar_mass": mw, "p_ref": pref, "rho": None}
+
+
+def adiabatic_bound(cn, mass, tt, p_in):
+    """Mean bead temperature [°C] on tt of the energy balance with the gas leaving at T̄, and τ."""
+    tin = cn["tin"]
+    rho = cn["rho"] if cn["rho"] is not None else p_in * cn["molar_mass"] / (8.314462618 * tin)
+    mdot = rho * cn["u"] * cn["area"]
+    capacity = mass * CP_P
+
+    def rate(T):
+        return -mdot * (cn["h"](T) - cn["h"](tin)) / capacity
+
+    T, out = T0_C + 273.15, [T0_C]
+    for t0, t1 in zip(tt[:-1], tt[1:]):  # RK4, 200 steps of at most 0.05 s: τ ≥ 20 s here
+        dt = t1 - t0
+        k1 = rate(T)
+        k2 = rate(T + 0.5 * dt * k1)
+        k3 = rate(T + 0.5 * dt * k2)
+        k4 = rate(T + dt * k3)
+        T += dt * (k1 + 2 * k2 + 2 * k3 + k4) / 6
+        out.append(T - 273.15)
+    tau = capacity * (T0_C + 273.15 - tin) / (mdot * (cn["h"](T0_C + 273.15) - cn["h"](tin)))
+    return np.array(out), tau
 
 
 def main():
@@ -93,8 +149,9 @@ def main():
         tp = np.concatenate([[T0_C], ts["mean_T_p"] - 273.15])
         ax.plot(t, tp, color=colors[inv], ls="--" if cold else "-", lw=1.5, label=label)
         mass = ts["dem.particle_mass_kg"][-1]
-        tau = mass * CP_P / (cn["rho"] * cn["u"] * cn["area"] * cn["cpg"])
-        bound = cn["tin"] - 273.15 + (T0_C - (cn["tin"] - 273.15)) * np.exp(-tt / tau)
+        p_in = cn.get("p_ref", 0.0) + float(np.mean(ts["gas.pressure_drop_Pa"]))
+        bound, tau = adiabatic_bound(cn, mass, tt, p_in)
+        bound_end, _ = adiabatic_bound(cn, mass, np.linspace(0.0, ts["t"][-1], 201), p_in)
         ax.plot(tt, bound, color=colors[inv], ls=":", lw=1,
                 label=f"adiabatic bound {label} (τ = {tau:.1f} s)" if not cold else None)
         # Ledger: particle side (E0 = M c_p T0 exactly: all beads start at 363.15 K).
@@ -106,7 +163,7 @@ def main():
                      "part_res": np.abs(dE - q), "gas_res": np.abs(ts["balance.heat_residual_J"]),
                      "wall": ts.get("dem.heat_wall_J", 0 * ts["t"]), "gasq": ts["dem.heat_from_gas_J"],
                      "tend": ts["t"][-1], "Tend": ts["mean_T_p"][-1] - 273.15,
-                     "bound_end": cn["tin"] - 273.15 + (T0_C - cn["tin"] + 273.15) * math.exp(-ts["t"][-1] / tau),
+                     "bound_end": bound_end[-1],
                      "seed_end": T0_C - SEED[inv] * ts["t"][-1], "tau": tau, "e0": e0,
                      # wall seconds per simulated second over the sampled rows
                      "wall_s": float(np.nansum(ts["wall_step_s"]) / np.nansum(ts["dt"]))})
