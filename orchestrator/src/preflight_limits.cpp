@@ -114,9 +114,9 @@ struct GasRange {
   double GasRanges::*hi;
   const char* unit;
 };
-// (T_g is warned about below 200 K by warnPrescribedGasTemperature, not refused here yet: the
-// campaign e2e tests use a member with T_g = -5 K that must fail at its start.)
 constexpr GasRange kGasRanges[] = {
+    {"T_g", "temperature", &GasPropertiesConfig::temperature, &GasRanges::temperatureMin,
+     &GasRanges::temperatureMax, "K"},
     {"rho_g", "density", &GasPropertiesConfig::density, &GasRanges::densityMin,
      &GasRanges::densityMax, "kg/m3"},
     {"mu_g", "viscosity", &GasPropertiesConfig::viscosity, &GasRanges::viscosityMin,

@@ -282,18 +282,34 @@ walls:)");
 }
 
 TEST(Preflight, CelsiusTemperaturesWarn) {
+  // Between the DEM's lower bound (100 K) and 200 K: plausible °C, warned about.
   std::string t = replace(kCase, "temperature: 300.0", "temperature: 90.0");
-  t = replace(t, "T_g: 500.0", "T_g: 20.0");
-  t = replace(t, "walls:\n", "gas_properties: {temperature: 20}\nwalls:\n");
+  t = replace(t, "T_g: 500.0", "T_g: 150.0");
+  t = replace(t, "walls:\n", "gas_properties: {temperature: 150}\nwalls:\n");
   const auto w = checkCaseConsistency(parse(t));
   ASSERT_EQ(w.size(), 3u);
   EXPECT_TRUE(contains(w[0], "case.yaml:10:18: particles[0].temperature: 90 K is below 200 K: "
                              "°C given?"))
       << w[0];
-  EXPECT_TRUE(contains(w[1], "gas_properties.temperature: 20 K")) << w[1];
-  EXPECT_TRUE(contains(w[2], "gas.T_g: 20 K")) << w[2];
+  EXPECT_TRUE(contains(w[1], "gas_properties.temperature: 150 K")) << w[1];
+  EXPECT_TRUE(contains(w[2], "gas.T_g: 150 K")) << w[2];
   // Warnings, not failures.
   EXPECT_EQ(failureOf(t), "");
+}
+
+TEST(Preflight, GasTemperatureOutsideTheDemRangeIsRefused) {
+  // The DEM server refuses a gas state below 100 K at the first exchange (common/limits.h);
+  // coredem-gas refused T_g = -5 K when the member started: check refuses both now.
+  const std::string prescribed = failureOf(replace(kCase, "T_g: 500.0", "T_g: -5.0"));
+  EXPECT_TRUE(contains(prescribed, "gas.T_g: -5 K is outside [100, 6000] K")) << prescribed;
+  const std::string table =
+      failureOf(replace(kCase, "T_g: 500.0", "T_g: {table: [[0, 300], [1, 20]]}"));
+  EXPECT_TRUE(contains(table, "20 K is outside [100, 6000] K")) << table;
+  const std::string constant = failureOf(
+      replace(kCase, "walls:\n", "gas_properties: {model: constant, temperature: 20}\nwalls:\n"));
+  EXPECT_TRUE(contains(constant, "gas_properties.temperature: 20 K is outside [100, 6000] K"))
+      << constant;
+  EXPECT_EQ(failureOf(replace(kCase, "T_g: 500.0", "T_g: 100.0")), "");
 }
 
 // ------------------------------------------------------------------ the OpenFOAM participant
