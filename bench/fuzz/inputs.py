@@ -2,7 +2,7 @@
 """Mutation fuzz of the input files `coredem check` reads (docs/security.md "Input files").
 
     bench/fuzz/inputs.py COREDEM [--per-kind N] [--seed S] [--timeout T] [--work DIR]
-                         [--kinds case,stl,polymesh,stages]
+                         [--kinds case,stl,polymesh,stages,sweep]
 
 Starts from valid inputs (cases/fluidized-bed-cooling with its blockMesh-generated polyMesh, a
 small ASCII and binary STL floor) and writes N mutants of each kind:
@@ -15,6 +15,9 @@ small ASCII and binary STL floor) and writes N mutants of each kind:
   polymesh constant/polyMesh/{points,faces,owner,boundary} of walls.meshes[0].from_cfd: counts
            and numbers replaced, lines deleted, truncated;
   stages   the `stages` list of a staged case (two stages) mutated as case.yaml is;
+  sweep    a campaign sweep file (grid and explicit members, collect windows) mutated as
+           case.yaml is, checked with `COREDEM check SWEEP` (every member pre-flighted, as
+           `coredem campaign run` does before launching anything);
 
 plus fixed special files (a FIFO as the STL and as boundary, points linked to /dev/zero, a
 directory as the STL). Each mutant is checked with `COREDEM check` under a T-second timeout and a
@@ -121,8 +124,10 @@ def limit_memory():
 
 
 def check(coredem, case_dir, timeout):
+    sweep = os.path.join(case_dir, "sweep.yaml")
+    target = sweep if os.path.exists(sweep) else case_dir
     try:
-        r = subprocess.run([coredem, "check", case_dir], capture_output=True, timeout=timeout,
+        r = subprocess.run([coredem, "check", target], capture_output=True, timeout=timeout,
                            preexec_fn=limit_memory)
     except subprocess.TimeoutExpired:
         return "hang", ""
@@ -142,7 +147,7 @@ def main():
     ap.add_argument("--seed", type=int, default=20261204)
     ap.add_argument("--timeout", type=float, default=20.0)
     ap.add_argument("--work", default=None)
-    ap.add_argument("--kinds", default="case,stl,polymesh,stages",
+    ap.add_argument("--kinds", default="case,stl,polymesh,stages,sweep",
                     help="comma-separated kinds to mutate (default: all)")
     a = ap.parse_args()
     rng = random.Random(a.seed)
@@ -198,6 +203,17 @@ def main():
         mutants.append(("stages", "stages-%d" % k, lambda k=k: fresh(
             "m", staged_case[:len(case_text)] + mutate_text(rng, staged_case[len(case_text):]))))
 
+    # Campaign sweeps over the base case (docs/campaigns.md): grid, explicit members, collect.
+    sweep_text = (b"name: fuzz\nbase_case: .\nconcurrency: 2\nretries: 1\ngrid:\n"
+                  b"  time.end: [0.01, 0.02]\n  particles[0].diameter: [1.0e-3, 1.2e-3]\n"
+                  b"collect:\n  scalars: [mean@0.005..:mean_T_p, {max: bed_height_m, from: 0.005, to: 0.02}]\n")
+    for k in range(a.per_kind):
+        def sweep(k=k):
+            d = fresh("m", case_text)
+            open(os.path.join(d, "sweep.yaml"), "wb").write(mutate_text(rng, sweep_text))
+            return d
+        mutants.append(("sweep", "sweep-%d" % k, sweep))
+
     def special(kind, what):
         def make():
             d = fresh("m", stl_case if kind == "stl" else cfd_case)
@@ -236,7 +252,7 @@ def main():
         shutil.rmtree(d, ignore_errors=True)
     outcomes = ["accepted", "refused", "unnamed", "internal", "hang"]
     print("%-9s %6s " % ("kind", "total") + " ".join("%9s" % o for o in outcomes))
-    for kind in ("case", "stl", "polymesh", "stages"):
+    for kind in ("case", "stl", "polymesh", "stages", "sweep"):
         c = counts.get(kind, {})
         print("%-9s %6d " % (kind, sum(c.values())) + " ".join("%9d" % c.get(o, 0)
                                                              for o in outcomes))

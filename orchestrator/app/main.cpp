@@ -41,6 +41,22 @@ bool isStaged(const fs::path& file) {
   return fs::is_regular_file(file) && !readStages(file).empty();
 }
 
+/// A campaign sweep file (docs/campaigns.md: a top-level `base_case:` key), not a case file.
+bool isSweepFile(const fs::path& file) {
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec) || fs::file_size(file, ec) > (std::uintmax_t{64} << 20)) {
+    return false; // the case reader names what is wrong with it
+  }
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("base_case", 0) == 0) {
+      const auto colon = line.find_first_not_of(" \t", 9);
+      return colon != std::string::npos && line[colon] == ':';
+    }
+  }
+  return false;
+}
+
 /// Runs scripts/plot/plot_run.py with the Python that CMake found (COREDEM_PYTHON); a failure
 /// is a warning, never an error of the run.
 void makePlots(const fs::path& runDir, bool interrupted) {
@@ -279,8 +295,11 @@ void addToolCommands(CLI::App& app, CommandLine& c) {
   c.stats->add_flag("--no-fields", c.statsNoFields,
                     "only the timeseries statistics (no averaged fields from the snapshots)");
 
-  c.check = app.add_subcommand("check", "validate a case file and exit (0 valid, 2 invalid)");
-  c.check->add_option("CASE_DIR", c.caseDir, "case folder with case.yaml (or a case file)")
+  c.check = app.add_subcommand(
+      "check", "validate a case file or a campaign sweep file and exit (0 valid, 2 invalid)");
+  c.check
+      ->add_option("CASE_DIR", c.caseDir,
+                   "case folder with case.yaml (or a case file, or a sweep file: every member)")
       ->required();
 }
 
@@ -436,6 +455,13 @@ int main(int argc, char** argv) {
       return runVerify(cmd.verifyOpts);
     }
     if (*cmd.check) {
+      if (const fs::path file = caseFileOf(cmd.caseDir); isSweepFile(file)) {
+        // what `campaign run` refuses before launching anything: every member pre-flighted
+        const Sweep sw = loadSweep(file);
+        std::cout << file.string() << ": valid sweep (" << sw.members.size() << " members of "
+                  << sw.baseCase.string() << ")\n";
+        return kExitOk;
+      }
       if (const fs::path file = caseFileOf(cmd.caseDir); isStaged(file)) {
         checkStages(file, checkParticipantInput);
         std::cout << file.string() << ": valid (" << readStages(file).size() << " stages)\n";

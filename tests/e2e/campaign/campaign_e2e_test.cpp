@@ -447,6 +447,8 @@ TEST(CampaignE2E, MalformedSweepIsRefusedNamingTheKey) {
        "executor: unknown executor 'pbs'; allowed: local, slurm"},
       {"base_case: tiny\ngrid: {gas.T_g: [1]}\ncollect: {scalars: [median:mean_T_p]}\n",
        "collect.scalars"},
+      {"base_case: tiny\ngrid: {gas.T_g: [400, -5.0]}\n",
+       "members/m001/case/case.yaml:30:8: gas.T_g: -5 K is outside [100, 6000] K"},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     { std::ofstream(d / "bad.yaml") << cases[i].body; }
@@ -458,7 +460,17 @@ TEST(CampaignE2E, MalformedSweepIsRefusedNamingTheKey) {
     EXPECT_NE(readAll(log).find(cases[i].expect), std::string::npos)
         << "expected '" << cases[i].expect << "' in: " << readAll(log);
     EXPECT_FALSE(fs::exists(out)) << "something was written for: " << cases[i].body;
+    // `coredem check SWEEP` refuses what `campaign run` refuses, with the same message
+    const fs::path checkLog = d / ("check" + std::to_string(i));
+    EXPECT_EQ(runCoredem({"check", (d / "bad.yaml").string()}, checkLog), 2) << cases[i].body;
+    EXPECT_NE(readAll(checkLog).find(cases[i].expect), std::string::npos)
+        << "expected '" << cases[i].expect << "' in: " << readAll(checkLog);
   }
+  { std::ofstream(d / "good.yaml") << "base_case: tiny\ngrid: {gas.T_g: [400, 500]}\n"; }
+  EXPECT_EQ(runCoredem({"check", (d / "good.yaml").string()}, d / "good.txt"), 0);
+  EXPECT_NE(readAll(d / "good.txt").find("good.yaml: valid sweep (2 members of "),
+            std::string::npos)
+      << readAll(d / "good.txt");
   if (!HasFailure()) {
     fs::remove_all(d);
   }
