@@ -96,7 +96,11 @@ TEST(CampaignSweep, GridExpandsWithTheFirstKeySlowest) {
 TEST(CampaignSweep, ExplicitMembers) {
   const Sweep sw = loadSweep(kCases / "failing.yaml");
   ASSERT_EQ(sw.members.size(), 4u);
-  EXPECT_EQ(sw.members[2].values.at(0).second, "-5.0");
+  ASSERT_EQ(sw.members[2].values.size(), 2u);
+  EXPECT_EQ(sw.members[2].values.at(0).first, "gas.T_g");
+  EXPECT_EQ(sw.members[2].values.at(0).second, "500.0");
+  EXPECT_EQ(sw.members[2].values.at(1).first, "gas.u_g[2]");
+  EXPECT_EQ(sw.members[2].values.at(1).second, "-30.0");
   EXPECT_EQ(sw.retries, 2);
   EXPECT_EQ(sw.scalars.at(0).column, "mean_T_p"); // default result
 }
