@@ -58,7 +58,8 @@ void fail(const std::string& file, const YAML::Mark& mark, const std::string& ke
 }
 
 void checkUniqueKeys(const YAML::Node& node, const std::string& file) {
-  // Iteratively (a deeply nested file must not exhaust the stack): every mapping's scalar keys.
+  // Iteratively (a deeply nested file must not exhaust the stack): every mapping's keys are
+  // plain names (a complex '? [a, b]' key would reach the readers as a list) and unique.
   std::vector<YAML::Node> todo{node};
   while (!todo.empty()) {
     const YAML::Node n = todo.back();
@@ -70,6 +71,12 @@ void checkUniqueKeys(const YAML::Node& node, const std::string& file) {
     } else if (n.IsMap()) {
       std::vector<std::pair<std::string, YAML::Mark>> seen;
       for (const auto& kv : n) {
+        if (!kv.first.IsScalar() && !kv.first.IsNull()) {
+          fail(file, kv.first.Mark(), "key",
+               fmt::format("a key must be a plain name, got {} (a '? ' complex key); write "
+                           "'name: value'",
+                           describe(kv.first)));
+        }
         if (kv.first.IsScalar()) {
           const std::string& key = kv.first.Scalar();
           for (const auto& [k, mark] : seen) {

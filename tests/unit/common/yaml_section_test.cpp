@@ -109,3 +109,23 @@ TEST(YamlSection, DuplicateKeysAndASecondDocumentAreRefused) {
             "one document and the rest would be ignored; remove the '---' separator or the "
             "second document");
 }
+
+// A complex key ('? [a, b]' or '? name: x') reaches a reader as a list or mapping where it expects
+// a name (found by the sweep fuzz: "internal error: yaml-cpp: bad conversion"); refused at parse.
+TEST(YamlSection, AKeyThatIsNotAPlainNameIsRefused) {
+  auto error = [](const std::string& text) -> std::string {
+    try {
+      (void)coredem::yaml::parse(text, "key.yaml");
+    } catch (const coredem::ConfigError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(error("? name: fuzz\nbase_case: .\n"),
+            "key.yaml:1:3: key: a key must be a plain name, got a mapping (a '? ' complex key); "
+            "write 'name: value'");
+  EXPECT_EQ(error("a:\n  ? [x, y]\n  : 1\n"),
+            "key.yaml:2:5: key: a key must be a plain name, got a list (a '? ' complex key); "
+            "write 'name: value'");
+  EXPECT_EQ(error("? plain\n: 1\n"), ""); // an explicit key that is a name is a name
+}

@@ -37,9 +37,11 @@ std::string describe(const YAML::Node& n);
                        const std::string& what);
 /// Parses YAML text; a syntax error becomes ConfigError "file:line:col: not valid YAML: ...".
 /// Refuses what YAML readers resolve differently: a key given twice in one mapping (naming both
-/// lines) and a second, non-empty document after `---` (naming its line).
+/// lines), a key that is not a plain name ('? [a, b]') and a second, non-empty document after
+/// `---` (naming its line).
 YAML::Node parse(const std::string& text, const std::string& file);
-/// The duplicate-key check of parse() on an already parsed node (ConfigError naming both lines).
+/// The key checks of parse() (plain, unique keys) on an already parsed node (ConfigError naming
+/// the line).
 void checkUniqueKeys(const YAML::Node& node, const std::string& file);
 
 /// A mapping with the keys it allows. The constructor refuses unknown keys; every accessor
