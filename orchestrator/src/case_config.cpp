@@ -34,6 +34,7 @@ const std::vector<CaseReader>& caseReaders() {
       {"contact_materials", {"materials", "models"}, checkContactMaterials},
       {"dem", {}, readDem},
       {"cfd", {}, readCfd},
+      {"boundaries", {"cfd", "species"}, readBoundaries},
       {"walls.meshes", {"walls", "grid", "cfd"}, readMeshWalls},
       {"gas", {}, readGasSection},
       {"solid_species", {"species", "particles"}, readSolidSpecies},
@@ -102,7 +103,7 @@ CaseConfig parseCase(const std::string& text, const fs::path& file, const fs::pa
        "species",    "gas_properties", "materials",     "particles", "initial_state",
        "walls",      "models",         "dem",           "cfd",       "gas",
        "checkpoint", "output",         "solid_species", "reactions", "chemistry",
-       "coupling",   "material_pairs"},
+       "coupling",   "material_pairs", "inlets",        "outlets"},
       YAML::Mark());
   caseread::CaseReading reading{top, c, std::nullopt, {}, std::nullopt};
   for (const caseread::CaseReader& reader : caseread::caseReaders()) {

@@ -60,6 +60,7 @@ void readWalls(CaseReading& r);
 void readModels(CaseReading& r);
 void readDem(CaseReading& r);
 void readCfd(CaseReading& r);
+void readBoundaries(CaseReading& r);
 void readMeshWalls(CaseReading& r);
 void readGasSection(CaseReading& r);
 void checkIdealGas(CaseReading& r);

@@ -430,6 +430,19 @@ TEST_F(ResultsE2E, TutorialRunsAsWritten) {
   }
   EXPECT_TRUE(fs::exists(run / "plots" / "timeseries.png"));
   EXPECT_NE(readAll(log).find("mybed/case.yaml: valid"), std::string::npos) << tail(log);
+  // Its fluidization curve: one member per inlet velocity of case.yaml, the pressure drop growing
+  // with it below minimum fluidization (the members above it are not checked).
+  EXPECT_NE(readAll(log).find("curve.yaml: valid sweep (4 members"), std::string::npos)
+      << tail(log);
+  const auto curve = readCsv(dir / "root" / "runs" / "curve" / "summary.csv");
+  ASSERT_EQ(curve.size(), 4u) << readAll(dir / "root" / "runs" / "curve" / "summary.csv");
+  std::vector<double> dp;
+  for (auto row : curve) {
+    EXPECT_EQ(row["status"], "done");
+    dp.push_back(std::stod(row["mean@0.01..:gas.pressure_drop_Pa"]));
+  }
+  EXPECT_LT(dp[0], dp[1]); // 0.3 and 0.6 m/s: below U_mf of the packing (~0.8 m/s)
+  EXPECT_TRUE(fs::exists(dir / "root" / "runs" / "curve" / "plots" / "campaign.png"));
   if (renderSkipped) {
     GTEST_SKIP() << "opted out (COREDEM_TEST_OPT_OUT=paraview): the tutorial ran without its "
                     "render step";

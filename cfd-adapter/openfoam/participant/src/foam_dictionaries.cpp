@@ -158,9 +158,7 @@ boundaryField
       config.caseFile.filename().string());
 }
 
-namespace {
-
-void writeFile(const fs::path& file, const std::string& text) {
+void writeFoamFile(const fs::path& file, const std::string& text) {
   fs::create_directories(file.parent_path());
   const fs::path tmp = file.string() + ".tmp";
   {
@@ -173,27 +171,26 @@ void writeFile(const fs::path& file, const std::string& text) {
   fs::rename(tmp, file);
 }
 
-} // namespace
-
 void writeGeneratedFoamDictionaries(const CaseConfig& config, const fs::path& workDir) {
+  writeFoamBoundaries(config, workDir); // before 0/p's dimensions: an outlet fixes p to 0
   if (!config.gasProperties.idealGas()) {
     return;
   }
-  writeFile(workDir / kThermophysicalProperties, thermophysicalPropertiesText(config));
+  writeFoamFile(workDir / kThermophysicalProperties, thermophysicalPropertiesText(config));
   // A zero gauge kinematic p (pre-flight allows no other) is the same field in Pa.
   const fs::path pFile = workDir / "0" / "p";
   if (isZeroGaugeKinematicPressure(readFoamField(pFile))) {
     std::ifstream in(pFile, std::ios::binary);
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const std::regex dims(R"(dimensions\s*\[\s*0\s+2\s+-2\s+0\s+0\s+0\s+0\s*\])");
-    writeFile(pFile, std::regex_replace(
+    writeFoamFile(pFile, std::regex_replace(
                          text, dims, std::string("dimensions      [") + kPressureDimensions + "]",
                          std::regex_constants::format_first_only));
   }
   // OpenFOAM's multiComponentMixture reads one field per species (or 0/Ydefault).
   const fs::path zero = workDir / "0";
   if (config.species.empty() && !fs::exists(zero / kAirSpecies) && !fs::exists(zero / "Ydefault")) {
-    writeFile(zero / kAirSpecies, airFieldText(config));
+    writeFoamFile(zero / kAirSpecies, airFieldText(config));
   }
 }
 

@@ -115,6 +115,7 @@ ParticipantDescriptor openFoamParticipant() {
   p.caseFolder = "an OpenFOAM case folder";
   p.caseFolderMarker = "system/controlDict";
   p.caseFolderHint = "give the folder with system/, constant/ and 0/";
+  p.takesBoundaries = true; // inlets, outlets: written into 0/U, 0/p, 0/T, 0/<species>
   p.solvesGas = true; // gas_properties.model ideal_gas: a variable-density gas
   p.workDir = "openfoam";
   p.meshPatches = &openFoamMeshPatches; // walls.meshes[].from_cfd reads its constant/polyMesh

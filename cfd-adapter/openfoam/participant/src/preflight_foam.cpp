@@ -562,6 +562,7 @@ void checkOpenFoamCase(const CaseConfig& c) {
   checkFoamGasState(c, at, dir);
   checkDecomposition(c, at, dir);
   checkOuterCorrectors(c, at, dir);
+  checkFoamBoundaries(c, at, dir);
 }
 
 } // namespace coredem::orchestrator

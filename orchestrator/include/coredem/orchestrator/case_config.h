@@ -160,6 +160,28 @@ struct CfdConfig {
   int ranks = 1;
 };
 
+/// inlets[i] (docs/case-schema.md "Inlets and outlets"): a patch of the CFD mesh through which
+/// gas enters, written into the CFD participant's case (the one source of truth: a campaign
+/// sweeps it by key).
+struct InletConfig {
+  std::string patch; ///< a patch of the CFD mesh
+  /// Superficial gas velocity (m/s): the gas volume flow per unit area of the patch, whatever
+  /// the particles in the cells at the inlet.
+  Vec3 velocity{0.0, 0.0, 0.0};
+  /// superficial_velocity_table: rows (t, ux, uy, uz), t strictly increasing, linear in
+  /// between and held beyond the ends; empty: the constant `velocity`.
+  std::vector<std::array<double, 4>> velocityTable;
+  std::optional<double> temperature; ///< K; nullopt: the CFD case's own
+  /// Mass fractions in the order of the case's species (all of them); empty: the CFD case's own.
+  std::vector<double> massFractions;
+};
+
+/// outlets[i]: a patch of the CFD mesh where the gas leaves at the case's pressure (p fixed,
+/// the velocity from the flow).
+struct OutletConfig {
+  std::string patch;
+};
+
 /// coupling: how CFD and DEM steps follow each other (docs/coupling-schemes.md).
 struct CouplingConfig {
   /// sequential: the CFD waits for the DEM's sources of the same step; staggered: the CFD advances
@@ -243,6 +265,8 @@ struct CaseConfig {
   double epsMin = 0.35;
   DemConfig dem;
   CfdConfig cfd;
+  std::vector<InletConfig> inlets;   ///< inlets (written into the CFD participant's case)
+  std::vector<OutletConfig> outlets; ///< outlets (written into the CFD participant's case)
   CouplingConfig coupling;
   CheckpointConfig checkpoint;
   OutputConfig output;

@@ -85,6 +85,9 @@ struct ParticipantDescriptor {
   std::optional<std::vector<double>> (*initialMassFractions)(
       const CaseConfig& config, const std::vector<std::string>& species) = nullptr;
 
+  /// True when the participant takes case.yaml's inlets and outlets (its `generate` writes them
+  /// into its case, its `preflight` checks them against it); false: they are refused.
+  bool takesBoundaries = false;
   /// Writes the input files case.yaml implies into the fresh copy of `cfd.case` (RUN/<workDir>),
   /// after the copy (coredemFoam: constant/thermophysicalProperties of the ideal-gas model);
   /// nullptr: none.

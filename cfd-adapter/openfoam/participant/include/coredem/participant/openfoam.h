@@ -77,7 +77,31 @@ inline const std::filesystem::path kThermophysicalProperties =
 /// `calculated`, constraint patches from OpenFOAM's caseDicts/setConstraintTypes).
 std::string airFieldText(const CaseConfig& config);
 
-/// The row's `generate`. ideal_gas only (no-op for the constant model): writes
+/// case.yaml's inlets and outlets against the case in `dir` (part of checkOpenFoamCase): each
+/// patch is a patch of type `patch` of the mesh (constant/polyMesh/boundary, or before meshing
+/// system/blockMeshDict's boundary list; skipped when neither can be read simply), the case does
+/// not fix the other variable there (p at an inlet, U at an outlet), an inlet's temperature has
+/// a 0/T and its mass fractions a 0/<species>. Throws CaseError naming the key and the file.
+void checkFoamBoundaries(const CaseConfig& config, const preflight::Locator& at,
+                         const std::filesystem::path& dir);
+
+/// `text` (an OpenFOAM field file, `file` its name for messages) with the boundaryField entry of
+/// `patch` replaced by `lines` (the entry's body, one keyword per line), or inserted first when
+/// the file has no entry of that exact name (patterns such as "(inlet|outlet)" match after exact
+/// names). Throws UserError when the text has no boundaryField.
+std::string replaceFoamPatchEntry(const std::string& text, const std::string& patch,
+                                  const std::string& lines, const std::string& file);
+
+/// Writes case.yaml's inlets and outlets into workDir/0 (docs/case-schema.md "Inlets and
+/// outlets"): an inlet's U as interstitialInletVelocity (the superficial velocity over the gas
+/// fraction alphac at the face) or, with a table, uniformFixedValue; its T and mass fractions as
+/// fixedValue; an outlet's p fixedValue 0 and U pressureInletOutletVelocity.
+void writeFoamBoundaries(const CaseConfig& config, const std::filesystem::path& workDir);
+
+/// Writes `text` into `file` through a temporary file renamed over it (UserError when it cannot).
+void writeFoamFile(const std::filesystem::path& file, const std::string& text);
+
+/// The row's `generate`: writeFoamBoundaries; then, for ideal_gas only: writes
 /// thermophysicalPropertiesText(config) into workDir/constant/thermophysicalProperties, 0/p of a
 /// zero gauge kinematic pressure with the dimensions of a pressure and, for a case without
 /// species whose copy has neither 0/air nor 0/Ydefault, airFieldText(config) into workDir/0/air

@@ -1,0 +1,191 @@
+// End-to-end tests of case.yaml's inlets and outlets (docs/case-schema.md "Inlets and outlets")
+// with coredemFoam, the real DEM server and the orchestrator, in the 1 x 4 x 1 cm column of the
+// coredemFoam e2e tests (tests/e2e/openfoam/cases/column): the OpenFOAM case's own inlet is
+// overridden by case.yaml's, the inflow is the superficial velocity whether or not particles fill
+// the inlet cells (Ergun's pressure drop), and a fluidization curve is one campaign sweeping the
+// inlet velocity by key.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "coredem_e2e.h"
+#include "foam_e2e.h"
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+namespace {
+
+const fs::path kBin = COREDEM_BIN_DIR;
+const fs::path kTemplate = COREDEM_FOAM_E2E_TEMPLATE;
+
+using coredem::e2e::readAll;
+using coredem::e2e::readTimeseries;
+using coredem::e2e::replaceAll;
+using coredem::e2e::writeAll;
+using coredem::e2e::foam::copyColumnTemplate;
+using coredem::e2e::foam::logTail;
+using coredem::e2e::foam::runCoredem;
+
+// Air at 20 °C and the 1 mm glass beads of the column tests.
+constexpr double kRhoG = 1.204, kMuG = 1.81e-5, kG = 9.81, kDp = 1.0e-3, kHeight = 0.04;
+
+/// Ergun's pressure gradient (Pa/m) of a packed bed: voidage eps, superficial velocity u.
+double ergunGradient(double eps, double u) {
+  const double s = 1.0 - eps;
+  return 150.0 * s * s * kMuG * u / (eps * eps * eps * kDp * kDp) +
+         1.75 * s * kRhoG * u * u / (eps * eps * eps * kDp);
+}
+
+/// The column with its template inlet at 5 m/s (what case.yaml's inlet must override) and a
+/// simple-cubic lattice of 1600 beads 16 mm high from `bedBottom` (voidage 1 - pi/6 in every bed
+/// cell); with `plate` a DEM distributor plane at 4 mm keeps the beads off the inlet cells.
+fs::path makeCase(const fs::path& dir, double u, double bedBottom, bool plate) {
+  const fs::path c = dir / "case";
+  fs::create_directories(c);
+  copyColumnTemplate(kTemplate, c / "openfoam", 5.0, 293.15);
+  std::string text = R"(name: column
+time: {end: 0.012, dt: 1.0e-3}
+grid: {origin: [0, 0, 0], spacing: [0.002, 0.002, 0.002], cells: [5, 20, 5]}
+gravity: [0.0, -9.81, 0.0]
+gas_properties: {density: 1.204, viscosity: 1.81e-5, conductivity: 0.0257, cp: 1006.0,
+                 temperature: 293.15, pressure: 101325.0}
+materials:
+  - {name: glass, density: 2500.0, k_n: 100.0, e_n: 0.5, friction: 0.3}
+particles:
+  - {name: bed, material: glass, count: 1600, diameter: 1.0e-3, packing: lattice,
+     region: {min: [0.0, @BOTTOM@, 0.0], max: [0.01, @TOP@, 0.01]}}
+walls:
+  box: {min: [0.0, 0.0, 0.0], max: [0.01, 0.04, 0.01]}
+@PLATE@cfd: {participant: coredemFoam, case: openfoam, timeout_s: 120}
+dem: {backend: cpu, threads: 1, timeout_s: 120}
+inlets:
+  - patch: inlet
+    superficial_velocity: [0.0, @U@, 0.0]
+outlets:
+  - patch: outlet
+)";
+  const auto num = [](double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  };
+  text = replaceAll(text, "@BOTTOM@", num(bedBottom));
+  text = replaceAll(text, "@TOP@", num(bedBottom + 0.016));
+  text = replaceAll(text, "@U@", num(u));
+  text = replaceAll(
+      text, "@PLATE@",
+      plate ? "  planes: [{point: [0.0, 0.004, 0.0], normal: [0.0, 1.0, 0.0]}]\n" : "");
+  writeAll(c / "case.yaml", text);
+  return c;
+}
+
+/// Mean of the last three pressure drops of a run (the packed bed is steady within 5 steps).
+double lastPressureDrop(const fs::path& run) {
+  auto ts = readTimeseries(run);
+  const auto& dp = ts["gas.pressure_drop_Pa"];
+  EXPECT_GE(dp.size(), 12u);
+  return dp.size() < 3 ? 0.0 : (dp[dp.size() - 1] + dp[dp.size() - 2] + dp[dp.size() - 3]) / 3.0;
+}
+
+/// `coredem ARGS...` (check, campaign) with output into `log`; its exit code.
+int runCli(const std::vector<std::string>& args, const fs::path& log,
+            std::chrono::seconds timeout = 60s) {
+  return coredem::e2e::waitExit(coredem::e2e::startProgram(kBin / "coredem", args, log), timeout);
+}
+
+class CoredemFoamInletE2E : public coredem::e2e::RunFolderTest {
+protected:
+  CoredemFoamInletE2E()
+      : RunFolderTest(kBin, {"coredem", "coredem-dem", "coredemFoam"}, "coredemfoam-inlet-e2e") {}
+};
+
+} // namespace
+
+// The same packed bed (0.3 m/s superficial, well below minimum fluidization) twice: on the
+// distributor plate (inlet cells free) and from the floor (the inlet cells packed, gas fraction
+// 1 - pi/6 at the inlet face). case.yaml's inlet replaces the template's 5 m/s in the run's copy
+// only, and in both runs the pressure drop is Ergun's at 0.3 m/s over the 16 mm bed plus the gas
+// column, within 5 % as the coredemFoam Ergun test: the inflow is the superficial velocity. A
+// fixedValue of 0.3 m/s at the face (the interstitial velocity) would let in only eps x 0.3 m/s
+// through the packed inlet cells, half of Ergun's drop.
+TEST_F(CoredemFoamInletE2E, InletFromTheCaseFileIsTheSuperficialVelocityWithParticlesAtTheInlet) {
+  const double u = 0.3, eps = 1.0 - std::numbers::pi / 6.0;
+  const double expected = ergunGradient(eps, u) * 0.016 + kRhoG * kG * kHeight;
+  for (const bool plate : {true, false}) {
+    const fs::path sub = dir / (plate ? "plate" : "floor");
+    const fs::path c = makeCase(sub, u, plate ? 0.004 : 0.0, plate);
+    const fs::path run = sub / "run";
+    ASSERT_EQ(runCoredem({"run", c.string(), "--out", run.string()}, sub / "coredem.log"), 0)
+        << readAll(sub / "coredem.log") << logTail(run);
+    const std::string written = readAll(run / "openfoam" / "0" / "U");
+    EXPECT_NE(written.find("// coredem: inlets[0] of case.yaml, superficial velocity (0 0.3 0) "
+                           "m/s\n        type            interstitialInletVelocity;"),
+              std::string::npos)
+        << written;
+    EXPECT_NE(readAll(c / "openfoam" / "0" / "U").find("(0 5.000000 0)"), std::string::npos)
+        << "cfd.case itself was changed";
+    const double measured = lastPressureDrop(run);
+    std::cout << (plate ? "bed on the plate" : "bed on the floor (inlet cells packed)")
+              << ": pressure drop " << measured << " Pa, Ergun + gas column " << expected
+              << " Pa (" << 100.0 * (measured / expected - 1.0) << " %)\n";
+    EXPECT_NEAR(measured / expected, 1.0, 0.05) << (plate ? "plate" : "floor");
+  }
+}
+
+// A fluidization-curve study as one campaign: the inlet's superficial velocity swept by key
+// (three values below minimum fluidization), the pressure drop averaged over a window that
+// leaves the start-up out, a numeric axis with its unit. Each member's pressure drop is Ergun's
+// at its velocity within 5 %, so it grows with the velocity as Ergun's does.
+TEST_F(CoredemFoamInletE2E, FluidizationCurveIsOneCampaignSweepingTheInletVelocity) {
+  const fs::path c = makeCase(dir, 0.3, 0.004, true);
+  writeAll(dir / "sweep.yaml", R"(name: fluidization-curve
+base_case: case
+concurrency: 1
+grid:
+  inlets[0].superficial_velocity[1]: [0.1, 0.2, 0.4]
+collect:
+  scalars: [mean@0.006..:gas.pressure_drop_Pa]
+  units: {inlets[0].superficial_velocity[1]: m/s}
+  plot: {x: inlets[0].superficial_velocity[1], y: mean@0.006..:gas.pressure_drop_Pa}
+)");
+  ASSERT_EQ(runCli({"check", (dir / "sweep.yaml").string()}, dir / "check.log"), 0)
+      << readAll(dir / "check.log");
+  EXPECT_NE(readAll(dir / "check.log").find("valid sweep (3 members"), std::string::npos)
+      << readAll(dir / "check.log");
+  const fs::path out = dir / "campaign";
+  ASSERT_EQ(runCli({"campaign", "run", (dir / "sweep.yaml").string(), "--out", out.string()},
+                   dir / "campaign.log", 400s),
+            0)
+      << readAll(dir / "campaign.log");
+  ASSERT_EQ(runCli({"campaign", "collect", out.string()}, dir / "collect.log"), 0)
+      << readAll(dir / "collect.log");
+  std::istringstream summary(readAll(out / "summary.csv"));
+  std::string header, line;
+  std::getline(summary, header);
+  EXPECT_NE(header.find("inlets[0].superficial_velocity[1]"), std::string::npos) << header;
+  const double eps = 1.0 - std::numbers::pi / 6.0;
+  int rows = 0;
+  while (std::getline(summary, line)) {
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string s; std::getline(fields, s, ',');) {
+      f.push_back(s);
+    }
+    ASSERT_GE(f.size(), 4u) << line;
+    EXPECT_EQ(f[1], "done") << line;
+    const double u = std::stod(f[2]), dp = std::stod(f[3]);
+    const double expected = ergunGradient(eps, u) * 0.016 + kRhoG * kG * kHeight;
+    std::cout << "U = " << u << " m/s: mean pressure drop " << dp << " Pa, Ergun + gas column "
+              << expected << " Pa\n";
+    EXPECT_NEAR(dp / expected, 1.0, 0.05) << line;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 3);
+}
