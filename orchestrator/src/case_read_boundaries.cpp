@@ -104,8 +104,8 @@ std::vector<double> readMassFractions(const Section& s, const CaseConfig& c) {
   for (std::size_t i = 0; i < y.size(); ++i) {
     if (y[i] < 0.0) {
       s.fail(s.markOf("mass_fractions"), key,
-             fmt::format("'{}' is missing: give the mass fraction of every species ({})",
-                         names[i], join(names)));
+             fmt::format("'{}' is missing: give the mass fraction of every species ({})", names[i],
+                         join(names)));
     }
   }
   if (std::abs(sum - 1.0) > 1e-9) {
@@ -153,8 +153,8 @@ void readBoundaries(CaseReading& r) {
                                      "gas inlets")) {
       InletConfig in;
       in.patch = patchOf(s);
-      const bool constant = s.has("superficial_velocity"), table =
-                                                               s.has("superficial_velocity_table");
+      const bool constant = s.has("superficial_velocity"),
+                 table = s.has("superficial_velocity_table");
       if (constant == table) {
         s.fail(s.markOf(constant ? "superficial_velocity_table" : "patch"), s.path(),
                "give one of superficial_velocity: [ux, uy, uz] (m/s) or "
@@ -169,10 +169,9 @@ void readBoundaries(CaseReading& r) {
       }
       if (s.has("temperature")) {
         const GasRanges g;
-        in.temperature =
-            s.number("temperature", std::nullopt, g.temperatureMin, g.temperatureMax,
-                     fmt::format("K, the DEM's gas range [{}, {}]", g.temperatureMin,
-                                 g.temperatureMax));
+        in.temperature = s.number(
+            "temperature", std::nullopt, g.temperatureMin, g.temperatureMax,
+            fmt::format("K, the DEM's gas range [{}, {}]", g.temperatureMin, g.temperatureMax));
       }
       if (s.has("mass_fractions")) {
         in.massFractions = readMassFractions(s, c);

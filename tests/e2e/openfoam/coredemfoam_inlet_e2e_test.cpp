@@ -79,9 +79,9 @@ outlets:
   text = replaceAll(text, "@BOTTOM@", num(bedBottom));
   text = replaceAll(text, "@TOP@", num(bedBottom + 0.016));
   text = replaceAll(text, "@U@", num(u));
-  text = replaceAll(
-      text, "@PLATE@",
-      plate ? "  planes: [{point: [0.0, 0.004, 0.0], normal: [0.0, 1.0, 0.0]}]\n" : "");
+  text =
+      replaceAll(text, "@PLATE@",
+                 plate ? "  planes: [{point: [0.0, 0.004, 0.0], normal: [0.0, 1.0, 0.0]}]\n" : "");
   writeAll(c / "case.yaml", text);
   return c;
 }
@@ -96,7 +96,7 @@ double lastPressureDrop(const fs::path& run) {
 
 /// `coredem ARGS...` (check, campaign) with output into `log`; its exit code.
 int runCli(const std::vector<std::string>& args, const fs::path& log,
-            std::chrono::seconds timeout = 60s) {
+           std::chrono::seconds timeout = 60s) {
   return coredem::e2e::waitExit(coredem::e2e::startProgram(kBin / "coredem", args, log), timeout);
 }
 
@@ -138,8 +138,8 @@ TEST_F(CoredemFoamInletE2E, InletFromTheCaseFileIsTheSuperficialVelocityWithPart
         << "cfd.case itself was changed";
     const double measured = lastPressureDrop(run);
     std::cout << (plate ? "bed on the plate" : "bed on the floor (inlet cells packed)")
-              << ": pressure drop " << measured << " Pa, Ergun + gas column " << expected
-              << " Pa (" << 100.0 * (measured / expected - 1.0) << " %)\n";
+              << ": pressure drop " << measured << " Pa, Ergun + gas column " << expected << " Pa ("
+              << 100.0 * (measured / expected - 1.0) << " %)\n";
     EXPECT_NEAR(measured / expected, 1.0, 0.05) << (plate ? "plate" : "floor");
   }
 }

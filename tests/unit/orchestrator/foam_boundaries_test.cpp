@@ -105,8 +105,9 @@ TEST(Boundaries, BadInletsAreRefusedNamingTheKey) {
   const std::string clg = readText(kSource / "cases" / "clg" / "case.yaml");
   const auto clgError = [&](const std::string& y) {
     return coredem::orchestrator::test::errorOf(
-        clg + "\ninlets:\n  - {patch: inlet, superficial_velocity: [0, 0.24, 0], "
-              "mass_fractions: " +
+        clg +
+        "\ninlets:\n  - {patch: inlet, superficial_velocity: [0, 0.24, 0], "
+        "mass_fractions: " +
         y + "}\n");
   };
   EXPECT_EQ(clgError("{CO: 0, CO2: 0, H2: 0, H2O: 0.5, N2: 0.5}"), "");
@@ -129,16 +130,16 @@ TEST(Boundaries, PreflightRefusesAPatchTheMeshLacksAWallAndAFixedOtherVariable) 
   EXPECT_TRUE(contains(missing, "inlets[0].patch: no patch 'bottom' in"));
   EXPECT_TRUE(contains(missing, "blockMeshDict; its patches: inlet (patch), outlet (patch), "
                                 "walls (wall)"));
-  EXPECT_TRUE(contains(fails("wall", "outlets:\n  - {patch: walls}\n"),
-                       "patch 'walls' is of type 'wall'"));
+  EXPECT_TRUE(
+      contains(fails("wall", "outlets:\n  - {patch: walls}\n"), "patch 'walls' is of type 'wall'"));
   // The case fixes U at its inlet: an outlet there contradicts it.
   EXPECT_TRUE(contains(fails("outlet-at-inlet", "outlets:\n  - {patch: inlet}\n"),
                        "fixes the velocity at 'inlet' (type fixedValue), but an outlet fixes the "
                        "pressure there"));
   // ... and p at its outlet: an inlet there too.
-  EXPECT_TRUE(contains(fails("inlet-at-outlet",
-                             "inlets:\n  - {patch: outlet, superficial_velocity: [0, -1, 0]}\n"),
-                       "fixes the pressure at 'outlet' (type fixedValue), but an inlet fixes"));
+  EXPECT_TRUE(contains(
+      fails("inlet-at-outlet", "inlets:\n  - {patch: outlet, superficial_velocity: [0, -1, 0]}\n"),
+      "fixes the pressure at 'outlet' (type fixedValue), but an inlet fixes"));
   // Species fields: cases/clg has them all.
   EXPECT_EQ(failureOf(caseCopy("clg", "clg",
                                "inlets:\n  - {patch: inlet, superficial_velocity: [0, 0.3, 0], "
