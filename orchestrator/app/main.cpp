@@ -6,6 +6,7 @@
 //   coredem render RUN_DIR [--times T,...] [--field F] [--gas-field G] [--out DIR] [--slice F]
 //                          [--particles all|none] [--particle-opacity A] [--particle-scale S]
 //   coredem check CASE_DIR
+//   coredem mesh VESSEL.yaml --out CASE_DIR [--openfoam NAME] [--force]
 //   coredem stats RUN_DIR [--from T] [--to T] [--json] [--no-fields]
 //   coredem verify [--out DIR] [--only NAME[,NAME]] [--list] [--cases DIR] [--no-plots]
 #include <cstdio>
@@ -30,6 +31,7 @@
 #include <coredem/orchestrator/stages.h>
 #include <coredem/orchestrator/stats.h>
 #include <coredem/orchestrator/verify.h>
+#include <coredem/participant/foam_vessel.h>
 
 using namespace coredem::orchestrator;
 namespace fs = std::filesystem;
@@ -191,8 +193,10 @@ struct CommandLine {
   double statsFrom = 0.0, statsTo = 0.0;
   CLI::Option *statsFromOpt = nullptr, *statsToOpt = nullptr;
   bool statsJson = false, statsNoFields = false;
+  std::string meshFoam = "openfoam";
+  bool meshForce = false;
   CLI::App *run = nullptr, *resume = nullptr, *inspect = nullptr, *verify = nullptr,
-           *render = nullptr, *check = nullptr, *stats = nullptr;
+           *render = nullptr, *check = nullptr, *stats = nullptr, *mesh = nullptr;
 };
 
 /// `coredem run` and `coredem resume`.
@@ -301,6 +305,41 @@ void addToolCommands(CLI::App& app, CommandLine& c) {
       ->add_option("CASE_DIR", c.caseDir,
                    "case folder with case.yaml (or a case file, or a sweep file: every member)")
       ->required();
+
+  c.mesh = app.add_subcommand(
+      "mesh", "a vessel (cylinder with an optional conical bottom, or box) from one description: "
+              "the OpenFOAM blockMeshDict and the matching case.yaml grid, DEM walls, inlet and "
+              "outlet (docs/case-schema.md \"Vessels\")");
+  c.mesh->add_option("VESSEL", c.file, "vessel description (YAML)")->required();
+  c.mesh->add_option("--out", c.out, "case folder to write into")->required();
+  c.mesh->add_option("--openfoam", c.meshFoam,
+                     "its OpenFOAM case folder (cfd.case), written as NAME/system/blockMeshDict");
+  c.mesh->add_flag("--force", c.meshForce, "replace a blockMeshDict that differs");
+}
+
+/// `coredem mesh`: CASE/<openfoam>/system/blockMeshDict and CASE/vessel.case.yaml.
+int meshVessel(const CommandLine& c) {
+  const fs::path file = fs::absolute(c.file);
+  const VesselFiles f = vesselFiles(readVesselSpec(file), file.filename().string());
+  const fs::path dict = fs::path(c.out) / c.meshFoam / "system" / "blockMeshDict";
+  const fs::path part = fs::path(c.out) / "vessel.case.yaml";
+  for (const auto& [path, text] : {std::pair{dict, f.blockMeshDict}, std::pair{part, f.caseYaml}}) {
+    if (fs::exists(path) && !c.meshForce) {
+      std::ifstream in(path, std::ios::binary);
+      if (std::string((std::istreambuf_iterator<char>(in)), {}) != text) {
+        throw coredem::UserError(
+            fmt::format("{} exists and differs; give --force to replace it", path.string()));
+      }
+    }
+  }
+  fs::create_directories(dict.parent_path());
+  for (const auto& [path, text] : {std::pair{dict, f.blockMeshDict}, std::pair{part, f.caseYaml}}) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
+  }
+  std::cout << f.summary << "\nwrote " << dict.string() << " (run blockMesh, or let coredem run "
+            << "do it) and " << part.string() << " (copy into case.yaml):\n\n"
+            << f.caseYaml;
+  return kExitOk;
 }
 
 /// `coredem stats`: RUN/stats/stats.json (+ averages.h5/.xdmf) and the table (or the JSON).
@@ -445,6 +484,9 @@ int main(int argc, char** argv) {
     }
     if (*cmd.stats) {
       return runStats(cmd);
+    }
+    if (*cmd.mesh) {
+      return meshVessel(cmd);
     }
     if (*cmd.verify) {
       cmd.verifyOpts.only = cmd.only;
