@@ -74,17 +74,17 @@ TEST(Vessel, BadDescriptionsAreRefusedNamingTheKey) {
 // The cylindrical bed's vessel (cases/cylindrical-bed): R 15 mm, 120 mm, a cone 15 mm high from
 // r 5 mm, 32 around, 2.5 mm cells: its hand-written O-grid had 7680 cells in 10 blocks.
 TEST(Vessel, CylinderOGridFollowsTheGeometry) {
-  const VesselSpec s = readVesselSpec(writeVessel(
-      "bed", "shape: cylinder\naxis: z\norigin: [0.001, -0.002, 0.003]\nradius: 0.015\n"
-             "height: 0.12\ncone: {height: 0.015, radius: 0.005}\ncell_size: 0.0025\n"
-             "around: 32\n"));
+  const VesselSpec s = readVesselSpec(
+      writeVessel("bed", "shape: cylinder\naxis: z\norigin: [0.001, -0.002, 0.003]\nradius: 0.015\n"
+                         "height: 0.12\ncone: {height: 0.015, radius: 0.005}\ncell_size: 0.0025\n"
+                         "around: 32\n"));
   const VesselFiles f = vesselFiles(s, "bed.yaml");
   EXPECT_EQ(f.cells, 7680);
   const std::regex hex(R"(hex \(([0-9 ]+)\) \((\d+) (\d+) (\d+)\))");
   long long cells = 0;
   int blocks = 0;
-  for (std::sregex_iterator it(f.blockMeshDict.begin(), f.blockMeshDict.end(), hex), end;
-       it != end; ++it, ++blocks) {
+  for (std::sregex_iterator it(f.blockMeshDict.begin(), f.blockMeshDict.end(), hex), end; it != end;
+       ++it, ++blocks) {
     cells += std::stoll((*it)[2]) * std::stoll((*it)[3]) * std::stoll((*it)[4]);
   }
   EXPECT_EQ(blocks, 10);
