@@ -13,6 +13,7 @@
 #include <coredem/orchestrator/participants.h>
 #include <coredem/orchestrator/preflight.h>
 #include <coredem/orchestrator/session.h>
+#include <coredem/participant/foam_vessel.h>
 
 #include "case_text.h"
 
@@ -447,6 +448,11 @@ TEST(Preflight, EveryShippedCasePasses) {
     const std::string name = e.path().filename().string();
     if (e.path().extension() != ".yaml" || name.rfind("sweep", 0) == 0 || // sweep*.yaml
         name == "verify.yaml") {
+      continue;
+    }
+    if (name == "vessel.yaml") { // a vessel description (coredem mesh), checked by it
+      const VesselSpec v = readVesselSpec(e.path());
+      EXPECT_GT(vesselFiles(v, name).cells, 0);
       continue;
     }
     SCOPED_TRACE(e.path().string());

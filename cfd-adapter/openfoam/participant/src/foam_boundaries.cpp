@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include <coredem/common/log.h>
 #include <coredem/common/yaml_section.h>
 #include <coredem/orchestrator/preflight_locator.h>
 #include <coredem/participant/foam_field.h>
@@ -319,6 +320,17 @@ void checkFoamBoundaries(const CaseConfig& c, const preflight::Locator& at, cons
     const InletConfig& in = c.inlets[i];
     const std::string key = fmt::format("inlets[{}]", i);
     check(in.patch, "inlets", i);
+    logger("orchestrator")
+        ->info("{} (patch {}): {}", key, in.patch,
+               in.velocityTable.empty()
+                   ? fmt::format("superficial velocity {} m/s, written into the run's 0/U as "
+                                 "interstitialInletVelocity (the face velocity is it over the "
+                                 "gas fraction there: the inflow is superficial with or without "
+                                 "particles in the inlet cells)",
+                                 vec(in.velocity))
+                   : std::string("superficial velocity table, written into the run's 0/U as "
+                                 "uniformFixedValue: the face velocity, superficial only while "
+                                 "the inlet cells hold no particles"));
     if (in.temperature && !fs::exists(dir / "0" / "T")) {
       at.fail({"inlets", std::to_string(i), "temperature"}, key + ".temperature",
               fmt::format("the OpenFOAM case has no temperature field ({}); remove the key or "
