@@ -430,6 +430,15 @@ TEST_F(ResultsE2E, TutorialRunsAsWritten) {
   }
   EXPECT_TRUE(fs::exists(run / "plots" / "timeseries.png"));
   EXPECT_NE(readAll(log).find("mybed/case.yaml: valid"), std::string::npos) << tail(log);
+  // Its settled start: one command, the settling stage with the inlet off, then the fluidized one.
+  for (const char* stage : {"01-settle", "02-fluidize"}) {
+    EXPECT_TRUE(fs::exists(dir / "root" / "runs" / "mybed-staged" / "stages" / stage / "done"))
+        << stage << "\n"
+        << tail(log);
+  }
+  const std::string settleU = readAll(dir / "root" / "runs" / "mybed-staged" / "stages" /
+                                      "01-settle" / "run" / "openfoam" / "0" / "U");
+  EXPECT_NE(settleU.find("superficial velocity (0 0 0) m/s"), std::string::npos) << settleU;
   // Its fluidization curve: one member per inlet velocity of case.yaml, the pressure drop growing
   // with it below minimum fluidization (the members above it are not checked).
   EXPECT_NE(readAll(log).find("curve.yaml: valid sweep (4 members"), std::string::npos)
