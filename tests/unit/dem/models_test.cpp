@@ -44,7 +44,7 @@ void expectRoundTrip(const ModelFamily<E>& f, std::size_t expectedCount) {
 
 // The names users write, one per enumerator ('_' and '-' alike on input).
 TEST(ModelRegistry, FamiliesMapNamesToEnums) {
-  expectRoundTrip(dragModels(), 1);
+  expectRoundTrip(dragModels(), 8);
   expectRoundTrip(nusseltModels(), 2);
   expectRoundTrip(reynoldsModels(), 2);
   expectRoundTrip(motionModels(), 2);
@@ -121,7 +121,9 @@ TEST(ModelRegistry, ApplySetsTheConfig) {
   EXPECT_FALSE(c.heat.enabled);
   EXPECT_FALSE(applyModelOption(c, "no_such_key", "1")); // the server warns and ignores it
   EXPECT_THROW(applyModelOption(c, "dem.history_slots", "33"), coredem::UserError);
-  EXPECT_THROW(applyModelOption(c, "drag", "wen-yu"), coredem::UserError);
+  EXPECT_TRUE(applyModelOption(c, "drag", "wen-yu"));
+  EXPECT_EQ(c.drag, k::dragLaw<k::WenYuDrag>());
+  EXPECT_THROW(applyModelOption(c, "drag", "stokes"), coredem::UserError);
 }
 
 // `coredem check` input: a misspelled key and a bad value, each named with the allowed ones.
