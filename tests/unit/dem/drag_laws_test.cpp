@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
 
+#include "coredem/dem/kernels/convection.h"
 #include "coredem/dem/kernels/drag.h"
 
 using namespace coredem::dem::kernels;
@@ -28,7 +29,8 @@ const std::map<std::string, DragLaw>& laws() {
                                                    {"di-felice", dragLaw<DiFeliceDrag>()},
                                                    {"rong", dragLaw<RongDrag>()},
                                                    {"syamlal-obrien", dragLaw<SyamlalObrienDrag>()},
-                                                   {"beetstra", dragLaw<BeetstraDrag>()}};
+                                                   {"beetstra", dragLaw<BeetstraDrag>()},
+                                                   {"koch-hill", dragLaw<KochHillDrag>()}};
   return m;
 }
 
@@ -76,7 +78,7 @@ TEST(DragLaws, ZeroSlipIsTheCreepingFlowLimit) {
 
 // ε → 1: one sphere in an unbounded gas. Wen–Yu's and Gidaspow's dilute branch give
 // Schiller–Naumann, Di Felice's, Rong's and Syamlal–O'Brien's the Dallavalle drag
-// (0.63 + 4.8/√Re)², Beetstra's Stokes drag at Re → 0 (F = 1), each within 1e-6.
+// (0.63 + 4.8/√Re)², Beetstra's and Koch–Hill's Stokes drag at Re → 0 (F = 1), each within 1e-6.
 TEST(DragLaws, OneSphereInAnUnboundedGasAtTheDiluteEnd) {
   const double eps = 1.0 - 1e-14, dp = 1e-3, slip = 0.3, pi = std::numbers::pi;
   const double re = kRho * dp * slip / kMu;
@@ -91,6 +93,7 @@ TEST(DragLaws, OneSphereInAnUnboundedGasAtTheDiluteEnd) {
   }
   const double stokes = 3.0 * pi * kMu * dp;
   EXPECT_NEAR(coefficient(dragLaw<BeetstraDrag>(), eps, dp, 0.0), stokes, 1e-6 * stokes);
+  EXPECT_NEAR(coefficient(dragLaw<KochHillDrag>(), eps, dp, 0.0), stokes, 1e-6 * stokes);
 }
 
 // The blend is continuous across ε = 0.8, where Gidaspow's switch jumps; far from it, it is
@@ -107,4 +110,27 @@ TEST(DragLaws, TheBlendIsContinuousWhereGidaspowSwitches) {
   EXPECT_NEAR(coefficient(dragLaw<GidaspowBlendDrag>(), 0.4, dp, slip), ergun, 2e-3 * ergun);
   const double wenYu = coefficient(dragLaw<WenYuDrag>(), 0.99, dp, slip);
   EXPECT_NEAR(coefficient(dragLaw<GidaspowBlendDrag>(), 0.99, dp, slip), wenYu, 1e-2 * wenYu);
+}
+
+// Gunn's Nusselt correlation (kernels/nusselt_gunn.h) through the convection kernel's dispatch
+// (the cell factors and the particle's Re, as the engine evaluates it) against the same
+// reference file's points, to 1e-12; Nu = 2 for one sphere in a still gas (ε = 1, Re = 0).
+TEST(NusseltLaws, GunnMatchesItsIndependentReference) {
+  const YAML::Node doc = YAML::LoadFile(COREDEM_DEM_TEST_DATA "/drag_laws.yaml");
+  const double tol = doc["relative_tolerance"].as<double>();
+  ConvectionParams p;
+  p.model = nusseltModel<GunnNusselt>();
+  const YAML::Node points = doc["nusselt"]["gunn"];
+  ASSERT_GE(points.size(), 20u);
+  double worst = 0.0;
+  for (const YAML::Node& pt : points) {
+    const double eps = pt[0].as<double>(), slip = pt[1].as<double>(), dp = pt[2].as<double>();
+    const GasState g{kRho, kMu, doc["k_g"].as<double>(), doc["cp_g"].as<double>(), 300.0, eps};
+    const double want = pt[3].as<double>(), got = nusselt(p, g, dp, slip);
+    worst = std::max(worst, std::abs(got / want - 1.0));
+    EXPECT_NEAR(got, want, tol * want) << "eps " << eps << " slip " << slip << " d " << dp;
+  }
+  std::cout << "gunn: " << points.size() << " points, worst relative error " << worst << "\n";
+  const GasState still{kRho, kMu, 0.026, 1006.0, 300.0, 1.0};
+  EXPECT_NEAR(nusselt(p, still, 1e-3, 0.0), 2.0, 1e-15);
 }

@@ -164,13 +164,16 @@ TEST(CaseConfig, ModelsBadValueNamesLineAndAllowedValues) {
   const std::string text = std::string(kGood) + "models: {convection: li-masn}\n";
   const std::string e = errorOf(text);
   EXPECT_NE(e.find("cases/x/case.yaml:21:22: models.convection: 'li-masn' is not allowed (did "
-                   "you mean 'li-mason'?); allowed: li-mason, ranz-marshall or off"),
+                   "you mean 'li-mason'?); allowed: li-mason, ranz-marshall, gunn or off"),
             std::string::npos)
       << e;
-  const std::string d = errorOf(std::string(kGood) + "models:\n  drag: wen-yu\n");
-  EXPECT_NE(d.find("case.yaml:22:9: models.drag: 'wen-yu' is not allowed; allowed: gidaspow"),
+  const std::string d = errorOf(std::string(kGood) + "models:\n  drag: stokes\n");
+  EXPECT_NE(d.find("case.yaml:22:9: models.drag: 'stokes' is not allowed; allowed: gidaspow, "
+                   "wen-yu, ergun, gidaspow-blend, di-felice, rong, syamlal-obrien, beetstra or "
+                   "koch-hill"),
             std::string::npos)
       << d;
+  EXPECT_EQ(errorOf(std::string(kGood) + "models:\n  drag: wen-yu\n"), "");
   const std::string n = errorOf(std::string(kGood) + "models:\n  flpc: 2\n");
   EXPECT_NE(n.find("models.flpc: '2' is not allowed; expected a number in [0, 1]"),
             std::string::npos)

@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""Independent reference for the drag laws of docs/physics.md §2.2 (kernels/drag*.h).
+"""Independent reference for the drag laws of docs/physics.md §2.2 (kernels/drag*.h) and the
+Nusselt correlations of §3.1 that are not the seed's (kernels/nusselt_*.h).
 
 Each law is written here as its paper (or MFiX's drag_gs.f) writes it: the interphase momentum
 transfer coefficient beta (kg/m3/s) or the drag force on one particle, evaluated with mpmath at
 40 digits, then turned into the per-particle coefficient beta V_p/(1 - eps) (kg/s) that the DEM's
-kernels return. Writes drag_laws.yaml:
+kernels return. Writes drag_laws.yaml (drag laws, then the Nusselt correlations):
     /usr/bin/python3 make_drag_reference.py > drag_laws.yaml
 """
 from mpmath import mp, mpf, sqrt, atan, exp, log10, pi
@@ -12,8 +13,8 @@ from mpmath import mp, mpf, sqrt, atan, exp, log10, pi
 mp.dps = 40
 
 RHO, MU = mpf("1.2"), mpf("1.8e-5")
-EPS = ["0.36", "0.4", "0.45", "0.5", "0.6", "0.7", "0.79", "0.81", "0.86", "0.9", "0.95",
-       "0.99", "0.999"]
+EPS = ["0.36", "0.4", "0.45", "0.5", "0.6", "0.7", "0.79", "0.81", "0.86", "0.91", "0.95",
+       "0.985", "0.999"]  # not 0.9, 0.99: Koch-Hill switches at phi = 0.1, 0.01
 SLIP = ["1e-4", "0.01", "0.1", "0.5", "2", "10", "40"]
 DIAM = ["1e-3", "2e-4"]
 
@@ -83,6 +84,43 @@ def beta_beetstra(e, u, d):
     return 18 * MU * e * phi * f / (d * d)
 
 
+def beta_koch_hill(e, u, d):
+    """MFiX DRAG_KOCH_HILL (Benyahia et al. 2006), written as there; the limit F_0 at Re = 0."""
+    phis = 1 - e
+    re = mpf("0.5") * d * u * e * RHO / MU
+    f_stokes = 18 * MU * e * e / (d * d)
+    w = exp(-10 * (mpf("0.4") - phis) / phis)
+    from mpmath import log
+    if mpf("0.01") < phis < mpf("0.4"):
+        f0 = ((1 - w) * (1 + 3 * sqrt(phis / 2) + mpf(135) / 64 * phis * log(phis) + mpf("17.14") * phis)
+              / (1 + mpf("0.681") * phis - mpf("8.48") * phis ** 2 + mpf("8.16") * phis ** 3)
+              + w * 10 * phis / (1 - phis) ** 3)
+    elif phis >= mpf("0.4"):
+        f0 = 10 * phis / (1 - phis) ** 3
+    if mpf("0.01") < phis <= mpf("0.1"):
+        f1 = sqrt(2 / phis) / 40
+    elif phis > mpf("0.1"):
+        f1 = mpf("0.11") + mpf("5.1e-4") * exp(mpf("11.6") * phis)
+    if phis < mpf("0.4"):
+        f2 = ((1 - w) * (1 + 3 * sqrt(phis / 2) + mpf(135) / 64 * phis * log(phis) + mpf("17.89") * phis)
+              / (1 + mpf("0.681") * phis - mpf("11.03") * phis ** 2 + mpf("15.41") * phis ** 3)
+              + w * 10 * phis / (1 - phis) ** 3)
+    else:
+        f2 = 10 * phis / (1 - phis) ** 3
+    f3 = mpf("0.9351") * phis + mpf("0.03667") if phis < mpf("0.0953") else \
+        mpf("0.0673") + mpf("0.212") * phis + mpf("0.0232") / (1 - phis) ** 5
+    re_t1 = (f2 - 1) / (mpf(3) / 8 - f3)
+    if phis > mpf("0.01"):
+        re_t2 = (f3 + sqrt(f3 * f3 - 4 * f1 * (f0 - f2))) / (2 * f1)
+    if phis <= mpf("0.01") and re <= re_t1:
+        f = 1 + mpf(3) / 8 * re
+    elif phis > mpf("0.01") and re <= re_t2:
+        f = f0 + f1 * re * re
+    else:
+        f = f2 + f3 * re
+    return f * f_stokes * phis
+
+
 def per_particle(beta, e, d):
     return beta * (pi * d ** 3 / 6) / (1 - e)
 
@@ -96,6 +134,7 @@ LAWS = {
     "rong": coef_rong,
     "syamlal-obrien": lambda e, u, d: per_particle(beta_syamlal(e, u, d), e, d),
     "beetstra": lambda e, u, d: per_particle(beta_beetstra(e, u, d), e, d),
+    "koch-hill": lambda e, u, d: per_particle(beta_koch_hill(e, u, d), e, d),
 }
 
 print("# drag_laws.yaml: per-particle drag coefficients beta V_p/(1 - eps) (kg/s) written by")
@@ -103,6 +142,25 @@ print("# make_drag_reference.py (mpmath, 40 digits) from the laws' published for
 print("rho_g: 1.2\nmu_g: 1.8e-5\nrelative_tolerance: 1.0e-12\nlaws:")
 for name, law in LAWS.items():
     print(f"  {name}:  # eps, slip (m/s), d_p (m), coefficient (kg/s)")
+    for e in EPS:
+        for u in SLIP:
+            for d in DIAM:
+                v = law(mpf(e), mpf(u), mpf(d))
+                print(f"    - [{e}, {u}, {d}, {mp.nstr(v, 20, min_fixed=0, max_fixed=0)}]")
+
+K_G, CP_G = mpf("0.026"), mpf("1006")
+
+
+def nusselt_gunn(e, u, d):
+    re = e * RHO * d * u / MU
+    pr = MU * CP_G / K_G
+    return ((7 - 10 * e + 5 * e * e) * (1 + mpf("0.7") * re ** mpf("0.2") * pr ** (mpf(1) / 3))
+            + (mpf("1.33") - mpf("2.4") * e + mpf("1.2") * e * e) * re ** mpf("0.7") * pr ** (mpf(1) / 3))
+
+
+print("k_g: 0.026\ncp_g: 1006.0\nnusselt:")
+for name, law in {"gunn": nusselt_gunn}.items():
+    print(f"  {name}:  # eps, slip (m/s), d_p (m), Nu")
     for e in EPS:
         for u in SLIP:
             for d in DIAM:

@@ -12,6 +12,7 @@
 
 #include "coredem/dem/kernels/common.h"
 #include "coredem/dem/kernels/drag_gidaspow.h"
+#include "coredem/dem/kernels/drag_koch_hill.h"
 #include "coredem/dem/kernels/drag_single_laws.h"
 #include "coredem/dem/kernels/drag_syamlal_beetstra.h"
 #include "coredem/dem/kernels/drag_voidage_function.h"
@@ -21,7 +22,7 @@ namespace coredem::dem::kernels {
 
 /// The drag laws, in id order (the registration line).
 using DragLaws = ModelList<GidaspowDrag, WenYuDrag, ErgunDrag, GidaspowBlendDrag, DiFeliceDrag,
-                           RongDrag, SyamlalObrienDrag, BeetstraDrag>;
+                           RongDrag, SyamlalObrienDrag, BeetstraDrag, KochHillDrag>;
 
 /// A drag law's id (its position in DragLaws; the configuration hash uses it). The default has
 /// a name; any law's id is dragLaw<Law>().
