@@ -25,6 +25,9 @@
 
 #include "coredem/common/check.h"
 #include "coredem/dem/dem_system.h"
+#include "coredem/dem/kernels/convection.h"
+#include "coredem/dem/kernels/drag.h"
+#include "coredem/dem/kernels/model_list.h"
 
 using namespace coredem::dem;
 
@@ -446,6 +449,34 @@ TYPED_TEST(StageConformance, DragPcmAndEveryHeatModelWithWallHeat) {
     EXPECT_GT(maxAbs(ref.windows.back().kSl), 0.0);
     expectSameRun(ref, r, this->tol, this->kind != BackendKind::Cuda);
   }
+}
+
+// Every registered drag law and Nusselt correlation (kernels/drag.h DragLaws,
+// kernels/convection.h NusseltModels) gives the same run on this backend as on the cpu one.
+TYPED_TEST(StageConformance, EveryDragLawAndNusseltCorrelation) {
+  namespace k = coredem::dem::kernels;
+  int laws = 0;
+  k::forEachModel(k::DragLaws{}, [&]<class M>() {
+    SCOPED_TRACE(std::string("drag ") + M::name);
+    DemConfig cfg = heatedBed();
+    cfg.drag = static_cast<k::DragLaw>(k::modelId<M, k::DragLaws>);
+    const Run ref = run(cfg, BackendKind::Cpu, 2, 10, 1e-4);
+    EXPECT_GT(maxAbs(ref.windows.back().kSl), 0.0);
+    expectSameRun(ref, run(cfg, this->kind, 2, 10, 1e-4), this->tol,
+                  this->kind != BackendKind::Cuda);
+    ++laws;
+  });
+  k::forEachModel(k::NusseltModels{}, [&]<class M>() {
+    SCOPED_TRACE(std::string("nusselt ") + M::name);
+    DemConfig cfg = heatedBed();
+    cfg.heat.nusselt = static_cast<k::NusseltModel>(k::modelId<M, k::NusseltModels>);
+    const Run ref = run(cfg, BackendKind::Cpu, 2, 10, 1e-4);
+    EXPECT_NE(ref.heat.convection, 0.0);
+    expectSameRun(ref, run(cfg, this->kind, 2, 10, 1e-4), this->tol,
+                  this->kind != BackendKind::Cuda);
+    ++laws;
+  });
+  EXPECT_EQ(laws, k::DragLaws::size + k::NusseltModels::size);
 }
 
 // 5,400 particles: many slabs of each colour (pair_lists.h "Slabs"), so that the cpu backend's

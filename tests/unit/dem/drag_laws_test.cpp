@@ -112,25 +112,42 @@ TEST(DragLaws, TheBlendIsContinuousWhereGidaspowSwitches) {
   EXPECT_NEAR(coefficient(dragLaw<GidaspowBlendDrag>(), 0.99, dp, slip), wenYu, 1e-2 * wenYu);
 }
 
-// Gunn's Nusselt correlation (kernels/nusselt_gunn.h) through the convection kernel's dispatch
-// (the cell factors and the particle's Re, as the engine evaluates it) against the same
-// reference file's points, to 1e-12; Nu = 2 for one sphere in a still gas (ε = 1, Re = 0).
-TEST(NusseltLaws, GunnMatchesItsIndependentReference) {
-  const YAML::Node doc = YAML::LoadFile(COREDEM_DEM_TEST_DATA "/drag_laws.yaml");
+// The Nusselt correlations of Gunn's form (kernels/nusselt_gunn.h: Gunn, Deen et al., Tavassoli
+// et al.) through the convection kernel's dispatch (the cell factors and the particle's Re, as the
+// engine evaluates it) against the same reference file's points, to 1e-12; Nu = 2 for one sphere
+// in a still gas (ε = 1, Re = 0); in a dense bed (ε 0.4, Re 50) both PR-DNS fits give about 20 %
+// less than Gunn's experimental fit (measured: Gunn 16.66, Deen 13.16, Tavassoli 13.28).
+template <class Law>
+double checkNusseltLaw(const YAML::Node& doc, const char* name) {
   const double tol = doc["relative_tolerance"].as<double>();
   ConvectionParams p;
-  p.model = nusseltModel<GunnNusselt>();
-  const YAML::Node points = doc["nusselt"]["gunn"];
-  ASSERT_GE(points.size(), 20u);
+  p.model = nusseltModel<Law>();
+  const YAML::Node points = doc["nusselt"][name];
+  EXPECT_GE(points.size(), 20u) << name;
   double worst = 0.0;
   for (const YAML::Node& pt : points) {
     const double eps = pt[0].as<double>(), slip = pt[1].as<double>(), dp = pt[2].as<double>();
     const GasState g{kRho, kMu, doc["k_g"].as<double>(), doc["cp_g"].as<double>(), 300.0, eps};
     const double want = pt[3].as<double>(), got = nusselt(p, g, dp, slip);
     worst = std::max(worst, std::abs(got / want - 1.0));
-    EXPECT_NEAR(got, want, tol * want) << "eps " << eps << " slip " << slip << " d " << dp;
+    EXPECT_NEAR(got, want, tol * want)
+        << name << ": eps " << eps << " slip " << slip << " d " << dp;
   }
-  std::cout << "gunn: " << points.size() << " points, worst relative error " << worst << "\n";
+  std::cout << name << ": " << points.size() << " points, worst relative error " << worst << "\n";
   const GasState still{kRho, kMu, 0.026, 1006.0, 300.0, 1.0};
-  EXPECT_NEAR(nusselt(p, still, 1e-3, 0.0), 2.0, 1e-15);
+  EXPECT_NEAR(nusselt(p, still, 1e-3, 0.0), 2.0, 1e-15) << name;
+  // Re = ε ρ d |Δu| / μ = 50 at ε = 0.4, d = 1 mm.
+  const GasState dense{kRho, kMu, 0.026, 1006.0, 300.0, 0.4};
+  return nusselt(p, dense, 1e-3, 50.0 * kMu / (0.4 * kRho * 1e-3));
+}
+
+TEST(NusseltLaws, GunnFormCorrelationsMatchTheirIndependentReference) {
+  const YAML::Node doc = YAML::LoadFile(COREDEM_DEM_TEST_DATA "/drag_laws.yaml");
+  const double gunn = checkNusseltLaw<GunnNusselt>(doc, "gunn");
+  const double deen = checkNusseltLaw<DeenNusselt>(doc, "deen");
+  const double tavassoli = checkNusseltLaw<TavassoliNusselt>(doc, "tavassoli");
+  std::cout << "Nu at eps 0.4, Re 50: Gunn " << gunn << ", Deen " << deen << ", Tavassoli "
+            << tavassoli << "\n";
+  EXPECT_LT(deen, 0.85 * gunn);
+  EXPECT_LT(tavassoli, 0.85 * gunn);
 }

@@ -45,7 +45,7 @@ void expectRoundTrip(const ModelFamily<E>& f, std::size_t expectedCount) {
 // The names users write, one per enumerator ('_' and '-' alike on input).
 TEST(ModelRegistry, FamiliesMapNamesToEnums) {
   expectRoundTrip(dragModels(), 9);
-  expectRoundTrip(nusseltModels(), 3);
+  expectRoundTrip(nusseltModels(), 5);
   expectRoundTrip(reynoldsModels(), 2);
   expectRoundTrip(motionModels(), 2);
   expectRoundTrip(rateLawModels(), 2);
@@ -146,8 +146,9 @@ TEST(ModelRegistry, ValidateNamesKeyValueAndAllowed) {
   EXPECT_NE(issues[1].message.find("'li-masn' is not allowed (did you mean 'li-mason'?)"),
             std::string::npos)
       << issues[1].message;
-  EXPECT_NE(issues[1].message.find("allowed: li-mason, ranz-marshall, gunn or off"),
-            std::string::npos)
+  EXPECT_NE(
+      issues[1].message.find("allowed: li-mason, ranz-marshall, gunn, deen, tavassoli or off"),
+      std::string::npos)
       << issues[1].message;
   EXPECT_EQ(issues[2].key, "flpc");
   EXPECT_NE(issues[2].message.find("[0, 1]"), std::string::npos) << issues[2].message;

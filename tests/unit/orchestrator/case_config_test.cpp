@@ -163,9 +163,11 @@ TEST(CaseConfig, ModelsMisspelledKeyNamesLineAndAllowedKeys) {
 TEST(CaseConfig, ModelsBadValueNamesLineAndAllowedValues) {
   const std::string text = std::string(kGood) + "models: {convection: li-masn}\n";
   const std::string e = errorOf(text);
-  EXPECT_NE(e.find("cases/x/case.yaml:21:22: models.convection: 'li-masn' is not allowed (did "
-                   "you mean 'li-mason'?); allowed: li-mason, ranz-marshall, gunn or off"),
-            std::string::npos)
+  EXPECT_NE(
+      e.find(
+          "cases/x/case.yaml:21:22: models.convection: 'li-masn' is not allowed (did "
+          "you mean 'li-mason'?); allowed: li-mason, ranz-marshall, gunn, deen, tavassoli or off"),
+      std::string::npos)
       << e;
   const std::string d = errorOf(std::string(kGood) + "models:\n  drag: stokes\n");
   EXPECT_NE(d.find("case.yaml:22:9: models.drag: 'stokes' is not allowed; allowed: gidaspow, "

@@ -151,15 +151,24 @@ for name, law in LAWS.items():
 K_G, CP_G = mpf("0.026"), mpf("1006")
 
 
-def nusselt_gunn(e, u, d):
-    re = e * RHO * d * u / MU
-    pr = MU * CP_G / K_G
-    return ((7 - 10 * e + 5 * e * e) * (1 + mpf("0.7") * re ** mpf("0.2") * pr ** (mpf(1) / 3))
-            + (mpf("1.33") - mpf("2.4") * e + mpf("1.2") * e * e) * re ** mpf("0.7") * pr ** (mpf(1) / 3))
+def gunn_form(a, c, e2):
+    """Gunn's form: (7 - 10 e + 5 e^2)(1 + a Re^0.2 Pr^1/3) + (1.33 - c e + e2 e^2) Re^0.7 Pr^1/3."""
+    def law(e, u, d):
+        re = e * RHO * d * u / MU
+        pr13 = (MU * CP_G / K_G) ** (mpf(1) / 3)
+        return ((7 - 10 * e + 5 * e * e) * (1 + mpf(a) * re ** mpf("0.2") * pr13)
+                + (mpf("1.33") - mpf(c) * e + mpf(e2) * e * e) * re ** mpf("0.7") * pr13)
+    return law
+
+
+# Gunn (1978); Deen, Peters, Padding & Kuipers (2014); Tavassoli, Peters & Kuipers (2015).
+NUSSELT = {"gunn": gunn_form("0.7", "2.4", "1.2"),
+           "deen": gunn_form("0.17", "2.31", "1.16"),
+           "tavassoli": gunn_form("0.1", "2.19", "1.15")}
 
 
 print("k_g: 0.026\ncp_g: 1006.0\nnusselt:")
-for name, law in {"gunn": nusselt_gunn}.items():
+for name, law in NUSSELT.items():
     print(f"  {name}:  # eps, slip (m/s), d_p (m), Nu")
     for e in EPS:
         for u in SLIP:

@@ -10,7 +10,8 @@
 ///        Nu = 2 + 4.5e-5 εⁿ Re^1.8                                 Re ≥ 1500
 ///   Ranz–Marshall (MFiX `des_thermo_conv.f`, option): Nu = 2 + 0.6 Re^0.5 Pr^(1/3)
 ///   Gunn (1978, option): Nu = (7 − 10ε + 5ε²)(1 + 0.7 Re^0.2 Pr^(1/3))
-///                             + (1.33 − 2.4ε + 1.2ε²) Re^0.7 Pr^(1/3)
+///                             + (1.33 − 2.4ε + 1.2ε²) Re^0.7 Pr^(1/3); Deen et al. (2014) and
+///   Tavassoli et al. (2015), options: the same form with their coefficients (nusselt_gunn.h)
 ///   Pr = μ_g C_p,g / κ_g.
 ///   Re_p = ε ρ_g d_p |u_g − v_p| / μ_g (default, same Re as the Gidaspow drag, docs/physics.md
 ///   §3.1 [C])
@@ -42,7 +43,8 @@
 namespace coredem::dem::kernels {
 
 /// The Nusselt correlations, in id order (the registration line).
-using NusseltModels = ModelList<LiMasonNusselt, RanzMarshallNusselt, GunnNusselt>;
+using NusseltModels =
+    ModelList<LiMasonNusselt, RanzMarshallNusselt, GunnNusselt, DeenNusselt, TavassoliNusselt>;
 
 /// A Nusselt correlation's id (its position in NusseltModels; the configuration hash uses it);
 /// case-file names in the registry (coredem/dem/models.h, nusseltModels()). Any correlation's id
