@@ -482,6 +482,25 @@ void warnTemperatures(Consistency& ck) {
   }
 }
 
+/// `walls.material` is the conduction material of fixed-temperature walls, not a contact material
+/// (docs/case-schema.md "walls"): with adiabatic walls and more than one material it is easily
+/// taken for the walls' contact material, which it is not.
+void warnWallMaterial(Consistency& ck) {
+  const CaseConfig& c = ck.c;
+  const YAML::Node walls = ck.at.root()["walls"];
+  if (c.walls.temperature > 0.0 || c.materials.size() < 2 || !walls || !walls.IsMap() ||
+      !walls["material"]) {
+    return;
+  }
+  ck.warnings.push_back(ck.at.warning(
+      {"walls", "material"}, "walls.material",
+      fmt::format("'{}' has no effect here: walls.material is the conduction material of "
+                  "fixed-temperature walls, and these walls are adiabatic; it does not set how "
+                  "particles touch the walls. For that give each wall its own contact material "
+                  "(walls.box.material, walls.planes[i].material, ...)",
+                  c.walls.material)));
+}
+
 /// The largest value of a scalar field of the prescribed gas section (a number or a time table
 /// {table: [[t, v], ...]}, at the domain level and in its regions); nullopt when not given.
 std::optional<double> largestPrescribed(const YAML::Node& gas, const char* key) {
@@ -715,6 +734,7 @@ const ConsistencyCheck kConsistencyChecks[] = {
     {"explicit positions do not overlap", checkOverlaps},
     {"placed sets do not intersect", warnIntersectingSets},
     {"temperatures in kelvin", warnTemperatures},
+    {"walls.material is not a contact material", warnWallMaterial},
     {"the staggered step against the particle response time", checkStaggeredStep},
     {"the prescribed gas temperature in kelvin", warnPrescribedGasTemperature},
     {"a constant-property gas near the particles' temperature", warnConstantHotGas},

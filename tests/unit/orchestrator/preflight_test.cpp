@@ -298,6 +298,28 @@ TEST(Preflight, CelsiusTemperaturesWarn) {
   EXPECT_EQ(failureOf(t), "");
 }
 
+// walls.material with adiabatic walls and a second material: easily taken for the walls' contact
+// material (it is the conduction material of fixed-temperature walls), so it is warned about,
+// naming the per-wall key that does set it; one material, or a wall's own material, is silent.
+TEST(Preflight, WallsMaterialWithAdiabaticWallsIsNotAContactMaterial) {
+  const std::string two = replace(kCase, "materials:\n",
+                                  "materials:\n  - {name: smooth, density: 2500, k_n: 1000, "
+                                  "e_n: 0.9, friction: 0.0}\n");
+  const std::string t = replace(two, "walls:\n", "walls:\n  material: smooth\n");
+  const auto w = checkCaseConsistency(parse(t));
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_TRUE(contains(w[0], "walls.material: 'smooth' has no effect here")) << w[0];
+  EXPECT_TRUE(contains(w[0], "walls.box.material")) << w[0];
+  EXPECT_EQ(failureOf(t), "");
+  EXPECT_TRUE(checkCaseConsistency(parse(replace(kCase, "walls:\n", "walls:\n  material: glass\n")))
+                  .empty());
+  EXPECT_TRUE(
+      checkCaseConsistency(
+          parse(replace(two, "box: {min: [0, 0, 0], max: [0.02, 0.02, 0.04]}",
+                        "box: {min: [0, 0, 0], max: [0.02, 0.02, 0.04], material: smooth}")))
+          .empty());
+}
+
 TEST(Preflight, GasTemperatureOutsideTheDemRangeIsRefused) {
   // The DEM server refuses a gas state below 100 K at the first exchange (common/limits.h);
   // coredem-gas refused T_g = -5 K when the member started: check refuses both now.
