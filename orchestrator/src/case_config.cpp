@@ -44,6 +44,7 @@ const std::vector<CaseReader>& caseReaders() {
        {"gas_properties", "particles", "walls", "models", "cfd", "reactions", "chemistry"},
        resolveGasModel},
       {"ideal_gas", {"species", "gas_model", "gas"}, checkIdealGas},
+      {"drag_calibration", {"models", "gravity", "particles", "gas_model"}, calibrateDrag},
       {"coupling", {"gas_model"}, readCoupling},
       {"checkpoint", {}, readCheckpoint},
       {"output", {}, readOutput},

@@ -27,6 +27,14 @@ struct CaseReading {
   std::vector<Section> species;         ///< the species entries, checked once (species, ideal gas)
   std::optional<Section> gasProperties; ///< checked once (gas_properties, ideal gas)
   bool gasModelGiven = false;           ///< gas_properties.model is in the file
+  /// models: {drag.syamlal-obrien.u_mf, .eps_mf}: the case reader's own keys (calibrateDrag turns
+  /// them into the DEM's c1 and d1), with their place in the file.
+  struct CalibrationKey {
+    std::string key;
+    double value;
+    YAML::Mark mark;
+  };
+  std::vector<CalibrationKey> dragCalibration;
 };
 
 /// One part of the case reader: the part (a top-level section, a sub-part such as
@@ -58,6 +66,7 @@ void readInitialState(CaseReading& r);
 void readParticles(CaseReading& r);
 void readWalls(CaseReading& r);
 void readModels(CaseReading& r);
+void calibrateDrag(CaseReading& r);
 void readDem(CaseReading& r);
 void readCfd(CaseReading& r);
 void readBoundaries(CaseReading& r);

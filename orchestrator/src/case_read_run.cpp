@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <coredem/common/log.h>
 #include <coredem/dem/dem_config.h>
+#include <coredem/dem/drag_calibration.h>
 #include <coredem/dem/models.h>
 #include <coredem/orchestrator/participants.h>
 
@@ -133,6 +136,23 @@ void readModels(CaseReading& r) {
       keyMarks.push_back(kv.first.Mark());
       valueMarks.push_back(kv.second.Mark());
     }
+    // The Syamlal–O'Brien calibration to U_mf is the reader's (calibrateDrag), not the server's.
+    for (std::size_t i = 0; i < c.models.size();) {
+      const std::string& key = c.models[i].first;
+      if (key == "drag.syamlal-obrien.u_mf" || key == "drag.syamlal-obrien.eps_mf") {
+        const bool velocity = key == "drag.syamlal-obrien.u_mf";
+        const double v = top.numberOf(m[key], "models." + key, 0.0, velocity ? 1e3 : 0.85,
+                                      velocity ? "m/s, > 0 (the measured U_mf)"
+                                               : "the bed's voidage at U_mf, in (0, 0.85]",
+                                      true);
+        r.dragCalibration.push_back({key, v, keyMarks[i]});
+        c.models.erase(c.models.begin() + std::ptrdiff_t(i));
+        keyMarks.erase(keyMarks.begin() + std::ptrdiff_t(i));
+        valueMarks.erase(valueMarks.begin() + std::ptrdiff_t(i));
+      } else {
+        ++i;
+      }
+    }
     // The DEM server's model registry (coredem/dem/models.h): every key and value it would refuse
     // or ignore fails here, before anything starts.
     const std::vector<dem::ModelIssue> issues = dem::validateModels(c.models);
@@ -157,6 +177,91 @@ void readModels(CaseReading& r) {
       c.epsMin = d.epsMinDrag;
     }
   }
+}
+
+/// models: {drag.syamlal-obrien.u_mf, drag.syamlal-obrien.eps_mf}: the Syamlal–O'Brien constants
+/// c1, d1 for which the law fluidizes the case's particles at the measured U_mf and ε_mf in its
+/// gas (dem/drag_calibration.h), added to the models sent to the DEM server.
+void calibrateDrag(CaseReading& r) {
+  if (r.dragCalibration.empty()) {
+    return;
+  }
+  CaseConfig& c = r.c;
+  const auto& first = r.dragCalibration.front();
+  const auto fail = [&](const std::string& what) {
+    r.top.fail(first.mark, "models." + first.key, what);
+  };
+  double uMf = 0.0, epsMf = 0.0;
+  for (const auto& k : r.dragCalibration) {
+    (k.key == "drag.syamlal-obrien.u_mf" ? uMf : epsMf) = k.value;
+  }
+  if (uMf <= 0.0 || epsMf <= 0.0) {
+    fail("the Syamlal-O'Brien calibration needs both drag.syamlal-obrien.u_mf (the measured "
+         "minimum fluidization velocity, m/s) and drag.syamlal-obrien.eps_mf (the bed's voidage "
+         "at it)");
+  }
+  std::string drag = "gidaspow";
+  for (const auto& [key, value] : c.models) {
+    if (key == "drag") {
+      drag = value;
+    }
+    if (key == "drag.syamlal-obrien.c1" || key == "drag.syamlal-obrien.d1") {
+      fail(fmt::format("give either u_mf and eps_mf (c1 and d1 are then calibrated from them) or "
+                       "c1 and d1, not both ({} is given too)",
+                       key));
+    }
+  }
+  if (drag != "syamlal-obrien") {
+    fail(fmt::format("calibrates the syamlal-obrien drag law, but models.drag is '{}': write "
+                     "drag: syamlal-obrien, or remove the calibration",
+                     drag));
+  }
+  if (c.particles.empty()) {
+    fail("the calibration needs the particles' diameter and density, and this case starts from "
+         "initial_state; give drag.syamlal-obrien.c1 and d1 instead (coredem check of the case "
+         "that made the state prints them)");
+  }
+  const auto densityOf = [&](const ParticleSetConfig& p) {
+    if (p.density > 0.0) {
+      return p.density;
+    }
+    for (const MaterialConfig& m : c.materials) {
+      if (m.name == p.material) {
+        return m.density;
+      }
+    }
+    return 0.0;
+  };
+  const ParticleSetConfig& p0 = c.particles.front();
+  const double dp = p0.diameter, rhoP = densityOf(p0);
+  for (const ParticleSetConfig& p : c.particles) {
+    if (std::abs(p.diameter / dp - 1.0) > 1e-12 || std::abs(densityOf(p) / rhoP - 1.0) > 1e-12) {
+      fail(fmt::format("the calibration is for one kind of particle, but particle sets '{}' "
+                       "({} m, {} kg/m3) and '{}' ({} m, {} kg/m3) differ; give "
+                       "drag.syamlal-obrien.c1 and d1 instead",
+                       p0.name, dp, rhoP, p.name, p.diameter, densityOf(p)));
+    }
+  }
+  const double g = std::hypot(c.gravity[0], c.gravity[1], c.gravity[2]);
+  const double rhoG = c.gasProperties.density, muG = c.gasProperties.viscosity;
+  if (g <= 0.0 || rhoP <= rhoG) {
+    fail("the calibration balances the bed's buoyant weight, and here it has none (gravity 0 or "
+         "particles no denser than the gas)");
+  }
+  const auto cal = dem::calibrateSyamlal(uMf, epsMf, dp, rhoP, rhoG, muG, g);
+  if (!cal) {
+    fail(fmt::format("no c1 in [0.001, 1.2] makes the Syamlal-O'Brien law fluidize {} m "
+                     "particles of {} kg/m3 at U_mf = {} m/s with voidage {} (gas {} kg/m3, {} "
+                     "Pa s): check U_mf (m/s) and eps_mf",
+                     dp, rhoP, uMf, epsMf, rhoG, muG));
+  }
+  c.models.emplace_back("drag.syamlal-obrien.c1", fmt::format("{:.17g}", cal->c1));
+  c.models.emplace_back("drag.syamlal-obrien.d1", fmt::format("{:.17g}", cal->d1));
+  logger("orchestrator")
+      ->info("models: Syamlal-O'Brien drag calibrated to U_mf = {} m/s at voidage {} ({} m "
+             "particles of {} kg/m3 in gas of {} kg/m3, {} Pa s): c1 = {:.6g}, d1 = {:.6g} "
+             "(defaults 0.8, 2.65)",
+             uMf, epsMf, dp, rhoP, rhoG, muG, cal->c1, cal->d1);
 }
 
 /// dem: endpoint, backend, keys

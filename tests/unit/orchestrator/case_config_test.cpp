@@ -2,9 +2,12 @@
 // what is allowed.
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <string>
 
 #include <gtest/gtest.h>
 
+#include <coredem/dem/drag_calibration.h>
 #include <coredem/orchestrator/case_config.h>
 
 #include "case_text.h"
@@ -203,4 +206,37 @@ TEST(CaseConfig, CaseNamesAreOneShortPrintableLine) {
   const std::string d =
       errorOf(replace(kGood, "name: unit-case", "name: d\ndescription: " + std::string(5000, 'y')));
   EXPECT_NE(d.find("description: 5000 bytes: at most 4096"), std::string::npos) << d.substr(0, 300);
+}
+
+// models: {drag.syamlal-obrien.u_mf, .eps_mf}: the reader calibrates c1 and d1 for the case's
+// particles and gas (dem/drag_calibration.h) and sends them as the law's parameters; what it
+// cannot calibrate is refused naming the key.
+TEST(CaseConfig, SyamlalObrienCalibratedToTheMinimumFluidizationVelocity) {
+  const std::string cal = std::string(kGood) +
+                          "models:\n  drag: syamlal-obrien\n  drag.syamlal-obrien.u_mf: 0.8\n"
+                          "  drag.syamlal-obrien.eps_mf: 0.42\n";
+  const CaseConfig c = parseCase(cal, "case.yaml", fs::temp_directory_path());
+  std::map<std::string, std::string> m(c.models.begin(), c.models.end());
+  ASSERT_EQ(m.count("drag.syamlal-obrien.c1"), 1u);
+  ASSERT_EQ(m.count("drag.syamlal-obrien.d1"), 1u);
+  EXPECT_EQ(m.count("drag.syamlal-obrien.u_mf"), 0u);
+  const double c1 = std::stod(m["drag.syamlal-obrien.c1"]);
+  EXPECT_GT(c1, 0.0);
+  EXPECT_LT(c1, 1.2);
+  // 2 mm glass in the default gas (air at 20 °C) with gravity 9.81: the calibration's balance.
+  EXPECT_NEAR(coredem::dem::syamlalBalance(c1, 0.8, 0.42, 2e-3, 2500.0, c.gasProperties.density,
+                                           c.gasProperties.viscosity, 9.81),
+              0.0, 1e-10);
+
+  EXPECT_NE(errorOf(replace(cal, "  drag.syamlal-obrien.eps_mf: 0.42\n", ""))
+                .find("needs both drag.syamlal-obrien.u_mf"),
+            std::string::npos);
+  EXPECT_NE(errorOf(replace(cal, "drag: syamlal-obrien", "drag: gidaspow"))
+                .find("models.drag is 'gidaspow'"),
+            std::string::npos);
+  EXPECT_NE(errorOf(cal + "  drag.syamlal-obrien.c1: 0.5\n").find("not both"), std::string::npos);
+  const std::string e = errorOf(replace(cal, "eps_mf: 0.42", "eps_mf: 0.9"));
+  EXPECT_NE(e.find("models.drag.syamlal-obrien.eps_mf"), std::string::npos) << e;
+  EXPECT_NE(e.find("(0, 0.85]"), std::string::npos) << e;
+  EXPECT_NE(errorOf(replace(cal, "u_mf: 0.8", "u_mf: 900")).find("no c1 in"), std::string::npos);
 }
