@@ -57,7 +57,7 @@ def wen_yu_umf(k):
     return re * k["mu"] / (k["rho_g"] * k["d"])
 
 
-def read_summary(path):
+def read_summary(path, label):
     rows = list(csv.DictReader(open(path, newline="")))
     if not rows:
         sys.exit(f"{path}: no members")
@@ -65,16 +65,16 @@ def read_summary(path):
     ucol = next((c for c in cols if "superficial_velocity" in c), None)
     dpcol = next((c for c in cols if "pressure_drop_Pa" in c), None)
     hcol = next((c for c in cols if "bed_height_m" in c), None)
-    if not (ucol and dpcol and hcol and "models.drag" in cols):
-        sys.exit(f"{path}: expected columns models.drag, the inlet velocity, the pressure drop "
-                 f"and bed_height_m; found {', '.join(cols)}")
+    if not (ucol and dpcol and hcol):
+        sys.exit(f"{path}: expected columns for the inlet velocity, the pressure drop and "
+                 f"bed_height_m; found {', '.join(cols)}")
     laws = {}
     for r in rows:
         if r.get("status") != "done" or not r[dpcol]:
-            print(f"{path}: member {r.get('member')} ({r['models.drag']}, U = {r[ucol]}) is "
+            print(f"{path}: member {r.get('member')} ({r.get('models.drag', label)}, U = {r[ucol]}) is "
                   f"{r.get('status')}: left out", file=sys.stderr)
             continue
-        laws.setdefault(r["models.drag"], []).append(
+        laws.setdefault(r.get("models.drag", label), []).append(
             (float(r[ucol]), float(r[dpcol]), float(r[hcol])))
     return {law: sorted(v) for law, v in laws.items()}
 
@@ -108,11 +108,13 @@ def main():
     ap.add_argument("summary")
     ap.add_argument("--case", required=True, help="the campaign's base case.yaml")
     ap.add_argument("--out", required=True, help="folder for umf.md and fluidization_curves.png")
+    ap.add_argument("--label", default="the case's law",
+                    help="the law's name when the sweep does not sweep models.drag")
     a = ap.parse_args()
     k = case_numbers(a.case)
     weight = k["n"] * k["rho_p"] * math.pi / 6 * k["d"] ** 3 * k["g"] / k["area"]
     weight *= 1.0 - k["rho_g"] / k["rho_p"]
-    laws = read_summary(a.summary)
+    laws = read_summary(a.summary, a.label)
     wy = wen_yu_umf(k)
     results = {law: analyse(p, k, weight) for law, p in laws.items()}
     eps_all = [r["eps"] for r in results.values() if not math.isnan(r["eps"])]
