@@ -222,15 +222,8 @@ void calibrateDrag(CaseReading& r) {
          "that made the state prints them)");
   }
   const auto densityOf = [&](const ParticleSetConfig& p) {
-    if (p.density > 0.0) {
-      return p.density;
-    }
-    for (const MaterialConfig& m : c.materials) {
-      if (m.name == p.material) {
-        return m.density;
-      }
-    }
-    return 0.0;
+    return p.density > 0.0 ? p.density
+                           : c.materials[std::size_t(materialIndex(c, p.material))].density;
   };
   const ParticleSetConfig& p0 = c.particles.front();
   const double dp = p0.diameter, rhoP = densityOf(p0);

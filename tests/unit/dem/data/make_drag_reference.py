@@ -137,16 +137,22 @@ LAWS = {
     "koch-hill": lambda e, u, d: per_particle(beta_koch_hill(e, u, d), e, d),
 }
 
+
+def write_table(laws, unit):
+    """One YAML list per law: [eps, slip, d_p, value] over the grid EPS x SLIP x DIAM."""
+    for name, law in laws.items():
+        print(f"  {name}:  # eps, slip (m/s), d_p (m), {unit}")
+        for e in EPS:
+            for u in SLIP:
+                for d in DIAM:
+                    v = law(mpf(e), mpf(u), mpf(d))
+                    print(f"    - [{e}, {u}, {d}, {mp.nstr(v, 20, min_fixed=0, max_fixed=0)}]")
+
+
 print("# drag_laws.yaml: per-particle drag coefficients beta V_p/(1 - eps) (kg/s) written by")
 print("# make_drag_reference.py (mpmath, 40 digits) from the laws' published forms.")
 print("rho_g: 1.2\nmu_g: 1.8e-5\nrelative_tolerance: 1.0e-12\nlaws:")
-for name, law in LAWS.items():
-    print(f"  {name}:  # eps, slip (m/s), d_p (m), coefficient (kg/s)")
-    for e in EPS:
-        for u in SLIP:
-            for d in DIAM:
-                v = law(mpf(e), mpf(u), mpf(d))
-                print(f"    - [{e}, {u}, {d}, {mp.nstr(v, 20, min_fixed=0, max_fixed=0)}]")
+write_table(LAWS, "coefficient (kg/s)")
 
 K_G, CP_G = mpf("0.026"), mpf("1006")
 
@@ -168,10 +174,4 @@ NUSSELT = {"gunn": gunn_form("0.7", "2.4", "1.2"),
 
 
 print("k_g: 0.026\ncp_g: 1006.0\nnusselt:")
-for name, law in NUSSELT.items():
-    print(f"  {name}:  # eps, slip (m/s), d_p (m), Nu")
-    for e in EPS:
-        for u in SLIP:
-            for d in DIAM:
-                v = law(mpf(e), mpf(u), mpf(d))
-                print(f"    - [{e}, {u}, {d}, {mp.nstr(v, 20, min_fixed=0, max_fixed=0)}]")
+write_table(NUSSELT, "Nu")
